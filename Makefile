@@ -1,0 +1,49 @@
+# The two set-up commands of the README:  make demo   and   make test
+# Both install what is missing (Debian packages), configure and build.
+BUILD   ?= build
+MODEL   ?= models/3prru_paper.json
+RESULTS ?= results
+PYTHON  ?= python3
+DEB_PACKAGES = cmake gcc make python3 libgsl-dev gnuplot-nox libmujoco-dev
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: all deps build demo test check-generated regenerate bench clean
+
+all: build
+
+deps:
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPRRU_MODEL=$(abspath $(MODEL))
+	cmake --build $(BUILD) -j 2
+
+demo: build
+	$(BUILD)/cli/prru paper --out $(RESULTS)
+
+test: build check-generated
+	cd $(BUILD) && ctest --output-on-failure -j 2
+
+# Fails when the committed generated/ is not what the generator makes now.
+check-generated:
+	@tmp=$$(mktemp -d) && \
+	$(PYTHON) gen/prru_gen.py $(MODEL) --out $$tmp --quiet && \
+	if diff -r -q $$tmp generated >/dev/null; then echo "generated/ is up to date"; rm -rf $$tmp; \
+	else diff -r -u generated $$tmp | head -40; rm -rf $$tmp; \
+	  echo "generated/ is stale: run 'make regenerate' and commit"; exit 1; fi
+
+regenerate:
+	$(PYTHON) gen/prru_gen.py $(MODEL) --out generated
+
+bench: build
+	$(BUILD)/bench/prru_bench
+
+clean:
+	rm -rf $(BUILD)

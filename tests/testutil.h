@@ -1,0 +1,55 @@
+/* Minimal assertion helpers shared by the C tests: every check counts,
+ * failures print what and by how much, main returns tu_finish(). */
+#ifndef PRRU_TESTUTIL_H
+#define PRRU_TESTUTIL_H
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static int tu_checks, tu_failures;
+
+/* max_i |a_i - b_i| / max(max_i |b_i|, floor): relative to the array's scale,
+ * so that structurally-zero entries do not demand absolute 0. */
+static double tu_relerr(const double *a, const double *b, int n, double floor)
+{
+  double err = 0, scale = floor;
+  for (int i = 0; i < n; i++) {
+    double e = fabs(a[i] - b[i]);
+    if (!(e <= err)) err = e; /* NaN propagates as a failure */
+    if (fabs(b[i]) > scale) scale = fabs(b[i]);
+  }
+  return err / scale;
+}
+
+static int tu_check(int ok, const char *what, double value, double bound)
+{
+  tu_checks++;
+  if (!ok) {
+    tu_failures++;
+    fprintf(stderr, "FAIL %s: %.3e (bound %.1e)\n", what, value, bound);
+  }
+  return ok;
+}
+
+#define TU_CLOSE(a, b, n, rtol, what) \
+  do { double tu_e_ = tu_relerr((a), (b), (n), 1e-300); \
+       tu_check(tu_e_ <= (rtol), (what), tu_e_, (rtol)); } while (0)
+#define TU_TRUE(cond, what) tu_check(!!(cond), (what), 0.0, 0.0)
+
+static int tu_finish(const char *suite)
+{
+  printf("%s: %d passed, %d failed\n", suite, tu_checks - tu_failures, tu_failures);
+  return tu_failures ? 1 : 0;
+}
+
+/* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */
+static unsigned long long tu_rng_state = 0x9E3779B97F4A7C15ULL;
+static double tu_uniform(double lo, double hi)
+{
+  tu_rng_state ^= tu_rng_state >> 12;
+  tu_rng_state ^= tu_rng_state << 25;
+  tu_rng_state ^= tu_rng_state >> 27;
+  unsigned long long r = tu_rng_state * 2685821657736338717ULL;
+  return lo + (hi - lo) * ((double)(r >> 11) / 9007199254740992.0);
+}
+#endif
