@@ -1,0 +1,278 @@
+"""Lowering symbolic expressions to straight-line C.
+
+The expressions of one kernel (all its outputs together) are lowered into a
+graph of binary operations that is itself hash-consed, so any operation that
+appears twice is computed once: that is the common-subexpression
+elimination, and it works across outputs (M, h and G share their terms).
+Nodes used more than once become `const double` temporaries; the rest are
+printed inline. Rational powers become products, one sqrt, and one shared
+reciprocal per denominator, so the only divisions are 1/x.
+"""
+
+from fractions import Fraction
+
+from . import sym
+from .model import c_double
+
+ARITH = ("add", "sub", "mul", "div", "neg")
+PREC = {"add": 1, "sub": 1, "mul": 2, "div": 2, "neg": 3}
+
+
+class Node:
+    __slots__ = ("op", "args", "index")
+
+    def __init__(self, op, args, index):
+        self.op, self.args, self.index = op, args, index
+
+
+class Graph:
+    """Hash-consed operation graph of one kernel."""
+
+    def __init__(self, names):
+        self.nodes = []
+        self._table = {}
+        self._lowered = {}
+        self.names = names          # symbol name -> C local name
+
+    def node(self, op, *args):
+        if op in ("add", "mul"):
+            args = tuple(sorted(args, key=lambda n: n.index))
+        key = (op,) + tuple(a.index if isinstance(a, Node) else a
+                            for a in args)
+        n = self._table.get(key)
+        if n is None:
+            n = Node(op, args, len(self.nodes))
+            self.nodes.append(n)
+            self._table[key] = n
+        return n
+
+    def num(self, value):
+        return self.node("num", c_double(value))
+
+    # -- lowering ---------------------------------------------------------
+    def lower(self, e):
+        n = self._lowered.get(e.id)
+        if n is None:
+            n = self._lower(e)
+            self._lowered[e.id] = n
+        return n
+
+    def _lower(self, e):
+        op = e.op
+        if op == "const":
+            v = e.args[0]
+            return self.num(v) if v >= 0 else self.node("neg", self.num(-v))
+        if op == "sym":
+            return self.node("in", self.names[e.args[0]])
+        if op == "add":
+            return self._sum(e)
+        if op == "mul":
+            coef, factors = e.args
+            n = self._product(factors)
+            if abs(coef) != 1:
+                n = self.node("mul", self.num(abs(coef)), n)
+            return self.node("neg", n) if coef < 0 else n
+        fn = {"atan2": "atan2"}.get(op, op)
+        return self.node("call", fn, *[self.lower(a) for a in e.args])
+
+    def _sum(self, e):
+        c, terms = e.args
+        signed = []
+        for k, t in terms:
+            n = self.lower(t)
+            if abs(k) != 1:
+                n = self.node("mul", self.num(abs(k)), n)
+            signed.append((k > 0, n))
+        if c != 0:
+            signed.append((c > 0, self.num(abs(c))))
+        first = next((i for i, (pos, _) in enumerate(signed) if pos), None)
+        if first is None:
+            acc = self.node("neg", signed[0][1])
+            rest = signed[1:]
+        else:
+            acc = signed[first][1]
+            rest = signed[:first] + signed[first + 1:]
+        for pos, n in rest:
+            acc = self.node("add" if pos else "sub", acc, n)
+        return acc
+
+    def _product(self, factors):
+        acc = None
+        for b, e in factors:
+            n = self.power(self.lower(b), e)
+            acc = n if acc is None else self.node("mul", acc, n)
+        return acc
+
+    def power(self, base, e):
+        if e.denominator == 1:
+            root = base
+        elif e.denominator == 2:
+            root = self.node("call", "sqrt", base)
+        else:
+            return self.node("call", "pow", base, self.num(e))
+        p = e.numerator
+        if p < 0:
+            root = self.node("div", self.num(1), root)
+            p = -p
+        return self._ipow(root, p)
+
+    def _ipow(self, base, p):
+        if p == 1:
+            return base
+        if p % 2 == 0:
+            half = self._ipow(base, p // 2)
+            return self.node("mul", half, half)
+        return self.node("mul", self._ipow(base, p - 1), base)
+
+
+class Kernel:
+    """One C function: inputs (C array, symbol names), outputs (C array, exprs)."""
+
+    def __init__(self, name, doc, inputs, outputs, guards=()):
+        self.name, self.doc = name, doc
+        self.inputs = inputs          # [(array name, [symbol names])]
+        self.outputs = outputs        # [(array name, [Expr])]
+        self.guards = list(guards)    # Exprs required to lie in [-1, 1]
+
+
+def _uses(roots):
+    """Operand-use counts of the nodes reachable from roots."""
+    uses, stack = {}, list(roots)
+    for r in roots:
+        uses[r.index] = uses.get(r.index, 0) + 1
+    seen = set()
+    while stack:
+        n = stack.pop()
+        if n.index in seen:
+            continue
+        seen.add(n.index)
+        for a in n.args:
+            if isinstance(a, Node):
+                uses[a.index] = uses.get(a.index, 0) + 1
+                stack.append(a)
+    return uses, seen
+
+
+class Emitted:
+    def __init__(self, name, signature, body, counts, doc):
+        self.name, self.signature, self.body = name, signature, body
+        self.counts, self.doc = counts, doc
+
+    @property
+    def arithmetic(self):
+        return sum(self.counts.get(k, 0) for k in ARITH)
+
+    def summary(self):
+        parts = ["%d %s" % (self.counts[k], k) for k in ARITH
+                 if self.counts.get(k)]
+        calls = sorted((k[5:], v) for k, v in self.counts.items()
+                       if k.startswith("call:"))
+        text = "%d arithmetic (%s)" % (self.arithmetic, ", ".join(parts)
+                                       or "none")
+        if calls:
+            text += "; calls: " + ", ".join("%s %d" % kv for kv in calls)
+        return text
+
+
+def emit(kernel, prefix):
+    names = {}
+    for arr, syms in kernel.inputs:
+        for i, s in enumerate(syms):
+            names[s] = "%s%d" % (arr, i + 1)
+    g = Graph(names)
+    guard_nodes = [g.lower(x) for x in kernel.guards]
+    # With guards, q itself must be finite too (q3 appears in no guard).
+    finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
+        if guard_nodes else []
+    out_nodes = [(arr, [g.lower(x) for x in exprs])
+                 for arr, exprs in kernel.outputs]
+    roots = guard_nodes + finite_nodes + [n for _, ns in out_nodes for n in ns]
+    uses, live = _uses(roots)
+
+    def materialized(n):
+        return n.op not in ("num", "in") and \
+            (uses.get(n.index, 0) > 1 or n.op == "call")
+
+    counts = {}
+    for i in sorted(live):
+        n = g.nodes[i]
+        if n.op in ARITH:
+            counts[n.op] = counts.get(n.op, 0) + 1
+        elif n.op == "call":
+            key = "call:" + n.args[0]
+            counts[key] = counts.get(key, 0) + 1
+
+    temp = {}
+
+    def expr(n, parent_prec=0, right=False):
+        if n.op == "in":
+            return n.args[0]
+        if n.op == "num":
+            return n.args[0]
+        if n.index in temp:
+            return temp[n.index]
+        return inline(n, parent_prec, right)
+
+    def inline(n, parent_prec=0, right=False):
+        op = n.op
+        if op == "call":
+            return "%s(%s)" % (n.args[0], ", ".join(expr(a) for a in n.args[1:]))
+        if op == "neg":
+            s = "-" + expr(n.args[0], 3)
+        else:
+            sym_op = {"add": "+", "sub": "-", "mul": "*", "div": "/"}[op]
+            p = PREC[op]
+            s = "%s %s %s" % (expr(n.args[0], p), sym_op,
+                              expr(n.args[1], p, right=True))
+        p = PREC[op]
+        # Left-associative printing: a right operand of equal precedence
+        # needs parentheses (a - (b + c)), a left one does not.
+        if p < parent_prec or (p == parent_prec and right):
+            return "(" + s + ")"
+        return s
+
+    # Inputs of the guard first, then the guard, then everything else.
+    guard_live = _uses(guard_nodes)[1] if guard_nodes else set()
+    lines = []
+    for arr, syms in kernel.inputs:
+        for i, s in enumerate(syms):
+            lines.append("const double %s%d = %s[%d];" % (arr, i + 1, arr, i))
+    used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
+    lines = [l for l in lines if l.split()[2] in used_inputs]
+
+    def emit_temps(indices):
+        for i in sorted(indices):
+            n = g.nodes[i]
+            if i in temp or not materialized(n):
+                continue
+            name = "t%d" % len(temp)
+            lines.append("const double %s = %s;" % (name, inline(n)))
+            temp[i] = name
+
+    if guard_nodes:
+        emit_temps(guard_live)
+        conds = ["fabs(%s) <= 1.0" % expr(n) for n in guard_nodes]
+        conds += ["fabs(%s) <= 1.7976931348623157e308" % expr(n)
+                  for n in finite_nodes]
+        fills = ["for (int i = 0; i < %d; i++) %s[i] = (double)NAN;" % (len(ns), arr)
+                 for arr, ns in out_nodes]
+        lines.append("/* Unreachable or non-finite q: every output is NaN. */")
+        lines.append("if (!(%s)) {" % " &&\n      ".join(conds))
+        lines += ["  " + f for f in fills]
+        lines.append("  return;")
+        lines.append("}")
+    emit_temps(live)
+    for arr, ns in out_nodes:
+        for i, n in enumerate(ns):
+            lines.append("%s[%d] = %s;" % (arr, i, expr(n)))
+    for arr, syms in kernel.inputs:
+        if not any(("%s%d" % (arr, i + 1)) in used_inputs
+                   for i in range(len(syms))):
+            lines.insert(0, "(void)%s;" % arr)
+
+    params = ["const double %s[%d]" % (arr, len(syms))
+              for arr, syms in kernel.inputs]
+    params += ["double %s[%d]" % (arr, len(ns)) for arr, ns in out_nodes]
+    signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(params))
+    body = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
+    return Emitted(kernel.name, signature, body, counts, kernel.doc)

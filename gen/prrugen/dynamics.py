@@ -1,0 +1,183 @@
+"""Newton-Euler in generalized coordinates, derived from the poses.
+
+For each body: J_T = dp/dq and mu = d/dt(J_T) qd by differentiation; the
+angular velocity from the rotation chain (chain rule on its angles),
+J_R = d omega / d qd and delta = d/dt(J_R) qd. Then
+
+  M = H^T Phi H = sum_b m_b J_T^T J_T + J_Rb^T D_b J_Rb
+  h = H^T K     = sum_b m_b J_T^T mu + J_Rb^T (D_b delta_b + w_b x D_b w_b)
+
+with the rotational part in each body's own frame (subscript b), where the
+inertia D_b is a constant diagonal: I_b = R D R^T never has to be formed,
+and R^T (I delta + w x I w) = D delta_b + w_b x D w_b because
+d/dt (R^T w) = R^T w'. The world-frame quantities (H, delta, mu, K, I_b)
+are derived too, for the kernels that return them.
+"""
+
+from . import sym
+from .linalg import vec, vadd, vscale, dot, cross, matvec, matmul, \
+    transpose, identity, rot, unit, diag, jacobian
+
+
+class BodyTerms:
+    """Derived velocity-level quantities of one body."""
+
+    def __init__(self, body, q, qd):
+        self.body = body
+        rates = [sym.directional(angle, q, qd) for _, angle in body.chain]
+        n = len(body.chain)
+        omega_w, omega_b = vec(0, 0, 0), vec(0, 0, 0)
+        prefix = identity()
+        for k, (axis, angle) in enumerate(body.chain):
+            omega_w = vadd(omega_w, vscale(rates[k], matvec(prefix,
+                                                            unit(axis))))
+            prefix = matmul(prefix, rot(axis, angle))
+        suffix = identity()
+        for k in range(n - 1, -1, -1):
+            axis, angle = body.chain[k]
+            omega_b = vadd(omega_b, vscale(rates[k], matvec(transpose(suffix),
+                                                            unit(axis))))
+            suffix = matmul(rot(axis, angle), suffix)
+        self.rotation = prefix
+        self.omega_w, self.omega_b = omega_w, omega_b
+        self.jr_w = jacobian(omega_w, qd)
+        self.jr_b = jacobian(omega_b, qd)
+        self.jt = jacobian(body.centre, q)
+        self.delta_w = [sym.directional(x, q, qd) for x in omega_w]
+        self.delta_b = [sym.directional(x, q, qd) for x in omega_b]
+        velocity = matvec(self.jt, qd)
+        self.mu = [sym.directional(x, q, qd) for x in velocity]
+        self.velocity = velocity
+        self.inertia = diag(body.inertia)
+
+    def gyro_b(self):
+        """D delta_b + w_b x D w_b: the body-frame rotational bias wrench."""
+        d_w = matvec(self.inertia, self.omega_b)
+        return vadd(matvec(self.inertia, self.delta_b),
+                    cross(self.omega_b, d_w))
+
+
+def _quad(a, d, b):
+    """a^T d b for 3x3 a, b and constant diagonal d."""
+    return [[sym.add(*[sym.mul(d[k][k], a[k][i], b[k][j]) for k in range(3)])
+             for j in range(3)] for i in range(3)]
+
+
+def _atb(a, v):
+    """a^T v."""
+    return [dot([a[k][i] for k in range(3)], v) for i in range(3)]
+
+
+class Derivation:
+    def __init__(self, mech, gravity):
+        self.mech = mech
+        self.gravity = gravity
+        q, qd = mech.q, mech.qd
+        self.terms = [BodyTerms(b, q, qd) for b in mech.bodies]
+
+    def mass(self):
+        parts = []
+        for t in self.terms:
+            m = t.body.mass
+            parts.append(_quad(t.jt, diag([m, m, m]), t.jt))
+            parts.append(_quad(t.jr_b, t.inertia, t.jr_b))
+        m = [sym.add(*[p[i][j] for p in parts]) for i in range(3)
+             for j in range(3)]
+        # Exact symmetry: take the upper triangle's expressions for both.
+        for i in range(3):
+            for j in range(i):
+                m[3 * i + j] = m[3 * j + i]
+        return m
+
+    def bias(self):
+        parts = []
+        for t in self.terms:
+            parts.append(_atb(t.jt, vscale(t.body.mass, t.mu)))
+            parts.append(_atb(t.jr_b, t.gyro_b()))
+        return [sym.add(*[p[i] for p in parts]) for i in range(3)]
+
+    def potential(self):
+        return sym.mul(self.gravity, sym.add(*[
+            sym.mul(t.body.mass, t.body.centre[2]) for t in self.terms]))
+
+    def gravity_force(self):
+        v = self.potential()
+        return [-sym.diff(v, x) for x in self.mech.q]
+
+    def kinetic(self):
+        total = []
+        for t in self.terms:
+            total.append(sym.mul(t.body.mass, dot(t.velocity, t.velocity)))
+            total.append(dot(t.omega_b, matvec(t.inertia, t.omega_b)))
+        return sym.mul(sym.Fraction(1, 2), sym.add(*total))
+
+    def actuators(self):
+        return list(self.mech.actuators)
+
+    def actuator_jacobian(self):
+        return [x for row in jacobian(self.mech.actuators, self.mech.q)
+                for x in row]
+
+    def jacobians(self):
+        rows = [r for t in self.terms for r in t.jr_w]
+        rows += [r for t in self.terms for r in t.jt]
+        return [x for r in rows for x in r]
+
+    def bias_terms(self):
+        return [x for t in self.terms for x in t.delta_w] + \
+            [x for t in self.terms for x in t.mu]
+
+    def platform_jacobian(self):
+        t = self.terms[0]
+        return [x for r in t.jr_w + t.jt for x in r]
+
+    def poses(self):
+        rs = [x for t in self.terms for r in t.rotation for x in r]
+        ps = [x for t in self.terms for x in t.body.centre]
+        return rs, ps
+
+    def inertia_world(self):
+        out = []
+        for t in self.terms:
+            r = t.rotation
+            out += [x for row in _quad(transpose(r), t.inertia, transpose(r))
+                    for x in row]
+        return out
+
+    def wrench_bias(self):
+        rot_part = [x for t in self.terms
+                    for x in matvec(t.rotation, t.gyro_b())]
+        lin_part = [x for t in self.terms for x in vscale(t.body.mass, t.mu)]
+        return rot_part + lin_part
+
+    def eom_rhs(self, fd, fp, mp):
+        """b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h."""
+        jd = jacobian(self.mech.actuators, self.mech.q)
+        t = self.terms[0]
+        g, h = self.gravity_force(), self.bias()
+        ad, af, am = _atb(jd, fd), _atb(t.jt, fp), _atb(t.jr_w, mp)
+        return [sym.add(g[i], ad[i], af[i], am[i], -h[i]) for i in range(3)]
+
+    def reaction_basis(self):
+        """Q (60 x 57): lambda -> wrenches about each body's centre."""
+        nb = len(self.terms)
+        cols = []
+        for joint in self.mech.joints:
+            for kind, e in joint.basis:
+                col = [sym.ZERO] * (6 * nb)
+                for body, sign in ((joint.distal, 1), (joint.proximal, -1)):
+                    if body is None:
+                        continue
+                    if kind == "f":
+                        arm = [c - p for c, p in
+                               zip(joint.centre, self.terms[body].body.centre)]
+                        moment = cross(arm, e)
+                        force = e
+                    else:
+                        moment, force = e, vec(0, 0, 0)
+                    for k in range(3):
+                        col[3 * body + k] = col[3 * body + k] + sign * moment[k]
+                        col[3 * nb + 3 * body + k] = \
+                            col[3 * nb + 3 * body + k] + sign * force[k]
+                cols.append(col)
+        return [cols[j][i] for i in range(6 * nb) for j in range(len(cols))]

@@ -1,0 +1,82 @@
+"""Which C functions are generated, and from which derived quantities."""
+
+from . import sym
+from .cgen import Kernel
+
+Q = ("q", ["q1", "q2", "q3"])
+QD = ("qd", ["qd1", "qd2", "qd3"])
+
+
+def _vec(name):
+    return [sym.sym("%s%d" % (name, i + 1)) for i in range(3)]
+
+
+def kernels(deriv):
+    """The kernel list, in the order the header declares them."""
+    guards = deriv.mech.guards
+    d, jd = deriv.actuators(), deriv.actuator_jacobian()
+    m, h, g = deriv.mass(), deriv.bias(), deriv.gravity_force()
+    fd, fp, mp = _vec("fd"), _vec("fp"), _vec("mp")
+    rs, ps = deriv.poses()
+    t, v = deriv.kinetic(), deriv.potential()
+    spec = [
+        ("ik", "Actuator displacements d_i (height of joint A_i on rail i).",
+         [Q], [("d", d)]),
+        ("jd", "Actuator Jacobian J_d = dd/dq (3x3).", [Q], [("Jd", jd)]),
+        ("ik_jd", "prru_ik and prru_jd fused.", [Q], [("d", d), ("Jd", jd)]),
+        ("jacobians", "H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], "
+         "world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3.",
+         [Q], [("H", deriv.jacobians())]),
+        ("bias_terms", "[delta_P..delta_S3; mu_P..mu_S3] (60): the parts of "
+         "the angular and linear accelerations that are quadratic in qd.",
+         [Q, QD], [("dm", deriv.bias_terms())]),
+        ("mass", "Mass matrix M = H^T Phi H (3x3).", [Q], [("M", m)]),
+        ("bias", "Bias forces h = H^T K (3).", [Q, QD], [("h", h)]),
+        ("gravity", "Generalized gravity G = sum_b J_T,b^T (-m_b g e3).",
+         [Q], [("G", g)]),
+        ("dynamics", "M, h and G fused (one shared evaluation).",
+         [Q, QD], [("M", m), ("h", h), ("G", g)]),
+        ("eom", "Forward-dynamics terms: M and b = G + J_d^T fd + "
+         "J_T,P^T fp + J_R,P^T mp - h, so that M qdd = b.",
+         [Q, QD, ("fd", ["fd1", "fd2", "fd3"]), ("fp", ["fp1", "fp2", "fp3"]),
+          ("mp", ["mp1", "mp2", "mp3"])],
+         [("M", m), ("b", deriv.eom_rhs(fd, fp, mp))]),
+        ("platform_jacobian", "Platform Jacobians: rows 0-2 J_R,P, rows 3-5 "
+         "J_T,P (6x3).", [Q], [("JP", deriv.platform_jacobian())]),
+        ("poses", "Body rotations R_b (3x3 each) and centres p_b, body order.",
+         [Q], [("R", rs), ("p", ps)]),
+        ("inertia_world", "Inertia tensors I_b = R_b D_b R_b^T about each "
+         "centre, in {S} (3x3 each), body order.",
+         [Q], [("I", deriv.inertia_world())]),
+        ("wrench_bias", "K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b].",
+         [Q, QD], [("K", deriv.wrench_bias())]),
+        ("energy", "E[0] = kinetic energy, E[1] = potential energy "
+         "g sum_b m_b z_b.", [Q, QD], [("E", [t, v])]),
+        ("reaction_basis", "Q (60x57) mapping the joint reaction "
+         "coordinates lambda to body wrenches about each centre, so that "
+         "Phi H qdd + K = Fbar + Q lambda.",
+         [Q], [("Q", deriv.reaction_basis())]),
+    ]
+    return [Kernel(name, doc, ins, outs, guards)
+            for name, doc, ins, outs in spec]
+
+
+def lambda_labels(mech):
+    """Names of the 57 reaction coordinates, e.g. 'C1_fx', 'C3_mn'."""
+    labels = []
+    axis_names = "xyz"
+    for j in mech.joints:
+        fi = mi = 0
+        for kind, e in j.basis:
+            named = [k for k in range(3) if e[k].op == "const" and
+                     e[k].args[0] == 1 and all(e[o].op == "const" and
+                                               e[o].args[0] == 0
+                                               for o in range(3) if o != k)]
+            if named:
+                suffix = axis_names[named[0]]
+            else:
+                suffix = "u" if j.name in ("C1", "C2") else "n"
+            labels.append("%s_%s%s" % (j.name, kind, suffix))
+            fi += kind == "f"
+            mi += kind == "m"
+    return labels

@@ -1,0 +1,149 @@
+"""The 3-PRRU mechanism: poses of its ten bodies as closed functions of q.
+
+This is the only place the mechanism's geometry is written down. Everything
+else (Jacobians, bias terms, mass matrix, reactions) is derived from it.
+
+Orientation is kept as a chain of elementary rotations [(axis, angle(q))],
+R = Rot(axis_1, angle_1) Rot(axis_2, angle_2) ..., so that angular velocity
+follows from the chain rule on the angles instead of from R^T dR/dt, whose
+entries only cancel to the short form after trigonometric identities.
+"""
+
+from fractions import Fraction
+
+from . import sym
+from .linalg import vec, vadd, vsub, vscale, matvec, matmul, identity, rot, \
+    unit, cross
+
+X, Y, Z = 0, 1, 2
+
+
+class Body:
+    def __init__(self, name, chain, centre, mass, inertia):
+        self.name = name
+        self.chain = chain            # [(axis, angle expression)]
+        self.centre = centre          # p_b, 3 expressions in {S}
+        self.mass = mass              # Fraction
+        self.inertia = inertia        # principal moments in the body frame
+
+    @property
+    def rotation(self):
+        r = identity()
+        for axis, angle in self.chain:
+            r = matmul(r, rot(axis, angle))
+        return r
+
+
+class Joint:
+    """A joint's reaction wrench: basis [(kind 'f' or 'm', unit vector)]."""
+
+    def __init__(self, name, proximal, distal, centre, basis):
+        self.name = name
+        self.proximal = proximal      # body index, or None for the rails
+        self.distal = distal
+        self.centre = centre
+        self.basis = basis
+
+
+class Mechanism:
+    def __init__(self, q, qd, bodies, joints, actuators, guards):
+        self.q, self.qd = q, qd
+        self.bodies = bodies
+        self.joints = joints
+        self.actuators = actuators    # d_i(q): slider heights
+        self.guards = guards          # acos arguments that must lie in [-1, 1]
+
+
+def _limb12(s, g, platform_rot, p_platform):
+    """Limbs 1 (s = -1) and 2 (s = +1): in the plane x = 0, hinges along e1."""
+    c_joint = vadd(p_platform, matvec(platform_rot, vec(0, s * g["a"], 0)))
+    r_lower = rot(X, sym.sym("q1"))
+    b_joint = vadd(c_joint, matvec(r_lower, vec(0, s * g["l2"], 0)))
+    p_lower = vadd(c_joint, matvec(r_lower, vec(0, s * g["l2"] / 2, 0)))
+    y_a = s * g["b12"]
+    cos_arg = s * (y_a - b_joint[Y]) / g["l1"]
+    alpha = s * sym.acos(cos_arg)
+    d = b_joint[Z] + s * g["l1"] * sym.sin(alpha)
+    a_joint = vec(0, y_a, d)
+    p_upper = vscale(Fraction(1, 2), vadd(a_joint, b_joint))
+    return dict(c=c_joint, b=b_joint, a=a_joint, d=d, guard=cos_arg,
+                lower=([(X, sym.sym("q1"))], p_lower),
+                upper=([(X, alpha)], p_upper),
+                slider=([], a_joint))
+
+
+def _limb3(g, p_platform):
+    """Limb 3: in the plane y = 0, hinges along e2; U joint centre is O'."""
+    q1, q2 = sym.sym("q1"), sym.sym("q2")
+    gamma = sym.atan2(sym.sin(q2), sym.cos(q1) * sym.cos(q2))
+    x3 = matvec(rot(Y, gamma), unit(X))
+    b_joint = vadd(p_platform, vscale(g["l2"], x3))
+    p_lower = vadd(p_platform, vscale(g["l2"] / 2, x3))
+    cos_arg = (b_joint[X] - g["b3"]) / g["l1"]
+    alpha = sym.acos(cos_arg)
+    d = b_joint[Z] + g["l1"] * sym.sin(alpha)
+    a_joint = vec(g["b3"], 0, d)
+    p_upper = vscale(Fraction(1, 2), vadd(a_joint, b_joint))
+    return dict(c=p_platform, b=b_joint, a=a_joint, d=d, guard=cos_arg,
+                x3=x3, lower=([(Y, gamma)], p_lower),
+                upper=([(Y, alpha)], p_upper),
+                slider=([], a_joint))
+
+
+def build(model):
+    """The mechanism of a validated model (see model.py)."""
+    g = model.geometry
+    q = [sym.sym("q1"), sym.sym("q2"), sym.sym("q3")]
+    qd = [sym.sym("qd1"), sym.sym("qd2"), sym.sym("qd3")]
+    platform_chain = [(X, q[0]), (Y, q[1])]
+    p_platform = vec(0, 0, q[2])
+    platform_rot = matmul(rot(X, q[0]), rot(Y, q[1]))
+    limbs = [_limb12(-1, g, platform_rot, p_platform),
+             _limb12(+1, g, platform_rot, p_platform),
+             _limb3(g, p_platform)]
+
+    parts = [(platform_chain, p_platform)]
+    parts += [limb["lower"] for limb in limbs]
+    parts += [limb["upper"] for limb in limbs]
+    parts += [limb["slider"] for limb in limbs]
+    from .model import BODY_NAMES
+    bodies = [Body(name, chain, centre, model.masses[i], model.inertias[i])
+              for i, (name, (chain, centre)) in
+              enumerate(zip(BODY_NAMES, parts))]
+
+    joints = _joints(limbs, platform_rot)
+    guards = []
+    for limb in limbs:
+        if limb["guard"] not in guards:
+            guards.append(limb["guard"])
+    return Mechanism(q, qd, bodies, joints, [l["d"] for l in limbs], guards)
+
+
+P_, L_, U_, S_ = 0, 1, 4, 7     # first index of each body group
+
+
+def _force_basis():
+    return [("f", unit(X)), ("f", unit(Y)), ("f", unit(Z))]
+
+
+def _joints(limbs, platform_rot):
+    """The joint table, in lambda order: C1..C3, B1..B3, A1..A3, P1..P3."""
+    u = [row[X] for row in platform_rot]          # R_P e1
+    w = [row[Z] for row in platform_rot]          # R_P e3
+    joints = []
+    for i, limb in enumerate(limbs):
+        axis = u if i < 2 else cross(w, limb["x3"])
+        joints.append(Joint("C%d" % (i + 1), L_ + i, P_, limb["c"],
+                            _force_basis() + [("m", axis)]))
+    for name, prox, dist, key in (("B", U_, L_, "b"), ("A", S_, U_, "a")):
+        for i, limb in enumerate(limbs):
+            hinge = X if i < 2 else Y
+            moments = [("m", unit(k)) for k in (X, Y, Z) if k != hinge]
+            joints.append(Joint("%s%d" % (name, i + 1), prox + i, dist + i,
+                                limb[key], _force_basis() + moments))
+    for i, limb in enumerate(limbs):
+        # The prismatic joint's moment is taken about the slider centre A_i.
+        joints.append(Joint("P%d" % (i + 1), None, S_ + i, limb["a"],
+                            [("f", unit(X)), ("f", unit(Y))]
+                            + [("m", unit(k)) for k in (X, Y, Z)]))
+    return joints
