@@ -276,3 +276,38 @@ def emit(kernel, prefix):
     signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(params))
     body = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
     return Emitted(kernel.name, signature, body, counts, kernel.doc)
+
+
+def evaluate_lowered(exprs, env):
+    """Evaluate exprs through the lowered graph, as the C code would.
+
+    Used by the tests to show that lowering and CSE preserve values."""
+    import math
+    names = {k: k for k in env}
+    g = Graph(names)
+    roots = [g.lower(sym.as_expr(e)) for e in exprs]
+    fns = {"sin": math.sin, "cos": math.cos, "tan": math.tan,
+           "asin": math.asin, "acos": math.acos, "atan2": math.atan2,
+           "sqrt": math.sqrt, "pow": lambda b, e: b ** e}
+    vals = []
+    for n in g.nodes:
+        a = [vals[x.index] if isinstance(x, Node) else x for x in n.args]
+        op = n.op
+        if op == "in":
+            v = float(env[a[0]])
+        elif op == "num":
+            v = float(a[0])
+        elif op == "add":
+            v = a[0] + a[1]
+        elif op == "sub":
+            v = a[0] - a[1]
+        elif op == "mul":
+            v = a[0] * a[1]
+        elif op == "div":
+            v = a[0] / a[1]
+        elif op == "neg":
+            v = -a[0]
+        else:
+            v = fns[a[0]](*a[1:])
+        vals.append(v)
+    return [vals[r.index] for r in roots]

@@ -1,0 +1,220 @@
+"""The generator as a whole: model validation, output, determinism."""
+
+import ast
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import unittest
+
+from prrugen import dynamics, mechanism, model, sym
+
+GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(GEN_DIR)
+MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
+ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
+
+
+def read_dir(d):
+    out = {}
+    for f in sorted(os.listdir(d)):
+        with open(os.path.join(d, f), "rb") as fh:
+            out[f] = fh.read()
+    return out
+
+
+def run_gen(*args, env=None):
+    return subprocess.run([sys.executable, ENTRY] + list(args),
+                          capture_output=True, text=True, env=env)
+
+
+class StandardLibraryOnly(unittest.TestCase):
+    def test_generator_imports_only_the_standard_library(self):
+        local = {"prrugen", "tests"}
+        for folder, _, files in os.walk(GEN_DIR):
+            for f in files:
+                if not f.endswith(".py"):
+                    continue
+                path = os.path.join(folder, f)
+                with open(path, encoding="utf-8") as fh:
+                    tree = ast.parse(fh.read(), path)
+                for node in ast.walk(tree):
+                    if isinstance(node, ast.Import):
+                        names = [a.name for a in node.names]
+                    elif isinstance(node, ast.ImportFrom):
+                        if node.level:
+                            continue
+                        names = [node.module]
+                    else:
+                        continue
+                    for n in names:
+                        top = n.split(".")[0]
+                        self.assertTrue(top in sys.stdlib_module_names
+                                        or top in local,
+                                        "%s imports %s" % (path, n))
+
+
+class Mechanism(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.model = model.load(MODEL)
+        cls.mech = mechanism.build(cls.model)
+        cls.deriv = dynamics.Derivation(cls.mech, cls.model.gravity)
+
+    def test_loops_close_at_random_reachable_states(self):
+        g = {k: float(v) for k, v in self.model.geometry.items()}
+        rng = random.Random(7)
+        rs, ps = self.deriv.poses()
+        joints = {j.name: j for j in self.mech.joints}
+        for _ in range(20):
+            env = {"q1": rng.uniform(-0.5, 0.5), "q2": rng.uniform(-0.6, 0.5),
+                   "q3": rng.uniform(-1, 0.2)}
+            for i in range(3):
+                a = sym.evaluate(joints["A%d" % (i + 1)].centre, env)
+                b = sym.evaluate(joints["B%d" % (i + 1)].centre, env)
+                c = sym.evaluate(joints["C%d" % (i + 1)].centre, env)
+                self.assertAlmostEqual(math.dist(a, b), g["l1"], places=12)
+                self.assertAlmostEqual(math.dist(b, c), g["l2"], places=12)
+            # every rotation is orthonormal
+            r = sym.evaluate(rs, env)
+            for k in range(10):
+                m = [r[9 * k + 3 * i:9 * k + 3 * i + 3] for i in range(3)]
+                for i in range(3):
+                    for j in range(3):
+                        dot = sum(m[i][t] * m[j][t] for t in range(3))
+                        self.assertAlmostEqual(dot, float(i == j), places=13)
+
+    def test_public_reference_point(self):
+        env = dict(q1=0.1, q2=0.2, q3=-0.8, qd1=0.3, qd2=-0.4, qd3=0.5)
+        want = {
+            "M": [0.45906598061227876, 0.0034180053946637732,
+                  -0.067202143647255787, 0.0034180053946637732,
+                  0.17775860212149512, -0.75886870659132982,
+                  -0.067202143647255787, -0.75886870659132982, 12.39],
+            "h": [-0.0026294266343440007, 0.0043554318154298796,
+                  -0.061280218724993618],
+            "G": [0.6592530291795793, 7.4445020116609459,
+                  -121.54590000000001],
+            "d": [-0.61587356199245987, -0.56196351700317267,
+                  -0.63523945236562458]}
+        got = {"M": self.deriv.mass(), "h": self.deriv.bias(),
+               "G": self.deriv.gravity_force(), "d": self.deriv.actuators()}
+        for key, values in want.items():
+            vals = sym.evaluate(got[key], env)
+            scale = max(abs(v) for v in values)
+            for v, w in zip(vals, values):
+                self.assertLessEqual(abs(v - w), 1e-12 * scale, key)
+        self.assertIs(self.deriv.mass()[8], sym.const(self.model.total_mass))
+
+
+class CommandLine(unittest.TestCase):
+    def test_regeneration_is_byte_identical_under_any_hash_seed(self):
+        outs = []
+        for seed in ("0", "12345"):
+            with tempfile.TemporaryDirectory() as d:
+                env = dict(os.environ, PYTHONHASHSEED=seed)
+                r = run_gen(MODEL, "--out", d, "--quiet", env=env)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                outs.append(read_dir(d))
+        self.assertEqual(outs[0], outs[1])
+        self.assertEqual(sorted(outs[0]), ["prru_kernels.c", "prru_kernels.h"])
+
+    def test_help_and_summary(self):
+        r = run_gen("--help")
+        self.assertEqual(r.returncode, 0)
+        self.assertIn("--out", r.stdout)
+        with tempfile.TemporaryDirectory() as d:
+            r = run_gen(MODEL, "--out", d)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertRegex(r.stdout, r"dynamics +\d+ arithmetic")
+
+
+def _paper():
+    with open(MODEL, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def _bad_models():
+    """(description, text, expected key, expected reason fragment)."""
+    cases = []
+
+    def edit(desc, fn, key, reason):
+        m = _paper()
+        fn(m)
+        cases.append((desc, json.dumps(m), key, reason))
+
+    cases.append(("truncated", json.dumps(_paper())[:-20], None, "not valid JSON"))
+    cases.append(("NaN", json.dumps(_paper()).replace("9.81", "NaN"), None,
+                  "non-finite"))
+    cases.append(("duplicate key", json.dumps(_paper()).replace(
+        '"gravity": 9.81', '"gravity": 9.81, "gravity": 9.8'), None,
+        "duplicate key"))
+    edit("missing body", lambda m: m["bodies"].pop("U2"), "bodies.U2",
+         "missing")
+    edit("unknown key", lambda m: m["geometry"].update(b4=1), "geometry.b4",
+         "unknown key")
+    edit("string mass", lambda m: m["bodies"]["P"].update(mass="1.7"),
+         "bodies.P.mass", "must be a number")
+    edit("bool", lambda m: m.update(gravity=True), "gravity",
+         "must be a number")
+    edit("negative length", lambda m: m["geometry"].update(l1=-0.23),
+         "geometry.l1", "must be positive")
+    edit("zero mass", lambda m: m["bodies"]["S3"].update(mass=0),
+         "bodies.S3.mass", "must be positive")
+    edit("huge", lambda m: m["geometry"].update(l2=1e300), "geometry.l2",
+         "outside")
+    edit("triangle", lambda m: m["bodies"]["L1"].update(
+        inertia=[0.0025, 0.0003, 0.0030]), "bodies.L1.inertia", "triangle")
+    edit("inertia count", lambda m: m["bodies"]["L1"].update(inertia=[1, 2]),
+         "bodies.L1.inertia", "3 principal moments")
+    edit("cannot assemble", lambda m: m["geometry"].update(b12=0.8),
+         "geometry", "cannot be assembled")
+    edit("bad name", lambda m: m.update(name="3prru"), "name",
+         "C identifier")
+    return cases
+
+
+class BadModels(unittest.TestCase):
+    def test_each_bad_model_is_rejected_with_key_and_reason(self):
+        for desc, text, key, reason in _bad_models():
+            with self.subTest(desc):
+                with self.assertRaises(model.ModelError) as ctx:
+                    model.parse(text, "m.json")
+                msg = str(ctx.exception)
+                self.assertTrue(msg.startswith("m.json: "), msg)
+                if key:
+                    self.assertIn(key + ":", msg)
+                self.assertIn(reason, msg)
+
+    def test_failed_generation_leaves_output_untouched(self):
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "out")
+            self.assertEqual(run_gen(MODEL, "--out", out, "--quiet")
+                             .returncode, 0)
+            before = read_dir(out)
+            bad = os.path.join(d, "bad.json")
+            with open(bad, "w") as f:
+                f.write(_bad_models()[7][1])
+            r = run_gen(bad, "--out", out)
+            self.assertEqual(r.returncode, 1)
+            self.assertIn("bad.json: geometry.l1: must be positive", r.stderr)
+            after = read_dir(out)
+            self.assertEqual(before, after)
+
+    def test_missing_and_oversized_files(self):
+        r = run_gen("/nonexistent/model.json", "--out", "/tmp/x")
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("/nonexistent/model.json: cannot read", r.stderr)
+        with tempfile.NamedTemporaryFile("w", suffix=".json") as f:
+            f.write(" " * (model.MAX_BYTES + 10))
+            f.flush()
+            with self.assertRaises(model.ModelError) as ctx:
+                model.load(f.name)
+            self.assertIn("larger than", str(ctx.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()
