@@ -5,22 +5,22 @@
  * Edit the model file or the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   ik                 27 arithmetic (5 add, 6 sub, 15 mul, 1 div); calls: cos 2, sin 2, sqrt 3
- *   jd                 69 arithmetic (1 add, 12 sub, 50 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   ik_jd              80 arithmetic (5 add, 14 sub, 55 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   jacobians          105 arithmetic (2 add, 20 sub, 70 mul, 4 div, 9 neg); calls: cos 2, sin 2, sqrt 3
- *   bias_terms         424 arithmetic (42 add, 72 sub, 299 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   mass               190 arithmetic (26 add, 25 sub, 128 mul, 6 div, 5 neg); calls: cos 2, sin 2, sqrt 3
- *   bias               543 arithmetic (69 add, 87 sub, 377 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3
- *   gravity            66 arithmetic (4 add, 8 sub, 49 mul, 3 div, 2 neg); calls: cos 2, sin 2, sqrt 3
- *   dynamics           648 arithmetic (96 add, 93 sub, 445 mul, 6 div, 8 neg); calls: cos 2, sin 2, sqrt 3
- *   eom                668 arithmetic (83 add, 121 sub, 451 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   ik                 30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3
+ *   jd                 63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   ik_jd              74 arithmetic (8 add, 11 sub, 52 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   jacobians          98 arithmetic (6 add, 11 sub, 70 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   bias_terms         191 arithmetic (14 add, 32 sub, 135 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   mass               161 arithmetic (31 add, 15 sub, 109 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   bias               287 arithmetic (35 add, 46 sub, 202 mul, 4 div); calls: cos 2, sin 2, sqrt 3
+ *   gravity            61 arithmetic (2 add, 10 sub, 45 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   dynamics           386 arithmetic (62 add, 51 sub, 266 mul, 6 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom                409 arithmetic (63 add, 62 sub, 278 mul, 6 div); calls: cos 2, sin 2, sqrt 3
  *   platform_jacobian  12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 2, sqrt 1
- *   poses              55 arithmetic (11 add, 9 sub, 25 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
- *   inertia_world      77 arithmetic (12 add, 8 sub, 52 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   wrench_bias        466 arithmetic (44 add, 75 sub, 336 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   energy             204 arithmetic (37 add, 23 sub, 135 mul, 5 div, 4 neg); calls: cos 2, sin 2, sqrt 3
- *   reaction_basis     57 arithmetic (2 add, 9 sub, 30 mul, 1 div, 15 neg); calls: cos 2, sin 2, sqrt 3
+ *   poses              60 arithmetic (11 add, 10 sub, 29 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
+ *   inertia_world      86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   wrench_bias        212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   energy             137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
 #define PRRU_KERNELS_H
@@ -65,38 +65,38 @@
   "A3_mx", "A3_mz", "P1_fx", "P1_fy", "P1_mx", "P1_my", "P1_mz", "P2_fx", \
   "P2_fy", "P2_mx", "P2_my", "P2_mz", "P3_fx", "P3_fy", "P3_mx", "P3_my", \
   "P3_mz" }
-#define PRRU_ARITH_IK 27 /* arithmetic operations */
-#define PRRU_ARITH_JD 69 /* arithmetic operations */
-#define PRRU_ARITH_IK_JD 80 /* arithmetic operations */
-#define PRRU_ARITH_JACOBIANS 105 /* arithmetic operations */
-#define PRRU_ARITH_BIAS_TERMS 424 /* arithmetic operations */
-#define PRRU_ARITH_MASS 190 /* arithmetic operations */
-#define PRRU_ARITH_BIAS 543 /* arithmetic operations */
-#define PRRU_ARITH_GRAVITY 66 /* arithmetic operations */
-#define PRRU_ARITH_DYNAMICS 648 /* arithmetic operations */
-#define PRRU_ARITH_EOM 668 /* arithmetic operations */
+#define PRRU_ARITH_IK 30 /* arithmetic operations */
+#define PRRU_ARITH_JD 63 /* arithmetic operations */
+#define PRRU_ARITH_IK_JD 74 /* arithmetic operations */
+#define PRRU_ARITH_JACOBIANS 98 /* arithmetic operations */
+#define PRRU_ARITH_BIAS_TERMS 191 /* arithmetic operations */
+#define PRRU_ARITH_MASS 161 /* arithmetic operations */
+#define PRRU_ARITH_BIAS 287 /* arithmetic operations */
+#define PRRU_ARITH_GRAVITY 61 /* arithmetic operations */
+#define PRRU_ARITH_DYNAMICS 386 /* arithmetic operations */
+#define PRRU_ARITH_EOM 409 /* arithmetic operations */
 #define PRRU_ARITH_PLATFORM_JACOBIAN 12 /* arithmetic operations */
-#define PRRU_ARITH_POSES 55 /* arithmetic operations */
-#define PRRU_ARITH_INERTIA_WORLD 77 /* arithmetic operations */
-#define PRRU_ARITH_WRENCH_BIAS 466 /* arithmetic operations */
-#define PRRU_ARITH_ENERGY 204 /* arithmetic operations */
-#define PRRU_ARITH_REACTION_BASIS 57 /* arithmetic operations */
-#define PRRU_OPS_IK "27 arithmetic (5 add, 6 sub, 15 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JD "69 arithmetic (1 add, 12 sub, 50 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_IK_JD "80 arithmetic (5 add, 14 sub, 55 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JACOBIANS "105 arithmetic (2 add, 20 sub, 70 mul, 4 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS_TERMS "424 arithmetic (42 add, 72 sub, 299 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_MASS "190 arithmetic (26 add, 25 sub, 128 mul, 6 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS "543 arithmetic (69 add, 87 sub, 377 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_GRAVITY "66 arithmetic (4 add, 8 sub, 49 mul, 3 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_DYNAMICS "648 arithmetic (96 add, 93 sub, 445 mul, 6 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM "668 arithmetic (83 add, 121 sub, 451 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_ARITH_POSES 60 /* arithmetic operations */
+#define PRRU_ARITH_INERTIA_WORLD 86 /* arithmetic operations */
+#define PRRU_ARITH_WRENCH_BIAS 212 /* arithmetic operations */
+#define PRRU_ARITH_ENERGY 137 /* arithmetic operations */
+#define PRRU_ARITH_REACTION_BASIS 58 /* arithmetic operations */
+#define PRRU_OPS_IK "30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JD "63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_IK_JD "74 arithmetic (8 add, 11 sub, 52 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JACOBIANS "98 arithmetic (6 add, 11 sub, 70 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS_TERMS "191 arithmetic (14 add, 32 sub, 135 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_MASS "161 arithmetic (31 add, 15 sub, 109 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS "287 arithmetic (35 add, 46 sub, 202 mul, 4 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_GRAVITY "61 arithmetic (2 add, 10 sub, 45 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_DYNAMICS "386 arithmetic (62 add, 51 sub, 266 mul, 6 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM "409 arithmetic (63 add, 62 sub, 278 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PLATFORM_JACOBIAN "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_OPS_POSES "55 arithmetic (11 add, 9 sub, 25 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INERTIA_WORLD "77 arithmetic (12 add, 8 sub, 52 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_WRENCH_BIAS "466 arithmetic (44 add, 75 sub, 336 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ENERGY "204 arithmetic (37 add, 23 sub, 135 mul, 5 div, 4 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_REACTION_BASIS "57 arithmetic (2 add, 9 sub, 30 mul, 1 div, 15 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_POSES "60 arithmetic (11 add, 10 sub, 29 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INERTIA_WORLD "86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_WRENCH_BIAS "212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ENERGY "137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_REACTION_BASIS "58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
 extern "C" {

@@ -68,6 +68,13 @@ class Graph:
             return self._sum(e)
         if op == "mul":
             coef, factors = e.args
+            base = factors[0][0]
+            if coef < 0 and len(factors) == 1 and factors[0][1] == 1 \
+                    and base.op == "add" and base.id not in self._lowered:
+                # -k (a - b) as k (b - a): no negation.
+                n = self._sum(base, negate=True)
+                return n if coef == -1 else \
+                    self.node("mul", self.num(-coef), n)
             n = self._product(factors)
             if abs(coef) != 1:
                 n = self.node("mul", self.num(abs(coef)), n)
@@ -75,16 +82,28 @@ class Graph:
         fn = {"atan2": "atan2"}.get(op, op)
         return self.node("call", fn, *[self.lower(a) for a in e.args])
 
-    def _sum(self, e):
+    def _sum(self, e, negate=False):
         c, terms = e.args
-        signed = []
+        if negate:
+            c, terms = -c, [(-k, t) for k, t in terms]
+        # Terms that share a coefficient are summed first and scaled once.
+        groups = {}
         for k, t in terms:
-            n = self.lower(t)
-            if abs(k) != 1:
-                n = self.node("mul", self.num(abs(k)), n)
-            signed.append((k > 0, n))
+            groups.setdefault(abs(k), []).append((k > 0, self.lower(t)))
+        signed = []
+        for k, members in groups.items():
+            if k == 1:
+                signed += members
+                continue
+            positive = members[0][0]
+            inner = self._fold([(p == positive, n) for p, n in members])
+            signed.append((positive, self.node("mul", self.num(k), inner)))
         if c != 0:
             signed.append((c > 0, self.num(abs(c))))
+        return self._fold(signed)
+
+    def _fold(self, signed):
+        """Left-to-right sum of (positive?, node), leading with a + term."""
         first = next((i for i, (pos, _) in enumerate(signed) if pos), None)
         if first is None:
             acc = self.node("neg", signed[0][1])

@@ -22,9 +22,9 @@ from .linalg import vec, vadd, vscale, dot, cross, matvec, matmul, \
 class BodyTerms:
     """Derived velocity-level quantities of one body."""
 
-    def __init__(self, body, q, qd):
+    def __init__(self, body, q, qd, dt):
         self.body = body
-        rates = [sym.directional(angle, q, qd) for _, angle in body.chain]
+        rates = [dt(angle) for _, angle in body.chain]
         n = len(body.chain)
         omega_w, omega_b = vec(0, 0, 0), vec(0, 0, 0)
         prefix = identity()
@@ -43,10 +43,10 @@ class BodyTerms:
         self.jr_w = jacobian(omega_w, qd)
         self.jr_b = jacobian(omega_b, qd)
         self.jt = jacobian(body.centre, q)
-        self.delta_w = [sym.directional(x, q, qd) for x in omega_w]
-        self.delta_b = [sym.directional(x, q, qd) for x in omega_b]
-        velocity = matvec(self.jt, qd)
-        self.mu = [sym.directional(x, q, qd) for x in velocity]
+        self.delta_w = [dt(x) for x in omega_w]
+        self.delta_b = [dt(x) for x in omega_b]
+        velocity = [dt(x) for x in body.centre]
+        self.mu = [dt(x) for x in velocity]
         self.velocity = velocity
         self.inertia = diag(body.inertia)
 
@@ -73,7 +73,8 @@ class Derivation:
         self.mech = mech
         self.gravity = gravity
         q, qd = mech.q, mech.qd
-        self.terms = [BodyTerms(b, q, qd) for b in mech.bodies]
+        dt = sym.TimeDerivative(q, qd)
+        self.terms = [BodyTerms(b, q, qd, dt) for b in mech.bodies]
 
     def mass(self):
         parts = []

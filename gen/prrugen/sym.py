@@ -116,20 +116,37 @@ def add(*xs):
             c += x.args[0]
             for k, t in x.args[1]:
                 acc[t] = acc.get(t, 0) + k
+        elif _is_scaled_sum(x):
+            # Flatten k (a + b) too, so that mirrored limbs cancel; the
+            # result is put back in primitive form below.
+            k0, s = x.args[0], x.args[1][0][0]
+            c += k0 * s.args[0]
+            for k, t in s.args[1]:
+                acc[t] = acc.get(t, 0) + k0 * k
         else:
             k, t = _split_coef(x)
             acc[t] = acc.get(t, 0) + k
     terms = [(k, t) for t, k in acc.items() if k != 0]
-    merged = _pythagoras(terms)
+    merged = _pythagoras(terms, c)
     if merged is not None:
-        return add(const(c), *merged)
+        return add(const(merged[1]), *[mul(k, t) for k, t in merged[0]])
     terms.sort(key=lambda kt: kt[1].id)
     if not terms:
         return const(c)
     if c == 0 and len(terms) == 1:
         k, t = terms[0]
         return mul(k, t)
-    return _intern("add", (c, tuple(terms)))
+    # Primitive part: k (t0 + c1 t1 + ...) with the first coefficient 1, so
+    # that scaled copies of one sum (a body's bias term times its mass, say)
+    # share a single node and cost one multiplication each.
+    k0 = terms[0][0]
+    node = _intern("add", (c / k0, tuple((k / k0, t) for k, t in terms)))
+    return node if k0 == 1 else _make_mul(k0, ((node, Fraction(1)),))
+
+
+def _is_scaled_sum(x):
+    return x.op == "mul" and len(x.args[1]) == 1 and x.args[1][0][1] == 1 \
+        and x.args[1][0][0].op == "add"
 
 
 def _trig_square(t, fn):
@@ -146,28 +163,37 @@ def _trig_square(t, fn):
     return None
 
 
-def _pythagoras(terms):
-    """Pairs k sin(u)^2 R + k cos(u)^2 R -> k R; None when there are none."""
-    cos_at = {}
+def _pythagoras(terms, c):
+    """sin^2 + cos^2 = 1 on a sum's terms: k R s^2 + k R c^2 -> k R and
+    k R c^2 - k R -> -k R s^2 (and with s, c swapped; R may be the constant
+    term). Returns (terms, constant) after one rewrite, or None."""
+    trig = []
     for pos, (k, t) in enumerate(terms):
-        found = _trig_square(t, "cos")
-        if found:
-            cos_at[(found[0].id, _key_part(found[1]), k)] = pos
-    if not cos_at:
+        for fn in ("sin", "cos"):
+            found = _trig_square(t, fn)
+            if found:
+                trig.append((pos, fn, found[0], found[1]))
+    if not trig:
         return None
-    replaced, dropped = {}, set()
-    for pos, (k, t) in enumerate(terms):
-        found = _trig_square(t, "sin")
-        if not found:
-            continue
-        partner = cos_at.get((found[0].id, _key_part(found[1]), k))
-        if partner is not None and partner not in dropped:
-            dropped.add(partner)
-            replaced[pos] = mul(k, _make_mul_or_one(found[1]))
-    if not replaced:
-        return None
-    return [replaced.get(pos, mul(k, t)) for pos, (k, t) in enumerate(terms)
-            if pos not in dropped]
+    index = {(fn, u.id, _key_part(rest)): pos for pos, fn, u, rest in trig}
+    position = {t.id: pos for pos, (_, t) in enumerate(terms)}
+    for pos, fn, u, rest in trig:
+        k = terms[pos][0]
+        other = "cos" if fn == "sin" else "sin"
+        rest_e = _make_mul_or_one(rest)
+        partner = index.get((other, u.id, _key_part(rest)))
+        if partner is not None and terms[partner][0] == k:
+            out = [kt for i, kt in enumerate(terms) if i not in (pos, partner)]
+            return out + [(k, rest_e)], c
+        square = power(cos(u) if other == "cos" else sin(u), 2)
+        if rest_e is ONE and c == -k:
+            out = [kt for i, kt in enumerate(terms) if i != pos]
+            return out + [(-k, square)], Fraction(0)
+        partner = position.get(rest_e.id)
+        if partner is not None and terms[partner][0] == -k:
+            out = [kt for i, kt in enumerate(terms) if i not in (pos, partner)]
+            return out + [(-k, mul(rest_e, square))], c
+    return None
 
 
 def _make_mul_or_one(factors):
@@ -210,13 +236,6 @@ def mul(*xs):
         else:
             factors.append((b, Fraction(e)))
     factors.sort(key=lambda be: be[0].id)
-    if coef != 1 and len(factors) == 1 and factors[0][1] == 1 \
-            and factors[0][0].op == "add":
-        # A number times a sum distributes (as SymPy does), so that the
-        # sum's terms can collect with others.
-        s = factors[0][0]
-        return add(const(coef * s.args[0]),
-                   *[mul(coef * k, t) for k, t in s.args[1]])
     return _make_mul(coef, factors)
 
 
@@ -439,6 +458,64 @@ def diff(e, s):
 def directional(e, qs, qds):
     """Time derivative of e(q) along q' = qd (qd held constant)."""
     return add(*[mul(diff(e, q), qd) for q, qd in zip(qs, qds)])
+
+
+class TimeDerivative:
+    """d/dt along q' = qd with qd constant, in forward mode.
+
+    Equal to directional() but applied node by node: every intermediate's
+    rate is one shared node, instead of three partial-derivative graphs
+    combined only at the root, which makes velocity and bias terms about
+    three times cheaper to evaluate."""
+
+    def __init__(self, qs, qds):
+        self.rate = {q.id: as_expr(qd) for q, qd in zip(qs, qds)}
+        self.ids = frozenset(self.rate)
+        self.memo = {}
+
+    def __call__(self, e):
+        e = as_expr(e)
+        if not (free_symbols(e) & self.ids):
+            return ZERO
+        hit = self.memo.get(e.id)
+        if hit is not None:
+            return hit
+        op = e.op
+        if op == "sym":
+            r = self.rate[e.id]
+        elif op == "add":
+            r = add(*[mul(k, self(t)) for k, t in e.args[1]])
+        elif op == "mul":
+            coef, factors = e.args
+            terms = []
+            for i, (b, ex) in enumerate(factors):
+                db = self(b)
+                if is_const(db, 0):
+                    continue
+                rest = [_make_mul(Fraction(1), ((bb, ee),))
+                        for j, (bb, ee) in enumerate(factors) if j != i]
+                terms.append(mul(coef, ex, power(b, ex - 1), db, *rest))
+            r = add(*terms)
+        elif op == "atan2":
+            y, x = e.args
+            r = (x * self(y) - y * self(x)) / (x * x + y * y)
+        else:
+            x = e.args[0]
+            dx = self(x)
+            if op == "sin":
+                r = cos(x) * dx
+            elif op == "cos":
+                r = -sin(x) * dx
+            elif op == "tan":
+                r = (1 + e * e) * dx
+            elif op == "asin":
+                r = dx * power(1 - x * x, Fraction(-1, 2))
+            elif op == "acos":
+                r = -dx * power(1 - x * x, Fraction(-1, 2))
+            else:
+                raise ValueError("cannot differentiate %s" % op)
+        self.memo[e.id] = r
+        return r
 
 
 # ------------------------------------------------------------ evaluation ---
