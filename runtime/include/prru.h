@@ -1,0 +1,157 @@
+/* prru runtime: forward/inverse dynamics, reactions, forward kinematics and
+ * simulation of the 3-PRRU over the generated kernels and GSL.
+ *
+ * Model (constant, prru_model) vs Data (per-call workspace, prru_data), as in
+ * MuJoCo: a prru_model is filled once from the generated model constants;
+ * a prru_data is plain storage the calls write into, so nothing allocates in
+ * the hot paths and one prru_data per thread makes every call re-entrant.
+ *
+ * Every function returns a prru_status; PRRU_OK is 0. Arrays are row-major,
+ * body order P L1 L2 L3 U1 U2 U3 S1 S2 S3, lambda order PRRU_LAMBDA_LABELS. */
+#ifndef PRRU_H
+#define PRRU_H
+
+#include "prru_kernels.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+  PRRU_OK = 0,
+  PRRU_EINPUT = 1,       /* an argument is NaN/inf or out of its range */
+  PRRU_EUNREACHABLE = 2, /* q outside the inverse kinematics' domain */
+  PRRU_ESINGULAR = 3,    /* J_d singular to the model's tolerance */
+  PRRU_ENOCONV = 4,      /* an iteration or the integrator failed */
+  PRRU_EINTERRUPTED = 5, /* stopped on request (SIGINT) */
+  PRRU_EIO = 6,          /* a file could not be read or written */
+  PRRU_ENOMEM = 7,
+  PRRU_EPARSE = 8        /* malformed number, list, CSV or scenario */
+} prru_status;
+
+/* A short, stable description of a status code. */
+const char *prru_strerror(int status);
+
+typedef struct {
+  double gravity;                  /* m/s^2, along -z */
+  double b12, b3, l1, l2, a;       /* geometry (m) */
+  double mass[PRRU_NBODY];         /* kg */
+  double inertia[3 * PRRU_NBODY];  /* principal moments, body frame */
+  double total_mass;
+  /* J_d counts as singular when its reciprocal condition number
+   * 1 / (|J_d|_1 |J_d^-1|_1) is below this (default 1e-8). */
+  double jd_rcond_min;
+} prru_model;
+
+/* The model the kernels were generated from. */
+void prru_model_default(prru_model *m);
+
+typedef struct {
+  double fd[3]; /* actuator forces along +e3 on the sliders (N) */
+  double fp[3]; /* force on the platform at O', {S} (N) */
+  double mp[3]; /* moment on the platform, {S} (N m) */
+} prru_loads;
+
+/* Per-call workspace and last results. */
+typedef struct {
+  double d[3], Jd[9];             /* actuator positions and Jacobian */
+  double M[9], b[3];              /* M qdd = b (prru_eom) */
+  double qdd[3];
+  double Q[60 * PRRU_NLAMBDA];    /* reaction basis */
+  double K[60], Ib[90];           /* wrench bias, world inertias */
+  double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
+  double r[PRRU_NLAMBDA];
+} prru_data;
+
+/* PRRU_OK, PRRU_EINPUT (non-finite q) or PRRU_EUNREACHABLE; fills d->d. */
+int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
+/* Reachable and J_d regular; fills d->d, d->Jd; *rcond if non-NULL. */
+int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
+
+/* Actuator displacements (inverse kinematics). */
+int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[3]);
+/* Newton's method (gsl_multiroot, hybridsj with J_d) from seed to q with
+ * d(q) = act to 1e-14 m; PRRU_ENOCONV when act is out of reach or the
+ * iteration meets a singularity. */
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[3],
+                            const double seed[3], double q[3]);
+/* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h (Cholesky). */
+int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
+                          const double qd[3], const prru_loads *l, double qdd[3]);
+/* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored). */
+int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
+                          const double qd[3], const double qdd[3], const prru_loads *l,
+                          double fd[3]);
+/* The 57 joint reaction coordinates (eq. 31) at the state's qdd. */
+int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                   const prru_loads *l, double lambda[PRRU_NLAMBDA]);
+/* T, V (J). */
+int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
+                  double *V);
+
+/* ---- Loads as functions of time ---- */
+typedef enum { PRRU_LOAD_CONSTANT, PRRU_LOAD_HARMONIC, PRRU_LOAD_TABLE } prru_load_kind;
+typedef struct {
+  prru_load_kind kind;
+  prru_loads base;         /* constant part */
+  /* harmonic: fp += amp * (sin(w t), -cos(w t), 0) (the paper's load) */
+  double amp, omega;
+  /* table: rows of t, fd1..3, fp1..3, mp1..3, linear interpolation, held
+   * constant outside [t_0, t_n] */
+  int nrows;
+  double *rows;            /* 10 * nrows, owned by the schedule */
+} prru_load_schedule;
+
+void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l);
+/* The paper's section 4.3 loads: fd = (50, 40, 25) N, fp = 50 (sin 4pi t,
+ * -cos 4pi t, 0) N, mp = 0. */
+void prru_schedule_paper(prru_load_schedule *s);
+/* Reads a CSV with header t,fd1,fd2,fd3[,fp1,fp2,fp3[,mp1,mp2,mp3]]; times
+ * strictly increasing. On error fills msg (file:line: reason). */
+int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen);
+void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out);
+void prru_schedule_free(prru_load_schedule *s);
+
+/* ---- Simulation ---- */
+typedef enum { PRRU_RK8PD, PRRU_RKF45, PRRU_RKCK, PRRU_MSBDF } prru_stepper;
+/* PRRU_OK and sets *s from "rk8pd", "rkf45", "rkck", "msbdf". */
+int prru_stepper_parse(const char *name, prru_stepper *s);
+const char *prru_stepper_name(prru_stepper s);
+
+typedef struct {
+  double t, q[3], qd[3], qdd[3], d[3];
+  double lambda[PRRU_NLAMBDA]; /* when options.reactions */
+  double T, V;
+} prru_sample;
+
+typedef int (*prru_sample_fn)(const prru_sample *s, void *ctx); /* non-zero stops */
+
+typedef struct {
+  prru_stepper stepper;
+  double t_end, dt_out;          /* s; samples at 0, dt_out, ..., t_end */
+  double abs_tol, rel_tol, h0;   /* gsl_odeiv2_driver tolerances, first step */
+  int reactions;                 /* compute lambda for each sample */
+  const prru_load_schedule *loads;
+  prru_sample_fn on_sample; void *ctx;
+  volatile int *interrupt;       /* polled between samples; non-zero stops */
+  int progress;                  /* progress bar on stderr */
+} prru_sim_options;
+
+void prru_sim_options_default(prru_sim_options *o);
+/* Integrates from (q0, qd0); calls on_sample for every sample it reached.
+ * Stops with PRRU_EUNREACHABLE / PRRU_ESINGULAR (state left the workspace),
+ * PRRU_ENOCONV (step failure), PRRU_EINTERRUPTED; *t_stop is the time of the
+ * last sample delivered. msg (may be NULL) says why it stopped. */
+int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
+                  const prru_sim_options *o, double *t_stop, char *msg, int msglen);
+
+/* ---- Parsing shared by the CLI (fuzzed) ---- */
+/* Exactly n comma-separated finite doubles, nothing else. */
+int prru_parse_list(const char *s, double *out, int n);
+/* One finite double, nothing else. */
+int prru_parse_double(const char *s, double *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PRRU_H */
