@@ -4,7 +4,10 @@
 #ifndef PRRU_CLI_COMMANDS_H
 #define PRRU_CLI_COMMANDS_H
 
+#include <signal.h>
 #include <stdio.h>
+
+#include "prru.h"
 
 int prru_cmd_eval(int argc, char **argv);
 int prru_cmd_simulate(int argc, char **argv);
@@ -24,5 +27,45 @@ void prru_cli_error(const char *cmd, const char *fmt, ...);
 /* Status code of a runtime call turned into an exit status (1, or 130 when
  * interrupted). */
 int prru_cli_exit_for(int status);
+
+/* Options of one sub-command: `--name value` or `--name=value`; flags take
+ * no value. Unknown options, missing values, repeats and positional
+ * arguments are usage errors. */
+typedef struct {
+  const char *name;   /* without the leading "--" */
+  int takes_value;
+  const char **value; /* set when given (takes_value) */
+  int *flag;          /* set to 1 when given (flags) */
+} prru_cli_option;
+/* 0 on success, else 2 after printing the reason and `prru CMD --help`. */
+int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
+                   int nopts);
+/* Exactly n comma-separated finite numbers for option `name`: 0, else 2
+ * after printing what was wrong. */
+int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n);
+/* One finite number, 0 or 2. */
+int prru_cli_number(const char *cmd, const char *name, const char *text, double *out);
+/* Writes a JSON number (%.17g) or null when not finite. */
+void prru_cli_json_number(FILE *f, double v);
+/* JSON array of n numbers; rows > 1 writes n/rows rows as nested arrays. */
+void prru_cli_json_array(FILE *f, const double *v, int n, int rows);
+/* Set by SIGINT once prru_cli_catch_sigint() ran. */
+extern volatile sig_atomic_t prru_cli_interrupted;
+void prru_cli_catch_sigint(void);
+
+/* CSV of simulation samples: t,q1..3,qd1..3,d1..3, the 57 reactions (when
+ * computed), qdd1..3, fd1..3, fp1..3, mp1..3, T, V. */
+typedef struct {
+  FILE *f;
+  const prru_load_schedule *loads;
+  int reactions;
+  long rows;
+} prru_cli_csv;
+void prru_cli_csv_header(prru_cli_csv *c);
+/* prru_sample_fn: writes one row; non-zero on a write error. */
+int prru_cli_csv_row(const prru_sample *s, void *ctx);
+/* Writes script to dir/script_name and runs gnuplot there; 0 or 1 with a
+ * message (gnuplot missing or failing). */
+int prru_cli_gnuplot(const char *dir, const char *script_name, const char *script);
 
 #endif

@@ -11,6 +11,9 @@
 #ifndef PRRU_H
 #define PRRU_H
 
+#include <signal.h>
+#include <stddef.h>
+
 #include "prru_kernels.h"
 
 #ifdef __cplusplus
@@ -133,7 +136,7 @@ typedef struct {
   int reactions;                 /* compute lambda for each sample */
   const prru_load_schedule *loads;
   prru_sample_fn on_sample; void *ctx;
-  volatile int *interrupt;       /* polled between samples; non-zero stops */
+  volatile sig_atomic_t *interrupt; /* polled between samples; non-zero stops */
   int progress;                  /* progress bar on stderr */
 } prru_sim_options;
 
@@ -144,6 +147,49 @@ void prru_sim_options_default(prru_sim_options *o);
  * last sample delivered. msg (may be NULL) says why it stopped. */
 int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                   const prru_sim_options *o, double *t_stop, char *msg, int msglen);
+
+/* ---- Scenarios: initial state, loads and integrator settings ---- */
+typedef struct {
+  double q0[3], qd0[3];
+  prru_load_schedule loads;
+  prru_sim_options opt;
+} prru_scenario;
+
+/* The paper's section 4.3 study: q0 = (0, pi/6, -0.8), qd0 = 0, paper loads,
+ * 1 s, samples every 1 ms, rk8pd at 1e-10. */
+void prru_scenario_paper(prru_scenario *s);
+/* A scenario file: one `key = value` per line, '#' comments; keys q0, qd0,
+ * fd, fp, mp (3 numbers each), harmonic (amplitude N, angular frequency
+ * rad/s), loads (a CSV file for prru_schedule_read_csv, relative to the
+ * scenario's directory), t_end, dt, stepper, atol, rtol, h0. Unset keys
+ * keep their defaults (zero state and loads, 1 s, 1 ms, rk8pd, 1e-10).
+ * On error msg says `name:line: reason`. */
+int prru_scenario_read(prru_scenario *s, const char *path, char *msg, int msglen);
+/* The same from memory; name is used in messages, base_dir for `loads`
+ * (NULL: loads not allowed). */
+int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const char *name,
+                        const char *base_dir, char *msg, int msglen);
+void prru_scenario_free(prru_scenario *s);
+
+/* ---- Numeric CSV tables (header row of column names) ---- */
+typedef struct {
+  int ncols, nrows;
+  char **names;  /* ncols */
+  double *data;  /* nrows * ncols, row-major */
+} prru_table;
+
+/* Reads a comma-separated table: one header row of names, then rows of
+ * finite numbers, all rows as long as the header. Limits: 1e6 rows, 1024
+ * columns. msg says `name:line: reason`. */
+int prru_table_parse(prru_table *t, const char *text, size_t len, const char *name, char *msg,
+                     int msglen);
+int prru_table_read(prru_table *t, const char *path, char *msg, int msglen);
+/* Index of a column by name, -1 if absent. */
+int prru_table_column(const prru_table *t, const char *name);
+void prru_table_free(prru_table *t);
+/* prru_schedule_read_csv from memory. */
+int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
+                            const char *name, char *msg, int msglen);
 
 /* ---- Parsing shared by the CLI (fuzzed) ---- */
 /* Exactly n comma-separated finite doubles, nothing else. */

@@ -1,0 +1,50 @@
+/* prru: dynamics of the 3-PRRU parallel manipulator from the command line. */
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+#include "prru.h"
+
+static const struct {
+  const char *name;
+  int (*run)(int, char **);
+  const char *help;
+} commands[] = {
+    {"eval", prru_cmd_eval, "M, h, G, d, J_d, qdd and the joint reactions at one state (JSON)"},
+    {"simulate", prru_cmd_simulate, "integrate the equations of motion, CSV of the samples"},
+    {"ik", prru_cmd_ik, "actuator displacements d and J_d for a pose q (JSON)"},
+    {"fk", prru_cmd_fk, "pose q for actuator displacements d (Newton from a seed, JSON)"},
+    {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics)"},
+    {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
+    {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
+    {"paper", prru_cmd_paper, "reproduce the paper's simulation study and fig. 7 into a directory"},
+};
+
+static void usage(FILE *f)
+{
+  fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n\n"
+             "Dynamics of the 3-PRRU 1T2R parallel manipulator: q = (q1, q2) rad rotations\n"
+             "of the platform about x then y', q3 its height (m); d the slider heights (m).\n\n"
+             "commands:\n");
+  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+    fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
+  fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
+             "convergence, I/O), 2 usage error, 130 interrupted.\n");
+}
+
+int main(int argc, char **argv)
+{
+  if (argc < 2) {
+    usage(stderr);
+    return 2;
+  }
+  if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
+    usage(stdout);
+    return 0;
+  }
+  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+    if (strcmp(argv[1], commands[i].name) == 0) return commands[i].run(argc - 2, argv + 2);
+  fprintf(stderr, "prru: unknown command '%s'\n\n", argv[1]);
+  usage(stderr);
+  return 2;
+}

@@ -1,0 +1,105 @@
+/* Argument parsing, messages and JSON output shared by the sub-commands. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+#include "prru.h"
+
+volatile sig_atomic_t prru_cli_interrupted = 0;
+
+static void on_sigint(int sig)
+{
+  (void)sig;
+  prru_cli_interrupted = 1;
+}
+
+void prru_cli_catch_sigint(void)
+{
+  signal(SIGINT, on_sigint);
+}
+
+void prru_cli_error(const char *cmd, const char *fmt, ...)
+{
+  va_list ap;
+  fprintf(stderr, "prru %s: ", cmd);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+int prru_cli_exit_for(int status)
+{
+  return status == PRRU_EINTERRUPTED ? 130 : 1;
+}
+
+static int usage_error(const char *cmd, const char *what, const char *arg)
+{
+  prru_cli_error(cmd, "%s '%s' (see 'prru %s --help')", what, arg, cmd);
+  return 2;
+}
+
+int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
+                   int nopts)
+{
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (strncmp(a, "--", 2) != 0 || a[2] == '\0') return usage_error(cmd, "unexpected argument", a);
+    const char *name = a + 2, *eq = strchr(name, '=');
+    size_t len = eq ? (size_t)(eq - name) : strlen(name);
+    const prru_cli_option *o = NULL;
+    for (int k = 0; k < nopts; k++)
+      if (strlen(opts[k].name) == len && strncmp(opts[k].name, name, len) == 0) o = &opts[k];
+    if (!o) return usage_error(cmd, "unknown option", a);
+    if (o->takes_value) {
+      const char *v = eq ? eq + 1 : (i + 1 < argc ? argv[++i] : NULL);
+      if (!v) return usage_error(cmd, "missing value for option", a);
+      if (*o->value) return usage_error(cmd, "option given twice:", a);
+      *o->value = v;
+    } else {
+      if (eq) return usage_error(cmd, "option takes no value:", a);
+      *o->flag = 1;
+    }
+  }
+  return 0;
+}
+
+int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n)
+{
+  if (prru_parse_list(text, out, n) == PRRU_OK) return 0;
+  if (n == 1)
+    prru_cli_error(cmd, "--%s: '%s' is not a finite number", name, text);
+  else
+    prru_cli_error(cmd, "--%s: '%s' is not %d comma-separated finite numbers", name, text, n);
+  return 2;
+}
+
+int prru_cli_number(const char *cmd, const char *name, const char *text, double *out)
+{
+  return prru_cli_numbers(cmd, name, text, out, 1);
+}
+
+void prru_cli_json_number(FILE *f, double v)
+{
+  if (isfinite(v))
+    fprintf(f, "%.17g", v);
+  else
+    fputs("null", f);
+}
+
+void prru_cli_json_array(FILE *f, const double *v, int n, int rows)
+{
+  int per = rows > 1 ? n / rows : n;
+  if (rows > 1) fputc('[', f);
+  for (int r = 0; r < (rows > 1 ? rows : 1); r++) {
+    fputs(r ? ", [" : "[", f);
+    for (int i = 0; i < per; i++) {
+      if (i) fputs(", ", f);
+      prru_cli_json_number(f, v[r * per + i]);
+    }
+    fputc(']', f);
+  }
+  if (rows > 1) fputc(']', f);
+}

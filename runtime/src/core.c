@@ -1,0 +1,177 @@
+/* Model constants, status strings, reachability and the dynamics calls. */
+#include <math.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
+#include "prru.h"
+
+const char *prru_strerror(int status)
+{
+  switch (status) {
+  case PRRU_OK: return "success";
+  case PRRU_EINPUT: return "invalid input (NaN, infinite or out of range)";
+  case PRRU_EUNREACHABLE: return "configuration not reachable (no inverse kinematics)";
+  case PRRU_ESINGULAR: return "singular configuration (J_d not invertible)";
+  case PRRU_ENOCONV: return "iteration did not converge";
+  case PRRU_EINTERRUPTED: return "interrupted";
+  case PRRU_EIO: return "input/output error";
+  case PRRU_ENOMEM: return "out of memory";
+  case PRRU_EPARSE: return "malformed input";
+  default: return "unknown status";
+  }
+}
+
+void prru_model_default(prru_model *m)
+{
+  static const double mass[PRRU_NBODY] = PRRU_BODY_MASSES;
+  static const double inertia[3 * PRRU_NBODY] = PRRU_BODY_INERTIAS;
+  m->gravity = PRRU_GRAVITY;
+  m->b12 = PRRU_GEOM_B12;
+  m->b3 = PRRU_GEOM_B3;
+  m->l1 = PRRU_GEOM_L1;
+  m->l2 = PRRU_GEOM_L2;
+  m->a = PRRU_GEOM_A;
+  memcpy(m->mass, mass, sizeof mass);
+  memcpy(m->inertia, inertia, sizeof inertia);
+  m->total_mass = PRRU_TOTAL_MASS;
+  m->jd_rcond_min = 1e-8;
+}
+
+static int finite3(const double v[3])
+{
+  return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
+{
+  (void)m;
+  if (!finite3(q)) return PRRU_EINPUT;
+  prru_ik(q, d->d);
+  /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
+  return finite3(d->d) ? PRRU_OK : PRRU_EUNREACHABLE;
+}
+
+/* 1 / (|A|_1 |A^-1|_1) of a 3x3 matrix via its adjugate; 0 when det = 0. */
+static double rcond3(const double a[9], double inv[9])
+{
+  double c[9];
+  c[0] = a[4] * a[8] - a[5] * a[7];
+  c[1] = a[2] * a[7] - a[1] * a[8];
+  c[2] = a[1] * a[5] - a[2] * a[4];
+  c[3] = a[5] * a[6] - a[3] * a[8];
+  c[4] = a[0] * a[8] - a[2] * a[6];
+  c[5] = a[2] * a[3] - a[0] * a[5];
+  c[6] = a[3] * a[7] - a[4] * a[6];
+  c[7] = a[1] * a[6] - a[0] * a[7];
+  c[8] = a[0] * a[4] - a[1] * a[3];
+  double det = a[0] * c[0] + a[1] * c[3] + a[2] * c[6];
+  if (!(det != 0.0) || !isfinite(det)) return 0.0;
+  double na = 0, ni = 0;
+  for (int j = 0; j < 3; j++) {
+    double sa = fabs(a[j]) + fabs(a[3 + j]) + fabs(a[6 + j]);
+    double si = fabs(c[j]) + fabs(c[3 + j]) + fabs(c[6 + j]);
+    if (sa > na) na = sa;
+    if (si > ni) ni = si;
+  }
+  if (inv)
+    for (int i = 0; i < 9; i++) inv[i] = c[i] / det;
+  return fabs(det) / (na * ni);
+}
+
+int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
+{
+  if (rcond) *rcond = 0.0;
+  if (!finite3(q)) return PRRU_EINPUT;
+  prru_ik_jd(q, d->d, d->Jd);
+  if (!finite3(d->d)) return PRRU_EUNREACHABLE;
+  double rc = rcond3(d->Jd, NULL);
+  if (rcond) *rcond = rc;
+  return rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
+}
+
+int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[3])
+{
+  int st = prru_check_reachable(m, d, q);
+  if (st == PRRU_OK) memcpy(act, d->d, sizeof d->d);
+  return st;
+}
+
+static int loads_finite(const prru_loads *l)
+{
+  return finite3(l->fd) && finite3(l->fp) && finite3(l->mp);
+}
+
+/* Why a kernel produced non-finite output: bad input or q out of reach. */
+static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
+{
+  int st = prru_check_reachable(m, d, q);
+  return st == PRRU_OK ? PRRU_EINPUT : st;
+}
+
+/* Solves M x = b in place with GSL's Cholesky (M SPD by construction);
+ * GSL's error handler is off so a failure is a status, not an abort. */
+static int solve_spd3(double M[9], double b[3])
+{
+  gsl_matrix_view mv = gsl_matrix_view_array(M, 3, 3);
+  gsl_vector_view bv = gsl_vector_view_array(b, 3);
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  int st = gsl_linalg_cholesky_decomp1(&mv.matrix);
+  if (st == GSL_SUCCESS) st = gsl_linalg_cholesky_svx(&mv.matrix, &bv.vector);
+  gsl_set_error_handler(old);
+  return st == GSL_SUCCESS ? PRRU_OK : PRRU_ESINGULAR;
+}
+
+int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
+                          const double qd[3], const prru_loads *l, double qdd[3])
+{
+  prru_eom(q, qd, l->fd, l->fp, l->mp, d->M, d->b);
+  /* One finiteness test on the result covers every bad input: NaN/inf
+   * anywhere in q, qd or the loads, or q out of reach, reaches b. */
+  if (!finite3(d->b)) {
+    if (!finite3(qd) || !loads_finite(l)) return PRRU_EINPUT;
+    return classify_failure(m, d, q);
+  }
+  double M[9];
+  memcpy(M, d->M, sizeof M);
+  memcpy(d->qdd, d->b, sizeof d->b);
+  int st = solve_spd3(M, d->qdd);
+  if (st != PRRU_OK) return st;
+  memcpy(qdd, d->qdd, sizeof d->qdd);
+  return PRRU_OK;
+}
+
+int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
+                          const double qd[3], const double qdd[3], const prru_loads *l,
+                          double fd[3])
+{
+  static const double zero[3] = {0, 0, 0};
+  if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))
+    return PRRU_EINPUT;
+  double rc;
+  int st = prru_check_regular(m, d, q, &rc);
+  if (st != PRRU_OK) return st;
+  /* J_d^T fd = M qdd - (G + J_T,P^T fp + J_R,P^T mp - h). */
+  prru_eom(q, qd, zero, l->fp, l->mp, d->M, d->b);
+  double r[3], inv[9];
+  for (int i = 0; i < 3; i++)
+    r[i] = d->M[3 * i] * qdd[0] + d->M[3 * i + 1] * qdd[1] + d->M[3 * i + 2] * qdd[2] - d->b[i];
+  rcond3(d->Jd, inv);
+  /* fd = J_d^-T r: row i of J_d^-T is column i of J_d^-1. */
+  for (int i = 0; i < 3; i++) fd[i] = inv[i] * r[0] + inv[3 + i] * r[1] + inv[6 + i] * r[2];
+  return finite3(fd) ? PRRU_OK : PRRU_EINPUT;
+}
+
+int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
+                  double *V)
+{
+  (void)m;
+  if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
+  double E[2];
+  prru_energy(q, qd, E);
+  if (!isfinite(E[0]) || !isfinite(E[1])) return PRRU_EUNREACHABLE;
+  *T = E[0];
+  *V = E[1];
+  return PRRU_OK;
+}

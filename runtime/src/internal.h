@@ -1,0 +1,17 @@
+/* Helpers shared inside the runtime, not part of its API. */
+#ifndef PRRU_INTERNAL_H
+#define PRRU_INTERNAL_H
+#include <stddef.h>
+
+/* C99 has no M_PI. */
+#define PRRU_PI 3.14159265358979323846
+
+/* Formats msg (if non-NULL) and returns status. */
+int prru_fail(char *msg, int msglen, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+/* Reads a whole file (at most 256 MiB); NULL with msg on failure. */
+char *prru_read_file(const char *path, size_t *len, char *msg, int msglen);
+#endif

@@ -1,0 +1,118 @@
+/* Loads as functions of time: constant, the paper's harmonic platform
+ * force, or a table with linear interpolation. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "prru.h"
+#include "internal.h"
+
+void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l)
+{
+  memset(s, 0, sizeof *s);
+  s->kind = PRRU_LOAD_CONSTANT;
+  s->base = *l;
+}
+
+void prru_schedule_paper(prru_load_schedule *s)
+{
+  prru_loads l = {{50.0, 40.0, 25.0}, {0, 0, 0}, {0, 0, 0}};
+  prru_schedule_constant(s, &l);
+  s->kind = PRRU_LOAD_HARMONIC;
+  s->amp = 50.0;
+  s->omega = 4.0 * PRRU_PI;
+}
+
+void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out)
+{
+  *out = s->base;
+  if (s->kind == PRRU_LOAD_HARMONIC) {
+    out->fp[0] += s->amp * sin(s->omega * t);
+    out->fp[1] -= s->amp * cos(s->omega * t);
+  } else if (s->kind == PRRU_LOAD_TABLE && s->nrows > 0) {
+    const double *r = s->rows;
+    int n = s->nrows;
+    double v[9];
+    if (t <= r[0]) {
+      memcpy(v, r + 1, sizeof v);
+    } else if (t >= r[10 * (n - 1)]) {
+      memcpy(v, r + 10 * (n - 1) + 1, sizeof v);
+    } else {
+      int lo = 0, hi = n - 1; /* r[10 lo] <= t < r[10 hi] */
+      while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (r[10 * mid] <= t) lo = mid; else hi = mid;
+      }
+      const double *a = r + 10 * lo, *b = r + 10 * hi;
+      double w = (t - a[0]) / (b[0] - a[0]);
+      for (int k = 0; k < 9; k++) v[k] = a[1 + k] + w * (b[1 + k] - a[1 + k]);
+    }
+    for (int k = 0; k < 3; k++) {
+      out->fd[k] += v[k];
+      out->fp[k] += v[3 + k];
+      out->mp[k] += v[6 + k];
+    }
+  }
+}
+
+void prru_schedule_free(prru_load_schedule *s)
+{
+  free(s->rows);
+  s->rows = NULL;
+  s->nrows = 0;
+}
+
+int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
+                            const char *name, char *msg, int msglen)
+{
+  static const char *cols[10] = {"t", "fd1", "fd2", "fd3", "fp1", "fp2", "fp3", "mp1", "mp2", "mp3"};
+  prru_table t;
+  memset(s, 0, sizeof *s);
+  int st = prru_table_parse(&t, text, len, name, msg, msglen);
+  if (st != PRRU_OK) return st;
+  int idx[10];
+  for (int k = 0; k < 10; k++) {
+    idx[k] = prru_table_column(&t, cols[k]);
+    if (idx[k] < 0 && k < 4) {
+      prru_table_free(&t);
+      return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: missing column '%s' (need t,fd1,fd2,fd3; fp1..3, mp1..3 optional)", name, cols[k]);
+    }
+  }
+  for (int j = 0; j < t.ncols; j++) {
+    int known = 0;
+    for (int k = 0; k < 10; k++) known |= idx[k] == j;
+    if (!known) {
+      prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: unknown column '%s' (expected t,fd1..3,fp1..3,mp1..3)", name, t.names[j]);
+      prru_table_free(&t);
+      return PRRU_EPARSE;
+    }
+  }
+  s->rows = malloc((size_t)t.nrows * 10 * sizeof *s->rows);
+  if (!s->rows) { prru_table_free(&t); return prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name); }
+  for (int i = 0; i < t.nrows; i++)
+    for (int k = 0; k < 10; k++)
+      s->rows[10 * i + k] = idx[k] < 0 ? 0.0 : t.data[(size_t)i * (size_t)t.ncols + (size_t)idx[k]];
+  for (int i = 1; i < t.nrows; i++)
+    if (!(s->rows[10 * i] > s->rows[10 * (i - 1)])) {
+      prru_fail(msg, msglen, PRRU_EPARSE, "%s: data row %d: time %g does not increase", name,
+                i + 1, s->rows[10 * i]);
+      prru_table_free(&t);
+      prru_schedule_free(s);
+      return PRRU_EPARSE;
+    }
+  s->nrows = t.nrows;
+  s->kind = PRRU_LOAD_TABLE;
+  prru_table_free(&t);
+  return PRRU_OK;
+}
+
+int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen)
+{
+  size_t len;
+  memset(s, 0, sizeof *s);
+  char *text = prru_read_file(path, &len, msg, msglen);
+  if (!text) return PRRU_EIO;
+  int st = prru_schedule_parse_csv(s, text, len, path, msg, msglen);
+  free(text);
+  return st;
+}
