@@ -108,6 +108,26 @@ int prru_cmd_simulate(int argc, char **argv)
     prru_cli_error("simulate", "--stepper: '%s' is not one of rk8pd, rkf45, rkck, msbdf", stepper);
     bad = 2;
   }
+  if (!bad && !(s.opt.t_end > 0)) {
+    prru_cli_error("simulate", "--t-end: %g is not a positive time (s)", s.opt.t_end);
+    bad = 2;
+  }
+  if (!bad && !(s.opt.dt_out > 0 && s.opt.dt_out <= s.opt.t_end)) {
+    prru_cli_error("simulate", "--dt: %g must be positive and at most t-end (%g s)", s.opt.dt_out, s.opt.t_end);
+    bad = 2;
+  }
+  if (!bad && !(s.opt.t_end / s.opt.dt_out <= 1e8)) {
+    prru_cli_error("simulate", "--t-end/--dt: more than 1e8 samples");
+    bad = 2;
+  }
+  if (!bad && !(s.opt.abs_tol >= 0 && s.opt.rel_tol >= 0 && s.opt.abs_tol + s.opt.rel_tol > 0)) {
+    prru_cli_error("simulate", "--atol/--rtol: must be non-negative and not both zero");
+    bad = 2;
+  }
+  if (!bad && !(s.opt.h0 > 0)) {
+    prru_cli_error("simulate", "--h0: must be a positive step (s)");
+    bad = 2;
+  }
   if (harm && loads) {
     prru_cli_error("simulate", "--harmonic and --loads exclude each other");
     bad = 2;

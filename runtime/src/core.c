@@ -2,9 +2,6 @@
 #include <math.h>
 #include <string.h>
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_linalg.h>
-
 #include "prru.h"
 
 const char *prru_strerror(int status)
@@ -103,24 +100,37 @@ static int loads_finite(const prru_loads *l)
   return finite3(l->fd) && finite3(l->fp) && finite3(l->mp);
 }
 
-/* Why a kernel produced non-finite output: bad input or q out of reach. */
+/* Why a kernel produced non-finite output from finite inputs: q out of
+ * reach, or exactly on the workspace boundary (an acos argument of +-1),
+ * where the velocity mapping divides by zero. */
 static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
 {
   int st = prru_check_reachable(m, d, q);
-  return st == PRRU_OK ? PRRU_EINPUT : st;
+  return st == PRRU_OK ? PRRU_ESINGULAR : st;
 }
 
-/* Solves M x = b in place with GSL's Cholesky (M SPD by construction);
- * GSL's error handler is off so a failure is a status, not an abort. */
-static int solve_spd3(double M[9], double b[3])
+/* Solves M x = b in place by Cholesky, unrolled for 3x3: GSL's generic
+ * gsl_linalg_cholesky_decomp1 + svx cost about 200 ns here, twice the whole
+ * generated dynamics kernel, so the hot path does the same arithmetic
+ * inline (the reference and the 57x57 reaction system use GSL's). */
+static int solve_spd3(const double M[9], double b[3])
 {
-  gsl_matrix_view mv = gsl_matrix_view_array(M, 3, 3);
-  gsl_vector_view bv = gsl_vector_view_array(b, 3);
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
-  int st = gsl_linalg_cholesky_decomp1(&mv.matrix);
-  if (st == GSL_SUCCESS) st = gsl_linalg_cholesky_svx(&mv.matrix, &bv.vector);
-  gsl_set_error_handler(old);
-  return st == GSL_SUCCESS ? PRRU_OK : PRRU_ESINGULAR;
+  double l00 = M[0];
+  if (!(l00 > 0)) return PRRU_ESINGULAR;
+  l00 = sqrt(l00);
+  double l10 = M[3] / l00, l20 = M[6] / l00;
+  double l11 = M[4] - l10 * l10;
+  if (!(l11 > 0)) return PRRU_ESINGULAR;
+  l11 = sqrt(l11);
+  double l21 = (M[7] - l20 * l10) / l11;
+  double l22 = M[8] - l20 * l20 - l21 * l21;
+  if (!(l22 > 0)) return PRRU_ESINGULAR;
+  l22 = sqrt(l22);
+  double y0 = b[0] / l00, y1 = (b[1] - l10 * y0) / l11, y2 = (b[2] - l20 * y0 - l21 * y1) / l22;
+  b[2] = y2 / l22;
+  b[1] = (y1 - l21 * b[2]) / l11;
+  b[0] = (y0 - l10 * b[1] - l20 * b[2]) / l00;
+  return PRRU_OK;
 }
 
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
@@ -133,10 +143,8 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
     if (!finite3(qd) || !loads_finite(l)) return PRRU_EINPUT;
     return classify_failure(m, d, q);
   }
-  double M[9];
-  memcpy(M, d->M, sizeof M);
   memcpy(d->qdd, d->b, sizeof d->b);
-  int st = solve_spd3(M, d->qdd);
+  int st = solve_spd3(d->M, d->qdd);
   if (st != PRRU_OK) return st;
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
