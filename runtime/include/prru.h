@@ -148,7 +148,9 @@ void prru_sim_options_default(prru_sim_options *o);
 int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                   const prru_sim_options *o, double *t_stop, char *msg, int msglen);
 
-/* ---- Scenarios: initial state, loads and integrator settings ---- */
+/* ---- Scenarios: initial state, loads and integrator settings ----
+ * opt.loads points at the scenario's own loads once it is set up; a copy of
+ * the struct must re-point it (opt.loads = &copy.loads). */
 typedef struct {
   double q0[3], qd0[3];
   prru_load_schedule loads;

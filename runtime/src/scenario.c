@@ -14,6 +14,7 @@ static void scenario_defaults(prru_scenario *s)
   memset(&zero, 0, sizeof zero);
   prru_schedule_constant(&s->loads, &zero);
   prru_sim_options_default(&s->opt);
+  s->opt.loads = &s->loads;
 }
 
 void prru_scenario_paper(prru_scenario *s)
@@ -92,6 +93,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
     if (st != PRRU_OK) return st;
     t.base = s->loads.base; /* constant parts given before add to the table */
     s->loads = t;
+    s->opt.loads = &s->loads;
     *has_table = 1;
     return PRRU_OK;
   }
