@@ -1,0 +1,330 @@
+/* Paper eqs. 25-30: H, Phi, K stacked in body order, M = H^T Phi H,
+ * h = H^T K, G, and the forward and inverse dynamics, all with GSL. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
+#include "ref_internal.h"
+
+#define NB PRRU_REF_NBODY
+#define NW (6 * NB)
+
+prru_ref_ws *prru_ref_alloc(void)
+{
+  prru_ref_ws *w = calloc(1, sizeof *w);
+  ref_priv *s = calloc(1, sizeof *s);
+  if (!w || !s) { free(w); free(s); return NULL; }
+  w->priv = s;
+  w->H = gsl_matrix_calloc(NW, 3);
+  w->Phi = gsl_matrix_calloc(NW, NW);
+  w->K = gsl_vector_calloc(NW);
+  w->dm = gsl_vector_calloc(NW);
+  w->PhiH = gsl_matrix_calloc(NW, 3);
+  w->M = gsl_matrix_calloc(3, 3);
+  w->Q = gsl_matrix_calloc(NW, NW - 3);
+  w->Jd = gsl_matrix_calloc(3, 3);
+  s->L = gsl_matrix_calloc(NW, NW);
+  s->Y = gsl_matrix_calloc(NW, NW - 3);
+  s->A = gsl_matrix_calloc(NW - 3, NW - 3);
+  s->r60 = gsl_vector_calloc(NW);
+  s->r57 = gsl_vector_calloc(NW - 3);
+  s->Fbar = gsl_vector_calloc(NW);
+  s->Fg = gsl_vector_calloc(NW);
+  s->m3a = gsl_matrix_calloc(3, 3);
+  s->m3b = gsl_matrix_calloc(3, 3);
+  s->m3c = gsl_matrix_calloc(3, 3);
+  s->m3d = gsl_matrix_calloc(3, 3);
+  s->v3a = gsl_vector_calloc(3);
+  s->v3b = gsl_vector_calloc(3);
+  s->v3c = gsl_vector_calloc(3);
+  s->perm3 = gsl_permutation_calloc(3);
+  if (!w->H || !w->Phi || !w->K || !w->dm || !w->PhiH || !w->M || !w->Q || !w->Jd || !s->L ||
+      !s->Y || !s->A || !s->r60 || !s->r57 || !s->Fbar || !s->Fg || !s->m3a || !s->m3b ||
+      !s->m3c || !s->m3d || !s->v3a || !s->v3b || !s->v3c || !s->perm3) {
+    prru_ref_free(w);
+    return NULL;
+  }
+  return w;
+}
+
+void prru_ref_free(prru_ref_ws *w)
+{
+  if (!w) return;
+  ref_priv *s = w->priv;
+  /* gsl_*_free accept NULL, so a partly failed allocation frees cleanly. */
+  gsl_matrix_free(w->H);
+  gsl_matrix_free(w->Phi);
+  gsl_vector_free(w->K);
+  gsl_vector_free(w->dm);
+  gsl_matrix_free(w->PhiH);
+  gsl_matrix_free(w->M);
+  gsl_matrix_free(w->Q);
+  gsl_matrix_free(w->Jd);
+  if (s) {
+    gsl_matrix_free(s->L);
+    gsl_matrix_free(s->Y);
+    gsl_matrix_free(s->A);
+    gsl_vector_free(s->r60);
+    gsl_vector_free(s->r57);
+    gsl_vector_free(s->Fbar);
+    gsl_vector_free(s->Fg);
+    gsl_matrix_free(s->m3a);
+    gsl_matrix_free(s->m3b);
+    gsl_matrix_free(s->m3c);
+    gsl_matrix_free(s->m3d);
+    gsl_vector_free(s->v3a);
+    gsl_vector_free(s->v3b);
+    gsl_vector_free(s->v3c);
+    gsl_permutation_free(s->perm3);
+    free(s);
+  }
+  free(w);
+}
+
+int ref_cholesky(gsl_matrix *A)
+{
+  /* GSL's default handler aborts on a non-positive-definite matrix; the
+   * reference reports it instead. */
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  int st = gsl_linalg_cholesky_decomp1(A);
+  gsl_set_error_handler(old);
+  return st ? GSL_ESING : GSL_SUCCESS;
+}
+
+int ref_lu3(gsl_matrix *A, gsl_permutation *perm, gsl_matrix *inv)
+{
+  double norm = 0, inorm = 0;
+  int signum;
+  for (int j = 0; j < 3; j++) {
+    double c = 0;
+    for (int i = 0; i < 3; i++) c += fabs(gsl_matrix_get(A, i, j));
+    norm = fmax(norm, c);
+  }
+  gsl_linalg_LU_decomp(A, perm, &signum);
+  for (int i = 0; i < 3; i++)
+    if (!(gsl_matrix_get(A, i, i) != 0.0)) return GSL_ESING;
+  gsl_linalg_LU_invert(A, perm, inv);
+  for (int j = 0; j < 3; j++) {
+    double c = 0;
+    for (int i = 0; i < 3; i++) c += fabs(gsl_matrix_get(inv, i, j));
+    inorm = fmax(inorm, c);
+  }
+  return 1.0 / (norm * inorm) >= DBL_EPSILON ? GSL_SUCCESS : GSL_ESING;
+}
+
+/* Stacks the per-body quantities of paper eq. 25-28 into the workspace. */
+int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], const double *qd)
+{
+  ref_priv *s = w->priv;
+  ref_kin *k = &s->kin;
+  int st = ref_kinematics(p, q, qd, k);
+  if (st) return st;
+  gsl_matrix_set_zero(w->Phi);
+  gsl_vector_set_zero(s->Fg);
+  for (int b = 0; b < NB; b++) {
+    const double *R = k->R[b];
+    for (int i = 0; i < 3; i++) {
+      for (int j = 0; j < 3; j++) {
+        gsl_matrix_set(w->H, 3 * b + i, j, k->JR[b][3 * i + j]);
+        gsl_matrix_set(w->H, 3 * NB + 3 * b + i, j, k->JT[b][3 * i + j]);
+        /* I_b = R diag(I) R^T, the body inertia seen in {S}. */
+        double Iij = 0;
+        for (int l = 0; l < 3; l++) Iij += R[3 * i + l] * p->inertia[b][l] * R[3 * j + l];
+        gsl_matrix_set(w->Phi, 3 * b + i, 3 * b + j, Iij);
+      }
+      gsl_matrix_set(w->Phi, 3 * NB + 3 * b + i, 3 * NB + 3 * b + i, p->mass[b]);
+      gsl_vector_set(w->dm, 3 * b + i, k->delta[b][i]);
+      gsl_vector_set(w->dm, 3 * NB + 3 * b + i, k->mu[b][i]);
+    }
+    gsl_vector_set(s->Fg, 3 * NB + 3 * b + 2, -p->mass[b] * p->g);
+  }
+  if (qd) {
+    /* K: I delta + omega x (I omega) (paper eq. 28, errata), m mu. */
+    for (int b = 0; b < NB; b++) {
+      double Id[3] = {0, 0, 0}, Iw[3] = {0, 0, 0};
+      const double *om = k->omega[b];
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+          double Iij = gsl_matrix_get(w->Phi, 3 * b + i, 3 * b + j);
+          Id[i] += Iij * k->delta[b][j];
+          Iw[i] += Iij * om[j];
+        }
+      double gyro[3] = {om[1] * Iw[2] - om[2] * Iw[1], om[2] * Iw[0] - om[0] * Iw[2],
+                        om[0] * Iw[1] - om[1] * Iw[0]};
+      for (int i = 0; i < 3; i++) {
+        gsl_vector_set(w->K, 3 * b + i, Id[i] + gyro[i]);
+        gsl_vector_set(w->K, 3 * NB + 3 * b + i, p->mass[b] * k->mu[b][i]);
+      }
+    }
+  }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) gsl_matrix_set(w->Jd, i, j, k->Jd[3 * i + j]);
+  return GSL_SUCCESS;
+}
+
+void ref_mass_from_H(prru_ref_ws *w)
+{
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, w->Phi, w->H, 0.0, w->PhiH);
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->H, w->PhiH, 0.0, w->M);
+}
+
+static void fill_nan(double *x, int n)
+{
+  if (x)
+    for (int i = 0; i < n; i++) x[i] = NAN;
+}
+
+static void copy_matrix(const gsl_matrix *A, double *out)
+{
+  for (size_t i = 0; i < A->size1; i++)
+    for (size_t j = 0; j < A->size2; j++) out[i * A->size2 + j] = gsl_matrix_get(A, i, j);
+}
+
+static void copy_vector(const gsl_vector *v, double *out)
+{
+  for (size_t i = 0; i < v->size; i++) out[i] = gsl_vector_get(v, i);
+}
+
+int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double H[180])
+{
+  int st = ref_assemble(p, w, q, NULL);
+  if (st) { fill_nan(H, 180); return st; }
+  copy_matrix(w->H, H);
+  return GSL_SUCCESS;
+}
+
+int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                        const double qd[3], double dm[60])
+{
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(dm, NW); return st; }
+  copy_vector(w->dm, dm);
+  return GSL_SUCCESS;
+}
+
+int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double M[9])
+{
+  int st = ref_assemble(p, w, q, NULL);
+  if (st) { fill_nan(M, 9); return st; }
+  ref_mass_from_H(w);
+  copy_matrix(w->M, M);
+  return GSL_SUCCESS;
+}
+
+int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                  const double qd[3], double h[3])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(h, 3); return st; }
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, s->v3a);
+  copy_vector(s->v3a, h);
+  return GSL_SUCCESS;
+}
+
+/* G = sum_b J_T,b^T (-m_b g e3) = H^T Fg with Fg the stacked gravity wrenches. */
+int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double G[3])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, NULL);
+  if (st) { fill_nan(G, 3); return st; }
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, s->Fg, 0.0, s->v3a);
+  copy_vector(s->v3a, G);
+  return GSL_SUCCESS;
+}
+
+int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                      const double qd[3], double M[9], double h[3], double G[3])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(M, 9); fill_nan(h, 3); fill_nan(G, 3); return st; }
+  ref_mass_from_H(w);
+  copy_matrix(w->M, M);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, s->v3a);
+  copy_vector(s->v3a, h);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, s->Fg, 0.0, s->v3a);
+  copy_vector(s->v3a, G);
+  return GSL_SUCCESS;
+}
+
+/* Body by body, from the velocities, not from M: the tests compare the two. */
+int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                    const double qd[3], double E[2])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(E, 2); return st; }
+  const ref_kin *k = &s->kin;
+  double T = 0, V = 0;
+  for (int b = 0; b < NB; b++) {
+    for (int i = 0; i < 3; i++) {
+      T += 0.5 * p->mass[b] * k->v[b][i] * k->v[b][i];
+      for (int j = 0; j < 3; j++)
+        T += 0.5 * k->omega[b][i] * gsl_matrix_get(w->Phi, 3 * b + i, 3 * b + j) * k->omega[b][j];
+    }
+    V += p->g * p->mass[b] * k->p[b][2];
+  }
+  E[0] = T;
+  E[1] = V;
+  return GSL_SUCCESS;
+}
+
+/* tau = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp (eq. 30's right-hand side). */
+static void generalized_load(prru_ref_ws *w, const double *fd, const double fp[3],
+                             const double mp[3], gsl_vector *tau)
+{
+  ref_priv *s = w->priv;
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, s->Fg, 0.0, tau);
+  for (int j = 0; j < 3; j++) {
+    double t = 0;
+    for (int i = 0; i < 3; i++) {
+      if (fd) t += gsl_matrix_get(w->Jd, i, j) * fd[i];
+      t += gsl_matrix_get(w->H, 3 * NB + 3 * REF_P + i, j) * fp[i];
+      t += gsl_matrix_get(w->H, 3 * REF_P + i, j) * mp[i];
+    }
+    gsl_vector_set(tau, j, gsl_vector_get(tau, j) + t);
+  }
+}
+
+int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                              const double qd[3], const double fd[3], const double fp[3],
+                              const double mp[3], double qdd[3])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(qdd, 3); return st; }
+  ref_mass_from_H(w);
+  generalized_load(w, fd, fp, mp, s->v3b);
+  gsl_blas_dgemv(CblasTrans, -1.0, w->H, w->K, 1.0, s->v3b); /* - h */
+  gsl_matrix_memcpy(s->m3a, w->M);
+  if (ref_cholesky(s->m3a)) { fill_nan(qdd, 3); return GSL_ESING; }
+  gsl_linalg_cholesky_solve(s->m3a, s->v3b, s->v3a);
+  copy_vector(s->v3a, qdd);
+  return GSL_SUCCESS;
+}
+
+/* fd = J_d^-T (M qdd + h - G - J_T,P^T fp - J_R,P^T mp). */
+int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                              const double qd[3], const double qdd[3], const double fp[3],
+                              const double mp[3], double fd[3])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(fd, 3); return st; }
+  ref_mass_from_H(w);
+  gsl_vector_const_view a = gsl_vector_const_view_array(qdd, 3);
+  generalized_load(w, NULL, fp, mp, s->v3b);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, -1.0, s->v3b);   /* h - (G + ...) */
+  gsl_blas_dgemv(CblasNoTrans, 1.0, w->M, &a.vector, 1.0, s->v3b); /* + M qdd */
+  gsl_matrix_transpose_memcpy(s->m3a, w->Jd);
+  if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, 3); return GSL_ESING; }
+  gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3b, s->v3a);
+  copy_vector(s->v3a, fd);
+  return GSL_SUCCESS;
+}
