@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Smoke test of prru_bench: `prru_bench --quick --json` exits 0 and prints
+one JSON object with every kernel of issue 5 and the build description.
+
+Timings are checked only for being positive and finite, never against
+targets: this runs on a shared machine under ctest -j.
+
+usage: check_json.py PATH_TO_PRRU_BENCH
+"""
+import json
+import math
+import subprocess
+import sys
+
+KERNELS = ["jd", "jacobians", "bias_terms", "mass", "bias", "gravity",
+           "dynamics", "forward_dynamics", "inverse_dynamics", "reactions"]
+
+
+def fail(msg):
+    print("bench_smoke: FAIL: " + msg, file=sys.stderr)
+    sys.exit(1)
+
+
+def positive(x):
+    return isinstance(x, (int, float)) and math.isfinite(x) and x > 0
+
+
+def main():
+    if len(sys.argv) != 2:
+        fail("usage: check_json.py PATH_TO_PRRU_BENCH")
+    run = subprocess.run([sys.argv[1], "--quick", "--json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         universal_newlines=True, timeout=600)
+    sys.stderr.write(run.stderr)
+    if run.returncode != 0:
+        fail("prru_bench exited with %d" % run.returncode)
+    try:
+        doc = json.loads(run.stdout)
+    except ValueError as e:
+        fail("stdout is not one JSON object (%s): %r" % (e, run.stdout[:200]))
+    if not isinstance(doc, dict):
+        fail("top level is not an object")
+    for key in ("cpu", "compiler", "flags"):
+        if not isinstance(doc.get(key), str) or not doc[key]:
+            fail("%r missing or empty" % key)
+    kernels = doc.get("kernels")
+    if not isinstance(kernels, dict):
+        fail("'kernels' missing")
+    names = list(KERNELS)
+    # w_r is required once the bench was built with the DME API.
+    if "w_r" in kernels or "w_r" not in doc.get("missing", {}):
+        names.append("w_r")
+    for name in names:
+        k = kernels.get(name)
+        if not isinstance(k, dict):
+            fail("kernel %r missing" % name)
+        if set(k) != {"generated_ns", "reference_ns", "ratio"}:
+            fail("kernel %r has keys %s" % (name, sorted(k)))
+        if not (positive(k["generated_ns"]) and positive(k["reference_ns"])
+                and positive(k["ratio"])):
+            fail("kernel %r: non-positive or non-finite value %s" % (name, k))
+        # ratio = reference / generated, up to the 4 printed digits
+        want = k["reference_ns"] / k["generated_ns"]
+        if abs(k["ratio"] - want) > 2e-3 * want:
+            fail("kernel %r: ratio %g is not reference/generated = %g"
+                 % (name, k["ratio"], want))
+    extra = sorted(set(kernels) - set(names))
+    if extra:
+        fail("unexpected kernels %s" % extra)
+    # The generated and reference paths agree: this is a correctness
+    # property, not a timing, so it is asserted.
+    for name, diff in doc.get("max_rel_diff", {}).items():
+        if not (isinstance(diff, (int, float)) and diff <= 1e-9):
+            fail("kernel %r: generated and reference differ by %r" % (name, diff))
+    sim = doc.get("simulated_second")
+    if not isinstance(sim, dict) or not positive(sim.get("generated_s")):
+        fail("simulated_second missing")
+    if not sim.get("max_abs_diff_q", 1.0) <= 1e-7:
+        fail("simulated second: final q differs by %r" % sim.get("max_abs_diff_q"))
+    if not positive(doc.get("regeneration_s")):
+        fail("regeneration_s missing")
+    print("bench_smoke: JSON complete, %d kernels" % len(names))
+
+
+if __name__ == "__main__":
+    main()
