@@ -63,6 +63,7 @@ typedef struct {
   double Q[60 * PRRU_NLAMBDA];    /* reaction basis */
   double K[60], Ib[90];           /* wrench bias, world inertias */
   double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
+  double P[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* its factor, arrowhead order */
   double r[PRRU_NLAMBDA];
 } prru_data;
 
