@@ -1,0 +1,169 @@
+/* Dynamic manipulability of the 3-PRRU (paper section 5, spec section 8):
+ * the rotational dynamic manipulability ellipse (DME), the translational
+ * segment, the index w_R at one configuration, and w_R maps over (q1, q2).
+ *
+ * Quantities. With the actuator displacements d(q), J_d = dd/dq, the mass
+ * matrix M(q) and the platform Jacobians (omega_P = J_R,P qd, v_P = J_T,P qd):
+ *   Mt  = J_d^-T M J_d^-1     inertia seen by the actuators: at rest (no
+ *                             velocity terms, no gravity) F_d = Mt dd''
+ *   JtR = J_R,P J_d^-1        actuator accelerations -> platform angular
+ *   JtT = J_T,P J_d^-1        acceleration, and linear acceleration.
+ * JtR has rank 2: the platform turns only about e1 and v (omega_P =
+ * q1' e1 + q2' v, no parasitic motion), so its range is the plane
+ * span{e1, v}. JtT has rank 1: O' moves only along e3.
+ *
+ * Rotational DME. An angular acceleration a in span{e1, v} needs at least
+ * the actuator accelerations JtR^+ a and hence the forces B a, B = Mt JtR^+.
+ * The ellipse is the set of a reachable with unit actuator-force norm:
+ *     a in span{e1, v},  a^T B^T B a = a^T JtR^+T Mt^T Mt JtR^+ a <= 1.
+ * (For a with a component normal to the plane, B a ignores it, so the 3-D
+ * set is an unbounded cylinder; the DME is its section by the plane.)
+ * With the SVD B = U S V^T, sigma_1 >= sigma_2 > 0 = sigma_3, the right
+ * singular vectors V_1, V_2 span the plane and the ellipse is
+ *     { t1 V_1 / sigma_1 + t2 V_2 / sigma_2 : t1^2 + t2^2 <= 1 },
+ * i.e. its semi-axes are V_i (directions in {S}, unit, angular acceleration
+ * per unit of force) with lengths 1/sigma_i in rad/s^2 per N (d in m, so
+ * B maps rad/s^2 to N). The LEFT singular vectors U_i are the matching
+ * actuator-force directions; they are not reported. Axis 0 (sigma_1) is the
+ * minor semi-axis, axis 1 the major one, and
+ *     w_R = sigma_1 / sigma_2 = (major semi-axis) / (minor semi-axis) >= 1,
+ * 1 for a circle (isotropic), growing as the ellipse flattens.
+ *
+ * Translational DME: the same with JtT; one non-zero singular value
+ * sigma_T, a segment of half-length 1/sigma_T (m/s^2 per N) along the unit
+ * direction of range(JtT), which is +-e3 (reported with a positive z).
+ *
+ * Computation (no SVD routine needed): Q = [q_1 q_2], an orthonormal basis
+ * of range(J_R,P) = range(JtR) from J_R,P's columns (Gram-Schmidt with
+ * pivoting); JtR = Q C with C = Q^T JtR (2x3, full row rank), so
+ * JtR^+ = C^T (C C^T)^-1 Q^T and B = G Q^T with the 3x2 G = Mt C^T (C C^T)^-1.
+ * One exact Jacobi rotation of G's two columns makes them orthogonal:
+ * their norms are sigma_1, sigma_2 (to rounding, without squaring the
+ * condition number) and the rotation's columns, mapped by Q, are V_1, V_2.
+ * tests/test_dme.c checks this against GSL SVDs built another way.
+ *
+ * Singular configurations: a q is PRRU_EUNREACHABLE when the inverse
+ * kinematics has no solution (an acos argument outside [-1, 1]) and
+ * PRRU_ESINGULAR when J_d's reciprocal 1-norm condition number
+ * 1 / (|J_d|_1 |J_d^-1|_1) is below m->jd_rcond_min (prru_check_regular;
+ * the model's default 1e-8 flags numerical singularity only, pass a model
+ * copy with a larger value for a practical-singularity band, see the
+ * global index below), or, as a last guard, when a result is not finite.
+ * w_R is not defined there: the outputs are NaN.
+ *
+ * Threading: the calls write only into their prru_data and outputs; use
+ * one prru_data per thread. prru_dme_eval does not allocate. */
+#ifndef PRRU_DME_H
+#define PRRU_DME_H
+
+#include <signal.h>
+
+#include "prru.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  int status;             /* PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESINGULAR, PRRU_EINPUT */
+  double jd_rcond;        /* reciprocal 1-norm condition number of J_d (0 if unreachable) */
+  double w_R;             /* sigma[0] / sigma[1]; NaN unless status == PRRU_OK */
+  double sigma[2];        /* non-zero singular values of Mt JtR^+, sigma[0] >= sigma[1] (N s^2/rad) */
+  double semi_axis[2];    /* 1 / sigma[i]: semi_axis[0] minor, semi_axis[1] major (rad/s^2 per N) */
+  double axis_dir[2][3];  /* unit direction of semi-axis i in {S}, in span{e1, v}; sign: the
+                             component of largest magnitude is positive */
+  double sigma_T;         /* the non-zero singular value of Mt JtT^+ (N s^2/m) */
+  double half_length_T;   /* 1 / sigma_T: half-length of the translational segment (m/s^2 per N) */
+  double dir_T[3];        /* its unit direction in {S} (e3) */
+  double Mt[9], JtR[9], JtT[9]; /* row-major, as defined above */
+} prru_dme;
+
+/* "ok", "singular", "unreachable" or "invalid" (PRRU_EINPUT). */
+const char *prru_dme_status_name(int status);
+
+/* Fills out at q (uses d->d, d->Jd, d->M as workspace) and returns
+ * out->status. At a non-OK status every double of out except jd_rcond is
+ * NaN. */
+int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme *out);
+
+/* ---- Maps over a rectangle of (q1, q2) at fixed q3 ---- */
+
+/* n1 values q1_i = (q1_lo (n1-1-i) + q1_hi i) / (n1-1), i = 0..n1-1 (the
+ * form keeps a grid symmetric about 0 exactly symmetric), the same for q2;
+ * n1, n2 >= 2, lo < hi, all finite. */
+typedef struct {
+  double q1_lo, q1_hi;
+  double q2_lo, q2_hi;
+  double q3;
+  int n1, n2;
+} prru_map_grid;
+
+/* Grid point i of an axis. */
+double prru_map_axis(double lo, double hi, int n, int i);
+
+/* The global index (the paper's "overall distance between the w_R surface
+ * and the plane w_R = 1"), defined over the grid points:
+ *   index = (1 / n_ok) sum over the status-OK points of (w_R - 1),
+ * the mean height of the surface above the plane on the regular part of the
+ * rectangle (on a uniform grid, the area-weighted mean to O(h)); NaN when
+ * n_ok = 0. It must be read together with
+ *   singular_fraction = (n_singular + n_unreachable) / (n1 n2),
+ * the share of the rectangle where w_R is undefined: a design can only look
+ * better by losing workspace if that fraction grows. Smaller index = more
+ * isotropic rotational dynamics.
+ *
+ * The tolerance matters. Near the locus det J_d = 0, w_R grows like
+ * 1/distance, whose integral over a plane region diverges (logarithmically):
+ * when the rectangle crosses the locus (fig. 7's corners do) and the
+ * tolerance is the numerical one (jd_rcond_min = 1e-8), the index is
+ * dominated by the few grid points that happen to fall nearest the locus
+ * and changes erratically with the resolution (1.10, 1.00, 1.44, 1.29 at
+ * 121^2, 201^2, 401^2, 1001^2 for fig. 7). For design comparison, map with
+ * a practical-singularity tolerance (a model copy with e.g. jd_rcond_min =
+ * 1e-3, cond_1(J_d) > 1000): the band around the locus is then singular,
+ * counted in singular_fraction, and the index converges (0.813, 0.811,
+ * 0.808, 0.807). index_log, the mean of ln w_R over the OK points, stays
+ * finite either way (the logarithm of 1/distance is integrable).
+ * The sums run over the points in grid order after all threads finish, so
+ * the result does not depend on threading. */
+typedef struct {
+  long n_points, n_ok, n_singular, n_unreachable;
+  double index;             /* mean of w_R - 1 over the OK points */
+  double index_log;         /* mean of ln w_R over the OK points */
+  double singular_fraction;
+  double w_min, w_max;      /* over the OK points (NaN when none) */
+  double w_min_q[2], w_max_q[2]; /* (q1, q2) of the first point reaching them */
+} prru_map_summary;
+
+/* Called from the calling thread with the number of grid points done so
+ * far; a non-zero return stops the map (PRRU_EINTERRUPTED). */
+typedef int (*prru_map_progress_fn)(long done, long total, void *ctx);
+
+typedef struct {
+  int nthreads;                      /* >= 1; the calling thread is one of them */
+  prru_map_progress_fn progress; void *ctx; /* may be NULL */
+  volatile sig_atomic_t *interrupt;  /* polled per grid row; non-zero stops (may be NULL) */
+} prru_map_options;
+
+/* nthreads = 2, no progress, no interrupt. */
+void prru_map_options_default(prru_map_options *o);
+
+/* PRRU_OK, or PRRU_EINPUT when the grid is invalid (see prru_map_grid). */
+int prru_map_check(const prru_map_grid *g);
+
+/* Evaluates w_R at every grid point: index k = i n2 + j for (q1_i, q2_j)
+ * (q1 outer). w_R[k] is NaN where status[k] != PRRU_OK. Allocates one
+ * prru_data per thread (not per point). status may be NULL if not needed;
+ * sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
+ * PRRU_ENOMEM, or PRRU_EINTERRUPTED (outputs partly filled, sum not set). */
+int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
+                  double *w_R, unsigned char *status, prru_map_summary *sum);
+
+/* The summary of an already computed map (used by prru_map_eval). */
+void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
+                        prru_map_summary *sum);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PRRU_DME_H */

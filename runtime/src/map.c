@@ -1,0 +1,181 @@
+/* w_R over a (q1, q2) grid with POSIX threads. Rows (fixed q1) are handed
+ * out one at a time under a mutex: a row is n2 evaluations, so the lock is
+ * negligible, and rows near the singular corners (cheaper: they stop at
+ * the rcond test) do not unbalance a static split. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+
+#include "prru_dme.h"
+
+void prru_map_options_default(prru_map_options *o)
+{
+  o->nthreads = 2;
+  o->progress = NULL;
+  o->ctx = NULL;
+  o->interrupt = NULL;
+}
+
+double prru_map_axis(double lo, double hi, int n, int i)
+{
+  return (lo * (double)(n - 1 - i) + hi * (double)i) / (double)(n - 1);
+}
+
+int prru_map_check(const prru_map_grid *g)
+{
+  if (!(isfinite(g->q1_lo) && isfinite(g->q1_hi) && isfinite(g->q2_lo) && isfinite(g->q2_hi) &&
+        isfinite(g->q3)))
+    return PRRU_EINPUT;
+  if (g->n1 < 2 || g->n2 < 2 || !(g->q1_lo < g->q1_hi) || !(g->q2_lo < g->q2_hi))
+    return PRRU_EINPUT;
+  /* k = i n2 + j must fit a long and the outputs an allocation. */
+  if ((double)g->n1 * (double)g->n2 > 1e10) return PRRU_EINPUT;
+  return PRRU_OK;
+}
+
+typedef struct {
+  const prru_model *m;
+  const prru_map_grid *g;
+  double *w;
+  unsigned char *st;
+  const prru_map_options *o;
+  pthread_mutex_t lock;
+  int next_row, stop;
+  long done;
+} map_job;
+
+typedef struct {
+  map_job *job;
+  prru_data *data;
+  int is_caller;
+} map_worker;
+
+/* The next row to do, or -1 when there is none or the map was stopped. */
+static int take_row(map_job *j, long finished_points)
+{
+  pthread_mutex_lock(&j->lock);
+  j->done += finished_points;
+  if (j->o->interrupt && *j->o->interrupt) j->stop = 1;
+  int row = (j->stop || j->next_row >= j->g->n1) ? -1 : j->next_row++;
+  pthread_mutex_unlock(&j->lock);
+  return row;
+}
+
+static void *map_worker_run(void *arg)
+{
+  map_worker *w = arg;
+  map_job *j = w->job;
+  const prru_map_grid *g = j->g;
+  const long total = (long)g->n1 * g->n2;
+  prru_dme dme;
+  int row = take_row(j, 0);
+  while (row >= 0) {
+    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, row), 0.0, g->q3};
+    for (int c = 0; c < g->n2; c++) {
+      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c);
+      int s = prru_dme_eval(j->m, w->data, q, &dme);
+      long k = (long)row * g->n2 + c;
+      j->w[k] = dme.w_R;
+      if (j->st) j->st[k] = (unsigned char)s;
+    }
+    row = take_row(j, g->n2);
+    if (w->is_caller && j->o->progress) {
+      pthread_mutex_lock(&j->lock);
+      long done = j->done;
+      pthread_mutex_unlock(&j->lock);
+      if (j->o->progress(done, total, j->o->ctx)) {
+        pthread_mutex_lock(&j->lock);
+        j->stop = 1;
+        pthread_mutex_unlock(&j->lock);
+      }
+    }
+  }
+  return NULL;
+}
+
+int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
+                  double *w_R, unsigned char *status, prru_map_summary *sum)
+{
+  if (prru_map_check(g) != PRRU_OK || o->nthreads < 1 || o->nthreads > 256) return PRRU_EINPUT;
+  int nt = o->nthreads > g->n1 ? g->n1 : o->nthreads;
+  map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, 0, 0, 0};
+  map_worker *workers = calloc((size_t)nt, sizeof *workers);
+  pthread_t *tid = calloc((size_t)nt, sizeof *tid);
+  int rc = PRRU_OK, started = 0;
+  if (!workers || !tid) rc = PRRU_ENOMEM;
+  for (int t = 0; t < nt && rc == PRRU_OK; t++) {
+    workers[t].job = &job;
+    workers[t].is_caller = t == 0;
+    workers[t].data = malloc(sizeof(prru_data));
+    if (!workers[t].data) rc = PRRU_ENOMEM;
+  }
+  if (rc == PRRU_OK) {
+    for (int t = 1; t < nt; t++) {
+      if (pthread_create(&tid[t], NULL, map_worker_run, &workers[t]) != 0) break;
+      started++;
+    }
+    /* With fewer threads than asked for the caller still does every row
+     * that is left: slower, never wrong. */
+    map_worker_run(&workers[0]);
+    for (int t = 1; t <= started; t++) pthread_join(tid[t], NULL);
+    if (job.stop) rc = PRRU_EINTERRUPTED;
+  }
+  if (workers)
+    for (int t = 0; t < nt; t++) free(workers[t].data);
+  free(workers);
+  free(tid);
+  pthread_mutex_destroy(&job.lock);
+  if (rc == PRRU_OK && o->progress) o->progress(job.done, job.done, o->ctx);
+  if (rc == PRRU_OK && sum) {
+    if (status) {
+      prru_map_summarize(g, w_R, status, sum);
+    } else {
+      /* Without statuses, NaN stands for "not OK" (counted as singular). */
+      long n = (long)g->n1 * g->n2;
+      unsigned char *tmp = malloc((size_t)n);
+      if (!tmp) return PRRU_ENOMEM;
+      for (long k = 0; k < n; k++) tmp[k] = isnan(w_R[k]) ? PRRU_ESINGULAR : PRRU_OK;
+      prru_map_summarize(g, w_R, tmp, sum);
+      free(tmp);
+    }
+  }
+  return rc;
+}
+
+void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
+                        prru_map_summary *sum)
+{
+  long n = (long)g->n1 * g->n2;
+  double acc = 0.0, acc_log = 0.0;
+  sum->n_points = n;
+  sum->n_ok = sum->n_singular = sum->n_unreachable = 0;
+  sum->w_min = sum->w_max = NAN;
+  sum->w_min_q[0] = sum->w_min_q[1] = sum->w_max_q[0] = sum->w_max_q[1] = NAN;
+  for (long k = 0; k < n; k++) {
+    if (status[k] == PRRU_OK) {
+      double w = w_R[k];
+      int i = (int)(k / g->n2), j = (int)(k % g->n2);
+      if (sum->n_ok == 0 || w < sum->w_min) {
+        sum->w_min = w;
+        sum->w_min_q[0] = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
+        sum->w_min_q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
+      }
+      if (sum->n_ok == 0 || w > sum->w_max) {
+        sum->w_max = w;
+        sum->w_max_q[0] = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
+        sum->w_max_q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
+      }
+      acc += w - 1.0;
+      acc_log += log(w);
+      sum->n_ok++;
+    } else if (status[k] == PRRU_EUNREACHABLE) {
+      sum->n_unreachable++;
+    } else {
+      sum->n_singular++;
+    }
+  }
+  sum->index = sum->n_ok ? acc / (double)sum->n_ok : NAN;
+  sum->index_log = sum->n_ok ? acc_log / (double)sum->n_ok : NAN;
+  sum->singular_fraction = (double)(sum->n_singular + sum->n_unreachable) / (double)n;
+}

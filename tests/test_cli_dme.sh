@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# prru dme and prru map: JSON and CSV outputs checked with python (stdlib),
+# singular/unreachable poses reported as statuses (null / NaN, never a
+# number), the printed global index recomputed from the CSV, and every kind
+# of bad grid rejected with exit 2 and a message naming the argument.
+set -u
+: "${PRRU:?set PRRU to the prru binary}"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0 fail=0
+ok()  { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+
+# expect STATUS NEEDLE -- ARGS...: exit status and a stderr substring.
+expect() {
+  local want=$1 needle=$2; shift 3
+  "$PRRU" "$@" >"$tmp/out" 2>"$tmp/err"
+  local got=$?
+  if [ "$got" -ne "$want" ]; then bad "prru $* exited $got, want $want: $(head -c 300 "$tmp/err")"; return; fi
+  if [ -n "$needle" ] && ! grep -qF -- "$needle" "$tmp/err"; then
+    bad "prru $*: stderr lacks '$needle': $(head -c 300 "$tmp/err")"; return; fi
+  ok
+}
+# check FILE EXPR: python expression over d (the parsed JSON) must be true.
+check() {
+  python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)" "$1" "$2" \
+    && ok || bad "$3: $(head -c 400 "$1")"
+}
+
+# dme at the home pose: the spec's w_R and the ellipse's geometry.
+"$PRRU" dme --q 0,0,0 >"$tmp/d.json" || bad "dme at q = 0 failed"
+check "$tmp/d.json" "d['status'] == 'ok' and abs(d['w_R'] - 1.80468) < 5e-6" "w_R(0,0) = 1.80468"
+check "$tmp/d.json" "abs(d['semi_axes'][1] / d['semi_axes'][0] - d['w_R']) < 1e-14 * d['w_R']" "w_R = major/minor"
+check "$tmp/d.json" "abs(d['sigma'][0] / d['sigma'][1] - d['w_R']) < 1e-14 * d['w_R']" "w_R = sigma1/sigma2"
+check "$tmp/d.json" "d['axis_directions'] == [[1, 0, 0], [0, 1, 0]] and d['translational_direction'] == [0, 0, 1]" "axes at home along e1, v = e2; segment along z"
+check "$tmp/d.json" "all(abs(d['Mt'][i][j] - d['Mt'][j][i]) == 0 for i in range(3) for j in range(3))" "Mt symmetric"
+# Away from home: the semi-axes stay in span{e1, v}, v = (0, cos q1, sin q1).
+"$PRRU" dme --q 0.3,-0.4,-0.5 >"$tmp/d2.json" || bad "dme failed"
+check "$tmp/d2.json" "max(abs(a[1] * math.sin(0.3) - a[2] * math.cos(0.3)) for a in d['axis_directions']) < 1e-14" "semi-axes in span{e1, v}"
+# Symmetry in q1 through the CLI.
+"$PRRU" dme --q -0.3,-0.4,-0.5 >"$tmp/d3.json" || bad "dme failed"
+w2=$(python3 -c "import json; print(repr(json.load(open('$tmp/d2.json'))['w_R']))")
+check "$tmp/d3.json" "abs(d['w_R'] - $w2) <= 1e-12 * $w2" "w_R symmetric in q1"
+
+# Unreachable and singular poses: a valid answer (exit 0) with a status and nulls.
+"$PRRU" dme --q 0,2,0 >"$tmp/u.json"; [ $? -eq 0 ] && ok || bad "dme of an unreachable pose should exit 0"
+check "$tmp/u.json" "d['status'] == 'unreachable' and d['w_R'] is None and d['semi_axes'] == [None, None] and d['translational_half_length'] is None" "unreachable -> nulls"
+"$PRRU" dme --q 0,0,0 --rcond-min 0.5 >"$tmp/s.json"; [ $? -eq 0 ] && ok || bad "dme of a singular pose should exit 0"
+check "$tmp/s.json" "d['status'] == 'singular' and d['w_R'] is None and 0 < d['Jd_rcond'] < 0.5" "singular -> w_R null, rcond shown"
+! grep -qiE 'nan|inf' "$tmp/u.json" "$tmp/s.json" && ok || bad "JSON must not contain NaN/Infinity"
+
+# map: CSV layout, NaN + status at singular/unreachable points, the index.
+"$PRRU" map --q1 -0.5235987755982988:0.5235987755982988:31 --q2 -0.7853981633974483:1.2:25 --q3 0 \
+  --rcond-min 1e-3 --out "$tmp/m.csv" >"$tmp/m.txt" 2>"$tmp/m.err" || bad "map failed: $(cat "$tmp/m.err")"
+r=$(python3 - "$tmp/m.csv" "$tmp/m.txt" <<'PY'
+import csv, math, sys
+rows = list(csv.reader(open(sys.argv[1])))
+errs = []
+if rows[0] != ['q1', 'q2', 'q3', 'w_R', 'status']: errs.append('header %s' % rows[0])
+rows = rows[1:]
+if len(rows) != 31 * 25: errs.append('%d rows' % len(rows))
+st = {}
+for r in rows:
+    w = float(r[3])
+    st[r[4]] = st.get(r[4], 0) + 1
+    if r[4] == 'ok' and not (math.isfinite(w) and w >= 1): errs.append('ok row %s' % r)
+    if r[4] != 'ok' and (r[3] != 'NaN' or r[4] not in ('singular', 'unreachable')): errs.append('bad row %s' % r)
+if not (st.get('ok') and st.get('singular') and st.get('unreachable')): errs.append('statuses %s' % st)
+ok = [float(r[3]) - 1 for r in rows if r[4] == 'ok']
+idx = sum(ok) / len(ok)
+frac = 1 - len(ok) / len(rows)
+out = dict(l.split(':', 1) for l in open(sys.argv[2]).read().splitlines() if ':' in l)
+gi = float(out['global_index'].split()[0]); sf = float(out['singular_fraction'].split()[0])
+if abs(gi - idx) > 1e-9 * idx: errs.append('global_index %r vs CSV %r' % (gi, idx))
+if abs(sf - frac) > 1e-9: errs.append('singular_fraction %r vs CSV %r' % (sf, frac))
+# q1 symmetry of the grid and of w_R (q1 outer, 25 points per q1).
+for i in range(31):
+    for j in range(25):
+        a, b = rows[i * 25 + j], rows[(30 - i) * 25 + j]
+        if float(a[0]) != -float(b[0]) or a[4] != b[4] or (a[4] == 'ok' and abs(float(a[3]) - float(b[3])) > 1e-12 * float(a[3])):
+            errs.append('asymmetry %s %s' % (a, b)); break
+print('; '.join(errs[:3]) if errs else 'ok')
+PY
+)
+[ "$r" = ok ] && ok || bad "map CSV: $r"
+# Threads do not change the file.
+"$PRRU" map --q1 -0.5235987755982988:0.5235987755982988:31 --q2 -0.7853981633974483:1.2:25 \
+  --rcond-min 1e-3 --threads 1 --out "$tmp/m1.csv" >/dev/null 2>&1 || bad "map --threads 1 failed"
+cmp -s "$tmp/m.csv" "$tmp/m1.csv" && ok || bad "map with 1 and 2 threads differ"
+# Progress bar on request.
+"$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out "$tmp/p.csv" --progress >/dev/null 2>"$tmp/p.err" || bad "map --progress"
+grep -q '100%' "$tmp/p.err" && ok || bad "no progress bar with --progress: $(cat "$tmp/p.err")"
+"$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out "$tmp/p.csv" >/dev/null 2>"$tmp/p.err" || bad "map"
+[ ! -s "$tmp/p.err" ] && ok || bad "small map, stderr not a TTY: no progress expected"
+
+# Bad grids and arguments: exit 2, message naming the argument.
+q2ok="--q2 -0.5:0.5:11"
+expect 2 "--q1 '0:1:1': COUNT" -- map --q1 0:1:1 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '1:0:10': START must be less than STOP" -- map --q1 1:0:10 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '0:0:10': START must be less than STOP" -- map --q1 0:0:10 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 'a:1:10': START 'a' is not a finite number" -- map --q1 a:1:10 $q2ok --out "$tmp/x.csv"
+expect 2 "STOP 'nan' is not a finite number" -- map --q1 0:nan:10 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '0:1:x': COUNT 'x'" -- map --q1 0:1:x $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '0:1:2.5': COUNT" -- map --q1 0:1:2.5 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '0:1': expected START:STOP:COUNT" -- map --q1 0:1 $q2ok --out "$tmp/x.csv"
+expect 2 "--q1 '0:1:5:6': expected START:STOP:COUNT" -- map --q1 0:1:5:6 $q2ok --out "$tmp/x.csv"
+expect 2 "--q2 '-1:1:0': COUNT" -- map --q1 0:1:5 --q2 -1:1:0 --out "$tmp/x.csv"
+expect 2 "--q3: 'z' is not a finite number" -- map --q1 0:1:5 $q2ok --q3 z --out "$tmp/x.csv"
+expect 2 "--q2 is required" -- map --q1 0:1:5 --out "$tmp/x.csv"
+expect 2 "--q1 is required" -- map $q2ok --out "$tmp/x.csv"
+expect 2 "--out is required" -- map --q1 0:1:5 $q2ok
+expect 2 "--threads '0'" -- map --q1 0:1:5 $q2ok --threads 0 --out "$tmp/x.csv"
+expect 2 "--rcond-min '2'" -- map --q1 0:1:5 $q2ok --rcond-min 2 --out "$tmp/x.csv"
+[ ! -e "$tmp/x.csv" ] && ok || bad "a rejected map must not write its output"
+expect 1 "cannot open for writing" -- map --q1 0:1:5 $q2ok --out "$tmp/no/such/dir.csv"
+expect 2 "--q: '0,0' is not 3" -- dme --q 0,0
+expect 2 "--q is required" -- dme
+expect 2 "unknown option" -- dme --q 0,0,0 --bogus 1
+
+echo "test_cli_dme: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,418 @@
+/* Dynamic manipulability (prru_dme.h) against evidence built another way:
+ * the reference library's M, J_d and platform Jacobian (paper equations
+ * with GSL, not the generated kernels), a pseudo-inverse of JtR from the
+ * regularized normal equations instead of a rotation, GSL's symmetric
+ * eigensolver on the 2x2 quadratic form of the ellipse instead of a Jacobi
+ * rotation, and the reference's own GSL-SVD w_R. Then the paper's claims
+ * (symmetry in q1, w_R(0, 0) = 1.80468, decrease with |q1| at q2 = 0), the
+ * geometry (ellipse in span{e1, v}, segment along z), singular and
+ * unreachable poses, and maps: threads vs serial, summary vs a recount. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_linalg.h>
+
+#include "prru_dme.h"
+#include "prru_ref.h"
+#include "testutil.h"
+
+#define PI 3.14159265358979323846
+
+static prru_model M;
+static prru_data *D;
+static prru_ref_params P;
+static prru_ref_ws *W;
+
+static void solve3(const double A[9], const double *B, int ncols, double *X)
+{
+  double a[9], b[3], x[3];
+  gsl_permutation *perm = gsl_permutation_alloc(3);
+  int sign;
+  memcpy(a, A, sizeof a);
+  gsl_matrix_view av = gsl_matrix_view_array(a, 3, 3);
+  gsl_linalg_LU_decomp(&av.matrix, perm, &sign);
+  for (int c = 0; c < ncols; c++) {
+    for (int i = 0; i < 3; i++) b[i] = B[i * ncols + c];
+    gsl_vector_view bv = gsl_vector_view_array(b, 3), xv = gsl_vector_view_array(x, 3);
+    gsl_linalg_LU_solve(&av.matrix, perm, &bv.vector, &xv.vector);
+    for (int i = 0; i < 3; i++) X[i * ncols + c] = x[i];
+  }
+  gsl_permutation_free(perm);
+}
+
+static void matmul(const double *A, const double *B, double *C, int n, int k, int m, int ta)
+{
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < m; j++) {
+      double s = 0;
+      for (int l = 0; l < k; l++) s += (ta ? A[l * n + i] : A[i * k + l]) * B[l * m + j];
+      C[i * m + j] = s;
+    }
+}
+
+static void cross(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+typedef struct {
+  double w_R, semi[2], dir[2][3], half_T, Mt[9];
+} indep;
+
+/* The DME from the reference library, built without the runtime's route.
+ * Errors found over the sample: about 5e-14 relative (w_R, lengths), so the
+ * 1e-12 bounds below leave a margin of 20 and still catch any real slip. */
+static int independent(const double q[3], indep *r)
+{
+  double Mref[9], Jd[9], H[180], I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Jinv[9];
+  if (prru_ref_mass(&P, W, q, Mref) || prru_ref_jd(&P, q, Jd) || prru_ref_jacobians(&P, W, q, H))
+    return 1;
+  solve3(Jd, I3, 3, Jinv);
+  double tmp[9], Mt[9], JtR[9], JtT[9];
+  matmul(Mref, Jinv, tmp, 3, 3, 3, 0);
+  matmul(Jinv, tmp, Mt, 3, 3, 3, 1);
+  matmul(H, Jinv, JtR, 3, 3, 3, 0);        /* rows 0-2 of H: J_R,P */
+  matmul(H + 30 * 3, Jinv, JtT, 3, 3, 3, 0); /* rows 30-32: J_T,P */
+
+  /* n: unit normal of range(JtR) = range(J_R,P), from its columns 0 and 1. */
+  double c0[3] = {H[0], H[3], H[6]}, c1[3] = {H[1], H[4], H[7]}, n[3], qa[3], qb[3];
+  cross(c0, c1, n);
+  double nn = sqrt(dot(n, n));
+  for (int i = 0; i < 3; i++) n[i] /= nn;
+  double e1[3] = {1, 0, 0}, t = dot(e1, n);
+  for (int i = 0; i < 3; i++) qa[i] = e1[i] - t * n[i];
+  t = sqrt(dot(qa, qa));
+  for (int i = 0; i < 3; i++) qa[i] /= t;
+  cross(n, qa, qb);
+  /* JtR^+ Q = JtR^T (JtR JtR^T + n n^T)^-1 Q (see the header of this file). */
+  double K[9], Q[6], Z[6], X[6], BQ[6];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double s = 0;
+      for (int l = 0; l < 3; l++) s += JtR[3 * i + l] * JtR[3 * j + l];
+      K[3 * i + j] = s + n[i] * n[j];
+    }
+  for (int i = 0; i < 3; i++) {
+    Q[2 * i] = qa[i];
+    Q[2 * i + 1] = qb[i];
+  }
+  solve3(K, Q, 2, Z);
+  matmul(JtR, Z, X, 3, 3, 2, 1);
+  matmul(Mt, X, BQ, 3, 3, 2, 0);
+  double F[4];
+  matmul(BQ, BQ, F, 2, 3, 2, 1);
+  gsl_matrix_view Fv = gsl_matrix_view_array(F, 2, 2);
+  double ev[2], evec[4];
+  gsl_vector_view evv = gsl_vector_view_array(ev, 2);
+  gsl_matrix_view evecv = gsl_matrix_view_array(evec, 2, 2);
+  gsl_eigen_symmv_workspace *ws = gsl_eigen_symmv_alloc(2);
+  gsl_eigen_symmv(&Fv.matrix, &evv.vector, &evecv.matrix, ws);
+  gsl_eigen_symmv_free(ws);
+  gsl_eigen_symmv_sort(&evv.vector, &evecv.matrix, GSL_EIGEN_SORT_VAL_DESC);
+  memcpy(r->Mt, Mt, sizeof Mt);
+  r->w_R = sqrt(ev[0] / ev[1]);
+  for (int k = 0; k < 2; k++) {
+    r->semi[k] = 1.0 / sqrt(ev[k]);
+    for (int i = 0; i < 3; i++) r->dir[k][i] = Q[2 * i] * evec[k] + Q[2 * i + 1] * evec[2 + k];
+  }
+  /* Translational: GSL SVD of JtT, pseudo-inverse from its one singular
+   * value, then the largest singular value of Mt JtT^+. */
+  double U[9], V[9], S[3], wk[3], Pi[9], B[9];
+  memcpy(U, JtT, sizeof U);
+  gsl_matrix_view Uv = gsl_matrix_view_array(U, 3, 3), Vv = gsl_matrix_view_array(V, 3, 3);
+  gsl_vector_view Sv = gsl_vector_view_array(S, 3), wkv = gsl_vector_view_array(wk, 3);
+  gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) Pi[3 * i + j] = V[3 * i] * U[3 * j] / S[0];
+  matmul(Mt, Pi, B, 3, 3, 3, 0);
+  memcpy(U, B, sizeof U);
+  gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
+  r->half_T = 1.0 / S[0];
+  return 0;
+}
+
+static double rel(double a, double b) { return fabs(a - b) / fabs(b); }
+
+static void test_against_independent(void)
+{
+  double worst_w = 0, worst_ref = 0, worst_len = 0, worst_dir = 0, worst_T = 0, worst_plane = 0,
+         worst_z = 0, worst_orth = 0;
+  int n_ok = 0;
+  for (int k = 0; k < 400; k++) {
+    double q[3] = {tu_uniform(-PI / 6, PI / 6), tu_uniform(-PI / 4, PI / 6), tu_uniform(-0.8, 0.1)};
+    if (k == 0) q[0] = q[1] = q[2] = 0.0;
+    prru_dme r;
+    if (prru_dme_eval(&M, D, q, &r) != PRRU_OK || r.jd_rcond < 1e-3) continue;
+    indep x;
+    double wref;
+    if (!TU_TRUE(independent(q, &x) == 0 && prru_ref_w_r(&P, W, q, &wref) == 0, "reference DME"))
+      continue;
+    n_ok++;
+    if (k < 20) TU_CLOSE(r.Mt, x.Mt, 9, 1e-12, "Mt vs J_d^-T M J_d^-1 from the reference");
+    const double scale = 1.0;
+    double e = rel(r.w_R, x.w_R) / scale;
+    if (!(e <= worst_w)) worst_w = e;
+    e = rel(r.w_R, wref) / scale;
+    if (!(e <= worst_ref)) worst_ref = e;
+    e = rel(r.half_length_T, x.half_T) / scale;
+    if (!(e <= worst_T)) worst_T = e;
+    double v[3] = {0, cos(q[0]), sin(q[0])}, e1[3] = {1, 0, 0}, nrm[3]; /* v = Rx(q1) e2 */
+    cross(e1, v, nrm);
+    for (int a = 0; a < 2; a++) {
+      e = rel(r.semi_axis[a], x.semi[a]) / scale;
+      if (!(e <= worst_len)) worst_len = e;
+      e = 1.0 - fabs(dot(r.axis_dir[a], x.dir[a]));
+      if (!(e <= worst_dir)) worst_dir = e;
+      e = fabs(dot(r.axis_dir[a], nrm));
+      if (!(e <= worst_plane)) worst_plane = e;
+      e = fabs(dot(r.axis_dir[a], r.axis_dir[a]) - 1.0);
+      if (!(e <= worst_orth)) worst_orth = e;
+    }
+    e = fabs(dot(r.axis_dir[0], r.axis_dir[1]));
+    if (!(e <= worst_orth)) worst_orth = e;
+    e = fabs(r.dir_T[0]) + fabs(r.dir_T[1]) + fabs(r.dir_T[2] - 1.0);
+    if (!(e <= worst_z)) worst_z = e;
+  }
+  TU_TRUE(n_ok > 300, "enough regular sample poses");
+  tu_check(worst_w <= 1e-12, "w_R vs reference M and 2x2 eigenvalues", worst_w, 1e-12);
+  tu_check(worst_ref <= 1e-12, "w_R vs prru_ref_w_r (GSL SVD)", worst_ref, 1e-12);
+  tu_check(worst_len <= 1e-12, "semi-axis lengths vs 1/sqrt(eigenvalues)", worst_len, 1e-12);
+  tu_check(worst_dir <= 1e-12, "semi-axis directions vs eigenvectors (1 - |cos|)", worst_dir, 1e-12);
+  tu_check(worst_T <= 1e-12, "translational half-length vs GSL SVD", worst_T, 1e-12);
+  tu_check(worst_plane <= 1e-14, "semi-axes lie in span{e1, v}", worst_plane, 1e-14);
+  tu_check(worst_orth <= 1e-14, "semi-axis directions orthonormal", worst_orth, 1e-14);
+  tu_check(worst_z <= 1e-15, "translational segment along +z", worst_z, 1e-15);
+}
+
+/* The ellipse's boundary: |Mt JtR^+ a| = 1 at a = semi_axis_i dir_i, with
+ * JtR^+ a found as the minimum-norm solution by GSL's SVD least squares. */
+static void test_boundary(void)
+{
+  double q[3] = {0.23, -0.31, -0.2}, worst = 0;
+  prru_dme r;
+  if (!TU_TRUE(prru_dme_eval(&M, D, q, &r) == PRRU_OK, "regular pose for the boundary test")) return;
+  for (int a = 0; a < 2; a++) {
+    double U[9], V[9], S[3], wk[3], x[3], b[3], f[3];
+    memcpy(U, r.JtR, sizeof U);
+    gsl_matrix_view Uv = gsl_matrix_view_array(U, 3, 3), Vv = gsl_matrix_view_array(V, 3, 3);
+    gsl_vector_view Sv = gsl_vector_view_array(S, 3), wkv = gsl_vector_view_array(wk, 3);
+    gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
+    S[2] = 0.0; /* rank 2: drop the rounding-level singular value */
+    for (int i = 0; i < 3; i++) b[i] = r.semi_axis[a] * r.axis_dir[a][i];
+    gsl_vector_view bv = gsl_vector_view_array(b, 3), xv = gsl_vector_view_array(x, 3);
+    gsl_linalg_SV_solve(&Uv.matrix, &Vv.matrix, &Sv.vector, &bv.vector, &xv.vector);
+    matmul(r.Mt, x, f, 3, 3, 1, 0);
+    double e = fabs(sqrt(dot(f, f)) - 1.0);
+    if (e > worst) worst = e;
+  }
+  tu_check(worst <= 1e-12, "|Mt JtR^+ a| = 1 at the semi-axis tips", worst, 1e-12);
+}
+
+static void test_paper_claims(void)
+{
+  prru_dme r, s;
+  double q0[3] = {0, 0, 0};
+  prru_dme_eval(&M, D, q0, &r);
+  tu_check(fabs(r.w_R - 1.80468) < 5e-6, "w_R(0, 0) = 1.80468 (spec)", fabs(r.w_R - 1.80468), 5e-6);
+  TU_TRUE(r.w_R > 1.5, "w_R(0, 0) well above 1");
+  double worst = 0;
+  for (int k = 0; k < 300; k++) {
+    double q[3] = {tu_uniform(0, PI / 6), tu_uniform(-PI / 4, PI / 6), tu_uniform(-0.8, 0.1)};
+    double qm[3] = {-q[0], q[1], q[2]};
+    int a = prru_dme_eval(&M, D, q, &r), b = prru_dme_eval(&M, D, qm, &s);
+    TU_TRUE(a == b, "status symmetric in q1");
+    if (a != PRRU_OK) continue;
+    double e = rel(s.w_R, r.w_R);
+    if (e > worst) worst = e;
+  }
+  tu_check(worst <= 1e-12, "w_R(-q1, q2) = w_R(q1, q2)", worst, 1e-12);
+  /* At q2 = 0 (q3 = 0) w_R falls monotonically from its value at q1 = 0. */
+  double prev = INFINITY;
+  int mono = 1;
+  for (int i = 0; i <= 200; i++) {
+    double q[3] = {PI / 6 * i / 200.0, 0, 0};
+    prru_dme_eval(&M, D, q, &r);
+    if (!(r.w_R < prev && r.w_R > 1.0)) mono = 0;
+    prev = r.w_R;
+  }
+  TU_TRUE(mono, "w_R strictly decreasing in |q1| at q2 = 0 and > 1");
+  prru_dme_eval(&M, D, (const double[3]){PI / 6, 0, 0}, &r);
+  prru_dme_eval(&M, D, q0, &s);
+  TU_TRUE(r.w_R - 1.0 < 0.8 * (s.w_R - 1.0), "w_R(pi/6, 0) - 1 well below w_R(0, 0) - 1");
+}
+
+static double det3(const double a[9])
+{
+  return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+         a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+static int all_nan(const prru_dme *r)
+{
+  return isnan(r->w_R) && isnan(r->sigma[0]) && isnan(r->sigma[1]) && isnan(r->semi_axis[1]) &&
+         isnan(r->axis_dir[1][2]) && isnan(r->sigma_T) && isnan(r->half_length_T) &&
+         isnan(r->dir_T[2]) && isnan(r->Mt[4]) && isnan(r->JtR[0]) && isnan(r->JtT[8]);
+}
+
+static void test_singular(void)
+{
+  prru_dme r;
+  TU_TRUE(prru_dme_eval(&M, D, (const double[3]){0, 2.0, 0}, &r) == PRRU_EUNREACHABLE &&
+              r.status == PRRU_EUNREACHABLE && all_nan(&r),
+          "unreachable pose flagged, outputs NaN");
+  TU_TRUE(prru_dme_eval(&M, D, (const double[3]){NAN, 0, 0}, &r) == PRRU_EINPUT && all_nan(&r),
+          "NaN pose rejected");
+  /* The singular locus det J_d = 0 crosses q2 = -pi/4 near |q1| = 0.29:
+   * bisect on the sign of det J_d to the last bit. */
+  double lo = 0.2, hi = 0.4, Jd[9];
+  prru_jd((const double[3]){lo, -PI / 4, 0}, Jd);
+  double slo = det3(Jd);
+  prru_jd((const double[3]){hi, -PI / 4, 0}, Jd);
+  TU_TRUE(slo * det3(Jd) < 0, "det J_d changes sign on q2 = -pi/4 between q1 = 0.2 and 0.4");
+  for (int i = 0; i < 200 && hi - lo > 0; i++) {
+    double mid = 0.5 * (lo + hi);
+    if (mid == lo || mid == hi) break;
+    prru_jd((const double[3]){mid, -PI / 4, 0}, Jd);
+    if (det3(Jd) * slo > 0) lo = mid; else hi = mid;
+  }
+  double qs[3] = {lo, -PI / 4, 0};
+  int st = prru_dme_eval(&M, D, qs, &r);
+  tu_check(st == PRRU_ESINGULAR && r.jd_rcond < M.jd_rcond_min && all_nan(&r),
+           "pose on det J_d = 0 flagged singular, outputs NaN (rcond)", r.jd_rcond, M.jd_rcond_min);
+  TU_TRUE(fabs(lo - 0.29) < 0.02, "singular locus at |q1| about 0.29 rad for q2 = -pi/4 (spec)");
+  /* Slightly off the locus: regular (huge w_R) at the numerical tolerance,
+   * singular at a practical one. */
+  double qn[3] = {lo - 1e-4, -PI / 4, 0};
+  TU_TRUE(prru_dme_eval(&M, D, qn, &r) == PRRU_OK && r.w_R > 100, "near the locus: regular, w_R > 100");
+  prru_model m3 = M;
+  m3.jd_rcond_min = 1e-3;
+  TU_TRUE(prru_dme_eval(&m3, D, qn, &r) == PRRU_ESINGULAR && isnan(r.w_R),
+          "near the locus: singular with jd_rcond_min = 1e-3");
+  TU_TRUE(strcmp(prru_dme_status_name(PRRU_OK), "ok") == 0 &&
+              strcmp(prru_dme_status_name(PRRU_ESINGULAR), "singular") == 0 &&
+              strcmp(prru_dme_status_name(PRRU_EUNREACHABLE), "unreachable") == 0,
+          "status names");
+}
+
+typedef struct {
+  long calls, last_done, last_total, stop_after;
+} prog;
+
+static int on_progress(long done, long total, void *ctx)
+{
+  prog *p = ctx;
+  p->calls++;
+  TU_TRUE(done >= p->last_done && done <= total, "progress monotone and bounded");
+  p->last_done = done;
+  p->last_total = total;
+  return p->stop_after && p->calls >= p->stop_after;
+}
+
+static void test_map(void)
+{
+  prru_model m3 = M;
+  m3.jd_rcond_min = 1e-3; /* a visible singular band */
+  /* q1 symmetric; q2 reaches past the locus and q2 = 1.2 is unreachable. */
+  prru_map_grid g = {-PI / 6, PI / 6, -PI / 4, 1.2, 0.0, 57, 43};
+  long n = (long)g.n1 * g.n2;
+  double *w[3];
+  unsigned char *st[3];
+  prru_map_summary sum[3];
+  prog pr = {0, 0, 0, 0};
+  for (int t = 0; t < 3; t++) {
+    w[t] = malloc(n * sizeof(double));
+    st[t] = malloc(n);
+    prru_map_options o;
+    prru_map_options_default(&o);
+    o.nthreads = t + 1;
+    if (t == 1) {
+      o.progress = on_progress;
+      o.ctx = &pr;
+    }
+    TU_TRUE(prru_map_eval(&m3, &g, &o, w[t], st[t], &sum[t]) == PRRU_OK, "map runs");
+  }
+  TU_TRUE(pr.calls > 0 && pr.last_done == n && pr.last_total == n, "progress reaches the total");
+  TU_TRUE(memcmp(w[0], w[1], n * sizeof(double)) == 0 && memcmp(w[0], w[2], n * sizeof(double)) == 0,
+          "1, 2 and 3 threads give bit-identical w_R");
+  TU_TRUE(memcmp(st[0], st[1], n) == 0 && memcmp(st[0], st[2], n) == 0, "and identical statuses");
+  TU_TRUE(memcmp(&sum[0], &sum[1], sizeof sum[0]) == 0 && memcmp(&sum[0], &sum[2], sizeof sum[0]) == 0,
+          "and identical summaries");
+  /* Every point as prru_dme_eval computes it alone; the summary recounted. */
+  int same = 1, sym = 1;
+  long n_ok = 0, n_sing = 0, n_unr = 0;
+  double acc = 0, worst_sym = 0;
+  for (int i = 0; i < g.n1; i++)
+    for (int j = 0; j < g.n2; j++) {
+      long k = (long)i * g.n2 + j;
+      double q[3] = {-PI / 6 + (PI / 3) * i / (g.n1 - 1), -PI / 4 + (1.2 + PI / 4) * j / (g.n2 - 1), 0};
+      prru_dme r;
+      int s = prru_dme_eval(&m3, D, q, &r);
+      if (s != st[0][k] || (s == PRRU_OK ? fabs(r.w_R - w[0][k]) > 1e-13 * r.w_R : !isnan(w[0][k])))
+        same = 0;
+      if (s == PRRU_OK) {
+        n_ok++;
+        acc += r.w_R - 1.0;
+      } else if (s == PRRU_EUNREACHABLE) {
+        n_unr++;
+      } else {
+        n_sing++;
+      }
+      long km = (long)(g.n1 - 1 - i) * g.n2 + j;
+      if (st[0][k] != st[0][km]) sym = 0;
+      if (st[0][k] == PRRU_OK && rel(w[0][km], w[0][k]) > worst_sym) worst_sym = rel(w[0][km], w[0][k]);
+    }
+  TU_TRUE(same, "map points equal prru_dme_eval at the same q");
+  TU_TRUE(sym, "map statuses symmetric in q1");
+  tu_check(worst_sym <= 1e-12, "map symmetric in q1", worst_sym, 1e-12);
+  TU_TRUE(n_sing > 0 && n_unr > 0 && n_ok > 0, "the grid has ok, singular and unreachable points");
+  TU_TRUE(sum[0].n_ok == n_ok && sum[0].n_singular == n_sing && sum[0].n_unreachable == n_unr &&
+              sum[0].n_points == n,
+          "summary counts");
+  tu_check(rel(sum[0].index, acc / n_ok) <= 1e-12, "global index = mean of w_R - 1",
+           rel(sum[0].index, acc / n_ok), 1e-12);
+  tu_check(fabs(sum[0].singular_fraction - (double)(n_sing + n_unr) / n) <= 1e-15,
+           "singular fraction", fabs(sum[0].singular_fraction - (double)(n_sing + n_unr) / n), 1e-15);
+  /* Stopping from the progress callback, and bad grids. */
+  prru_map_options o;
+  prru_map_options_default(&o);
+  prog stop = {0, 0, 0, 1};
+  o.progress = on_progress;
+  o.ctx = &stop;
+  TU_TRUE(prru_map_eval(&m3, &g, &o, w[0], st[0], &sum[0]) == PRRU_EINTERRUPTED, "progress can stop");
+  prru_map_options_default(&o);
+  prru_map_grid bad[4] = {g, g, g, g};
+  bad[0].n1 = 1;
+  bad[1].q2_lo = bad[1].q2_hi;
+  bad[2].q1_lo = 1.0;
+  bad[3].q3 = NAN;
+  for (int b = 0; b < 4; b++)
+    TU_TRUE(prru_map_eval(&m3, &bad[b], &o, w[0], st[0], NULL) == PRRU_EINPUT, "bad grid rejected");
+  o.nthreads = 0;
+  TU_TRUE(prru_map_eval(&m3, &g, &o, w[0], st[0], NULL) == PRRU_EINPUT, "0 threads rejected");
+  for (int t = 0; t < 3; t++) {
+    free(w[t]);
+    free(st[t]);
+  }
+}
+
+int main(void)
+{
+  prru_model_default(&M);
+  prru_ref_params_default(&P);
+  D = malloc(sizeof *D);
+  W = prru_ref_alloc();
+  test_against_independent();
+  test_boundary();
+  test_paper_claims();
+  test_singular();
+  test_map();
+  prru_ref_free(W);
+  free(D);
+  return tu_finish("test_dme");
+}
