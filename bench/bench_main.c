@@ -30,6 +30,8 @@
 #include "bench_timer.h"
 #include "prru.h"
 #include "prru_ref.h"
+
+#define PRRU_BENCH_PI 3.14159265358979323846
 #ifdef PRRU_BENCH_HAVE_DME
 #include "prru_dme.h"
 #endif
@@ -73,7 +75,7 @@
 #define PRRU_BENCH_OPS_REACTIONS "forward_dynamics + poses + reaction_basis + wrench_bias (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_POSES) " + " \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_REACTION_BASIS) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_WRENCH_BIAS) \
-  " arithmetic) + sparse Q^T Phi^-1 Q + GSL 57x57 Cholesky"
+  " arithmetic) + per-body Q^T Phi^-1 Q + arrowhead block Cholesky (GSL)"
 #define PRRU_BENCH_OPS_W_R "ik_jd + mass + platform_jacobian (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_MASS) " + " \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_PLATFORM_JACOBIAN) " arithmetic) + 3x3 algebra, one Jacobi rotation"
@@ -478,6 +480,75 @@ static void simulated_second(const prru_model *m, int reps, sim_result *res)
   res->ok = 1;
 }
 
+/* ---- Map throughput (w_R over the fig. 7 rectangle) ---- */
+
+typedef struct {
+  int ok, n, n_ref;
+  bench_stats gen2_s, gen1_s, ref_s; /* wall seconds: 2 threads, 1 thread, reference */
+  double max_rel_diff;               /* generated vs reference w_R on the reference grid */
+} map_result;
+
+#ifdef PRRU_BENCH_HAVE_DME
+static void map_throughput(const prru_model *m, int quick, map_result *res)
+{
+  prru_map_grid g = {-PRRU_BENCH_PI / 6, PRRU_BENCH_PI / 6, -PRRU_BENCH_PI / 4, PRRU_BENCH_PI / 6,
+                     0.0, 0, 0};
+  int n = quick ? 101 : 1001, nref = quick ? 21 : 101, reps = quick ? 1 : 3;
+  double t2[MAXREPS], t1[MAXREPS], tr[MAXREPS];
+  double *w = malloc((size_t)n * (size_t)n * sizeof *w);
+  double *wr = malloc((size_t)nref * (size_t)nref * sizeof *wr);
+  prru_ref_params p;
+  prru_ref_ws *ws = prru_ref_alloc();
+  prru_data *d = malloc(sizeof *d);
+  res->ok = 0;
+  if (!w || !wr || !ws || !d) goto done;
+  prru_ref_params_default(&p);
+  g.n1 = g.n2 = n;
+  for (int r = 0; r < reps; r++) {
+    prru_map_options o;
+    prru_map_options_default(&o);
+    o.nthreads = 2;
+    double t0 = bench_now_ns();
+    if (prru_map_eval(m, &g, &o, w, NULL, NULL) != PRRU_OK) goto done;
+    t2[r] = (bench_now_ns() - t0) * 1e-9;
+    o.nthreads = 1;
+    t0 = bench_now_ns();
+    if (prru_map_eval(m, &g, &o, w, NULL, NULL) != PRRU_OK) goto done;
+    t1[r] = (bench_now_ns() - t0) * 1e-9;
+    /* The reference path: one prru_ref_w_r (GSL assembly and SVD) per point
+     * on a coarser grid of the same rectangle, one thread. */
+    t0 = bench_now_ns();
+    for (int i = 0; i < nref; i++)
+      for (int j = 0; j < nref; j++) {
+        double q[3] = {prru_map_axis(g.q1_lo, g.q1_hi, nref, i),
+                       prru_map_axis(g.q2_lo, g.q2_hi, nref, j), g.q3};
+        if (prru_ref_w_r(&p, ws, q, &wr[i * nref + j]) != GSL_SUCCESS) wr[i * nref + j] = NAN;
+      }
+    tr[r] = (bench_now_ns() - t0) * 1e-9;
+  }
+  res->max_rel_diff = 0.0;
+  for (int i = 0; i < nref; i++)
+    for (int j = 0; j < nref; j++) {
+      double q[3] = {prru_map_axis(g.q1_lo, g.q1_hi, nref, i),
+                     prru_map_axis(g.q2_lo, g.q2_hi, nref, j), g.q3};
+      prru_dme e;
+      if (prru_dme_eval(m, d, q, &e) == PRRU_OK && isfinite(wr[i * nref + j]))
+        res->max_rel_diff = fmax(res->max_rel_diff, fabs(e.w_R - wr[i * nref + j]) / e.w_R);
+    }
+  res->n = n;
+  res->n_ref = nref;
+  res->gen2_s = bench_stats_of(t2, reps);
+  res->gen1_s = bench_stats_of(t1, reps);
+  res->ref_s = bench_stats_of(tr, reps);
+  res->ok = 1;
+done:
+  free(w);
+  free(wr);
+  free(d);
+  if (ws) prru_ref_free(ws);
+}
+#endif
+
 /* ---- Regeneration of the kernels from the model file ---- */
 
 static void remove_tree_flat(const char *dir)
@@ -575,7 +646,7 @@ typedef struct {
 } bench_options;
 
 static void print_json(const bench_options *op, const char *cpu, const sim_result *sim,
-                       int regen_ok, const bench_stats *regen)
+                       const map_result *map, int regen_ok, const bench_stats *regen)
 {
   printf("{\"kernels\": {");
   for (int i = 0; i < NKERNELS; i++) {
@@ -620,6 +691,17 @@ static void print_json(const bench_options *op, const char *cpu, const sim_resul
            sim->tol, sim->ref_steps, sim->q[0], sim->q[1], sim->q[2], sim->dq, sim->dqd);
   else
     printf(", \"simulated_second\": null");
+  if (map->ok) {
+    double pts = (double)map->n * map->n, rpts = (double)map->n_ref * map->n_ref;
+    printf(", \"map\": {\"grid\": %d, \"seconds_2_threads\": %.4g, \"seconds_1_thread\": %.4g, "
+           "\"generated_points_per_s\": %.4g, \"generated_points_per_s_1_thread\": %.4g, "
+           "\"reference_points_per_s\": %.4g, \"ratio_1_thread\": %.4g, \"max_rel_diff\": %.3g}",
+           map->n, map->gen2_s.median, map->gen1_s.median, pts / map->gen2_s.median,
+           pts / map->gen1_s.median, rpts / map->ref_s.median,
+           (pts / map->gen1_s.median) / (rpts / map->ref_s.median), map->max_rel_diff);
+  } else {
+    printf(", \"map\": null");
+  }
   if (regen_ok)
     printf(", \"regeneration_s\": %.4g", regen->median);
   else
@@ -628,7 +710,7 @@ static void print_json(const bench_options *op, const char *cpu, const sim_resul
 }
 
 static void print_table(const bench_options *op, const char *cpu, const sim_result *sim,
-                        int regen_ok, const bench_stats *regen)
+                        const map_result *map, int regen_ok, const bench_stats *regen)
 {
   printf("prru_bench: ns per call, median [min-max] of %d repetitions, %d input states\n",
          op->reps, NSTATES);
@@ -661,6 +743,19 @@ static void print_table(const bench_options *op, const char *cpu, const sim_resu
            sim->dqd);
   } else {
     printf("simulated second: failed (see above)\n");
+  }
+  if (map->ok) {
+    double pts = (double)map->n * map->n, rpts = (double)map->n_ref * map->n_ref;
+    printf("w_R map over the fig. 7 rectangle (q3 = 0):\n");
+    printf("  generated  %dx%d in %.3f s [%.3f-%.3f] with 2 threads (%.3g points/s), %.3f s with 1"
+           "\n", map->n, map->n, map->gen2_s.median, map->gen2_s.min, map->gen2_s.max,
+           pts / map->gen2_s.median, map->gen1_s.median);
+    printf("  reference  %dx%d in %.3f s, 1 thread (%.3g points/s); per-thread ratio %.1fx; "
+           "max rel diff %.1e\n", map->n_ref, map->n_ref, map->ref_s.median,
+           rpts / map->ref_s.median, (pts / map->gen1_s.median) / (rpts / map->ref_s.median),
+           map->max_rel_diff);
+  } else {
+    printf("w_R map: not measured\n");
   }
   if (regen_ok)
     printf("regeneration of every kernel from %s: %.3f s [%.3f-%.3f] (target < 2 s)\n",
@@ -786,6 +881,12 @@ int main(int argc, char **argv)
   sim_result sim;
   memset(&sim, 0, sizeof sim);
   simulated_second(&c.m, op.quick ? 1 : (op.reps > 7 ? op.reps : 7), &sim);
+  map_result map;
+  memset(&map, 0, sizeof map);
+#ifdef PRRU_BENCH_HAVE_DME
+  if (!op.json) fprintf(stderr, "mapping...\n");
+  map_throughput(&c.m, op.quick, &map);
+#endif
   if (!op.json) fprintf(stderr, "regenerating...\n");
   bench_stats regen = {0, 0, 0};
   int regen_ok = time_regeneration(op.quick ? 1 : 3, &regen) == 0;
@@ -795,10 +896,10 @@ int main(int argc, char **argv)
   /* Without --json the table comes first and the same numbers follow as the
    * last line, so `make bench` shows both from one run. */
   if (!op.json) {
-    print_table(&op, cpu, &sim, regen_ok, &regen);
+    print_table(&op, cpu, &sim, &map, regen_ok, &regen);
     printf("\n");
   }
-  print_json(&op, cpu, &sim, regen_ok, &regen);
+  print_json(&op, cpu, &sim, &map, regen_ok, &regen);
   free(c.d);
   prru_ref_free(c.w);
   /* A failed simulation or regeneration is a broken project, not a slow one. */
