@@ -344,7 +344,7 @@ static const char fig7_script[] =
     "set cbtics (1, 1.2, 1.5, 2, 3, 5, 10, 20)\n"
     "set cblabel 'w_R = {/Symbol s}_1/{/Symbol s}_2 (-)'\n"
     "set xyplane at 1\n"
-    "set view 50, 140\n"
+    "set view 55, 35\n"
     "set pm3d depthorder border lc rgb '#303030' lw 0.2\n"
     "set key at screen 0.98, screen 0.90 box opaque\n"
     "set grid\n"
