@@ -10,6 +10,7 @@ import hashlib
 import json
 import math
 import re
+from decimal import Decimal, InvalidOperation
 from fractions import Fraction
 
 BODY_NAMES = ("P", "L1", "L2", "L3", "U1", "U2", "U3", "S1", "S2", "S3")
@@ -60,11 +61,44 @@ def _pairs_no_duplicates(pairs):
     return seen
 
 
+class _OutOfRange:
+    """A JSON number far outside any model's range, kept as its text: its
+    exact value could be a gigantic integer (1e99999999)."""
+
+    def __init__(self, text):
+        self.text = text if len(text) <= 40 else text[:20] + "..." + text[-10:]
+
+
+def _parse_number(text):
+    """json.loads hook for every number: exact Fraction via Decimal, which
+    reads the exponent without expanding the value."""
+    try:
+        d = Decimal(text)
+    except InvalidOperation:
+        raise ValueError("bad number %r" % text[:40]) from None
+    if d.is_finite() and (d == 0 or -30 <= d.adjusted() <= 30):
+        return Fraction(d)
+    return _OutOfRange(text)
+
+
+def _json_text(value):
+    def default(v):
+        if isinstance(v, Fraction):
+            return float(v)
+        if isinstance(v, _OutOfRange):
+            return v.text
+        raise TypeError(type(v).__name__)
+    text = json.dumps(value, default=default)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _number(path, key, value):
+    if isinstance(value, _OutOfRange):
+        raise ModelError(path, key, "magnitude %s is outside [1e-9, 1e6]"
+                         % value.text)
     if isinstance(value, bool) or not isinstance(value, (int, Fraction)):
         raise ModelError(path, key, "must be a number (got %s)"
-                         % json.dumps(value if not isinstance(value, Fraction)
-                                      else float(value)))
+                         % _json_text(value))
     value = Fraction(value)
     if abs(value) > 10 ** 6 or (value != 0 and abs(value) < Fraction(1, 10 ** 9)):
         raise ModelError(path, key, "magnitude %s is outside [1e-9, 1e6]"
@@ -133,7 +167,8 @@ def parse(text, path="<model>"):
         raise ModelError(path, None, "file is %d bytes; a model file is at "
                          "most %d" % (len(text), MAX_BYTES))
     try:
-        data = json.loads(text, parse_float=Fraction, parse_int=Fraction,
+        data = json.loads(text, parse_float=_parse_number,
+                          parse_int=_parse_number,
                           parse_constant=_reject_constant,
                           object_pairs_hook=_pairs_no_duplicates)
     except (ValueError, RecursionError) as exc:
