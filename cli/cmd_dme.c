@@ -162,6 +162,10 @@ static int parse_range(const char *name, const char *text, double *lo, double *h
     prru_cli_error("map", "--%s '%s': START must be less than STOP", name, text);
     return 2;
   }
+  if (!isfinite(*hi - *lo)) {
+    prru_cli_error("map", "--%s '%s': the range STOP - START overflows", name, text);
+    return 2;
+  }
   *n = (int)v;
   return 0;
 }

@@ -117,7 +117,7 @@ static const char id_help[] =
     "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); `prru simulate`\n"
     "output qualifies. Writes t,fd1,fd2,fd3 (N) to --out or stdout. A row where\n"
     "the pose is unreachable or J_d singular stops with exit 1; the rows before\n"
-    "it are kept.\n";
+    "it are kept. An unreadable or malformed FILE exits 2.\n";
 
 int prru_cmd_id(int argc, char **argv)
 {
@@ -139,15 +139,15 @@ int prru_cmd_id(int argc, char **argv)
   prru_table t;
   int st = prru_table_read(&t, traj, msg, sizeof msg);
   if (st != PRRU_OK) {
-    prru_cli_error("id", "%s", msg);
-    return 1;
+    prru_cli_error("id", "--traj %s", msg);
+    return 2;
   }
   int col[16];
   for (int k = 0; k < 10; k++)
     if ((col[k] = prru_table_column(&t, need[k])) < 0) {
-      prru_cli_error("id", "%s: missing column '%s' (need t, q1..3, qd1..3, qdd1..3)", traj, need[k]);
+      prru_cli_error("id", "--traj %s: missing column '%s' (need t, q1..3, qd1..3, qdd1..3)", traj, need[k]);
       prru_table_free(&t);
-      return 1;
+      return 2;
     }
   for (int k = 0; k < 6; k++) col[10 + k] = prru_table_column(&t, opt[k]);
   FILE *f = out ? fopen(out, "w") : stdout;

@@ -94,7 +94,8 @@ expect 1 "not reachable" -- ik --q 0,1.5,0
 expect 1 "not reachable" -- simulate --q0 1.4,0,-0.8
 expect 1 "cannot open for writing" -- simulate --t-end 0.01 --out /nonexistent/dir/x.csv
 expect 1 "d out of reach" -- fk --d 1,-1,0
-expect 1 "missing column" -- id --traj "$tmp/loads.csv"
+expect 2 "missing column" -- id --traj "$tmp/loads.csv"
+expect 2 "cannot open" -- id --traj "$tmp/nonexistent.csv"
 expect 1 "cannot create" -- paper --out /proc/nope
 expect 0 "" -- --help
 expect 0 "" -- simulate --help

@@ -100,13 +100,18 @@ static int loads_finite(const prru_loads *l)
   return finite3(l->fd) && finite3(l->fp) && finite3(l->mp);
 }
 
-/* Why a kernel produced non-finite output from finite inputs: q out of
- * reach, or exactly on the workspace boundary (an acos argument of +-1),
- * where the velocity mapping divides by zero. */
+/* Why prru_eom produced non-finite output from finite inputs: q out of
+ * reach; exactly on the workspace boundary (an acos argument of +-1, where
+ * the velocity mapping divides by zero); or velocities and loads so large
+ * that the arithmetic overflows at a regular q. */
 static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
 {
+  static const double zero[3] = {0, 0, 0};
   int st = prru_check_reachable(m, d, q);
-  return st == PRRU_OK ? PRRU_ESINGULAR : st;
+  if (st != PRRU_OK) return st;
+  double M[9], b[3];
+  prru_eom(q, zero, zero, zero, zero, M, b);
+  return finite3(b) ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
 
 /* Solves M x = b in place by Cholesky, unrolled for 3x3: GSL's generic
@@ -136,16 +141,19 @@ static int solve_spd3(const double M[9], double b[3])
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3])
 {
+  /* A load component that does no work at this pose never reaches b, so
+   * the loads are checked here; NaN/inf in q or qd, or q out of reach,
+   * always shows in b. */
+  if (!loads_finite(l)) return PRRU_EINPUT;
   prru_eom(q, qd, l->fd, l->fp, l->mp, d->M, d->b);
-  /* One finiteness test on the result covers every bad input: NaN/inf
-   * anywhere in q, qd or the loads, or q out of reach, reaches b. */
   if (!finite3(d->b)) {
-    if (!finite3(qd) || !loads_finite(l)) return PRRU_EINPUT;
+    if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
     return classify_failure(m, d, q);
   }
   memcpy(d->qdd, d->b, sizeof d->b);
   int st = solve_spd3(d->M, d->qdd);
   if (st != PRRU_OK) return st;
+  if (!finite3(d->qdd)) return PRRU_EINPUT; /* b finite, M^-1 b overflowed */
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }

@@ -29,6 +29,8 @@ int prru_map_check(const prru_map_grid *g)
     return PRRU_EINPUT;
   if (g->n1 < 2 || g->n2 < 2 || !(g->q1_lo < g->q1_hi) || !(g->q2_lo < g->q2_hi))
     return PRRU_EINPUT;
+  /* The spacing must be representable (1e308 - -1e308 is not). */
+  if (!isfinite(g->q1_hi - g->q1_lo) || !isfinite(g->q2_hi - g->q2_lo)) return PRRU_EINPUT;
   /* k = i n2 + j must fit a long and the outputs an allocation. */
   if ((double)g->n1 * (double)g->n2 > 1e10) return PRRU_EINPUT;
   return PRRU_OK;

@@ -22,7 +22,9 @@ static const char *parse_one(const char *s, double *out)
   char *end;
   errno = 0;
   double v = strtod(s, &end);
-  if (end == s || errno == ERANGE || !isfinite(v)) return NULL;
+  /* ERANGE also flags underflow (1e-400 -> 0 or a subnormal): that is a
+   * finite number, only overflow is refused. */
+  if (end == s || !isfinite(v) || (errno == ERANGE && fabs(v) == HUGE_VAL)) return NULL;
   while (*end == ' ' || *end == '\t') end++;
   *out = v;
   return end;

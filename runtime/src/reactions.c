@@ -160,6 +160,8 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
     }
   }
   if (solve_arrowhead(d->A, d->r, d->P) != PRRU_OK) return PRRU_ESINGULAR;
+  for (int i = 0; i < NL; i++)
+    if (!isfinite(d->r[i])) return PRRU_EINPUT; /* loads so large the solve overflows */
   memcpy(lambda, d->r, sizeof d->r);
   return PRRU_OK;
 }

@@ -44,8 +44,14 @@ void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out)
         if (r[10 * mid] <= t) lo = mid; else hi = mid;
       }
       const double *a = r + 10 * lo, *b = r + 10 * hi;
-      double w = (t - a[0]) / (b[0] - a[0]);
-      for (int k = 0; k < 9; k++) v[k] = a[1 + k] + w * (b[1 + k] - a[1 + k]);
+      /* Halved time differences, and a convex combination where b - a
+       * overflows: no overflow for any finite table. a + w (b - a)
+       * otherwise, so that a constant column stays exactly constant. */
+      double w = (0.5 * t - 0.5 * a[0]) / (0.5 * b[0] - 0.5 * a[0]);
+      for (int k = 0; k < 9; k++) {
+        double diff = b[1 + k] - a[1 + k];
+        v[k] = isfinite(diff) ? a[1 + k] + w * diff : (1.0 - w) * a[1 + k] + w * b[1 + k];
+      }
     }
     for (int k = 0; k < 3; k++) {
       out->fd[k] += v[k];
