@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Drop-in quality of the committed generated kernels: a user copies
+# generated/ into their own controller and builds it with their compiler and
+# their warning flags. So copy ONLY generated/ (plus tests/dropin_main.c as
+# main.c) into an empty directory, build with nothing but -lm under strict
+# warnings as C99 and C11 with gcc and clang and as C++ with g++, and run
+# each binary against the spec's section 10 reference point.
+#
+# A missing clang or g++ is reported as SKIPPED (nothing is installed here);
+# set PRRU_DROPIN_REQUIRE_ALL=1 (CI does) to make a skipped compiler a failure.
+set -u
+
+SRC=${PRRU_SOURCE_DIR:-$(cd "$(dirname "$0")/.." && pwd)}
+FLAGS=(-O2 -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion -Werror)
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/prru-dropin.XXXXXX") || exit 1
+trap 'rm -rf "$work"' EXIT
+cp -R "$SRC/generated/." "$work/" || { echo "FAIL: cannot copy $SRC/generated"; exit 1; }
+cp "$SRC/tests/dropin_main.c" "$work/main.c" || exit 1
+cd "$work" || exit 1
+
+fail=0
+skipped=()
+
+# The header promises "depends only on <math.h>": any other include would be
+# a dependency the user has to discover by a failed build.
+for f in ./*.c ./*.h; do
+  allowed='<math\.h>|"prru_kernels\.h"'
+  [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>"
+  bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
+  if [ -n "$bad" ]; then
+    echo "FAIL: $f includes more than <math.h> and its own header:"
+    echo "$bad"
+    fail=1
+  fi
+done
+
+kernels=()
+for f in ./*.c; do [ "$f" = ./main.c ] || kernels+=("$f"); done
+
+build_and_run() { # label compiler args...
+  local label=$1 cc=$2
+  shift 2
+  if ! command -v "$cc" >/dev/null 2>&1; then
+    echo "SKIPPED $label: $cc not installed"
+    skipped+=("$label")
+    return
+  fi
+  local exe="./dropin_${label//[^a-z0-9]/_}"
+  if ! "$cc" "$@" "${FLAGS[@]}" -I. main.c "${kernels[@]}" -o "$exe" -lm >"$exe.log" 2>&1; then
+    echo "FAIL $label: compile"
+    cat "$exe.log"
+    fail=1
+    return
+  fi
+  if [ -s "$exe.log" ]; then
+    echo "FAIL $label: compiler output with -Werror build:"
+    cat "$exe.log"
+    fail=1
+  fi
+  if "$exe" >"$exe.out" 2>&1; then
+    echo "ok   $label: $(tail -n 1 "$exe.out")"
+  else
+    echo "FAIL $label: run"
+    cat "$exe.out"
+    fail=1
+  fi
+}
+
+build_and_run "gcc c99" gcc -std=c99
+build_and_run "gcc c11" gcc -std=c11
+build_and_run "clang c99" clang -std=c99
+build_and_run "clang c11" clang -std=c11
+build_and_run "g++ c++" g++ -x c++
+
+if [ ${#skipped[@]} -gt 0 ]; then
+  echo "skipped: ${skipped[*]}"
+  if [ "${PRRU_DROPIN_REQUIRE_ALL:-0}" = 1 ]; then
+    echo "FAIL: PRRU_DROPIN_REQUIRE_ALL=1 and a compiler is missing"
+    fail=1
+  fi
+fi
+# The gcc C99 build is the floor: without it nothing was tested.
+case " ${skipped[*]:-} " in *" gcc c99 "*) fail=1 ;; esac
+exit $fail
