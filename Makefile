@@ -4,10 +4,12 @@ BUILD   ?= build
 MODEL   ?= models/3prru_paper.json
 RESULTS ?= results
 PYTHON  ?= python3
-DEB_PACKAGES = cmake gcc make python3 libgsl-dev gnuplot-nox libmujoco-dev
+DEB_PACKAGES = cmake gcc g++ clang libclang-rt-14-dev valgrind make python3 libgsl-dev \
+               gnuplot-nox libmujoco-dev
+FUZZ_SECONDS ?= 60
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build demo test check-generated regenerate bench clean
+.PHONY: all deps build demo test test-asan fuzz check-generated regenerate bench clean
 
 all: build
 
@@ -30,6 +32,15 @@ demo: build
 
 test: build check-generated
 	cd $(BUILD) && ctest --output-on-failure -j 2
+
+# AddressSanitizer + UBSan build and ctest, fuzz corpus replay, valgrind on
+# `prru paper` (own build directories; `make test` first for the Release one).
+test-asan: build
+	RELEASE_BUILD=$(abspath $(BUILD)) tests/sanitize.sh
+
+# libFuzzer over the number, table, load-schedule and scenario parsers.
+fuzz: deps
+	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run.sh
 
 # Fails when the committed generated/ is not what the generator makes now.
 check-generated:
