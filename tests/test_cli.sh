@@ -2,24 +2,7 @@
 # The prru command line: outputs checked against the spec's public values,
 # round trips through the CSV interfaces, and the exit status and message of
 # every kind of bad argument. Needs $PRRU (path to the binary).
-set -u
-: "${PRRU:?set PRRU to the prru binary}"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0 fail=0
-ok()  { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
-
-# expect STATUS NEEDLE -- ARGS...: exit status and a stderr substring.
-expect() {
-  local want=$1 needle=$2; shift 3
-  "$PRRU" "$@" >"$tmp/out" 2>"$tmp/err"
-  local got=$?
-  if [ "$got" -ne "$want" ]; then bad "prru $* exited $got, want $want: $(head -c 300 "$tmp/err")"; return; fi
-  if [ -n "$needle" ] && ! grep -qF -- "$needle" "$tmp/err"; then
-    bad "prru $*: stderr lacks '$needle': $(head -c 300 "$tmp/err")"; return; fi
-  ok
-}
+. "$(dirname "$0")/cli_lib.sh"
 
 # Numbers from JSON with python (stdlib) so comparisons are numeric.
 json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
@@ -100,5 +83,4 @@ expect 1 "cannot create" -- paper --out /proc/nope
 expect 0 "" -- --help
 expect 0 "" -- simulate --help
 
-echo "test_cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish test_cli

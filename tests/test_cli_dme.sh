@@ -3,24 +3,7 @@
 # singular/unreachable poses reported as statuses (null / NaN, never a
 # number), the printed global index recomputed from the CSV, and every kind
 # of bad grid rejected with exit 2 and a message naming the argument.
-set -u
-: "${PRRU:?set PRRU to the prru binary}"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0 fail=0
-ok()  { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
-
-# expect STATUS NEEDLE -- ARGS...: exit status and a stderr substring.
-expect() {
-  local want=$1 needle=$2; shift 3
-  "$PRRU" "$@" >"$tmp/out" 2>"$tmp/err"
-  local got=$?
-  if [ "$got" -ne "$want" ]; then bad "prru $* exited $got, want $want: $(head -c 300 "$tmp/err")"; return; fi
-  if [ -n "$needle" ] && ! grep -qF -- "$needle" "$tmp/err"; then
-    bad "prru $*: stderr lacks '$needle': $(head -c 300 "$tmp/err")"; return; fi
-  ok
-}
+. "$(dirname "$0")/cli_lib.sh"
 # check FILE EXPR: python expression over d (the parsed JSON) must be true.
 check() {
   python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)" "$1" "$2" \
@@ -117,5 +100,4 @@ expect 2 "--q: '0,0' is not 3" -- dme --q 0,0
 expect 2 "--q is required" -- dme
 expect 2 "unknown option" -- dme --q 0,0,0 --bogus 1
 
-echo "test_cli_dme: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish test_cli_dme

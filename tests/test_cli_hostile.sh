@@ -5,32 +5,8 @@
 # never a signal or a sanitizer abort), a message naming the option or the
 # reason, and no NaN/inf/null in any JSON or CSV it writes (test_cli.sh
 # covers the ordinary bad arguments; this file the extreme ones).
-#
-# Cases marked `known` are bugs reported to the lead: they are run, a
-# failure is printed as XFAIL and does not fail the test, but one that
-# passes fails it ("known bug fixed"), so the marker gets removed and the
-# case becomes an ordinary regression check. PRRU_HOSTILE_STRICT=1 makes
-# XFAIL a failure too.
-set -u
-: "${PRRU:?set PRRU to the prru binary}"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0 fail=0 xfail=0
-mode=normal
-bad() {
-  if [ "$mode" = known ] && [ "${PRRU_HOSTILE_STRICT:-0}" != 1 ]; then
-    xfail=$((xfail + 1)); echo "XFAIL (known bug): $*" >&2
-  else
-    fail=$((fail + 1)); echo "FAIL: $*" >&2
-  fi
-}
-good() {
-  if [ "$mode" = known ]; then
-    fail=$((fail + 1)); echo "FAIL: known bug fixed, drop the 'known' marker: $*" >&2
-  else
-    pass=$((pass + 1))
-  fi
-}
+
+. "$(dirname "$0")/cli_lib.sh"
 
 # Outputs that must never carry a non-finite number (case-insensitive:
 # printf's nan/inf, JSON null from prru_cli_json_number).
@@ -61,9 +37,8 @@ check() {
     if nonfinite "$f"; then
       bad "$what: non-finite value in $(basename "$f"): $(grep -iE 'nan|inf' "$f" | head -n 1 | cut -c1-200)"; return; fi
   done
-  good "$what"
+  ok
 }
-known() { mode=known; check "$@"; mode=normal; }
 
 # A regular pose (the spec's point), a singular one (det J_d = 0 to 3e-17,
 # found by bisection on the generated J_d) and an unreachable one.
@@ -128,7 +103,7 @@ check 1 "singular" -- id --traj "$tmp/traj_sing.csv" --out "$tmp/out.csv"
 # dme's documented answer at a singular pose is status "singular" with null
 # fields and exit 0: only check that it says so.
 "$PRRU" dme --q "$QSING" >"$tmp/dme.json" 2>&1
-grep -q '"singular"' "$tmp/dme.json" && good "dme singular" || bad "dme at $QSING: $(head -c 200 "$tmp/dme.json")"
+grep -q '"singular"' "$tmp/dme.json" && ok || bad "dme at $QSING: $(head -c 200 "$tmp/dme.json")"
 
 # ---- Finite inputs whose dynamics overflow: exit 1, never non-finite output ----
 # A trajectory runs out of the workspace fast; rows before the stop are kept.
@@ -173,8 +148,7 @@ check 0 "" -- simulate --loads "$tmp/l_span.csv" --t-end 0.01 --out "$tmp/out.cs
 # Underflowing decimals are finite numbers; rejecting them is acceptable, but
 # not with the claim that they are not finite.
 "$PRRU" eval --q "$Q" --qd "$tiny,0,0" >/dev/null 2>"$tmp/stderr"
-if [ $? -eq 0 ] || ! grep -q "not 3 comma-separated finite" "$tmp/stderr"; then good "underflow"
+if [ $? -eq 0 ] || ! grep -q "not 3 comma-separated finite" "$tmp/stderr"; then ok
 else bad "eval --qd $tiny,0,0: $(cat "$tmp/stderr")"; fi
 
-echo "test_cli_hostile: $pass passed, $fail failed, $xfail known bugs"
-[ "$fail" -eq 0 ]
+finish test_cli_hostile

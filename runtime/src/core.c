@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "prru.h"
+#include "internal.h"
 
 const char *prru_strerror(int status)
 {
@@ -50,8 +51,7 @@ int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
   return finite3(d->d) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
 
-/* 1 / (|A|_1 |A^-1|_1) of a 3x3 matrix via its adjugate; 0 when det = 0. */
-static double rcond3(const double a[9], double inv[9])
+double prru_rcond3(const double a[9], double inv[9])
 {
   double c[9];
   c[0] = a[4] * a[8] - a[5] * a[7];
@@ -83,7 +83,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik_jd(q, d->d, d->Jd);
   if (!finite3(d->d)) return PRRU_EUNREACHABLE;
-  double rc = rcond3(d->Jd, NULL);
+  double rc = prru_rcond3(d->Jd, NULL);
   if (rcond) *rcond = rc;
   return rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
@@ -173,7 +173,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   double r[3], inv[9];
   for (int i = 0; i < 3; i++)
     r[i] = d->M[3 * i] * qdd[0] + d->M[3 * i + 1] * qdd[1] + d->M[3 * i + 2] * qdd[2] - d->b[i];
-  rcond3(d->Jd, inv);
+  prru_rcond3(d->Jd, inv);
   /* fd = J_d^-T r: row i of J_d^-T is column i of J_d^-1. */
   for (int i = 0; i < 3; i++) fd[i] = inv[i] * r[0] + inv[3 + i] * r[1] + inv[6 + i] * r[2];
   return finite3(fd) ? PRRU_OK : PRRU_EINPUT;

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "prru_dme.h"
+#include "internal.h"
 
 const char *prru_dme_status_name(int status)
 {
@@ -18,26 +19,6 @@ const char *prru_dme_status_name(int status)
 static double dot3(const double *a, const double *b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/* The inverse of a 3x3 by its adjugate; 0 when the determinant is 0 or not
- * finite. J_d's conditioning was checked before, so no pivoting is needed. */
-static int inv3(const double a[9], double inv[9])
-{
-  double c[9];
-  c[0] = a[4] * a[8] - a[5] * a[7];
-  c[1] = a[2] * a[7] - a[1] * a[8];
-  c[2] = a[1] * a[5] - a[2] * a[4];
-  c[3] = a[5] * a[6] - a[3] * a[8];
-  c[4] = a[0] * a[8] - a[2] * a[6];
-  c[5] = a[2] * a[3] - a[0] * a[5];
-  c[6] = a[3] * a[7] - a[4] * a[6];
-  c[7] = a[1] * a[6] - a[0] * a[7];
-  c[8] = a[0] * a[4] - a[1] * a[3];
-  double det = a[0] * c[0] + a[1] * c[3] + a[2] * c[6];
-  if (!(det != 0.0) || !isfinite(det)) return 0;
-  for (int i = 0; i < 9; i++) inv[i] = c[i] / det;
-  return 1;
 }
 
 /* c = a b, 3x3 row-major. */
@@ -85,7 +66,7 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   if (st != PRRU_OK) return fail(out, st);
 
   double jinv[9], jp[18], tmp[9];
-  if (!inv3(d->Jd, jinv)) return fail(out, PRRU_ESINGULAR);
+  if (!(prru_rcond3(d->Jd, jinv) > 0)) return fail(out, PRRU_ESINGULAR);
   prru_mass(q, d->M);
   prru_platform_jacobian(q, jp);
   const double *jrp = jp, *jtp = jp + 9;

@@ -14,4 +14,9 @@ int prru_fail(char *msg, int msglen, int status, const char *fmt, ...)
     ;
 /* Reads a whole file (at most 256 MiB); NULL with msg on failure. */
 char *prru_read_file(const char *path, size_t *len, char *msg, int msglen);
+/* 1 / (|A|_1 |A^-1|_1) of a 3x3 matrix via its adjugate (no pivoting:
+ * callers only invert J_d, whose conditioning this is); 0 when the
+ * determinant is 0 or not finite. Fills inv = A^-1 when non-NULL and the
+ * determinant is usable. */
+double prru_rcond3(const double a[9], double inv[9]);
 #endif
