@@ -35,11 +35,38 @@ static void note(int o, const double *kernel, const double *ref, int n)
   if (!(e <= worst[o])) worst[o] = e; /* keeps NaN */
 }
 
+/* Every generated kernel's outputs at one state. */
+typedef struct {
+  double d[3], Jd[9], d2[3], Jd2[9], H[180], dm[60], M[9], h[3], G[3], M2[9], h2[3], G2[3];
+  double Me[9], be[3], JP[18], R[90], p[30], I[90], K[60], E[2], Q[60 * NL];
+} kernel_outputs;
+
+static void eval_all(const double q[3], const double qd[3], const double fd[3],
+                     const double fp[3], const double mp[3], kernel_outputs *o)
+{
+  prru_ik(q, o->d);
+  prru_jd(q, o->Jd);
+  prru_ik_jd(q, o->d2, o->Jd2);
+  prru_jacobians(q, o->H);
+  prru_bias_terms(q, qd, o->dm);
+  prru_mass(q, o->M);
+  prru_bias(q, qd, o->h);
+  prru_gravity(q, o->G);
+  prru_dynamics(q, qd, o->M2, o->h2, o->G2);
+  prru_eom(q, qd, fd, fp, mp, o->Me, o->be);
+  prru_platform_jacobian(q, o->JP);
+  prru_poses(q, o->R, o->p);
+  prru_inertia_world(q, o->I);
+  prru_wrench_bias(q, qd, o->K);
+  prru_energy(q, qd, o->E);
+  prru_reaction_basis(q, o->Q);
+}
+
 static void test_against_reference(void)
 {
   int states = 0, skipped = 0, ref_fail = 0;
   double fused = 0;
-  static double Q[60 * NL], Qr[60 * NL];
+  static double Qr[60 * NL];
   while (states < NSTATE) {
     double q[3] = {tu_uniform(-0.5, 0.5), tu_uniform(-0.5, 0.5), tu_uniform(-1.0, -0.5)};
     double qd[3], fd[3], fp[3], mp[3];
@@ -74,24 +101,11 @@ static void test_against_reference(void)
     memcpy(JP_r, H_r, 9 * sizeof(double));
     memcpy(JP_r + 9, H_r + 90, 9 * sizeof(double));
 
-    double d[3], Jd[9], d2[3], Jd2[9], H[180], dm[60], M[9], h[3], G[3], M2[9], h2[3], G2[3];
-    double Me[9], be[3], JP[18], R[90], p[30], I[90], K[60], E[2];
-    prru_ik(q, d);
-    prru_jd(q, Jd);
-    prru_ik_jd(q, d2, Jd2);
-    prru_jacobians(q, H);
-    prru_bias_terms(q, qd, dm);
-    prru_mass(q, M);
-    prru_bias(q, qd, h);
-    prru_gravity(q, G);
-    prru_dynamics(q, qd, M2, h2, G2);
-    prru_eom(q, qd, fd, fp, mp, Me, be);
-    prru_platform_jacobian(q, JP);
-    prru_poses(q, R, p);
-    prru_inertia_world(q, I);
-    prru_wrench_bias(q, qd, K);
-    prru_energy(q, qd, E);
-    prru_reaction_basis(q, Q);
+    static kernel_outputs ko;
+    eval_all(q, qd, fd, fp, mp, &ko);
+    double *d = ko.d, *Jd = ko.Jd, *d2 = ko.d2, *Jd2 = ko.Jd2, *H = ko.H, *dm = ko.dm, *M = ko.M,
+           *h = ko.h, *G = ko.G, *M2 = ko.M2, *h2 = ko.h2, *G2 = ko.G2, *Me = ko.Me, *be = ko.be,
+           *JP = ko.JP, *R = ko.R, *p = ko.p, *I = ko.I, *K = ko.K, *E = ko.E, *Q = ko.Q;
 
     note(O_IK, d, d_r, 3);
     note(O_JD, Jd, Jd_r, 9);
@@ -188,27 +202,13 @@ static void test_nan_outputs(void)
   const double bad[6][3] = {{1.4, 0, -0.8}, {0, 1.2, -0.8}, {NAN, 0, -0.8},
                             {0, INFINITY, -0.8}, {0, 0, -INFINITY}, {0, 0, NAN}};
   const double qd[3] = {0.1, -0.2, 0.3}, f3[3] = {1, 2, 3};
-  static double Q[60 * NL];
   for (int c = 0; c < 6; c++) {
     const double *q = bad[c];
-    double d[3], Jd[9], d2[3], Jd2[9], H[180], dm[60], M[9], h[3], G[3], M2[9], h2[3], G2[3];
-    double Me[9], be[3], JP[18], R[90], p[30], I[90], K[60], E[2];
-    prru_ik(q, d);
-    prru_jd(q, Jd);
-    prru_ik_jd(q, d2, Jd2);
-    prru_jacobians(q, H);
-    prru_bias_terms(q, qd, dm);
-    prru_mass(q, M);
-    prru_bias(q, qd, h);
-    prru_gravity(q, G);
-    prru_dynamics(q, qd, M2, h2, G2);
-    prru_eom(q, qd, f3, f3, f3, Me, be);
-    prru_platform_jacobian(q, JP);
-    prru_poses(q, R, p);
-    prru_inertia_world(q, I);
-    prru_wrench_bias(q, qd, K);
-    prru_energy(q, qd, E);
-    prru_reaction_basis(q, Q);
+    static kernel_outputs ko;
+    eval_all(q, qd, f3, f3, f3, &ko);
+    double *d = ko.d, *Jd = ko.Jd, *d2 = ko.d2, *Jd2 = ko.Jd2, *H = ko.H, *dm = ko.dm, *M = ko.M,
+           *h = ko.h, *G = ko.G, *M2 = ko.M2, *h2 = ko.h2, *G2 = ko.G2, *Me = ko.Me, *be = ko.be,
+           *JP = ko.JP, *R = ko.R, *p = ko.p, *I = ko.I, *K = ko.K, *E = ko.E, *Q = ko.Q;
     const struct { const char *name; const double *x; int n; } out[] = {
       {"ik", d, 3}, {"jd", Jd, 9}, {"ik_jd d", d2, 3}, {"ik_jd Jd", Jd2, 9}, {"jacobians", H, 180},
       {"bias_terms", dm, 60}, {"mass", M, 9}, {"bias", h, 3}, {"gravity", G, 3},
