@@ -71,7 +71,7 @@ int prru_cmd_eval(int argc, char **argv)
   printf(", \"qd\": ");
   prru_cli_json_array(stdout, qd, 3, 1);
   printf(",\n \"M\": ");
-  prru_cli_json_array(stdout, M, 9, 3);
+  prru_cli_json_array(stdout, M, 9, 1);
   printf(",\n \"h\": ");
   prru_cli_json_array(stdout, h, 3, 1);
   printf(", \"G\": ");
@@ -79,7 +79,7 @@ int prru_cmd_eval(int argc, char **argv)
   printf(",\n \"d\": ");
   prru_cli_json_array(stdout, act, 3, 1);
   printf(", \"Jd\": ");
-  prru_cli_json_array(stdout, Jd, 9, 3);
+  prru_cli_json_array(stdout, Jd, 9, 1);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   printf(",\n \"fd\": ");

@@ -44,7 +44,7 @@ int prru_cmd_ik(int argc, char **argv)
   printf(", \"d\": ");
   prru_cli_json_array(stdout, d->d, 3, 1);
   printf(", \"Jd\": ");
-  prru_cli_json_array(stdout, d->Jd, 9, 3);
+  prru_cli_json_array(stdout, d->Jd, 9, 1);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   printf(", \"singular\": %s}\n", st == PRRU_ESINGULAR ? "true" : "false");

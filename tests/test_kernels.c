@@ -68,10 +68,10 @@ static void test_against_reference(void)
   double fused = 0;
   static double Qr[60 * NL];
   while (states < NSTATE) {
-    double q[3] = {tu_uniform(-0.5, 0.5), tu_uniform(-0.5, 0.5), tu_uniform(-1.0, -0.5)};
+    double q[3] = {tu_uniform(-0.5, 0.5), tu_uniform(-0.6, 0.5), tu_uniform(-1.0, 0.2)};
     double qd[3], fd[3], fp[3], mp[3];
     for (int i = 0; i < 3; i++) {
-      qd[i] = tu_uniform(-1, 1);
+      qd[i] = tu_uniform(-1.15, 1.15); /* |qd| <= 2 */
       fd[i] = tu_uniform(-60, 60);
       fp[i] = tu_uniform(-30, 30);
       mp[i] = tu_uniform(-3, 3);
