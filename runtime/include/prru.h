@@ -86,7 +86,8 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[3]);
-/* The 57 joint reaction coordinates (eq. 31) at the state's qdd. */
+/* The 57 joint reaction coordinates (eq. 31) at the state's qdd, which it
+ * solves for first and leaves in d->qdd. */
 int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                    const prru_loads *l, double lambda[PRRU_NLAMBDA]);
 /* T, V (J). */

@@ -105,12 +105,13 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   int st = prru_check_regular(m, d, s->q, NULL);
   if (st != PRRU_OK) return st;
   memcpy(s->d, d->d, sizeof s->d);
-  st = prru_forward_dynamics(m, d, s->q, s->qd, &l, s->qdd);
-  if (st != PRRU_OK) return st;
-  if (reactions) {
+  if (reactions) { /* solves the forward dynamics too (d->qdd) */
     st = prru_reactions(m, d, s->q, s->qd, &l, s->lambda);
     if (st != PRRU_OK) return st;
+    memcpy(s->qdd, d->qdd, sizeof s->qdd);
   } else {
+    st = prru_forward_dynamics(m, d, s->q, s->qd, &l, s->qdd);
+    if (st != PRRU_OK) return st;
     for (int i = 0; i < PRRU_NLAMBDA; i++) s->lambda[i] = NAN;
   }
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
