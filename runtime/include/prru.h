@@ -57,7 +57,7 @@ typedef struct {
 
 /* Per-call workspace and last results. */
 typedef struct {
-  double d[3], Jd[9];             /* actuator positions and Jacobian */
+  double d[3], Jd[9], Jdinv[9];  /* actuator positions, Jacobian, its inverse */
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
   double Q[60 * PRRU_NLAMBDA];    /* reaction basis */
@@ -69,7 +69,8 @@ typedef struct {
 
 /* PRRU_OK, PRRU_EINPUT (non-finite q) or PRRU_EUNREACHABLE; fills d->d. */
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
-/* Reachable and J_d regular; fills d->d, d->Jd; *rcond if non-NULL. */
+/* Reachable and J_d regular; fills d->d, d->Jd, d->Jdinv (when regular);
+ * *rcond if non-NULL. */
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
 
 /* Actuator displacements (inverse kinematics). */

@@ -83,9 +83,10 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik_jd(q, d->d, d->Jd);
   if (!finite3(d->d)) return PRRU_EUNREACHABLE;
-  double rc = prru_rcond3(d->Jd, NULL);
+  double rc = prru_rcond3(d->Jd, d->Jdinv);
   if (rcond) *rcond = rc;
-  return rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
+  /* rc > 0 also when jd_rcond_min is 0: an exactly singular J_d has no inverse. */
+  return rc > 0 && rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
 
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[3])
@@ -165,15 +166,14 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   static const double zero[3] = {0, 0, 0};
   if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))
     return PRRU_EINPUT;
-  double rc;
-  int st = prru_check_regular(m, d, q, &rc);
+  int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
   /* J_d^T fd = M qdd - (G + J_T,P^T fp + J_R,P^T mp - h). */
   prru_eom(q, qd, zero, l->fp, l->mp, d->M, d->b);
-  double r[3], inv[9];
+  double r[3];
+  const double *inv = d->Jdinv;
   for (int i = 0; i < 3; i++)
     r[i] = d->M[3 * i] * qdd[0] + d->M[3 * i + 1] * qdd[1] + d->M[3 * i + 2] * qdd[2] - d->b[i];
-  prru_rcond3(d->Jd, inv);
   /* fd = J_d^-T r: row i of J_d^-T is column i of J_d^-1. */
   for (int i = 0; i < 3; i++) fd[i] = inv[i] * r[0] + inv[3 + i] * r[1] + inv[6 + i] * r[2];
   return finite3(fd) ? PRRU_OK : PRRU_EINPUT;

@@ -4,7 +4,6 @@
 #include <string.h>
 
 #include "prru_dme.h"
-#include "internal.h"
 
 const char *prru_dme_status_name(int status)
 {
@@ -65,8 +64,8 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   int st = prru_check_regular(m, d, q, &out->jd_rcond);
   if (st != PRRU_OK) return fail(out, st);
 
-  double jinv[9], jp[18], tmp[9];
-  if (!(prru_rcond3(d->Jd, jinv) > 0)) return fail(out, PRRU_ESINGULAR);
+  const double *jinv = d->Jdinv; /* regular: prru_check_regular inverted J_d */
+  double jp[18], tmp[9];
   prru_mass(q, d->M);
   prru_platform_jacobian(q, jp);
   const double *jrp = jp, *jtp = jp + 9;
