@@ -3,6 +3,7 @@
  * balance, agreement with the dense reference), the paper scenario against
  * an independent integration, and clean stops. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -58,6 +59,7 @@ static void test_inverse_of_forward(void)
     prru_ref_forward_dynamics(&p, w, q, qd, l.fd, l.fp, l.mp, qdd_ref);
     worst_ref = fmax(worst_ref, tu_relerr(qdd, qdd_ref, 3, 1e-3));
   }
+  printf("ID(FD) %.1e, FD vs reference solve %.1e\n", worst, worst_ref);
   tu_check(worst <= 1e-10, "inverse dynamics of forward dynamics returns fd", worst, 1e-10);
   tu_check(worst_ref <= 1e-10, "forward dynamics agrees with the reference's GSL solve", worst_ref, 1e-10);
 }
@@ -75,6 +77,7 @@ static void test_fk(void)
     worst = fmax(worst, tu_relerr(sol, q, 3, 1.0));
   }
   tu_check(fails == 0, "FK converges from a nearby seed", fails, 0);
+  printf("FK(IK(q)) %.1e\n", worst);
   tu_check(worst <= 1e-12, "FK(IK(q)) = q", worst, 1e-12);
   /* Out of reach: sliders far apart vertically (limb 1 2 m above limb 2). */
   double act[3] = {1.0, -1.0, 0.0}, seed[3] = {0, 0, -0.2}, sol[3];
@@ -200,6 +203,8 @@ static void test_reactions(void)
     e_machine = fmax(e_machine, tu_relerr(ext, lhs, 2, fmax(50.0, fmax(fabs(lhs[0]), fabs(lhs[1])))));
   }
   prru_ref_free(w);
+  printf("reactions: H^T Q %.1e, vs dense reference %.1e, platform force %.1e, moment %.1e, "
+         "machine horizontal force %.1e\n", e_htq, e_ref, e_force, e_moment, e_machine);
   tu_check(e_htq <= 1e-12, "H^T Q = 0 relative to |H||Q|", e_htq, 1e-12);
   tu_check(e_ref <= 1e-10, "fast reactions = dense reference eq. 31", e_ref, 1e-10);
   tu_check(e_force <= 1e-10, "platform force balance (Newton)", e_force, 1e-10);
@@ -253,6 +258,7 @@ static void test_energy(void)
   TU_TRUE(st == PRRU_OK && k.n == 101, "free motion simulates 1 s");
   double e0 = k.first.T + k.first.V, e1 = k.last.T + k.last.V;
   double scale = fmax(fabs(k.last.T), fabs(k.last.V));
+  printf("energy drift over 1 s without actuation: %.1e relative\n", fabs(e1 - e0) / scale);
   tu_check(fabs(e1 - e0) <= 1e-9 * scale, "T + V conserved without actuation", fabs(e1 - e0) / scale, 1e-9);
 
   /* Constant actuator and platform forces: the work is exact,
@@ -268,6 +274,8 @@ static void test_energy(void)
   for (int i = 0; i < 3; i++) work += l.fd[i] * (k.last.d[i] - k.first.d[i]);
   work += l.fp[2] * (k.last.q[2] - k.first.q[2]);
   double dE = (k.last.T + k.last.V) - (k.first.T + k.first.V);
+  printf("work-energy: dE %.9f J, work %.9f J, residual %.1e relative\n", dE, work,
+         fabs(dE - work) / fmax(fabs(work), fabs(k.last.V)));
   tu_check(fabs(dE - work) <= 1e-9 * fmax(fabs(work), fabs(k.last.V)), "change of energy = work of the forces",
            fabs(dE - work) / fmax(fabs(work), fabs(k.last.V)), 1e-9);
 }
@@ -297,6 +305,8 @@ static void test_paper_scenario(void)
   int sc = run(s.q0, s.qd0, &s.loads, PRRU_MSBDF, 1e-11, 1.0, &c, msg);
   TU_TRUE(sa == PRRU_OK && sb == PRRU_OK && sc == PRRU_OK, "paper scenario runs with three steppers");
   double e = tu_relerr(a.last.q, b.last.q, 3, 1.0);
+  printf("paper q(1 s) = (%.10f, %.10f, %.10f); rk8pd vs rkck %.1e, vs msbdf %.1e\n",
+         a.last.q[0], a.last.q[1], a.last.q[2], e, tu_relerr(a.last.q, c.last.q, 3, 1.0));
   tu_check(e <= 1e-8, "rk8pd and rkck agree on q(1 s)", e, 1e-8);
   e = tu_relerr(a.last.q, c.last.q, 3, 1.0);
   tu_check(e <= 1e-6, "rk8pd and msbdf agree on q(1 s)", e, 1e-6);
@@ -319,6 +329,7 @@ static void test_paper_scenario(void)
     for (int j = 0; j < 6; j++) y[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
   }
   e = tu_relerr(a.last.q, y, 3, 1.0);
+  printf("paper q(1 s) vs RK4 on the reference dynamics: %.1e\n", e);
   tu_check(e <= 1e-8, "paper q(1 s) = RK4 on the reference dynamics", e, 1e-8);
   e = tu_relerr(a.last.qd, y + 3, 3, 1.0);
   tu_check(e <= 1e-7, "paper qd(1 s) = RK4 on the reference dynamics", e, 1e-7);
