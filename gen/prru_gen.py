@@ -10,14 +10,13 @@ model's "name". Nothing in DIR changes unless generation succeeds.
 import argparse
 import os
 import sys
-import tempfile
 import time
 
 sys.setrecursionlimit(20000)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
-from prrugen import mechanism, dynamics, render  # noqa: E402
+from prrugen import mechanism, dynamics, output, render  # noqa: E402
 
 TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates")
@@ -28,25 +27,6 @@ def generate(model_path, templates_dir=TEMPLATES):
     model = model_mod.load(model_path)
     deriv = dynamics.Derivation(mechanism.build(model), model.gravity)
     return render.render(model, deriv, templates_dir)
-
-
-def write_atomically(out_dir, files):
-    """Write every file to a temporary name first, then rename them all."""
-    os.makedirs(out_dir, exist_ok=True)
-    staged = []
-    try:
-        for name, text in sorted(files.items()):
-            fd, tmp = tempfile.mkstemp(prefix="." + name + ".", dir=out_dir)
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-                f.write(text)
-            os.chmod(tmp, 0o644)
-            staged.append((tmp, os.path.join(out_dir, name)))
-    except BaseException:
-        for tmp, _ in staged:
-            os.unlink(tmp)
-        raise
-    for tmp, final in staged:
-        os.replace(tmp, final)
 
 
 def main(argv=None):
@@ -68,7 +48,7 @@ def main(argv=None):
         print("prru_gen: error: %s" % exc, file=sys.stderr)
         return 1
     try:
-        write_atomically(args.out, files)
+        output.write_files_atomically(args.out, files)
     except OSError as exc:
         print("prru_gen: error: %s: cannot write: %s"
               % (args.out, exc.strerror), file=sys.stderr)

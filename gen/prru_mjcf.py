@@ -18,11 +18,11 @@ import os
 import re
 import string
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
+from prrugen import output  # noqa: E402
 
 TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates", "prru_mjcf.xml")
@@ -236,22 +236,6 @@ def render(model_path, template_path=TEMPLATE):
     return out
 
 
-def write_atomically(path, text):
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".",
-                               dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="prru_mjcf.py",
@@ -268,7 +252,9 @@ def main(argv=None):
         print("prru_mjcf: error: %s" % exc, file=sys.stderr)
         return 1
     try:
-        write_atomically(args.out, text)
+        out = os.path.abspath(args.out)
+        output.write_files_atomically(os.path.dirname(out),
+                                      {os.path.basename(out): text})
     except OSError as exc:
         print("prru_mjcf: error: %s: cannot write: %s"
               % (args.out, exc.strerror), file=sys.stderr)
