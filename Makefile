@@ -1,7 +1,10 @@
 # The two set-up commands of the README:  make demo   and   make test
 # Both install what is missing (Debian packages), configure and build.
-BUILD   ?= build
-MODEL   ?= models/3prru_paper.json
+PAPER_MODEL = models/3prru_paper.json
+MODEL   ?= $(PAPER_MODEL)
+# Each model builds in its own directory: build/ for the paper's, build-<file>
+# for any other, so `make test MODEL=x.json` never mixes kernels.
+BUILD   ?= $(if $(filter $(abspath $(MODEL)),$(abspath $(PAPER_MODEL))),build,build-$(basename $(notdir $(MODEL))))
 RESULTS ?= results
 PYTHON  ?= python3
 DEB_PACKAGES = cmake gcc g++ clang libclang-rt-14-dev valgrind make python3 libgsl-dev \
@@ -42,16 +45,17 @@ test-asan: build
 fuzz: deps
 	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run.sh
 
-# Fails when the committed generated/ is not what the generator makes now.
+# Fails when the committed generated/ (the paper model's kernels) is not
+# what the generator makes now, whichever MODEL the build uses.
 check-generated:
 	@tmp=$$(mktemp -d) && \
-	$(PYTHON) gen/prru_gen.py $(MODEL) --out $$tmp --quiet && \
+	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) --out $$tmp --quiet && \
 	if diff -r -q $$tmp generated >/dev/null; then echo "generated/ is up to date"; rm -rf $$tmp; \
 	else diff -r -u generated $$tmp | head -40; rm -rf $$tmp; \
 	  echo "generated/ is stale: run 'make regenerate' and commit"; exit 1; fi
 
 regenerate:
-	$(PYTHON) gen/prru_gen.py $(MODEL) --out generated
+	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) --out generated
 
 bench: build
 	$(BUILD)/bench/prru_bench

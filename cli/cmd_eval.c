@@ -64,7 +64,7 @@ int prru_cmd_eval(int argc, char **argv)
   prru_dynamics(q, qd, M, h, G);
   double act[3], Jd[9];
   prru_ik_jd(q, act, Jd);
-  static const char *const labels[PRRU_NLAMBDA] = PRRU_LAMBDA_LABELS;
+  const char *const *labels = prru_mech.lambda_labels;
 
   printf("{\"q\": ");
   prru_cli_json_array(stdout, q, 3, 1);

@@ -134,7 +134,7 @@ static int make_dir(const char *dir)
 
 static void summarize(FILE *f, const paper_run *r, double t_stop)
 {
-  static const char *const labels[PRRU_NLAMBDA] = PRRU_LAMBDA_LABELS;
+  const char *const *labels = prru_mech.lambda_labels;
   const prru_sample *a = &r->first, *b = &r->last;
   fprintf(f, "Paper study (section 4.3): q(0) = (0, pi/6, -0.8), fd = (50, 40, 25) N,\n"
              "fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N, rk8pd at 1e-10, %ld samples to t = %.3f s\n",

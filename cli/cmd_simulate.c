@@ -10,7 +10,7 @@
 
 void prru_cli_csv_header(prru_cli_csv *c)
 {
-  static const char *const labels[PRRU_NLAMBDA] = PRRU_LAMBDA_LABELS;
+  const char *const *labels = prru_mech.lambda_labels;
   fputs("t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3", c->f);
   if (c->reactions)
     for (int i = 0; i < PRRU_NLAMBDA; i++) fprintf(c->f, ",%s", labels[i]);

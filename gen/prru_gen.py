@@ -3,12 +3,14 @@
 
 usage: python3 gen/prru_gen.py MODEL.json --out DIR [--quiet]
 
-Writes DIR/<name>_kernels.h and DIR/<name>_kernels.c, where <name> is the
-model's "name". Nothing in DIR changes unless generation succeeds.
+Writes DIR/<prefix>_kernels.{h,c} (the kernels) and DIR/<prefix>_mechanism.{h,c}
+(the mechanism descriptor), where <prefix> is the model's "name" unless
+--prefix says otherwise. Nothing in DIR changes unless generation succeeds.
 """
 
 import argparse
 import os
+import re
 import sys
 import time
 
@@ -16,17 +18,25 @@ sys.setrecursionlimit(20000)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
-from prrugen import mechanism, dynamics, output, render  # noqa: E402
+from prrugen import mechanism, dynamics, output, render, sym  # noqa: E402
 
 TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates")
 
 
-def generate(model_path, templates_dir=TEMPLATES):
+def generate(model_path, templates_dir=TEMPLATES, prefix=None):
     """(files {name: text}, emitted kernels) for a model file."""
     model = model_mod.load(model_path)
-    deriv = dynamics.Derivation(mechanism.build(model), model.gravity)
-    return render.render(model, deriv, templates_dir)
+    sym.reset()
+    deriv = dynamics.Derivation(mechanism.build(model), model)
+    return render.render(model, deriv, templates_dir, prefix)
+
+
+def _prefix(text):
+    if not re.fullmatch(r"[a-z][a-z0-9_]{0,15}", text):
+        raise argparse.ArgumentTypeError("must be a lower-case C identifier "
+                                         "of at most 16 characters")
+    return text
 
 
 def main(argv=None):
@@ -38,12 +48,15 @@ def main(argv=None):
                         "models/3prru_paper.json")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing)")
+    parser.add_argument("--prefix", metavar="NAME", type=_prefix,
+                        help="C prefix of the generated functions and types "
+                        "(default: the model's name)")
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
     start = time.perf_counter()
     try:
-        files, emitted = generate(args.model)
+        files, emitted = generate(args.model, prefix=args.prefix)
     except model_mod.ModelError as exc:
         print("prru_gen: error: %s" % exc, file=sys.stderr)
         return 1

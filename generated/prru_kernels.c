@@ -20,6 +20,8 @@
  *   inertia_world      86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3
  *   wrench_bias        212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  *   energy             137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
  */
 #include <math.h>
@@ -1547,6 +1549,102 @@ void prru_energy(const double q[3], const double qd[3], double E[2])
   const double t48 = t43 + t42 * 0.22010869565217392;
   E[0] = ((t48 * t48 + (t46 * t46 + t47 * t47)) * 662.5 + (t27 * (1.0 / t40) * 2.5918596408317582 + (t13 * (1.0 / t31) * 7.464555765595463 + ((t44 * t44 + (t37 * t37 + t39 * t39)) * 545.8333333333334 + (t28 * t28 * (t29 * t29) * 1.0416666666666667 + (t27 * 10.283203125 + ((t21 * t21 + (t16 * t16 + t17 * t17)) * 266.6666666666667 + (t10 * 2.0833333333333335 + (1.3333333333333333 * (t5 * t10) + (qd2 * qd2 * 1.1666666666666667 + (qd3 * qd3 * 737.5 + (t3 * t10 + t13 * 33.125625)))))))))))) * 0.0012;
   E[1] = (t41 * 0.04167473769168684 + (q3 + t32 * 0.08334947538337369 - t4 * t8 * 0.05847457627118644)) * 121.5459;
+}
+
+void prru_actuator_rates(const double q[3], const double qd[3], double dd[3], double ddb[3])
+{
+  const double q1 = q[0];
+  const double q2 = q[1];
+  const double q3 = q[2];
+  const double qd1 = qd[0];
+  const double qd2 = qd[1];
+  const double qd3 = qd[2];
+  const double t0 = cos(q1);
+  const double t1 = cos(q2);
+  const double t2 = t0 * t1;
+  const double t3 = t0 * t0;
+  const double t4 = t1 * t1;
+  const double t5 = sin(q2);
+  const double t6 = t5 * t5;
+  const double t7 = sqrt(t3 * t4 + t6);
+  const double t8 = 1.0 / t7;
+  const double t9 = t2 * t8 - 1.4;
+  /* Unreachable or non-finite q: every output is NaN. */
+  if (!(fabs((1.3333333333333333 - t0) * 1.173913043478261) <= 1.0 &&
+        fabs(t9 * 0.9782608695652174) <= 1.0 &&
+        fabs(q1) <= 1.7976931348623157e308 &&
+        fabs(q2) <= 1.7976931348623157e308 &&
+        fabs(q3) <= 1.7976931348623157e308)) {
+    for (int i = 0; i < 3; i++) dd[i] = (double)NAN;
+    for (int i = 0; i < 3; i++) ddb[i] = (double)NAN;
+    return;
+  }
+  const double t10 = t0 * qd1;
+  const double t11 = sin(q1);
+  const double t12 = qd1 * t11;
+  const double t13 = t0 - 1.3333333333333333;
+  const double t14 = t13 * t13;
+  const double t15 = sqrt((0.7256515775034293 - t14) * 1.3780718336483933);
+  const double t16 = 1.0 / t15;
+  const double t17 = t10 * 0.27;
+  const double t18 = t12 * t13 * t16 * 0.3169565217391304;
+  const double t19 = t1 * qd2;
+  const double t20 = t8 * t8;
+  const double t21 = t8 * t20;
+  const double t22 = t5 * t21;
+  const double t23 = t11 * t11;
+  const double t24 = t4 * (t10 * t11) - t5 * (t1 * (qd2 * t23));
+  const double t25 = t9 * t9;
+  const double t26 = sqrt((1.0449382716049382 - t25) * 0.9569943289224953);
+  const double t27 = 1.0 / t26;
+  const double t28 = t9 * t27;
+  const double t29 = t1 * t12;
+  const double t30 = t5 * (t0 * qd2);
+  const double t31 = t2 * t21;
+  const double t32 = t8 * t29 + t8 * t30 - t24 * t31;
+  const double t33 = qd1 * qd1;
+  const double t34 = t11 * t33;
+  const double t35 = t0 * t33;
+  const double t36 = t23 * t33;
+  const double t37 = 1.173913043478261 * (t16 * (t13 * t35) - t16 * t36);
+  const double t38 = t14 * t36 * (t16 * (t16 * t16)) * 1.617736500369853;
+  const double t39 = qd2 * qd2;
+  const double t40 = qd1 * qd2;
+  const double t41 = t23 * t39;
+  const double t42 = t6 * t41 + (t4 * (t3 * t33) - t4 * t36 - t4 * t41) - t5 * (t1 * (t11 * (t0 * t40))) * 4.0;
+  const double t43 = t8 * (t20 * t20);
+  const double t44 = t24 * t24;
+  const double t45 = t32 * t32;
+  dd[0] = t18 + (qd3 - t17);
+  dd[1] = t18 + (qd3 + t17);
+  dd[2] = t28 * t32 * 0.22010869565217392 + (qd3 - (t8 * t19 + t22 * t24) * 0.225);
+  ddb[0] = 0.27 * (t34 + t37 - t38);
+  ddb[1] = 0.27 * (t37 - t34 - t38);
+  ddb[2] = ((t28 * ((t24 * (t21 * t30) + (t24 * (t21 * t29) - t8 * (t5 * (t11 * t40)))) * 2.0 + (t8 * (t1 * t35) + t8 * (t1 * (t0 * t39)) - t31 * t42) - t44 * (t2 * t43) * 3.0) - t27 * t45) * 0.4891304347826087 + ((t8 * (t5 * t39) - t22 * t42) * 0.5 - t24 * (t19 * t21) - t5 * t43 * t44 * 1.5) - t45 * (t25 * (t27 * (t27 * t27))) * 0.46809505219035097) * 0.45;
+}
+
+void prru_passive(const double q[3], const double qd[3], double Qp[3])
+{
+  (void)qd;
+  const double q1 = q[0];
+  const double q2 = q[1];
+  const double q3 = q[2];
+  const double t0 = cos(q1);
+  const double t1 = cos(q2);
+  const double t2 = sin(q2);
+  const double t3 = sqrt(t0 * t0 * (t1 * t1) + t2 * t2);
+  /* Unreachable or non-finite q: every output is NaN. */
+  if (!(fabs((1.3333333333333333 - t0) * 1.173913043478261) <= 1.0 &&
+        fabs((t0 * t1 * (1.0 / t3) - 1.4) * 0.9782608695652174) <= 1.0 &&
+        fabs(q1) <= 1.7976931348623157e308 &&
+        fabs(q2) <= 1.7976931348623157e308 &&
+        fabs(q3) <= 1.7976931348623157e308)) {
+    for (int i = 0; i < 3; i++) Qp[i] = (double)NAN;
+    return;
+  }
+  Qp[0] = 0.0;
+  Qp[1] = 0.0;
+  Qp[2] = 0.0;
 }
 
 void prru_reaction_basis(const double q[3], double Q[3420])

@@ -20,6 +20,8 @@
  *   inertia_world      86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3
  *   wrench_bias        212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  *   energy             137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
@@ -33,38 +35,13 @@
  * No globals, no allocation, re-entrant; depends only on <math.h>. */
 
 #define PRRU_NQ 3
+#define PRRU_NACT 3
+#define PRRU_NLIMB 3
 #define PRRU_NBODY 10
+#define PRRU_NJOINT 12
 #define PRRU_NLAMBDA 57
-#define PRRU_GRAVITY 9.81 /* m/s^2, along -z */
-#define PRRU_GEOM_B12 0.36 /* m */
-#define PRRU_GEOM_B3 0.315 /* m */
-#define PRRU_GEOM_L1 0.23 /* m */
-#define PRRU_GEOM_L2 0.225 /* m */
-#define PRRU_GEOM_A 0.045 /* m */
-#define PRRU_TOTAL_MASS 12.39 /* kg */
-/* Body order of every array: P L1 L2 L3 U1 U2 U3 S1 S2 S3. */
-#define PRRU_BODY_NAMES { \
-  "P", "L1", "L2", "L3", "U1", "U2", "U3", "S1", "S2", "S3" }
-/* kg */
-#define PRRU_BODY_MASSES { \
-  1.77, 0.64, 0.64, 0.64, 1.31, 1.31, 1.31, 1.59, 1.59, 1.59 }
-/* Principal moments Ixx, Iyy, Izz about each centre, in the body frame (kg m^2). */
-#define PRRU_BODY_INERTIAS { \
-  0.0024, 0.0028, 0.0032, 0.0025, 0.0003, 0.0027, 0.0025, 0.0003, 0.0027, \
-  0.0003, 0.0025, 0.0027, 0.0065, 0.0016, 0.0079, 0.0065, 0.0016, 0.0079, \
-  0.0016, 0.0065, 0.0079, 0.0036, 0.0032, 0.0015, 0.0036, 0.0032, 0.0015, \
-  0.0036, 0.0032, 0.0015 }
-/* Reaction coordinates (lambda order): joint, f(orce) or m(oment), axis
-   (u = platform u axis, n = w x x3). */
-#define PRRU_LAMBDA_LABELS { \
-  "C1_fx", "C1_fy", "C1_fz", "C1_mu", "C2_fx", "C2_fy", "C2_fz", "C2_mu", \
-  "C3_fx", "C3_fy", "C3_fz", "C3_mn", "B1_fx", "B1_fy", "B1_fz", "B1_my", \
-  "B1_mz", "B2_fx", "B2_fy", "B2_fz", "B2_my", "B2_mz", "B3_fx", "B3_fy", \
-  "B3_fz", "B3_mx", "B3_mz", "A1_fx", "A1_fy", "A1_fz", "A1_my", "A1_mz", \
-  "A2_fx", "A2_fy", "A2_fz", "A2_my", "A2_mz", "A3_fx", "A3_fy", "A3_fz", \
-  "A3_mx", "A3_mz", "P1_fx", "P1_fy", "P1_mx", "P1_my", "P1_mz", "P2_fx", \
-  "P2_fy", "P2_mx", "P2_my", "P2_mz", "P3_fx", "P3_fy", "P3_mx", "P3_my", \
-  "P3_mz" }
+/* Body order of every array: P L1 L2 L3 U1 U2 U3 S1 S2 S3. The model's numbers and layout tables
+   are in prru_mechanism.h. */
 #define PRRU_ARITH_IK 30 /* arithmetic operations */
 #define PRRU_ARITH_JD 63 /* arithmetic operations */
 #define PRRU_ARITH_IK_JD 74 /* arithmetic operations */
@@ -80,6 +57,8 @@
 #define PRRU_ARITH_INERTIA_WORLD 86 /* arithmetic operations */
 #define PRRU_ARITH_WRENCH_BIAS 212 /* arithmetic operations */
 #define PRRU_ARITH_ENERGY 137 /* arithmetic operations */
+#define PRRU_ARITH_ACTUATOR_RATES 148 /* arithmetic operations */
+#define PRRU_ARITH_PASSIVE 12 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 58 /* arithmetic operations */
 #define PRRU_OPS_IK "30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JD "63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -96,6 +75,8 @@
 #define PRRU_OPS_INERTIA_WORLD "86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_WRENCH_BIAS "212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_ENERGY "137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ACTUATOR_RATES "148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_PASSIVE "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
@@ -117,10 +98,10 @@ void prru_jacobians(const double q[3], double H[180]);
 /* [delta_P..delta_S3; mu_P..mu_S3] (60): the parts of the angular and linear accelerations that are quadratic in qd. */
 void prru_bias_terms(const double q[3], const double qd[3], double dm[60]);
 
-/* Mass matrix M = H^T Phi H (3x3). */
+/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */
 void prru_mass(const double q[3], double M[9]);
 
-/* Bias forces h = H^T K (3). */
+/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). */
 void prru_bias(const double q[3], const double qd[3], double h[3]);
 
 /* Generalized gravity G = sum_b J_T,b^T (-m_b g e3). */
@@ -129,7 +110,7 @@ void prru_gravity(const double q[3], double G[3]);
 /* M, h and G fused (one shared evaluation). */
 void prru_dynamics(const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
 
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, so that M qdd = b. */
+/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive - h, so that M qdd = b. */
 void prru_eom(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3]);
 
 /* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,P (6x3). */
@@ -144,8 +125,14 @@ void prru_inertia_world(const double q[3], double I[90]);
 /* K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]. */
 void prru_wrench_bias(const double q[3], const double qd[3], double K[60]);
 
-/* E[0] = kinetic energy, E[1] = potential energy g sum_b m_b z_b. */
+/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. */
 void prru_energy(const double q[3], const double qd[3], double E[2]);
+
+/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. */
+void prru_actuator_rates(const double q[3], const double qd[3], double dd[3], double ddb[3]);
+
+/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). */
+void prru_passive(const double q[3], const double qd[3], double Qp[3]);
 
 /* Q (60x57) mapping the joint reaction coordinates lambda to body wrenches about each centre, so that Phi H qdd + K = Fbar + Q lambda. */
 void prru_reaction_basis(const double q[3], double Q[3420]);

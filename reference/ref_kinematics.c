@@ -12,22 +12,21 @@
 
 #include <gsl/gsl_errno.h>
 
-#include "prru_kernels.h"
+#include "prru_mechanism.h"
 #include "ref_internal.h"
 
 void prru_ref_params_default(prru_ref_params *p)
 {
-  static const double mass[PRRU_REF_NBODY] = PRRU_BODY_MASSES;
-  static const double inertia[3 * PRRU_REF_NBODY] = PRRU_BODY_INERTIAS;
-  p->g = PRRU_GRAVITY;
-  p->b12 = PRRU_GEOM_B12;
-  p->b3 = PRRU_GEOM_B3;
-  p->l1 = PRRU_GEOM_L1;
-  p->l2 = PRRU_GEOM_L2;
-  p->a = PRRU_GEOM_A;
+  const prru_mechanism *me = &prru_mech;
+  p->g = -me->gravity[2];
+  p->b12 = me->b[0];
+  p->b3 = me->b[2];
+  p->l1 = me->l1[0];
+  p->l2 = me->l2[0];
+  p->a = me->a[0];
   for (int b = 0; b < PRRU_REF_NBODY; b++) {
-    p->mass[b] = mass[b];
-    for (int i = 0; i < 3; i++) p->inertia[b][i] = inertia[3 * b + i];
+    p->mass[b] = me->mass[b];
+    for (int i = 0; i < 3; i++) p->inertia[b][i] = me->inertia[b][4 * i];
   }
 }
 

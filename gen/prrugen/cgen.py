@@ -306,6 +306,7 @@ def evaluate_lowered(exprs, env):
     g = Graph(names)
     roots = [g.lower(sym.as_expr(e)) for e in exprs]
     fns = {"sin": math.sin, "cos": math.cos, "tan": math.tan,
+           "tanh": math.tanh,
            "asin": math.asin, "acos": math.acos, "atan2": math.atan2,
            "sqrt": math.sqrt, "pow": lambda b, e: b ** e}
     vals = []

@@ -8,10 +8,16 @@ J_R = d omega / d qd and delta = d/dt(J_R) qd. Then
   h = H^T K     = sum_b m_b J_T^T mu + J_Rb^T (D_b delta_b + w_b x D_b w_b)
 
 with the rotational part in each body's own frame (subscript b), where the
-inertia D_b is a constant diagonal: I_b = R D R^T never has to be formed,
+inertia D_b is a constant tensor: I_b = R D R^T never has to be formed,
 and R^T (I delta + w x I w) = D delta_b + w_b x D w_b because
 d/dt (R^T w) = R^T w'. The world-frame quantities (H, delta, mu, K, I_b)
 are derived too, for the kernels that return them.
+
+Drives (model format 2) enter through the actuator coordinates d(q): an
+armature k_i adds the kinetic energy k_i dd_i^2 / 2, so M += J_d^T K J_d
+and h += J_d^T K (Jd' qd); damping and Coulomb friction are generalized
+forces J_d^T (-c dd - f tanh(dd / v_s)) kept out of h (as MuJoCo keeps
+qfrc_passive out of qfrc_bias) and added where accelerations are computed.
 """
 
 from . import sym
@@ -48,7 +54,7 @@ class BodyTerms:
         velocity = [dt(x) for x in body.centre]
         self.mu = [dt(x) for x in velocity]
         self.velocity = velocity
-        self.inertia = diag(body.inertia)
+        self.inertia = body.inertia
 
     def gyro_b(self):
         """D delta_b + w_b x D w_b: the body-frame rotational bias wrench."""
@@ -58,23 +64,46 @@ class BodyTerms:
 
 
 def _quad(a, d, b):
-    """a^T d b for 3x3 a, b and constant diagonal d."""
-    return [[sym.add(*[sym.mul(d[k][k], a[k][i], b[k][j]) for k in range(3)])
+    """a^T d b for 3x3 a, b and a constant symmetric d (its zero entries
+    contribute no terms, so a diagonal d gives the diagonal formula)."""
+    return [[sym.add(*[sym.mul(d[k][l], a[k][i], b[l][j])
+                       for k in range(3) for l in range(3)
+                       if not sym.is_const(d[k][l], 0)])
              for j in range(3)] for i in range(3)]
 
 
 def _atb(a, v):
-    """a^T v."""
-    return [dot([a[k][i] for k in range(3)], v) for i in range(3)]
+    """a^T v (a has len(v) rows and 3 columns)."""
+    return [dot([a[k][i] for k in range(len(v))], v) for i in range(3)]
+
+
+def _quad_n(a, d, b):
+    """a^T d b for n x 3 a, b and a constant n x n diagonal d."""
+    n = len(d)
+    return [[sym.add(*[sym.mul(d[k][k], a[k][i], b[k][j]) for k in range(n)
+                       if d[k][k]])
+             for j in range(3)] for i in range(3)]
 
 
 class Derivation:
-    def __init__(self, mech, gravity):
+    def __init__(self, mech, model):
         self.mech = mech
-        self.gravity = gravity
+        self.gravity = model.gravity
+        self.armature = model.armature
+        self.damping = model.damping
+        self.coulomb = model.coulomb
+        self.coulomb_velocity = model.coulomb_velocity
         q, qd = mech.q, mech.qd
         dt = sym.TimeDerivative(q, qd)
         self.terms = [BodyTerms(b, q, qd, dt) for b in mech.bodies]
+        self._jd = jacobian(mech.actuators, q)
+        self.actuator_rates = [dt(x) for x in mech.actuators]
+        self.actuator_bias = [dt(x) for x in self.actuator_rates]
+
+    def _armature_mass(self):
+        k = [[self.armature[i] if i == j else 0 for j in range(len(
+            self.armature))] for i in range(len(self.armature))]
+        return _quad_n(self._jd, k, self._jd)
 
     def mass(self):
         parts = []
@@ -82,6 +111,8 @@ class Derivation:
             m = t.body.mass
             parts.append(_quad(t.jt, diag([m, m, m]), t.jt))
             parts.append(_quad(t.jr_b, t.inertia, t.jr_b))
+        if any(self.armature):
+            parts.append(self._armature_mass())
         m = [sym.add(*[p[i][j] for p in parts]) for i in range(3)
              for j in range(3)]
         # Exact symmetry: take the upper triangle's expressions for both.
@@ -95,11 +126,32 @@ class Derivation:
         for t in self.terms:
             parts.append(_atb(t.jt, vscale(t.body.mass, t.mu)))
             parts.append(_atb(t.jr_b, t.gyro_b()))
+        if any(self.armature):
+            parts.append(_atb(self._jd, [sym.mul(k, a) for k, a in zip(
+                self.armature, self.actuator_bias)]))
         return [sym.add(*[p[i] for p in parts]) for i in range(3)]
 
+    def passive(self):
+        """J_d^T (-c dd - f tanh(dd / v_s)): damping and Coulomb friction of
+        the drives as generalized forces (zero without drives)."""
+        forces = []
+        for c, f, dd in zip(self.damping, self.coulomb, self.actuator_rates):
+            terms = [sym.mul(-c, dd)]
+            if f:
+                terms.append(sym.mul(-f, sym.tanh(sym.mul(
+                    1 / self.coulomb_velocity, dd))))
+            forces.append(sym.add(*terms))
+        return _atb(self._jd, forces)
+
     def potential(self):
-        return sym.mul(self.gravity, sym.add(*[
-            sym.mul(t.body.mass, t.body.centre[2]) for t in self.terms]))
+        gx, gy, gz = self.gravity
+        if gx == 0 and gy == 0:
+            # Format-1 models: V = g sum m z, the expressions as they were.
+            return sym.mul(-gz, sym.add(*[
+                sym.mul(t.body.mass, t.body.centre[2]) for t in self.terms]))
+        return sym.add(*[sym.mul(-g, sym.add(*[
+            sym.mul(t.body.mass, t.body.centre[k]) for t in self.terms]))
+            for k, g in enumerate(self.gravity) if g != 0])
 
     def gravity_force(self):
         v = self.potential()
@@ -110,14 +162,16 @@ class Derivation:
         for t in self.terms:
             total.append(sym.mul(t.body.mass, dot(t.velocity, t.velocity)))
             total.append(dot(t.omega_b, matvec(t.inertia, t.omega_b)))
+        if any(self.armature):
+            total += [sym.mul(k, dd, dd) for k, dd in
+                      zip(self.armature, self.actuator_rates) if k]
         return sym.mul(sym.Fraction(1, 2), sym.add(*total))
 
     def actuators(self):
         return list(self.mech.actuators)
 
     def actuator_jacobian(self):
-        return [x for row in jacobian(self.mech.actuators, self.mech.q)
-                for x in row]
+        return [x for row in self._jd for x in row]
 
     def jacobians(self):
         rows = [r for t in self.terms for r in t.jr_w]
@@ -152,12 +206,14 @@ class Derivation:
         return rot_part + lin_part
 
     def eom_rhs(self, fd, fp, mp):
-        """b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h."""
-        jd = jacobian(self.mech.actuators, self.mech.q)
+        """b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive - h."""
         t = self.terms[0]
         g, h = self.gravity_force(), self.bias()
-        ad, af, am = _atb(jd, fd), _atb(t.jt, fp), _atb(t.jr_w, mp)
-        return [sym.add(g[i], ad[i], af[i], am[i], -h[i]) for i in range(3)]
+        ad, af, am = _atb(self._jd, fd), _atb(t.jt, fp), _atb(t.jr_w, mp)
+        parts = [g, ad, af, am, [-x for x in h]]
+        if any(self.damping) or any(self.coulomb):
+            parts.append(self.passive())
+        return [sym.add(*[p[i] for p in parts]) for i in range(3)]
 
     def reaction_basis(self):
         """Q (60 x 57): lambda -> wrenches about each body's centre."""

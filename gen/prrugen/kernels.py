@@ -7,8 +7,12 @@ Q = ("q", ["q1", "q2", "q3"])
 QD = ("qd", ["qd1", "qd2", "qd3"])
 
 
-def _vec(name):
-    return [sym.sym("%s%d" % (name, i + 1)) for i in range(3)]
+def _vec(name, n=3):
+    return [sym.sym("%s%d" % (name, i + 1)) for i in range(n)]
+
+
+def _arg(name, n):
+    return (name, ["%s%d" % (name, i + 1) for i in range(n)])
 
 
 def kernels(deriv):
@@ -16,13 +20,15 @@ def kernels(deriv):
     guards = deriv.mech.guards
     d, jd = deriv.actuators(), deriv.actuator_jacobian()
     m, h, g = deriv.mass(), deriv.bias(), deriv.gravity_force()
-    fd, fp, mp = _vec("fd"), _vec("fp"), _vec("mp")
+    nact = len(d)
+    fd, fp, mp = _vec("fd", nact), _vec("fp"), _vec("mp")
     rs, ps = deriv.poses()
     t, v = deriv.kinetic(), deriv.potential()
     spec = [
         ("ik", "Actuator displacements d_i (height of joint A_i on rail i).",
          [Q], [("d", d)]),
-        ("jd", "Actuator Jacobian J_d = dd/dq (3x3).", [Q], [("Jd", jd)]),
+        ("jd", "Actuator Jacobian J_d = dd/dq (%dx3)." % nact, [Q],
+         [("Jd", jd)]),
         ("ik_jd", "prru_ik and prru_jd fused.", [Q], [("d", d), ("Jd", jd)]),
         ("jacobians", "H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], "
          "world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3.",
@@ -30,16 +36,18 @@ def kernels(deriv):
         ("bias_terms", "[delta_P..delta_S3; mu_P..mu_S3] (60): the parts of "
          "the angular and linear accelerations that are quadratic in qd.",
          [Q, QD], [("dm", deriv.bias_terms())]),
-        ("mass", "Mass matrix M = H^T Phi H (3x3).", [Q], [("M", m)]),
-        ("bias", "Bias forces h = H^T K (3).", [Q, QD], [("h", h)]),
+        ("mass", "Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3).",
+         [Q], [("M", m)]),
+        ("bias", "Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive "
+         "damping and friction are not in h (see passive).",
+         [Q, QD], [("h", h)]),
         ("gravity", "Generalized gravity G = sum_b J_T,b^T (-m_b g e3).",
          [Q], [("G", g)]),
         ("dynamics", "M, h and G fused (one shared evaluation).",
          [Q, QD], [("M", m), ("h", h), ("G", g)]),
         ("eom", "Forward-dynamics terms: M and b = G + J_d^T fd + "
-         "J_T,P^T fp + J_R,P^T mp - h, so that M qdd = b.",
-         [Q, QD, ("fd", ["fd1", "fd2", "fd3"]), ("fp", ["fp1", "fp2", "fp3"]),
-          ("mp", ["mp1", "mp2", "mp3"])],
+         "J_T,P^T fp + J_R,P^T mp + passive - h, so that M qdd = b.",
+         [Q, QD, _arg("fd", nact), _arg("fp", 3), _arg("mp", 3)],
          [("M", m), ("b", deriv.eom_rhs(fd, fp, mp))]),
         ("platform_jacobian", "Platform Jacobians: rows 0-2 J_R,P, rows 3-5 "
          "J_T,P (6x3).", [Q], [("JP", deriv.platform_jacobian())]),
@@ -50,11 +58,21 @@ def kernels(deriv):
          [Q], [("I", deriv.inertia_world())]),
         ("wrench_bias", "K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b].",
          [Q, QD], [("K", deriv.wrench_bias())]),
-        ("energy", "E[0] = kinetic energy, E[1] = potential energy "
-         "g sum_b m_b z_b.", [Q, QD], [("E", [t, v])]),
-        ("reaction_basis", "Q (60x57) mapping the joint reaction "
+        ("energy", "E[0] = kinetic energy (with the drives' armature), "
+         "E[1] = potential energy -sum_b m_b g . p_b.", [Q, QD],
+         [("E", [t, v])]),
+        ("actuator_rates", "Slider velocities dd = J_d qd and the "
+         "qd-quadratic part of their accelerations, ddb = Jd' qd.",
+         [Q, QD], [("dd", deriv.actuator_rates),
+                   ("ddb", deriv.actuator_bias)]),
+        ("passive", "Generalized drive forces J_d^T (-c dd - f tanh(dd / "
+         "v_s)): viscous damping and smoothed Coulomb friction (zero without "
+         "drives).", [Q, QD], [("Qp", deriv.passive())]),
+        ("reaction_basis", "Q (%dx%d) mapping the joint reaction "
          "coordinates lambda to body wrenches about each centre, so that "
-         "Phi H qdd + K = Fbar + Q lambda.",
+         "Phi H qdd + K = Fbar + Q lambda." % (6 * len(deriv.terms),
+                                                sum(len(j.basis) for j in
+                                                    deriv.mech.joints)),
          [Q], [("Q", deriv.reaction_basis())]),
     ]
     return [Kernel(name, doc, ins, outs, guards)

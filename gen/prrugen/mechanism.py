@@ -19,12 +19,19 @@ X, Y, Z = 0, 1, 2
 
 
 class Body:
-    def __init__(self, name, chain, centre, mass, inertia):
+    def __init__(self, name, chain, origin, mass, com, inertia):
         self.name = name
         self.chain = chain            # [(axis, angle expression)]
-        self.centre = centre          # p_b, 3 expressions in {S}
+        self.origin = origin          # frame origin of the pose functions
         self.mass = mass              # Fraction
-        self.inertia = inertia        # principal moments in the body frame
+        self.com = com                # centre of mass in the body frame
+        self.inertia = inertia        # 3x3 tensor about the centre, body axes
+        # p_b = origin_b + R_b com: the centre every Newton-Euler quantity
+        # refers to (the origin itself when com = 0).
+        if any(com):
+            self.centre = vadd(origin, matvec(self.rotation, vec(*com)))
+        else:
+            self.centre = origin
 
     @property
     def rotation(self):
@@ -46,8 +53,9 @@ class Joint:
 
 
 class Mechanism:
-    def __init__(self, q, qd, bodies, joints, actuators, guards):
+    def __init__(self, q, qd, bodies, joints, actuators, guards, limbs):
         self.q, self.qd = q, qd
+        self.limbs = limbs            # per limb: joint centres, d, slider
         self.bodies = bodies
         self.joints = joints
         self.actuators = actuators    # d_i(q): slider heights
@@ -56,14 +64,14 @@ class Mechanism:
 
 def _limb12(s, g, platform_rot, p_platform):
     """Limbs 1 (s = -1) and 2 (s = +1): in the plane x = 0, hinges along e1."""
-    c_joint = vadd(p_platform, matvec(platform_rot, vec(0, s * g["a"], 0)))
+    c_joint = vadd(p_platform, matvec(platform_rot, vec(0, s * g.a, 0)))
     r_lower = rot(X, sym.sym("q1"))
-    b_joint = vadd(c_joint, matvec(r_lower, vec(0, s * g["l2"], 0)))
-    p_lower = vadd(c_joint, matvec(r_lower, vec(0, s * g["l2"] / 2, 0)))
-    y_a = s * g["b12"]
-    cos_arg = s * (y_a - b_joint[Y]) / g["l1"]
+    b_joint = vadd(c_joint, matvec(r_lower, vec(0, s * g.l2, 0)))
+    p_lower = vadd(c_joint, matvec(r_lower, vec(0, s * g.l2 / 2, 0)))
+    y_a = s * g.b
+    cos_arg = s * (y_a - b_joint[Y]) / g.l1
     alpha = s * sym.acos(cos_arg)
-    d = b_joint[Z] + s * g["l1"] * sym.sin(alpha)
+    d = b_joint[Z] + s * g.l1 * sym.sin(alpha)
     a_joint = vec(0, y_a, d)
     p_upper = vscale(Fraction(1, 2), vadd(a_joint, b_joint))
     return dict(c=c_joint, b=b_joint, a=a_joint, d=d, guard=cos_arg,
@@ -77,12 +85,12 @@ def _limb3(g, p_platform):
     q1, q2 = sym.sym("q1"), sym.sym("q2")
     gamma = sym.atan2(sym.sin(q2), sym.cos(q1) * sym.cos(q2))
     x3 = matvec(rot(Y, gamma), unit(X))
-    b_joint = vadd(p_platform, vscale(g["l2"], x3))
-    p_lower = vadd(p_platform, vscale(g["l2"] / 2, x3))
-    cos_arg = (b_joint[X] - g["b3"]) / g["l1"]
+    b_joint = vadd(p_platform, vscale(g.l2, x3))
+    p_lower = vadd(p_platform, vscale(g.l2 / 2, x3))
+    cos_arg = (b_joint[X] - g.b) / g.l1
     alpha = sym.acos(cos_arg)
-    d = b_joint[Z] + g["l1"] * sym.sin(alpha)
-    a_joint = vec(g["b3"], 0, d)
+    d = b_joint[Z] + g.l1 * sym.sin(alpha)
+    a_joint = vec(g.b, 0, d)
     p_upper = vscale(Fraction(1, 2), vadd(a_joint, b_joint))
     return dict(c=p_platform, b=b_joint, a=a_joint, d=d, guard=cos_arg,
                 x3=x3, lower=([(Y, gamma)], p_lower),
@@ -92,23 +100,24 @@ def _limb3(g, p_platform):
 
 def build(model):
     """The mechanism of a validated model (see model.py)."""
-    g = model.geometry
+    g = model.limbs
     q = [sym.sym("q1"), sym.sym("q2"), sym.sym("q3")]
     qd = [sym.sym("qd1"), sym.sym("qd2"), sym.sym("qd3")]
     platform_chain = [(X, q[0]), (Y, q[1])]
     p_platform = vec(0, 0, q[2])
     platform_rot = matmul(rot(X, q[0]), rot(Y, q[1]))
-    limbs = [_limb12(-1, g, platform_rot, p_platform),
-             _limb12(+1, g, platform_rot, p_platform),
-             _limb3(g, p_platform)]
+    limbs = [_limb12(-1, g[0], platform_rot, p_platform),
+             _limb12(+1, g[1], platform_rot, p_platform),
+             _limb3(g[2], p_platform)]
 
     parts = [(platform_chain, p_platform)]
     parts += [limb["lower"] for limb in limbs]
     parts += [limb["upper"] for limb in limbs]
     parts += [limb["slider"] for limb in limbs]
     from .model import BODY_NAMES
-    bodies = [Body(name, chain, centre, model.masses[i], model.inertias[i])
-              for i, (name, (chain, centre)) in
+    bodies = [Body(name, chain, origin, model.masses[i], model.coms[i],
+                   _tensor(model.inertias[i]))
+              for i, (name, (chain, origin)) in
               enumerate(zip(BODY_NAMES, parts))]
 
     joints = _joints(limbs, platform_rot)
@@ -116,7 +125,14 @@ def build(model):
     for limb in limbs:
         if limb["guard"] not in guards:
             guards.append(limb["guard"])
-    return Mechanism(q, qd, bodies, joints, [l["d"] for l in limbs], guards)
+    return Mechanism(q, qd, bodies, joints, [l["d"] for l in limbs], guards,
+                     limbs)
+
+
+def _tensor(entries):
+    """(Ixx, Iyy, Izz, Ixy, Ixz, Iyz) -> symmetric 3x3 of constants."""
+    xx, yy, zz, xy, xz, yz = (sym.const(v) for v in entries)
+    return [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
 
 
 P_, L_, U_, S_ = 0, 1, 4, 7     # first index of each body group

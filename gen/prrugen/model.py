@@ -4,6 +4,14 @@ A model file is JSON; every number becomes an exact Fraction (parsed from its
 decimal text, never through a binary float) so that the geometry folds
 exactly in the symbolic engine. Every rejection names the file, the key path
 and the reason, because users edit these files by hand.
+
+Two formats are read into one normalized Model:
+  format 1 (no "format" key): the paper's idealised robot, one b12/b3/l1/l2/a,
+    gravity as a magnitude along -z, principal moments only;
+  format 2 ("format": 2): per-limb geometry, a gravity vector, centres of mass
+    off the body-frame origins, full inertia tensors and drive parameters
+    (armature, viscous damping, smoothed Coulomb friction).
+A format-1 file and its format-2 transcription give the same Model.
 """
 
 import hashlib
@@ -13,10 +21,15 @@ import re
 from decimal import Decimal, InvalidOperation
 from fractions import Fraction
 
+NLIMB = 3
 BODY_NAMES = ("P", "L1", "L2", "L3", "U1", "U2", "U3", "S1", "S2", "S3")
 GEOMETRY_KEYS = ("b12", "b3", "l1", "l2", "a")
+GEOMETRY2_KEYS = ("b", "l1", "l2", "a")
 TOP_KEYS = ("name", "description", "gravity", "geometry", "bodies")
+TOP2_KEYS = ("format",) + TOP_KEYS + ("actuators",)
 BODY_KEYS = ("mass", "inertia")
+BODY2_KEYS = ("mass", "inertia", "com")
+ACTUATOR_KEYS = ("armature", "damping", "coulomb", "coulomb_velocity")
 MAX_BYTES = 1 << 20
 
 
@@ -29,23 +42,53 @@ class ModelError(Exception):
         super().__init__("%s: %s" % (where, reason))
 
 
-class Model:
-    """A validated model: exact Fractions, plus the file's SHA-256."""
+class Limb:
+    """Geometry of one limb (m): rail offset b, upper link l1 (A to B),
+    lower link l2 (B to C), U-joint offset a of C on the platform (limbs 1,
+    2 only; limb 3's U joint is O' itself, a = 0)."""
 
-    def __init__(self, name, description, gravity, geometry, masses,
-                 inertias, sha256, path):
+    def __init__(self, b, l1, l2, a):
+        self.b, self.l1, self.l2, self.a = b, l1, l2, a
+
+
+class Model:
+    """A validated model: exact Fractions, plus the file's SHA-256.
+
+    gravity: acceleration vector in {S}; inertias: (Ixx, Iyy, Izz, Ixy, Ixz,
+    Iyz) about each centre of mass in body axes; coms: centre of mass in the
+    body frame from the frame origin of the pose functions; drives: per
+    actuator armature (kg), damping (N s/m), Coulomb force (N), and the
+    Coulomb smoothing velocity (m/s, None when no friction)."""
+
+    def __init__(self, name, description, fmt, gravity, limbs, masses, coms,
+                 inertias, armature, damping, coulomb, coulomb_velocity,
+                 sha256, path):
         self.name = name
         self.description = description
+        self.format = fmt
         self.gravity = gravity
-        self.geometry = geometry      # dict name -> Fraction
-        self.masses = masses          # tuple of Fraction, body order
-        self.inertias = inertias      # tuple of (Ixx, Iyy, Izz), body order
+        self.limbs = limbs
+        self.masses = masses
+        self.coms = coms
+        self.inertias = inertias
+        self.armature = armature
+        self.damping = damping
+        self.coulomb = coulomb
+        self.coulomb_velocity = coulomb_velocity
         self.sha256 = sha256
         self.path = path
 
     @property
     def total_mass(self):
         return sum(self.masses, Fraction(0))
+
+    @property
+    def has_drives(self):
+        return any(self.armature) or any(self.damping) or any(self.coulomb)
+
+    @property
+    def has_passive(self):
+        return any(self.damping) or any(self.coulomb)
 
 
 def _reject_constant(name):
@@ -113,6 +156,14 @@ def _positive(path, key, value):
     return value
 
 
+def _nonnegative(path, key, value):
+    value = _number(path, key, value)
+    if value < 0:
+        raise ModelError(path, key, "must not be negative (got %s)"
+                         % _fmt(value))
+    return value
+
+
 def _fmt(value):
     return repr(float(value))
 
@@ -123,57 +174,195 @@ def _object(path, key, value, allowed, required):
     prefix = key + "." if key else ""
     for k in value:
         if k not in allowed:
-            raise ModelError(path, prefix + k, "unknown key (allowed: %s)"
-                             % ", ".join(allowed))
+            raise ModelError(path, prefix + _key_text(k),
+                             "unknown key (allowed: %s)" % ", ".join(allowed))
     for k in required:
         if k not in value:
             raise ModelError(path, prefix + k, "missing")
     return value
 
 
-def _inertia(path, key, value):
+def _key_text(key):
+    """A user's key as it may appear in a one-line message: escaped, short."""
+    text = key.encode("unicode_escape").decode("ascii").replace('"', '\\"')
+    return '"%s"' % (text if len(text) <= 40 else text[:37] + "...") \
+        if not re.fullmatch(r"[A-Za-z0-9_]{1,40}", key) else key
+
+
+def _per_limb(path, key, value, count, check, what):
+    """One number for every limb, or a list of exactly count numbers."""
+    if isinstance(value, list):
+        if len(value) != count:
+            raise ModelError(path, key, "must be one number or a list of %d "
+                             "(%s), got %d entries" % (count, what,
+                                                       len(value)))
+        return tuple(check(path, "%s[%d]" % (key, i), v)
+                     for i, v in enumerate(value))
+    return (check(path, key, value),) * count
+
+
+def _vector3(path, key, value, what):
     if not isinstance(value, list) or len(value) != 3:
+        raise ModelError(path, key, "must be a list of 3 numbers (%s)" % what)
+    return tuple(_number(path, "%s[%d]" % (key, i), v)
+                 for i, v in enumerate(value))
+
+
+def _minors_ok(m, strict):
+    """Sylvester's criterion on an exact symmetric 3x3: positive definite
+    (strict) from the leading minors, positive semidefinite from all
+    principal minors."""
+    det2 = lambda i, j: m[i][i] * m[j][j] - m[i][j] * m[j][i]  # noqa: E731
+    det3 = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+    if strict:
+        return m[0][0] > 0 and det2(0, 1) > 0 and det3 > 0
+    return (all(m[i][i] >= 0 for i in range(3))
+            and all(det2(i, j) >= 0 for i, j in ((0, 1), (0, 2), (1, 2)))
+            and det3 >= 0)
+
+
+def _tensor(t):
+    xx, yy, zz, xy, xz, yz = t
+    return ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz))
+
+
+def _inertia(path, key, value, fmt):
+    sizes = (3,) if fmt == 1 else (3, 6)
+    if not isinstance(value, list) or len(value) not in sizes:
         raise ModelError(path, key, "must be a list of 3 principal moments "
-                         "[Ixx, Iyy, Izz] in the body frame")
-    moments = tuple(_positive(path, "%s[%d]" % (key, i), v)
+                         "[Ixx, Iyy, Izz] in the body frame" if fmt == 1 else
+                         "must be a list of 3 principal moments [Ixx, Iyy, "
+                         "Izz] or 6 tensor entries [Ixx, Iyy, Izz, Ixy, Ixz, "
+                         "Iyz] about the centre of mass, in body axes")
+    if len(value) == 3:
+        moments = tuple(_positive(path, "%s[%d]" % (key, i), v)
+                        for i, v in enumerate(value))
+        for i in range(3):
+            j, k = (i + 1) % 3, (i + 2) % 3
+            if moments[i] > moments[j] + moments[k]:
+                raise ModelError(path, key, "violates the triangle "
+                                 "inequality (I%d = %s > %s + %s): no rigid "
+                                 "body has it"
+                                 % (i + 1, _fmt(moments[i]), _fmt(moments[j]),
+                                    _fmt(moments[k])))
+        return moments + (Fraction(0),) * 3
+    entries = tuple(_number(path, "%s[%d]" % (key, i), v)
                     for i, v in enumerate(value))
-    for i in range(3):
-        j, k = (i + 1) % 3, (i + 2) % 3
-        if moments[i] > moments[j] + moments[k]:
-            raise ModelError(path, key, "violates the triangle inequality "
-                             "(I%d = %s > %s + %s): no rigid body has it"
-                             % (i + 1, _fmt(moments[i]), _fmt(moments[j]),
-                                _fmt(moments[k])))
-    return moments
+    tensor = _tensor(entries)
+    if not _minors_ok(tensor, strict=True):
+        raise ModelError(path, key, "is not positive definite: no rigid body "
+                         "has this inertia tensor")
+    # I = tr(I)/2 E - S with S = integral of r r^T dm, which must be positive
+    # semidefinite: the tensor form of the triangle inequality.
+    half = sum(tensor[i][i] for i in range(3)) / 2
+    second = tuple(tuple((half if i == j else 0) - tensor[i][j]
+                         for j in range(3)) for i in range(3))
+    if not _minors_ok(second, strict=False):
+        raise ModelError(path, key, "violates the triangle inequality of "
+                         "its principal moments: no rigid body has it")
+    return entries
 
 
-def _check_assembly(path, geometry):
+def _check_assembly(path, limbs, fmt):
     # At q = 0 the limbs must close with the upper links strictly short of
     # full stretch; otherwise acos() is undefined or J_d singular at home.
-    g = geometry
-    for limb, num in (("limbs 1, 2", g["b12"] - g["a"] - g["l2"]),
-                      ("limb 3", g["b3"] - g["l2"])):
-        x = num / g["l1"]
-        if not -1 < x < 1:
+    if fmt == 1:
+        groups = (("limbs 1, 2", limbs[0]), ("limb 3", limbs[2]))
+    else:
+        groups = tuple(("limb %d" % (i + 1), l) for i, l in enumerate(limbs))
+    for label, limb in groups:
+        gap = limb.b - limb.a - limb.l2
+        if not -1 < gap / limb.l1 < 1:
             raise ModelError(path, "geometry", "%s cannot be assembled at "
                              "q = 0: the horizontal gap %s m must be shorter "
                              "than the upper link l1 = %s m"
-                             % (limb, _fmt(num), _fmt(g["l1"])))
+                             % (label, _fmt(gap), _fmt(limb.l1)))
 
 
-def parse(text, path="<model>"):
-    """Validate model JSON text; returns a Model or raises ModelError."""
+def _geometry1(path, geo):
+    geo = _object(path, "geometry", geo, GEOMETRY_KEYS, GEOMETRY_KEYS)
+    g = {k: _positive(path, "geometry." + k, geo[k]) for k in GEOMETRY_KEYS}
+    return (Limb(g["b12"], g["l1"], g["l2"], g["a"]),
+            Limb(g["b12"], g["l1"], g["l2"], g["a"]),
+            Limb(g["b3"], g["l1"], g["l2"], Fraction(0)))
+
+
+def _geometry2(path, geo):
+    geo = _object(path, "geometry", geo, GEOMETRY2_KEYS, GEOMETRY2_KEYS)
+    if not isinstance(geo["b"], list):
+        raise ModelError(path, "geometry.b", "must be a list of %d rail "
+                         "offsets [b1, b2, b3]" % NLIMB)
+    b = _per_limb(path, "geometry.b", geo["b"], NLIMB, _positive,
+                  "rail offsets b1, b2, b3")
+    l1 = _per_limb(path, "geometry.l1", geo["l1"], NLIMB, _positive,
+                   "one upper link per limb")
+    l2 = _per_limb(path, "geometry.l2", geo["l2"], NLIMB, _positive,
+                   "one lower link per limb")
+    a = _per_limb(path, "geometry.a", geo["a"], 2, _positive,
+                  "U-joint offsets a1, a2 of limbs 1 and 2")
+    return tuple(Limb(b[i], l1[i], l2[i], a[i] if i < 2 else Fraction(0))
+                 for i in range(NLIMB))
+
+
+def _gravity(path, value, fmt):
+    if fmt == 2 and isinstance(value, list):
+        return _vector3(path, "gravity", value, "acceleration in {S}, m/s^2")
+    g = _number(path, "gravity", value)
+    if g < 0:
+        raise ModelError(path, "gravity", "is the magnitude along -z and "
+                         "must not be negative (got %s)" % _fmt(g))
+    return (Fraction(0), Fraction(0), -g)
+
+
+def _actuators(path, value):
+    zero = (Fraction(0),) * NLIMB
+    if value is None:
+        return zero, zero, zero, None
+    value = _object(path, "actuators", value, ACTUATOR_KEYS, ())
+    lists = [_per_limb(path, "actuators." + k, value[k], NLIMB, _nonnegative,
+                       "one per actuator") if k in value else zero
+             for k in ACTUATOR_KEYS[:3]]
+    vs = None
+    if "coulomb_velocity" in value:
+        vs = _positive(path, "actuators.coulomb_velocity",
+                       value["coulomb_velocity"])
+    if any(lists[2]) and vs is None:
+        raise ModelError(path, "actuators.coulomb_velocity", "missing: the "
+                         "Coulomb force -f tanh(dd / v_s) needs the smoothing "
+                         "velocity v_s (m/s)")
+    return lists[0], lists[1], lists[2], vs if any(lists[2]) else None
+
+
+def _load_json(text, path):
     if len(text) > MAX_BYTES:
         raise ModelError(path, None, "file is %d bytes; a model file is at "
                          "most %d" % (len(text), MAX_BYTES))
     try:
-        data = json.loads(text, parse_float=_parse_number,
+        return json.loads(text, parse_float=_parse_number,
                           parse_int=_parse_number,
                           parse_constant=_reject_constant,
                           object_pairs_hook=_pairs_no_duplicates)
     except (ValueError, RecursionError) as exc:
         raise ModelError(path, None, "not valid JSON: %s" % exc) from None
-    _object(path, "", data, TOP_KEYS, TOP_KEYS)
+
+
+def parse(text, path="<model>"):
+    """Validate model JSON text; returns a Model or raises ModelError."""
+    data = _load_json(text, path)
+    if isinstance(data, dict) and "format" in data:
+        fmt = data["format"]
+        if isinstance(fmt, bool) or fmt not in (1, 2):
+            raise ModelError(path, "format", "must be 1 or 2 (got %s)"
+                             % _json_text(fmt))
+        fmt = int(fmt)
+    else:
+        fmt = 1
+    if fmt == 1:
+        _object(path, "", data, ("format",) + TOP_KEYS, TOP_KEYS)
+    else:
+        _object(path, "", data, TOP2_KEYS, TOP_KEYS)
     name = data["name"]
     if not isinstance(name, str) or not re.fullmatch(r"[a-z][a-z0-9_]{0,15}",
                                                       name):
@@ -184,25 +373,25 @@ def parse(text, path="<model>"):
             or any(ord(c) < 32 for c in description) or len(description) > 400:
         raise ModelError(path, "description", "must be one line of text "
                          "(at most 400 characters, no '*/')")
-    gravity = _number(path, "gravity", data["gravity"])
-    if gravity < 0:
-        raise ModelError(path, "gravity", "is the magnitude along -z and "
-                         "must not be negative (got %s)" % _fmt(gravity))
-    geo = _object(path, "geometry", data["geometry"], GEOMETRY_KEYS,
-                  GEOMETRY_KEYS)
-    geometry = {k: _positive(path, "geometry." + k, geo[k])
-                for k in GEOMETRY_KEYS}
-    _check_assembly(path, geometry)
+    gravity = _gravity(path, data["gravity"], fmt)
+    limbs = _geometry1(path, data["geometry"]) if fmt == 1 else \
+        _geometry2(path, data["geometry"])
+    _check_assembly(path, limbs, fmt)
+    body_keys = BODY_KEYS if fmt == 1 else BODY2_KEYS
     bodies = _object(path, "bodies", data["bodies"], BODY_NAMES, BODY_NAMES)
-    masses, inertias = [], []
+    masses, coms, inertias = [], [], []
     for b in BODY_NAMES:
         key = "bodies." + b
-        body = _object(path, key, bodies[b], BODY_KEYS, BODY_KEYS)
+        body = _object(path, key, bodies[b], body_keys, BODY_KEYS)
         masses.append(_positive(path, key + ".mass", body["mass"]))
-        inertias.append(_inertia(path, key + ".inertia", body["inertia"]))
+        inertias.append(_inertia(path, key + ".inertia", body["inertia"], fmt))
+        coms.append(_vector3(path, key + ".com", body["com"], "centre of mass "
+                             "in the body frame, m") if "com" in body
+                    else (Fraction(0),) * 3)
+    drives = _actuators(path, data.get("actuators"))
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    return Model(name, description, gravity, geometry, tuple(masses),
-                 tuple(inertias), sha, path)
+    return Model(name, description, fmt, gravity, limbs, tuple(masses),
+                 tuple(coms), tuple(inertias), *drives, sha256=sha, path=path)
 
 
 def load(path):

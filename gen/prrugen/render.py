@@ -1,11 +1,11 @@
-"""Filling the C templates: file headers, model constants, kernels."""
+"""Filling the C templates: file headers, kernels, mechanism descriptor."""
 
 import os
 from string import Template
 
 from . import cgen
 from .kernels import kernels, lambda_labels
-from .model import BODY_NAMES, GEOMETRY_KEYS, c_double
+from .model import c_double
 
 GENERATOR = "gen/prru_gen.py"
 
@@ -27,46 +27,123 @@ def _wrap_list(items, indent="  "):
     return " \\\n".join(lines)
 
 
-def render(model, deriv, templates_dir):
-    """{file name: text} for the kernels of model, and the emitted kernels."""
-    prefix, upper = model.name, model.name.upper()
+def _c_string(text):
+    return '"%s"' % text.replace("\\", "\\\\").replace('"', '\\"')
+
+
+def _tensor3(entries):
+    from fractions import Fraction
+    xx, yy, zz, xy, xz, yz = entries
+    return [[Fraction(xx), xy, xz], [xy, Fraction(yy), yz], [xz, yz, zz]]
+
+
+def _inverse3(m):
+    """Exact inverse of a 3x3 of Fractions (the model checked it regular)."""
+    c = [[m[(j + 1) % 3][(i + 1) % 3] * m[(j + 2) % 3][(i + 2) % 3]
+          - m[(j + 1) % 3][(i + 2) % 3] * m[(j + 2) % 3][(i + 1) % 3]
+          for j in range(3)] for i in range(3)]
+    det = sum(m[0][k] * c[k][0] for k in range(3))
+    return [[c[i][j] / det for j in range(3)] for i in range(3)]
+
+
+def _block(values, indent="    "):
+    """{a, b, ...} wrapped at 78 columns, continuation lines indented."""
+    lines, line = [], "{"
+    for i, v in enumerate(values):
+        piece = v + (", " if i < len(values) - 1 else "}")
+        if len(line) + len(piece.rstrip()) > 74 and line.strip("{"):
+            lines.append(line.rstrip())
+            line = indent
+        line += piece
+    lines.append(line)
+    return "\n".join(lines)
+
+
+def _descriptor(model, mech, prefix, labels):
+    """Initializer fields of the mechanism descriptor, in struct order."""
+    nb, nl = len(mech.bodies), len(mech.limbs)
+    body_limb = [-1] + [i % nl for i in range(nb - 1)]
+    joints = []
+    offset = 0
+    for j in mech.joints:
+        kind = {"C": "U", "B": "R", "A": "R", "P": "P"}[j.name[0]]
+        n = len(j.basis)
+        joints.append('{"%s", \'%s\', %d, %d, %d, %d, %d}'
+                      % (j.name, kind, int(j.name[1:]) - 1,
+                         -1 if j.proximal is None else j.proximal, j.distal,
+                         offset, n))
+        offset += n
+    inertia = [_tensor3(i) for i in model.inertias]
+    num = lambda v: c_double(v)  # noqa: E731
+    fields = [
+        ("name", _c_string(model.name)),
+        ("description", _c_string(model.description)),
+        ("model_file", _c_string(os.path.basename(model.path))),
+        ("sha256", _c_string(model.sha256)),
+        ("format", str(model.format)),
+        ("nq", "%s_NQ" % prefix.upper()), ("nact", "%s_NACT" % prefix.upper()),
+        ("nlimb", "%s_NLIMB" % prefix.upper()),
+        ("nbody", "%s_NBODY" % prefix.upper()),
+        ("nlambda", "%s_NLAMBDA" % prefix.upper()),
+        ("njoint", "%s_NJOINT" % prefix.upper()),
+        ("body_names", _block(['"%s"' % b.name for b in mech.bodies])),
+        ("body_limb", _block([str(x) for x in body_limb])),
+        ("platform", "0"),
+        ("lower", _block([str(1 + i) for i in range(nl)])),
+        ("upper", _block([str(1 + nl + i) for i in range(nl)])),
+        ("slider", _block([str(1 + 2 * nl + i) for i in range(nl)])),
+        ("gravity", _block([num(g) for g in model.gravity])),
+        ("mass", _block([num(m) for m in model.masses])),
+        ("total_mass", num(model.total_mass)),
+        ("com", _block([_block([num(x) for x in c], "      ")
+                        for c in model.coms])),
+        ("inertia", _block([_block([num(x) for r in t for x in r], "      ")
+                            for t in inertia])),
+        ("inertia_inv", _block([_block([num(x) for r in _inverse3(t)
+                                        for x in r], "      ")
+                                for t in inertia])),
+        ("b", _block([num(l.b) for l in model.limbs])),
+        ("l1", _block([num(l.l1) for l in model.limbs])),
+        ("l2", _block([num(l.l2) for l in model.limbs])),
+        ("a", _block([num(l.a) for l in model.limbs])),
+        ("armature", _block([num(x) for x in model.armature])),
+        ("damping", _block([num(x) for x in model.damping])),
+        ("coulomb", _block([num(x) for x in model.coulomb])),
+        ("coulomb_velocity", num(model.coulomb_velocity or 0)),
+        ("joint", "{\n      " + ",\n      ".join(joints) + "}"),
+        ("lambda_labels", _block(['"%s"' % l for l in labels])),
+    ]
+    return ",\n".join("  /* .%s = */ %s" % f for f in fields)
+
+
+def render(model, deriv, templates_dir, prefix=None):
+    """{file name: text} for the kernels and mechanism descriptor of model,
+    and the emitted kernels. prefix: the C prefix (default: model name)."""
+    prefix = prefix or model.name
+    upper = prefix.upper()
+    mech = deriv.mech
     emitted = [cgen.emit(k, prefix) for k in kernels(deriv)]
+    labels = lambda_labels(mech)
     model_file = os.path.basename(model.path)
     op_table = "\n".join(" *   %-18s %s" % (e.name, e.summary())
                          for e in emitted)
-    banner = ("/* GENERATED FILE: DO NOT EDIT.\n"
-              " * Generated by `python3 %s %s --out <dir>` from the model file\n"
-              " * %s (sha256 %s):\n * %s\n"
-              " * Edit the model file or the generator and regenerate instead.\n"
-              " *\n * Operation counts per kernel:\n%s\n */"
-              % (GENERATOR, model_file, model_file, model.sha256,
-                 model.description, op_table))
-    g = model.geometry
-    macros = ["#define %s_NQ 3" % upper,
-              "#define %s_NBODY %d" % (upper, len(BODY_NAMES)),
-              "#define %s_NLAMBDA %d" % (upper, len(lambda_labels(deriv.mech))),
-              "#define %s_GRAVITY %s /* m/s^2, along -z */"
-              % (upper, c_double(model.gravity))]
-    macros += ["#define %s_GEOM_%s %s /* m */" % (upper, k.upper(),
-                                                 c_double(g[k]))
-               for k in GEOMETRY_KEYS]
-    macros.append("#define %s_TOTAL_MASS %s /* kg */"
-                  % (upper, c_double(model.total_mass)))
-    macros.append("/* Body order of every array: %s. */"
-                  % " ".join(BODY_NAMES))
-    macros.append("#define %s_BODY_NAMES { \\\n%s }" % (upper, _wrap_list(
-        ['"%s"' % b for b in BODY_NAMES])))
-    macros.append("/* kg */\n#define %s_BODY_MASSES { \\\n%s }"
-                  % (upper, _wrap_list([c_double(m) for m in model.masses])))
-    macros.append("/* Principal moments Ixx, Iyy, Izz about each centre, in "
-                  "the body frame (kg m^2). */\n#define %s_BODY_INERTIAS { \\\n"
-                  "%s }" % (upper, _wrap_list([c_double(x) for i in
-                                              model.inertias for x in i])))
-    macros.append("/* Reaction coordinates (lambda order): joint, f(orce) or "
-                  "m(oment), axis\n   (u = platform u axis, n = w x x3). */\n"
-                  "#define %s_LAMBDA_LABELS { \\\n%s }"
-                  % (upper, _wrap_list(['"%s"' % l for l in
-                                        lambda_labels(deriv.mech)])))
+    head = ("/* GENERATED FILE: DO NOT EDIT.\n"
+            " * Generated by `python3 %s %s --out <dir>` from the model file\n"
+            " * %s (sha256 %s):\n * %s\n"
+            " * Edit the model file or the generator and regenerate instead.\n"
+            % (GENERATOR, model_file, model_file, model.sha256,
+               model.description))
+    banner = head + (" *\n * Operation counts per kernel:\n%s\n */"
+                     % op_table)
+    macros = ["#define %s_NQ %d" % (upper, len(mech.q)),
+              "#define %s_NACT %d" % (upper, len(mech.actuators)),
+              "#define %s_NLIMB %d" % (upper, len(mech.limbs)),
+              "#define %s_NBODY %d" % (upper, len(mech.bodies)),
+              "#define %s_NJOINT %d" % (upper, len(mech.joints)),
+              "#define %s_NLAMBDA %d" % (upper, len(labels)),
+              "/* Body order of every array: %s. The model's numbers and "
+              "layout tables\n   are in %s_mechanism.h. */"
+              % (" ".join(b.name for b in mech.bodies), prefix)]
     macros += ["#define %s_ARITH_%s %d /* arithmetic operations */"
                % (upper, e.name.upper(), e.arithmetic) for e in emitted]
     macros += ['#define %s_OPS_%s "%s"' % (upper, e.name.upper(), e.summary())
@@ -75,11 +152,14 @@ def render(model, deriv, templates_dir):
                         for e in emitted)
     bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
                          for e in emitted)
-    values = dict(banner=banner, prefix=prefix, PREFIX=upper,
-                  macros="\n".join(macros), declarations=decls,
-                  functions=bodies)
+    values = dict(banner=banner, head=head + " */", prefix=prefix,
+                  PREFIX=upper, macros="\n".join(macros),
+                  declarations=decls, functions=bodies,
+                  descriptor=_descriptor(model, mech, prefix, labels))
     files = {}
     for tmpl, out in (("kernels.h.in", "%s_kernels.h" % prefix),
-                      ("kernels.c.in", "%s_kernels.c" % prefix)):
+                      ("kernels.c.in", "%s_kernels.c" % prefix),
+                      ("mechanism.h.in", "%s_mechanism.h" % prefix),
+                      ("mechanism.c.in", "%s_mechanism.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
     return files, emitted

@@ -11,7 +11,7 @@ Node kinds (Expr.op):
   sym    args = (name,)
   add    args = (constant, ((coef, term), ...))   term: not const/add, coef 1
   mul    args = (coef, ((base, exponent), ...))   exponent: Fraction != 0
-  sin cos tan asin acos   args = (x,)
+  sin cos tan tanh asin acos   args = (x,)
   atan2  args = (y, x)
 
 Simplifications applied at construction, because they are what makes the
@@ -82,6 +82,16 @@ def sym(name):
 
 ZERO = const(0)
 ONE = const(1)
+
+
+def reset():
+    """Forget every expression built since import. Term order follows
+    creation order, so a generator run starts from here: the output of one
+    model then never depends on what else the process built before."""
+    global _table
+    _table = dict(_BASE_TABLE)
+    _counter[0] = _BASE_COUNT
+    _diff_cache.clear()
 
 
 def as_expr(x):
@@ -347,6 +357,16 @@ def tan(x):
     return _intern("tan", (x,))
 
 
+def tanh(x):
+    x = as_expr(x)
+    if is_const(x, 0):
+        return ZERO
+    y = _negated(x)
+    if y is not None:
+        return -tanh(y)
+    return _intern("tanh", (x,))
+
+
 def asin(x):
     x = as_expr(x)
     if is_const(x, 0):
@@ -442,6 +462,8 @@ def diff(e, s):
             r = -sin(x) * dx
         elif op == "tan":
             r = (1 + e * e) * dx
+        elif op == "tanh":
+            r = (1 - e * e) * dx
         elif op == "asin":
             r = dx * power(1 - x * x, Fraction(-1, 2))
         elif op == "acos":
@@ -508,6 +530,8 @@ class TimeDerivative:
                 r = -sin(x) * dx
             elif op == "tan":
                 r = (1 + e * e) * dx
+            elif op == "tanh":
+                r = (1 - e * e) * dx
             elif op == "asin":
                 r = dx * power(1 - x * x, Fraction(-1, 2))
             elif op == "acos":
@@ -531,6 +555,7 @@ def _safe(fn):
 
 _NUMERIC = {
     "sin": _safe(math.sin), "cos": _safe(math.cos), "tan": _safe(math.tan),
+    "tanh": _safe(math.tanh),
     "asin": _safe(math.asin), "acos": _safe(math.acos),
     "atan2": _safe(math.atan2),
 }
@@ -621,3 +646,8 @@ def to_str(e):
             parts.insert(0, str(e.args[0]))
         return "*".join(parts)
     return "%s(%s)" % (op, ", ".join(to_str(a) for a in e.args))
+
+
+# Everything interned at import (ZERO, ONE, ...) survives reset().
+_BASE_TABLE = dict(_table)
+_BASE_COUNT = _counter[0]

@@ -6,8 +6,17 @@
  * a prru_data is plain storage the calls write into, so nothing allocates in
  * the hot paths and one prru_data per thread makes every call re-entrant.
  *
+ * The mechanism itself (sizes, bodies, joints, the model's numbers) is the
+ * generated descriptor prru_mech (prru_mechanism.h); prru_model points at it
+ * and adds only the runtime's own settings, so nothing here can disagree
+ * with the kernels.
+ *
+ * GSL: every GSL status is checked here, so the first call that uses GSL
+ * turns GSL's abort-on-error handler off, once per process
+ * (gsl_set_error_handler_off); the runtime never changes it per call.
+ *
  * Every function returns a prru_status; PRRU_OK is 0. Arrays are row-major,
- * body order P L1 L2 L3 U1 U2 U3 S1 S2 S3, lambda order PRRU_LAMBDA_LABELS. */
+ * body order prru_mech.body_names, lambda order prru_mech.lambda_labels. */
 #ifndef PRRU_H
 #define PRRU_H
 
@@ -15,6 +24,11 @@
 #include <stddef.h>
 
 #include "prru_kernels.h"
+#include "prru_mechanism.h"
+
+/* Rows of H, Phi, K and the body wrenches: 3 rotational and 3 translational
+ * per body (see prru_mechanism.h for the stacking). */
+#define PRRU_NH (6 * PRRU_NBODY)
 
 #ifdef __cplusplus
 extern "C" {
@@ -36,32 +50,28 @@ typedef enum {
 const char *prru_strerror(int status);
 
 typedef struct {
-  double gravity;                  /* m/s^2, along -z */
-  double b12, b3, l1, l2, a;       /* geometry (m) */
-  double mass[PRRU_NBODY];         /* kg */
-  double inertia[3 * PRRU_NBODY];  /* principal moments, body frame */
-  double total_mass;
+  const prru_mechanism *mech;      /* the generated descriptor: &prru_mech */
   /* J_d counts as singular when its reciprocal condition number
    * 1 / (|J_d|_1 |J_d^-1|_1) is below this (default 1e-8). */
   double jd_rcond_min;
 } prru_model;
 
-/* The model the kernels were generated from. */
+/* The mechanism the kernels were generated from, default settings. */
 void prru_model_default(prru_model *m);
 
 typedef struct {
-  double fd[3]; /* actuator forces along +e3 on the sliders (N) */
+  double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */
   double fp[3]; /* force on the platform at O', {S} (N) */
   double mp[3]; /* moment on the platform, {S} (N m) */
 } prru_loads;
 
 /* Per-call workspace and last results. */
 typedef struct {
-  double d[3], Jd[9], Jdinv[9];  /* actuator positions, Jacobian, its inverse */
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3], Jdinv[9]; /* actuators, J_d, J_d^-1 */
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
-  double Q[60 * PRRU_NLAMBDA];    /* reaction basis */
-  double K[60], Ib[90];           /* wrench bias, world inertias */
+  double Q[PRRU_NH * PRRU_NLAMBDA]; /* reaction basis */
+  double K[PRRU_NH];              /* wrench bias */
   double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
   double P[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* its factor, arrowhead order */
   double r[PRRU_NLAMBDA];
@@ -87,8 +97,10 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[3]);
-/* The 57 joint reaction coordinates (eq. 31) at the state's qdd, which it
- * solves for first and leaves in d->qdd. */
+/* The joint reaction coordinates (eq. 31, PRRU_NLAMBDA of them) at the
+ * state's qdd, which it solves for first and leaves in d->qdd. The sliders
+ * receive the actuator forces net of the drives' armature, damping and
+ * friction (model format 2). */
 int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                    const prru_loads *l, double lambda[PRRU_NLAMBDA]);
 /* T, V (J). */

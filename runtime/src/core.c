@@ -1,6 +1,9 @@
 /* Model constants, status strings, reachability and the dynamics calls. */
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
+
+#include <gsl/gsl_errno.h>
 
 #include "prru.h"
 #include "internal.h"
@@ -23,19 +26,15 @@ const char *prru_strerror(int status)
 
 void prru_model_default(prru_model *m)
 {
-  static const double mass[PRRU_NBODY] = PRRU_BODY_MASSES;
-  static const double inertia[3 * PRRU_NBODY] = PRRU_BODY_INERTIAS;
-  m->gravity = PRRU_GRAVITY;
-  m->b12 = PRRU_GEOM_B12;
-  m->b3 = PRRU_GEOM_B3;
-  m->l1 = PRRU_GEOM_L1;
-  m->l2 = PRRU_GEOM_L2;
-  m->a = PRRU_GEOM_A;
-  memcpy(m->mass, mass, sizeof mass);
-  memcpy(m->inertia, inertia, sizeof inertia);
-  m->total_mass = PRRU_TOTAL_MASS;
+  m->mech = &prru_mech;
   m->jd_rcond_min = 1e-8;
 }
+
+static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
+
+static void gsl_handler_off(void) { gsl_set_error_handler_off(); }
+
+void prru_gsl_init(void) { pthread_once(&gsl_once, gsl_handler_off); }
 
 static int finite3(const double v[3])
 {

@@ -7,6 +7,7 @@
 #include <gsl/gsl_multiroots.h>
 
 #include "prru.h"
+#include "internal.h"
 
 typedef struct {
   const double *act;
@@ -56,9 +57,9 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   double x0[3] = {seed[0], seed[1], seed[2]};
   gsl_vector_view xv = gsl_vector_view_array(x0, 3);
   /* The solver allocates; FK is a set-up call, not a hot path. */
+  prru_gsl_init();
   gsl_multiroot_fdfsolver *s = gsl_multiroot_fdfsolver_alloc(gsl_multiroot_fdfsolver_hybridsj, 3);
   if (!s) return PRRU_ENOMEM;
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
   int gs = gsl_multiroot_fdfsolver_set(s, &fn, &xv.vector);
   int iter = 0, converged = 0;
   while (gs == GSL_SUCCESS && iter++ < 200) {
@@ -67,7 +68,6 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
     /* 1e-14 m on displacements of order 1 m: a few ulps. */
     if (gsl_multiroot_test_residual(s->f, 1e-14) == GSL_SUCCESS) { converged = 1; break; }
   }
-  gsl_set_error_handler(old);
   double sol[3] = {gsl_vector_get(s->x, 0), gsl_vector_get(s->x, 1), gsl_vector_get(s->x, 2)};
   double res = 0;
   for (int i = 0; i < 3; i++) res = fmax(res, fabs(gsl_vector_get(s->f, (size_t)i)));

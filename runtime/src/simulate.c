@@ -168,12 +168,12 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
   }
   sim_ctx c = {m, ls, drhs, PRRU_OK};
   gsl_odeiv2_system sys = {rhs, jac, 6, &c};
+  prru_gsl_init();
   gsl_odeiv2_driver *drv =
       gsl_odeiv2_driver_alloc_y_new(&sys, step_type(o->stepper), o->h0, o->abs_tol, o->rel_tol);
   double y[6] = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, t = 0.0;
   /* Samples at k dt, the last one at exactly t_end. */
   long nsamp = (long)ceil(o->t_end / o->dt_out - 1e-9);
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
   st = drv ? PRRU_OK : PRRU_ENOMEM;
   if (st != PRRU_OK) prru_fail(msg, msglen, st, "out of memory");
   for (long k = 0; st == PRRU_OK && k <= nsamp; k++) {
@@ -210,7 +210,6 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
     if (o->progress && (k % 50 == 0 || k == nsamp)) progress(tk, o->t_end);
   }
   if (o->progress) fputc('\n', stderr);
-  gsl_set_error_handler(old);
   if (drv) gsl_odeiv2_driver_free(drv);
   free(d); free(drhs); free(s);
   if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
