@@ -110,10 +110,10 @@ void prru_gravity(const double q[3], double G[3]);
 /* M, h and G fused (one shared evaluation). */
 void prru_dynamics(const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
 
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive - h, so that M qdd = b. */
+/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
 void prru_eom(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3]);
 
-/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,P (6x3). */
+/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). */
 void prru_platform_jacobian(const double q[3], double JP[18]);
 
 /* Body rotations R_b (3x3 each) and centres p_b, body order. */

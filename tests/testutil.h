@@ -10,7 +10,7 @@ static int tu_checks, tu_failures;
 
 /* max_i |a_i - b_i| / max(max_i |b_i|, floor): relative to the array's scale,
  * so that structurally-zero entries do not demand absolute 0. */
-static double tu_relerr(const double *a, const double *b, int n, double floor)
+static inline double tu_relerr(const double *a, const double *b, int n, double floor)
 {
   double err = 0, scale = floor;
   for (int i = 0; i < n; i++) {
@@ -21,7 +21,7 @@ static double tu_relerr(const double *a, const double *b, int n, double floor)
   return err / scale;
 }
 
-static int tu_check(int ok, const char *what, double value, double bound)
+static inline int tu_check(int ok, const char *what, double value, double bound)
 {
   tu_checks++;
   if (!ok) {
@@ -36,7 +36,7 @@ static int tu_check(int ok, const char *what, double value, double bound)
        tu_check(tu_e_ <= (rtol), (what), tu_e_, (rtol)); } while (0)
 #define TU_TRUE(cond, what) tu_check(!!(cond), (what), 0.0, 0.0)
 
-static int tu_finish(const char *suite)
+static inline int tu_finish(const char *suite)
 {
   printf("%s: %d passed, %d failed\n", suite, tu_checks - tu_failures, tu_failures);
   return tu_failures ? 1 : 0;
@@ -44,7 +44,7 @@ static int tu_finish(const char *suite)
 
 /* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */
 static unsigned long long tu_rng_state = 0x9E3779B97F4A7C15ULL;
-static double tu_uniform(double lo, double hi)
+static inline double tu_uniform(double lo, double hi)
 {
   tu_rng_state ^= tu_rng_state >> 12;
   tu_rng_state ^= tu_rng_state << 25;

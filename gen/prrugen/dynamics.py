@@ -184,7 +184,7 @@ class Derivation:
 
     def platform_jacobian(self):
         t = self.terms[0]
-        return [x for r in t.jr_w + t.jt for x in r]
+        return [x for r in t.jr_w + self.tool_jacobian() for x in r]
 
     def poses(self):
         rs = [x for t in self.terms for r in t.rotation for x in r]
@@ -205,11 +205,17 @@ class Derivation:
         lin_part = [x for t in self.terms for x in vscale(t.body.mass, t.mu)]
         return rot_part + lin_part
 
+    def tool_jacobian(self):
+        """J_T of the platform's frame origin O', where the external force
+        acts (the platform's centre of mass only when its com is 0)."""
+        return jacobian(self.terms[0].body.origin, self.mech.q)
+
     def eom_rhs(self, fd, fp, mp):
-        """b = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive - h."""
+        """b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h."""
         t = self.terms[0]
         g, h = self.gravity_force(), self.bias()
-        ad, af, am = _atb(self._jd, fd), _atb(t.jt, fp), _atb(t.jr_w, mp)
+        ad, am = _atb(self._jd, fd), _atb(t.jr_w, mp)
+        af = _atb(self.tool_jacobian(), fp)
         parts = [g, ad, af, am, [-x for x in h]]
         if any(self.damping) or any(self.coulomb):
             parts.append(self.passive())

@@ -46,11 +46,12 @@ def kernels(deriv):
         ("dynamics", "M, h and G fused (one shared evaluation).",
          [Q, QD], [("M", m), ("h", h), ("G", g)]),
         ("eom", "Forward-dynamics terms: M and b = G + J_d^T fd + "
-         "J_T,P^T fp + J_R,P^T mp + passive - h, so that M qdd = b.",
+         "J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp "
+         "acts at the platform frame's origin O').",
          [Q, QD, _arg("fd", nact), _arg("fp", 3), _arg("mp", 3)],
          [("M", m), ("b", deriv.eom_rhs(fd, fp, mp))]),
         ("platform_jacobian", "Platform Jacobians: rows 0-2 J_R,P, rows 3-5 "
-         "J_T,P (6x3).", [Q], [("JP", deriv.platform_jacobian())]),
+         "J_T,O' of the tool point O' (6x3).", [Q], [("JP", deriv.platform_jacobian())]),
         ("poses", "Body rotations R_b (3x3 each) and centres p_b, body order.",
          [Q], [("R", rs), ("p", ps)]),
         ("inertia_world", "Inertia tensors I_b = R_b D_b R_b^T about each "

@@ -87,10 +87,11 @@ ONE = const(1)
 def reset():
     """Forget every expression built since import. Term order follows
     creation order, so a generator run starts from here: the output of one
-    model then never depends on what else the process built before."""
+    model then never depends on what else the process built before. Ids
+    keep increasing (only their order matters), so an expression kept from
+    before a reset can never be confused with a new one."""
     global _table
     _table = dict(_BASE_TABLE)
-    _counter[0] = _BASE_COUNT
     _diff_cache.clear()
 
 
@@ -650,4 +651,3 @@ def to_str(e):
 
 # Everything interned at import (ZERO, ONE, ...) survives reset().
 _BASE_TABLE = dict(_table)
-_BASE_COUNT = _counter[0]

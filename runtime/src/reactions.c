@@ -47,16 +47,23 @@ static void slider_forces(const prru_mechanism *me, const prru_data *d, const do
 }
 
 /* Fbar: gravity on every body, the drives' forces along +e3 on the
- * sliders, platform force and moment at its centre. */
+ * sliders, the platform force at the tool point O' = (0, 0, q3) and the
+ * platform moment, both reduced to the platform's centre p (which differs
+ * from O' when the platform's centre of mass is offset). */
 static void applied_wrenches(const prru_mechanism *me, const double fs[PRRU_NACT],
-                             const prru_loads *l, double F[NH])
+                             const prru_loads *l, const double q[3], const double p[3 * NB],
+                             double F[NH])
 {
   memset(F, 0, NH * sizeof F[0]);
   for (int b = 0; b < NB; b++)
     for (int k = 0; k < 3; k++) F[body_row(b, 3 + k)] = me->mass[b] * me->gravity[k];
   for (int i = 0; i < PRRU_NACT; i++) F[body_row(me->slider[i], 5)] += fs[i];
+  const double *pp = p + 3 * me->platform;
+  double r[3] = {-pp[0], -pp[1], q[2] - pp[2]}; /* O' - p */
+  double rxf[3] = {r[1] * l->fp[2] - r[2] * l->fp[1], r[2] * l->fp[0] - r[0] * l->fp[2],
+                   r[0] * l->fp[1] - r[1] * l->fp[0]};
   for (int k = 0; k < 3; k++) {
-    F[body_row(me->platform, k)] += l->mp[k];
+    F[body_row(me->platform, k)] += l->mp[k] + rxf[k];
     F[body_row(me->platform, 3 + k)] += l->fp[k];
   }
 }
@@ -158,7 +165,7 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
   prru_wrench_bias(q, qd, d->K);
   prru_jd(q, d->Jd);
   slider_forces(me, d, q, qd, l, fs);
-  applied_wrenches(me, fs, l, F);
+  applied_wrenches(me, fs, l, q, p, F);
   for (int i = 0; i < NH; i++) d->K[i] -= F[i]; /* K - Fbar */
 
   memset(d->A, 0, sizeof d->A);
