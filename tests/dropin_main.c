@@ -1,6 +1,7 @@
 /* Drop-in check of the generated kernels: this file and generated/ are all
  * that test_dropin.sh copies into an empty directory, so it may use nothing
- * but prru_kernels.h and the C library (no runtime, no GSL, no testutil.h).
+ * but prru_kernels.h, prru_mechanism.h and the C library (no runtime, no
+ * GSL, no testutil.h).
  * It must stay valid C99, C11 and C++ and warning-free under -Wconversion
  * -Wdouble-promotion, because a user's controller build may be any of those.
  * The expected values are the spec's section 10 public reference point,
@@ -8,7 +9,10 @@
 #include <math.h>
 #include <stdio.h>
 
+#include <string.h>
+
 #include "prru_kernels.h"
+#include "prru_mechanism.h"
 
 static int failures = 0;
 
@@ -55,7 +59,7 @@ static void check_all_nan(const char *what, const double *got, int n)
 static void check_nan_everywhere(const char *label, const double q[3], const double qd[3])
 {
   static double H[180], dm[60], JP[18], R[90], p[30], I[90], K[60], Q[3420];
-  double d[3], Jd[9], M[9], h[3], G[3], b[3], E[2];
+  double d[3], Jd[9], M[9], h[3], G[3], b[3], E[2], dd[3], ddb[3], Qp[3];
   const double f[3] = {1.0, 2.0, 3.0};
   char name[96];
 #define NAN_CHECK(kernel_call, arr, n)                       \
@@ -82,6 +86,9 @@ static void check_nan_everywhere(const char *label, const double q[3], const dou
   NAN_CHECK(prru_wrench_bias(q, qd, K), K, 60);
   NAN_CHECK(prru_energy(q, qd, E), E, 2);
   NAN_CHECK(prru_reaction_basis(q, Q), Q, 3420);
+  NAN_CHECK(prru_actuator_rates(q, qd, dd, ddb), dd, 3);
+  check_all_nan("  actuator_rates ddb", ddb, 3);
+  NAN_CHECK(prru_passive(q, qd, Qp), Qp, 3);
   NAN_CHECK(prru_dynamics(q, qd, M, h, G), M, 9);
   check_all_nan("  dynamics h", h, 3);
   check_all_nan("  dynamics G", G, 3);
@@ -131,9 +138,16 @@ int main(void)
   check_array("prru_eom b (no loads)", b, b_ref, 3, 1e-12);
   prru_ik(q0, d);
   check_array("prru_ik d at q = 0", d, d0_ref, 3, 1e-12);
-  if (!(PRRU_TOTAL_MASS == M_ref[8])) {
-    printf("FAIL PRRU_TOTAL_MASS %.17g != M33 %.17g\n", PRRU_TOTAL_MASS, M_ref[8]);
+  /* The descriptor describes these kernels: the paper's model, its sizes. */
+  if (!(prru_mech.total_mass == M_ref[8]) || strcmp(prru_mech.name, "prru") != 0 ||
+      prru_mech.nlambda != PRRU_NLAMBDA || prru_mech.nbody != PRRU_NBODY ||
+      prru_mech.joint[PRRU_NJOINT - 1].lambda_offset + prru_mech.joint[PRRU_NJOINT - 1].lambda_count !=
+          PRRU_NLAMBDA) {
+    printf("FAIL descriptor: total mass %.17g (M33 %.17g), name %s, nlambda %d\n",
+           prru_mech.total_mass, M_ref[8], prru_mech.name, prru_mech.nlambda);
     failures++;
+  } else {
+    printf("ok   descriptor of model %s (sha256 %.12s...)\n", prru_mech.name, prru_mech.sha256);
   }
 
   {
