@@ -63,7 +63,7 @@
 
 /* A power of two, so the state index is a mask, not a division. */
 #define NSTATES 64
-#define MAXOUT 180 /* largest output of one call: H, 60x3 */
+#define MAXOUT (3 * PRRU_NH) /* largest output of one call: H, 6 NBODY x 3 */
 #define MAXREPS 1000
 
 /* What the generated side of the runtime's paths executes (runtime/src/core.c,
@@ -219,7 +219,7 @@ typedef int (*eval_fn)(bench_ctx *c, const bench_state *s, double *out);
 
 /* n calls of one side of one kernel. Only the first and last output feed the
  * sink: the kernels live in another library (no LTO), so the compiler cannot
- * drop any of their work, and summing all 180 outputs of H would add more
+ * drop any of their work, and summing all outputs of H would add more
  * than a cheap kernel costs. */
 #define BENCH_BATCH(fn, eval, nout)                          \
   static void fn(bench_ctx *c, long n)                       \
@@ -238,8 +238,8 @@ typedef int (*eval_fn)(bench_ctx *c, const bench_state *s, double *out);
   BENCH_BATCH(rb_##name, r_##name, nout)
 
 BENCH_PAIR(jd, 9)
-BENCH_PAIR(jacobians, 180)
-BENCH_PAIR(bias_terms, 60)
+BENCH_PAIR(jacobians, 3 * PRRU_NH)
+BENCH_PAIR(bias_terms, PRRU_NH)
 BENCH_PAIR(mass, 9)
 BENCH_PAIR(bias, 3)
 BENCH_PAIR(gravity, 3)
@@ -267,8 +267,8 @@ typedef struct {
 
 static bench_kernel kernels[] = {
   KERNEL(jd, 9, PRRU_OPS_JD),
-  KERNEL(jacobians, 180, PRRU_OPS_JACOBIANS),
-  KERNEL(bias_terms, 60, PRRU_OPS_BIAS_TERMS),
+  KERNEL(jacobians, 3 * PRRU_NH, PRRU_OPS_JACOBIANS),
+  KERNEL(bias_terms, PRRU_NH, PRRU_OPS_BIAS_TERMS),
   KERNEL(mass, 9, PRRU_OPS_MASS),
   KERNEL(bias, 3, PRRU_OPS_BIAS),
   KERNEL(gravity, 3, PRRU_OPS_GRAVITY),
@@ -654,6 +654,12 @@ static void print_json(const bench_options *op, const char *cpu, const sim_resul
     printf("%s\"%s\": {\"generated_ns\": %.4g, \"reference_ns\": %.4g, \"ratio\": %.4g}",
            i ? ", " : "", k->name, k->gen.median, k->ref.median, k->ref.median / k->gen.median);
   }
+  printf("}, \"model\": {\"name\": ");
+  json_string(prru_mech.name);
+  printf(", \"file\": ");
+  json_string(prru_mech.model_file);
+  printf(", \"sha256\": ");
+  json_string(prru_mech.sha256);
   printf("}, \"cpu\": ");
   json_string(cpu);
   printf(", \"compiler\": ");
@@ -714,6 +720,7 @@ static void print_table(const bench_options *op, const char *cpu, const sim_resu
 {
   printf("prru_bench: ns per call, median [min-max] of %d repetitions, %d input states\n",
          op->reps, NSTATES);
+  printf("model: %s (%s, sha256 %s)\n", prru_mech.name, prru_mech.model_file, prru_mech.sha256);
   printf("cpu: %s | compiler: %s | flags: %s (%s)\n\n", cpu, BENCH_COMPILER, PRRU_BENCH_FLAGS,
          PRRU_BENCH_BUILD_TYPE);
   printf("%-17s %-26s %-32s %8s %9s  %s\n", "kernel", "generated ns", "reference ns", "ratio",

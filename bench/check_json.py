@@ -43,6 +43,10 @@ def main():
     for key in ("cpu", "compiler", "flags"):
         if not isinstance(doc.get(key), str) or not doc[key]:
             fail("%r missing or empty" % key)
+    model = doc.get("model")
+    if not isinstance(model, dict) or set(model) != {"name", "file", "sha256"} \
+            or len(model["sha256"]) != 64:
+        fail("'model' (name, file, sha256) missing: %r" % (model,))
     kernels = doc.get("kernels")
     if not isinstance(kernels, dict):
         fail("'kernels' missing")
