@@ -87,11 +87,11 @@ int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
 
 /* Actuator displacements (inverse kinematics). */
-int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[3]);
+int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT]);
 /* Newton's method (gsl_multiroot, hybridsj with J_d) from seed to q with
  * d(q) = act to 1e-14 m; PRRU_ENOCONV when act is out of reach or the
  * iteration meets a singularity. */
-int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[3],
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                             const double seed[3], double q[3]);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h (Cholesky). */
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
@@ -99,7 +99,7 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
 /* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored). */
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
-                          double fd[3]);
+                          double fd[PRRU_NACT]);
 /* The joint reaction coordinates (eq. 31, PRRU_NLAMBDA of them) at the
  * state's qdd, which it solves for first and leaves in d->qdd. The sliders
  * receive the actuator forces net of the drives' armature, damping and
@@ -117,18 +117,19 @@ typedef struct {
   prru_loads base;         /* constant part */
   /* harmonic: fp += amp * (sin(w t), -cos(w t), 0) (the paper's load) */
   double amp, omega;
-  /* table: rows of t, fd1..3, fp1..3, mp1..3, linear interpolation, held
-   * constant outside [t_0, t_n] */
+  /* table: rows of t, fd1..fdN, fp1..3, mp1..3 (N = PRRU_NACT), linear
+   * interpolation, held constant outside [t_0, t_n] */
   int nrows;
-  double *rows;            /* 10 * nrows, owned by the schedule */
+  double *rows;            /* (PRRU_NACT + 7) * nrows, owned by the schedule */
 } prru_load_schedule;
 
 void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l);
 /* The paper's section 4.3 loads: fd = (50, 40, 25) N, fp = 50 (sin 4pi t,
  * -cos 4pi t, 0) N, mp = 0. */
 void prru_schedule_paper(prru_load_schedule *s);
-/* Reads a CSV with header t,fd1,fd2,fd3[,fp1,fp2,fp3[,mp1,mp2,mp3]]; times
- * strictly increasing. On error fills msg (file:line: reason). */
+/* Reads a CSV with header t,fd1..fdN[,fp1,fp2,fp3[,mp1,mp2,mp3]] (N =
+ * PRRU_NACT); times strictly increasing. On error fills msg (file:line:
+ * reason). */
 int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen);
 void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out);
 void prru_schedule_free(prru_load_schedule *s);
@@ -140,7 +141,7 @@ int prru_stepper_parse(const char *name, prru_stepper *s);
 const char *prru_stepper_name(prru_stepper s);
 
 typedef struct {
-  double t, q[3], qd[3], qdd[3], d[3];
+  double t, q[3], qd[3], qdd[3], d[PRRU_NACT];
   double lambda[PRRU_NLAMBDA]; /* when options.reactions */
   double T, V;
 } prru_sample;

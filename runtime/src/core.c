@@ -93,7 +93,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   return rc > 0 && rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
 
-int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[3])
+int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT])
 {
   int st = prru_check_reachable(m, d, q);
   if (st == PRRU_OK) memcpy(act, d->d, sizeof d->d);
@@ -165,7 +165,7 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
 
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
-                          double fd[3])
+                          double fd[PRRU_NACT])
 {
   static const double zero[3] = {0, 0, 0};
   if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))

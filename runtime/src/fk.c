@@ -46,7 +46,7 @@ static int fk_df(const gsl_vector *x, void *p, gsl_matrix *J)
   return fk_fdf(x, p, &fv.vector, J);
 }
 
-int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[3],
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                             const double seed[3], double q[3])
 {
   if (!isfinite(act[0]) || !isfinite(act[1]) || !isfinite(act[2])) return PRRU_EINPUT;

@@ -42,13 +42,13 @@ static char *trim(char *s)
 static int apply_key(prru_scenario *s, const char *key, const char *val, const char *where,
                      const char *base_dir, int *has_table, char *msg, int msglen)
 {
-  struct { const char *name; double *dst; } vec3[] = {
-      {"q0", s->q0}, {"qd0", s->qd0}, {"fd", s->loads.base.fd},
-      {"fp", s->loads.base.fp}, {"mp", s->loads.base.mp}};
-  for (size_t i = 0; i < sizeof vec3 / sizeof vec3[0]; i++)
-    if (strcmp(key, vec3[i].name) == 0) {
-      if (prru_parse_list(val, vec3[i].dst, 3) != PRRU_OK)
-        return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected 3 comma-separated finite numbers, got '%.60s'", where, key, val);
+  struct { const char *name; double *dst; int n; } vec[] = {
+      {"q0", s->q0, 3}, {"qd0", s->qd0, 3}, {"fd", s->loads.base.fd, PRRU_NACT},
+      {"fp", s->loads.base.fp, 3}, {"mp", s->loads.base.mp, 3}};
+  for (size_t i = 0; i < sizeof vec / sizeof vec[0]; i++)
+    if (strcmp(key, vec[i].name) == 0) {
+      if (prru_parse_list(val, vec[i].dst, vec[i].n) != PRRU_OK)
+        return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected %d comma-separated finite numbers, got '%.60s'", where, key, vec[i].n, val);
       return PRRU_OK;
     }
   struct { const char *name; double *dst; int positive; } num[] = {

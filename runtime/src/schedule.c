@@ -4,8 +4,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <stdio.h>
+
 #include "prru.h"
 #include "internal.h"
+
+/* A table row: t, then the load values in prru_loads order. */
+#define NV (PRRU_NACT + 6)
+#define ROW (1 + NV)
+
+static void loads_add(prru_loads *l, const double v[NV])
+{
+  for (int k = 0; k < PRRU_NACT; k++) l->fd[k] += v[k];
+  for (int k = 0; k < 3; k++) {
+    l->fp[k] += v[PRRU_NACT + k];
+    l->mp[k] += v[PRRU_NACT + 3 + k];
+  }
+}
 
 void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l)
 {
@@ -32,32 +47,28 @@ void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out)
   } else if (s->kind == PRRU_LOAD_TABLE && s->nrows > 0) {
     const double *r = s->rows;
     int n = s->nrows;
-    double v[9];
+    double v[NV];
     if (t <= r[0]) {
       memcpy(v, r + 1, sizeof v);
-    } else if (t >= r[10 * (n - 1)]) {
-      memcpy(v, r + 10 * (n - 1) + 1, sizeof v);
+    } else if (t >= r[ROW * (n - 1)]) {
+      memcpy(v, r + ROW * (n - 1) + 1, sizeof v);
     } else {
-      int lo = 0, hi = n - 1; /* r[10 lo] <= t < r[10 hi] */
+      int lo = 0, hi = n - 1; /* r[ROW lo] <= t < r[ROW hi] */
       while (hi - lo > 1) {
         int mid = (lo + hi) / 2;
-        if (r[10 * mid] <= t) lo = mid; else hi = mid;
+        if (r[ROW * mid] <= t) lo = mid; else hi = mid;
       }
-      const double *a = r + 10 * lo, *b = r + 10 * hi;
+      const double *a = r + ROW * lo, *b = r + ROW * hi;
       /* Halved time differences, and a convex combination where b - a
        * overflows: no overflow for any finite table. a + w (b - a)
        * otherwise, so that a constant column stays exactly constant. */
       double w = (0.5 * t - 0.5 * a[0]) / (0.5 * b[0] - 0.5 * a[0]);
-      for (int k = 0; k < 9; k++) {
+      for (int k = 0; k < NV; k++) {
         double diff = b[1 + k] - a[1 + k];
         v[k] = isfinite(diff) ? a[1 + k] + w * diff : (1.0 - w) * a[1 + k] + w * b[1 + k];
       }
     }
-    for (int k = 0; k < 3; k++) {
-      out->fd[k] += v[k];
-      out->fp[k] += v[3 + k];
-      out->mp[k] += v[6 + k];
-    }
+    loads_add(out, v);
   }
 }
 
@@ -71,37 +82,44 @@ void prru_schedule_free(prru_load_schedule *s)
 int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
                             const char *name, char *msg, int msglen)
 {
-  static const char *cols[10] = {"t", "fd1", "fd2", "fd3", "fp1", "fp2", "fp3", "mp1", "mp2", "mp3"};
+  /* Column names: t, fd1..fdN (required), fp1..3, mp1..3 (optional). */
+  char cols[ROW][8];
+  snprintf(cols[0], sizeof cols[0], "t");
+  for (int k = 0; k < NV; k++) {
+    const char *base = k < PRRU_NACT ? "fd" : k < PRRU_NACT + 3 ? "fp" : "mp";
+    int i = k < PRRU_NACT ? k : (k - PRRU_NACT) % 3;
+    snprintf(cols[1 + k], sizeof cols[1 + k], "%s%d", base, i + 1);
+  }
   prru_table t;
   memset(s, 0, sizeof *s);
   int st = prru_table_parse(&t, text, len, name, msg, msglen);
   if (st != PRRU_OK) return st;
-  int idx[10];
-  for (int k = 0; k < 10; k++) {
+  int idx[ROW];
+  for (int k = 0; k < ROW; k++) {
     idx[k] = prru_table_column(&t, cols[k]);
-    if (idx[k] < 0 && k < 4) {
+    if (idx[k] < 0 && k <= PRRU_NACT) {
       prru_table_free(&t);
-      return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: missing column '%s' (need t,fd1,fd2,fd3; fp1..3, mp1..3 optional)", name, cols[k]);
+      return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: missing column '%s' (need t,fd1..fd%d; fp1..3, mp1..3 optional)", name, cols[k], PRRU_NACT);
     }
   }
   for (int j = 0; j < t.ncols; j++) {
     int known = 0;
-    for (int k = 0; k < 10; k++) known |= idx[k] == j;
+    for (int k = 0; k < ROW; k++) known |= idx[k] == j;
     if (!known) {
-      prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: unknown column '%s' (expected t,fd1..3,fp1..3,mp1..3)", name, t.names[j]);
+      prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: unknown column '%s' (expected t,fd1..%d,fp1..3,mp1..3)", name, t.names[j], PRRU_NACT);
       prru_table_free(&t);
       return PRRU_EPARSE;
     }
   }
-  s->rows = malloc((size_t)t.nrows * 10 * sizeof *s->rows);
+  s->rows = malloc((size_t)t.nrows * ROW * sizeof *s->rows);
   if (!s->rows) { prru_table_free(&t); return prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name); }
   for (int i = 0; i < t.nrows; i++)
-    for (int k = 0; k < 10; k++)
-      s->rows[10 * i + k] = idx[k] < 0 ? 0.0 : t.data[(size_t)i * (size_t)t.ncols + (size_t)idx[k]];
+    for (int k = 0; k < ROW; k++)
+      s->rows[ROW * i + k] = idx[k] < 0 ? 0.0 : t.data[(size_t)i * (size_t)t.ncols + (size_t)idx[k]];
   for (int i = 1; i < t.nrows; i++)
-    if (!(s->rows[10 * i] > s->rows[10 * (i - 1)])) {
+    if (!(s->rows[ROW * i] > s->rows[ROW * (i - 1)])) {
       prru_fail(msg, msglen, PRRU_EPARSE, "%s: data row %d: time %g does not increase", name,
-                i + 1, s->rows[10 * i]);
+                i + 1, s->rows[ROW * i]);
       prru_table_free(&t);
       prru_schedule_free(s);
       return PRRU_EPARSE;

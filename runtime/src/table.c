@@ -50,11 +50,12 @@ static char *dup_line(const char *s, const char *e)
   return b;
 }
 
-static int parse_header(prru_table *t, char *line, const char *name, char *msg, int msglen)
+static int parse_header(prru_table *t, char *line, int lineno, const char *name, char *msg,
+                        int msglen)
 {
   int n = 1;
   for (char *c = line; *c; c++) n += *c == ',';
-  if (n > MAX_COLS) return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: more than %d columns", name, MAX_COLS);
+  if (n > MAX_COLS) return prru_fail(msg, msglen, PRRU_EPARSE, "%s:%d: more than %d columns", name, lineno, MAX_COLS);
   t->names = calloc((size_t)n, sizeof *t->names);
   if (!t->names) return prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name);
   char *s = line;
@@ -64,10 +65,10 @@ static int parse_header(prru_table *t, char *line, const char *name, char *msg, 
     while (*s == ' ' || *s == '\t') s++;
     size_t len = strlen(s);
     while (len > 0 && (s[len - 1] == ' ' || s[len - 1] == '\t')) s[--len] = '\0';
-    if (len == 0) return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: column %d has no name", name, i + 1);
+    if (len == 0) return prru_fail(msg, msglen, PRRU_EPARSE, "%s:%d: column %d has no name", name, lineno, i + 1);
     for (int j = 0; j < i; j++)
       if (strcmp(t->names[j], s) == 0)
-        return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: column '%s' appears twice", name, s);
+        return prru_fail(msg, msglen, PRRU_EPARSE, "%s:%d: column '%s' appears twice", name, lineno, s);
     t->names[i] = malloc(len + 1);
     if (!t->names[i]) return prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name);
     memcpy(t->names[i], s, len + 1);
@@ -97,9 +98,11 @@ int prru_table_parse(prru_table *t, const char *text, size_t len, const char *na
     if (!line) { st = prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name); break; }
     char *s = line;
     while (*s == ' ' || *s == '\t') s++;
-    if (*s == '\0' || *s == '#') continue; /* blank lines and comments */
+    /* Blank lines and '#' comments anywhere, so the '# prru ... model ...'
+     * line the CLI writes before the header is skipped. */
+    if (*s == '\0' || *s == '#') continue;
     if (t->ncols == 0) {
-      st = parse_header(t, s, name, msg, msglen);
+      st = parse_header(t, s, lineno, name, msg, msglen);
       if (st != PRRU_OK) break;
       continue;
     }
