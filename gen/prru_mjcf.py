@@ -6,10 +6,16 @@ usage: python3 gen/prru_mjcf.py MODEL.json --out FILE.xml
 The MJCF is the independent check of the generated dynamics (see
 validation/validate_mujoco.c), so this file deliberately does not reuse the
 symbolic mechanism of prrugen: it evaluates the spec's pose formulas
-(section 4 of 3prru-model.md) once, in floating point, at the home pose and
-places every MuJoCo body frame there. From then on MuJoCo's own tree
-kinematics and dynamics take over; the only thing shared with the generator
-is the validated model file (prrugen.model).
+(section 4 of 3prru-model.md, with each limb's own geometry) once, in
+floating point, at the home pose and places every MuJoCo body frame at the
+frame origin of its pose function there; each body's <inertial> then puts
+the centre of mass at the model's com (p_b = origin_b + R_b com) with the
+inertia tensor about it. Format 2's gravity vector, and the drives' armature
+and damping (MuJoCo's slide-joint armature and damping) are MJCF settings;
+the smoothed Coulomb force is not a MuJoCo law and rides along as custom
+data for validate_mujoco. From then on MuJoCo's own tree kinematics and
+dynamics take over; the only thing shared with the generator is the
+validated model file (prrugen.model).
 """
 
 import argparse
@@ -28,7 +34,8 @@ TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates", "prru_mjcf.xml")
 
 # Every MuJoCo joint coordinate is 0 here. q1 = q2 = 0 makes every rotation
-# of the home pose elementary; q3 is the paper's working height. Any
+# of the home pose elementary, and every valid model file assembles there at
+# any height (prrugen.model checks it); q3 is the paper's working height. Any
 # reachable pose would do: the validation sets states through the poses.
 HOME_Q = (0.0, 0.0, -0.8)
 
@@ -103,41 +110,44 @@ def acos_checked(x, what):
     return math.acos(x)
 
 
-def poses(g, q):
-    """Spec section 4 at q: per limb the frames (R, p) of S, U, L, the joint
-    centres A, B, C and the U joint's first axis (world); and the platform."""
+IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def poses(limbs, q):
+    """Spec section 4 at q for per-limb geometry (limbs: three dicts of
+    floats b, l1, l2, a): per limb the frames (R, p) of S, U, L at the frame
+    origins of section 4, the joint centres A, B, C and the U joint's first
+    axis (world); and the platform."""
     q1, q2, q3 = q
     r_p = matmul(rx(q1), ry(q2))
     p_p = (0.0, 0.0, q3)
-    limbs = []
-    for s in (-1.0, 1.0):
+    out = []
+    for s, g in ((-1.0, limbs[0]), (1.0, limbs[1])):
         c = add(p_p, matvec(r_p, (0.0, s * g["a"], 0.0)))
         r_l = rx(q1)
         b = add(c, matvec(r_l, (0.0, s * g["l2"], 0.0)))
         p_l = add(c, matvec(r_l, (0.0, s * g["l2"] / 2, 0.0)))
-        y_a = s * g["b12"]
+        y_a = s * g["b"]
         alpha = s * acos_checked(s * (y_a - b[1]) / g["l1"],
                                  "limb %d" % (1 if s < 0 else 2))
         d = b[2] + s * g["l1"] * math.sin(alpha)
         a = (0.0, y_a, d)
-        limbs.append(dict(S=(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), a),
-                          U=(rx(alpha), scale(0.5, add(a, b))),
-                          L=(r_l, p_l), A=a, B=b, C=c,
-                          hinge=E1, u_first=matvec(r_l, E2),
-                          long_axis=matvec(r_l, E2)))
+        out.append(dict(S=(IDENTITY, a), U=(rx(alpha), scale(0.5, add(a, b))),
+                        L=(r_l, p_l), A=a, B=b, C=c,
+                        hinge=E1, u_first=matvec(r_l, E2)))
+    g = limbs[2]
     gamma = math.atan2(math.sin(q2), math.cos(q1) * math.cos(q2))
     r_l = ry(gamma)
     x3 = matvec(r_l, E1)
     b = add(p_p, scale(g["l2"], x3))
     p_l = add(p_p, scale(g["l2"] / 2, x3))
-    alpha = acos_checked((b[0] - g["b3"]) / g["l1"], "limb 3")
+    alpha = acos_checked((b[0] - g["b"]) / g["l1"], "limb 3")
     d = b[2] + g["l1"] * math.sin(alpha)
-    a = (g["b3"], 0.0, d)
-    limbs.append(dict(S=(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), a),
-                      U=(ry(alpha), scale(0.5, add(a, b))),
-                      L=(r_l, p_l), A=a, B=b, C=p_p,
-                      hinge=E2, u_first=x3, long_axis=x3))
-    return (r_p, p_p), limbs
+    a = (g["b"], 0.0, d)
+    out.append(dict(S=(IDENTITY, a), U=(ry(alpha), scale(0.5, add(a, b))),
+                    L=(r_l, p_l), A=a, B=b, C=p_p,
+                    hinge=E2, u_first=x3))
+    return (r_p, p_p), out
 
 
 def fmt(values):
@@ -157,31 +167,107 @@ def in_frame(frame, point):
     return matvec(transpose(r), sub(point, p))
 
 
+def principal_axes(t):
+    """Eigen-decomposition of a symmetric 3x3 tensor t = V diag(w) V^T by
+    cyclic Jacobi rotations, iterated until the off-diagonal entries are
+    below rounding (Numerical Recipes' test): w and the rotation V
+    (det +1, columns = principal axes)."""
+    a = [list(map(float, row)) for row in t]
+    v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    for _ in range(100):
+        if all(a[p][q] == 0.0 for p, q in ((0, 1), (0, 2), (1, 2))):
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = a[p][q]
+            if apq == 0.0:
+                continue
+            g = 100.0 * abs(apq)
+            if abs(a[p][p]) + g == abs(a[p][p]) \
+                    and abs(a[q][q]) + g == abs(a[q][q]):
+                a[p][q] = a[q][p] = 0.0
+                continue
+            theta = (a[q][q] - a[p][p]) / (2.0 * apq)
+            tan = math.copysign(1.0, theta) / (abs(theta)
+                                                + math.sqrt(theta * theta + 1.0))
+            c = 1.0 / math.sqrt(tan * tan + 1.0)
+            s = tan * c
+            # a <- J^T a J, v <- v J with J the rotation in the (p, q) plane
+            for k in range(3):
+                akp, akq = a[k][p], a[k][q]
+                a[k][p], a[k][q] = c * akp - s * akq, s * akp + c * akq
+            for k in range(3):
+                apk, aqk = a[p][k], a[q][k]
+                a[p][k], a[q][k] = c * apk - s * aqk, s * apk + c * aqk
+            a[p][q] = a[q][p] = 0.0
+            for k in range(3):
+                vkp, vkq = v[k][p], v[k][q]
+                v[k][p], v[k][q] = c * vkp - s * vkq, s * vkp + c * vkq
+    else:
+        raise ValueError("inertia tensor: Jacobi iteration did not converge")
+    v = tuple(tuple(row) for row in v)
+    det = sum(v[0][i] * (v[1][(i + 1) % 3] * v[2][(i + 2) % 3]
+                         - v[1][(i + 2) % 3] * v[2][(i + 1) % 3])
+              for i in range(3))
+    if det < 0:
+        v = tuple((row[0], row[1], -row[2]) for row in v)
+    # the moments from the original tensor, w_i = v_i^T t v_i
+    w = tuple(sum(v[k][i] * float(t[k][l]) * v[l][i] for k in range(3)
+                  for l in range(3)) for i in range(3))
+    return w, v
+
+
+def inertial(mass, com, entries, share=1):
+    """The <inertial> attributes of one body: mass and centre of mass in
+    the body frame, and the tensor (Ixx Iyy Izz Ixy Ixz Iyz) about that
+    centre in body axes, divided by share (the platform's copies).
+
+    A tensor without products of inertia is diaginertia with the identity
+    quat. MJCF's fullinertia would state any other tensor directly, but
+    MuJoCo 2.2.2's compiler diagonalises it with mju_eig3, whose Jacobi
+    iteration stops once a rotation's cosine exceeds 1 - 1e-12 (angles up
+    to ~1e-6 rad): the compiled tensor is off by up to ~1e-8 relative,
+    which the exact level of validate_mujoco sees (~3e-10 in the
+    accelerations). So the principal axes are computed here to rounding and
+    written as quat + diaginertia, which MuJoCo uses as given."""
+    xx, yy, zz, xy, xz, yz = (float(x) / share for x in entries)
+    if xy == 0 and xz == 0 and yz == 0:
+        quat_text, moments = "1.0 0.0 0.0 0.0", (xx, yy, zz)
+    else:
+        moments, axes = principal_axes(((xx, xy, xz), (xy, yy, yz),
+                                        (xz, yz, zz)))
+        quat_text = fmt(quat(axes))
+    return {"mass": repr(float(mass) / share), "com": fmt(com),
+            "iquat": quat_text, "inertia": fmt(moments)}
+
+
 def substitutions(m, path):
-    g = {k: float(v) for k, v in m.geometry.items()}
-    (r_p, p_p), limbs = poses(g, HOME_Q)
+    limbs = [{k: float(getattr(limb, k)) for k in ("b", "l1", "l2", "a")}
+             for limb in m.limbs]
+    (r_p, p_p), chains = poses(limbs, HOME_Q)
     platform = (r_p, p_p)
-    masses = dict(zip(model_mod.BODY_NAMES, (float(x) for x in m.masses)))
-    inertias = dict(zip(model_mod.BODY_NAMES,
-                        (tuple(float(x) for x in i) for i in m.inertias)))
-    world = (((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
-             (0.0, 0.0, 0.0))
+    index = {name: i for i, name in enumerate(model_mod.BODY_NAMES)}
+    world = (IDENTITY, (0.0, 0.0, 0.0))
     description = m.description.replace("--", "- -")  # "--" ends an XML comment
     sub_ = dict(model_file=os.path.basename(path), model_sha256=m.sha256,
                 description=description, name=m.name,
                 home_q=", ".join(repr(x) for x in HOME_Q),
-                gravity_z=repr(-float(m.gravity)),
-                platform_mass=repr(masses["P"] / 3),
-                platform_inertia=fmt(x / 3 for x in inertias["P"]))
-    for i, limb in enumerate(limbs, start=1):
+                gravity=fmt(m.gravity))
+    i_p = index["P"]
+    for key, value in inertial(m.masses[i_p], m.coms[i_p], m.inertias[i_p],
+                               share=len(chains)).items():
+        sub_["platform_" + key] = value
+    for i, limb in enumerate(chains, start=1):
         names = {"S": "S%d" % i, "U": "U%d" % i, "L": "L%d" % i}
         chain = [("S", world), ("U", limb["S"]), ("L", limb["U"])]
         for key, parent in chain:
+            name = names[key]
             pos, q = relative(parent, limb[key])
-            sub_[names[key] + "_pos"] = fmt(pos)
-            sub_[names[key] + "_quat"] = fmt(q)
-            sub_[names[key] + "_mass"] = repr(masses[names[key]])
-            sub_[names[key] + "_inertia"] = fmt(inertias[names[key]])
+            sub_[name + "_pos"] = fmt(pos)
+            sub_[name + "_quat"] = fmt(q)
+            b = index[name]
+            for attr, value in inertial(m.masses[b], m.coms[b],
+                                        m.inertias[b]).items():
+                sub_["%s_%s" % (name, attr)] = value
         pos, q = relative(limb["L"], platform)
         sub_["platform%d_pos" % i] = fmt(pos)
         sub_["platform%d_quat" % i] = fmt(q)
@@ -189,6 +275,16 @@ def substitutions(m, path):
         frame_s, frame_u, frame_l = limb["S"], limb["U"], limb["L"]
         sub_["P%d_pos" % i] = fmt(in_frame(frame_s, limb["A"]))
         sub_["P%d_axis" % i] = fmt(matvec(transpose(frame_s[0]), E3))
+        # The drive acts along the slide: its reflected inertia is MuJoCo's
+        # armature and its viscous damping MuJoCo's (passive) damping on
+        # that dof. The smoothed Coulomb force -f tanh(v / v_s) has no MJCF
+        # counterpart (frictionloss is a different law); its parameters
+        # travel as custom data and validate_mujoco applies the force
+        # through qfrc_applied.
+        sub_["P%d_armature" % i] = repr(float(m.armature[i - 1]))
+        sub_["P%d_damping" % i] = repr(float(m.damping[i - 1]))
+        sub_["P%d_coulomb" % i] = fmt((m.coulomb[i - 1],
+                                       m.coulomb_velocity or 0))
         sub_["A%d_pos" % i] = fmt(in_frame(frame_u, limb["A"]))
         sub_["A%d_axis" % i] = fmt(matvec(transpose(frame_u[0]), limb["hinge"]))
         sub_["B%d_pos" % i] = fmt(in_frame(frame_l, limb["B"]))

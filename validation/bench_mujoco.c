@@ -4,8 +4,11 @@
  *
  * 1. One forward-dynamics call at the same state and loads (the spec's
  *    reference state q = (0.1, 0.2, -0.8), qd = (0.3, -0.4, 0.5), paper
- *    loads at t = 0): prru_forward_dynamics vs mj_forward on the 15-DOF
- *    tree with 12 weld rows.
+ *    loads at t = 0): prru_forward_dynamics vs mj_forward on the tree of
+ *    5 DOF per limb with 6 weld rows per platform copy after the first
+ *    (15 DOF, 12 rows for three limbs), on the model the kernels and the
+ *    MJCF were made from (the drives' Coulomb force, which MuJoCo does not
+ *    model, goes in through qfrc_applied, see prru_mujoco.h).
  * 2. A simulated second of the paper's scenario, 1001 samples, at the same
  *    accuracy. Accuracy is max |q - q_ref| over the samples, q_ref being
  *    prru_simulate at tolerance 1e-13. MuJoCo's soft welds put a floor of
@@ -125,9 +128,8 @@ int main(int argc, char **argv)
   prru_loads l;
   prru_schedule_eval(&sc.loads, 0.0, &l);
   state_residuals sr;
-  for (int i = 0; i < 3; i++) d->qfrc_applied[m->jnt_dofadr[mp.jnt[i][0]]] = l.fd[i];
-  mju_copy3(d->xfrc_applied + 6 * mp.P[0], l.fp);
   if (!set_state(m, d, &mp, q, qd, &sr)) return 1;
+  mj_load_forces(m, d, &mp, &l, d->qfrc_applied);
   enum { BATCH = 20000 };
   double *ours = malloc(sizeof(double) * (size_t)reps), *mj = malloc(sizeof(double) * (size_t)reps);
   for (int r = 0; r < reps; r++) {
@@ -161,8 +163,7 @@ int main(int argc, char **argv)
   enum { NDT = sizeof dts / sizeof dts[0] };
   double mj_err[NDT], best = INFINITY;
   g_schedule = &sc.loads;
-  g_platform = mp.P[0];
-  for (int i = 0; i < 3; i++) g_slide_dof[i] = m->jnt_dofadr[mp.jnt[i][0]];
+  g_map = &mp;
   mjcb_control = apply_loads;
   printf("a simulated second of the paper scenario (error = max |q - q_ref|, q_ref at tol 1e-13):\n");
   for (int i = 0; i < NDT; i++) {

@@ -4,6 +4,8 @@ import importlib.util
 import json
 import math
 import os
+import random
+import re
 import subprocess
 import sys
 import tempfile
@@ -13,6 +15,7 @@ import xml.etree.ElementTree as ET
 GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROOT = os.path.dirname(GEN_DIR)
 MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
+PROTO = os.path.join(ROOT, "models", "prototype_example.json")
 ENTRY = os.path.join(GEN_DIR, "prru_mjcf.py")
 
 # Loaded by path: prru_mjcf is a script beside the prrugen package, not a
@@ -58,8 +61,27 @@ def world_frames(root):
     return out
 
 
-def modified_model(tmpdir, edit):
-    with open(MODEL, encoding="utf-8") as f:
+def body(root, name):
+    return next(b for b in root.iter("body") if b.get("name") == name)
+
+
+def inertia_tensor(inertial):
+    """R diag(moments) R^T of an <inertial>: the tensor MuJoCo uses, in the
+    body frame (entries Ixx Iyy Izz Ixy Ixz Iyz)."""
+    r = quat_mat(numbers(inertial.get("quat")))
+    d = numbers(inertial.get("diaginertia"))
+    t = [[sum(r[i][k] * d[k] * r[j][k] for k in range(3)) for j in range(3)]
+         for i in range(3)]
+    return [t[0][0], t[1][1], t[2][2], t[0][1], t[0][2], t[1][2]]
+
+
+def without_header(text):
+    """The MJCF without its leading comment (file name, hash, description)."""
+    return re.sub(r"\A<!--.*?-->\n", "", text, flags=re.S)
+
+
+def modified_model(tmpdir, edit, base=MODEL):
+    with open(base, encoding="utf-8") as f:
         data = json.load(f)
     edit(data)
     path = os.path.join(tmpdir, "model.json")
@@ -122,6 +144,7 @@ class Output(unittest.TestCase):
             inert = body.find("inertial")
             self.assertEqual(numbers(inert.get("pos")), [0.0, 0.0, 0.0])
             mass, moments = float(inert.get("mass")), numbers(inert.get("diaginertia"))
+            self.assertEqual(numbers(inert.get("quat")), [1.0, 0.0, 0.0, 0.0])
             if name.startswith("platform"):
                 total_p += mass
                 inertia_p = [a + b for a, b in zip(inertia_p, moments)]
@@ -157,6 +180,35 @@ class Output(unittest.TestCase):
                 for a, b in zip(w, c):
                     self.assertAlmostEqual(a, b, delta=1e-15)
 
+    def test_no_drives_and_no_coulomb(self):
+        for i in (1, 2, 3):
+            slide = next(j for j in self.root.iter("joint")
+                         if j.get("name") == "P%d" % i)
+            self.assertEqual((float(slide.get("armature")),
+                              float(slide.get("damping"))), (0.0, 0.0))
+        data = {n.get("name"): numbers(n.get("data"))
+                for n in self.root.find("custom").findall("numeric")}
+        self.assertEqual(data, {"P%d_coulomb" % i: [0.0, 0.0]
+                                for i in (1, 2, 3)})
+
+    def test_format2_transcription_gives_the_same_mjcf(self):
+        # spec section 11: format-1 files stay valid, and the same robot
+        # written in format 2 is the same MuJoCo model
+        with open(MODEL, encoding="utf-8") as f:
+            d = json.load(f)
+        g = d["geometry"]
+        d.update(format=2, gravity=[0, 0, -d["gravity"]])
+        d["geometry"] = {"b": [g["b12"], g["b12"], g["b3"]], "l1": g["l1"],
+                         "l2": [g["l2"]] * 3, "a": [g["a"], g["a"]]}
+        for name, b in d["bodies"].items():
+            b.update(com=[0, 0, 0], inertia=b["inertia"] + [0, 0, 0])
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "paper2.json")
+            with open(path, "w", encoding="utf-8") as f:
+                json.dump(d, f)
+            text = prru_mjcf.render(path)
+        self.assertEqual(without_header(text), without_header(self.text))
+
     def test_geometry_change_reaches_the_mjcf(self):
         with tempfile.TemporaryDirectory() as tmp:
             path = modified_model(tmp, lambda d: d["geometry"].update(l1=0.25))
@@ -165,6 +217,129 @@ class Output(unittest.TestCase):
         # d = z_B + l1 sin(acos((b12 - a - l2) / l1)) at q1 = q2 = 0
         expect = prru_mjcf.HOME_Q[2] + math.sqrt(0.25 ** 2 - 0.09 ** 2)
         self.assertAlmostEqual(s1, expect, delta=1e-15)
+
+
+class Format2(unittest.TestCase):
+    """models/prototype_example.json: per-limb geometry, gravity vector,
+    centres of mass, inertia tensors with products, drives."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.text = prru_mjcf.render(PROTO)
+        cls.root = ET.fromstring(cls.text)
+        with open(PROTO, encoding="utf-8") as f:
+            cls.spec = json.load(f)
+
+    def test_gravity_vector(self):
+        self.assertEqual(numbers(self.root.find("option").get("gravity")),
+                         self.spec["gravity"])
+
+    def test_per_limb_geometry_home_pose_and_loops(self):
+        g = self.spec["geometry"]
+        b, l1, l2, a = g["b"], g["l1"], g["l2"], g["a"] + [0.0]
+        q3 = prru_mjcf.HOME_Q[2]
+        frames = world_frames(self.root)
+        rails = ((0.0, -b[0]), (0.0, b[1]), (b[2], 0.0))
+        centres = ((0.0, -a[0], q3), (0.0, a[1], q3), (0.0, 0.0, q3))
+        for i in range(3):
+            r, p = frames["S%d" % (i + 1)]
+            self.assertEqual(p[:2], rails[i])
+            # d_i at q1 = q2 = 0: z_B + sqrt(l1^2 - (b - a - l2)^2)
+            gap = b[i] - a[i] - l2[i]
+            self.assertAlmostEqual(p[2], q3 + math.sqrt(l1[i] ** 2 - gap ** 2),
+                                   delta=1e-15)
+            # the U joint's centre, seen from the platform copy, is C_i
+            rp, pp = frames["platform%d" % (i + 1)]
+            for jn in body(self.root, "platform%d" % (i + 1)).findall("joint"):
+                w = prru_mjcf.add(pp, prru_mjcf.matvec(rp, numbers(jn.get("pos"))))
+                for x, y in zip(w, centres[i]):
+                    self.assertAlmostEqual(x, y, delta=1e-15)
+            # joint B_i from the upper and the lower link coincide
+            ru, pu = frames["U%d" % (i + 1)]
+            rl, pl = frames["L%d" % (i + 1)]
+            b_u = numbers(body(self.root, "U%d" % (i + 1)).find("geom")
+                          .get("fromto"))[3:]
+            b_l = numbers(body(self.root, "L%d" % (i + 1)).find("joint")
+                          .get("pos"))
+            for x, y in zip(prru_mjcf.add(pu, prru_mjcf.matvec(ru, b_u)),
+                            prru_mjcf.add(pl, prru_mjcf.matvec(rl, b_l))):
+                self.assertAlmostEqual(x, y, delta=1e-15)
+
+    def test_centres_of_mass_and_inertia_tensors(self):
+        bodies = self.spec["bodies"]
+        copies = [body(self.root, "platform%d" % i).find("inertial")
+                  for i in (1, 2, 3)]
+        for name, spec in bodies.items():
+            if name == "P":
+                inertials, share = copies, 3
+            else:
+                inertials, share = [body(self.root, name).find("inertial")], 1
+            for inert in inertials:
+                # com is the inertial's position in the body frame, exactly
+                self.assertEqual(numbers(inert.get("pos")), spec["com"], name)
+                # no fullinertia: MuJoCo 2.2.2 diagonalises it inexactly
+                self.assertIsNone(inert.get("fullinertia"))
+                self.assertAlmostEqual(float(inert.get("mass")) * share,
+                                       spec["mass"], delta=1e-15)
+                t = inertia_tensor(inert)
+                scale = max(abs(x) for x in spec["inertia"])
+                for k, (x, y) in enumerate(zip(t, spec["inertia"])):
+                    # rounding (MuJoCo's own fullinertia: ~1e-8)
+                    self.assertLess(abs(x * share - y), 2e-15 * scale,
+                                    "%s inertia[%d]" % (name, k))
+
+    def test_drives(self):
+        act = self.spec["actuators"]
+        data = {n.get("name"): numbers(n.get("data"))
+                for n in self.root.find("custom").findall("numeric")}
+        for i in range(3):
+            slide = next(j for j in self.root.iter("joint")
+                         if j.get("name") == "P%d" % (i + 1))
+            self.assertEqual(float(slide.get("armature")), act["armature"][i])
+            self.assertEqual(float(slide.get("damping")), act["damping"][i])
+            self.assertIsNone(slide.get("frictionloss"))  # not MuJoCo's law
+            self.assertEqual(data["P%d_coulomb" % (i + 1)],
+                             [act["coulomb"][i], act["coulomb_velocity"]])
+
+    def test_com_change_reaches_the_mjcf(self):
+        def edit(d):
+            d["bodies"]["U2"]["com"] = [0.01, -0.02, 0.03]
+            d["bodies"]["U2"]["inertia"][5] = 0.0001
+        with tempfile.TemporaryDirectory() as tmp:
+            root = ET.fromstring(prru_mjcf.render(modified_model(tmp, edit,
+                                                                 PROTO)))
+        inert = body(root, "U2").find("inertial")
+        self.assertEqual(numbers(inert.get("pos")), [0.01, -0.02, 0.03])
+        self.assertAlmostEqual(inertia_tensor(inert)[5], 0.0001, delta=1e-18)
+
+
+class PrincipalAxes(unittest.TestCase):
+    def test_reconstructs_random_tensors_to_rounding(self):
+        rng = random.Random(7)
+        for _ in range(300):
+            # a rigid body's tensor: tr(S) E - S with S = sum m r r^T
+            pts = [[rng.uniform(-1, 1) for _ in range(3)] for _ in range(4)]
+            s_ = [[sum(p[i] * p[j] for p in pts) for j in range(3)]
+                  for i in range(3)]
+            tr = sum(s_[i][i] for i in range(3))
+            t = [[(tr if i == j else 0) - s_[i][j] for j in range(3)]
+                 for i in range(3)]
+            w, v = prru_mjcf.principal_axes(t)
+            for i in range(3):
+                for j in range(3):
+                    rec = sum(v[i][k] * w[k] * v[j][k] for k in range(3))
+                    self.assertLess(abs(rec - t[i][j]), 4e-15 * tr)
+                    dot = sum(v[k][i] * v[k][j] for k in range(3))
+                    self.assertLess(abs(dot - (i == j)), 4e-15)
+            det = sum(v[0][i] * (v[1][(i + 1) % 3] * v[2][(i + 2) % 3]
+                                 - v[1][(i + 2) % 3] * v[2][(i + 1) % 3])
+                      for i in range(3))
+            self.assertAlmostEqual(det, 1.0, delta=4e-15)
+
+    def test_diagonal_tensor_is_its_own_principal_form(self):
+        w, v = prru_mjcf.principal_axes(((3.0, 0, 0), (0, 1.0, 0), (0, 0, 2.0)))
+        self.assertEqual(w, (3.0, 1.0, 2.0))
+        self.assertEqual(v, ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
 
 
 class Errors(unittest.TestCase):
