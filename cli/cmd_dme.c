@@ -29,7 +29,8 @@ static const char dme_help[] =
     "its semi-axes have lengths 1/sigma_i (rad/s^2 per N) along the right singular\n"
     "vectors of Mt JtR^+ (unit, in {S}); w_R = sigma_1/sigma_2 (>= 1). The\n"
     "translational segment runs along z with half-length 1/sigma_T (m/s^2 per N).\n"
-    "Prints JSON: q, status (\"ok\", \"singular\" or \"unreachable\"), w_R, Jd_rcond,\n"
+    "Prints JSON: model (name, file, sha256), q, status (\"ok\", \"singular\" or\n"
+    "\"unreachable\"), w_R, Jd_rcond,\n"
     "sigma, semi_axes (minor, major), axis_directions, sigma_T,\n"
     "translational_half_length, translational_direction, Mt, JtR, JtT. At a\n"
     "singular or unreachable pose the status says so and every quantity that is\n"
@@ -69,8 +70,8 @@ int prru_cmd_dme(int argc, char **argv)
     prru_cli_error("dme", "--q is required (see 'prru dme --help')");
     return 2;
   }
-  double q[3];
-  if (prru_cli_numbers("dme", "q", qs, q, 3)) return 2;
+  double q[PRRU_NQ];
+  if (prru_cli_numbers("dme", "q", qs, q, PRRU_NQ)) return 2;
   prru_model m;
   prru_model_default(&m);
   if (parse_rcond("dme", rcs, &m)) return 2;
@@ -84,8 +85,10 @@ int prru_cmd_dme(int argc, char **argv)
     return 2;
   }
   FILE *f = stdout;
-  fputs("{\"q\": ", f);
-  json_vec(f, q, 3);
+  fputc('{', f);
+  prru_cli_json_model(f);
+  fputs(",\n \"q\": ", f);
+  json_vec(f, q, PRRU_NQ);
   fprintf(f, ", \"status\": \"%s\", \"w_R\": ", prru_dme_status_name(st));
   prru_cli_json_number(f, r.w_R);
   fputs(", \"Jd_rcond\": ", f);
@@ -103,11 +106,11 @@ int prru_cmd_dme(int argc, char **argv)
   fputs(", \"translational_direction\": ", f);
   json_vec(f, r.dir_T, 3);
   fputs(", \"Mt\": ", f);
-  prru_cli_json_array(f, r.Mt, 9, 3);
+  prru_cli_json_array(f, r.Mt, PRRU_NACT * PRRU_NACT, PRRU_NACT);
   fputs(", \"JtR\": ", f);
-  prru_cli_json_array(f, r.JtR, 9, 3);
+  prru_cli_json_array(f, r.JtR, 3 * PRRU_NACT, 3);
   fputs(", \"JtT\": ", f);
-  prru_cli_json_array(f, r.JtT, 9, 3);
+  prru_cli_json_array(f, r.JtT, 3 * PRRU_NACT, 3);
   fputs("}\n", f);
   return ferror(f) ? 1 : 0;
 }
@@ -119,9 +122,10 @@ static const char map_help[] =
     "                --out FILE.csv [--rcond-min R] [--threads N] [--progress]\n"
     "w_R (see 'prru dme --help') at every grid point q1 = START..STOP (COUNT\n"
     "equally spaced values, rad, COUNT >= 2, START < STOP), q2 likewise, q3 = Z\n"
-    "(m, default 0). Writes FILE.csv with the columns q1,q2,q3,w_R,status (q1\n"
-    "outer); where the pose is singular or unreachable w_R is NaN and status says\n"
-    "which. Prints the global index to stdout: the mean of w_R - 1 over the ok\n"
+    "(m, default 0). Writes FILE.csv: the model line (# prru ... model ...), then\n"
+    "the columns q1,q2,q3,w_R,status (q1 outer); where the pose is singular or\n"
+    "unreachable w_R is NaN and status says which. Prints to stdout the model\n"
+    "(name, file, sha256) and the global index: the mean of w_R - 1 over the ok\n"
     "points, with the fraction of the grid that is singular or unreachable (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
     "and the range of w_R. J_d counts as singular when 1/(|J_d|_1 |J_d^-1|_1) < R\n"
@@ -202,6 +206,7 @@ static int write_map_csv(const char *cmd, const char *path, const prru_map_grid 
   }
   static char buf[1 << 16];
   setvbuf(f, buf, _IOFBF, sizeof buf);
+  prru_cli_csv_comment(f);
   fputs("q1,q2,q3,w_R,status\n", f);
   for (int i = 0; i < g->n1; i++) {
     double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
@@ -224,6 +229,7 @@ static int write_map_csv(const char *cmd, const char *path, const prru_map_grid 
 
 static void print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
 {
+  fprintf(f, "model: %s\n", prru_cli_model_id());
   fprintf(f, "points: %ld (ok %ld, singular %ld, unreachable %ld; J_d singular below rcond %g)\n",
           s->n_points, s->n_ok, s->n_singular, s->n_unreachable, rcond_min);
   fprintf(f, "global_index: %.10g (mean of w_R - 1 over the ok points)\n", s->index);
@@ -338,7 +344,7 @@ static const char fig7_script[] =
     "set yrange [-pi/4:pi/6]\n"
     "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n"
     "set output 'fig7_surface.png'\n"
-    "set title sprintf(\"Rotational dynamic manipulability index w_R over the workspace, q_3 = 0 m (paper fig. 7)\\n201 x 201 grid, w_R from %.3f to %.3g; red: J_d singular, cond_1(J_d) > 10^3\", STATS_min, STATS_max)\n"
+    "set title sprintf(\"Rotational dynamic manipulability index w_R over the workspace, q_3 = 0 m (paper fig. 7), model %s\\n201 x 201 grid, w_R from %.3f to %.3g; red: J_d singular, cond_1(J_d) > 10^3\", model, STATS_min, STATS_max)\n"
     "set zlabel 'w_R (-), log scale' rotate by 90\n"
     "set logscale z\n"
     "set logscale cb\n"
@@ -371,7 +377,7 @@ static const char fig7_script[] =
     "unset logscale cb\n"
     "set cbrange [1:2.5]\n"
     "set cbtics auto\n"
-    "set title \"w_R over the workspace, q_3 = 0 m (paper fig. 7), contours 1.1 to 2.1 by 0.1, then 2.5, 3, 5, 10\\nred: J_d singular, cond_1(J_d) > 10^3 (the corners beyond that band are another assembly mode)\"\n"
+    "set title \"w_R over the workspace, q_3 = 0 m (paper fig. 7), model \".model.\", contours 1.1 to 2.1 by 0.1, then 2.5, 3, 5, 10\\nred: J_d singular, cond_1(J_d) > 10^3 (the corners beyond that band are another assembly mode)\"\n"
     "set size ratio -1\n"
     "set key inside left top textcolor rgb 'white' noopaque nobox\n"
     "set grid front\n"
@@ -386,7 +392,7 @@ static const char fig7_script[] =
     "unset logscale\n"
     "set size noratio\n"
     "set key outside bottom center horizontal\n"
-    "set multiplot layout 1,2 title 'Dynamic manipulability at a few poses, q_3 = 0 m: accelerations reachable with 1 N of actuator force (paper fig. 7a)'\n"
+    "set multiplot layout 1,2 title 'Dynamic manipulability at a few poses, q_3 = 0 m: accelerations reachable with 1 N of actuator force (paper fig. 7a), model '.model\n"
     "set title 'Rotational DME (in the plane of e_1 and v)'\n"
     "set xlabel 'angular acceleration along e_1 (rad s^{-2} per N)'\n"
     "set ylabel 'angular acceleration along v (rad s^{-2} per N)'\n"
@@ -440,9 +446,11 @@ static int write_fig7a(const char *outdir, const prru_model *m, prru_data *d)
     fclose(fe);
     return 1;
   }
+  prru_cli_csv_comment(fe);
+  prru_cli_csv_comment(fs);
   fputs("# pose index, half-length (m/s^2 per N), label\n", fs);
   for (int k = 0; k < FIG7A_NPOSE; k++) {
-    double q[3] = {fig7a_poses[k][0], fig7a_poses[k][1], 0.0};
+    double q[PRRU_NQ] = {fig7a_poses[k][0], fig7a_poses[k][1], 0.0};
     prru_dme r;
     int st = prru_dme_eval(m, d, q, &r);
     char label[96];
@@ -500,6 +508,7 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   FILE *f = rc == 0 ? open_out(outdir, "fig7_grid.dat", path, sizeof path) : NULL;
   if (rc == 0 && !f) rc = 1;
   if (f) {
+    prru_cli_csv_comment(f);
     fputs("# q1 (rad) q2 (rad) w_R (NaN: singular or unreachable)\n", f);
     for (int i = 0; i < g.n1; i++) {
       for (int j = 0; j < g.n2; j++) {
@@ -518,6 +527,7 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   f = rc == 0 ? open_out(outdir, "fig7_singular.dat", path, sizeof path) : NULL;
   if (rc == 0 && !f) rc = 1;
   if (f) {
+    prru_cli_csv_comment(f);
     fputs("# q1 (rad) q2 (rad) of the singular or unreachable grid points\n", f);
     for (long k = 0; k < (long)g.n1 * g.n2; k++)
       if (st[k] != PRRU_OK)
@@ -536,9 +546,20 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   }
   free(d);
   if (rc == 0) {
-    char script[sizeof fig7_script + 64];
-    snprintf(script, sizeof script, "NCONF = %d\n%s", FIG7A_NPOSE, fig7_script);
-    rc = prru_cli_gnuplot(outdir, "fig7_plots.gp", script);
+    char *script = NULL;
+    size_t len = 0;
+    FILE *gp = open_memstream(&script, &len);
+    if (gp) {
+      prru_cli_gnuplot_model(gp);
+      fprintf(gp, "NCONF = %d\n%s", FIG7A_NPOSE, fig7_script);
+    }
+    if (!gp || fclose(gp) != 0) {
+      prru_cli_error("paper", "out of memory for the fig. 7 script");
+      rc = 1;
+    } else {
+      rc = prru_cli_gnuplot(outdir, "fig7_plots.gp", script);
+    }
+    free(script);
   }
   if (rc == 0) {
     FILE *outs[2] = {summary, stdout};
@@ -547,9 +568,10 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
       if (!s) continue;
       fprintf(s, "\nWorkspace map (paper fig. 7): q3 = 0, q1 in [-pi/6, pi/6], q2 in [-pi/4, pi/6], "
                  "201 x 201 grid\n");
-      fprintf(s, "w_R(0, 0) = %.12g (spec: 1.80468); rotational semi-axes %.6g, %.6g rad/s^2 per N; "
+      fprintf(s, "w_R(0, 0) = %.12g%s; rotational semi-axes %.6g, %.6g rad/s^2 per N; "
                  "translational half-length %.6g m/s^2 per N\n",
-              home.w_R, home.semi_axis[0], home.semi_axis[1], home.half_length_T);
+              home.w_R, prru_model_is_paper(&m) ? " (the paper's value: 1.80468)" : "",
+              home.semi_axis[0], home.semi_axis[1], home.half_length_T);
       fprintf(s, "with J_d singular where cond_1(J_d) > 1e3 (rcond < %g):\n", FIG7_RCOND_MIN);
       fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum.index);
       fprintf(s, "  singular fraction = %.6g (%ld singular, %ld unreachable of %ld points)\n",

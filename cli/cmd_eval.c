@@ -6,23 +6,36 @@
 #include "commands.h"
 #include "prru.h"
 
+/* %s: the --fd names; %d: PRRU_NLAMBDA. */
 static const char eval_help[] =
-    "usage: prru eval --q q1,q2,q3 [--qd qd1,qd2,qd3] [--fd f1,f2,f3]\n"
+    "usage: prru eval --q q1,q2,q3 [--qd qd1,qd2,qd3] [--fd %s]\n"
     "                 [--fp fx,fy,fz] [--mp mx,my,mz]\n"
-    "Prints JSON with q, qd, M (3x3), h, G, d, Jd (3x3), qdd (under the given\n"
-    "actuator forces fd (N), platform force fp (N) and moment mp (N m) at O', in\n"
-    "{S}) and lambda (the 57 joint reaction coordinates, order lambda_labels).\n"
+    "Prints JSON with model (name, file, sha256 of the model the build computes),\n"
+    "q, qd, M (3x3), h, G, passive (the drives' damping and friction as\n"
+    "generalized forces; zero for a model without them), d, Jd (actuators x q),\n"
+    "qdd (under the given actuator forces fd (N), platform force fp (N) and\n"
+    "moment mp (N m) at O', in {S}: M qdd + h = G + Jd^T fd + J_T,P^T fp +\n"
+    "J_R,P^T mp + passive) and lambda (the %d joint reaction coordinates: force\n"
+    "(N) and moment (N m) components of what each joint's proximal body exerts\n"
+    "on the distal one, named in lambda_labels as JOINT_COMPONENT, e.g. %s).\n"
     "Velocities and loads default to 0. Exit 1 when q is unreachable or J_d is\n"
     "singular there, 2 on bad arguments.\n";
 
-/* Reads the --q/--qd/--fd/--fp/--mp family shared by eval-like commands. */
-static int read_vec(const char *cmd, const char *name, const char *text, double out[3])
+/* Reads the --q/--qd/--fd/--fp/--mp family shared by eval-like commands:
+ * n numbers, all 0 when the option is absent. */
+static int read_vec(const char *cmd, const char *name, const char *text, double *out, int n)
 {
   if (!text) {
-    out[0] = out[1] = out[2] = 0.0;
+    for (int i = 0; i < n; i++) out[i] = 0.0;
     return 0;
   }
-  return prru_cli_numbers(cmd, name, text, out, 3);
+  return prru_cli_numbers(cmd, name, text, out, n);
+}
+
+static void member(const char *sep, const char *name, const double *v, int n)
+{
+  printf("%s\"%s\": ", sep, name);
+  prru_cli_json_array(stdout, v, n, 1);
 }
 
 int prru_cmd_eval(int argc, char **argv)
@@ -33,25 +46,28 @@ int prru_cmd_eval(int argc, char **argv)
                             {"fp", 1, &fps, NULL}, {"mp", 1, &mps, NULL}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("eval", argc, argv, opts, 6)) return 2;
   if (help) {
-    fputs(eval_help, stdout);
+    char fd_names[256];
+    printf(eval_help, prru_cli_names(fd_names, sizeof fd_names, "f", PRRU_NACT, ","), PRRU_NLAMBDA,
+           prru_mech.lambda_labels[0]);
     return 0;
   }
   if (!qs) {
     prru_cli_error("eval", "--q is required (see 'prru eval --help')");
     return 2;
   }
-  double q[3], qd[3];
+  double q[PRRU_NQ], qd[PRRU_NQ];
   prru_loads l;
-  if (read_vec("eval", "q", qs, q) || read_vec("eval", "qd", qds, qd) ||
-      read_vec("eval", "fd", fds, l.fd) || read_vec("eval", "fp", fps, l.fp) ||
-      read_vec("eval", "mp", mps, l.mp))
+  if (read_vec("eval", "q", qs, q, PRRU_NQ) || read_vec("eval", "qd", qds, qd, PRRU_NQ) ||
+      read_vec("eval", "fd", fds, l.fd, PRRU_NACT) || read_vec("eval", "fp", fps, l.fp, 3) ||
+      read_vec("eval", "mp", mps, l.mp, 3))
     return 2;
 
   prru_model m;
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
-  double rcond, M[9], h[3], G[3], lambda[PRRU_NLAMBDA], qdd[3];
+  double rcond, M[PRRU_NQ * PRRU_NQ], h[PRRU_NQ], G[PRRU_NQ], passive[PRRU_NQ];
+  double lambda[PRRU_NLAMBDA], qdd[PRRU_NQ];
   int st = prru_check_regular(&m, d, q, &rcond);
   if (st == PRRU_OK) st = prru_reactions(&m, d, q, qd, &l, lambda);
   if (st != PRRU_OK) {
@@ -62,38 +78,33 @@ int prru_cmd_eval(int argc, char **argv)
   }
   memcpy(qdd, d->qdd, sizeof qdd);
   prru_dynamics(q, qd, M, h, G);
-  double act[3], Jd[9];
+  prru_passive(q, qd, passive);
+  double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ];
   prru_ik_jd(q, act, Jd);
   const char *const *labels = prru_mech.lambda_labels;
 
-  printf("{\"q\": ");
-  prru_cli_json_array(stdout, q, 3, 1);
-  printf(", \"qd\": ");
-  prru_cli_json_array(stdout, qd, 3, 1);
-  printf(",\n \"M\": ");
-  prru_cli_json_array(stdout, M, 9, 1);
-  printf(",\n \"h\": ");
-  prru_cli_json_array(stdout, h, 3, 1);
-  printf(", \"G\": ");
-  prru_cli_json_array(stdout, G, 3, 1);
-  printf(",\n \"d\": ");
-  prru_cli_json_array(stdout, act, 3, 1);
-  printf(", \"Jd\": ");
-  prru_cli_json_array(stdout, Jd, 9, 1);
+  printf("{");
+  prru_cli_json_model(stdout);
+  member(",\n ", "q", q, PRRU_NQ);
+  member(", ", "qd", qd, PRRU_NQ);
+  member(",\n ", "M", M, PRRU_NQ * PRRU_NQ);
+  member(",\n ", "h", h, PRRU_NQ);
+  member(", ", "G", G, PRRU_NQ);
+  member(", ", "passive", passive, PRRU_NQ);
+  member(",\n ", "d", act, PRRU_NACT);
+  member(", ", "Jd", Jd, PRRU_NACT * PRRU_NQ);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
-  printf(",\n \"fd\": ");
-  prru_cli_json_array(stdout, l.fd, 3, 1);
-  printf(", \"fp\": ");
-  prru_cli_json_array(stdout, l.fp, 3, 1);
-  printf(", \"mp\": ");
-  prru_cli_json_array(stdout, l.mp, 3, 1);
-  printf(",\n \"qdd\": ");
-  prru_cli_json_array(stdout, qdd, 3, 1);
-  printf(",\n \"lambda\": ");
-  prru_cli_json_array(stdout, lambda, PRRU_NLAMBDA, 1);
+  member(",\n ", "fd", l.fd, PRRU_NACT);
+  member(", ", "fp", l.fp, 3);
+  member(", ", "mp", l.mp, 3);
+  member(",\n ", "qdd", qdd, PRRU_NQ);
+  member(",\n ", "lambda", lambda, PRRU_NLAMBDA);
   printf(",\n \"lambda_labels\": [");
-  for (int i = 0; i < PRRU_NLAMBDA; i++) printf("%s\"%s\"", i ? ", " : "", labels[i]);
+  for (int i = 0; i < PRRU_NLAMBDA; i++) {
+    if (i) fputs(", ", stdout);
+    prru_cli_json_string(stdout, labels[i]);
+  }
   printf("]}\n");
   free(d);
   return ferror(stdout) ? 1 : 0;

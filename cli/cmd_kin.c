@@ -9,8 +9,10 @@
 
 static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
-    "Prints JSON with the actuator displacements d (m, slider heights) and J_d =\n"
-    "dd/dq. Exit 1 when q is unreachable.\n";
+    "Prints JSON with model (name, file, sha256), q, the actuator displacements d\n"
+    "(m, slider heights), J_d = dd/dq (actuators x q, row-major), its reciprocal\n"
+    "condition number and whether J_d is singular there. Exit 1 when q is\n"
+    "unreachable.\n";
 
 int prru_cmd_ik(int argc, char **argv)
 {
@@ -22,12 +24,12 @@ int prru_cmd_ik(int argc, char **argv)
     fputs(ik_help, stdout);
     return 0;
   }
-  double q[3];
+  double q[PRRU_NQ];
   if (!qs) {
     prru_cli_error("ik", "--q is required (see 'prru ik --help')");
     return 2;
   }
-  if (prru_cli_numbers("ik", "q", qs, q, 3)) return 2;
+  if (prru_cli_numbers("ik", "q", qs, q, PRRU_NQ)) return 2;
   prru_model m;
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
@@ -39,12 +41,14 @@ int prru_cmd_ik(int argc, char **argv)
     free(d);
     return 1;
   }
-  printf("{\"q\": ");
-  prru_cli_json_array(stdout, q, 3, 1);
+  putchar('{');
+  prru_cli_json_model(stdout);
+  printf(",\n \"q\": ");
+  prru_cli_json_array(stdout, q, PRRU_NQ, 1);
   printf(", \"d\": ");
-  prru_cli_json_array(stdout, d->d, 3, 1);
+  prru_cli_json_array(stdout, d->d, PRRU_NACT, 1);
   printf(", \"Jd\": ");
-  prru_cli_json_array(stdout, d->Jd, 9, 1);
+  prru_cli_json_array(stdout, d->Jd, PRRU_NACT * PRRU_NQ, 1);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   printf(", \"singular\": %s}\n", st == PRRU_ESINGULAR ? "true" : "false");
@@ -52,12 +56,14 @@ int prru_cmd_ik(int argc, char **argv)
   return ferror(stdout) ? 1 : 0;
 }
 
+/* %s: the --d names. */
 static const char fk_help[] =
-    "usage: prru fk --d d1,d2,d3 [--seed q1,q2,q3]\n"
+    "usage: prru fk --d %s [--seed q1,q2,q3]\n"
     "Solves d(q) = d for q by Newton's method (GSL hybridsj with J_d) from the\n"
     "seed (default: q1 = q2 = 0 and the height that matches the mean of d).\n"
-    "Prints JSON with q and the residual. Exit 1 when d is out of reach or the\n"
-    "iteration meets a singularity.\n";
+    "Prints JSON with model (name, file, sha256), d, q and the residual\n"
+    "max |d(q) - d| (m). Exit 1 when d is out of reach or the iteration meets a\n"
+    "singularity.\n";
 
 int prru_cmd_fk(int argc, char **argv)
 {
@@ -66,43 +72,51 @@ int prru_cmd_fk(int argc, char **argv)
   prru_cli_option opts[] = {{"d", 1, &ds, NULL}, {"seed", 1, &seeds, NULL}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("fk", argc, argv, opts, 3)) return 2;
   if (help) {
-    fputs(fk_help, stdout);
+    char names[256];
+    printf(fk_help, prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
     return 0;
   }
-  double act[3], seed[3], q[3];
+  double act[PRRU_NACT], seed[PRRU_NQ], q[PRRU_NQ];
   if (!ds) {
     prru_cli_error("fk", "--d is required (see 'prru fk --help')");
     return 2;
   }
-  if (prru_cli_numbers("fk", "d", ds, act, 3)) return 2;
+  if (prru_cli_numbers("fk", "d", ds, act, PRRU_NACT)) return 2;
   prru_model m;
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   if (seeds) {
-    if (prru_cli_numbers("fk", "seed", seeds, seed, 3)) { free(d); return 2; }
+    if (prru_cli_numbers("fk", "seed", seeds, seed, PRRU_NQ)) { free(d); return 2; }
   } else {
     /* At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0). */
-    double zero[3] = {0, 0, 0}, d0[3];
+    double zero[PRRU_NQ] = {0, 0, 0}, d0[PRRU_NACT], sum = 0.0;
     prru_ik(zero, d0);
+    for (int i = 0; i < PRRU_NACT; i++) sum += act[i] - d0[i];
     seed[0] = seed[1] = 0.0;
-    seed[2] = (act[0] + act[1] + act[2] - d0[0] - d0[1] - d0[2]) / 3.0;
+    seed[2] = sum / PRRU_NACT;
   }
   int st = prru_forward_kinematics(&m, d, act, seed, q);
   if (st != PRRU_OK) {
-    prru_cli_error("fk", "d = (%.17g, %.17g, %.17g) from seed (%.6g, %.6g, %.6g): %s%s", act[0],
-                   act[1], act[2], seed[0], seed[1], seed[2], prru_strerror(st),
+    char dtext[64 * PRRU_NACT];
+    size_t used = 0;
+    for (int i = 0; i < PRRU_NACT; i++)
+      used += (size_t)snprintf(dtext + used, sizeof dtext - used, "%s%.17g", i ? ", " : "", act[i]);
+    prru_cli_error("fk", "d = (%s) from seed (%.6g, %.6g, %.6g): %s%s", dtext, seed[0], seed[1],
+                   seed[2], prru_strerror(st),
                    st == PRRU_ENOCONV ? " (d out of reach, or a singularity near the path; try another --seed)" : "");
     free(d);
     return 1;
   }
-  double dq[3], res = 0;
+  double dq[PRRU_NACT], res = 0;
   prru_ik(q, dq);
-  for (int i = 0; i < 3; i++) res = fmax(res, fabs(dq[i] - act[i]));
-  printf("{\"d\": ");
-  prru_cli_json_array(stdout, act, 3, 1);
+  for (int i = 0; i < PRRU_NACT; i++) res = fmax(res, fabs(dq[i] - act[i]));
+  putchar('{');
+  prru_cli_json_model(stdout);
+  printf(",\n \"d\": ");
+  prru_cli_json_array(stdout, act, PRRU_NACT, 1);
   printf(", \"q\": ");
-  prru_cli_json_array(stdout, q, 3, 1);
+  prru_cli_json_array(stdout, q, PRRU_NQ, 1);
   printf(", \"residual\": ");
   prru_cli_json_number(stdout, res);
   printf("}\n");
@@ -110,14 +124,16 @@ int prru_cmd_fk(int argc, char **argv)
   return ferror(stdout) ? 1 : 0;
 }
 
+/* %s: the output's columns. */
 static const char id_help[] =
     "usage: prru id --traj FILE.csv [--out FILE.csv]\n"
     "Inverse dynamics along a trajectory: FILE has a header row and columns\n"
     "t, q1..q3, qd1..qd3, qdd1..qdd3 (any order, other columns ignored) and\n"
-    "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); `prru simulate`\n"
-    "output qualifies. Writes t,fd1,fd2,fd3 (N) to --out or stdout. A row where\n"
-    "the pose is unreachable or J_d singular stops with exit 1; the rows before\n"
-    "it are kept. An unreadable or malformed FILE exits 2.\n";
+    "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); lines starting\n"
+    "with '#' are skipped, so `prru simulate` output qualifies. Writes the model\n"
+    "line (# prru ... model ...) and t,%s (N) to --out or stdout. A row\n"
+    "where the pose is unreachable or J_d singular stops with exit 1; the rows\n"
+    "before it are kept. An unreadable or malformed FILE exits 2.\n";
 
 int prru_cmd_id(int argc, char **argv)
 {
@@ -125,8 +141,10 @@ int prru_cmd_id(int argc, char **argv)
   int help = 0;
   prru_cli_option opts[] = {{"traj", 1, &traj, NULL}, {"out", 1, &out, NULL}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("id", argc, argv, opts, 3)) return 2;
+  char fd_names[256];
+  prru_cli_names(fd_names, sizeof fd_names, "fd", PRRU_NACT, ",");
   if (help) {
-    fputs(id_help, stdout);
+    printf(id_help, fd_names);
     return 0;
   }
   if (!traj) {
@@ -160,10 +178,11 @@ int prru_cmd_id(int argc, char **argv)
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
   st = d ? PRRU_OK : PRRU_ENOMEM;
-  fprintf(f, "t,fd1,fd2,fd3\n");
+  prru_cli_csv_comment(f);
+  fprintf(f, "t,%s\n", fd_names);
   for (int i = 0; st == PRRU_OK && i < t.nrows; i++) {
     const double *row = t.data + (size_t)i * (size_t)t.ncols;
-    double v[16], fd[3];
+    double v[16], fd[PRRU_NACT];
     for (int k = 0; k < 16; k++) v[k] = col[k] < 0 ? 0.0 : row[col[k]];
     prru_loads l;
     memset(&l, 0, sizeof l);
@@ -175,7 +194,9 @@ int prru_cmd_id(int argc, char **argv)
                      prru_strerror(st), i);
       break;
     }
-    fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", v[0], fd[0], fd[1], fd[2]);
+    fprintf(f, "%.17g", v[0]);
+    for (int k = 0; k < PRRU_NACT; k++) fprintf(f, ",%.17g", fd[k]);
+    fputc('\n', f);
   }
   int bad_io = ferror(f) != 0;
   if (f != stdout) bad_io |= fclose(f) != 0;

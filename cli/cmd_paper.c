@@ -18,14 +18,18 @@ static const char paper_help[] =
     "the platform force fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N, then the w_R map.\n"
     "Writes DIR/paper_sim.csv (columns as `prru simulate`), fig_q.png, fig_d.png,\n"
     "fig4_u_joint_forces.png, fig6_p_joint_reactions.png, the fig. 7 files and\n"
-    "DIR/summary.txt. Needs gnuplot for the PNGs.\n";
+    "DIR/summary.txt. Needs gnuplot for the PNGs.\n"
+    "Every file names the model the build computes; with a model other than the\n"
+    "paper's (models/3prru_paper.json) the study runs on that model and a warning\n"
+    "says that the figures are not the paper's results.\n";
 
 /* Keeps the samples in memory (for the summary) and writes the CSV. */
 typedef struct {
   prru_cli_csv csv;
   prru_sample first, last;
-  double work;      /* integral of fd . dd/dt + fp . v_P (trapezoid) */
-  double prev_power;
+  double work;         /* integral of fd . dd/dt + fp . v_P + mp . w_P (trapezoid) */
+  double work_passive; /* integral of the drives' passive forces . qd */
+  double prev_power, prev_passive;
   double max_abs[PRRU_NLAMBDA];
   long n;
 } paper_run;
@@ -35,20 +39,32 @@ static int on_sample(const prru_sample *s, void *ctx)
   paper_run *r = ctx;
   prru_loads l;
   prru_schedule_eval(r->csv.loads, s->t, &l);
-  double Jd[9], JP[18], power = 0;
+  double Jd[PRRU_NACT * PRRU_NQ], JP[6 * PRRU_NQ], Qp[PRRU_NQ], power = 0, passive = 0;
   prru_jd(s->q, Jd);
   prru_platform_jacobian(s->q, JP);
-  for (int i = 0; i < 3; i++) {
-    double dd = Jd[3 * i] * s->qd[0] + Jd[3 * i + 1] * s->qd[1] + Jd[3 * i + 2] * s->qd[2];
-    double w = JP[3 * i] * s->qd[0] + JP[3 * i + 1] * s->qd[1] + JP[3 * i + 2] * s->qd[2];
-    double v = JP[9 + 3 * i] * s->qd[0] + JP[9 + 3 * i + 1] * s->qd[1] + JP[9 + 3 * i + 2] * s->qd[2];
-    power += l.fd[i] * dd + l.fp[i] * v + l.mp[i] * w;
+  prru_passive(s->q, s->qd, Qp);
+  for (int i = 0; i < PRRU_NACT; i++) {
+    double dd = 0;
+    for (int k = 0; k < PRRU_NQ; k++) dd += Jd[PRRU_NQ * i + k] * s->qd[k];
+    power += l.fd[i] * dd;
   }
-  if (r->n == 0)
+  for (int i = 0; i < 3; i++) {
+    double w = 0, v = 0;
+    for (int k = 0; k < PRRU_NQ; k++) {
+      w += JP[PRRU_NQ * i + k] * s->qd[k];
+      v += JP[PRRU_NQ * (3 + i) + k] * s->qd[k];
+    }
+    power += l.fp[i] * v + l.mp[i] * w;
+  }
+  for (int k = 0; k < PRRU_NQ; k++) passive += Qp[k] * s->qd[k];
+  if (r->n == 0) {
     r->first = *s;
-  else
+  } else {
     r->work += 0.5 * (power + r->prev_power) * (s->t - r->last.t);
+    r->work_passive += 0.5 * (passive + r->prev_passive) * (s->t - r->last.t);
+  }
   r->prev_power = power;
+  r->prev_passive = passive;
   r->last = *s;
   for (int i = 0; i < PRRU_NLAMBDA; i++)
     if (fabs(s->lambda[i]) > r->max_abs[i]) r->max_abs[i] = fabs(s->lambda[i]);
@@ -56,48 +72,121 @@ static int on_sample(const prru_sample *s, void *ctx)
   return prru_cli_csv_row(s, &r->csv);
 }
 
-static const char plot_script[] =
-    "set datafile separator ','\n"
-    "set terminal pngcairo size 1000,700 enhanced font 'Sans,11'\n"
-    "set grid\n"
-    "set key outside right\n"
-    "f = 'paper_sim.csv'\n"
-    "set output 'fig_q.png'\n"
-    "set multiplot layout 2,1 title 'Generalized coordinates, paper scenario (section 4.3)'\n"
-    "set ylabel 'rotation (rad)'\n"
-    "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
-    "set xlabel 'time t (s)'\n"
-    "set ylabel 'height (m)'\n"
-    "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
-    "unset multiplot\n"
-    "set output 'fig_d.png'\n"
-    "set title 'Actuator displacements (slider heights)'\n"
-    "set xlabel 'time t (s)'\n"
-    "set ylabel 'd_i (m)'\n"
-    "plot f using 't':'d1' with lines lw 2 title 'd_1', '' using 't':'d2' with lines lw 2 title 'd_2', '' using 't':'d3' with lines lw 2 title 'd_3'\n"
-    "unset title\n"
-    "set output 'fig4_u_joint_forces.png'\n"
-    "set multiplot layout 3,1 title 'Reaction forces in the U joints C_i (force of the lower link on the platform, base frame S; paper fig. 4)'\n"
-    "set xlabel ''\n"
-    "set ylabel 'C_1 force (N)'\n"
-    "plot f using 't':'C1_fx' w l lw 2 t 'f_x', '' using 't':'C1_fy' w l lw 2 t 'f_y', '' using 't':'C1_fz' w l lw 2 t 'f_z'\n"
-    "set ylabel 'C_2 force (N)'\n"
-    "plot f using 't':'C2_fx' w l lw 2 t 'f_x', '' using 't':'C2_fy' w l lw 2 t 'f_y', '' using 't':'C2_fz' w l lw 2 t 'f_z'\n"
-    "set xlabel 'time t (s)'\n"
-    "set ylabel 'C_3 force (N)'\n"
-    "plot f using 't':'C3_fx' w l lw 2 t 'f_x', '' using 't':'C3_fy' w l lw 2 t 'f_y', '' using 't':'C3_fz' w l lw 2 t 'f_z'\n"
-    "unset multiplot\n"
-    "set output 'fig6_p_joint_reactions.png'\n"
-    "set terminal pngcairo size 1200,800 enhanced font 'Sans,11'\n"
-    "set multiplot layout 3,2 title 'Reactions in the prismatic joints P_i (rail on slider, base frame S; paper fig. 6)'\n"
-    "do for [i=1:3] {\n"
-    "  set xlabel (i == 3 ? 'time t (s)' : '')\n"
-    "  set ylabel sprintf('P_%d force (N)', i)\n"
-    "  plot f using 't':sprintf('P%d_fx', i) w l lw 2 t 'f_x', '' using 't':sprintf('P%d_fy', i) w l lw 2 t 'f_y'\n"
-    "  set ylabel sprintf('P_%d moment (N m)', i)\n"
-    "  plot f using 't':sprintf('P%d_mx', i) w l lw 2 t 'm_x', '' using 't':sprintf('P%d_my', i) w l lw 2 t 'm_y', '' using 't':sprintf('P%d_mz', i) w l lw 2 t 'm_z'\n"
-    "}\n"
-    "unset multiplot\n";
+/* The model's name as the gnuplot string variable `model` (single quotes
+ * doubled, underscores escaped for enhanced text). */
+void prru_cli_gnuplot_model(FILE *g)
+{
+  fputs("model = '", g);
+  for (const char *c = prru_mech.name; *c; c++) {
+    if (*c == '\'')
+      fputs("''", g);
+    else if (*c == '_' || *c == '^' || *c == '{' || *c == '}' || *c == '@' || *c == '&' || *c == '~')
+      fprintf(g, "\\%c", *c);
+    else if ((unsigned char)*c >= 0x20)
+      fputc(*c, g);
+  }
+  fputs("'\n", g);
+}
+
+/* "C1" -> "C_1" (letters, then the rest as a subscript) for gnuplot labels. */
+static void put_subscripted(FILE *g, const char *name)
+{
+  const char *c = name;
+  while (*c && !(*c >= '0' && *c <= '9')) fputc(*c++, g);
+  if (*c) fprintf(g, "_{%s}", c);
+}
+
+/* One plot command of joint j's reaction components whose name (after the
+ * '_') starts with kind ('f' forces, 'm' moments). */
+static void plot_components(FILE *g, int j, char kind)
+{
+  const prru_joint_info *jt = &prru_mech.joint[j];
+  int first = 1;
+  for (int k = 0; k < jt->lambda_count; k++) {
+    const char *label = prru_mech.lambda_labels[jt->lambda_offset + k];
+    const char *comp = strchr(label, '_');
+    comp = comp ? comp + 1 : label;
+    if (comp[0] != kind) continue;
+    fprintf(g, "%s'%s' w l lw 2 t '%c_%s'", first ? "plot f using 't':" : ", '' using 't':", label,
+            comp[0], comp[0] ? comp + 1 : "");
+    first = 0;
+  }
+  fputs(first ? "plot 0 notitle\n" : "\n", g);
+}
+
+/* The gnuplot script for paper_sim.csv, written from the mechanism's
+ * actuators and joints; NULL when out of memory. */
+static char *plot_script(void)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return NULL;
+  int nu = 0, np = 0;
+  for (int j = 0; j < PRRU_NJOINT; j++) {
+    nu += prru_mech.joint[j].type == 'U';
+    np += prru_mech.joint[j].type == 'P';
+  }
+  prru_cli_gnuplot_model(g);
+  fputs("set datafile separator ','\n"
+        "set terminal pngcairo size 1000,700 enhanced font 'Sans,11'\n"
+        "set grid\n"
+        "set key outside right\n"
+        "f = 'paper_sim.csv'\n"
+        "set output 'fig_q.png'\n"
+        "set multiplot layout 2,1 title 'Generalized coordinates, paper scenario (section 4.3), model '.model\n"
+        "set ylabel 'rotation (rad)'\n"
+        "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
+        "set xlabel 'time t (s)'\n"
+        "set ylabel 'height (m)'\n"
+        "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
+        "unset multiplot\n"
+        "set output 'fig_d.png'\n"
+        "set title 'Actuator displacements (slider heights), model '.model\n"
+        "set xlabel 'time t (s)'\n"
+        "set ylabel 'd_i (m)'\n"
+        "plot ", g);
+  for (int i = 1; i <= PRRU_NACT; i++)
+    fprintf(g, "%s't':'d%d' with lines lw 2 title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i);
+  fputs("\nunset title\n"
+        "set output 'fig4_u_joint_forces.png'\n", g);
+  fprintf(g, "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", 100 + 200 * (nu ? nu : 1));
+  fprintf(g, "set multiplot layout %d,1 title 'Reaction forces in the U joints (force of the lower "
+             "link on the platform, base frame S; paper fig. 4), model '.model\n", nu ? nu : 1);
+  for (int j = 0, u = 0; j < PRRU_NJOINT; j++) {
+    if (prru_mech.joint[j].type != 'U') continue;
+    fprintf(g, "set xlabel '%s'\n", ++u == nu ? "time t (s)" : "");
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" force (N)'\n", g);
+    plot_components(g, j, 'f');
+  }
+  if (!nu) fputs("plot 0 notitle\n", g);
+  fputs("unset multiplot\n"
+        "set output 'fig6_p_joint_reactions.png'\n", g);
+  fprintf(g, "set terminal pngcairo size 1200,%d enhanced font 'Sans,11'\n", 200 + 200 * (np ? np : 1));
+  fprintf(g, "set multiplot layout %d,2 title 'Reactions in the prismatic joints (rail on slider, "
+             "base frame S; paper fig. 6), model '.model\n", np ? np : 1);
+  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
+    if (prru_mech.joint[j].type != 'P') continue;
+    fprintf(g, "set xlabel '%s'\n", ++p == np ? "time t (s)" : "");
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" force (N)'\n", g);
+    plot_components(g, j, 'f');
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" moment (N m)'\n", g);
+    plot_components(g, j, 'm');
+  }
+  if (!np) fputs("plot 0 notitle\n", g);
+  fputs("unset multiplot\n", g);
+  if (fclose(g) != 0) {
+    free(buf);
+    return NULL;
+  }
+  return buf;
+}
 
 /* Runs gnuplot on a script in dir (cd there so outputs land beside it). */
 int prru_cli_gnuplot(const char *dir, const char *script_name, const char *script)
@@ -132,19 +221,27 @@ static int make_dir(const char *dir)
   return 1;
 }
 
-static void summarize(FILE *f, const paper_run *r, double t_stop)
+static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, double t_stop,
+                      int is_paper)
 {
   const char *const *labels = prru_mech.lambda_labels;
   const prru_sample *a = &r->first, *b = &r->last;
-  fprintf(f, "Paper study (section 4.3): q(0) = (0, pi/6, -0.8), fd = (50, 40, 25) N,\n"
-             "fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N, rk8pd at 1e-10, %ld samples to t = %.3f s\n",
-          r->n, t_stop);
+  fprintf(f, "Model: %s%s\n", prru_cli_model_id(),
+          is_paper ? ", the paper's" : "; not the paper's model: the results below are this model's");
+  fputs("Paper study (section 4.3): q(0) = (0, pi/6, -0.8), fd = (", f);
+  for (int i = 0; i < PRRU_NACT; i++) fprintf(f, "%s%g", i ? ", " : "", s->loads.base.fd[i]);
+  const double w_pi = s->loads.omega / 3.14159265358979323846;
+  fprintf(f, ") N,\nfp = %g (sin %g pi t, -cos %g pi t, 0) N, rk8pd at 1e-10, %ld samples to t = %.3f s\n",
+          s->loads.amp, w_pi, w_pi, r->n, t_stop);
   fprintf(f, "q(%.3f)   = (%.10f, %.10f, %.10f) rad, rad, m\n", b->t, b->q[0], b->q[1], b->q[2]);
   fprintf(f, "qd(%.3f)  = (%.10f, %.10f, %.10f)\n", b->t, b->qd[0], b->qd[1], b->qd[2]);
-  fprintf(f, "d(%.3f)   = (%.10f, %.10f, %.10f) m\n", b->t, b->d[0], b->d[1], b->d[2]);
-  double dE = (b->T + b->V) - (a->T + a->V);
-  fprintf(f, "energy balance: change of T + V = %.9f J, work of fd and fp = %.9f J "
-             "(trapezoid on the samples), difference %.2e J\n", dE, r->work, dE - r->work);
+  fprintf(f, "d(%.3f)   = (", b->t);
+  for (int i = 0; i < PRRU_NACT; i++) fprintf(f, "%s%.10f", i ? ", " : "", b->d[i]);
+  fputs(") m\n", f);
+  double dE = (b->T + b->V) - (a->T + a->V), W = r->work + r->work_passive;
+  fprintf(f, "energy balance: change of T + V = %.9f J, work of fd, fp and mp = %.9f J, of the "
+             "drives' damping and friction = %.9f J (trapezoid on the samples), difference %.2e J\n",
+          dE, r->work, r->work_passive, dE - W);
   fprintf(f, "peak reaction magnitudes over the run:\n");
   for (int j = 0; j < PRRU_NLAMBDA; j++)
     fprintf(f, "  %-6s %12.4f%s", labels[j], r->max_abs[j], j % 4 == 3 || j == PRRU_NLAMBDA - 1 ? "\n" : "");
@@ -164,6 +261,12 @@ int prru_cmd_paper(int argc, char **argv)
     prru_cli_error("paper", "--out DIR is required (see 'prru paper --help')");
     return 2;
   }
+  prru_model m;
+  prru_model_default(&m);
+  int is_paper = prru_model_is_paper(&m);
+  if (!is_paper)
+    prru_cli_error("paper", "warning: model %s is not the paper's; the figures show this model, "
+                   "not the paper's results", prru_mech.name);
   if (make_dir(out)) return 1;
   char path[4200], msg[600];
   snprintf(path, sizeof path, "%s/paper_sim.csv", out);
@@ -172,8 +275,6 @@ int prru_cmd_paper(int argc, char **argv)
     prru_cli_error("paper", "%s: cannot open for writing", path);
     return 1;
   }
-  prru_model m;
-  prru_model_default(&m);
   prru_scenario s;
   prru_scenario_paper(&s);
   paper_run *r = calloc(1, sizeof *r);
@@ -205,13 +306,17 @@ int prru_cmd_paper(int argc, char **argv)
   if (!sum) {
     prru_cli_error("paper", "%s: cannot open for writing", path);
     free(r);
+    prru_scenario_free(&s);
     return 1;
   }
-  summarize(sum, r, t_stop);
-  summarize(stdout, r, t_stop);
+  summarize(sum, r, &s, t_stop, is_paper);
+  summarize(stdout, r, &s, t_stop, is_paper);
   free(r);
   prru_scenario_free(&s);
-  int rc = prru_cli_gnuplot(out, "paper_plots.gp", plot_script);
+  char *script = plot_script();
+  int rc = script ? prru_cli_gnuplot(out, "paper_plots.gp", script) : 1;
+  if (!script) prru_cli_error("paper", "out of memory for the plot script");
+  free(script);
   if (rc == 0 && !skip_map) rc = prru_paper_fig7(out, sum);
   if (fclose(sum) != 0 && rc == 0) rc = 1;
   if (rc == 0) printf("wrote %s/: paper_sim.csv, fig_q.png, fig_d.png, fig4_u_joint_forces.png, "

@@ -8,13 +8,20 @@
 #include "commands.h"
 #include "prru.h"
 
+/* The runtime's samples and loads carry one d and fd per actuator. */
+typedef char prru_cli_sample_d_is_nact[sizeof ((prru_sample *)0)->d == PRRU_NACT * sizeof(double) ? 1 : -1];
+typedef char prru_cli_loads_fd_is_nact[sizeof ((prru_loads *)0)->fd == PRRU_NACT * sizeof(double) ? 1 : -1];
+
 void prru_cli_csv_header(prru_cli_csv *c)
 {
   const char *const *labels = prru_mech.lambda_labels;
-  fputs("t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3", c->f);
+  char names[256];
+  prru_cli_csv_comment(c->f);
+  fprintf(c->f, "t,q1,q2,q3,qd1,qd2,qd3,%s", prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
   if (c->reactions)
     for (int i = 0; i < PRRU_NLAMBDA; i++) fprintf(c->f, ",%s", labels[i]);
-  fputs(",qdd1,qdd2,qdd3,fd1,fd2,fd3,fp1,fp2,fp3,mp1,mp2,mp3,T,V\n", c->f);
+  fprintf(c->f, ",qdd1,qdd2,qdd3,%s", prru_cli_names(names, sizeof names, "fd", PRRU_NACT, ","));
+  fputs(",fp1,fp2,fp3,mp1,mp2,mp3,T,V\n", c->f);
 }
 
 static void put(FILE *f, const double *v, int n)
@@ -28,12 +35,12 @@ int prru_cli_csv_row(const prru_sample *s, void *ctx)
   prru_loads l;
   prru_schedule_eval(c->loads, s->t, &l);
   fprintf(c->f, "%.17g", s->t);
-  put(c->f, s->q, 3);
-  put(c->f, s->qd, 3);
-  put(c->f, s->d, 3);
+  put(c->f, s->q, PRRU_NQ);
+  put(c->f, s->qd, PRRU_NQ);
+  put(c->f, s->d, PRRU_NACT);
   if (c->reactions) put(c->f, s->lambda, PRRU_NLAMBDA);
-  put(c->f, s->qdd, 3);
-  put(c->f, l.fd, 3);
+  put(c->f, s->qdd, PRRU_NQ);
+  put(c->f, l.fd, PRRU_NACT);
   put(c->f, l.fp, 3);
   put(c->f, l.mp, 3);
   fprintf(c->f, ",%.17g,%.17g\n", s->T, s->V);
@@ -43,20 +50,25 @@ int prru_cli_csv_row(const prru_sample *s, void *ctx)
   return ferror(c->f) ? 1 : 0;
 }
 
+/* %s: d names, %d: PRRU_NLAMBDA, %s: the first label, %s: joint names in
+ * column order, %s: fd names, %s: fd names. */
 static const char simulate_help[] =
     "usage: prru simulate [--scenario paper|FILE] [--q0 ..] [--qd0 ..] [--fd ..]\n"
     "                     [--fp ..] [--mp ..] [--harmonic AMP,OMEGA] [--loads FILE.csv]\n"
     "                     [--t-end S] [--dt S] [--stepper rk8pd|rkf45|rkck|msbdf]\n"
     "                     [--atol X] [--rtol X] [--h0 S] [--no-reactions]\n"
     "                     [--progress] [--out FILE.csv]\n"
-    "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp from (q0, qd0)\n"
-    "with GSL's odeiv2 driver and writes one CSV row per sample (every dt, last at\n"
-    "t-end): t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3, the 57 joint reactions (spec order),\n"
-    "qdd1..3, fd1..3, fp1..3, mp1..3, T, V (J).\n"
+    "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive drive\n"
+    "forces from (q0, qd0) with GSL's odeiv2 driver and writes a CSV: a first line\n"
+    "`# prru VERSION model NAME (FILE, sha256 HASH)`, the header, then one row per\n"
+    "sample (every dt, last at t-end): t,q1,q2,q3,qd1,qd2,qd3,%s, the %d joint\n"
+    "reaction coordinates (columns JOINT_COMPONENT, e.g. %s, joint by joint in\n"
+    "the order %s; see 'prru eval --help'),\n"
+    "qdd1..3, %s, fp1..3, mp1..3, T, V (J).\n"
     "A scenario file has `key = value` lines (q0 qd0 fd fp mp harmonic loads t_end\n"
     "dt stepper atol rtol h0); options override it. `--scenario paper` is the\n"
     "paper's section 4.3 study. `--harmonic A,W` adds fp = A (sin W t, -cos W t, 0);\n"
-    "`--loads` reads a table t,fd1,fd2,fd3[,fp1..3[,mp1..3]] (linear interpolation).\n"
+    "`--loads` reads a table t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
     "Defaults: zero state and loads, 1 s, dt 1 ms, rk8pd, atol = rtol = 1e-10.\n"
     "A run that leaves the workspace, meets a singular J_d, fails a step or gets\n"
     "Ctrl-C stops with a message and exit 1 (130 for Ctrl-C), keeping every row\n"
@@ -78,7 +90,15 @@ int prru_cmd_simulate(int argc, char **argv)
       {"help", 0, NULL, &help}};
   if (prru_cli_parse("simulate", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (help) {
-    fputs(simulate_help, stdout);
+    char dn[256], fdn[256], joints[16 * PRRU_NJOINT + 1];
+    size_t used = 0;
+    joints[0] = '\0';
+    for (int j = 0; j < PRRU_NJOINT && used < sizeof joints; j++)
+      used += (size_t)snprintf(joints + used, sizeof joints - used, "%s%.12s", j ? " " : "",
+                               prru_mech.joint[j].name);
+    prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+    prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
+    printf(simulate_help, dn, PRRU_NLAMBDA, prru_mech.lambda_labels[0], joints, fdn, fdn);
     return 0;
   }
   prru_scenario s;
@@ -96,7 +116,7 @@ int prru_cmd_simulate(int argc, char **argv)
   int bad = 0;
   if (q0s) bad |= prru_cli_numbers("simulate", "q0", q0s, s.q0, 3);
   if (qd0s) bad |= prru_cli_numbers("simulate", "qd0", qd0s, s.qd0, 3);
-  if (fds) bad |= prru_cli_numbers("simulate", "fd", fds, s.loads.base.fd, 3);
+  if (fds) bad |= prru_cli_numbers("simulate", "fd", fds, s.loads.base.fd, PRRU_NACT);
   if (fps) bad |= prru_cli_numbers("simulate", "fp", fps, s.loads.base.fp, 3);
   if (mps) bad |= prru_cli_numbers("simulate", "mp", mps, s.loads.base.mp, 3);
   if (tend) bad |= prru_cli_number("simulate", "t-end", tend, &s.opt.t_end);

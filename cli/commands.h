@@ -9,6 +9,16 @@
 
 #include "prru.h"
 
+/* The program's version, the CMake project version (cli/CMakeLists.txt). */
+#ifndef PRRU_VERSION
+#error "PRRU_VERSION (the program version string) must be defined by the build"
+#endif
+
+/* The CLI writes q as q1,q2,q3 (names, help texts): the 3-PRRU's three
+ * coordinates. Everything else sized by the mechanism uses prru_mech and
+ * the PRRU_N* macros. */
+typedef char prru_cli_nq_is_3[PRRU_NQ == 3 ? 1 : -1];
+
 int prru_cmd_eval(int argc, char **argv);
 int prru_cmd_simulate(int argc, char **argv);
 int prru_cmd_ik(int argc, char **argv);
@@ -23,6 +33,20 @@ int prru_cmd_map(int argc, char **argv);
 int prru_paper_fig7(const char *outdir, FILE *summary);
 
 /* Shared helpers (cli/util.c). */
+/* `prru --version`: program version and the model's name, file, format
+ * and SHA-256, one per line. */
+void prru_cli_print_version(FILE *f);
+/* Model identity in outputs. JSON: the member
+ * "model": {"name": .., "file": .., "sha256": ..} (no separator around it);
+ * CSV: the first line "# prru VERSION model NAME (FILE, sha256 HASH)". */
+void prru_cli_json_model(FILE *f);
+void prru_cli_csv_comment(FILE *f);
+/* "NAME (FILE, sha256 HASH)", control characters replaced by '?'. */
+const char *prru_cli_model_id(void);
+/* JSON string literal with escapes. */
+void prru_cli_json_string(FILE *f, const char *s);
+/* prefix1<sep>prefix2<sep>...prefixN into buf ("f1,f2,f3"); returns buf. */
+const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, const char *sep);
 void prru_cli_error(const char *cmd, const char *fmt, ...);
 /* Status code of a runtime call turned into an exit status (1, or 130 when
  * interrupted). */
@@ -53,19 +77,24 @@ void prru_cli_json_array(FILE *f, const double *v, int n, int rows);
 extern volatile sig_atomic_t prru_cli_interrupted;
 void prru_cli_catch_sigint(void);
 
-/* CSV of simulation samples: t,q1..3,qd1..3,d1..3, the 57 reactions (when
- * computed), qdd1..3, fd1..3, fp1..3, mp1..3, T, V. */
+/* CSV of simulation samples: the model comment line, then the header
+ * t,q1..3,qd1..3,d1..dNACT, the PRRU_NLAMBDA reactions (named by
+ * prru_mech.lambda_labels, when computed), qdd1..3, fd1..fdNACT, fp1..3,
+ * mp1..3, T, V. */
 typedef struct {
   FILE *f;
   const prru_load_schedule *loads;
   int reactions;
   long rows;
 } prru_cli_csv;
+/* The comment line and the header row. */
 void prru_cli_csv_header(prru_cli_csv *c);
 /* prru_sample_fn: writes one row; non-zero on a write error. */
 int prru_cli_csv_row(const prru_sample *s, void *ctx);
 /* Writes script to dir/script_name and runs gnuplot there; 0 or 1 with a
  * message (gnuplot missing or failing). */
 int prru_cli_gnuplot(const char *dir, const char *script_name, const char *script);
+/* Writes the line model = '<model name>' (a gnuplot string for titles). */
+void prru_cli_gnuplot_model(FILE *g);
 
 #endif

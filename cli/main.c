@@ -10,7 +10,7 @@ static const struct {
   int (*run)(int, char **);
   const char *help;
 } commands[] = {
-    {"eval", prru_cmd_eval, "M, h, G, d, J_d, qdd and the joint reactions at one state (JSON)"},
+    {"eval", prru_cmd_eval, "M, h, G, drive forces, d, J_d, qdd and the joint reactions at one state (JSON)"},
     {"simulate", prru_cmd_simulate, "integrate the equations of motion, CSV of the samples"},
     {"ik", prru_cmd_ik, "actuator displacements d and J_d for a pose q (JSON)"},
     {"fk", prru_cmd_fk, "pose q for actuator displacements d (Newton from a seed, JSON)"},
@@ -22,12 +22,18 @@ static const struct {
 
 static void usage(FILE *f)
 {
-  fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n\n"
+  fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n"
+             "       prru --version\n\n"
              "Dynamics of the 3-PRRU 1T2R parallel manipulator: q = (q1, q2) rad rotations\n"
-             "of the platform about x then y', q3 its height (m); d the slider heights (m).\n\n"
-             "commands:\n");
+             "of the platform about x then y', q3 its height (m); d the %d slider heights (m).\n"
+             "Model: %s (%s), built in (see prru --version).\n"
+             "Every JSON output names it in \"model\", every CSV in its first line\n"
+             "(# prru VERSION model NAME (FILE, sha256 HASH)).\n\n"
+             "commands:\n",
+          PRRU_NACT, prru_mech.name, prru_mech.model_file);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
+  fprintf(f, "  %-9s %s\n", "version", "program version and the model (name, file, format, SHA-256)");
   fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
              "convergence, I/O), 2 usage error, 130 interrupted.\n");
 }
@@ -41,6 +47,14 @@ int main(int argc, char **argv)
   if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
     usage(stdout);
     return 0;
+  }
+  if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
+    if (argc > 2) {
+      fprintf(stderr, "prru: %s takes no arguments\n", argv[1]);
+      return 2;
+    }
+    prru_cli_print_version(stdout);
+    return ferror(stdout) ? 1 : 0;
   }
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     if (strcmp(argv[1], commands[i].name) == 0) return commands[i].run(argc - 2, argv + 2);

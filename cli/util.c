@@ -103,3 +103,76 @@ void prru_cli_json_array(FILE *f, const double *v, int n, int rows)
   }
   if (rows > 1) fputc(']', f);
 }
+
+const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, const char *sep)
+{
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int i = 0; i < n && used < len; i++) {
+    int w = snprintf(buf + used, len - used, "%s%s%d", i ? sep : "", prefix, i + 1);
+    if (w < 0) break;
+    used += (size_t)w;
+  }
+  return buf;
+}
+
+void prru_cli_json_string(FILE *f, const char *s)
+{
+  fputc('"', f);
+  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+    if (*c == '"' || *c == '\\')
+      fprintf(f, "\\%c", *c);
+    else if (*c < 0x20 || *c == 0x7f)
+      fprintf(f, "\\u%04x", *c);
+    else
+      fputc(*c, f);
+  }
+  fputc('"', f);
+}
+
+/* s with control characters replaced, so that it stays on one line. */
+static void put_plain(char *out, size_t len, size_t *used, const char *s)
+{
+  for (const unsigned char *c = (const unsigned char *)s; *c && *used + 1 < len; c++)
+    out[(*used)++] = (char)(*c < 0x20 || *c == 0x7f ? '?' : *c);
+  out[*used] = '\0';
+}
+
+const char *prru_cli_model_id(void)
+{
+  static char id[1024];
+  size_t used = 0;
+  id[0] = '\0';
+  put_plain(id, sizeof id, &used, prru_mech.name);
+  put_plain(id, sizeof id, &used, " (");
+  put_plain(id, sizeof id, &used, prru_mech.model_file);
+  put_plain(id, sizeof id, &used, ", sha256 ");
+  put_plain(id, sizeof id, &used, prru_mech.sha256);
+  put_plain(id, sizeof id, &used, ")");
+  return id;
+}
+
+void prru_cli_print_version(FILE *f)
+{
+  fprintf(f, "prru %s\n", PRRU_VERSION);
+  fprintf(f, "model: %s\n", prru_mech.name);
+  fprintf(f, "model file: %s\n", prru_mech.model_file);
+  fprintf(f, "model format: %d\n", prru_mech.format);
+  fprintf(f, "model sha256: %s\n", prru_mech.sha256);
+}
+
+void prru_cli_json_model(FILE *f)
+{
+  fputs("\"model\": {\"name\": ", f);
+  prru_cli_json_string(f, prru_mech.name);
+  fputs(", \"file\": ", f);
+  prru_cli_json_string(f, prru_mech.model_file);
+  fputs(", \"sha256\": ", f);
+  prru_cli_json_string(f, prru_mech.sha256);
+  fputc('}', f);
+}
+
+void prru_cli_csv_comment(FILE *f)
+{
+  fprintf(f, "# prru %s model %s\n", PRRU_VERSION, prru_cli_model_id());
+}

@@ -1,12 +1,29 @@
-# Shared by the tests/test_cli*.sh scripts (sourced): a scratch directory,
-# pass/fail counting and `expect`. Needs $PRRU (path to the binary).
+# Shared by the tests/{test,paper}_cli*.sh scripts (sourced): a scratch
+# directory, pass/fail counting, `expect`, JSON checks and the identity of
+# the model the binary was built from. Needs $PRRU (path to the binary);
+# $PRRU_MODEL (the model file, default the paper's) and $PRRU_SOURCE_DIR
+# (default: this file's parent directory) as ctest sets them.
 set -u
 : "${PRRU:?set PRRU to the prru binary}"
+: "${PRRU_SOURCE_DIR:=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}"
+: "${PRRU_MODEL:=$PRRU_SOURCE_DIR/models/3prru_paper.json}"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 pass=0 fail=0
 ok()  { pass=$((pass + 1)); }
 bad() { fail=$((fail + 1)); echo "FAIL: $*" >&2; }
+
+# The model's identity as the CLI must print it: name, file name, format,
+# SHA-256 of the file, the program version (CMake project version) and the
+# comment line every CSV starts with.
+model_name=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["name"])' "$PRRU_MODEL")
+model_format=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1])).get("format", 1))' "$PRRU_MODEL")
+model_file=$(basename "$PRRU_MODEL")
+model_sha=$(sha256sum "$PRRU_MODEL" | cut -d' ' -f1)
+paper_sha=$(sha256sum "$PRRU_SOURCE_DIR/models/3prru_paper.json" | cut -d' ' -f1)
+prru_version=$(sed -n 's/^project(prru VERSION \([0-9][0-9.]*\).*/\1/p' "$PRRU_SOURCE_DIR/CMakeLists.txt")
+csv_comment="# prru $prru_version model $model_name ($model_file, sha256 $model_sha)"
+export model_name model_file model_sha
 
 # expect STATUS NEEDLE -- ARGS...: exit status and a stderr substring.
 expect() {
@@ -17,6 +34,23 @@ expect() {
   if [ -n "$needle" ] && ! grep -qF -- "$needle" "$tmp/err"; then
     bad "prru $*: stderr lacks '$needle': $(head -c 300 "$tmp/err")"; return; fi
   ok
+}
+
+# json FILE EXPR: prints a python expression over d (the parsed JSON).
+json() { python3 -c "import json, math, sys; d = json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+# jcheck FILE EXPR WHAT: the python expression over d (and math, the model
+# identity `model` as the CLI prints it) must be true.
+jcheck() {
+  python3 -c "
+import json, math, os, sys
+d = json.load(open(sys.argv[1]))
+model = {'name': os.environ['model_name'], 'file': os.environ['model_file'], 'sha256': os.environ['model_sha']}
+sys.exit(0 if eval(sys.argv[2]) else 1)" "$1" "$2" && ok || bad "$3: $(head -c 400 "$1")"
+}
+# below X LIMIT WHAT: the number X is below LIMIT.
+below() {
+  python3 -c "import sys; sys.exit(0 if float(sys.argv[1]) < float(sys.argv[2]) else 1)" "$1" "$2" \
+    && ok || bad "$3: $1 (limit $2)"
 }
 
 # finish NAME: the summary line and the exit status.

@@ -1,29 +1,26 @@
 #!/usr/bin/env bash
-# prru dme and prru map: JSON and CSV outputs checked with python (stdlib),
+# prru dme and prru map, for any model: JSON and CSV outputs checked with
+# python (stdlib), the model's identity in them,
 # singular/unreachable poses reported as statuses (null / NaN, never a
 # number), the printed global index recomputed from the CSV, and every kind
 # of bad grid rejected with exit 2 and a message naming the argument.
 . "$(dirname "$0")/cli_lib.sh"
-# check FILE EXPR: python expression over d (the parsed JSON) must be true.
-check() {
-  python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); sys.exit(0 if eval(sys.argv[2]) else 1)" "$1" "$2" \
-    && ok || bad "$3: $(head -c 400 "$1")"
-}
+# The paper's values (w_R(0) = 1.80468, symmetry in q1) are in
+# paper_cli_dme.sh; these checks hold for any model.
+check() { jcheck "$@"; }
 
-# dme at the home pose: the spec's w_R and the ellipse's geometry.
+# dme at the home pose: the model object and the ellipse's geometry.
 "$PRRU" dme --q 0,0,0 >"$tmp/d.json" || bad "dme at q = 0 failed"
-check "$tmp/d.json" "d['status'] == 'ok' and abs(d['w_R'] - 1.80468) < 5e-6" "w_R(0,0) = 1.80468"
+check "$tmp/d.json" "d['model'] == model" "dme: model object"
+check "$tmp/d.json" "d['status'] == 'ok' and d['w_R'] >= 1" "dme at home: ok, w_R >= 1"
 check "$tmp/d.json" "abs(d['semi_axes'][1] / d['semi_axes'][0] - d['w_R']) < 1e-14 * d['w_R']" "w_R = major/minor"
 check "$tmp/d.json" "abs(d['sigma'][0] / d['sigma'][1] - d['w_R']) < 1e-14 * d['w_R']" "w_R = sigma1/sigma2"
-check "$tmp/d.json" "d['axis_directions'] == [[1, 0, 0], [0, 1, 0]] and d['translational_direction'] == [0, 0, 1]" "axes at home along e1, v = e2; segment along z"
+check "$tmp/d.json" "max(abs(a[2]) for a in d['axis_directions']) < 1e-14 and d['translational_direction'] == [0, 0, 1]" "axes at home in span{e1, e2}; segment along z"
+check "$tmp/d.json" "all(abs(sum(x * x for x in a) - 1) < 1e-14 for a in d['axis_directions']) and abs(sum(x * y for x, y in zip(*d['axis_directions']))) < 1e-14" "semi-axis directions orthonormal"
 check "$tmp/d.json" "all(abs(d['Mt'][i][j] - d['Mt'][j][i]) == 0 for i in range(3) for j in range(3))" "Mt symmetric"
 # Away from home: the semi-axes stay in span{e1, v}, v = (0, cos q1, sin q1).
 "$PRRU" dme --q 0.3,-0.4,-0.5 >"$tmp/d2.json" || bad "dme failed"
 check "$tmp/d2.json" "max(abs(a[1] * math.sin(0.3) - a[2] * math.cos(0.3)) for a in d['axis_directions']) < 1e-14" "semi-axes in span{e1, v}"
-# Symmetry in q1 through the CLI.
-"$PRRU" dme --q -0.3,-0.4,-0.5 >"$tmp/d3.json" || bad "dme failed"
-w2=$(python3 -c "import json; print(repr(json.load(open('$tmp/d2.json'))['w_R']))")
-check "$tmp/d3.json" "abs(d['w_R'] - $w2) <= 1e-12 * $w2" "w_R symmetric in q1"
 
 # Unreachable and singular poses: a valid answer (exit 0) with a status and nulls.
 "$PRRU" dme --q 0,2,0 >"$tmp/u.json"; [ $? -eq 0 ] && ok || bad "dme of an unreachable pose should exit 0"
@@ -35,9 +32,10 @@ check "$tmp/s.json" "d['status'] == 'singular' and d['w_R'] is None and 0 < d['J
 # map: CSV layout, NaN + status at singular/unreachable points, the index.
 "$PRRU" map --q1 -0.5235987755982988:0.5235987755982988:31 --q2 -0.7853981633974483:1.2:25 --q3 0 \
   --rcond-min 1e-3 --out "$tmp/m.csv" >"$tmp/m.txt" 2>"$tmp/m.err" || bad "map failed: $(cat "$tmp/m.err")"
+[ "$(head -1 "$tmp/m.csv")" = "$csv_comment" ] && ok || bad "map CSV: comment line"
 r=$(python3 - "$tmp/m.csv" "$tmp/m.txt" <<'PY'
 import csv, math, sys
-rows = list(csv.reader(open(sys.argv[1])))
+rows = list(csv.reader(l for l in open(sys.argv[1]) if not l.startswith('#')))
 errs = []
 if rows[0] != ['q1', 'q2', 'q3', 'w_R', 'status']: errs.append('header %s' % rows[0])
 rows = rows[1:]
@@ -48,7 +46,7 @@ for r in rows:
     st[r[4]] = st.get(r[4], 0) + 1
     if r[4] == 'ok' and not (math.isfinite(w) and w >= 1): errs.append('ok row %s' % r)
     if r[4] != 'ok' and (r[3] != 'NaN' or r[4] not in ('singular', 'unreachable')): errs.append('bad row %s' % r)
-if not (st.get('ok') and st.get('singular') and st.get('unreachable')): errs.append('statuses %s' % st)
+if not st.get('ok'): errs.append('statuses %s' % st)
 ok = [float(r[3]) - 1 for r in rows if r[4] == 'ok']
 idx = sum(ok) / len(ok)
 frac = 1 - len(ok) / len(rows)
@@ -56,12 +54,12 @@ out = dict(l.split(':', 1) for l in open(sys.argv[2]).read().splitlines() if ':'
 gi = float(out['global_index'].split()[0]); sf = float(out['singular_fraction'].split()[0])
 if abs(gi - idx) > 1e-9 * idx: errs.append('global_index %r vs CSV %r' % (gi, idx))
 if abs(sf - frac) > 1e-9: errs.append('singular_fraction %r vs CSV %r' % (sf, frac))
-# q1 symmetry of the grid and of w_R (q1 outer, 25 points per q1).
+# The grid: q1 outer, 25 points per q1, symmetric about q1 = 0.
 for i in range(31):
     for j in range(25):
         a, b = rows[i * 25 + j], rows[(30 - i) * 25 + j]
-        if float(a[0]) != -float(b[0]) or a[4] != b[4] or (a[4] == 'ok' and abs(float(a[3]) - float(b[3])) > 1e-12 * float(a[3])):
-            errs.append('asymmetry %s %s' % (a, b)); break
+        if float(a[0]) != -float(b[0]) or a[1] != b[1]:
+            errs.append('grid %s %s' % (a, b)); break
 print('; '.join(errs[:3]) if errs else 'ok')
 PY
 )

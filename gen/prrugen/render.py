@@ -1,6 +1,7 @@
 """Filling the C templates: file headers, kernels, mechanism descriptor."""
 
 import os
+import re
 from string import Template
 
 from . import cgen
@@ -25,6 +26,12 @@ def _wrap_list(items, indent="  "):
         line += piece + " "
     lines.append(line.rstrip())
     return " \\\n".join(lines)
+
+
+def _safe_name(name):
+    """A file name as it may appear in C comments and strings: anything
+    outside a portable file-name alphabet becomes '_' (no '*/', no escapes)."""
+    return re.sub(r"[^A-Za-z0-9._+-]", "_", name)[:120]
 
 
 def _c_string(text):
@@ -78,7 +85,7 @@ def _descriptor(model, mech, prefix, labels):
     fields = [
         ("name", _c_string(model.name)),
         ("description", _c_string(model.description)),
-        ("model_file", _c_string(os.path.basename(model.path))),
+        ("model_file", _c_string(_safe_name(os.path.basename(model.path)))),
         ("sha256", _c_string(model.sha256)),
         ("format", str(model.format)),
         ("nq", "%s_NQ" % prefix.upper()), ("nact", "%s_NACT" % prefix.upper()),
@@ -124,7 +131,7 @@ def render(model, deriv, templates_dir, prefix=None):
     mech = deriv.mech
     emitted = [cgen.emit(k, prefix) for k in kernels(deriv)]
     labels = lambda_labels(mech)
-    model_file = os.path.basename(model.path)
+    model_file = _safe_name(os.path.basename(model.path))
     op_table = "\n".join(" *   %-18s %s" % (e.name, e.summary())
                          for e in emitted)
     head = ("/* GENERATED FILE: DO NOT EDIT.\n"
