@@ -104,7 +104,7 @@ void prru_mass(const double q[3], double M[9]);
 /* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). */
 void prru_bias(const double q[3], const double qd[3], double h[3]);
 
-/* Generalized gravity G = sum_b J_T,b^T (-m_b g e3). */
+/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. */
 void prru_gravity(const double q[3], double G[3]);
 
 /* M, h and G fused (one shared evaluation). */

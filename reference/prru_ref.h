@@ -1,86 +1,123 @@
 /* The straightforward reference: the paper's closed-form equations 1-13
- * (with the errata of docs/model.md) assembled with GSL vectors and
- * matrices, exactly as the paper writes them: per-body J_R, J_T, delta, mu,
- * then H (60x3), Phi (60x60), K (60), M = H^T Phi H and h = H^T K with
- * gsl_blas_dgemm / dgemv.
+ * (with the errata of the spec) assembled with GSL vectors and matrices,
+ * exactly as the paper writes them: per-body J_R, J_T, delta, mu, then
+ * H (6 NBODY x 3), Phi, K, M = H^T Phi H and h = H^T K with
+ * gsl_blas_dgemm / dgemv; the drives of model format 2 (spec section 11)
+ * on top through the actuator coordinates d(q).
  *
- * It shares nothing with the generator but the model's numbers (PRRU_*
- * macros): it is the independent check the tests compare the generated
- * kernels against, and the baseline bench/ measures them against. Plain and
- * readable on purpose, not fast.
+ * It shares nothing with the generator but the model's numbers (prru_mech,
+ * read by prru_ref_params_default, and the PRRU_N* sizes): it is the
+ * independent check the tests compare the generated kernels against, and
+ * the baseline bench/ measures them against. Plain and readable on purpose,
+ * not fast.
  *
  * All arrays are row-major, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3.
  * Functions return GSL_SUCCESS, GSL_EDOM when q is unreachable (an acos
  * argument outside [-1, 1]) or not finite, GSL_ESING when a matrix that must
- * be inverted is singular. */
+ * be inverted is singular; on failure every output element is NaN. */
 #ifndef PRRU_REF_H
 #define PRRU_REF_H
 
 #include <gsl/gsl_matrix.h>
 #include <gsl/gsl_vector.h>
 
+#include "prru_kernels.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define PRRU_REF_NBODY 10
+/* The derivation below is written for the three-limb machine of spec
+ * sections 1-11 (ten bodies, 57 reaction coordinates). */
+#if PRRU_NQ != 3 || PRRU_NACT != 3 || PRRU_NLIMB != 3 || PRRU_NBODY != 10 || PRRU_NLAMBDA != 57
+#error "the reference implements the three-limb 3-PRRU of spec sections 1-11 only"
+#endif
 
+/* Spec section 11 (format 2; a format-1 model is the special case with
+ * equal limbs, gravity (0, 0, -g), com = 0, diagonal inertia, no drives). */
 typedef struct {
-  double g;                          /* m/s^2, along -z */
-  double b12, b3, l1, l2, a;         /* m */
-  double mass[PRRU_REF_NBODY];       /* kg */
-  double inertia[PRRU_REF_NBODY][3]; /* principal moments in the body frame */
+  double g[3];                            /* gravity in {S}, m/s^2 */
+  double b[PRRU_NLIMB];                   /* rail offsets, m (limb 1 at y = -b1) */
+  double l1[PRRU_NLIMB], l2[PRRU_NLIMB];  /* upper and lower links, m */
+  double a[PRRU_NLIMB];                   /* U-joint offsets, m; a[2] = 0 (C_3 = O') */
+  double mass[PRRU_NBODY];                /* kg */
+  double com[PRRU_NBODY][3];              /* centre of mass in the body frame, m */
+  double inertia[PRRU_NBODY][9];          /* about the centre, body axes, row-major, kg m^2 */
+  double armature[PRRU_NACT];             /* reflected drive inertia k_i, kg */
+  double damping[PRRU_NACT];              /* c_i, N s/m */
+  double coulomb[PRRU_NACT];              /* f_i, N */
+  double coulomb_velocity;                /* v_s, m/s (unused where every f_i = 0) */
 } prru_ref_params;
 
-/* The model the kernels were generated from (PRRU_* macros). */
+/* The model the kernels were generated from (prru_mech). */
 void prru_ref_params_default(prru_ref_params *p);
 
 /* Preallocated GSL workspace; the public members hold the last results. */
 typedef struct {
-  gsl_matrix *H;   /* 60 x 3  */
-  gsl_matrix *Phi; /* 60 x 60 */
-  gsl_vector *K;   /* 60 */
-  gsl_vector *dm;  /* 60: [delta; mu] */
-  gsl_matrix *PhiH, *M, *Q, *Jd; /* 60x3, 3x3, 60x57, 3x3 */
+  gsl_matrix *H;   /* 6 NBODY x 3 */
+  gsl_matrix *Phi; /* 6 NBODY x 6 NBODY: the bodies only (the armature is not a body) */
+  gsl_vector *K;   /* 6 NBODY: the bodies only */
+  gsl_vector *dm;  /* 6 NBODY: [delta; mu] */
+  gsl_matrix *PhiH, *M, *Q, *Jd; /* 6 NBODY x 3; 3x3 (with armature); 6 NBODY x NLAMBDA; 3x3 */
   void *priv;      /* further scratch owned by the reference */
 } prru_ref_ws;
 
 prru_ref_ws *prru_ref_alloc(void);
 void prru_ref_free(prru_ref_ws *w);
 
-int prru_ref_ik(const prru_ref_params *p, const double q[3], double d[3]);
-int prru_ref_jd(const prru_ref_params *p, const double q[3], double Jd[9]);
-int prru_ref_poses(const prru_ref_params *p, const double q[3], double R[90], double pos[30]);
-int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double H[180]);
-int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                        const double qd[3], double dm[60]);
-int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double M[9]);
-int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                  const double qd[3], double h[3]);
-int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double G[3]);
-int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                      const double qd[3], double M[9], double h[3], double G[3]);
-/* T and V = g sum m_b z_b. */
-int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                    const double qd[3], double E[2]);
-/* M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved with GSL. */
-int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                              const double qd[3], const double fd[3], const double fp[3],
-                              const double mp[3], double qdd[3]);
-/* The fd that produce qdd under fp, mp. */
-int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                              const double qd[3], const double qdd[3], const double fp[3],
-                              const double mp[3], double fd[3]);
-/* Q (60x57), spec section 7 joint table, lambda order of PRRU_LAMBDA_LABELS. */
-int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                            double Q[3420]);
-/* lambda by eq. 31 with the dense 60x60 Phi. */
-int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                       const double qd[3], const double fd[3], const double fp[3],
-                       const double mp[3], double lambda[57]);
-/* w_R = sigma_1/sigma_2 of Mt JtR^+ (spec section 8), GSL SVD; GSL_ESING
- * when J_d is singular. */
-int prru_ref_w_r(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double *w_r);
+int prru_ref_ik(const prru_ref_params *p, const double q[PRRU_NQ], double d[PRRU_NACT]);
+int prru_ref_jd(const prru_ref_params *p, const double q[PRRU_NQ], double Jd[PRRU_NACT * PRRU_NQ]);
+/* R_b and the centres of mass p_b = origin_b + R_b com_b. */
+int prru_ref_poses(const prru_ref_params *p, const double q[PRRU_NQ], double R[9 * PRRU_NBODY],
+                   double pos[3 * PRRU_NBODY]);
+int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                       double H[6 * PRRU_NBODY * PRRU_NQ]);
+int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                        const double qd[PRRU_NQ], double dm[6 * PRRU_NBODY]);
+/* H^T Phi H + J_d^T diag(armature) J_d. */
+int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                  double M[PRRU_NQ * PRRU_NQ]);
+/* H^T K + J_d^T diag(armature) (Jd' qd); without damping and friction. */
+int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                  const double qd[PRRU_NQ], double h[PRRU_NQ]);
+/* G = sum_b J_T,b^T m_b g. */
+int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                     double G[PRRU_NQ]);
+int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                      const double qd[PRRU_NQ], double M[PRRU_NQ * PRRU_NQ], double h[PRRU_NQ],
+                      double G[PRRU_NQ]);
+/* E[0] = T (bodies, from their velocities, plus sum k_i dd_i^2 / 2),
+ * E[1] = V = -sum_b m_b g . p_b. */
+int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                    const double qd[PRRU_NQ], double E[2]);
+/* dd = J_d qd and ddb = Jd' qd, the qd-quadratic part of d''. */
+int prru_ref_actuator_rates(const prru_ref_params *p, const double q[PRRU_NQ],
+                            const double qd[PRRU_NQ], double dd[PRRU_NACT],
+                            double ddb[PRRU_NACT]);
+/* Qp = J_d^T (-c dd - f tanh(dd / v_s)): the drives' damping and friction. */
+int prru_ref_passive(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                     const double qd[PRRU_NQ], double Qp[PRRU_NQ]);
+/* M qdd = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + Qp - h, solved with GSL;
+ * fp acts at the tool point O' = (0, 0, q3), mp on the platform. */
+int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                              const double qd[PRRU_NQ], const double fd[PRRU_NACT],
+                              const double fp[3], const double mp[3], double qdd[PRRU_NQ]);
+/* The fd that produce qdd under fp, mp (and the drives' Qp). */
+int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                              const double qd[PRRU_NQ], const double qdd[PRRU_NQ],
+                              const double fp[3], const double mp[3], double fd[PRRU_NACT]);
+/* Q (6 NBODY x NLAMBDA), spec section 7 joint table, lambda order of
+ * prru_mech.lambda_labels. */
+int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                            double Q[6 * PRRU_NBODY * PRRU_NLAMBDA]);
+/* lambda by eq. 31 with the dense Phi, at the qdd of the forward dynamics;
+ * slider i receives fd_i - k_i dd_i'' - c_i dd_i - f_i tanh(dd_i / v_s). */
+int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                       const double qd[PRRU_NQ], const double fd[PRRU_NACT], const double fp[3],
+                       const double mp[3], double lambda[PRRU_NLAMBDA]);
+/* w_R = sigma_1/sigma_2 of Mt JtR^+ (spec section 8, M with the armature),
+ * GSL SVD; GSL_ESING when J_d is singular. */
+int prru_ref_w_r(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ], double *w_r);
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,7 @@
 /* Rotational dynamic manipulability (paper section 5): w_R = sigma_1/sigma_2
- * of Mt JtR^+, Mt = J_d^-T M J_d^-1, JtR = J_R,P J_d^-1, with GSL's SVD. */
+ * of Mt JtR^+, Mt = J_d^-T M J_d^-1, JtR = J_R,P J_d^-1, with GSL's SVD.
+ * M is the full mass matrix, the drives' armature included: Mt is then the
+ * inertia the actuators feel. */
 #include <math.h>
 
 #include <gsl/gsl_blas.h>
@@ -8,13 +10,13 @@
 
 #include "ref_internal.h"
 
-int prru_ref_w_r(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double *w_r)
+int prru_ref_w_r(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ], double *w_r)
 {
   ref_priv *s = w->priv;
   *w_r = NAN;
   int st = ref_assemble(p, w, q, NULL);
   if (st) return st;
-  ref_mass_from_H(w);
+  ref_mass_matrix(p, w);
 
   double jinv[9], mt[9], tmp[9], jtr[9], u[9], v[9], pinv[9], bm[9], sv[3], work[3];
   gsl_matrix_view Jinv = gsl_matrix_view_array(jinv, 3, 3), Mt = gsl_matrix_view_array(mt, 3, 3),

@@ -1,5 +1,15 @@
 /* Paper eqs. 25-30: H, Phi, K stacked in body order, M = H^T Phi H,
- * h = H^T K, G, and the forward and inverse dynamics, all with GSL. */
+ * h = H^T K, G, and the forward and inverse dynamics, all with GSL; the
+ * drives of spec section 11 on top.
+ *
+ * The drives act on the actuator coordinates d(q) only. An armature k_i is
+ * a point mass that moves with d_i: kinetic energy k_i dd_i^2 / 2 with
+ * dd = J_d qd, so (Lagrange, exactly as for a body with J_T = row i of
+ * J_d) it adds J_d^T K J_d to M and, since dd' = J_d qdd + Jd' qd, adds
+ * J_d^T K (Jd' qd) to h. Damping and Coulomb friction are forces along the
+ * rails, phi_i = -c_i dd_i - f_i tanh(dd_i / v_s); by virtual power
+ * (dd = J_d qd) they reach the generalized coordinates as Qp = J_d^T phi.
+ * Qp is not part of h (spec section 11) but of every acceleration. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -11,8 +21,9 @@
 
 #include "ref_internal.h"
 
-#define NB PRRU_REF_NBODY
-#define NW (6 * NB)
+#define NB REF_NB
+#define NW REF_NW
+#define NL REF_NL
 
 prru_ref_ws *prru_ref_alloc(void)
 {
@@ -26,13 +37,13 @@ prru_ref_ws *prru_ref_alloc(void)
   w->dm = gsl_vector_calloc(NW);
   w->PhiH = gsl_matrix_calloc(NW, 3);
   w->M = gsl_matrix_calloc(3, 3);
-  w->Q = gsl_matrix_calloc(NW, NW - 3);
+  w->Q = gsl_matrix_calloc(NW, NL);
   w->Jd = gsl_matrix_calloc(3, 3);
   s->L = gsl_matrix_calloc(NW, NW);
-  s->Y = gsl_matrix_calloc(NW, NW - 3);
-  s->A = gsl_matrix_calloc(NW - 3, NW - 3);
+  s->Y = gsl_matrix_calloc(NW, NL);
+  s->A = gsl_matrix_calloc(NL, NL);
   s->r60 = gsl_vector_calloc(NW);
-  s->r57 = gsl_vector_calloc(NW - 3);
+  s->r57 = gsl_vector_calloc(NL);
   s->Fbar = gsl_vector_calloc(NW);
   s->Fg = gsl_vector_calloc(NW);
   s->m3a = gsl_matrix_calloc(3, 3);
@@ -117,7 +128,7 @@ int ref_lu3(gsl_matrix *A, gsl_permutation *perm, gsl_matrix *inv)
   return 1.0 / (norm * inorm) >= DBL_EPSILON ? GSL_SUCCESS : GSL_ESING;
 }
 
-/* Stacks the per-body quantities of paper eq. 25-28 into the workspace. */
+/* Stacks the per-body quantities of paper eqs. 25-28 into the workspace. */
 int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], const double *qd)
 {
   ref_priv *s = w->priv;
@@ -126,22 +137,26 @@ int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], co
   if (st) return st;
   gsl_matrix_set_zero(w->Phi);
   gsl_vector_set_zero(s->Fg);
+  gsl_vector_set_zero(w->K);
   for (int b = 0; b < NB; b++) {
-    const double *R = k->R[b];
+    const double *R = k->R[b], *Ib = p->inertia[b];
     for (int i = 0; i < 3; i++) {
       for (int j = 0; j < 3; j++) {
         gsl_matrix_set(w->H, 3 * b + i, j, k->JR[b][3 * i + j]);
         gsl_matrix_set(w->H, 3 * NB + 3 * b + i, j, k->JT[b][3 * i + j]);
-        /* I_b = R diag(I) R^T, the body inertia seen in {S}. */
+        /* I_b = R I R^T: the body-axes tensor about the centre seen in
+         * {S} (the angular momentum R I R^T omega = R (I (R^T omega))). */
         double Iij = 0;
-        for (int l = 0; l < 3; l++) Iij += R[3 * i + l] * p->inertia[b][l] * R[3 * j + l];
+        for (int l = 0; l < 3; l++)
+          for (int m = 0; m < 3; m++) Iij += R[3 * i + l] * Ib[3 * l + m] * R[3 * j + m];
         gsl_matrix_set(w->Phi, 3 * b + i, 3 * b + j, Iij);
       }
       gsl_matrix_set(w->Phi, 3 * NB + 3 * b + i, 3 * NB + 3 * b + i, p->mass[b]);
-      gsl_vector_set(w->dm, 3 * b + i, k->delta[b][i]);
-      gsl_vector_set(w->dm, 3 * NB + 3 * b + i, k->mu[b][i]);
+      gsl_vector_set(w->dm, 3 * b + i, qd ? k->delta[b][i] : 0.0);
+      gsl_vector_set(w->dm, 3 * NB + 3 * b + i, qd ? k->mu[b][i] : 0.0);
+      /* Gravity: the force m_b g at the centre of mass, no moment about it. */
+      gsl_vector_set(s->Fg, 3 * NB + 3 * b + i, p->mass[b] * p->g[i]);
     }
-    gsl_vector_set(s->Fg, 3 * NB + 3 * b + 2, -p->mass[b] * p->g);
   }
   if (qd) {
     /* K: I delta + omega x (I omega) (paper eq. 28, errata), m mu. */
@@ -162,15 +177,55 @@ int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], co
       }
     }
   }
-  for (int i = 0; i < 3; i++)
+  for (int i = 0; i < REF_NA; i++)
     for (int j = 0; j < 3; j++) gsl_matrix_set(w->Jd, i, j, k->Jd[3 * i + j]);
   return GSL_SUCCESS;
 }
 
-void ref_mass_from_H(prru_ref_ws *w)
+void ref_mass_matrix(const prru_ref_params *p, prru_ref_ws *w)
 {
+  ref_priv *s = w->priv;
   gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, w->Phi, w->H, 0.0, w->PhiH);
   gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->H, w->PhiH, 0.0, w->M);
+  /* + J_d^T diag(k) J_d (the armature, see the top of this file). */
+  gsl_matrix_memcpy(s->m3d, w->Jd);
+  for (int i = 0; i < REF_NA; i++) {
+    gsl_vector_view row = gsl_matrix_row(s->m3d, i);
+    gsl_vector_scale(&row.vector, p->armature[i]);
+  }
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->Jd, s->m3d, 1.0, w->M);
+}
+
+/* h = H^T K + J_d^T diag(k) (Jd' qd) after ref_assemble(.., qd). */
+static void bias_vector(const prru_ref_params *p, prru_ref_ws *w, gsl_vector *h)
+{
+  ref_priv *s = w->priv;
+  double fa[REF_NA];
+  for (int i = 0; i < REF_NA; i++) fa[i] = p->armature[i] * s->kin.ddb[i];
+  gsl_vector_view Fa = gsl_vector_view_array(fa, REF_NA);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, h);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->Jd, &Fa.vector, 1.0, h);
+}
+
+/* phi_i = -c_i dd_i - f_i tanh(dd_i / v_s), the force drive i puts on its
+ * slider besides fd_i and the armature's inertia (v_s is only defined,
+ * and only read, where f_i != 0). */
+void ref_drive_friction(const prru_ref_params *p, const ref_kin *k, double phi[REF_NA])
+{
+  for (int i = 0; i < REF_NA; i++) {
+    phi[i] = -p->damping[i] * k->dd[i];
+    if (p->coulomb[i] != 0.0) phi[i] -= p->coulomb[i] * tanh(k->dd[i] / p->coulomb_velocity);
+  }
+}
+
+/* Qp = J_d^T phi (virtual power: phi . dd = phi . J_d qd). */
+static void passive_vector(const prru_ref_params *p, prru_ref_ws *w, gsl_vector *Qp)
+{
+  ref_priv *s = w->priv;
+  double phi[REF_NA];
+  ref_drive_friction(p, &s->kin, phi);
+  gsl_vector_view Phi = gsl_vector_view_array(phi, REF_NA);
+  gsl_blas_dgemv(CblasTrans, 1.0, w->Jd, &Phi.vector, 0.0, Qp);
 }
 
 static void fill_nan(double *x, int n)
@@ -190,16 +245,17 @@ static void copy_vector(const gsl_vector *v, double *out)
   for (size_t i = 0; i < v->size; i++) out[i] = gsl_vector_get(v, i);
 }
 
-int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double H[180])
+int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                       double H[6 * PRRU_NBODY * PRRU_NQ])
 {
   int st = ref_assemble(p, w, q, NULL);
-  if (st) { fill_nan(H, 180); return st; }
+  if (st) { fill_nan(H, NW * 3); return st; }
   copy_matrix(w->H, H);
   return GSL_SUCCESS;
 }
 
-int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                        const double qd[3], double dm[60])
+int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                        const double qd[PRRU_NQ], double dm[6 * PRRU_NBODY])
 {
   int st = ref_assemble(p, w, q, qd);
   if (st) { fill_nan(dm, NW); return st; }
@@ -207,28 +263,30 @@ int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q
   return GSL_SUCCESS;
 }
 
-int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double M[9])
+int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                  double M[PRRU_NQ * PRRU_NQ])
 {
   int st = ref_assemble(p, w, q, NULL);
   if (st) { fill_nan(M, 9); return st; }
-  ref_mass_from_H(w);
+  ref_mass_matrix(p, w);
   copy_matrix(w->M, M);
   return GSL_SUCCESS;
 }
 
-int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                  const double qd[3], double h[3])
+int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                  const double qd[PRRU_NQ], double h[PRRU_NQ])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
   if (st) { fill_nan(h, 3); return st; }
-  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, s->v3a);
+  bias_vector(p, w, s->v3a);
   copy_vector(s->v3a, h);
   return GSL_SUCCESS;
 }
 
-/* G = sum_b J_T,b^T (-m_b g e3) = H^T Fg with Fg the stacked gravity wrenches. */
-int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double G[3])
+/* G = sum_b J_T,b^T (m_b g) = H^T Fg with Fg the stacked gravity wrenches. */
+int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                     double G[PRRU_NQ])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, NULL);
@@ -238,24 +296,27 @@ int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[3]
   return GSL_SUCCESS;
 }
 
-int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                      const double qd[3], double M[9], double h[3], double G[3])
+int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                      const double qd[PRRU_NQ], double M[PRRU_NQ * PRRU_NQ], double h[PRRU_NQ],
+                      double G[PRRU_NQ])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
   if (st) { fill_nan(M, 9); fill_nan(h, 3); fill_nan(G, 3); return st; }
-  ref_mass_from_H(w);
+  ref_mass_matrix(p, w);
   copy_matrix(w->M, M);
-  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, s->v3a);
+  bias_vector(p, w, s->v3a);
   copy_vector(s->v3a, h);
   gsl_blas_dgemv(CblasTrans, 1.0, w->H, s->Fg, 0.0, s->v3a);
   copy_vector(s->v3a, G);
   return GSL_SUCCESS;
 }
 
-/* Body by body, from the velocities, not from M: the tests compare the two. */
-int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                    const double qd[3], double E[2])
+/* Body by body, from the velocities, not from M: the tests compare the two.
+ * The armature's share is k_i dd_i^2 / 2; V is the work against the
+ * constant field g: -sum_b m_b g . p_b. */
+int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                    const double qd[PRRU_NQ], double E[2])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
@@ -267,64 +328,96 @@ int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
       T += 0.5 * p->mass[b] * k->v[b][i] * k->v[b][i];
       for (int j = 0; j < 3; j++)
         T += 0.5 * k->omega[b][i] * gsl_matrix_get(w->Phi, 3 * b + i, 3 * b + j) * k->omega[b][j];
+      V -= p->mass[b] * p->g[i] * k->p[b][i];
     }
-    V += p->g * p->mass[b] * k->p[b][2];
   }
+  for (int i = 0; i < REF_NA; i++) T += 0.5 * p->armature[i] * k->dd[i] * k->dd[i];
   E[0] = T;
   E[1] = V;
   return GSL_SUCCESS;
 }
 
-/* tau = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp (eq. 30's right-hand side). */
+int prru_ref_passive(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                     const double qd[PRRU_NQ], double Qp[PRRU_NQ])
+{
+  ref_priv *s = w->priv;
+  int st = ref_assemble(p, w, q, qd);
+  if (st) { fill_nan(Qp, 3); return st; }
+  passive_vector(p, w, s->v3a);
+  copy_vector(s->v3a, Qp);
+  return GSL_SUCCESS;
+}
+
+/* tau = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp (eq. 30's right-hand side;
+ * fd may be NULL). The platform force acts at the tool point O' (spec
+ * section 5), which is the platform's centre of mass only when its com is
+ * 0: its virtual power is fp . v_O'. */
 static void generalized_load(prru_ref_ws *w, const double *fd, const double fp[3],
                              const double mp[3], gsl_vector *tau)
 {
   ref_priv *s = w->priv;
+  const double *JTO = s->kin.JTO;
   gsl_blas_dgemv(CblasTrans, 1.0, w->H, s->Fg, 0.0, tau);
   for (int j = 0; j < 3; j++) {
     double t = 0;
     for (int i = 0; i < 3; i++) {
       if (fd) t += gsl_matrix_get(w->Jd, i, j) * fd[i];
-      t += gsl_matrix_get(w->H, 3 * NB + 3 * REF_P + i, j) * fp[i];
+      t += JTO[3 * i + j] * fp[i];
       t += gsl_matrix_get(w->H, 3 * REF_P + i, j) * mp[i];
     }
     gsl_vector_set(tau, j, gsl_vector_get(tau, j) + t);
   }
 }
 
-int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                              const double qd[3], const double fd[3], const double fp[3],
-                              const double mp[3], double qdd[3])
+int ref_solve_qdd(const prru_ref_params *p, prru_ref_ws *w, const double *fd, const double fp[3],
+                  const double mp[3], gsl_vector *qdd)
+{
+  ref_priv *s = w->priv;
+  generalized_load(w, fd, fp, mp, s->v3b);
+  passive_vector(p, w, s->v3c);
+  gsl_vector_add(s->v3b, s->v3c); /* + Qp */
+  bias_vector(p, w, s->v3c);
+  gsl_vector_sub(s->v3b, s->v3c); /* - h */
+  gsl_matrix_memcpy(s->m3a, w->M);
+  if (ref_cholesky(s->m3a)) return GSL_ESING;
+  gsl_linalg_cholesky_solve(s->m3a, s->v3b, qdd);
+  return GSL_SUCCESS;
+}
+
+int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                              const double qd[PRRU_NQ], const double fd[PRRU_NACT],
+                              const double fp[3], const double mp[3], double qdd[PRRU_NQ])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
+  if (!st) {
+    ref_mass_matrix(p, w);
+    st = ref_solve_qdd(p, w, fd, fp, mp, s->v3a);
+  }
   if (st) { fill_nan(qdd, 3); return st; }
-  ref_mass_from_H(w);
-  generalized_load(w, fd, fp, mp, s->v3b);
-  gsl_blas_dgemv(CblasTrans, -1.0, w->H, w->K, 1.0, s->v3b); /* - h */
-  gsl_matrix_memcpy(s->m3a, w->M);
-  if (ref_cholesky(s->m3a)) { fill_nan(qdd, 3); return GSL_ESING; }
-  gsl_linalg_cholesky_solve(s->m3a, s->v3b, s->v3a);
   copy_vector(s->v3a, qdd);
   return GSL_SUCCESS;
 }
 
-/* fd = J_d^-T (M qdd + h - G - J_T,P^T fp - J_R,P^T mp). */
-int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                              const double qd[3], const double qdd[3], const double fp[3],
-                              const double mp[3], double fd[3])
+/* fd = J_d^-T (M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - Qp). */
+int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                              const double qd[PRRU_NQ], const double qdd[PRRU_NQ],
+                              const double fp[3], const double mp[3], double fd[PRRU_NACT])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
-  if (st) { fill_nan(fd, 3); return st; }
-  ref_mass_from_H(w);
+  if (st) { fill_nan(fd, REF_NA); return st; }
+  ref_mass_matrix(p, w);
   gsl_vector_const_view a = gsl_vector_const_view_array(qdd, 3);
   generalized_load(w, NULL, fp, mp, s->v3b);
-  gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, -1.0, s->v3b);   /* h - (G + ...) */
-  gsl_blas_dgemv(CblasNoTrans, 1.0, w->M, &a.vector, 1.0, s->v3b); /* + M qdd */
+  passive_vector(p, w, s->v3c);
+  gsl_vector_add(s->v3b, s->v3c);                                  /* G + ... + Qp */
+  bias_vector(p, w, s->v3c);
+  gsl_vector_sub(s->v3c, s->v3b);                                  /* h - (G + ... + Qp) */
+  gsl_blas_dgemv(CblasNoTrans, 1.0, w->M, &a.vector, 1.0, s->v3c); /* + M qdd */
   gsl_matrix_transpose_memcpy(s->m3a, w->Jd);
-  if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, 3); return GSL_ESING; }
-  gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3b, s->v3a);
+  if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, REF_NA); return GSL_ESING; }
+  gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3c, s->v3a);
   copy_vector(s->v3a, fd);
   return GSL_SUCCESS;
 }

@@ -1,4 +1,5 @@
-/* Paper eqs. 1-13 by hand: poses, J_R, J_T, delta, mu of every body.
+/* Paper eqs. 1-13 by hand: poses, J_R, J_T, delta, mu of every body, for
+ * the per-limb geometry and centres of mass of spec section 11.
  *
  * Every limb is a function of one scalar xi of q plus the height q3 (which
  * enters every position as + q3 e3): xi = q1 for limbs 1, 2 (everything
@@ -6,7 +7,15 @@
  * limb 3 (plane y = 0, axes e2). A body quantity f(xi) then has
  *   df/dq_j = f_x dxi/dq_j,   quadratic part of f'' = f_xx xi'^2 + f_x xi'',
  * where xi'' here is only the qd-quadratic part qd^T (d2xi/dq2) qd. Each
- * closed-form scalar is carried with its first two xi-derivatives. */
+ * closed-form scalar is carried with its first two xi-derivatives.
+ *
+ * A limb body turns by an angle ang(xi) about a fixed axis e (e1 or e2), so
+ * its centre of mass origin(xi) + Rot(e, ang) com moves, beyond its frame
+ * origin, by the offset r = Rot(e, ang) com whose xi-derivatives follow
+ * from dRot/dang = [e]x Rot: r_x = ang_x e x r and
+ * r_xx = ang_xx e x r + ang_x^2 e x (e x r). The platform turns about two
+ * axes and is done with partial derivatives in q1, q2 instead (platform()).
+ * Sliders do not turn (R = I): their com is a constant offset from A_i. */
 #include <math.h>
 #include <string.h>
 
@@ -18,16 +27,25 @@
 void prru_ref_params_default(prru_ref_params *p)
 {
   const prru_mechanism *me = &prru_mech;
-  p->g = -me->gravity[2];
-  p->b12 = me->b[0];
-  p->b3 = me->b[2];
-  p->l1 = me->l1[0];
-  p->l2 = me->l2[0];
-  p->a = me->a[0];
-  for (int b = 0; b < PRRU_REF_NBODY; b++) {
-    p->mass[b] = me->mass[b];
-    for (int i = 0; i < 3; i++) p->inertia[b][i] = me->inertia[b][4 * i];
+  memset(p, 0, sizeof *p);
+  for (int i = 0; i < 3; i++) p->g[i] = me->gravity[i];
+  for (int l = 0; l < PRRU_NLIMB; l++) {
+    p->b[l] = me->b[l];
+    p->l1[l] = me->l1[l];
+    p->l2[l] = me->l2[l];
+    p->a[l] = me->a[l];
   }
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    p->mass[b] = me->mass[b];
+    for (int i = 0; i < 3; i++) p->com[b][i] = me->com[b][i];
+    for (int i = 0; i < 9; i++) p->inertia[b][i] = me->inertia[b][i];
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    p->armature[i] = me->armature[i];
+    p->damping[i] = me->damping[i];
+    p->coulomb[i] = me->coulomb[i];
+  }
+  p->coulomb_velocity = me->coulomb_velocity;
 }
 
 /* A scalar of the limb and its first two derivatives in xi. */
@@ -37,20 +55,27 @@ typedef struct { double v, x, xx; } scal;
  * qd-quadratic part of xi''. */
 typedef struct { double g[3], rate, quad; } chain;
 
-static const double E1[3] = {1, 0, 0}, E2[3] = {0, 1, 0};
+enum { AX_X, AX_Y };
+static const double E[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
-static void rot_x(double t, double R[9])
+static void cross(const double a[3], const double b[3], double c[3])
 {
-  double c = cos(t), s = sin(t);
-  double M[9] = {1, 0, 0, 0, c, -s, 0, s, c};
-  memcpy(R, M, sizeof M);
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-static void rot_y(double t, double R[9])
+static void matvec(const double R[9], const double x[3], double y[3])
 {
-  double c = cos(t), s = sin(t);
-  double M[9] = {c, 0, s, 0, 1, 0, -s, 0, c};
-  memcpy(R, M, sizeof M);
+  for (int i = 0; i < 3; i++) y[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
+}
+
+/* Rx(t) or Ry(t), the exponential of t [e]x. */
+static void rot(int axis, double t, double R[9])
+{
+  const double c = cos(t), s = sin(t);
+  const double Rx[9] = {1, 0, 0, 0, c, -s, 0, s, c}, Ry[9] = {c, 0, s, 0, 1, 0, -s, 0, c};
+  memcpy(R, axis == AX_X ? Rx : Ry, sizeof Rx);
 }
 
 /* theta = acos(r) and sin(theta) = sqrt(1 - r^2) with their xi-derivatives:
@@ -87,69 +112,115 @@ static void set_rotation(ref_kin *k, int b, scal ang, const double axis[3], cons
   }
 }
 
-/* Platform (eqs. 1-2): R_P = Rx(q1) Ry(q2), omega = q1' e1 + q2' Rx(q1) e2,
- * whose derivative along the motion is q1' q2' e1 x Rx(q1) e2. */
-static void platform(const double q[3], const double *qd, ref_kin *k)
+/* A limb body: frame origin O(xi) with its xi-derivatives, rotation
+ * Rot(axis, ang(xi)), centre of mass O + Rot com (see the top comment). */
+static void set_body(ref_kin *k, const prru_ref_params *p, int b, const double O[3],
+                     const double Ox[3], const double Oxx[3], scal ang, int axis, const chain *c)
 {
-  double c1 = cos(q[0]), s1 = sin(q[0]), Rx[9], Ry[9];
-  rot_x(q[0], Rx);
-  rot_y(q[1], Ry);
+  const double *e = E[axis];
+  double r[3], t[3], tt[3], P[3], Px[3], Pxx[3];
+  rot(axis, ang.v, k->R[b]);
+  matvec(k->R[b], p->com[b], r);
+  cross(e, r, t);
+  cross(e, t, tt);
+  for (int i = 0; i < 3; i++) {
+    P[i] = O[i] + r[i];
+    Px[i] = Ox[i] + ang.x * t[i];
+    Pxx[i] = Oxx[i] + ang.xx * t[i] + ang.x * ang.x * tt[i];
+  }
+  set_translation(k, b, P, Px, Pxx, c);
+  set_rotation(k, b, ang, e, c);
+}
+
+/* The actuator of limb i from d(xi) (d_i depends on q3 as + q3): row i of
+ * J_d, and Jd' qd = the qd-quadratic part of d_i''. */
+static void set_actuator(ref_kin *k, int i, scal d, const chain *c)
+{
+  k->d[i] = d.v;
+  for (int j = 0; j < 3; j++) k->Jd[3 * i + j] = d.x * c->g[j] + (j == 2 ? 1.0 : 0.0);
+  k->ddb[i] = d.xx * c->rate * c->rate + d.x * c->quad;
+}
+
+/* Platform (eqs. 1-2): R_P = Rx(q1) Ry(q2), omega = q1' e1 + q2' u with
+ * u = Rx(q1) e2, whose derivative along the motion is q1' q2' e1 x u.
+ * Its centre of mass is O' + r, r = R_P com: dRx/dq1 = [e1]x Rx gives
+ * r_1 = e1 x r, and Rx [e2]x Ry com = [u]x Rx Ry com gives r_2 = u x r; once
+ * more, r_11 = e1 x r_1, r_12 = e1 x r_2 (= d/dq2 of e1 x r) and
+ * r_22 = u x r_2 (u does not depend on q2); mu = sum_jk r_jk qd_j qd_k. */
+static void platform(const prru_ref_params *p, const double q[3], const double *qd, ref_kin *k)
+{
+  const double c1 = cos(q[0]), s1 = sin(q[0]);
+  const double u[3] = {0, c1, s1};
+  double Rx[9], Ry[9], r[3], r1[3], r2[3], r11[3], r12[3], r22[3];
+  rot(AX_X, q[0], Rx);
+  rot(AX_Y, q[1], Ry);
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
       k->R[REF_P][3 * i + j] = Rx[3 * i] * Ry[j] + Rx[3 * i + 1] * Ry[3 + j] + Rx[3 * i + 2] * Ry[6 + j];
-  k->p[REF_P][2] = q[2];
-  double JR[9] = {1, 0, 0, 0, c1, 0, 0, s1, 0};
-  memcpy(k->JR[REF_P], JR, sizeof JR);
-  k->JT[REF_P][8] = 1.0;
+  matvec(k->R[REF_P], p->com[REF_P], r);
+  cross(E[0], r, r1);
+  cross(u, r, r2);
+  cross(E[0], r1, r11);
+  cross(E[0], r2, r12);
+  cross(u, r2, r22);
+  for (int i = 0; i < 3; i++) {
+    k->p[REF_P][i] = r[i] + (i == 2 ? q[2] : 0.0);
+    k->JT[REF_P][3 * i] = r1[i];
+    k->JT[REF_P][3 * i + 1] = r2[i];
+    k->JT[REF_P][3 * i + 2] = i == 2 ? 1.0 : 0.0;
+    k->JR[REF_P][3 * i] = E[0][i];
+    k->JR[REF_P][3 * i + 1] = u[i];
+  }
+  /* The tool point O' = (0, 0, q3), where the platform load acts. */
+  k->JTO[8] = 1.0;
   if (qd) {
     k->delta[REF_P][1] = -s1 * qd[0] * qd[1];
     k->delta[REF_P][2] = c1 * qd[0] * qd[1];
+    for (int i = 0; i < 3; i++)
+      k->mu[REF_P][i] = r11[i] * qd[0] * qd[0] + 2.0 * r12[i] * qd[0] * qd[1] + r22[i] * qd[1] * qd[1];
   }
 }
 
-/* Limbs 1 and 2 (eqs. 3-4, 6-11), s = -1, +1; xi = q1. With e = a + l2,
- * B_i = (0, s e cos q1, q3 + s e sin q1) and alpha_i = s beta with
- * beta = acos((b12 - e cos q1)/l1), so d_i = z_Bi + l1 sin(beta). */
+/* Limbs 1 and 2 (eqs. 3-4, 6-11), s = -1, +1, with the limb's own b, l1,
+ * l2, a; xi = q1. With e = a + l2, B_i = (0, s e cos q1, q3 + s e sin q1)
+ * and alpha_i = s beta with beta = acos((b - e cos q1)/l1) (the spec's
+ * s (y_A - y_B)/l1 with y_A = s b), so d_i = z_Bi + l1 sin(beta). */
 static int limb12(const prru_ref_params *p, const double q[3], int limb, const chain *c, ref_kin *k)
 {
   const double s = limb == 0 ? -1.0 : 1.0;
+  const double b = p->b[limb], l1 = p->l1[limb], l2 = p->l2[limb], a = p->a[limb];
   const double c1 = cos(q[0]), s1 = sin(q[0]), q3 = q[2];
-  const double e = p->a + p->l2, kl = p->a + 0.5 * p->l2;
+  const double e = a + l2, kl = a + 0.5 * l2;
   const int L = REF_L1 + limb, U = REF_U1 + limb, S = REF_S1 + limb;
 
-  double C[3] = {0, s * p->a * c1, q3 + s * p->a * s1};
+  double C[3] = {0, s * a * c1, q3 + s * a * s1};
   double B[3] = {0, s * e * c1, q3 + s * e * s1};
   memcpy(k->C[limb], C, sizeof C);
   memcpy(k->B[limb], B, sizeof B);
 
-  /* Lower link: R = Rx(q1), centre halfway along s l2 from C_i. */
-  double PL[3] = {0, s * kl * c1, q3 + s * kl * s1};
-  double PLx[3] = {0, -s * kl * s1, s * kl * c1};
-  double PLxx[3] = {0, -s * kl * c1, -s * kl * s1};
-  rot_x(q[0], k->R[L]);
-  set_translation(k, L, PL, PLx, PLxx, c);
-  set_rotation(k, L, (scal){q[0], 1.0, 0.0}, E1, c);
+  /* Lower link: R = Rx(q1), frame origin halfway along s l2 from C_i. */
+  double OL[3] = {0, s * kl * c1, q3 + s * kl * s1};
+  double OLx[3] = {0, -s * kl * s1, s * kl * c1};
+  double OLxx[3] = {0, -s * kl * c1, -s * kl * s1};
+  set_body(k, p, L, OL, OLx, OLxx, (scal){q[0], 1.0, 0.0}, AX_X, c);
 
-  scal r = {(p->b12 - e * c1) / p->l1, e * s1 / p->l1, e * c1 / p->l1}, beta, sb;
+  scal r = {(b - e * c1) / l1, e * s1 / l1, e * c1 / l1}, beta, sb;
   if (acos_chain(r, &beta, &sb) != GSL_SUCCESS) return GSL_EDOM;
   scal alpha = {s * beta.v, s * beta.x, s * beta.xx};
   scal zB = {B[2], s * e * c1, -s * e * s1};
-  scal d = {zB.v + p->l1 * sb.v, zB.x + p->l1 * sb.x, zB.xx + p->l1 * sb.xx};
+  scal d = {zB.v + l1 * sb.v, zB.x + l1 * sb.x, zB.xx + l1 * sb.xx};
 
-  /* Upper link: R = Rx(alpha_i), centre (A_i + B_i)/2. */
-  double PU[3] = {0, 0.5 * s * (p->b12 + e * c1), zB.v + 0.5 * p->l1 * sb.v};
-  double PUx[3] = {0, -0.5 * s * e * s1, zB.x + 0.5 * p->l1 * sb.x};
-  double PUxx[3] = {0, -0.5 * s * e * c1, zB.xx + 0.5 * p->l1 * sb.xx};
-  rot_x(alpha.v, k->R[U]);
-  set_translation(k, U, PU, PUx, PUxx, c);
-  set_rotation(k, U, alpha, E1, c);
+  /* Upper link: R = Rx(alpha_i), frame origin (A_i + B_i)/2. */
+  double OU[3] = {0, 0.5 * s * (b + e * c1), zB.v + 0.5 * l1 * sb.v};
+  double OUx[3] = {0, -0.5 * s * e * s1, zB.x + 0.5 * l1 * sb.x};
+  double OUxx[3] = {0, -0.5 * s * e * c1, zB.xx + 0.5 * l1 * sb.xx};
+  set_body(k, p, U, OU, OUx, OUxx, alpha, AX_X, c);
 
-  /* Slider: translates along e3 only, centre A_i. */
-  double PS[3] = {0, s * p->b12, d.v}, PSx[3] = {0, 0, d.x}, PSxx[3] = {0, 0, d.xx};
-  rot_x(0.0, k->R[S]); /* R_S = I */
-  set_translation(k, S, PS, PSx, PSxx, c);
-  memcpy(k->A[limb], PS, sizeof PS);
-  k->d[limb] = d.v;
+  /* Slider: translates along e3 only (R = I), frame origin A_i. */
+  double OS[3] = {0, s * b, d.v}, OSx[3] = {0, 0, d.x}, OSxx[3] = {0, 0, d.xx};
+  set_body(k, p, S, OS, OSx, OSxx, (scal){0.0, 0.0, 0.0}, AX_X, c);
+  memcpy(k->A[limb], OS, sizeof OS);
+  set_actuator(k, limb, d, c);
   return GSL_SUCCESS;
 }
 
@@ -174,42 +245,39 @@ static double gamma_chain(const double q[3], const double *qd, chain *c)
   return atan2(s2, c1 * c2);
 }
 
-/* Limb 3 (eqs. 5, 12-13); xi = gamma. x3 = (cos gamma, 0, -sin gamma). */
+/* Limb 3 (eqs. 5, 12-13) with its own b, l1, l2; xi = gamma,
+ * x3 = (cos gamma, 0, -sin gamma). Its U joint centre is O' itself (spec
+ * section 4): a[2] plays no part. */
 static int limb3(const prru_ref_params *p, const double q[3], const double *qd, ref_kin *k)
 {
   chain c;
   const double gam = gamma_chain(q, qd, &c), cg = cos(gam), sg = sin(gam), q3 = q[2];
-  const double kl = 0.5 * p->l2;
+  const double b = p->b[2], l1 = p->l1[2], l2 = p->l2[2], kl = 0.5 * l2;
   k->gamma = gam;
 
-  double C[3] = {0, 0, q3}, B[3] = {p->l2 * cg, 0, q3 - p->l2 * sg};
+  double C[3] = {0, 0, q3}, B[3] = {l2 * cg, 0, q3 - l2 * sg};
   memcpy(k->C[2], C, sizeof C);
   memcpy(k->B[2], B, sizeof B);
 
-  double PL[3] = {kl * cg, 0, q3 - kl * sg};
-  double PLx[3] = {-kl * sg, 0, -kl * cg};
-  double PLxx[3] = {-kl * cg, 0, kl * sg};
-  rot_y(gam, k->R[REF_L3]);
-  set_translation(k, REF_L3, PL, PLx, PLxx, &c);
-  set_rotation(k, REF_L3, (scal){gam, 1.0, 0.0}, E2, &c);
+  double OL[3] = {kl * cg, 0, q3 - kl * sg};
+  double OLx[3] = {-kl * sg, 0, -kl * cg};
+  double OLxx[3] = {-kl * cg, 0, kl * sg};
+  set_body(k, p, REF_L3, OL, OLx, OLxx, (scal){gam, 1.0, 0.0}, AX_Y, &c);
 
-  scal r = {(p->l2 * cg - p->b3) / p->l1, -p->l2 * sg / p->l1, -p->l2 * cg / p->l1}, alpha, sa;
+  scal r = {(l2 * cg - b) / l1, -l2 * sg / l1, -l2 * cg / l1}, alpha, sa;
   if (acos_chain(r, &alpha, &sa) != GSL_SUCCESS) return GSL_EDOM;
-  scal zB = {B[2], -p->l2 * cg, p->l2 * sg};
-  scal d = {zB.v + p->l1 * sa.v, zB.x + p->l1 * sa.x, zB.xx + p->l1 * sa.xx};
+  scal zB = {B[2], -l2 * cg, l2 * sg};
+  scal d = {zB.v + l1 * sa.v, zB.x + l1 * sa.x, zB.xx + l1 * sa.xx};
 
-  double PU[3] = {0.5 * (p->b3 + p->l2 * cg), 0, zB.v + 0.5 * p->l1 * sa.v};
-  double PUx[3] = {-0.5 * p->l2 * sg, 0, zB.x + 0.5 * p->l1 * sa.x};
-  double PUxx[3] = {-0.5 * p->l2 * cg, 0, zB.xx + 0.5 * p->l1 * sa.xx};
-  rot_y(alpha.v, k->R[REF_U3]);
-  set_translation(k, REF_U3, PU, PUx, PUxx, &c);
-  set_rotation(k, REF_U3, alpha, E2, &c);
+  double OU[3] = {0.5 * (b + l2 * cg), 0, zB.v + 0.5 * l1 * sa.v};
+  double OUx[3] = {-0.5 * l2 * sg, 0, zB.x + 0.5 * l1 * sa.x};
+  double OUxx[3] = {-0.5 * l2 * cg, 0, zB.xx + 0.5 * l1 * sa.xx};
+  set_body(k, p, REF_U3, OU, OUx, OUxx, alpha, AX_Y, &c);
 
-  double PS[3] = {p->b3, 0, d.v}, PSx[3] = {0, 0, d.x}, PSxx[3] = {0, 0, d.xx};
-  rot_y(0.0, k->R[REF_S3]); /* R_S = I */
-  set_translation(k, REF_S3, PS, PSx, PSxx, &c);
-  memcpy(k->A[2], PS, sizeof PS);
-  k->d[2] = d.v;
+  double OS[3] = {b, 0, d.v}, OSx[3] = {0, 0, d.x}, OSxx[3] = {0, 0, d.xx};
+  set_body(k, p, REF_S3, OS, OSx, OSxx, (scal){0.0, 0.0, 0.0}, AX_Y, &c);
+  memcpy(k->A[2], OS, sizeof OS);
+  set_actuator(k, 2, d, &c);
   return GSL_SUCCESS;
 }
 
@@ -218,18 +286,18 @@ int ref_kinematics(const prru_ref_params *p, const double q[3], const double *qd
   memset(k, 0, sizeof *k);
   if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]))) return GSL_EDOM;
   chain c12 = {{1.0, 0.0, 0.0}, qd ? qd[0] : 0.0, 0.0}; /* xi = q1 exactly */
-  platform(q, qd, k);
+  platform(p, q, qd, k);
   if (limb12(p, q, 0, &c12, k) || limb12(p, q, 1, &c12, k) || limb3(p, q, qd, k)) return GSL_EDOM;
-  /* J_d is the slider's vertical velocity row: d_i = z_Si. */
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) k->Jd[3 * i + j] = k->JT[REF_S1 + i][6 + j];
-  if (qd)
-    for (int b = 0; b < PRRU_REF_NBODY; b++)
+  if (qd) {
+    for (int b = 0; b < REF_NB; b++)
       for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
           k->omega[b][i] += k->JR[b][3 * i + j] * qd[j];
           k->v[b][i] += k->JT[b][3 * i + j] * qd[j];
         }
+    for (int i = 0; i < REF_NA; i++)
+      for (int j = 0; j < 3; j++) k->dd[i] += k->Jd[3 * i + j] * qd[j];
+  }
   return GSL_SUCCESS;
 }
 
@@ -238,30 +306,44 @@ static void fill_nan(double *x, int n)
   for (int i = 0; i < n; i++) x[i] = NAN;
 }
 
-int prru_ref_ik(const prru_ref_params *p, const double q[3], double d[3])
+int prru_ref_ik(const prru_ref_params *p, const double q[PRRU_NQ], double d[PRRU_NACT])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(d, 3); return st; }
+  if (st) { fill_nan(d, REF_NA); return st; }
   memcpy(d, k.d, sizeof k.d);
   return GSL_SUCCESS;
 }
 
-int prru_ref_jd(const prru_ref_params *p, const double q[3], double Jd[9])
+int prru_ref_jd(const prru_ref_params *p, const double q[PRRU_NQ], double Jd[PRRU_NACT * PRRU_NQ])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(Jd, 9); return st; }
+  if (st) { fill_nan(Jd, 3 * REF_NA); return st; }
   memcpy(Jd, k.Jd, sizeof k.Jd);
   return GSL_SUCCESS;
 }
 
-int prru_ref_poses(const prru_ref_params *p, const double q[3], double R[90], double pos[30])
+int prru_ref_poses(const prru_ref_params *p, const double q[PRRU_NQ], double R[9 * PRRU_NBODY],
+                   double pos[3 * PRRU_NBODY])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(R, 90); fill_nan(pos, 30); return st; }
+  if (st) { fill_nan(R, 9 * REF_NB); fill_nan(pos, 3 * REF_NB); return st; }
   memcpy(R, k.R, sizeof k.R);
   memcpy(pos, k.p, sizeof k.p);
+  return GSL_SUCCESS;
+}
+
+/* d' = J_d qd, and d'' = J_d qdd + Jd' qd from the chain rule on d_i(xi)
+ * (set_actuator): d_i'' = d_xx xi'^2 + d_x xi'' with xi'' = g.qdd + quad. */
+int prru_ref_actuator_rates(const prru_ref_params *p, const double q[PRRU_NQ],
+                            const double qd[PRRU_NQ], double dd[PRRU_NACT], double ddb[PRRU_NACT])
+{
+  ref_kin k;
+  int st = ref_kinematics(p, q, qd, &k);
+  if (st) { fill_nan(dd, REF_NA); fill_nan(ddb, REF_NA); return st; }
+  memcpy(dd, k.dd, sizeof k.dd);
+  memcpy(ddb, k.ddb, sizeof k.ddb);
   return GSL_SUCCESS;
 }

@@ -1,6 +1,8 @@
 /* Equations of reaction (paper eqs. 14-24, 28-31 with the spec's single sign
  * convention): the basis Q of the joint reaction wrenches and lambda by
- * eq. 31 with the dense 60x60 Phi. */
+ * eq. 31 with the dense Phi. Joint centres are points of the section-4
+ * geometry (C_i, B_i, A_i); the moment arms run to each body's centre of
+ * mass p_b (not its frame origin), about which Phi, K and Fbar are taken. */
 #include <math.h>
 #include <string.h>
 
@@ -10,9 +12,9 @@
 
 #include "ref_internal.h"
 
-#define NB PRRU_REF_NBODY
-#define NW (6 * NB)
-#define NL (NW - 3)
+#define NB REF_NB
+#define NW REF_NW
+#define NL REF_NL
 #define GROUND (-1)
 
 /* A unit force f through the joint centre c: on body b (centre p_b) it is
@@ -81,13 +83,13 @@ static void build_Q(const ref_kin *k, gsl_matrix *Q)
   for (int l = 0; l < 3; l++)
     joint(Q, &col, k, REF_S1 + l, REF_U1 + l, k->A[l], E, 3, l < 2 ? m12 : m3, 2);
 
-  /* P joints: rail (ground) to slider, free along e3; the slider's centre
-   * A_i is the joint centre. */
+  /* P joints: rail (ground) to slider, free along e3; the joint centre is
+   * A_i, the slider's frame origin (its centre of mass lies com off it). */
   for (int l = 0; l < 3; l++) joint(Q, &col, k, GROUND, REF_S1 + l, k->A[l], E, 2, E, 3);
 }
 
-int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                            double Q[3420])
+int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                            double Q[6 * PRRU_NBODY * PRRU_NLAMBDA])
 {
   int st = ref_assemble(p, w, q, NULL);
   if (st) {
@@ -101,20 +103,50 @@ int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const doub
 }
 
 /* lambda = (Q^T Phi^-1 Q)^-1 Q^T Phi^-1 (K - Fbar) (eq. 31): with Phi = L L^T
- * and Y = L^-1 Q, Q^T Phi^-1 Q = Y^T Y and Q^T Phi^-1 x = Y^T L^-1 x. */
-int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
-                       const double qd[3], const double fd[3], const double fp[3],
-                       const double mp[3], double lambda[57])
+ * and Y = L^-1 Q, Q^T Phi^-1 Q = Y^T Y and Q^T Phi^-1 x = Y^T L^-1 x.
+ *
+ * Fbar holds what acts on the bodies from outside the joints: gravity
+ * m_b g at every centre, fp at the tool point O' and mp on the platform
+ * (as in tau = J_T,O'^T fp + J_R,P^T mp) and, on slider i along e3, the
+ * force its drive delivers. Of fd_i the drive keeps k_i dd_i'' to
+ * accelerate its own armature (which is no body of Phi) and loses
+ * c_i dd_i + f_i tanh(dd_i / v_s); the slider receives the rest. That
+ * needs the actual d'' = J_d qdd + Jd' qd, so qdd comes from the forward
+ * dynamics first; with it the bodies' equations Phi H qdd + K = Fbar +
+ * Q lambda are consistent (their H^T projection is the EOM with the
+ * armature moved to the right-hand side), and qdd itself drops out of
+ * lambda through H^T Q = 0. */
+int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                       const double qd[PRRU_NQ], const double fd[PRRU_NACT], const double fp[3],
+                       const double mp[3], double lambda[PRRU_NLAMBDA])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
   if (!st) {
-    build_Q(&s->kin, w->Q);
+    ref_mass_matrix(p, w);
+    st = ref_solve_qdd(p, w, fd, fp, mp, s->v3a);
+  }
+  if (!st) {
+    const ref_kin *k = &s->kin;
+    double phi[REF_NA];
+    ref_drive_friction(p, k, phi);
+    build_Q(k, w->Q);
     gsl_vector_memcpy(s->Fbar, s->Fg);
+    /* fp at O' = (0, 0, q3) is fp at the platform's centre p_P plus the
+     * moment (O' - p_P) x fp. */
+    const double *pP = k->p[REF_P];
+    const double r[3] = {-pP[0], -pP[1], q[2] - pP[2]};
+    const double rxf[3] = {r[1] * fp[2] - r[2] * fp[1], r[2] * fp[0] - r[0] * fp[2],
+                           r[0] * fp[1] - r[1] * fp[0]};
     for (int i = 0; i < 3; i++) {
-      *gsl_vector_ptr(s->Fbar, 3 * REF_P + i) += mp[i];
+      *gsl_vector_ptr(s->Fbar, 3 * REF_P + i) += mp[i] + rxf[i];
       *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_P + i) += fp[i];
-      *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * (REF_S1 + i) + 2) += fd[i];
+    }
+    for (int i = 0; i < REF_NA; i++) {
+      double dd2 = k->ddb[i];
+      for (int j = 0; j < 3; j++) dd2 += k->Jd[3 * i + j] * gsl_vector_get(s->v3a, j);
+      *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * (REF_S1 + i) + 2) +=
+          fd[i] - p->armature[i] * dd2 + phi[i];
     }
     gsl_vector_memcpy(s->r60, w->K);
     gsl_vector_sub(s->r60, s->Fbar);

@@ -41,7 +41,8 @@ def kernels(deriv):
         ("bias", "Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive "
          "damping and friction are not in h (see passive).",
          [Q, QD], [("h", h)]),
-        ("gravity", "Generalized gravity G = sum_b J_T,b^T (-m_b g e3).",
+        ("gravity", "Generalized gravity G = sum_b J_T,b^T (m_b g), g the "
+         "gravity vector.",
          [Q], [("G", g)]),
         ("dynamics", "M, h and G fused (one shared evaluation).",
          [Q, QD], [("M", m), ("h", h), ("G", g)]),
