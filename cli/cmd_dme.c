@@ -570,7 +570,7 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
                  "201 x 201 grid\n");
       fprintf(s, "w_R(0, 0) = %.12g%s; rotational semi-axes %.6g, %.6g rad/s^2 per N; "
                  "translational half-length %.6g m/s^2 per N\n",
-              home.w_R, prru_model_is_paper(&m) ? " (the paper's value: 1.80468)" : "",
+              home.w_R, prru_cli_is_paper_model() ? " (the paper's value: 1.80468)" : "",
               home.semi_axis[0], home.semi_axis[1], home.half_length_T);
       fprintf(s, "with J_d singular where cond_1(J_d) > 1e3 (rcond < %g):\n", FIG7_RCOND_MIN);
       fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum.index);

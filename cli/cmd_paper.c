@@ -263,7 +263,7 @@ int prru_cmd_paper(int argc, char **argv)
   }
   prru_model m;
   prru_model_default(&m);
-  int is_paper = prru_model_is_paper(&m);
+  int is_paper = prru_cli_is_paper_model();
   if (!is_paper)
     prru_cli_error("paper", "warning: model %s is not the paper's; the figures show this model, "
                    "not the paper's results", prru_mech.name);

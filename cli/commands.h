@@ -36,6 +36,9 @@ int prru_paper_fig7(const char *outdir, FILE *summary);
 /* `prru --version`: program version and the model's name, file, format
  * and SHA-256, one per line. */
 void prru_cli_print_version(FILE *f);
+/* 1 when the kernels were generated from the paper's model file
+ * (models/3prru_paper.json, by its SHA-256), 0 otherwise. */
+int prru_cli_is_paper_model(void);
 /* Model identity in outputs. JSON: the member
  * "model": {"name": .., "file": .., "sha256": ..} (no separator around it);
  * CSV: the first line "# prru VERSION model NAME (FILE, sha256 HASH)". */

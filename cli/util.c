@@ -152,6 +152,8 @@ const char *prru_cli_model_id(void)
   return id;
 }
 
+int prru_cli_is_paper_model(void) { return strcmp(prru_mech.sha256, PRRU_PAPER_SHA256) == 0; }
+
 void prru_cli_print_version(FILE *f)
 {
   fprintf(f, "prru %s\n", PRRU_VERSION);

@@ -58,9 +58,6 @@ typedef struct {
 
 /* The mechanism the kernels were generated from, default settings. */
 void prru_model_default(prru_model *m);
-/* 1 when m's mechanism was generated from the paper's model file
- * (models/3prru_paper.json, by its SHA-256), 0 otherwise. */
-int prru_model_is_paper(const prru_model *m);
 
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */

@@ -30,11 +30,6 @@ void prru_model_default(prru_model *m)
   m->jd_rcond_min = 1e-8;
 }
 
-int prru_model_is_paper(const prru_model *m)
-{
-  return strcmp(m->mech->sha256, PRRU_PAPER_SHA256) == 0;
-}
-
 static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
 
 static void gsl_handler_off(void) { gsl_set_error_handler_off(); }
