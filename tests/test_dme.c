@@ -52,13 +52,6 @@ static void matmul(const double *A, const double *B, double *C, int n, int k, in
     }
 }
 
-static void cross(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 typedef struct {
@@ -86,14 +79,14 @@ static int independent(const double q[3], indep *r)
 
   /* n: unit normal of range(JtR) = range(J_R,P), from its columns 0 and 1. */
   double c0[3] = {H[0], H[3], H[6]}, c1[3] = {H[1], H[4], H[7]}, n[3], qa[3], qb[3];
-  cross(c0, c1, n);
+  tu_cross(c0, c1, n);
   double nn = sqrt(dot(n, n));
   for (int i = 0; i < 3; i++) n[i] /= nn;
   double e1[3] = {1, 0, 0}, t = dot(e1, n);
   for (int i = 0; i < 3; i++) qa[i] = e1[i] - t * n[i];
   t = sqrt(dot(qa, qa));
   for (int i = 0; i < 3; i++) qa[i] /= t;
-  cross(n, qa, qb);
+  tu_cross(n, qa, qb);
   /* JtR^+ Q = JtR^T (JtR JtR^T + n n^T)^-1 Q (see the header of this file). */
   double K[9], Q[6], Z[6], X[6], BQ[6];
   for (int i = 0; i < 3; i++)
@@ -167,7 +160,7 @@ static void test_against_independent(void)
     e = rel(r.half_length_T, x.half_T) / scale;
     if (!(e <= worst_T)) worst_T = e;
     double v[3] = {0, cos(q[0]), sin(q[0])}, e1[3] = {1, 0, 0}, nrm[3]; /* v = Rx(q1) e2 */
-    cross(e1, v, nrm);
+    tu_cross(e1, v, nrm);
     for (int a = 0; a < 2; a++) {
       e = rel(r.semi_axis[a], x.semi[a]) / scale;
       if (!(e <= worst_len)) worst_len = e;

@@ -13,6 +13,7 @@
 
 #include "prru_mechanism.h"
 #include "prru_ref.h"
+#include "testref.h"
 #include "testutil.h"
 
 #define PI 3.14159265358979323846
@@ -132,28 +133,13 @@ static int random_q(double q[3])
   return tries - 1;
 }
 
-/* How far a reachable q is from the singular boundaries, in (0, 1]: the
- * smallest |sin| of an upper link's angle (= sqrt(1 - r^2) for the acos
- * argument r; read off R_Ui = Rx(alpha_i): R[7], or Ry(alpha_3): R[2]) and
- * cos(phi) of limb 3's U joint (phi = asin(-sin q1 cos q2); gamma's
- * gradient grows like 1/cos^2 phi). Toward 0 the inverse kinematics is
+/* At margin m (testref.h) below MARGIN the inverse kinematics is
  * ill-conditioned: 1 - r^2 carries an absolute rounding error ~eps, so
  * both sides' d, J_d, Jd' qd, ... are only defined to ~eps / (1 - r^2),
- * whatever formulas compute them. So at margin m < MARGIN the error is
- * held to the same 1e-12 after taking that factor out, i.e. scaled by
- * (m / MARGIN)^2; at m >= MARGIN it is held to 1e-12 as it is. */
-static double margin(const double q[3])
-{
-  double R[9 * NB], p[3 * NB];
-  if (prru_ref_poses(&P, q, R, p) != GSL_SUCCESS) return -1;
-  double m = 1.0;
-  for (int i = 0; i < NA; i++) {
-    const double *Ru = R + 9 * prru_mech.upper[i];
-    m = fmin(m, fabs(i < 2 ? Ru[7] : Ru[2]));
-  }
-  const double sp = sin(q[0]) * cos(q[1]);
-  return fmin(m, sqrt(1.0 - sp * sp));
-}
+ * whatever formulas compute them. So there the error is held to the same
+ * 1e-12 after taking that factor out, i.e. scaled by (m / MARGIN)^2; at
+ * m >= MARGIN it is held to 1e-12 as it is. */
+static double margin(const double q[3]) { return ref_margin(&P, q); }
 
 static void test_against_reference(void)
 {

@@ -14,6 +14,7 @@
 
 #include "prru_mechanism.h"
 #include "prru_ref.h"
+#include "testref.h"
 #include "testutil.h"
 
 #define PI 3.14159265358979323846
@@ -139,18 +140,6 @@ static double norm(const double *x, int n)
   return sqrt(s);
 }
 
-static void cross(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static void matvec(const double A[9], const double x[3], double y[3])
-{
-  for (int i = 0; i < 3; i++) y[i] = A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
-}
-
 /* ---- sampling ----
  * Any q1, q2 of a half turn and any height; what the model cannot reach
  * is rejected. So are states too close to a singular boundary for finite
@@ -166,18 +155,7 @@ static void matvec(const double A[9], const double x[3], double y[3])
 #define MARGIN 0.3
 #define COND_JD 1e3
 
-static double margin(const double q[3])
-{
-  double R[9 * NB], p[3 * NB];
-  if (prru_ref_poses(&P, q, R, p) != GSL_SUCCESS) return -1;
-  double m = 1.0;
-  for (int i = 0; i < NA; i++) {
-    const double *Ru = R + 9 * prru_mech.upper[i];
-    m = fmin(m, fabs(i < 2 ? Ru[7] : Ru[2]));
-  }
-  const double sp = sin(q[0]) * cos(q[1]);
-  return fmin(m, sqrt(1.0 - sp * sp));
-}
+static double margin(const double q[3]) { return ref_margin(&P, q); }
 
 /* 1-norm condition number of J_d at q (cofactor inverse). */
 static double cond_jd(const double q[3])
@@ -596,7 +574,7 @@ static void test_reactions(void)
     const double *pP = pos + 3 * prru_mech.platform;
     const double arm[3] = {-pP[0], -pP[1], q[2] - pP[2]}; /* O' - p_P */
     double fpm[3];
-    cross(arm, fp, fpm);
+    tu_cross(arm, fp, fpm);
     double Fbar[NW];
     memset(Fbar, 0, sizeof Fbar);
     for (int b = 0; b < NB; b++)
@@ -630,13 +608,13 @@ static void test_reactions(void)
     const double u[3] = {RP[0], RP[3], RP[6]}, wv[3] = {RP[2], RP[5], RP[8]};
     const double gam = atan2(s2, c1 * c2), x3[3] = {cos(gam), 0, -sin(gam)};
     double n3[3];
-    cross(wv, x3, n3);
+    tu_cross(wv, x3, n3);
     const double nn = norm(n3, 3);
     for (int i = 0; i < 3; i++) n3[i] /= nn;
     const int ip = prru_mech.platform;
     const double mP = P.mass[ip];
     double rc[3], F[3], Mo[3];
-    matvec(RP, P.com[ip], rc); /* p_P - O' */
+    tu_matvec3(RP, P.com[ip], rc); /* p_P - O' */
     for (int i = 0; i < 3; i++) {
       F[i] = fp[i] + mP * P.g[i];
       Mo[i] = mp[i] + fpm[i];
@@ -646,9 +624,9 @@ static void test_reactions(void)
       /* C_i - O' = R_P (0, s a_i, 0) for limbs 1, 2; C_3 = O'. */
       const double loc[3] = {0, l == 0 ? -P.a[0] : l == 1 ? P.a[1] : 0.0, 0};
       double c[3], r[3], rxf[3];
-      matvec(RP, loc, c);
+      tu_matvec3(RP, loc, c);
       for (int i = 0; i < 3; i++) r[i] = c[i] - rc[i];
-      cross(r, f, rxf);
+      tu_cross(r, f, rxf);
       const double *ax = l < 2 ? u : n3;
       for (int i = 0; i < 3; i++) {
         F[i] += f[i];
@@ -659,7 +637,7 @@ static void test_reactions(void)
      * e1 x e1'; a_P = q3'' e3 + alpha x rc + omega x (omega x rc). */
     const double e1p[3] = {0, c1, s1};
     double om[3], al[3], e1xe1p[3], IP[9], Iom[3], Ial[3], gyro[3], t1[3], t2[3], aP[3];
-    cross(EJ[0], e1p, e1xe1p);
+    tu_cross(EJ[0], e1p, e1xe1p);
     for (int i = 0; i < 3; i++) {
       om[i] = EJ[0][i] * qd[0] + e1p[i] * qd[1];
       al[i] = EJ[0][i] * qdd[0] + e1p[i] * qdd[1] + qd[0] * qd[1] * e1xe1p[i];
@@ -670,12 +648,12 @@ static void test_reactions(void)
         for (int l = 0; l < 3; l++)
           for (int m = 0; m < 3; m++) IP[3 * i + j] += RP[3 * i + l] * P.inertia[ip][3 * l + m] * RP[3 * j + m];
       }
-    matvec(IP, om, Iom);
-    matvec(IP, al, Ial);
-    cross(om, Iom, gyro);
-    cross(al, rc, t1);
-    cross(om, rc, t2);
-    cross(om, t2, aP);
+    tu_matvec3(IP, om, Iom);
+    tu_matvec3(IP, al, Ial);
+    tu_cross(om, Iom, gyro);
+    tu_cross(al, rc, t1);
+    tu_cross(om, rc, t2);
+    tu_cross(om, t2, aP);
     for (int i = 0; i < 3; i++) aP[i] += t1[i] + (i == 2 ? qdd[2] : 0.0);
     double lhsF[3], lhsM[3];
     for (int i = 0; i < 3; i++) {

@@ -134,13 +134,6 @@ static void test_bad_input(void)
 }
 
 /* ---- reactions ---- */
-static void cross(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* Joint j's lambda coordinates. */
 static const double *joint_lambda(const double *lam, int j)
 {
@@ -195,9 +188,9 @@ static void test_reactions(void)
       alpha[i] += dm[3 * me->platform + i];
     }
     mat3vec(I + 9 * me->platform, 3, om, Iom);
-    cross(om, Iom, gyro);
+    tu_cross(om, Iom, gyro);
     double o_p[3] = {-pp[0], -pp[1], q[2] - pp[2]}, lever[3]; /* O' - p */
-    cross(o_p, l.fp, lever);
+    tu_cross(o_p, l.fp, lever);
     double f[3], mo[3], mscale = 0, fscale = 0;
     for (int i = 0; i < 3; i++) {
       f[i] = l.fp[i] + mP * g[i];
@@ -218,12 +211,12 @@ static void test_reactions(void)
         memcpy(axis, u, sizeof axis);
       } else {
         double x3[3] = {RL[0], RL[3], RL[6]};
-        cross(wv, x3, axis);
+        tu_cross(wv, x3, axis);
         double nn = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
         for (int i = 0; i < 3; i++) axis[i] /= nn;
       }
       for (int i = 0; i < 3; i++) r[i] = c[i] - pp[i];
-      cross(r, fj, rxf);
+      tu_cross(r, fj, rxf);
       for (int i = 0; i < 3; i++) {
         f[i] += fj[i];
         mo[i] += rxf[i] + fj[3] * axis[i];

@@ -42,6 +42,19 @@ static inline int tu_finish(const char *suite)
   return tu_failures ? 1 : 0;
 }
 
+/* c = a x b, y = A x for row-major 3x3 A. */
+static inline void tu_cross(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static inline void tu_matvec3(const double A[9], const double x[3], double y[3])
+{
+  for (int i = 0; i < 3; i++) y[i] = A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
+}
+
 /* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */
 static unsigned long long tu_rng_state = 0x9E3779B97F4A7C15ULL;
 static inline double tu_uniform(double lo, double hi)

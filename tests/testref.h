@@ -1,0 +1,28 @@
+/* Shared by the tests that compare against the reference library. */
+#ifndef PRRU_TESTREF_H
+#define PRRU_TESTREF_H
+#include <math.h>
+
+#include <gsl/gsl_errno.h>
+
+#include "prru_mechanism.h"
+#include "prru_ref.h"
+
+/* How far a reachable q is from the singular boundaries, in (0, 1]: the
+ * smallest |sin| of an upper link's angle (= sqrt(1 - r^2) for the acos
+ * argument r; read off R_Ui = Rx(alpha_i): R[7], or Ry(alpha_3): R[2]) and
+ * cos(phi) of limb 3's U joint (phi = asin(-sin q1 cos q2); gamma's
+ * gradient grows like 1/cos^2 phi). -1 where q is out of reach. */
+static inline double ref_margin(const prru_ref_params *P, const double q[3])
+{
+  double R[9 * PRRU_NBODY], p[3 * PRRU_NBODY];
+  if (prru_ref_poses(P, q, R, p) != GSL_SUCCESS) return -1;
+  double m = 1.0;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double *Ru = R + 9 * prru_mech.upper[i];
+    m = fmin(m, fabs(i < 2 ? Ru[7] : Ru[2]));
+  }
+  const double sp = sin(q[0]) * cos(q[1]);
+  return fmin(m, sqrt(1.0 - sp * sp));
+}
+#endif
