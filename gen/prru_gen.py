@@ -11,6 +11,7 @@ Writes DIR/<prefix>_kernels.{h,c} (the kernels) and DIR/<prefix>_mechanism.{h,c}
 import argparse
 import os
 import re
+import signal
 import sys
 import time
 
@@ -26,7 +27,11 @@ TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
 
 def generate(model_path, templates_dir=TEMPLATES, prefix=None):
     """(files {name: text}, emitted kernels) for a model file."""
-    model = model_mod.load(model_path)
+    return generate_model(model_mod.load(model_path), templates_dir, prefix)
+
+
+def generate_model(model, templates_dir=TEMPLATES, prefix=None):
+    """(files {name: text}, emitted kernels) for a loaded model."""
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
     return render.render(model, deriv, templates_dir, prefix)
@@ -54,12 +59,27 @@ def main(argv=None):
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
+    output.handle_termination()
+    try:
+        return _run(args)
+    except (KeyboardInterrupt, output.Terminated) as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print("prru_gen: stopped by signal %d: %s left as it was"
+              % (signum, args.out), file=sys.stderr)
+        return 128 + signum
+
+
+def _run(args):
     start = time.perf_counter()
     try:
-        files, emitted = generate(args.model, prefix=args.prefix)
+        model = model_mod.load(args.model)
     except model_mod.ModelError as exc:
         print("prru_gen: error: %s" % exc, file=sys.stderr)
         return 1
+    for warning in model.warnings():
+        print("prru_gen: warning: %s: %s" % (args.model, warning),
+              file=sys.stderr)
+    files, emitted = generate_model(model, prefix=args.prefix)
     try:
         output.write_files_atomically(args.out, files)
     except OSError as exc:

@@ -22,6 +22,7 @@ import argparse
 import math
 import os
 import re
+import signal
 import string
 import sys
 
@@ -342,6 +343,17 @@ def main(argv=None):
     parser.add_argument("--out", required=True, metavar="FILE",
                         help="MJCF file to write")
     args = parser.parse_args(argv)
+    output.handle_termination()
+    try:
+        return _run(args)
+    except (KeyboardInterrupt, output.Terminated) as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print("prru_mjcf: stopped by signal %d: %s left as it was"
+              % (signum, args.out), file=sys.stderr)
+        return 128 + signum
+
+
+def _run(args):
     try:
         text = render(args.model)
     except (model_mod.ModelError, ValueError) as exc:

@@ -344,7 +344,10 @@ static void test_map(void)
   for (int i = 0; i < g.n1; i++)
     for (int j = 0; j < g.n2; j++) {
       long k = (long)i * g.n2 + j;
-      double q[3] = {-PI / 6 + (PI / 3) * i / (g.n1 - 1), -PI / 4 + (1.2 + PI / 4) * j / (g.n2 - 1), 0};
+      /* The grid's own abscissae: a point on the tolerance's edge must be
+       * the same double in both. */
+      double q[3] = {prru_map_axis(g.q1_lo, g.q1_hi, g.n1, i), prru_map_axis(g.q2_lo, g.q2_hi, g.n2, j),
+                     g.q3};
       prru_dme r;
       int s = prru_dme_eval(&m3, D, q, &r);
       if (s != st[0][k] || (s == PRRU_OK ? fabs(r.w_R - w[0][k]) > 1e-13 * r.w_R : !isnan(w[0][k])))

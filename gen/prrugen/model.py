@@ -31,6 +31,9 @@ BODY_KEYS = ("mass", "inertia")
 BODY2_KEYS = ("mass", "inertia", "com")
 ACTUATOR_KEYS = ("armature", "damping", "coulomb", "coulomb_velocity")
 MAX_BYTES = 1 << 20
+# |cos| of the upper link's angle at q = 0 above which a model is warned
+# about: within 5 % of full stretch the limb tolerates almost no tilt.
+NEAR_STRETCH = Fraction(95, 100)
 
 
 class ModelError(Exception):
@@ -89,6 +92,22 @@ class Model:
     @property
     def has_passive(self):
         return any(self.damping) or any(self.coulomb)
+
+    def warnings(self):
+        """Valid but probably unintended: limbs that assemble at q = 0 only
+        near full stretch or fold, so that most of the workspace is out of
+        reach (a map of such a model is nearly all 'unreachable')."""
+        out = []
+        for i, limb in enumerate(self.limbs):
+            r = (limb.b - limb.a - limb.l2) / limb.l1
+            if abs(r) > NEAR_STRETCH:
+                out.append("limb %d is within %.1f%% of full %s at q = 0 "
+                           "(horizontal gap %s m, upper link %s m): most "
+                           "poses will be out of reach"
+                           % (i + 1, 100 * (1 - abs(float(r))),
+                              "stretch" if r > 0 else "fold",
+                              _fmt(limb.b - limb.a - limb.l2), _fmt(limb.l1)))
+        return out
 
 
 def _reject_constant(name):

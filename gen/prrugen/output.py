@@ -1,9 +1,38 @@
 """Writing generated files so that a failure never leaves a half-written or
 mixed set behind: every file goes to a temporary name in its directory
-first, and only when all are written are they renamed into place."""
+first, and only when all are written are they renamed into place.
+
+Signals: SIGINT raises KeyboardInterrupt and, once handle_termination() is
+called, SIGTERM and SIGHUP raise Terminated, so the cleanup below runs for
+them too; during the renames they are held back, so a stop leaves either
+the old set or the new one. (SIGKILL cannot be caught: it may leave a
+hidden `.<name>.XXXX` file, never a mixed set of visible ones.)
+"""
 
 import os
+import signal
 import tempfile
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived; .signum says which."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum, _frame):
+    raise Terminated(signum)
+
+
+def handle_termination():
+    """Make SIGTERM and SIGHUP raise Terminated (for command-line entry
+    points; a library caller keeps its own handlers)."""
+    for s in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(s, _raise_terminated)
 
 
 def write_files_atomically(out_dir, files):
@@ -17,10 +46,16 @@ def write_files_atomically(out_dir, files):
             with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
                 f.write(text)
             os.chmod(tmp, 0o644)
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
     except BaseException:
         for tmp, _ in staged:
             if os.path.exists(tmp):
                 os.unlink(tmp)
         raise
-    for tmp, final in staged:
-        os.replace(tmp, final)
+    try:
+        for tmp, final in staged:
+            os.replace(tmp, final)
+    finally:
+        # A signal that arrived meanwhile is delivered here, after the set
+        # is complete.
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)

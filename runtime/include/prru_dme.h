@@ -45,7 +45,8 @@
  * Singular configurations: a q is PRRU_EUNREACHABLE when the inverse
  * kinematics has no solution (an acos argument outside [-1, 1]) and
  * PRRU_ESINGULAR when J_d's reciprocal 1-norm condition number
- * 1 / (|J_d|_1 |J_d^-1|_1) is below m->jd_rcond_min (prru_check_regular;
+ * 1 / (|J|_1 |J^-1|_1), J = J_d with its rotation columns divided by the
+ * model's length scale, is below m->jd_rcond_min (prru_check_regular;
  * the model's default 1e-8 flags numerical singularity only, pass a model
  * copy with a larger value for a practical-singularity band, see the
  * global index below), or, as a last guard, when a result is not finite.
@@ -120,9 +121,10 @@ double prru_map_axis(double lo, double hi, int n, int i);
  * and changes erratically with the resolution (1.10, 1.00, 1.44, 1.29 at
  * 121^2, 201^2, 401^2, 1001^2 for fig. 7). For design comparison, map with
  * a practical-singularity tolerance (a model copy with e.g. jd_rcond_min =
- * 1e-3, cond_1(J_d) > 1000): the band around the locus is then singular,
- * counted in singular_fraction, and the index converges (0.813, 0.811,
- * 0.808, 0.807). index_log, the mean of ln w_R over the OK points, stays
+ * 4e-3, cond_1 > 250): the band around the locus is then singular,
+ * counted in singular_fraction, and the index converges (0.818, 0.815,
+ * 0.812, 0.811 at 121^2, 201^2, 401^2, 801^2 for fig. 7). index_log, the
+ * mean of ln w_R over the OK points, stays
  * finite either way (the logarithm of 1/distance is integrable).
  * The sums run over the points in grid order after all threads finish, so
  * the result does not depend on threading. */

@@ -76,13 +76,34 @@ double prru_rcond3(const double a[9], double inv[9])
   return fabs(det) / (na * ni);
 }
 
+double prru_length_scale(const prru_mechanism *me)
+{
+  double s = 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) s += me->l1[i];
+  return s / PRRU_NLIMB;
+}
+
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
 {
   if (rcond) *rcond = 0.0;
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik_jd(q, d->d, d->Jd);
   if (!finite3(d->d)) return PRRU_EUNREACHABLE;
-  double rc = prru_rcond3(d->Jd, d->Jdinv);
+  /* J_d's rotation columns are lengths per radian, its height column is
+   * dimensionless: conditioned as it stands, a model scaled by 1e-7 would
+   * be singular everywhere. So the condition number is that of
+   * Js = J_d diag(1/L, 1/L, 1) (rotations measured as arc lengths at the
+   * model's own scale), the same for a robot of any size; and
+   * J_d^-1 = diag(1/L, 1/L, 1) Js^-1. */
+  const double L = prru_length_scale(m->mech);
+  double Js[9];
+  for (int i = 0; i < 3; i++) {
+    Js[3 * i] = d->Jd[3 * i] / L;
+    Js[3 * i + 1] = d->Jd[3 * i + 1] / L;
+    Js[3 * i + 2] = d->Jd[3 * i + 2];
+  }
+  double rc = prru_rcond3(Js, d->Jdinv);
+  for (int j = 0; j < 6; j++) d->Jdinv[j] /= L;
   if (rcond) *rcond = rc;
   /* rc > 0 also when jd_rcond_min is 0: an exactly singular J_d has no inverse. */
   return rc > 0 && rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;

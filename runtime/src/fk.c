@@ -1,5 +1,6 @@
 /* Forward kinematics: q with d(q) = act by Newton's method on the closed
  * inverse kinematics, GSL's hybridsj with the exact Jacobian J_d. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -60,20 +61,24 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   prru_gsl_init();
   gsl_multiroot_fdfsolver *s = gsl_multiroot_fdfsolver_alloc(gsl_multiroot_fdfsolver_hybridsj, 3);
   if (!s) return PRRU_ENOMEM;
+  /* The residual tolerance is relative: 100 ulps of the larger of the
+   * model's length and the slider heights, whatever the robot's size. */
+  double scale = prru_length_scale(m->mech);
+  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
+  const double tol = 100 * DBL_EPSILON * scale;
   int gs = gsl_multiroot_fdfsolver_set(s, &fn, &xv.vector);
   int iter = 0, converged = 0;
   while (gs == GSL_SUCCESS && iter++ < 200) {
     gs = gsl_multiroot_fdfsolver_iterate(s);
     if (gs != GSL_SUCCESS) break;
-    /* 1e-14 m on displacements of order 1 m: a few ulps. */
-    if (gsl_multiroot_test_residual(s->f, 1e-14) == GSL_SUCCESS) { converged = 1; break; }
+    if (gsl_multiroot_test_residual(s->f, tol) == GSL_SUCCESS) { converged = 1; break; }
   }
   double sol[3] = {gsl_vector_get(s->x, 0), gsl_vector_get(s->x, 1), gsl_vector_get(s->x, 2)};
   double res = 0;
   for (int i = 0; i < 3; i++) res = fmax(res, fabs(gsl_vector_get(s->f, (size_t)i)));
   gsl_multiroot_fdfsolver_free(s);
-  /* hybridsj may stall one ulp short of 1e-14; accept a few ulps more. */
-  if (!converged && !(res <= 1e-13)) return PRRU_ENOCONV;
+  /* hybridsj may stall a few ulps short of tol; accept ten times it. */
+  if (!converged && !(res <= 10 * tol)) return PRRU_ENOCONV;
   st = prru_check_regular(m, d, sol, NULL);
   if (st != PRRU_OK) return st == PRRU_EUNREACHABLE ? PRRU_ENOCONV : st;
   memcpy(q, sol, sizeof sol);

@@ -1,0 +1,140 @@
+"""Stopping the generator: a SIGTERM, SIGHUP or SIGINT at any moment
+leaves the output directory with either the old files or the complete new
+set, and no hidden temporary file; a model that assembles only near full
+stretch is generated with a warning."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from unittest import mock
+
+from prrugen import output
+
+GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(GEN_DIR)
+PAPER = os.path.join(ROOT, "models", "3prru_paper.json")
+ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
+
+
+def listing(d):
+    out = {}
+    for name in sorted(os.listdir(d)):
+        with open(os.path.join(d, name), "rb") as f:
+            out[name] = f.read()
+    return out
+
+
+class AtomicWrites(unittest.TestCase):
+    def setUp(self):
+        self.saved = {s: signal.getsignal(s) for s in output.STOP_SIGNALS}
+        output.handle_termination()
+        self.dir = tempfile.mkdtemp()
+        output.write_files_atomically(self.dir, {"a.c": "old a", "b.h": "old b"})
+        self.new = {"a.c": "new a", "b.h": "new b"}
+
+    def tearDown(self):
+        for s, h in self.saved.items():
+            signal.signal(s, h)
+        for name in os.listdir(self.dir):
+            os.unlink(os.path.join(self.dir, name))
+        os.rmdir(self.dir)
+
+    def _stop_on(self, target, call_no, signum):
+        real = getattr(os, target)
+        calls = [0]
+
+        def hook(*args, **kwargs):
+            calls[0] += 1
+            if calls[0] == call_no:
+                os.kill(os.getpid(), signum)
+            return real(*args, **kwargs)
+        return mock.patch.object(output.os, target, hook)
+
+    def test_signal_while_writing_keeps_the_old_set(self):
+        for signum, exc in ((signal.SIGTERM, output.Terminated),
+                            (signal.SIGHUP, output.Terminated),
+                            (signal.SIGINT, KeyboardInterrupt)):
+            with self.subTest(signum=signum):
+                with self._stop_on("chmod", 2, signum):
+                    with self.assertRaises(exc):
+                        output.write_files_atomically(self.dir, self.new)
+                self.assertEqual(listing(self.dir),
+                                 {"a.c": b"old a", "b.h": b"old b"})
+
+    def test_signal_while_renaming_completes_the_new_set(self):
+        with self._stop_on("replace", 1, signal.SIGTERM):
+            with self.assertRaises(output.Terminated):
+                output.write_files_atomically(self.dir, self.new)
+        self.assertEqual(listing(self.dir), {"a.c": b"new a", "b.h": b"new b"})
+
+
+class KilledGenerator(unittest.TestCase):
+    def test_sigterm_at_any_time_leaves_old_or_new_and_no_temp_file(self):
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "out")
+            os.makedirs(out)
+            with open(os.path.join(out, "prru_kernels.c"), "w") as f:
+                f.write("old")
+            old = listing(out)
+            seen = set()
+            for delay in (0.02, 0.08, 0.15, 0.2, 0.25, 0.3, 0.4):
+                proc = subprocess.Popen([sys.executable, ENTRY, PAPER, "--out",
+                                         out, "--quiet"],
+                                        stderr=subprocess.PIPE, text=True)
+                time.sleep(delay)
+                proc.send_signal(signal.SIGTERM)
+                _, err = proc.communicate(timeout=60)
+                files = listing(out)
+                self.assertFalse([n for n in files if n.startswith(".")],
+                                 "temporary file left: %s" % sorted(files))
+                if proc.returncode == 0:
+                    self.assertEqual(len(files), 4)   # the new set, whole
+                    seen.add("finished")
+                elif proc.returncode == -signal.SIGTERM:
+                    # Killed while Python was still starting, before the
+                    # generator installed its handlers: nothing written.
+                    self.assertEqual(files, old)
+                else:
+                    self.assertEqual(proc.returncode, 128 + signal.SIGTERM, err)
+                    self.assertIn("stopped by signal", err)
+                    self.assertNotIn("Traceback", err)
+                    self.assertIn(files, (old, listing(out)))
+                    if files == old:
+                        seen.add("stopped")
+                if files != old:
+                    old = files          # later runs replace this set
+            self.assertTrue(seen, "no run was observed")
+
+
+class Warnings(unittest.TestCase):
+    def test_near_full_stretch_is_generated_with_a_warning(self):
+        with open(PAPER, encoding="utf-8") as f:
+            m = json.load(f)
+        # gap b3 - l2 = 0.224 m against l1 = 0.23 m: 97.4 % of full stretch
+        m["geometry"]["b3"] = 0.449
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "stretched.json")
+            with open(path, "w") as f:
+                json.dump(m, f)
+            r = subprocess.run([sys.executable, ENTRY, path, "--out",
+                                os.path.join(d, "out"), "--quiet"],
+                               capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("warning: %s: limb 3 is within 2.6%% of full stretch"
+                      % path, r.stderr)
+        self.assertEqual(r.stderr.count("\n"), 1)
+
+    def test_paper_model_has_no_warning(self):
+        with tempfile.TemporaryDirectory() as d:
+            r = subprocess.run([sys.executable, ENTRY, PAPER, "--out", d,
+                                "--quiet"], capture_output=True, text=True)
+        self.assertEqual((r.returncode, r.stderr), (0, ""))
+
+
+if __name__ == "__main__":
+    unittest.main()
