@@ -24,17 +24,20 @@ def kernels(deriv):
     fd, fp, mp = _vec("fd", nact), _vec("fp"), _vec("mp")
     rs, ps = deriv.poses()
     t, v = deriv.kinetic(), deriv.potential()
+    names = [b.name for b in deriv.mech.bodies]
+    nh, last = 6 * len(names), names[-1]
     spec = [
         ("ik", "Actuator displacements d_i (height of joint A_i on rail i).",
          [Q], [("d", d)]),
         ("jd", "Actuator Jacobian J_d = dd/dq (%dx3)." % nact, [Q],
          [("Jd", jd)]),
         ("ik_jd", "prru_ik and prru_jd fused.", [Q], [("d", d), ("Jd", jd)]),
-        ("jacobians", "H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], "
-         "world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3.",
+        ("jacobians", "H (%dx3) = [J_R,P; ..; J_R,%s; J_T,P; ..; J_T,%s], "
+         "world frame, body order %s." % (nh, last, last, " ".join(names)),
          [Q], [("H", deriv.jacobians())]),
-        ("bias_terms", "[delta_P..delta_S3; mu_P..mu_S3] (60): the parts of "
-         "the angular and linear accelerations that are quadratic in qd.",
+        ("bias_terms", "[delta_P..delta_%s; mu_P..mu_%s] (%d): the parts of "
+         "the angular and linear accelerations that are quadratic in qd."
+         % (last, last, nh),
          [Q, QD], [("dm", deriv.bias_terms())]),
         ("mass", "Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3).",
          [Q], [("M", m)]),
@@ -58,7 +61,7 @@ def kernels(deriv):
         ("inertia_world", "Inertia tensors I_b = R_b D_b R_b^T about each "
          "centre, in {S} (3x3 each), body order.",
          [Q], [("I", deriv.inertia_world())]),
-        ("wrench_bias", "K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b].",
+        ("wrench_bias", "K (%d) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]." % nh,
          [Q, QD], [("K", deriv.wrench_bias())]),
         ("energy", "E[0] = kinetic energy (with the drives' armature), "
          "E[1] = potential energy -sum_b m_b g . p_b.", [Q, QD],

@@ -80,20 +80,23 @@ def _limb12(s, g, platform_rot, p_platform):
                 slider=([], a_joint))
 
 
-def _limb3(g, p_platform):
-    """Limb 3: in the plane y = 0, hinges along e2; U joint centre is O'."""
+def _limb34(s, g, p_platform):
+    """Limb 3 (s = +1) and its mirror, the redundant limb 4 (s = -1, spec
+    section 12): in the plane y = 0, hinges along e2, U joint centre O',
+    rail at x = s b, lower link along s x3."""
     q1, q2 = sym.sym("q1"), sym.sym("q2")
     gamma = sym.atan2(sym.sin(q2), sym.cos(q1) * sym.cos(q2))
     x3 = matvec(rot(Y, gamma), unit(X))
-    b_joint = vadd(p_platform, vscale(g.l2, x3))
-    p_lower = vadd(p_platform, vscale(g.l2 / 2, x3))
-    cos_arg = (b_joint[X] - g.b) / g.l1
+    outward = x3 if s > 0 else [-x for x in x3]
+    b_joint = vadd(p_platform, vscale(s * g.l2, x3))
+    p_lower = vadd(p_platform, vscale(s * g.l2 / 2, x3))
+    cos_arg = (b_joint[X] - s * g.b) / g.l1
     alpha = sym.acos(cos_arg)
     d = b_joint[Z] + g.l1 * sym.sin(alpha)
-    a_joint = vec(g.b, 0, d)
+    a_joint = vec(s * g.b, 0, d)
     p_upper = vscale(Fraction(1, 2), vadd(a_joint, b_joint))
     return dict(c=p_platform, b=b_joint, a=a_joint, d=d, guard=cos_arg,
-                x3=x3, lower=([(Y, gamma)], p_lower),
+                x3=outward, lower=([(Y, gamma)], p_lower),
                 upper=([(Y, alpha)], p_upper),
                 slider=([], a_joint))
 
@@ -108,17 +111,18 @@ def build(model):
     platform_rot = matmul(rot(X, q[0]), rot(Y, q[1]))
     limbs = [_limb12(-1, g[0], platform_rot, p_platform),
              _limb12(+1, g[1], platform_rot, p_platform),
-             _limb3(g[2], p_platform)]
+             _limb34(+1, g[2], p_platform)]
+    if len(g) == 4:
+        limbs.append(_limb34(-1, g[3], p_platform))
 
     parts = [(platform_chain, p_platform)]
     parts += [limb["lower"] for limb in limbs]
     parts += [limb["upper"] for limb in limbs]
     parts += [limb["slider"] for limb in limbs]
-    from .model import BODY_NAMES
     bodies = [Body(name, chain, origin, model.masses[i], model.coms[i],
                    _tensor(model.inertias[i]))
               for i, (name, (chain, origin)) in
-              enumerate(zip(BODY_NAMES, parts))]
+              enumerate(zip(model.body_names, parts))]
 
     joints = _joints(limbs, platform_rot)
     guards = []
@@ -135,15 +139,14 @@ def _tensor(entries):
     return [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
 
 
-P_, L_, U_, S_ = 0, 1, 4, 7     # first index of each body group
-
-
 def _force_basis():
     return [("f", unit(X)), ("f", unit(Y)), ("f", unit(Z))]
 
 
 def _joints(limbs, platform_rot):
-    """The joint table, in lambda order: C1..C3, B1..B3, A1..A3, P1..P3."""
+    """The joint table, in lambda order: every limb's C, then B, A, P."""
+    n = len(limbs)
+    P_, L_, U_, S_ = 0, 1, 1 + n, 1 + 2 * n     # first body of each group
     u = [row[X] for row in platform_rot]          # R_P e1
     w = [row[Z] for row in platform_rot]          # R_P e3
     joints = []

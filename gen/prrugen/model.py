@@ -22,7 +22,16 @@ from decimal import Decimal, InvalidOperation
 from fractions import Fraction
 
 NLIMB = 3
-BODY_NAMES = ("P", "L1", "L2", "L3", "U1", "U2", "U3", "S1", "S2", "S3")
+LIMB_COUNTS = (3, 4)    # the 3-PRRU, and the redundant 4-PRRU (spec 12)
+
+
+def body_names(nlimb):
+    """P, then every limb's lower link, upper link and slider."""
+    return ("P",) + tuple("%s%d" % (kind, i + 1) for kind in "LUS"
+                          for i in range(nlimb))
+
+
+BODY_NAMES = body_names(NLIMB)
 GEOMETRY_KEYS = ("b12", "b3", "l1", "l2", "a")
 GEOMETRY2_KEYS = ("b", "l1", "l2", "a")
 TOP_KEYS = ("name", "description", "gravity", "geometry", "bodies")
@@ -80,6 +89,14 @@ class Model:
         self.coulomb_velocity = coulomb_velocity
         self.sha256 = sha256
         self.path = path
+
+    @property
+    def nlimb(self):
+        return len(self.limbs)
+
+    @property
+    def body_names(self):
+        return body_names(self.nlimb)
 
     @property
     def total_mass(self):
@@ -309,20 +326,26 @@ def _geometry1(path, geo):
 
 
 def _geometry2(path, geo):
+    """Per-limb geometry; the number of rails in b sets the number of limbs:
+    3, or 4 for the redundant variant whose limb 4 mirrors limb 3 (rail at
+    x = -b4)."""
     geo = _object(path, "geometry", geo, GEOMETRY2_KEYS, GEOMETRY2_KEYS)
-    if not isinstance(geo["b"], list):
-        raise ModelError(path, "geometry.b", "must be a list of %d rail "
-                         "offsets [b1, b2, b3]" % NLIMB)
-    b = _per_limb(path, "geometry.b", geo["b"], NLIMB, _positive,
-                  "rail offsets b1, b2, b3")
-    l1 = _per_limb(path, "geometry.l1", geo["l1"], NLIMB, _positive,
+    if not isinstance(geo["b"], list) or len(geo["b"]) not in LIMB_COUNTS:
+        raise ModelError(path, "geometry.b", "must be a list of 3 rail "
+                         "offsets [b1, b2, b3], or 4 for the redundant "
+                         "4-limb variant [b1, b2, b3, b4]")
+    n = len(geo["b"])
+    names = ", ".join("b%d" % (i + 1) for i in range(n))
+    b = _per_limb(path, "geometry.b", geo["b"], n, _positive,
+                  "rail offsets " + names)
+    l1 = _per_limb(path, "geometry.l1", geo["l1"], n, _positive,
                    "one upper link per limb")
-    l2 = _per_limb(path, "geometry.l2", geo["l2"], NLIMB, _positive,
+    l2 = _per_limb(path, "geometry.l2", geo["l2"], n, _positive,
                    "one lower link per limb")
     a = _per_limb(path, "geometry.a", geo["a"], 2, _positive,
                   "U-joint offsets a1, a2 of limbs 1 and 2")
     return tuple(Limb(b[i], l1[i], l2[i], a[i] if i < 2 else Fraction(0))
-                 for i in range(NLIMB))
+                 for i in range(n))
 
 
 def _gravity(path, value, fmt):
@@ -335,12 +358,12 @@ def _gravity(path, value, fmt):
     return (Fraction(0), Fraction(0), -g)
 
 
-def _actuators(path, value):
-    zero = (Fraction(0),) * NLIMB
+def _actuators(path, value, nlimb):
+    zero = (Fraction(0),) * nlimb
     if value is None:
         return zero, zero, zero, None
     value = _object(path, "actuators", value, ACTUATOR_KEYS, ())
-    lists = [_per_limb(path, "actuators." + k, value[k], NLIMB, _nonnegative,
+    lists = [_per_limb(path, "actuators." + k, value[k], nlimb, _nonnegative,
                        "one per actuator") if k in value else zero
              for k in ACTUATOR_KEYS[:3]]
     vs = None
@@ -397,9 +420,10 @@ def parse(text, path="<model>"):
         _geometry2(path, data["geometry"])
     _check_assembly(path, limbs, fmt)
     body_keys = BODY_KEYS if fmt == 1 else BODY2_KEYS
-    bodies = _object(path, "bodies", data["bodies"], BODY_NAMES, BODY_NAMES)
+    names = body_names(len(limbs))
+    bodies = _object(path, "bodies", data["bodies"], names, names)
     masses, coms, inertias = [], [], []
-    for b in BODY_NAMES:
+    for b in names:
         key = "bodies." + b
         body = _object(path, key, bodies[b], body_keys, BODY_KEYS)
         masses.append(_positive(path, key + ".mass", body["mass"]))
@@ -407,7 +431,7 @@ def parse(text, path="<model>"):
         coms.append(_vector3(path, key + ".com", body["com"], "centre of mass "
                              "in the body frame, m") if "com" in body
                     else (Fraction(0),) * 3)
-    drives = _actuators(path, data.get("actuators"))
+    drives = _actuators(path, data.get("actuators"), len(limbs))
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     return Model(name, description, fmt, gravity, limbs, tuple(masses),
                  tuple(coms), tuple(inertias), *drives, sha256=sha, path=path)
