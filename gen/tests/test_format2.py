@@ -291,3 +291,79 @@ class Determinism(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+FOUR = os.path.join(ROOT, "models", "4prru.json")
+
+
+class FourLimbs(unittest.TestCase):
+    """The redundant 4-PRRU (spec section 12): limb 4 is limb 3 mirrored in
+    the plane x = 0, so for models/4prru.json (b4 = b3, equal links)
+    d_4(q1, q2, q3) = d_3(q1, -q2, q3); and the height q3 feels limb 4's
+    mass exactly: M33 and G3 grow by its weight."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.model, cls.deriv = _derive(FOUR)
+
+    def test_sizes(self):
+        mech = self.deriv.mech
+        self.assertEqual(len(mech.bodies), 13)
+        self.assertEqual([b.name for b in mech.bodies][-4:],
+                         ["S1", "S2", "S3", "S4"])
+        self.assertEqual(len(mech.actuators), 4)
+        self.assertEqual(sum(len(j.basis) for j in mech.joints), 76)
+        self.assertEqual([j.name for j in mech.joints][:4],
+                         ["C1", "C2", "C3", "C4"])
+
+    def test_limb4_mirrors_limb3(self):
+        d = self.deriv.actuators()
+        for env in _states(10, 8):
+            mirrored = dict(env, q2=-env["q2"])
+            d4 = self.ev_one(d[3], env)
+            d3m = self.ev_one(d[2], mirrored)
+            self.assertAlmostEqual(d4, d3m, delta=1e-15)
+
+    def ev_one(self, e, env):
+        return sym.evaluate([e], env)[0]
+
+    def test_loops_close(self):
+        joints = {j.name: j for j in self.deriv.mech.joints}
+        for env in _states(5, 9):
+            a = sym.evaluate(joints["A4"].centre, env)
+            b = sym.evaluate(joints["B4"].centre, env)
+            c = sym.evaluate(joints["C4"].centre, env)
+            self.assertAlmostEqual(math.dist(a, b), 0.23, places=12)
+            self.assertAlmostEqual(math.dist(b, c), 0.225, places=12)
+            self.assertAlmostEqual(a[0], -0.315, places=15)
+            self.assertAlmostEqual(a[1], 0.0, places=15)
+
+    def test_adding_limb4_adds_its_mass_to_the_height(self):
+        _, three = _derive(PAPER)
+        m3, g3 = three.mass(), three.gravity_force()
+        _, four = _derive(FOUR)
+        m4, g4 = four.mass(), four.gravity_force()
+        for env in _states(5, 10):
+            v3 = sym.evaluate(m3 + g3, env)
+            v4 = sym.evaluate(m4 + g4, env)
+            self.assertAlmostEqual(v4[8] - v3[8], 0.64 + 1.31 + 1.59, delta=1e-12)
+            self.assertAlmostEqual(v4[11] - v3[11], -9.81 * (0.64 + 1.31 + 1.59),
+                                   delta=1e-10)
+
+    def test_rejections(self):
+        m = _load_json(FOUR)
+        m["bodies"].pop("S4")
+        with self.assertRaises(model.ModelError) as ctx:
+            model.parse(json.dumps(m), "f.json")
+        self.assertIn("bodies.S4: missing", str(ctx.exception))
+        m = _load_json(FOUR)
+        m["geometry"]["b"] = [0.36] * 5
+        with self.assertRaises(model.ModelError) as ctx:
+            model.parse(json.dumps(m), "f.json")
+        self.assertIn("geometry.b: must be a list of 3", str(ctx.exception))
+        m = _load_json(FOUR)
+        m["geometry"]["l1"] = [0.23] * 3
+        with self.assertRaises(model.ModelError) as ctx:
+            model.parse(json.dumps(m), "f.json")
+        self.assertIn("geometry.l1: must be one number or a list of 4",
+                      str(ctx.exception))
