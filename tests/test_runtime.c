@@ -2,12 +2,18 @@
  * balance (with the drives' dissipation), inverse of the forward dynamics,
  * FK(IK), reactions (H^T Q = 0, platform Newton-Euler, machine force
  * balance, agreement with the dense reference), the integrators against an
- * independent RK4, clean stops, parsing. The paper's scenario is checked in
- * paper_runtime.c. */
+ * independent RK4, clean stops, bounded integrator work (tolerance floor,
+ * step budget, interrupts inside a step), msbdf at the workspace boundary,
+ * parsing. The paper's scenario is checked in paper_runtime.c. */
+#define _XOPEN_SOURCE 700 /* setitimer, sigaction, clock_gettime, write, _exit */
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/time.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "prru.h"
 #include "prru_ref.h"
@@ -428,6 +434,249 @@ static void test_stops(void)
   TU_TRUE(prru_simulate(&model, q0, qd0, &o, &t_stop, msg, 300) == PRRU_EINPUT, "negative dt refused");
 }
 
+/* ---- bounded work, interrupts, the boundary (issue 16, items 3, 4, 6) ---- */
+static const double q_mid[3] = {0.1, -0.05, -0.8}; /* as in test_steppers */
+
+static double wall_now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* A hang is a failure: while armed, SIGALRM after `seconds` of wall time
+ * ends the test with FAIL and the name of what hung. */
+static const char *watchdog_what = "";
+static void on_watchdog(int sig)
+{
+  (void)sig;
+  static const char head[] = "FAIL did not finish in time (hang): ";
+  ssize_t r = write(2, head, sizeof head - 1);
+  r = write(2, watchdog_what, strlen(watchdog_what));
+  r = write(2, "\n", 1);
+  (void)r;
+  _exit(1);
+}
+
+static void watchdog(int seconds, const char *what)
+{
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_watchdog;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGALRM, &sa, NULL);
+  watchdog_what = what ? what : "";
+  struct itimerval it;
+  memset(&it, 0, sizeof it);
+  it.it_value.tv_sec = seconds; /* 0 disarms */
+  setitimer(ITIMER_REAL, &it, NULL);
+}
+
+/* Loads that hold q at rest (inverse dynamics at qd = qdd = 0) plus, from
+ * t_from on, fd_1 alternating between -amp and +amp every tau (a table,
+ * linear in between): the integrator has to resolve every kink, so an
+ * interval costs many steps while the state hardly moves. amp scales with
+ * the model's static forces. */
+static void busy_loads(prru_load_schedule *s, const double q[3], double t_from, double t_end,
+                       double tau)
+{
+  const int R = PRRU_NACT + 7;
+  const double zero[3] = {0, 0, 0};
+  prru_loads eq;
+  memset(&eq, 0, sizeof eq);
+  TU_TRUE(prru_inverse_dynamics(&model, &data, q, zero, zero, &eq, eq.fd) == PRRU_OK,
+          "static actuator forces");
+  double amp = 1.0;
+  for (int i = 0; i < PRRU_NACT; i++) amp = fmax(amp, 0.5 * fabs(eq.fd[i]));
+  prru_schedule_constant(s, &eq);
+  int n = (int)((t_end - t_from) / tau) + 2;
+  s->rows = calloc((size_t)n * R, sizeof(double));
+  if (!s->rows) { TU_TRUE(0, "out of memory"); return; }
+  s->kind = PRRU_LOAD_TABLE;
+  s->nrows = n;
+  for (int i = 0; i < n; i++) {
+    s->rows[R * i] = t_from + i * tau;
+    s->rows[R * i + 1] = i == 0 ? 0.0 : i % 2 ? amp : -amp;
+  }
+}
+
+/* Item 4: tolerances below PRRU_TOL_MIN are refused at once (1e-25 used
+ * to run for ever with every stepper); at the floor every stepper runs. */
+static void test_tolerances(void)
+{
+  char msg[300];
+  const double qd0[3] = {0.2, -0.1, 0.05};
+  for (int stp = PRRU_RK8PD; stp <= PRRU_MSBDF; stp++) {
+    prru_sim_options o;
+    prru_sim_options_default(&o);
+    o.stepper = (prru_stepper)stp;
+    o.t_end = 0.05, o.dt_out = 0.01;
+    keep k;
+    memset(&k, 0, sizeof k);
+    o.on_sample = keep_sample, o.ctx = &k;
+    double t_stop, t0 = wall_now();
+    o.abs_tol = o.rel_tol = 1e-25;
+    int st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+    TU_TRUE(st == PRRU_EINPUT && strstr(msg, "rel_tol") && k.n == 0, "rel_tol 1e-25 refused");
+    o.rel_tol = 1e-10;
+    st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+    TU_TRUE(st == PRRU_EINPUT && strstr(msg, "abs_tol") && k.n == 0, "abs_tol 1e-25 refused");
+    o.abs_tol = 1e-10, o.rel_tol = 0.5 * PRRU_TOL_MIN;
+    TU_TRUE(prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300) == PRRU_EINPUT,
+            "rel_tol just below the floor refused");
+    o.abs_tol = o.rel_tol = PRRU_TOL_MIN;
+    st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+    printf("%s at tolerance %.2g: %.3f s, %s\n", prru_stepper_name(o.stepper), PRRU_TOL_MIN,
+           wall_now() - t0, st == PRRU_OK ? "completes" : msg);
+    TU_TRUE(st == PRRU_OK && k.n == 6, "a run at the tolerance floor completes");
+  }
+  prru_sim_options o;
+  prru_sim_options_default(&o);
+  double t_stop;
+  o.stepper = PRRU_MSBDF, o.abs_tol = 0;
+  TU_TRUE(prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300) == PRRU_EINPUT &&
+              strstr(msg, "abs_tol"), "msbdf with abs_tol = 0 refused");
+  prru_sim_options_default(&o);
+  o.max_steps = -1;
+  TU_TRUE(prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300) == PRRU_EINPUT &&
+              strstr(msg, "max_steps"), "negative max_steps refused");
+}
+
+/* Item 4: the step budget ends a run that needs too many steps between two
+ * samples with PRRU_ENOCONV, keeping every sample delivered. */
+static void test_step_budget(void)
+{
+  char msg[300];
+  const double qd0[3] = {0, 0, 0};
+  prru_load_schedule ls;
+  busy_loads(&ls, q_mid, 0.05, 0.1, 1e-4); /* quiet up to 0.05 s, then 100 kinks per 10 ms */
+  prru_sim_options o;
+  prru_sim_options_default(&o);
+  o.t_end = 0.1, o.dt_out = 0.01, o.loads = &ls;
+  keep k;
+  memset(&k, 0, sizeof k);
+  o.on_sample = keep_sample, o.ctx = &k;
+  double t_stop = -1, t0 = wall_now();
+  o.max_steps = 50;
+  int st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+  printf("budget of 50 steps: %s (%ld samples, %.3f s)\n", msg, k.n, wall_now() - t0);
+  TU_TRUE(st == PRRU_ENOCONV && strstr(msg, "step budget of 50 steps exhausted at t ="),
+          "a run beyond its step budget stops with PRRU_ENOCONV and says so");
+  TU_TRUE(k.n >= 5 && k.n < 11 && t_stop == k.last.t && k.last.t >= 0.04 - 1e-12,
+          "the samples before the budget ran out are kept");
+  /* The default budget is per output interval and generous. */
+  memset(&k, 0, sizeof k);
+  o.max_steps = 0;
+  t0 = wall_now();
+  st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+  printf("default budget: %s, %ld samples, %.3f s\n", st == PRRU_OK ? "completes" : msg, k.n,
+         wall_now() - t0);
+  TU_TRUE(st == PRRU_OK && k.n == 11, "the same run completes with the default budget");
+  prru_schedule_free(&ls);
+  /* From rest with h0 = 1e-4 s a 10 ms interval takes at least 4 steps
+   * (a step grows at most 5x): a budget of 1 stops in the first one. */
+  prru_sim_options_default(&o);
+  o.t_end = 0.1, o.dt_out = 0.01, o.max_steps = 1;
+  memset(&k, 0, sizeof k);
+  o.on_sample = keep_sample, o.ctx = &k;
+  st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+  TU_TRUE(st == PRRU_ENOCONV && k.n == 1 && t_stop == 0 && strstr(msg, "step budget of 1 steps"),
+          "a budget of 1 step stops in the first interval, keeping the sample at t = 0");
+}
+
+/* Item 3: the interrupt flag is polled inside the right-hand side, so it
+ * stops a run in the middle of one long interval (it was only polled
+ * between samples). A CPU-time timer (SIGVTALRM: SIGALRM is the watchdog's)
+ * raises it 30 ms into a 0.5 s interval that takes several tenths of a
+ * second to integrate. */
+static volatile sig_atomic_t test_interrupt_flag;
+static void on_test_alarm(int sig)
+{
+  (void)sig;
+  test_interrupt_flag = 1;
+}
+
+static void test_interrupt_in_step(void)
+{
+  char msg[300];
+  const double qd0[3] = {0, 0, 0};
+  prru_load_schedule ls;
+  busy_loads(&ls, q_mid, 0.0, 0.5, 1e-4);
+  prru_sim_options o;
+  prru_sim_options_default(&o);
+  o.t_end = o.dt_out = 0.5;
+  o.loads = &ls, o.max_steps = 10000000;
+  keep k;
+  memset(&k, 0, sizeof k);
+  o.on_sample = keep_sample, o.ctx = &k;
+  test_interrupt_flag = 0;
+  o.interrupt = &test_interrupt_flag;
+  struct sigaction sa, old;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_test_alarm;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGVTALRM, &sa, &old);
+  struct itimerval it, off;
+  memset(&it, 0, sizeof it);
+  memset(&off, 0, sizeof off);
+  it.it_value.tv_usec = 30000;
+  double t_stop = -1, t0 = wall_now();
+  setitimer(ITIMER_VIRTUAL, &it, NULL);
+  int st = prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300);
+  double wall = wall_now() - t0;
+  setitimer(ITIMER_VIRTUAL, &off, NULL);
+  sigaction(SIGVTALRM, &old, NULL);
+  printf("interrupt 30 ms into one 0.5 s interval: stopped after %.3f s: %s\n", wall, msg);
+  TU_TRUE(st == PRRU_EINTERRUPTED, "an interrupt during an interval stops the run");
+  TU_TRUE(k.n == 1 && t_stop == 0 && strstr(msg, "interrupted at t = 0 s (during the step"),
+          "it stops inside the interval, reporting the last sample (t = 0), which stays delivered");
+  prru_schedule_free(&ls);
+}
+
+/* Item 6: near the workspace boundary msbdf's finite-difference Jacobian
+ * probed outside and stopped the run at t = 0, where rk8pd completes. The
+ * boundary is found by bisection along q1 and q2 (both signs) from
+ * (0, 0, -0.8); the run starts 1e-9 inside, well within a difference
+ * step. Wherever rk8pd completes, msbdf must complete and agree. */
+static void test_msbdf_boundary(void)
+{
+  char msg[300];
+  const double qd0[3] = {0, 0, 0};
+  prru_loads zero;
+  memset(&zero, 0, sizeof zero);
+  prru_load_schedule ls;
+  prru_schedule_constant(&ls, &zero);
+  int cases = 0;
+  for (int axis = 0; axis < 2; axis++)
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      double q[3] = {0, 0, -0.8}, lo = 0, hi = 0.01;
+      for (;;) { /* bracket */
+        q[axis] = sgn * hi;
+        if (prru_check_regular(&model, &data, q, NULL) != PRRU_OK || hi > 3.2) break;
+        lo = hi, hi *= 1.5;
+      }
+      if (hi > 3.2) continue;
+      for (int i = 0; i < 80; i++) {
+        double mid = 0.5 * (lo + hi);
+        q[axis] = sgn * mid;
+        if (prru_check_regular(&model, &data, q, NULL) == PRRU_OK) lo = mid; else hi = mid;
+      }
+      q[axis] = sgn * (lo - 1e-9);
+      if (prru_check_regular(&model, &data, q, NULL) != PRRU_OK) continue;
+      keep a, b;
+      int sa = run_sim(&model, q, qd0, &ls, PRRU_RK8PD, 1e-10, 0.05, &a, msg);
+      if (sa != PRRU_OK) continue;
+      int sb = run_sim(&model, q, qd0, &ls, PRRU_MSBDF, 1e-10, 0.05, &b, msg);
+      double e = sb == PRRU_OK ? tu_relerr(b.last.q, a.last.q, 3, 1.0) : INFINITY;
+      printf("q%d = %+.9f (boundary %+.9f): rk8pd completes, msbdf %s, |q| difference %.1e\n",
+             axis + 1, q[axis], sgn * lo, sb == PRRU_OK ? "completes" : msg, e);
+      TU_TRUE(sb == PRRU_OK && b.n == a.n, "msbdf runs from next to the boundary where rk8pd does");
+      tu_check(e <= 1e-6, "msbdf agrees with rk8pd there", e, 1e-6);
+      cases++;
+    }
+  TU_TRUE(cases > 0, "some start next to the boundary where rk8pd completes");
+}
+
 /* ---- schedules, scenarios, parsing ---- */
 static void test_parsing(void)
 {
@@ -470,6 +719,11 @@ static void test_parsing(void)
               sc.q0[1] == 0.5 && sc.opt.stepper == PRRU_RKCK && sc.loads.kind == PRRU_LOAD_HARMONIC,
           "scenario parses");
   prru_scenario_free(&sc);
+  const char *budget = "max_steps = 500\natol = 0\nrtol = 2.3e-14\n";
+  TU_TRUE(prru_scenario_parse(&sc, budget, strlen(budget), "mem", NULL, msg, 300) == PRRU_OK &&
+              sc.opt.max_steps == 500 && sc.opt.rel_tol == 2.3e-14,
+          "scenario max_steps and a tolerance at the floor parse");
+  prru_scenario_free(&sc);
   const struct { const char *text, *needle; } bad_sc[] = {
       {"q0 = 1,2\n", "mem:1: q0"},
       {"speed = 3\n", "unknown key 'speed'"},
@@ -479,6 +733,10 @@ static void test_parsing(void)
       {"junk\n", "expected 'key = value'"},
       {"loads = x.csv\n", "not allowed"},
       {"dt = 2\n", "larger than t_end"},
+      {"atol = 1e-25\n", "mem:1: atol: 1e-25 is below"},
+      {"rtol = 1e-16\n", "mem:1: rtol"},
+      {"max_steps = -3\n", "mem:1: max_steps"},
+      {"max_steps = 2.5\n", "mem:1: max_steps"},
   };
   for (size_t i = 0; i < sizeof bad_sc / sizeof bad_sc[0]; i++) {
     int st = prru_scenario_parse(&sc, bad_sc[i].text, strlen(bad_sc[i].text), "mem", NULL, msg, 300);
@@ -497,6 +755,16 @@ int main(void)
   test_energy();
   test_steppers();
   test_stops();
+  /* Release builds take well under a second for these four. */
+  watchdog(60, "tolerance floor (a tolerance of 1e-25 used to run for ever)");
+  test_tolerances();
+  watchdog(60, "step budget");
+  test_step_budget();
+  watchdog(60, "interrupt inside an interval");
+  test_interrupt_in_step();
+  watchdog(60, "msbdf next to the workspace boundary");
+  test_msbdf_boundary();
+  watchdog(0, NULL);
   test_parsing();
   return tu_finish("test_runtime");
 }

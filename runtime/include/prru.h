@@ -20,6 +20,7 @@
 #ifndef PRRU_H
 #define PRRU_H
 
+#include <float.h>
 #include <signal.h>
 #include <stddef.h>
 
@@ -51,8 +52,11 @@ const char *prru_strerror(int status);
 
 typedef struct {
   const prru_mechanism *mech;      /* the generated descriptor: &prru_mech */
-  /* J_d counts as singular when its reciprocal condition number
-   * 1 / (|J_d|_1 |J_d^-1|_1) is below this (default 1e-8). */
+  /* J_d counts as singular when the reciprocal condition number
+   * 1 / (|J|_1 |J^-1|_1) of J = J_d diag(1/L, 1/L, 1) is below this
+   * (default 1e-8); L, the mean upper-link length, measures rotations as arc
+   * lengths at the robot's own scale, so the test means the same for a
+   * robot of any size. */
   double jd_rcond_min;
 } prru_model;
 
@@ -143,24 +147,57 @@ typedef struct {
   double T, V;
 } prru_sample;
 
-typedef int (*prru_sample_fn)(const prru_sample *s, void *ctx); /* non-zero stops */
+/* The sample consumer: PRRU_OK (0) to go on; non-zero stops the run after
+ * this sample, and prru_simulate returns PRRU_EINTERRUPTED with msg
+ * "stopped at t = ... by the sample consumer". The status says only that
+ * the consumer stopped the run: a consumer that stops for a reason of its
+ * own (a write error) keeps the reason in ctx and reports it (the CLI
+ * returns PRRU_EIO and keeps errno; it then exits 1 with the reason, not
+ * as an interrupt). */
+typedef int (*prru_sample_fn)(const prru_sample *s, void *ctx);
+
+/* The smallest non-zero tolerance prru_simulate accepts, for abs_tol and
+ * rel_tol alike: 100 DBL_EPSILON (about 2.2e-14). A step's error estimate
+ * is a difference of two solutions that each carry rounding of a few
+ * DBL_EPSILON |y| per stage; the state's components (rad, m and their
+ * rates) are of order 1 or larger, so a smaller tolerance is either
+ * dominated by the other one or cannot be met at all (the step size then
+ * collapses and the run never ends). 0 switches that part of the error
+ * control off; both 0 is refused. */
+#define PRRU_TOL_MIN (100 * DBL_EPSILON)
+/* Default step budget: accepted integrator steps per output interval. */
+#define PRRU_MAX_STEPS_DEFAULT 100000L
 
 typedef struct {
   prru_stepper stepper;
   double t_end, dt_out;          /* s; samples at 0, dt_out, ..., t_end */
-  double abs_tol, rel_tol, h0;   /* gsl_odeiv2_driver tolerances, first step */
+  double abs_tol, rel_tol, h0;   /* gsl_odeiv2_driver tolerances (0 or at
+                                    least PRRU_TOL_MIN), first step */
   int reactions;                 /* compute lambda for each sample */
   const prru_load_schedule *loads;
   prru_sample_fn on_sample; void *ctx;
-  volatile sig_atomic_t *interrupt; /* polled between samples; non-zero stops */
+  /* Non-zero stops the run: polled between samples and inside every
+   * evaluation of the right-hand side, so a long integrator step stops too. */
+  volatile sig_atomic_t *interrupt;
   int progress;                  /* progress bar on stderr */
+  /* Step budget: the run stops (PRRU_ENOCONV) once the integrator needs
+   * more than this many accepted steps between two samples (GSL's driver
+   * takes nmax + 2 before it gives up; gsl_odeiv2_driver_set_nmax), so no
+   * run can spin forever; 0 means PRRU_MAX_STEPS_DEFAULT, negative is
+   * refused. */
+  long max_steps;
 } prru_sim_options;
 
 void prru_sim_options_default(prru_sim_options *o);
 /* Integrates from (q0, qd0); calls on_sample for every sample it reached.
  * Stops with PRRU_EUNREACHABLE / PRRU_ESINGULAR (state left the workspace),
- * PRRU_ENOCONV (step failure), PRRU_EINTERRUPTED; *t_stop is the time of the
- * last sample delivered. msg (may be NULL) says why it stopped. */
+ * PRRU_ENOCONV (step failure, or the step budget max_steps exhausted:
+ * "step budget of N steps exhausted at t = ..."), PRRU_EINTERRUPTED
+ * (*interrupt, also in the middle of a step, or the sample consumer);
+ * PRRU_EINPUT for bad options, among them a tolerance below PRRU_TOL_MIN
+ * and abs_tol = 0 with msbdf. *t_stop is the time of the last sample
+ * delivered; every sample delivered stays delivered. msg (may be NULL)
+ * says why it stopped, naming the option for PRRU_EINPUT. */
 int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                   const prru_sim_options *o, double *t_stop, char *msg, int msglen);
 
@@ -179,8 +216,9 @@ void prru_scenario_paper(prru_scenario *s);
 /* A scenario file: one `key = value` per line, '#' comments; keys q0, qd0,
  * fd, fp, mp (3 numbers each), harmonic (amplitude N, angular frequency
  * rad/s), loads (a CSV file for prru_schedule_read_csv, relative to the
- * scenario's directory), t_end, dt, stepper, atol, rtol, h0. Unset keys
- * keep their defaults (zero state and loads, 1 s, 1 ms, rk8pd, 1e-10).
+ * scenario's directory), t_end, dt, stepper, atol, rtol, h0, max_steps
+ * (opt.max_steps). Unset keys keep their defaults (zero state and loads,
+ * 1 s, 1 ms, rk8pd, 1e-10, PRRU_MAX_STEPS_DEFAULT).
  * On error msg says `name:line: reason`. */
 int prru_scenario_read(prru_scenario *s, const char *path, char *msg, int msglen);
 /* The same from memory; name is used in messages, base_dir for `loads`

@@ -1,4 +1,5 @@
 /* Scenario files: `key = value` lines describing one simulation. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,9 +60,19 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
       double v;
       if (prru_parse_double(val, &v) != PRRU_OK || v < 0 || (num[i].positive && v == 0))
         return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected a %s number, got '%.60s'", where, key, num[i].positive ? "positive" : "non-negative", val);
+      if ((num[i].dst == &s->opt.abs_tol || num[i].dst == &s->opt.rel_tol) && v > 0 &&
+          v < PRRU_TOL_MIN)
+        return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: %g is below %.2g (100 x DBL_EPSILON), which no double-precision step can resolve: use 0 (off) or at least %.2g", where, key, v, PRRU_TOL_MIN, PRRU_TOL_MIN);
       *num[i].dst = v;
       return PRRU_OK;
     }
+  if (strcmp(key, "max_steps") == 0) {
+    double v;
+    if (prru_parse_double(val, &v) != PRRU_OK || !(v >= 0 && v < (double)LONG_MAX && v == floor(v)))
+      return prru_fail(msg, msglen, PRRU_EPARSE, "%s: max_steps: expected a whole number of steps per output interval (0: default %ld), got '%.60s'", where, PRRU_MAX_STEPS_DEFAULT, val);
+    s->opt.max_steps = (long)v;
+    return PRRU_OK;
+  }
   if (strcmp(key, "stepper") == 0) {
     if (prru_stepper_parse(val, &s->opt.stepper) != PRRU_OK)
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: stepper: '%.60s' is not one of rk8pd, rkf45, rkck, msbdf", where, val);
@@ -97,7 +108,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
     *has_table = 1;
     return PRRU_OK;
   }
-  return prru_fail(msg, msglen, PRRU_EPARSE, "%s: unknown key '%.40s' (known: q0 qd0 fd fp mp harmonic loads t_end dt stepper atol rtol h0)", where, key);
+  return prru_fail(msg, msglen, PRRU_EPARSE, "%s: unknown key '%.40s' (known: q0 qd0 fd fp mp harmonic loads t_end dt stepper atol rtol h0 max_steps)", where, key);
 }
 
 int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const char *name,
@@ -110,7 +121,8 @@ int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const ch
   int lineno = 0, st = PRRU_OK, has_table = 0;
   unsigned seen = 0;
   static const char *const keys[] = {"q0", "qd0", "fd", "fp", "mp", "harmonic", "loads",
-                                     "t_end", "dt", "stepper", "atol", "rtol", "h0"};
+                                     "t_end", "dt", "stepper", "atol", "rtol", "h0",
+                                     "max_steps"};
   while (p < end && st == PRRU_OK) {
     const char *e = memchr(p, '\n', (size_t)(end - p));
     if (!e) e = end;

@@ -1,7 +1,9 @@
 /* Simulation with the gsl_odeiv2 driver: state y = (q, qd), samples at
  * fixed times, every sample handed out as soon as it exists so that a run
- * that stops (workspace left, J_d singular, step failure, SIGINT) keeps all
- * it computed. */
+ * that stops (workspace left, J_d singular, step failure, step budget
+ * spent, SIGINT, also in the middle of a step) keeps all it computed.
+ * Tolerances below PRRU_TOL_MIN are refused up front: they cannot be met
+ * and used to make the step size collapse for ever. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,41 +47,84 @@ typedef struct {
   const prru_model *m;
   const prru_load_schedule *loads;
   prru_data *d;
-  int status; /* why the right-hand side failed */
+  volatile sig_atomic_t *interrupt;
+  int status; /* why the right-hand side last failed */
 } sim_ctx;
+
+/* When the right-hand side cannot evaluate (a state outside the
+ * workspace, J_d singular, not finite; or an interrupt) it returns
+ * GSL_EBADFUNC, on which every stepper, GSL's evolve and the driver return
+ * at once, even in the middle of a long step; c->status says why. (Any
+ * other status would make evolve retry with half the step: a run would
+ * then skirt the singular set between accepted states and crawl towards
+ * the boundary in steps of a few ulp instead of stopping.) */
+#define RHS_STOP GSL_EBADFUNC
 
 static int rhs(double t, const double y[], double f[], void *p)
 {
   sim_ctx *c = p;
+  if (c->interrupt && *c->interrupt) {
+    c->status = PRRU_EINTERRUPTED;
+    return RHS_STOP;
+  }
   prru_loads l;
   prru_schedule_eval(c->loads, t, &l);
   memcpy(f, y + 3, 3 * sizeof y[0]);
   int st = prru_forward_dynamics(c->m, c->d, y, y + 3, &l, f + 3);
   if (st != PRRU_OK) {
     c->status = st;
-    return GSL_EBADFUNC; /* the driver stops and reports */
+    return RHS_STOP;
   }
   return GSL_SUCCESS;
 }
 
-/* msbdf needs df/dy and df/dt: central differences of the right-hand
- * side, accurate enough for a Newton matrix. */
+/* msbdf needs df/dy and df/dt, by finite differences of the right-hand
+ * side, accurate enough for a Newton matrix. msbdf asks for them at its
+ * predicted point, which may lie within a difference step of the
+ * workspace's boundary (an acos argument near +-1, J_d nearly singular),
+ * so a probe that fails must not end the run: column j takes central
+ * differences where both probes y +- h e_j evaluate, else second-order
+ * one-sided differences on the side that does (y + 2h e_j there, else
+ * first order), else the same with h / 16, three times. The Jacobian fails
+ * only when y itself, or every probe of a column, does; probes that fail
+ * leave c->status as it was. */
 static int jac(double t, const double y[], double *dfdy, double dfdt[], void *p)
 {
-  double yp[6], fp[6], fm[6];
+  sim_ctx *c = p;
+  const int status0 = c->status;
+  double yp[6], f0[6], fp[6], fm[6], f2[6];
+  if (rhs(t, y, f0, p) != GSL_SUCCESS) return RHS_STOP;
   for (int j = 0; j < 6; j++) {
     double h = 1e-7 * fmax(1.0, fabs(y[j]));
-    memcpy(yp, y, sizeof yp);
-    yp[j] = y[j] + h;
-    if (rhs(t, yp, fp, p) != GSL_SUCCESS) return GSL_EBADFUNC;
-    yp[j] = y[j] - h;
-    if (rhs(t, yp, fm, p) != GSL_SUCCESS) return GSL_EBADFUNC;
-    for (int i = 0; i < 6; i++) dfdy[6 * i + j] = (fp[i] - fm[i]) / (2 * h);
+    int done = 0;
+    for (int shrink = 0; shrink < 4 && !done; shrink++, h /= 16) {
+      memcpy(yp, y, sizeof yp);
+      yp[j] = y[j] + h;
+      int okp = rhs(t, yp, fp, p) == GSL_SUCCESS;
+      yp[j] = y[j] - h;
+      int okm = rhs(t, yp, fm, p) == GSL_SUCCESS;
+      if (c->status == PRRU_EINTERRUPTED) return RHS_STOP;
+      if (okp && okm) {
+        for (int i = 0; i < 6; i++) dfdy[6 * i + j] = (fp[i] - fm[i]) / (2 * h);
+        done = 1;
+      } else if (okp || okm) { /* one-sided, sh the step towards the inside */
+        const double sh = okp ? h : -h, *f1 = okp ? fp : fm;
+        yp[j] = y[j] + 2 * sh;
+        int ok2 = rhs(t, yp, f2, p) == GSL_SUCCESS;
+        if (c->status == PRRU_EINTERRUPTED) return RHS_STOP;
+        for (int i = 0; i < 6; i++)
+          dfdy[6 * i + j] = ok2 ? (-3 * f0[i] + 4 * f1[i] - f2[i]) / (2 * sh) : (f1[i] - f0[i]) / sh;
+        done = 1;
+      }
+    }
+    if (!done) return RHS_STOP; /* c->status: the last probe's reason */
   }
+  /* t enters through the loads only, which are defined for every t. */
   double ht = 1e-7 * fmax(1.0, fabs(t));
   if (rhs(t + ht, y, fp, p) != GSL_SUCCESS || rhs(t - ht, y, fm, p) != GSL_SUCCESS)
-    return GSL_EBADFUNC;
+    return RHS_STOP;
   for (int i = 0; i < 6; i++) dfdt[i] = (fp[i] - fm[i]) / (2 * ht);
+  c->status = status0;
   return GSL_SUCCESS;
 }
 
@@ -133,12 +178,30 @@ static int check_options(const prru_sim_options *o, char *msg, int msglen)
     return prru_fail(msg, msglen, PRRU_EINPUT, "dt must be positive and at most t_end");
   if (o->t_end / o->dt_out > 1e8)
     return prru_fail(msg, msglen, PRRU_EINPUT, "t_end/dt above 1e8 samples");
+  if ((unsigned)o->stepper > PRRU_MSBDF) return prru_fail(msg, msglen, PRRU_EINPUT, "unknown stepper");
   if (!(o->abs_tol >= 0 && o->rel_tol >= 0 && o->abs_tol + o->rel_tol > 0 &&
         isfinite(o->abs_tol) && isfinite(o->rel_tol)))
     return prru_fail(msg, msglen, PRRU_EINPUT, "tolerances must be non-negative, not both zero");
+  /* Below PRRU_TOL_MIN a tolerance is rounding noise (see prru.h). */
+  const struct { const char *name; double v; } tol[2] = {{"rel_tol", o->rel_tol},
+                                                         {"abs_tol", o->abs_tol}};
+  for (int i = 0; i < 2; i++)
+    if (tol[i].v > 0 && tol[i].v < PRRU_TOL_MIN)
+      return prru_fail(msg, msglen, PRRU_EINPUT,
+                       "%s = %g is below %.2g (100 x DBL_EPSILON), which no double-precision "
+                       "step can resolve: use 0 (off) or at least %.2g",
+                       tol[i].name, tol[i].v, PRRU_TOL_MIN, PRRU_TOL_MIN);
+  if (o->stepper == PRRU_MSBDF && o->abs_tol == 0)
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "abs_tol = 0 (relative control only) does not work with msbdf, which "
+                     "divides by each component's error level (0 wherever the component is 0): "
+                     "give abs_tol > 0");
+  if (o->max_steps < 0)
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "max_steps = %ld: give a positive number of steps per output interval, or 0 "
+                     "for the default (%ld)", o->max_steps, PRRU_MAX_STEPS_DEFAULT);
   if (!(isfinite(o->h0) && o->h0 > 0))
     return prru_fail(msg, msglen, PRRU_EINPUT, "first step h0 must be positive");
-  if ((unsigned)o->stepper > PRRU_MSBDF) return prru_fail(msg, msglen, PRRU_EINPUT, "unknown stepper");
   return PRRU_OK;
 }
 
@@ -166,11 +229,16 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
     free(d); free(drhs); free(s);
     return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
   }
-  sim_ctx c = {m, ls, drhs, PRRU_OK};
+  sim_ctx c = {m, ls, drhs, o->interrupt, PRRU_OK};
   gsl_odeiv2_system sys = {rhs, jac, 6, &c};
   prru_gsl_init();
   gsl_odeiv2_driver *drv =
       gsl_odeiv2_driver_alloc_y_new(&sys, step_type(o->stepper), o->h0, o->abs_tol, o->rel_tol);
+  /* GSL's driver returns GSL_EMAXITER once an apply has taken more than
+   * nmax accepted steps (rejected ones are bounded per accepted step). */
+  const long budget = o->max_steps > 0 ? o->max_steps : PRRU_MAX_STEPS_DEFAULT;
+  if (drv) gsl_odeiv2_driver_set_nmax(drv, (unsigned long)budget);
+  double t_last = 0.0; /* the last sample delivered */
   double y[6] = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2]}, t = 0.0;
   /* Samples at k dt, the last one at exactly t_end. */
   long nsamp = (long)ceil(o->t_end / o->dt_out - 1e-9);
@@ -181,11 +249,27 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
     if (k > 0) {
       c.status = PRRU_OK;
       int gs = gsl_odeiv2_driver_apply(drv, &t, tk, y);
+      if (gs == RHS_STOP && c.status == PRRU_EINTERRUPTED) {
+        st = PRRU_EINTERRUPTED;
+        prru_fail(msg, msglen, st, "interrupted at t = %.9g s (during the step to t = %.9g s)",
+                  t_last, tk);
+        break;
+      }
+      if (gs == GSL_EMAXITER) {
+        st = PRRU_ENOCONV;
+        prru_fail(msg, msglen, st,
+                  "stopped at t = %.9g s: step budget of %ld steps exhausted at t = %.9g s on the "
+                  "way to the sample at t = %.9g s (raise max_steps, or loosen the tolerances)",
+                  t_last, budget, t, tk);
+        break;
+      }
       if (gs != GSL_SUCCESS) {
-        st = c.status != PRRU_OK ? c.status : PRRU_ENOCONV;
+        /* RHS_STOP: c.status is the failed evaluation's reason. */
+        int why = gs == RHS_STOP ? c.status : PRRU_OK;
+        st = why != PRRU_OK ? why : PRRU_ENOCONV;
         prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s%s", t,
-                  c.status != PRRU_OK ? prru_strerror(c.status) : "integrator failed: ",
-                  c.status != PRRU_OK ? "" : gsl_strerror(gs));
+                  why != PRRU_OK ? prru_strerror(why) : "integrator failed: ",
+                  why != PRRU_OK ? "" : gsl_strerror(gs));
         break;
       }
     }
@@ -196,6 +280,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                 prru_strerror(ss), y[0], y[1], y[2]);
       break;
     }
+    t_last = tk;
     if (t_stop) *t_stop = tk;
     if (o->on_sample && o->on_sample(s, o->ctx) != 0) {
       st = PRRU_EINTERRUPTED;
