@@ -1,14 +1,15 @@
 #!/usr/bin/env python3
-"""Write the MuJoCo (MJCF) model of a 3-PRRU model file.
+"""Write the MuJoCo (MJCF) model of a 3-PRRU (or 4-PRRU) model file.
 
 usage: python3 gen/prru_mjcf.py MODEL.json --out FILE.xml
 
 The MJCF is the independent check of the generated dynamics (see
 validation/validate_mujoco.c), so this file deliberately does not reuse the
 symbolic mechanism of prrugen: it evaluates the spec's pose formulas
-(section 4 of 3prru-model.md, with each limb's own geometry) once, in
-floating point, at the home pose and places every MuJoCo body frame at the
-frame origin of its pose function there; each body's <inertial> then puts
+(section 4 of 3prru-model.md, and section 12 for the fourth limb of the
+redundant variant, with each limb's own geometry) once, in floating point,
+at the home pose and places every MuJoCo body frame at the frame origin of
+its pose function there; each body's <inertial> then puts
 the centre of mass at the model's com (p_b = origin_b + R_b com) with the
 inertia tensor about it. Format 2's gravity vector, and the drives' armature
 and damping (MuJoCo's slide-joint armature and damping) are MJCF settings;
@@ -16,6 +17,10 @@ the smoothed Coulomb force is not a MuJoCo law and rides along as custom
 data for validate_mujoco. From then on MuJoCo's own tree kinematics and
 dynamics take over; the only thing shared with the generator is the
 validated model file (prrugen.model).
+
+The template (templates/prru_mjcf.xml) holds one limb's chain, one weld
+and one drive's custom data as blocks that are written once per limb (per
+platform copy 2..n for the welds): three or four limbs, one template.
 """
 
 import argparse
@@ -115,14 +120,16 @@ IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 def poses(limbs, q):
-    """Spec section 4 at q for per-limb geometry (limbs: three dicts of
-    floats b, l1, l2, a): per limb the frames (R, p) of S, U, L at the frame
-    origins of section 4, the joint centres A, B, C and the U joint's first
-    axis (world); and the platform."""
+    """Spec sections 4 and 12 at q for per-limb geometry (limbs: three or
+    four dicts of floats b, l1, l2, a): per limb the frames (R, p) of S, U,
+    L at the frame origins of the spec, the joint centres A, B, C and the
+    U joint's first axis (the lower link's long axis, world); and the
+    platform."""
     q1, q2, q3 = q
     r_p = matmul(rx(q1), ry(q2))
     p_p = (0.0, 0.0, q3)
     out = []
+    # limbs 1, 2 (section 4): plane x = 0, hinges along e1
     for s, g in ((-1.0, limbs[0]), (1.0, limbs[1])):
         c = add(p_p, matvec(r_p, (0.0, s * g["a"], 0.0)))
         r_l = rx(q1)
@@ -136,10 +143,12 @@ def poses(limbs, q):
         out.append(dict(S=(IDENTITY, a), U=(rx(alpha), scale(0.5, add(a, b))),
                         L=(r_l, p_l), A=a, B=b, C=c,
                         hinge=E1, u_first=matvec(r_l, E2)))
-    g = limbs[2]
+    # limb 3 (section 4) and limb 4 (section 12): plane y = 0, hinges along
+    # e2, U joint at O', lower link R_L3 = R_L4 = Ry(gamma)
     gamma = math.atan2(math.sin(q2), math.cos(q1) * math.cos(q2))
     r_l = ry(gamma)
     x3 = matvec(r_l, E1)
+    g = limbs[2]
     b = add(p_p, scale(g["l2"], x3))
     p_l = add(p_p, scale(g["l2"] / 2, x3))
     alpha = acos_checked((b[0] - g["b"]) / g["l1"], "limb 3")
@@ -148,6 +157,21 @@ def poses(limbs, q):
     out.append(dict(S=(IDENTITY, a), U=(ry(alpha), scale(0.5, add(a, b))),
                     L=(r_l, p_l), A=a, B=b, C=p_p,
                     hinge=E2, u_first=x3))
+    if len(limbs) == 4:
+        # B_4 = p_P - l2_4 x3, alpha_4 = acos((x_B4 + b4) / l1_4),
+        # d_4 = z_B4 + l1_4 sin(alpha_4), A_4 = (-b4, 0, d_4),
+        # R_U4 = Ry(alpha_4); the U joint's first axis x4 = -x3
+        g = limbs[3]
+        b = sub(p_p, scale(g["l2"], x3))
+        p_l = sub(p_p, scale(g["l2"] / 2, x3))
+        alpha = acos_checked((b[0] + g["b"]) / g["l1"], "limb 4")
+        d = b[2] + g["l1"] * math.sin(alpha)
+        a = (-g["b"], 0.0, d)
+        out.append(dict(S=(IDENTITY, a), U=(ry(alpha), scale(0.5, add(a, b))),
+                        L=(r_l, p_l), A=a, B=b, C=p_p,
+                        hinge=E2, u_first=scale(-1.0, x3)))
+    elif len(limbs) != 3:
+        raise ValueError("%d limbs: a model has 3 or 4" % len(limbs))
     return (r_p, p_p), out
 
 
@@ -241,68 +265,115 @@ def inertial(mass, com, entries, share=1):
             "iquat": quat_text, "inertia": fmt(moments)}
 
 
+LIMB_NOTES = (
+    "rail at x = 0, y = -b1; hinges along e1; U joint about v, w",
+    "rail at x = 0, y = +b2; hinges along e1; U joint about v, w",
+    "rail at x = +b3, y = 0; hinges along e2; U joint about x3, w",
+    "rail at x = -b4, y = 0; hinges along e2; U joint about x4 = -x3, w",
+)
+
 def substitutions(m, path):
+    """The template's values: (values of the document, {block name: one
+    dict of values per repetition})."""
     limbs = [{k: float(getattr(limb, k)) for k in ("b", "l1", "l2", "a")}
              for limb in m.limbs]
     (r_p, p_p), chains = poses(limbs, HOME_Q)
+    n = len(chains)
     platform = (r_p, p_p)
-    index = {name: i for i, name in enumerate(model_mod.BODY_NAMES)}
+    index = {name: i for i, name in enumerate(m.body_names)}
     world = (IDENTITY, (0.0, 0.0, 0.0))
     description = m.description.replace("--", "- -")  # "--" ends an XML comment
-    sub_ = dict(model_file=os.path.basename(path), model_sha256=m.sha256,
-                description=description, name=m.name,
-                home_q=", ".join(repr(x) for x in HOME_Q),
-                gravity=fmt(m.gravity))
+    nrows = 6 * (n - 1)
+    # Every weld row is independent for three limbs. With four, limbs 3 and
+    # 4 both hold O' in the plane y = 0: 5 n - 6 (n - 1) = 2, but the
+    # rows' rank is one less, and the mechanism keeps its 3 DOF.
+    if n == 3:
+        redundancy = "15 - 12 = 3, no redundant row."
+    else:
+        redundancy = ("%d - %d + 1 = 3: limbs 3 and 4 both hold O' along e2, "
+                      "so one\n     weld row is redundant (the %d rows have "
+                      "rank %d)." % (5 * n, nrows, nrows, nrows - 1))
+    doc = dict(model_file=os.path.basename(path), model_sha256=m.sha256,
+               description=description, name=m.name,
+               nlimb=str(n), nweld=str(n - 1), nweld_rows=str(nrows),
+               ntree=str(5 * n), redundancy=redundancy,
+               home_q=", ".join(repr(x) for x in HOME_Q),
+               gravity=fmt(m.gravity))
     i_p = index["P"]
-    for key, value in inertial(m.masses[i_p], m.coms[i_p], m.inertias[i_p],
-                               share=len(chains)).items():
-        sub_["platform_" + key] = value
+    platform_inertial = inertial(m.masses[i_p], m.coms[i_p], m.inertias[i_p],
+                                 share=n)
+    limb_values, coulomb_values = [], []
     for i, limb in enumerate(chains, start=1):
-        names = {"S": "S%d" % i, "U": "U%d" % i, "L": "L%d" % i}
+        v = {"i": str(i), "limb_note": LIMB_NOTES[i - 1]}
+        for key, value in platform_inertial.items():
+            v["platform_" + key] = value
         chain = [("S", world), ("U", limb["S"]), ("L", limb["U"])]
         for key, parent in chain:
-            name = names[key]
             pos, q = relative(parent, limb[key])
-            sub_[name + "_pos"] = fmt(pos)
-            sub_[name + "_quat"] = fmt(q)
-            b = index[name]
+            v[key + "_pos"] = fmt(pos)
+            v[key + "_quat"] = fmt(q)
+            b = index["%s%d" % (key, i)]
             for attr, value in inertial(m.masses[b], m.coms[b],
                                         m.inertias[b]).items():
-                sub_["%s_%s" % (name, attr)] = value
+                v["%s_%s" % (key, attr)] = value
         pos, q = relative(limb["L"], platform)
-        sub_["platform%d_pos" % i] = fmt(pos)
-        sub_["platform%d_quat" % i] = fmt(q)
+        v["platform_pos"] = fmt(pos)
+        v["platform_quat"] = fmt(q)
         # Joint positions and axes are in the child body's frame.
         frame_s, frame_u, frame_l = limb["S"], limb["U"], limb["L"]
-        sub_["P%d_pos" % i] = fmt(in_frame(frame_s, limb["A"]))
-        sub_["P%d_axis" % i] = fmt(matvec(transpose(frame_s[0]), E3))
+        v["P_pos"] = fmt(in_frame(frame_s, limb["A"]))
+        v["P_axis"] = fmt(matvec(transpose(frame_s[0]), E3))
         # The drive acts along the slide: its reflected inertia is MuJoCo's
         # armature and its viscous damping MuJoCo's (passive) damping on
         # that dof. The smoothed Coulomb force -f tanh(v / v_s) has no MJCF
         # counterpart (frictionloss is a different law); its parameters
         # travel as custom data and validate_mujoco applies the force
         # through qfrc_applied.
-        sub_["P%d_armature" % i] = repr(float(m.armature[i - 1]))
-        sub_["P%d_damping" % i] = repr(float(m.damping[i - 1]))
-        sub_["P%d_coulomb" % i] = fmt((m.coulomb[i - 1],
-                                       m.coulomb_velocity or 0))
-        sub_["A%d_pos" % i] = fmt(in_frame(frame_u, limb["A"]))
-        sub_["A%d_axis" % i] = fmt(matvec(transpose(frame_u[0]), limb["hinge"]))
-        sub_["B%d_pos" % i] = fmt(in_frame(frame_l, limb["B"]))
-        sub_["B%d_axis" % i] = fmt(matvec(transpose(frame_l[0]), limb["hinge"]))
+        v["P_armature"] = repr(float(m.armature[i - 1]))
+        v["P_damping"] = repr(float(m.damping[i - 1]))
+        coulomb_values.append({"i": str(i), "coulomb": fmt(
+            (m.coulomb[i - 1], m.coulomb_velocity or 0))})
+        v["A_pos"] = fmt(in_frame(frame_u, limb["A"]))
+        v["A_axis"] = fmt(matvec(transpose(frame_u[0]), limb["hinge"]))
+        v["B_pos"] = fmt(in_frame(frame_l, limb["B"]))
+        v["B_axis"] = fmt(matvec(transpose(frame_l[0]), limb["hinge"]))
         # U joint: MuJoCo fixes a body's first joint axis in the parent and
         # its last in the body itself, so the pair (lower link's long axis,
         # platform normal w) needs no intermediate body.
-        sub_["C%da_pos" % i] = fmt(in_frame(platform, limb["C"]))
-        sub_["C%da_axis" % i] = fmt(matvec(transpose(r_p), limb["u_first"]))
-        sub_["C%db_pos" % i] = sub_["C%da_pos" % i]
-        sub_["C%db_axis" % i] = fmt(E3)  # w, in the platform's own frame
+        v["Ca_pos"] = fmt(in_frame(platform, limb["C"]))
+        v["Ca_axis"] = fmt(matvec(transpose(r_p), limb["u_first"]))
+        v["Cb_pos"] = v["Ca_pos"]
+        v["Cb_axis"] = fmt(E3)  # w, in the platform's own frame
         # Display geoms along the links, joint centre to joint centre.
-        sub_["U%d_fromto" % i] = fmt(in_frame(frame_u, limb["A"])
-                                     + in_frame(frame_u, limb["B"]))
-        sub_["L%d_fromto" % i] = fmt(in_frame(frame_l, limb["B"])
-                                     + in_frame(frame_l, limb["C"]))
-    return sub_
+        v["U_fromto"] = fmt(in_frame(frame_u, limb["A"])
+                            + in_frame(frame_u, limb["B"]))
+        v["L_fromto"] = fmt(in_frame(frame_l, limb["B"])
+                            + in_frame(frame_l, limb["C"]))
+        limb_values.append(v)
+    welds = [{"j": str(j)} for j in range(2, n + 1)]
+    return doc, {"limb": limb_values, "weld": welds, "coulomb": coulomb_values}
+
+
+# A block of the template repeated once per entry of its value list:
+# "<!--@repeat NAME ...-->" and "<!--@end NAME -->" on lines of their own.
+BLOCK = re.compile(r"^<!--@repeat (\w+)\b[^\n]*-->\n(.*?)^<!--@end \1 -->\n",
+                   re.M | re.S)
+
+
+def _fill(template_path, where, text, values):
+    """string.Template substitution that insists on a value for every
+    placeholder and a placeholder for every value."""
+    template = string.Template(text)
+    used = set(template.get_identifiers())
+    missing = sorted(used - set(values))
+    unused = sorted(set(values) - used)
+    if missing or unused:
+        raise ValueError("%s: template and generator disagree in %s "
+                         "(placeholders without a value: %s; values without "
+                         "a placeholder: %s)"
+                         % (template_path, where, ", ".join(missing) or "none",
+                            ", ".join(unused) or "none"))
+    return template.substitute(values)
 
 
 def render(model_path, template_path=TEMPLATE):
@@ -315,19 +386,35 @@ def render(model_path, template_path=TEMPLATE):
         raise ValueError("%s: cannot read template: %s"
                          % (template_path, exc.strerror)) from None
     try:
-        values = substitutions(m, model_path)
+        doc, blocks = substitutions(m, model_path)
     except ValueError as exc:
         raise ValueError("%s: %s" % (model_path, exc)) from None
-    template = string.Template(text)
-    used = set(template.get_identifiers())
-    missing = sorted(used - set(values))
-    unused = sorted(set(values) - used)
-    if missing or unused:
-        raise ValueError("%s: template and generator disagree (placeholders "
-                         "without a value: %s; values without a placeholder: "
-                         "%s)" % (template_path, ", ".join(missing) or "none",
-                                  ", ".join(unused) or "none"))
-    out = template.substitute(values)
+    # The blocks are expanded first and stand in the document as markers
+    # (NUL cannot occur in a model's name or description), so that the
+    # document's own substitution never sees their text.
+    expanded, found = {}, []
+
+    def cut(match):
+        name = match.group(1)
+        if name not in blocks or name in found:
+            raise ValueError("%s: unknown or repeated block '%s'"
+                             % (template_path, name))
+        found.append(name)
+        expanded[name] = "".join(
+            _fill(template_path, "block '%s'" % name, match.group(2), v)
+            for v in blocks[name])
+        return "\0%s\0" % name
+
+    outer = BLOCK.sub(cut, text)
+    if sorted(found) != sorted(blocks):
+        raise ValueError("%s: template and generator disagree (blocks "
+                         "missing: %s)" % (template_path, ", ".join(
+                             sorted(set(blocks) - set(found)))))
+    out = _fill(template_path, "the document", outer, doc)
+    for name, body in expanded.items():
+        out = out.replace("\0%s\0" % name, body)
+    if "\0" in out or "<!--@" in out:
+        raise ValueError("%s: malformed block markers" % template_path)
     if re.search(r"<!--(?:(?!-->).)*--(?!>)", out, re.S):
         raise ValueError("%s: generated comment contains '--'" % template_path)
     return out
@@ -336,8 +423,9 @@ def render(model_path, template_path=TEMPLATE):
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="prru_mjcf.py",
-        description="Write the MuJoCo MJCF model of a 3-PRRU model file "
-                    "(three tree chains, platform copies welded together).")
+        description="Write the MuJoCo MJCF model of a 3-PRRU (or redundant "
+                    "4-PRRU) model file (one tree chain per limb, platform "
+                    "copies welded together).")
     parser.add_argument("model", help="model file (JSON), e.g. "
                         "models/3prru_paper.json")
     parser.add_argument("--out", required=True, metavar="FILE",

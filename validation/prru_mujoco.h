@@ -30,8 +30,10 @@
 
 /* Sizes of the MJCF, from the descriptor: per limb five tree DOF (slide,
  * two hinges, the U joint's two hinges) and one platform copy; the copies
- * 2..n are welded to copy 1 (6 rows each), so the closed mechanism has
- * 5 n - 6 (n - 1) = PRRU_NQ DOF for n = 3. */
+ * 2..n are welded to copy 1 (6 rows each). For n = 3 the 12 rows are
+ * independent and the closed mechanism has 15 - 12 = PRRU_NQ DOF; for the
+ * redundant n = 4 one of the 18 rows repeats another (limbs 3 and 4 both
+ * hold O' in the plane y = 0): rank 17, and again 20 - 17 = PRRU_NQ DOF. */
 #define NLIMB PRRU_NLIMB
 #define NJL 5 /* joints per limb: slide, A, B, C a, C b */
 #define NV (NJL * NLIMB)

@@ -16,6 +16,7 @@ GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROOT = os.path.dirname(GEN_DIR)
 MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
 PROTO = os.path.join(ROOT, "models", "prototype_example.json")
+FOUR = os.path.join(ROOT, "models", "4prru.json")
 ENTRY = os.path.join(GEN_DIR, "prru_mjcf.py")
 
 # Loaded by path: prru_mjcf is a script beside the prrugen package, not a
@@ -313,6 +314,257 @@ class Format2(unittest.TestCase):
         self.assertAlmostEqual(inertia_tensor(inert)[5], 0.0001, delta=1e-18)
 
 
+def ry(t):
+    c, s_ = math.cos(t), math.sin(t)
+    return ((c, 0.0, s_), (0.0, 1.0, 0.0), (-s_, 0.0, c))
+
+
+def assert_close(case, u, v, delta, msg=None):
+    case.assertEqual(len(u), len(v))
+    for x, y in zip(u, v):
+        case.assertAlmostEqual(x, y, delta=delta, msg=msg)
+
+
+class FourLimbs(unittest.TestCase):
+    """models/4prru.json, the redundant 4-PRRU (spec section 12): limb 4
+    mirrors limb 3 (rail at x = -b4, hinges along e2, U joint at O'); four
+    chains, a quarter of the platform on each copy, three welds (18 rows,
+    one of them redundant)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.text = prru_mjcf.render(FOUR)
+        cls.root = ET.fromstring(cls.text)
+        with open(FOUR, encoding="utf-8") as f:
+            cls.spec = json.load(f)
+        # limb 4 with its own numbers, none equal to limb 3's
+        def edit(d):
+            d["geometry"].update(b=[0.36, 0.36, 0.315, 0.30],
+                                 l1=[0.23, 0.23, 0.23, 0.24],
+                                 l2=[0.225, 0.225, 0.225, 0.21])
+        with tempfile.TemporaryDirectory() as tmp:
+            cls.own_text = prru_mjcf.render(modified_model(tmp, edit, FOUR))
+        cls.own = ET.fromstring(cls.own_text)
+
+    def test_structure_and_body_count(self):
+        bodies = [b.get("name") for b in self.root.iter("body")]
+        self.assertEqual(len(bodies), 16)
+        self.assertEqual(sorted(bodies), sorted(
+            "%s%d" % (k, i) for k in ("S", "U", "L", "platform")
+            for i in (1, 2, 3, 4)))
+        # the model file's 13 bodies, each once; P split into 4 copies
+        self.assertEqual(sorted(set(bodies) - {"platform%d" % i
+                                                for i in (1, 2, 3, 4)}),
+                         sorted(set(self.spec["bodies"]) - {"P"}))
+        joints = {j.get("name"): j.get("type")
+                  for j in self.root.find("worldbody").iter("joint")}
+        self.assertEqual(len(joints), 20)           # 5 per chain
+        for i in (1, 2, 3, 4):
+            self.assertEqual(joints["P%d" % i], "slide")
+            for k in ("A%d", "B%d", "C%da", "C%db"):
+                self.assertEqual(joints[k % i], "hinge")
+        welds = self.root.find("equality").findall("weld")
+        # 3 welds = 18 rows; 20 - 18 = 2 < 3 DOF: one row is redundant
+        self.assertEqual([(w.get("body1"), w.get("body2")) for w in welds],
+                         [("platform1", "platform%d" % j) for j in (2, 3, 4)])
+        data = {n.get("name"): numbers(n.get("data"))
+                for n in self.root.find("custom").findall("numeric")}
+        self.assertEqual(data, {"P%d_coulomb" % i: [0.0, 0.0]
+                                for i in (1, 2, 3, 4)})
+        self.assertEqual(self.root.get("model"), self.spec["name"])
+        self.assertIn("one\n     weld row is redundant", self.text)
+
+    def test_masses_and_a_quarter_of_the_platform_per_copy(self):
+        bodies = self.spec["bodies"]
+        total, moments = 0.0, [0.0, 0.0, 0.0]
+        for b in self.root.iter("body"):
+            name, inert = b.get("name"), b.find("inertial")
+            mass = float(inert.get("mass"))
+            if name.startswith("platform"):
+                # a power-of-two share: exact
+                self.assertEqual(mass * 4, bodies["P"]["mass"])
+                self.assertEqual([x * 4 for x in numbers(inert.get("diaginertia"))],
+                                 bodies["P"]["inertia"])
+                total += mass
+                moments = [x + y for x, y in
+                           zip(moments, numbers(inert.get("diaginertia")))]
+            else:
+                self.assertEqual(mass, bodies[name]["mass"], name)
+                self.assertEqual(numbers(inert.get("diaginertia")),
+                                 bodies[name]["inertia"], name)
+        self.assertEqual(total, bodies["P"]["mass"])
+        self.assertEqual(moments, bodies["P"]["inertia"])
+
+    def check_home(self, root, g):
+        """Spec 12 at q1 = q2 = 0: limb 4's frames, d_4 and its loop."""
+        b4, l1, l2 = g["b"][3], g["l1"][3], g["l2"][3]
+        q3 = prru_mjcf.HOME_Q[2]
+        frames = world_frames(root)
+        ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        # B_4 = p_P - l2 x3 with x3 = e1; alpha_4 = acos((x_B4 + b4) / l1)
+        b_4 = (-l2, 0.0, q3)
+        alpha = math.acos((b_4[0] + b4) / l1)
+        d_4 = b_4[2] + l1 * math.sin(alpha)
+        self.assertAlmostEqual(d_4, q3 + math.sqrt(l1 ** 2 - (b4 - l2) ** 2),
+                               delta=1e-15)
+        a_4 = (-b4, 0.0, d_4)
+        r, p = frames["S4"]
+        assert_close(self, p, a_4, 1e-15, "S_4 at A_4")
+        for row, e in zip(r, ident):
+            assert_close(self, row, e, 1e-15)
+        r, p = frames["U4"]
+        for row, e in zip(r, ry(alpha)):
+            assert_close(self, row, e, 1e-15, "R_U4 = Ry(alpha_4)")
+        assert_close(self, p, prru_mjcf.scale(0.5, prru_mjcf.add(a_4, b_4)),
+                     1e-15, "p_U4")
+        r, p = frames["L4"]
+        for row, e in zip(r, ident):
+            assert_close(self, row, e, 1e-15, "R_L4 = Ry(gamma = 0)")
+        assert_close(self, p, (-l2 / 2, 0.0, q3), 1e-15, "p_L4")
+        for i in (1, 2, 3, 4):
+            r, p = frames["platform%d" % i]
+            assert_close(self, p, (0.0, 0.0, q3), 1e-15)
+            for row, e in zip(r, ident):
+                assert_close(self, row, e, 1e-15)
+        # joint axes in world: slide e3, hinges e2, U joint x4 = -x3 and w
+        axes = {}
+        for name in ("S4", "U4", "L4", "platform4"):
+            rb, _ = frames[name]
+            for jn in body(root, name).findall("joint"):
+                axes[jn.get("name")] = prru_mjcf.matvec(rb, numbers(jn.get("axis")))
+        self.assertEqual(sorted(axes), ["A4", "B4", "C4a", "C4b", "P4"])
+        for name, axis in (("P4", (0, 0, 1)), ("A4", (0, 1, 0)), ("B4", (0, 1, 0)),
+                           ("C4a", (-1, 0, 0)), ("C4b", (0, 0, 1))):
+            assert_close(self, axes[name], axis, 1e-15, name)
+        return a_4, b_4, d_4
+
+    def check_loops(self, root, centres):
+        """Every joint's centre is the same world point from both of its
+        bodies: A_i (slider frame origin / upper link), B_i (upper / lower
+        link), C_i (lower link / platform copy)."""
+        frames = world_frames(root)
+
+        def world(name, local):
+            r, p = frames[name]
+            return prru_mjcf.add(p, prru_mjcf.matvec(r, local))
+
+        for i, c in enumerate(centres, start=1):
+            u = numbers(body(root, "U%d" % i).find("geom").get("fromto"))
+            l_ = numbers(body(root, "L%d" % i).find("geom").get("fromto"))
+            a_from_s = world("S%d" % i, numbers(
+                body(root, "S%d" % i).find("joint").get("pos")))
+            a_from_u = world("U%d" % i, numbers(
+                body(root, "U%d" % i).find("joint").get("pos")))
+            assert_close(self, a_from_s, a_from_u, 1e-15, "A%d" % i)
+            assert_close(self, a_from_u, world("U%d" % i, u[:3]), 1e-15)
+            b_from_u = world("U%d" % i, u[3:])
+            b_from_l = world("L%d" % i, numbers(
+                body(root, "L%d" % i).find("joint").get("pos")))
+            assert_close(self, b_from_u, b_from_l, 1e-15, "B%d" % i)
+            c_from_l = world("L%d" % i, l_[3:])
+            for jn in body(root, "platform%d" % i).findall("joint"):
+                assert_close(self, world("platform%d" % i,
+                                         numbers(jn.get("pos"))), c, 1e-15)
+            assert_close(self, c_from_l, c, 1e-15, "C%d" % i)
+            yield a_from_s, b_from_u, c
+
+    def test_limb4_home_pose_d4_and_closed_loops(self):
+        g = self.spec["geometry"]
+        a_4, b_4, d_4 = self.check_home(self.root, {
+            "b": g["b"], "l1": [g["l1"]] * 4, "l2": [g["l2"]] * 4})
+        # the paper's geometry: d_4 = d_3 = q3 + 0.2116601048851672 (spec 10)
+        frames = world_frames(self.root)
+        self.assertAlmostEqual(d_4, prru_mjcf.HOME_Q[2] + 0.2116601048851672,
+                               delta=1e-15)
+        self.assertAlmostEqual(frames["S3"][1][2], d_4, delta=1e-15)
+        # limb 4 is limb 3 mirrored in the plane x = 0
+        for name in ("S", "U", "L"):
+            p3, p4 = frames[name + "3"][1], frames[name + "4"][1]
+            assert_close(self, p4, (-p3[0], p3[1], p3[2]), 1e-15, name)
+        q3 = prru_mjcf.HOME_Q[2]
+        centres = ((0, -g["a"], q3), (0, g["a"], q3), (0, 0, q3), (0, 0, q3))
+        for i, (a, b, c) in enumerate(self.check_loops(self.root, centres)):
+            self.assertAlmostEqual(math.dist(a, b), g["l1"], delta=1e-15)
+            self.assertAlmostEqual(math.dist(b, c), g["l2"], delta=1e-15)
+        assert_close(self, a, a_4, 1e-15)
+        assert_close(self, b, b_4, 1e-15)
+
+    def test_limb4_uses_its_own_geometry(self):
+        g = {"b": [0.36, 0.36, 0.315, 0.30], "l1": [0.23, 0.23, 0.23, 0.24],
+             "l2": [0.225, 0.225, 0.225, 0.21]}
+        self.check_home(self.own, g)
+        q3 = prru_mjcf.HOME_Q[2]
+        centres = ((0, -0.045, q3), (0, 0.045, q3), (0, 0, q3), (0, 0, q3))
+        lengths = list(zip(g["l1"], g["l2"]))
+        for (l1, l2), (a, b, c) in zip(lengths, self.check_loops(self.own,
+                                                                 centres)):
+            self.assertAlmostEqual(math.dist(a, b), l1, delta=1e-15)
+            self.assertAlmostEqual(math.dist(b, c), l2, delta=1e-15)
+        # limbs 1-3 are the paper's: the same frames as in 4prru.json
+        mine, paper = world_frames(self.own), world_frames(self.root)
+        for k in ("S", "U", "L", "platform"):
+            for i in (1, 2, 3):
+                self.assertEqual(mine["%s%d" % (k, i)], paper["%s%d" % (k, i)])
+
+    def test_pose_formulas_off_home(self):
+        """prru_mjcf.poses away from home, against spec 12 written out:
+        limb 4 closes (|A_4 B_4| = l1_4, |B_4 O'| = l2_4, the upper link's
+        local x runs from A_4 to B_4) and, for b4 = b3 and equal links,
+        d_4(q1, q2, q3) = d_3(q1, -q2, q3) (the mirror)."""
+        rng = random.Random(11)
+        paper = [dict(b=0.36, l1=0.23, l2=0.225, a=0.045)] * 2 + \
+            [dict(b=0.315, l1=0.23, l2=0.225, a=0.0)] * 2
+        own = paper[:3] + [dict(b=0.30, l1=0.24, l2=0.21, a=0.0)]
+        for _ in range(50):
+            q = (rng.uniform(-0.3, 0.3), rng.uniform(-0.4, 0.4),
+                 rng.uniform(-1.0, 0.0))
+            for limbs in (paper, own):
+                g = limbs[3]
+                (r_p, p_p), chains = prru_mjcf.poses(limbs, q)
+                self.assertEqual(len(chains), 4)
+                l4 = chains[3]
+                gamma = math.atan2(math.sin(q[1]), math.cos(q[0]) * math.cos(q[1]))
+                x3 = (math.cos(gamma), 0.0, -math.sin(gamma))
+                b_4 = tuple(p - g["l2"] * x for p, x in zip(p_p, x3))
+                alpha = math.acos((b_4[0] + g["b"]) / g["l1"])
+                d_4 = b_4[2] + g["l1"] * math.sin(alpha)
+                assert_close(self, l4["B"], b_4, 1e-15)
+                assert_close(self, l4["A"], (-g["b"], 0.0, d_4), 1e-15)
+                assert_close(self, l4["C"], p_p, 0.0)
+                assert_close(self, l4["u_first"], [-x for x in x3], 1e-15)
+                for row, e in zip(l4["U"][0], ry(alpha)):
+                    assert_close(self, row, e, 1e-15)
+                for row, e in zip(l4["L"][0], ry(gamma)):
+                    assert_close(self, row, e, 1e-15)
+                self.assertAlmostEqual(math.dist(l4["A"], l4["B"]), g["l1"],
+                                       delta=1e-15)
+                self.assertAlmostEqual(math.dist(l4["B"], p_p), g["l2"],
+                                       delta=1e-15)
+                along = prru_mjcf.matvec(l4["U"][0], (g["l1"], 0.0, 0.0))
+                assert_close(self, prru_mjcf.add(l4["A"], along), l4["B"], 1e-15)
+            (_, _), mirrored = prru_mjcf.poses(paper, (q[0], -q[1], q[2]))
+            (_, _), chains = prru_mjcf.poses(paper, q)
+            self.assertAlmostEqual(chains[3]["A"][2], mirrored[2]["A"][2],
+                                   delta=1e-15)
+
+    def test_unreachable_limb4_is_reported(self):
+        # a pose where limb 4's upper link cannot reach: named, not a NaN
+        limbs = [dict(b=0.36, l1=0.23, l2=0.225, a=0.045)] * 2 + \
+            [dict(b=0.315, l1=0.23, l2=0.225, a=0.0),
+             dict(b=0.60, l1=0.23, l2=0.225, a=0.0)]
+        with self.assertRaises(ValueError) as ctx:
+            prru_mjcf.poses(limbs, prru_mjcf.HOME_Q)
+        self.assertIn("limb 4", str(ctx.exception))
+
+    def test_cli_writes_the_four_limb_model(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "m4.xml")
+            r = run(FOUR, "--out", path)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(path, encoding="utf-8") as f:
+                self.assertEqual(f.read(), self.text)
+
+
 class PrincipalAxes(unittest.TestCase):
     def test_reconstructs_random_tensors_to_rounding(self):
         rng = random.Random(7)
@@ -373,11 +625,34 @@ class Errors(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             bad = os.path.join(tmp, "t.xml")
             with open(bad, "w", encoding="utf-8") as f:
-                f.write(text.replace("$S1_mass", "1.0"))
+                f.write(text.replace("$S_mass", "1.0"))
             with self.assertRaises(ValueError) as ctx:
                 prru_mjcf.render(MODEL, bad)
-        self.assertIn("S1_mass", str(ctx.exception))
+        self.assertIn("S_mass", str(ctx.exception))
+        self.assertIn("block 'limb'", str(ctx.exception))
         self.assertIn(bad, str(ctx.exception))
+
+    def test_template_block_mismatch_is_reported(self):
+        with open(prru_mjcf.TEMPLATE, encoding="utf-8") as f:
+            text = f.read()
+        cases = (
+            # a block the generator has no values for
+            (text.replace("@repeat weld", "@repeat welds")
+                 .replace("@end weld ", "@end welds "), "welds"),
+            # a block without its end: its text stays and is reported
+            (text.replace("<!--@end coulomb -->\n", ""), "coulomb"),
+            # a per-limb value used outside its block
+            (text.replace('model="$name"', 'model="$S_pos"'), "S_pos"),
+        )
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = os.path.join(tmp, "t.xml")
+            for bad_text, needle in cases:
+                with open(bad, "w", encoding="utf-8") as f:
+                    f.write(bad_text)
+                with self.assertRaises(ValueError) as ctx:
+                    prru_mjcf.render(MODEL, bad)
+                self.assertIn(needle, str(ctx.exception))
+                self.assertIn(bad, str(ctx.exception))
 
     def test_description_cannot_break_the_xml_comment(self):
         with tempfile.TemporaryDirectory() as tmp:
