@@ -1,7 +1,12 @@
 /* Rotational dynamic manipulability (paper section 5): w_R = sigma_1/sigma_2
  * of Mt JtR^+, Mt = J_d^-T M J_d^-1, JtR = J_R,P J_d^-1, with GSL's SVD.
  * M is the full mass matrix, the drives' armature included: Mt is then the
- * inertia the actuators feel. */
+ * inertia the actuators feel.
+ *
+ * Four limbs (spec section 12): J_d is 4x3 and J_d^-1 becomes J_d^+ =
+ * (J_d^T J_d)^-1 J_d^T (ref_jd_pinv), so Mt is 4x4 and JtR 3x4; for three
+ * limbs J_d^+ is J_d^-1 itself (the same LU inverse as ever). */
+#include <float.h>
 #include <math.h>
 
 #include <gsl/gsl_blas.h>
@@ -10,38 +15,44 @@
 
 #include "ref_internal.h"
 
+#define NA REF_NA
+
 int prru_ref_w_r(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ], double *w_r)
 {
-  ref_priv *s = w->priv;
   *w_r = NAN;
   int st = ref_assemble(p, w, q, NULL);
   if (st) return st;
   ref_mass_matrix(p, w);
 
-  double jinv[9], mt[9], tmp[9], jtr[9], u[9], v[9], pinv[9], bm[9], sv[3], work[3];
-  gsl_matrix_view Jinv = gsl_matrix_view_array(jinv, 3, 3), Mt = gsl_matrix_view_array(mt, 3, 3),
-                  T = gsl_matrix_view_array(tmp, 3, 3), JtR = gsl_matrix_view_array(jtr, 3, 3),
-                  U = gsl_matrix_view_array(u, 3, 3), V = gsl_matrix_view_array(v, 3, 3),
-                  Pinv = gsl_matrix_view_array(pinv, 3, 3), B = gsl_matrix_view_array(bm, 3, 3);
+  double jp[3 * NA], mt[NA * NA], tmp[3 * NA], jtr[3 * NA], u[NA * 3], v[9], pinv[NA * 3],
+      bm[NA * 3], sv[3], work[3];
+  gsl_matrix_view Jp = gsl_matrix_view_array(jp, 3, NA), Mt = gsl_matrix_view_array(mt, NA, NA),
+                  T = gsl_matrix_view_array(tmp, 3, NA), JtR = gsl_matrix_view_array(jtr, 3, NA),
+                  U = gsl_matrix_view_array(u, NA, 3), V = gsl_matrix_view_array(v, 3, 3),
+                  Pinv = gsl_matrix_view_array(pinv, NA, 3), B = gsl_matrix_view_array(bm, NA, 3);
   gsl_vector_view S = gsl_vector_view_array(sv, 3), Work = gsl_vector_view_array(work, 3);
 
-  gsl_matrix_memcpy(s->m3a, w->Jd);
-  if (ref_lu3(s->m3a, s->perm3, &Jinv.matrix)) return GSL_ESING;
-  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, w->M, &Jinv.matrix, 0.0, &T.matrix);
-  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, &Jinv.matrix, &T.matrix, 0.0, &Mt.matrix);
+  if (ref_jd_pinv(w, &Jp.matrix)) return GSL_ESING;
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, w->M, &Jp.matrix, 0.0, &T.matrix);
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, &Jp.matrix, &T.matrix, 0.0, &Mt.matrix);
   gsl_matrix_const_view JRP = gsl_matrix_const_submatrix(w->H, 3 * REF_P, 0, 3, 3);
-  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &JRP.matrix, &Jinv.matrix, 0.0, &JtR.matrix);
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &JRP.matrix, &Jp.matrix, 0.0, &JtR.matrix);
 
-  /* JtR has rank 2 (the platform cannot turn about w): pseudo-inverse
-   * V S^+ U^T dropping singular values at rounding level. */
-  gsl_matrix_memcpy(&U.matrix, &JtR.matrix);
+  /* JtR has rank 2 (the platform cannot turn about w): pseudo-inverse from
+   * an SVD X = U S V^T, dropping singular values at or below
+   * NA DBL_EPSILON sigma_1 (max(rows, columns) eps sigma_1: rounding). GSL
+   * wants rows >= columns: for three limbs X = JtR and JtR^+ = V S^+ U^T,
+   * for four X = JtR^T (4x3) and JtR^+ = U S^+ V^T. */
+  if (NA == 3) gsl_matrix_memcpy(&U.matrix, &JtR.matrix);
+  else gsl_matrix_transpose_memcpy(&U.matrix, &JtR.matrix);
   gsl_linalg_SV_decomp(&U.matrix, &V.matrix, &S.vector, &Work.vector);
-  const double tol = 3.0 * 2.220446049250313e-16 * sv[0];
-  for (int i = 0; i < 3; i++)
+  const double tol = NA * DBL_EPSILON * sv[0];
+  for (int i = 0; i < NA; i++)
     for (int j = 0; j < 3; j++) {
       double x = 0;
       for (int l = 0; l < 3; l++)
-        if (sv[l] > tol) x += v[3 * i + l] * u[3 * j + l] / sv[l];
+        if (sv[l] > tol)
+          x += (NA == 3 ? v[3 * i + l] * u[3 * j + l] : u[3 * i + l] * v[3 * j + l]) / sv[l];
       pinv[3 * i + j] = x;
     }
   gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &Mt.matrix, &Pinv.matrix, 0.0, &B.matrix);

@@ -9,7 +9,11 @@
  * J_d^T K (Jd' qd) to h. Damping and Coulomb friction are forces along the
  * rails, phi_i = -c_i dd_i - f_i tanh(dd_i / v_s); by virtual power
  * (dd = J_d qd) they reach the generalized coordinates as Qp = J_d^T phi.
- * Qp is not part of h (spec section 11) but of every acceleration. */
+ * Qp is not part of h (spec section 11) but of every acceleration.
+ *
+ * With four limbs (spec section 12) J_d is 4x3: everything above holds as
+ * written (J_d^T maps the four slider forces to the three coordinates); only
+ * the inverse dynamics, which must undo J_d^T, changes (see there). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -38,25 +42,28 @@ prru_ref_ws *prru_ref_alloc(void)
   w->PhiH = gsl_matrix_calloc(NW, 3);
   w->M = gsl_matrix_calloc(3, 3);
   w->Q = gsl_matrix_calloc(NW, NL);
-  w->Jd = gsl_matrix_calloc(3, 3);
+  w->Jd = gsl_matrix_calloc(REF_NA, 3);
   s->L = gsl_matrix_calloc(NW, NW);
   s->Y = gsl_matrix_calloc(NW, NL);
   s->A = gsl_matrix_calloc(NL, NL);
-  s->r60 = gsl_vector_calloc(NW);
-  s->r57 = gsl_vector_calloc(NL);
+  s->V = gsl_matrix_calloc(NL, NL);
+  s->S = gsl_vector_calloc(NL);
+  s->svw = gsl_vector_calloc(NL);
+  s->rW = gsl_vector_calloc(NW);
+  s->rL = gsl_vector_calloc(NL);
   s->Fbar = gsl_vector_calloc(NW);
   s->Fg = gsl_vector_calloc(NW);
   s->m3a = gsl_matrix_calloc(3, 3);
   s->m3b = gsl_matrix_calloc(3, 3);
   s->m3c = gsl_matrix_calloc(3, 3);
-  s->m3d = gsl_matrix_calloc(3, 3);
+  s->jdk = gsl_matrix_calloc(REF_NA, 3);
   s->v3a = gsl_vector_calloc(3);
   s->v3b = gsl_vector_calloc(3);
   s->v3c = gsl_vector_calloc(3);
   s->perm3 = gsl_permutation_calloc(3);
   if (!w->H || !w->Phi || !w->K || !w->dm || !w->PhiH || !w->M || !w->Q || !w->Jd || !s->L ||
-      !s->Y || !s->A || !s->r60 || !s->r57 || !s->Fbar || !s->Fg || !s->m3a || !s->m3b ||
-      !s->m3c || !s->m3d || !s->v3a || !s->v3b || !s->v3c || !s->perm3) {
+      !s->Y || !s->A || !s->V || !s->S || !s->svw || !s->rW || !s->rL || !s->Fbar || !s->Fg || !s->m3a ||
+      !s->m3b || !s->m3c || !s->jdk || !s->v3a || !s->v3b || !s->v3c || !s->perm3) {
     prru_ref_free(w);
     return NULL;
   }
@@ -80,14 +87,17 @@ void prru_ref_free(prru_ref_ws *w)
     gsl_matrix_free(s->L);
     gsl_matrix_free(s->Y);
     gsl_matrix_free(s->A);
-    gsl_vector_free(s->r60);
-    gsl_vector_free(s->r57);
+    gsl_matrix_free(s->V);
+    gsl_vector_free(s->S);
+    gsl_vector_free(s->svw);
+    gsl_vector_free(s->rW);
+    gsl_vector_free(s->rL);
     gsl_vector_free(s->Fbar);
     gsl_vector_free(s->Fg);
     gsl_matrix_free(s->m3a);
     gsl_matrix_free(s->m3b);
     gsl_matrix_free(s->m3c);
-    gsl_matrix_free(s->m3d);
+    gsl_matrix_free(s->jdk);
     gsl_vector_free(s->v3a);
     gsl_vector_free(s->v3b);
     gsl_vector_free(s->v3c);
@@ -188,12 +198,12 @@ void ref_mass_matrix(const prru_ref_params *p, prru_ref_ws *w)
   gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, w->Phi, w->H, 0.0, w->PhiH);
   gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->H, w->PhiH, 0.0, w->M);
   /* + J_d^T diag(k) J_d (the armature, see the top of this file). */
-  gsl_matrix_memcpy(s->m3d, w->Jd);
+  gsl_matrix_memcpy(s->jdk, w->Jd);
   for (int i = 0; i < REF_NA; i++) {
-    gsl_vector_view row = gsl_matrix_row(s->m3d, i);
+    gsl_vector_view row = gsl_matrix_row(s->jdk, i);
     gsl_vector_scale(&row.vector, p->armature[i]);
   }
-  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->Jd, s->m3d, 1.0, w->M);
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->Jd, s->jdk, 1.0, w->M);
 }
 
 /* h = H^T K + J_d^T diag(k) (Jd' qd) after ref_assemble(.., qd). */
@@ -365,6 +375,8 @@ static void generalized_load(prru_ref_ws *w, const double *fd, const double fp[3
       t += JTO[3 * i + j] * fp[i];
       t += gsl_matrix_get(w->H, 3 * REF_P + i, j) * mp[i];
     }
+    for (int i = 3; i < REF_NA; i++)
+      if (fd) t += gsl_matrix_get(w->Jd, i, j) * fd[i]; /* limb 4 */
     gsl_vector_set(tau, j, gsl_vector_get(tau, j) + t);
   }
 }
@@ -399,7 +411,28 @@ int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const do
   return GSL_SUCCESS;
 }
 
-/* fd = J_d^-T (M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - Qp). */
+int ref_jd_pinv(prru_ref_ws *w, gsl_matrix *Jp)
+{
+  ref_priv *s = w->priv;
+  if (REF_NA == 3) {
+    gsl_matrix_memcpy(s->m3a, w->Jd);
+    return ref_lu3(s->m3a, s->perm3, Jp);
+  }
+  /* J_d^T J_d is 3x3 and positive definite where J_d has full column rank;
+   * its condition number is J_d's squared, still checked against the
+   * machine precision by ref_lu3. */
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->Jd, w->Jd, 0.0, s->m3a);
+  if (ref_lu3(s->m3a, s->perm3, s->m3b)) return GSL_ESING;
+  gsl_blas_dgemm(CblasNoTrans, CblasTrans, 1.0, s->m3b, w->Jd, 0.0, Jp);
+  return GSL_SUCCESS;
+}
+
+/* J_d^T fd = tau with tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - Qp:
+ * fd = J_d^-T tau for three limbs; for four, J_d^T (4 unknowns, 3
+ * equations) leaves fd free along the null vector of J_d^T (an internal
+ * preload the platform does not feel) and the minimum-norm solution is the
+ * one in the range of J_d, fd = J_d x with J_d^T J_d x = tau, i.e.
+ * fd = J_d (J_d^T J_d)^-1 tau = J_d^+T tau (spec section 12). */
 int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
                               const double qd[PRRU_NQ], const double qdd[PRRU_NQ],
                               const double fp[3], const double mp[3], double fd[PRRU_NACT])
@@ -415,9 +448,18 @@ int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const do
   bias_vector(p, w, s->v3c);
   gsl_vector_sub(s->v3c, s->v3b);                                  /* h - (G + ... + Qp) */
   gsl_blas_dgemv(CblasNoTrans, 1.0, w->M, &a.vector, 1.0, s->v3c); /* + M qdd */
-  gsl_matrix_transpose_memcpy(s->m3a, w->Jd);
-  if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, REF_NA); return GSL_ESING; }
-  gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3c, s->v3a);
-  copy_vector(s->v3a, fd);
+  if (REF_NA == 3) {
+    /* As J_d^-T tau, but by LU solve of J_d^T rather than the inverse. */
+    gsl_matrix_transpose_memcpy(s->m3a, w->Jd);
+    if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, REF_NA); return GSL_ESING; }
+    gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3c, s->v3a);
+    copy_vector(s->v3a, fd);
+    return GSL_SUCCESS;
+  }
+  double jp[3 * REF_NA];
+  gsl_matrix_view Jp = gsl_matrix_view_array(jp, 3, REF_NA);
+  gsl_vector_view Fd = gsl_vector_view_array(fd, REF_NA);
+  if (ref_jd_pinv(w, &Jp.matrix)) { fill_nan(fd, REF_NA); return GSL_ESING; }
+  gsl_blas_dgemv(CblasTrans, 1.0, &Jp.matrix, s->v3c, 0.0, &Fd.vector);
   return GSL_SUCCESS;
 }

@@ -13,8 +13,17 @@
 #define REF_NW (6 * PRRU_NBODY)
 #define REF_NL PRRU_NLAMBDA
 #define REF_NA PRRU_NACT
+#define REF_NLIMB PRRU_NLIMB
+/* Rank of Q: 6 NBODY body coordinates less the 3 degrees of freedom
+ * (H^T Q = 0); NLAMBDA - REF_RANK reaction directions are redundant. */
+#define REF_RANK (6 * PRRU_NBODY - 3)
 
-enum { REF_P, REF_L1, REF_L2, REF_L3, REF_U1, REF_U2, REF_U3, REF_S1, REF_S2, REF_S3 };
+/* Body indices: the platform, then every limb's lower link, upper link,
+ * slider (limb l = 0 .. NLIMB - 1). */
+#define REF_P 0
+#define REF_L(l) (1 + (l))
+#define REF_U(l) (1 + REF_NLIMB + (l))
+#define REF_S(l) (1 + 2 * REF_NLIMB + (l))
 
 /* Everything the paper's eqs. 1-13 give for one q (and qd): 3x3 matrices
  * row-major, column j = derivative with respect to q_j. */
@@ -26,9 +35,9 @@ typedef struct {
   double JTO[9];        /* velocity of the tool point O' = J_T,O' qd */
   double delta[REF_NB][3], mu[REF_NB][3]; /* qd-quadratic accelerations */
   double omega[REF_NB][3], v[REF_NB][3];
-  double C[3][3];               /* U joint centres C_i */
-  double B[3][3], A[3][3];      /* joint centres B_i, A_i */
-  double gamma;                 /* limb 3's lower-link angle */
+  double C[REF_NLIMB][3];       /* U joint centres C_i */
+  double B[REF_NLIMB][3], A[REF_NLIMB][3]; /* joint centres B_i, A_i */
+  double gamma;                 /* lower-link angle of limb 3 (and 4) */
   double d[REF_NA], Jd[REF_NA * 3];
   double dd[REF_NA], ddb[REF_NA]; /* J_d qd and Jd' qd (zero without qd) */
 } ref_kin;
@@ -40,12 +49,15 @@ int ref_kinematics(const prru_ref_params *p, const double q[3], const double *qd
 typedef struct {
   ref_kin kin;
   gsl_matrix *L;          /* NW x NW: Cholesky factor of Phi */
-  gsl_matrix *Y;          /* NW x NL: L^-1 Q */
-  gsl_matrix *A;          /* NL x NL: Q^T Phi^-1 Q */
-  gsl_vector *r60, *r57;  /* K - Fbar and its projection */
+  gsl_matrix *Y;          /* NW x NL: L^-1 Q, overwritten by U of its SVD */
+  gsl_matrix *A;          /* NL x NL: Q^T Phi^-1 Q = Y^T Y (full rank), its Cholesky factor */
+  gsl_matrix *V;          /* NL x NL: V of the SVD L^-1 Q = U S V^T */
+  gsl_vector *S, *svw;    /* NL: singular values (descending), SVD work */
+  gsl_vector *rW, *rL;    /* NW: L^-1 (K - Fbar); NL: its projection */
   gsl_vector *Fbar;       /* NW */
   gsl_vector *Fg;         /* NW: gravity wrenches only */
-  gsl_matrix *m3a, *m3b, *m3c, *m3d; /* 3x3 scratch */
+  gsl_matrix *m3a, *m3b, *m3c;       /* 3x3 scratch */
+  gsl_matrix *jdk;                   /* NA x 3: diag(k) J_d */
   gsl_vector *v3a, *v3b, *v3c;       /* 3 scratch */
   gsl_permutation *perm3;
 } ref_priv;
@@ -58,6 +70,9 @@ void ref_mass_matrix(const prru_ref_params *p, prru_ref_ws *w);
 /* LU of A (3x3, overwritten by its LU) with inv = A^-1, and a check of the
  * reciprocal 1-norm condition number: GSL_ESING below machine precision. */
 int ref_lu3(gsl_matrix *A, gsl_permutation *perm, gsl_matrix *inv);
+/* J_d^+ (3 x NA) after ref_assemble: J_d^-1 for three limbs, (J_d^T J_d)^-1
+ * J_d^T for four (spec section 12), via ref_lu3 (GSL_ESING as there). */
+int ref_jd_pinv(prru_ref_ws *w, gsl_matrix *Jp);
 /* Cholesky with GSL's abort-on-error handler suspended: GSL_ESING when the
  * matrix is not numerically positive definite. */
 int ref_cholesky(gsl_matrix *A);

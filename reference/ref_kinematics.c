@@ -1,10 +1,12 @@
 /* Paper eqs. 1-13 by hand: poses, J_R, J_T, delta, mu of every body, for
- * the per-limb geometry and centres of mass of spec section 11.
+ * the per-limb geometry and centres of mass of spec section 11, and the
+ * fourth limb of spec section 12.
  *
  * Every limb is a function of one scalar xi of q plus the height q3 (which
  * enters every position as + q3 e3): xi = q1 for limbs 1, 2 (everything
  * lives in the plane x = 0 and turns about e1), xi = gamma(q1, q2) for
- * limb 3 (plane y = 0, axes e2). A body quantity f(xi) then has
+ * limb 3 and its mirror image limb 4 (plane y = 0, axes e2; limb3() below
+ * derives both). A body quantity f(xi) then has
  *   df/dq_j = f_x dxi/dq_j,   quadratic part of f'' = f_xx xi'^2 + f_x xi'',
  * where xi'' here is only the qd-quadratic part qd^T (d2xi/dq2) qd. Each
  * closed-form scalar is carried with its first two xi-derivatives.
@@ -191,7 +193,7 @@ static int limb12(const prru_ref_params *p, const double q[3], int limb, const c
   const double b = p->b[limb], l1 = p->l1[limb], l2 = p->l2[limb], a = p->a[limb];
   const double c1 = cos(q[0]), s1 = sin(q[0]), q3 = q[2];
   const double e = a + l2, kl = a + 0.5 * l2;
-  const int L = REF_L1 + limb, U = REF_U1 + limb, S = REF_S1 + limb;
+  const int L = REF_L(limb), U = REF_U(limb), S = REF_S(limb);
 
   double C[3] = {0, s * a * c1, q3 + s * a * s1};
   double B[3] = {0, s * e * c1, q3 + s * e * s1};
@@ -245,39 +247,54 @@ static double gamma_chain(const double q[3], const double *qd, chain *c)
   return atan2(s2, c1 * c2);
 }
 
-/* Limb 3 (eqs. 5, 12-13) with its own b, l1, l2; xi = gamma,
- * x3 = (cos gamma, 0, -sin gamma). Its U joint centre is O' itself (spec
- * section 4): a[2] plays no part. */
-static int limb3(const prru_ref_params *p, const double q[3], const double *qd, ref_kin *k)
+/* Limb 3 (eqs. 5, 12-13) and limb 4 (spec section 12), each with its own
+ * b, l1, l2; xi = gamma for both. Both lower links turn with R_L = Ry(gamma)
+ * and x3 = R_L e1 = (cos gamma, 0, -sin gamma), limb 3's reaching out along
+ * +x3 to its rail at x = +b, limb 4's along x4 = -x3 to its rail at x = -b.
+ * With s = +1 (limb 3) or -1 (limb 4) limb 4 is limb 3 reflected in the
+ * plane x = 0 (x -> -x, q2 -> -q2, gamma -> -gamma):
+ *   B = O' + s l2 x3 = (s l2 cos gamma, 0, q3 - s l2 sin gamma),
+ *   r = (x_B - s b) / l1 = s (l2 cos gamma - b) / l1,  alpha = acos(r),
+ *   d = z_B + l1 sin(alpha),  A = (s b, 0, d).
+ * alpha carries no sign: B - A = l1 (r, 0, -sin alpha) = l1 Ry(alpha) e1 in
+ * both limbs, so R_U = Ry(alpha) and the upper link's local x runs from A
+ * to B in both. Every x-coordinate and every xi-derivative of a point in
+ * the limb (its scalar factors cos and sin of gamma and their derivatives)
+ * takes the factor s; the bodies' angles gamma and alpha do not. Their U
+ * joint centre is O' itself (spec sections 4, 12): a[2], a[3] play no part. */
+static int limb3(const prru_ref_params *p, const double q[3], int limb, double s, const chain *c,
+                 ref_kin *k)
 {
-  chain c;
-  const double gam = gamma_chain(q, qd, &c), cg = cos(gam), sg = sin(gam), q3 = q[2];
-  const double b = p->b[2], l1 = p->l1[2], l2 = p->l2[2], kl = 0.5 * l2;
-  k->gamma = gam;
+  const double gam = k->gamma, cg = cos(gam), sg = sin(gam), q3 = q[2];
+  const double b = p->b[limb], l1 = p->l1[limb], l2 = p->l2[limb], kl = 0.5 * l2;
+  const int L = REF_L(limb), U = REF_U(limb), S = REF_S(limb);
 
-  double C[3] = {0, 0, q3}, B[3] = {l2 * cg, 0, q3 - l2 * sg};
-  memcpy(k->C[2], C, sizeof C);
-  memcpy(k->B[2], B, sizeof B);
+  double C[3] = {0, 0, q3}, B[3] = {s * l2 * cg, 0, q3 - s * l2 * sg};
+  memcpy(k->C[limb], C, sizeof C);
+  memcpy(k->B[limb], B, sizeof B);
 
-  double OL[3] = {kl * cg, 0, q3 - kl * sg};
-  double OLx[3] = {-kl * sg, 0, -kl * cg};
-  double OLxx[3] = {-kl * cg, 0, kl * sg};
-  set_body(k, p, REF_L3, OL, OLx, OLxx, (scal){gam, 1.0, 0.0}, AX_Y, &c);
+  /* Lower link: R = Ry(gamma), frame origin O' + s (l2/2) x3. */
+  double OL[3] = {s * kl * cg, 0, q3 - s * kl * sg};
+  double OLx[3] = {-s * kl * sg, 0, -s * kl * cg};
+  double OLxx[3] = {-s * kl * cg, 0, s * kl * sg};
+  set_body(k, p, L, OL, OLx, OLxx, (scal){gam, 1.0, 0.0}, AX_Y, c);
 
-  scal r = {(l2 * cg - b) / l1, -l2 * sg / l1, -l2 * cg / l1}, alpha, sa;
+  scal r = {s * (l2 * cg - b) / l1, -s * l2 * sg / l1, -s * l2 * cg / l1}, alpha, sa;
   if (acos_chain(r, &alpha, &sa) != GSL_SUCCESS) return GSL_EDOM;
-  scal zB = {B[2], -l2 * cg, l2 * sg};
+  scal zB = {B[2], -s * l2 * cg, s * l2 * sg};
   scal d = {zB.v + l1 * sa.v, zB.x + l1 * sa.x, zB.xx + l1 * sa.xx};
 
-  double OU[3] = {0.5 * (b + l2 * cg), 0, zB.v + 0.5 * l1 * sa.v};
-  double OUx[3] = {-0.5 * l2 * sg, 0, zB.x + 0.5 * l1 * sa.x};
-  double OUxx[3] = {-0.5 * l2 * cg, 0, zB.xx + 0.5 * l1 * sa.xx};
-  set_body(k, p, REF_U3, OU, OUx, OUxx, alpha, AX_Y, &c);
+  /* Upper link: R = Ry(alpha), frame origin (A + B)/2. */
+  double OU[3] = {0.5 * s * (b + l2 * cg), 0, zB.v + 0.5 * l1 * sa.v};
+  double OUx[3] = {-0.5 * s * l2 * sg, 0, zB.x + 0.5 * l1 * sa.x};
+  double OUxx[3] = {-0.5 * s * l2 * cg, 0, zB.xx + 0.5 * l1 * sa.xx};
+  set_body(k, p, U, OU, OUx, OUxx, alpha, AX_Y, c);
 
-  double OS[3] = {b, 0, d.v}, OSx[3] = {0, 0, d.x}, OSxx[3] = {0, 0, d.xx};
-  set_body(k, p, REF_S3, OS, OSx, OSxx, (scal){0.0, 0.0, 0.0}, AX_Y, &c);
-  memcpy(k->A[2], OS, sizeof OS);
-  set_actuator(k, 2, d, &c);
+  /* Slider: translates along e3 only (R = I), frame origin A. */
+  double OS[3] = {s * b, 0, d.v}, OSx[3] = {0, 0, d.x}, OSxx[3] = {0, 0, d.xx};
+  set_body(k, p, S, OS, OSx, OSxx, (scal){0.0, 0.0, 0.0}, AX_Y, c);
+  memcpy(k->A[limb], OS, sizeof OS);
+  set_actuator(k, limb, d, c);
   return GSL_SUCCESS;
 }
 
@@ -285,9 +302,13 @@ int ref_kinematics(const prru_ref_params *p, const double q[3], const double *qd
 {
   memset(k, 0, sizeof *k);
   if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]))) return GSL_EDOM;
-  chain c12 = {{1.0, 0.0, 0.0}, qd ? qd[0] : 0.0, 0.0}; /* xi = q1 exactly */
+  chain c12 = {{1.0, 0.0, 0.0}, qd ? qd[0] : 0.0, 0.0}, c34; /* xi = q1 exactly; xi = gamma */
+  k->gamma = gamma_chain(q, qd, &c34);
   platform(p, q, qd, k);
-  if (limb12(p, q, 0, &c12, k) || limb12(p, q, 1, &c12, k) || limb3(p, q, qd, k)) return GSL_EDOM;
+  if (limb12(p, q, 0, &c12, k) || limb12(p, q, 1, &c12, k) || limb3(p, q, 2, +1.0, &c34, k))
+    return GSL_EDOM;
+  for (int l = 3; l < REF_NLIMB; l++)
+    if (limb3(p, q, l, -1.0, &c34, k)) return GSL_EDOM;
   if (qd) {
     for (int b = 0; b < REF_NB; b++)
       for (int i = 0; i < 3; i++)

@@ -1,8 +1,10 @@
 /* Equations of reaction (paper eqs. 14-24, 28-31 with the spec's single sign
  * convention): the basis Q of the joint reaction wrenches and lambda by
- * eq. 31 with the dense Phi. Joint centres are points of the section-4
+ * eq. 31 with the dense Phi (its minimum-norm solution where, with four
+ * limbs, one reaction direction is redundant). Joint centres are points of the section-4
  * geometry (C_i, B_i, A_i); the moment arms run to each body's centre of
  * mass p_b (not its frame origin), about which Phi, K and Fbar are taken. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -61,31 +63,39 @@ static void build_Q(const ref_kin *k, gsl_matrix *Q)
   int col = 0;
   gsl_matrix_set_zero(Q);
 
-  /* C joints: the U joints turn about v and w (limbs 1, 2), x3 and w
-   * (limb 3); the reaction moment is along their common normal. For limbs 1,
-   * 2 that is v x w = u = R_P e1; for limb 3 n3 = w x x3 / |w x x3|. */
+  /* C joints: the U joints turn about v and w (limbs 1, 2), about the lower
+   * link's outward axis x_l and w (limbs 3, 4); the reaction moment is along
+   * their common normal. For limbs 1, 2 that is v x w = u = R_P e1; for
+   * limb 3 n3 = w x x3 / |w x x3| with x3 = R_L3 e1, for limb 4 (spec
+   * section 12) n4 = w x x4 / |w x x4| with x4 = -R_L4 e1 (its lower link
+   * points along local -x). */
   const double u[3] = {RP[0], RP[3], RP[6]}, wv[3] = {RP[2], RP[5], RP[8]};
-  const double *Rl3 = k->R[REF_L3];
-  const double x3[3] = {Rl3[0], Rl3[3], Rl3[6]};
-  double n3[3] = {wv[1] * x3[2] - wv[2] * x3[1], wv[2] * x3[0] - wv[0] * x3[2],
-                  wv[0] * x3[1] - wv[1] * x3[0]};
-  const double nn = sqrt(n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2]);
-  for (int i = 0; i < 3; i++) n3[i] /= nn;
-  const double mu1[1][3] = {{u[0], u[1], u[2]}}, mn3[1][3] = {{n3[0], n3[1], n3[2]}};
-  for (int l = 0; l < 3; l++)
-    joint(Q, &col, k, REF_L1 + l, REF_P, k->C[l], E, 3, l < 2 ? mu1 : mn3, 1);
+  for (int l = 0; l < REF_NLIMB; l++) {
+    double n[3] = {u[0], u[1], u[2]};
+    if (l >= 2) {
+      const double *Rl = k->R[REF_L(l)], s = l == 2 ? 1.0 : -1.0;
+      const double x[3] = {s * Rl[0], s * Rl[3], s * Rl[6]};
+      n[0] = wv[1] * x[2] - wv[2] * x[1];
+      n[1] = wv[2] * x[0] - wv[0] * x[2];
+      n[2] = wv[0] * x[1] - wv[1] * x[0];
+      const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (int i = 0; i < 3; i++) n[i] /= nn;
+    }
+    const double mn[1][3] = {{n[0], n[1], n[2]}};
+    joint(Q, &col, k, REF_L(l), REF_P, k->C[l], E, 3, mn, 1);
+  }
 
   /* R joints B_i, A_i: moments along the two coordinate axes normal to the
-   * hinge axis (e1 in limbs 1, 2, e2 in limb 3). */
-  const double m12[2][3] = {{0, 1, 0}, {0, 0, 1}}, m3[2][3] = {{1, 0, 0}, {0, 0, 1}};
-  for (int l = 0; l < 3; l++)
-    joint(Q, &col, k, REF_U1 + l, REF_L1 + l, k->B[l], E, 3, l < 2 ? m12 : m3, 2);
-  for (int l = 0; l < 3; l++)
-    joint(Q, &col, k, REF_S1 + l, REF_U1 + l, k->A[l], E, 3, l < 2 ? m12 : m3, 2);
+   * hinge axis (e1 in limbs 1, 2, e2 in limbs 3, 4). */
+  const double m12[2][3] = {{0, 1, 0}, {0, 0, 1}}, m34[2][3] = {{1, 0, 0}, {0, 0, 1}};
+  for (int l = 0; l < REF_NLIMB; l++)
+    joint(Q, &col, k, REF_U(l), REF_L(l), k->B[l], E, 3, l < 2 ? m12 : m34, 2);
+  for (int l = 0; l < REF_NLIMB; l++)
+    joint(Q, &col, k, REF_S(l), REF_U(l), k->A[l], E, 3, l < 2 ? m12 : m34, 2);
 
   /* P joints: rail (ground) to slider, free along e3; the joint centre is
    * A_i, the slider's frame origin (its centre of mass lies com off it). */
-  for (int l = 0; l < 3; l++) joint(Q, &col, k, GROUND, REF_S1 + l, k->A[l], E, 2, E, 3);
+  for (int l = 0; l < REF_NLIMB; l++) joint(Q, &col, k, GROUND, REF_S(l), k->A[l], E, 2, E, 3);
 }
 
 int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
@@ -102,8 +112,83 @@ int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const doub
   return GSL_SUCCESS;
 }
 
+/* Q from the kinematics, Phi = L L^T (Cholesky) and Y = L^-1 Q, after
+ * ref_assemble: then Q^T Phi^-1 Q = Y^T Y, and Y's null space is Q's (L is
+ * invertible). */
+static int reaction_factor(prru_ref_ws *w)
+{
+  ref_priv *s = w->priv;
+  build_Q(&s->kin, w->Q);
+  gsl_matrix_memcpy(s->L, w->Phi);
+  if (ref_cholesky(s->L)) return GSL_ESING;
+  gsl_matrix_memcpy(s->Y, w->Q);
+  gsl_blas_dtrsm(CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, 1.0, s->L, s->Y);
+  return GSL_SUCCESS;
+}
+
+/* The singular value decomposition Y = L^-1 Q = U S V^T after
+ * reaction_factor (GSL's Golub-Reinsch SVD, U overwriting s->Y, V in s->V,
+ * S descending in s->S), so Q^T Phi^-1 Q = V S^2 V^T, and Q's null space is
+ * spanned by the columns of V whose singular values are cut. The cut-off
+ * is relative: sigma_i <= max(NW, NL) DBL_EPSILON sigma_1 counts as zero
+ * (the usual numerical-rank rule: the rounding error of Y and of its SVD is
+ * about that size; measured over the reachable workspace, the redundant
+ * direction of four limbs has sigma / sigma_1 ~ 1e-17 and the smallest kept
+ * one ~ 1e-4). *rank counts the singular values kept; GSL_ESING unless that
+ * is the rank REF_RANK = 6 NBODY - 3 of the mechanism's Q: fewer is a
+ * constraint singularity, more would leave the redundant direction
+ * unresolved (H^T Q = 0 rules it out in exact arithmetic). */
+static int reaction_svd(prru_ref_ws *w, int *rank)
+{
+  ref_priv *s = w->priv;
+  *rank = 0;
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  int st = gsl_linalg_SV_decomp(s->Y, s->V, s->S, s->svw);
+  gsl_set_error_handler(old);
+  if (st) return GSL_ESING;
+  const double tol = (NW > NL ? NW : NL) * DBL_EPSILON * gsl_vector_get(s->S, 0);
+  for (int i = 0; i < NL; i++) *rank += gsl_vector_get(s->S, i) > tol;
+  return *rank == REF_RANK ? GSL_SUCCESS : GSL_ESING;
+}
+
+int prru_ref_reaction_null(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
+                           double z[PRRU_NLAMBDA], int *nullity)
+{
+  ref_priv *s = w->priv;
+  int rank = 0, st = ref_assemble(p, w, q, NULL);
+  if (!st) st = reaction_factor(w);
+  if (st) {
+    for (int i = 0; i < NL; i++) z[i] = NAN;
+    *nullity = -1;
+    return st;
+  }
+  st = reaction_svd(w, &rank);
+  *nullity = NL - rank;
+  /* The last column of V: the smallest singular value's right vector. */
+  int imax = 0;
+  for (int i = 0; i < NL; i++) {
+    z[i] = gsl_matrix_get(s->V, i, NL - 1);
+    if (fabs(z[i]) > fabs(z[imax])) imax = i;
+  }
+  if (z[imax] < 0)
+    for (int i = 0; i < NL; i++) z[i] = -z[i];
+  return st;
+}
+
 /* lambda = (Q^T Phi^-1 Q)^-1 Q^T Phi^-1 (K - Fbar) (eq. 31): with Phi = L L^T
  * and Y = L^-1 Q, Q^T Phi^-1 Q = Y^T Y and Q^T Phi^-1 x = Y^T L^-1 x.
+ *
+ * Three limbs: Y^T Y is positive definite, solved by Cholesky (GSL_ESING
+ * where it is not numerically, a constraint singularity).
+ *
+ * Four limbs (spec section 12): Y^T Y is singular (rank 75 of 76) and eq.
+ * 31's inverse becomes the pseudo-inverse: lambda = (Y^T Y)^+ Y^T L^-1 x =
+ * Y^+ L^-1 x = V S^+ U^T L^-1 x with the SVD of reaction_svd (S^+ inverts
+ * the singular values kept, zeroes the one cut). Of all lambda with
+ * Q lambda = Phi H qdd + K - Fbar (they differ by multiples of Q's null
+ * vector z, and they are exactly the solutions of the normal equations
+ * Y^T Y lambda = Y^T L^-1 x, since H^T Q = 0 makes the qdd term drop out of
+ * those) this is the one of least norm, the one with lambda . z = 0.
  *
  * Fbar holds what acts on the bodies from outside the joints: gravity
  * m_b g at every centre, fp at the tool point O' and mp on the platform
@@ -121,51 +206,57 @@ int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[
                        const double mp[3], double lambda[PRRU_NLAMBDA])
 {
   ref_priv *s = w->priv;
+  int rank = NL;
   int st = ref_assemble(p, w, q, qd);
   if (!st) {
     ref_mass_matrix(p, w);
     st = ref_solve_qdd(p, w, fd, fp, mp, s->v3a);
   }
+  if (!st) st = reaction_factor(w);
   if (!st) {
-    const ref_kin *k = &s->kin;
-    double phi[REF_NA];
-    ref_drive_friction(p, k, phi);
-    build_Q(k, w->Q);
-    gsl_vector_memcpy(s->Fbar, s->Fg);
-    /* fp at O' = (0, 0, q3) is fp at the platform's centre p_P plus the
-     * moment (O' - p_P) x fp. */
-    const double *pP = k->p[REF_P];
-    const double r[3] = {-pP[0], -pP[1], q[2] - pP[2]};
-    const double rxf[3] = {r[1] * fp[2] - r[2] * fp[1], r[2] * fp[0] - r[0] * fp[2],
-                           r[0] * fp[1] - r[1] * fp[0]};
-    for (int i = 0; i < 3; i++) {
-      *gsl_vector_ptr(s->Fbar, 3 * REF_P + i) += mp[i] + rxf[i];
-      *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_P + i) += fp[i];
+    if (REF_RANK == NL) {
+      gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, s->Y, s->Y, 0.0, s->A);
+      st = ref_cholesky(s->A);
+    } else {
+      st = reaction_svd(w, &rank);
     }
-    for (int i = 0; i < REF_NA; i++) {
-      double dd2 = k->ddb[i];
-      for (int j = 0; j < 3; j++) dd2 += k->Jd[3 * i + j] * gsl_vector_get(s->v3a, j);
-      *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * (REF_S1 + i) + 2) +=
-          fd[i] - p->armature[i] * dd2 + phi[i];
-    }
-    gsl_vector_memcpy(s->r60, w->K);
-    gsl_vector_sub(s->r60, s->Fbar);
-    gsl_matrix_memcpy(s->L, w->Phi);
-    st = ref_cholesky(s->L);
-  }
-  if (!st) {
-    gsl_matrix_memcpy(s->Y, w->Q);
-    gsl_blas_dtrsm(CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, 1.0, s->L, s->Y);
-    gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, s->Y, s->Y, 0.0, s->A);
-    gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, s->L, s->r60);
-    gsl_blas_dgemv(CblasTrans, 1.0, s->Y, s->r60, 0.0, s->r57);
-    st = ref_cholesky(s->A);
   }
   if (st) {
     for (int i = 0; i < NL; i++) lambda[i] = NAN;
     return st;
   }
+  const ref_kin *k = &s->kin;
+  double phi[REF_NA];
+  ref_drive_friction(p, k, phi);
+  gsl_vector_memcpy(s->Fbar, s->Fg);
+  /* fp at O' = (0, 0, q3) is fp at the platform's centre p_P plus the
+   * moment (O' - p_P) x fp. */
+  const double *pP = k->p[REF_P];
+  const double r[3] = {-pP[0], -pP[1], q[2] - pP[2]};
+  const double rxf[3] = {r[1] * fp[2] - r[2] * fp[1], r[2] * fp[0] - r[0] * fp[2],
+                         r[0] * fp[1] - r[1] * fp[0]};
+  for (int i = 0; i < 3; i++) {
+    *gsl_vector_ptr(s->Fbar, 3 * REF_P + i) += mp[i] + rxf[i];
+    *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_P + i) += fp[i];
+  }
+  for (int i = 0; i < REF_NA; i++) {
+    double dd2 = k->ddb[i];
+    for (int j = 0; j < 3; j++) dd2 += k->Jd[3 * i + j] * gsl_vector_get(s->v3a, j);
+    *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_S(i) + 2) += fd[i] - p->armature[i] * dd2 + phi[i];
+  }
+  /* rW = L^-1 (K - Fbar), rL = Y^T rW (three limbs) or U^T rW (four). */
+  gsl_vector_memcpy(s->rW, w->K);
+  gsl_vector_sub(s->rW, s->Fbar);
+  gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, s->L, s->rW);
+  gsl_blas_dgemv(CblasTrans, 1.0, s->Y, s->rW, 0.0, s->rL);
   gsl_vector_view lam = gsl_vector_view_array(lambda, NL);
-  gsl_linalg_cholesky_solve(s->A, s->r57, &lam.vector);
+  if (REF_RANK == NL) {
+    gsl_linalg_cholesky_solve(s->A, s->rL, &lam.vector);
+    return GSL_SUCCESS;
+  }
+  /* lambda = V S^+ (U^T rW). */
+  for (int i = 0; i < NL; i++)
+    gsl_vector_set(s->rL, i, i < rank ? gsl_vector_get(s->rL, i) / gsl_vector_get(s->S, i) : 0.0);
+  gsl_blas_dgemv(CblasNoTrans, 1.0, s->V, s->rL, 0.0, &lam.vector);
   return GSL_SUCCESS;
 }

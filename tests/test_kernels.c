@@ -3,8 +3,9 @@
  * 1e-12 relative to its own max-norm), the drives' kernels (actuator
  * rates, passive force, the passive force inside eom) included; the fused
  * kernels against the separate ones, h against the Christoffel symbols of
- * M by finite differences, and NaN on every output where q is unreachable
- * or not finite. */
+ * M by finite differences, limb 4 against limb 3 mirrored (four limbs,
+ * spec section 12), and NaN on every output where q is unreachable or not
+ * finite. */
 #include <math.h>
 #include <string.h>
 
@@ -65,12 +66,12 @@ static void note(int o, const double *kernel, const double *ref, int n)
 
 /* Every generated kernel's outputs at one state. */
 typedef struct {
-  double d[3], Jd[9], d2[3], Jd2[9], H[3 * NW], dm[NW], M[9], h[3], G[3], M2[9], h2[3], G2[3];
+  double d[NA], Jd[3 * NA], d2[NA], Jd2[3 * NA], H[3 * NW], dm[NW], M[9], h[3], G[3], M2[9], h2[3], G2[3];
   double Me[9], be[3], JP[18], R[9 * NB], p[3 * NB], I[9 * NB], K[NW], E[2], dd[NA], ddb[NA];
   double Qp[3], Q[NW * NL];
 } kernel_outputs;
 
-static void eval_all(const double q[3], const double qd[3], const double fd[3],
+static void eval_all(const double q[3], const double qd[3], const double fd[NA],
                      const double fp[3], const double mp[3], kernel_outputs *o)
 {
   prru_ik(q, o->d);
@@ -147,7 +148,7 @@ static void test_against_reference(void)
   double fused = 0;
   static double Qr[NW * NL];
   while (states < NSTATE) {
-    double q[3], qd[3], fd[3], fp[3], mp[3];
+    double q[3], qd[3], fd[NA], fp[3], mp[3];
     skipped += random_q(q);
     for (int i = 0; i < 3; i++) {
       qd[i] = tu_uniform(-1.15, 1.15); /* |qd| <= 2 */
@@ -155,6 +156,7 @@ static void test_against_reference(void)
       fp[i] = tu_uniform(-30, 30);
       mp[i] = tu_uniform(-3, 3);
     }
+    for (int i = 3; i < NA; i++) fd[i] = tu_uniform(-60, 60); /* limb 4 */
     /* Every third state slowly, where the drives' tanh(dd / v_s) is not
      * saturated. */
     if (states % 3 == 0)
@@ -162,7 +164,7 @@ static void test_against_reference(void)
     states++;
     state_margin = margin(q);
     nnear += state_margin < MARGIN;
-    double d_r[3], Jd_r[9], H_r[3 * NW], dm_r[NW], M_r[9], h_r[3], G_r[3], R_r[9 * NB], p_r[3 * NB];
+    double d_r[NA], Jd_r[3 * NA], H_r[3 * NW], dm_r[NW], M_r[9], h_r[3], G_r[3], R_r[9 * NB], p_r[3 * NB];
     double E_r[2], dd_r[NA], ddb_r[NA], Qp_r[3], qdd_r[3];
     int st = prru_ref_ik(&P, q, d_r) | prru_ref_jd(&P, q, Jd_r) | prru_ref_jacobians(&P, W, q, H_r) |
              prru_ref_bias_terms(&P, W, q, qd, dm_r) | prru_ref_poses(&P, q, R_r, p_r) |
@@ -190,8 +192,8 @@ static void test_against_reference(void)
     double b_r[3];
     for (int j = 0; j < 3; j++) {
       b_r[j] = G_r[j] - h_r[j] + Qp_r[j];
-      for (int i = 0; i < 3; i++)
-        b_r[j] += Jd_r[3 * i + j] * fd[i] + JP_r[9 + 3 * i + j] * fp[i] + JP_r[3 * i + j] * mp[i];
+      for (int i = 0; i < NA; i++) b_r[j] += Jd_r[3 * i + j] * fd[i];
+      for (int i = 0; i < 3; i++) b_r[j] += JP_r[9 + 3 * i + j] * fp[i] + JP_r[3 * i + j] * mp[i];
     }
 
     static kernel_outputs ko;
@@ -199,10 +201,10 @@ static void test_against_reference(void)
     double qdd[3];
     solve3(ko.Me, ko.be, qdd);
 
-    note(O_IK, ko.d, d_r, 3);
-    note(O_JD, ko.Jd, Jd_r, 9);
-    note(O_IKJD_D, ko.d2, d_r, 3);
-    note(O_IKJD_J, ko.Jd2, Jd_r, 9);
+    note(O_IK, ko.d, d_r, NA);
+    note(O_JD, ko.Jd, Jd_r, 3 * NA);
+    note(O_IKJD_D, ko.d2, d_r, NA);
+    note(O_IKJD_J, ko.Jd2, Jd_r, 3 * NA);
     note(O_JAC, ko.H, H_r, 3 * NW);
     note(O_BT, ko.dm, dm_r, NW);
     note(O_MASS, ko.M, M_r, 9);
@@ -232,7 +234,7 @@ static void test_against_reference(void)
     note(O_Q, ko.Q, Qr, NW * NL);
 
     /* Fused kernels against the separate ones. */
-    double f[6] = {tu_relerr(ko.d2, ko.d, 3, 1e-300), tu_relerr(ko.Jd2, ko.Jd, 9, 1e-300),
+    double f[6] = {tu_relerr(ko.d2, ko.d, NA, 1e-300), tu_relerr(ko.Jd2, ko.Jd, 3 * NA, 1e-300),
                    tu_relerr(ko.M2, ko.M, 9, 1e-300), tu_relerr(ko.h2, ko.h, 3, 1e-300),
                    tu_relerr(ko.G2, ko.G, 3, 1e-300), tu_relerr(ko.Me, ko.M, 9, 1e-300)};
     for (int i = 0; i < 6; i++)
@@ -300,6 +302,38 @@ static void test_christoffel(void)
   printf("Christoffel consistency (%d states): %.1e\n", used, worst_c);
 }
 
+/* Limb 4 mirrors limb 3 (spec section 12): where the descriptor gives
+ * limbs 3 and 4 the same b, l1 and l2, the kernels' d_4(q1, q2, q3) =
+ * d_3(q1, -q2, q3) and the other way round, and J_d's rows 3 and 4 follow
+ * with the q2 column negated (reflection in the plane x = 0). */
+static void test_mirror(void)
+{
+  if (PRRU_NLIMB != 4) return;
+  const int l3 = 2, l4 = PRRU_NLIMB - 1;
+  if (!(prru_mech.b[l4] == prru_mech.b[l3] && prru_mech.l1[l4] == prru_mech.l1[l3] &&
+        prru_mech.l2[l4] == prru_mech.l2[l3])) {
+    printf("mirror: limbs 3 and 4 differ in b, l1 or l2; not checked\n");
+    return;
+  }
+  double e_d = 0, e_j = 0;
+  for (int n = 0; n < 500; n++) {
+    double q[3], d[NA], dm[NA], J[3 * NA], Jm[3 * NA];
+    random_q(q);
+    const double qm[3] = {q[0], -q[1], q[2]};
+    prru_ik_jd(q, d, J);
+    prru_ik_jd(qm, dm, Jm);
+    const double a[2] = {d[l4], d[l3]}, b[2] = {dm[l3], dm[l4]};
+    const double ja[6] = {J[3 * l4], J[3 * l4 + 1], J[3 * l4 + 2], J[3 * l3], J[3 * l3 + 1], J[3 * l3 + 2]};
+    const double jb[6] = {Jm[3 * l3], -Jm[3 * l3 + 1], Jm[3 * l3 + 2], Jm[3 * l4], -Jm[3 * l4 + 1], Jm[3 * l4 + 2]};
+    const double ed = tu_relerr(a, b, 2, 1e-300), ej = tu_relerr(ja, jb, 6, 1e-300);
+    if (!(ed <= e_d)) e_d = ed; /* keeps NaN */
+    if (!(ej <= e_j)) e_j = ej;
+  }
+  tu_check(e_d <= 1e-15, "kernel d_4(q1, q2, q3) = d_3(q1, -q2, q3) and d_3 = d_4 mirrored", e_d, 1e-15);
+  tu_check(e_j <= 1e-15, "kernel J_d rows 3, 4 mirror each other (q2 column negated)", e_j, 1e-15);
+  printf("mirror (500 states): d %.1e, J_d %.1e\n", e_d, e_j);
+}
+
 static int all_nan(const double *x, int n)
 {
   for (int i = 0; i < n; i++)
@@ -331,13 +365,13 @@ static void test_nan_outputs(void)
   for (int axis = 0; axis < 2; axis++)
     if (unreachable_along(axis, bad[nbad])) nbad++;
     else printf("no unreachable q along q%d in (0, pi]\n", axis + 1);
-  const double qd[3] = {0.1, -0.2, 0.3}, f3[3] = {1, 2, 3};
+  const double qd[3] = {0.1, -0.2, 0.3}, f3[4] = {1, 2, 3, 4}; /* f3[0..NA-1]: fd */
   for (int c = 0; c < nbad; c++) {
     const double *q = bad[c];
     static kernel_outputs ko;
     eval_all(q, qd, f3, f3, f3, &ko);
     const struct { const char *name; const double *x; int n; } out[] = {
-      {"ik", ko.d, 3}, {"jd", ko.Jd, 9}, {"ik_jd d", ko.d2, 3}, {"ik_jd Jd", ko.Jd2, 9},
+      {"ik", ko.d, NA}, {"jd", ko.Jd, 3 * NA}, {"ik_jd d", ko.d2, NA}, {"ik_jd Jd", ko.Jd2, 3 * NA},
       {"jacobians", ko.H, 3 * NW}, {"bias_terms", ko.dm, NW}, {"mass", ko.M, 9}, {"bias", ko.h, 3},
       {"gravity", ko.G, 3}, {"dynamics M", ko.M2, 9}, {"dynamics h", ko.h2, 3},
       {"dynamics G", ko.G2, 3}, {"eom M", ko.Me, 9}, {"eom b", ko.be, 3},
@@ -361,6 +395,7 @@ int main(void)
   if (!W) { fprintf(stderr, "prru_ref_alloc failed\n"); return 1; }
   test_against_reference();
   test_christoffel();
+  test_mirror();
   test_nan_outputs();
   prru_ref_free(W);
   return tu_finish("test_kernels");

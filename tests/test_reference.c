@@ -6,7 +6,11 @@
  * (spec section 11), the virtual-power identity H^T Q = 0, every body's
  * Newton-Euler equation with the reactions (eq. 28) and the platform's
  * written out from the spec's geometry, and the inverse of the forward
- * dynamics. The paper's numbers are in paper_reference.c. */
+ * dynamics. With four limbs (spec section 12) also the mirror symmetry of
+ * limbs 3 and 4, the minimum-norm inverse dynamics, the redundant reaction
+ * direction z (Q z = 0) and lambda . z = 0; w_R against section 8 (three
+ * limbs) and section 12 (J_d^+) written out here. The paper's numbers are
+ * in paper_reference.c. */
 #include <math.h>
 #include <string.h>
 
@@ -42,7 +46,7 @@ static int fd_dir(vfun f, const double q[3], const double qd[3], const double di
                   double *deriv)
 {
   static const double step[4] = {2, 1, -1, -2}, wgt[4] = {-1, 8, -8, 1};
-  double out[200];
+  double out[3 * NW]; /* the largest output: H */
   for (int i = 0; i < n; i++) deriv[i] = 0;
   for (int s = 0; s < 4; s++) {
     double qs[3];
@@ -157,28 +161,58 @@ static double norm(const double *x, int n)
 
 static double margin(const double q[3]) { return ref_margin(&P, q); }
 
-/* 1-norm condition number of J_d at q (cofactor inverse). */
-static double cond_jd(const double q[3])
+/* A^-1 of a 3x3 matrix by cofactors; returns det A. */
+static double inv3(const double A[9], double Ai[9])
 {
-  double J[9], C[9];
-  if (prru_ref_jd(&P, q, J) != GSL_SUCCESS) return INFINITY;
+  double C[9];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       const int r0 = (i + 1) % 3, r1 = (i + 2) % 3, c0 = (j + 1) % 3, c1 = (j + 2) % 3;
-      C[3 * j + i] = J[3 * r0 + c0] * J[3 * r1 + c1] - J[3 * r0 + c1] * J[3 * r1 + c0];
+      C[3 * j + i] = A[3 * r0 + c0] * A[3 * r1 + c1] - A[3 * r0 + c1] * A[3 * r1 + c0];
     }
-  const double det = J[0] * C[0] + J[1] * C[3] + J[2] * C[6];
-  double nj = 0, ni = 0;
+  const double det = A[0] * C[0] + A[1] * C[3] + A[2] * C[6];
+  for (int i = 0; i < 9; i++) Ai[i] = C[i] / det;
+  return det;
+}
+
+/* J^T J of an NA x 3 row-major J. */
+static void gram(const double *J, double N[9])
+{
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      N[3 * i + j] = 0;
+      for (int l = 0; l < NA; l++) N[3 * i + j] += J[3 * l + i] * J[3 * l + j];
+    }
+}
+
+/* 1-norm condition number of a 3x3 matrix (cofactor inverse). */
+static double cond3(const double A[9])
+{
+  double Ai[9];
+  inv3(A, Ai);
+  double na = 0, ni = 0;
   for (int j = 0; j < 3; j++) {
     double a = 0, b = 0;
     for (int i = 0; i < 3; i++) {
-      a += fabs(J[3 * i + j]);
-      b += fabs(C[3 * i + j] / det);
+      a += fabs(A[3 * i + j]);
+      b += fabs(Ai[3 * i + j]);
     }
-    nj = fmax(nj, a);
+    na = fmax(na, a);
     ni = fmax(ni, b);
   }
-  return nj * ni;
+  return na * ni;
+}
+
+/* Condition number of J_d at q: the 1-norm one for three limbs; for four
+ * (J_d is 4x3) sqrt(cond_1(J_d^T J_d)), the same measure (cond_2(J_d)^2 =
+ * cond_2(J_d^T J_d)) of what the minimum-norm inverse dynamics inverts. */
+static double cond_jd(const double q[3])
+{
+  double J[3 * NA], N[9];
+  if (prru_ref_jd(&P, q, J) != GSL_SUCCESS) return INFINITY;
+  if (NA == 3) return cond3(J);
+  gram(J, N);
+  return sqrt(cond3(N));
 }
 
 static double machine_size(void)
@@ -201,13 +235,14 @@ static void random_state(double q[3], double qd[3], int regular_jd)
   for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
 }
 
-static void random_loads(double fd[3], double fp[3], double mp[3])
+static void random_loads(double fd[NA], double fp[3], double mp[3])
 {
   for (int i = 0; i < 3; i++) {
     fd[i] = tu_uniform(-60, 60);
     fp[i] = tu_uniform(-30, 30);
     mp[i] = tu_uniform(-3, 3);
   }
+  for (int i = 3; i < NA; i++) fd[i] = tu_uniform(-60, 60); /* limb 4 */
 }
 
 /* The drive forces of spec section 11 written out here:
@@ -245,15 +280,18 @@ static void test_params(void)
             P.coulomb[i] == prru_mech.coulomb[i];
   same &= P.coulomb_velocity == prru_mech.coulomb_velocity;
   TU_TRUE(same, "prru_ref_params_default copies prru_mech");
-  /* The reference puts C_3 at O' whatever a[2] says (spec section 4). */
-  TU_TRUE(P.a[2] == 0.0, "a[2] = 0: limb 3's U joint is O'");
-  /* The layout the tests below read: C1..C3 first in lambda, 3 forces
+  /* The reference puts C_3 (and C_4) at O' whatever a[2] (a[3]) says (spec
+   * sections 4, 12). */
+  int at_o = 1;
+  for (int l = 2; l < PRRU_NLIMB; l++) at_o &= P.a[l] == 0.0;
+  TU_TRUE(at_o, "a[2] (a[3]) = 0: the U joints of limbs 3 (and 4) are O'");
+  /* The layout the tests below read: C1..C3 (C4) first in lambda, 3 forces
    * then the moment. */
   int layout = 1;
-  for (int l = 0; l < 3; l++)
+  for (int l = 0; l < PRRU_NLIMB; l++)
     layout &= prru_mech.joint[l].type == 'U' && prru_mech.joint[l].limb == l &&
               prru_mech.joint[l].lambda_count == 4 && prru_mech.joint[l].distal == prru_mech.platform;
-  TU_TRUE(layout, "lambda starts with the U joints C1..C3 (4 each)");
+  TU_TRUE(layout, "lambda starts with the U joints C1..C3 (C4) (4 each)");
   printf("model %s (format %d): drives %s\n", prru_mech.name, prru_mech.format,
          has_drives() ? "yes" : "none");
 }
@@ -264,7 +302,7 @@ static void test_finite_differences(void)
   double e_jd = 0, e_jt = 0, e_jr = 0, e_dm = 0, e_g = 0, e_skew = 0, e_dd = 0, e_ddb = 0;
   int fails = 0;
   for (int n = 0; n < 200; n++) {
-    double q[3], qd[3], Jd[9], H[3 * NW], dm[NW], G[3], dd[NA], ddb[NA];
+    double q[3], qd[3], Jd[3 * NA], H[3 * NW], dm[NW], G[3], dd[NA], ddb[NA];
     random_state(q, qd, 0);
     if (prru_ref_jd(&P, q, Jd) || prru_ref_jacobians(&P, W, q, H) ||
         prru_ref_bias_terms(&P, W, q, qd, dm) || prru_ref_gravity(&P, W, q, G) ||
@@ -272,7 +310,7 @@ static void test_finite_differences(void)
       fails++;
       continue;
     }
-    double Jd_fd[9], H_fd[3 * NW], dm_fd[NW], G_fd[3], R[9 * NB], pos[3 * NB], dd_fd[NA], ddb_fd[NA];
+    double Jd_fd[3 * NA], H_fd[3 * NW], dm_fd[NW], G_fd[3], R[9 * NB], pos[3 * NB], dd_fd[NA], ddb_fd[NA];
     prru_ref_poses(&P, q, R, pos);
     int bad = 0;
     for (int j = 0; j < 3; j++) {
@@ -311,7 +349,7 @@ static void test_finite_differences(void)
     bad |= fd_along(f_ik, q, qd, NA, dd_fd);
     if (bad) { fails++; continue; }
     const double s_dm = quad_form(dH[0], qd, NW, dm_fd), s_ddb = quad_form(dJ[0], qd, NA, ddb_fd);
-    e_jd = fmax(e_jd, tu_relerr(Jd, Jd_fd, 9, 1e-300));
+    e_jd = fmax(e_jd, tu_relerr(Jd, Jd_fd, 3 * NA, 1e-300));
     e_jr = fmax(e_jr, tu_relerr(H, H_fd, 3 * 3 * NB, 1e-300));
     e_jt = fmax(e_jt, tu_relerr(H + 9 * NB, H_fd + 9 * NB, 9 * NB, 1e-300));
     e_dm = fmax(e_dm, tu_relerr(dm, dm_fd, NW, s_dm));
@@ -391,7 +429,7 @@ static void test_mass_energy(void)
 
     /* The armature's share: against the same machine without it,
      * M - M0 = J_d^T K J_d, h - h0 = J_d^T K (Jd' qd), T - T0 = sum k dd^2/2. */
-    double M0[9], h[3], h0[3], E0[2], Jd[9], dd[NA], ddb[NA], JKJ[9], JKb[3], dM[9], dh[3];
+    double M0[9], h[3], h0[3], E0[2], Jd[3 * NA], dd[NA], ddb[NA], JKJ[9], JKb[3], dM[9], dh[3];
     prru_ref_mass(&P0, W, q, M0);
     prru_ref_bias(&P, W, q, qd, h);
     prru_ref_bias(&P0, W, q, qd, h0);
@@ -464,13 +502,13 @@ static void test_passive(void)
   memset(Pnd.damping, 0, sizeof Pnd.damping);
   memset(Pnd.coulomb, 0, sizeof Pnd.coulomb);
   for (int n = 0; n < 300; n++) {
-    double q[3], qd[3], fd[3], fp[3], mp[3];
+    double q[3], qd[3], fd[NA], fp[3], mp[3];
     random_state(q, qd, 0);
     random_loads(fd, fp, mp);
     /* Low slider speeds too, where tanh(dd / v_s) is not saturated. */
     if (n % 3 == 0)
       for (int i = 0; i < 3; i++) qd[i] *= 1e-3;
-    double Qp[3], Qp0[3], Jd[9], dd[NA], ddb[NA], phi[NA], Qdef[3];
+    double Qp[3], Qp0[3], Jd[3 * NA], dd[NA], ddb[NA], phi[NA], Qdef[3];
     if (prru_ref_passive(&P, W, q, qd, Qp) || prru_ref_jd(&P, q, Jd) ||
         prru_ref_actuator_rates(&P, q, qd, dd, ddb) || prru_ref_passive(&Pnd, W, q, qd, Qp0)) {
       fails++;
@@ -511,6 +549,7 @@ static void test_passive(void)
         t[1] += Jd[3 * i + j] * fd[i];
         t[3] += H[3 * i + j] * mp[i];
       }
+      for (int i = 3; i < NA; i++) t[1] += Jd[3 * i + j] * fd[i]; /* limb 4 */
       rhs[j] = 0;
       for (int k = 0; k < 6; k++) {
         rhs[j] += t[k];
@@ -531,12 +570,33 @@ static void test_passive(void)
 }
 
 /* ---- reactions ---- */
+
+/* The unit null vector of J_d^T for four limbs (NA = 4): n_i = (-1)^i det
+ * of J_d without row i (J_d^T n = 0 is the Laplace expansion of a 4x4
+ * determinant with a repeated column); fd along n moves no coordinate. */
+static void jdt_null(const double *J, double n[NA])
+{
+  double nn = 0;
+  for (int i = 0; i < NA; i++) {
+    double A[9] = {0}, Ai[9];
+    for (int r = 0, k = 0; r < NA; r++) {
+      if (r == i) continue;
+      for (int c = 0; c < 3; c++) A[3 * k + c] = J[3 * r + c];
+      k++;
+    }
+    n[i] = (i % 2 ? -1.0 : 1.0) * inv3(A, Ai);
+    nn += n[i] * n[i];
+  }
+  for (int i = 0; i < NA; i++) n[i] /= sqrt(nn);
+}
+
 static void test_reactions(void)
 {
-  double e_HQ = 0, e_trip = 0, e_ne_f = 0, e_ne_m = 0, e_all = 0;
-  int fails = 0;
+  double e_HQ = 0, e_trip = 0, e_ne_f = 0, e_ne_m = 0, e_all = 0, e_Qz = 0, e_lz = 0, e_zs = 0;
+  int fails = 0, bad_nullity = 0;
+  const int redundant = NL - (6 * NB - 3); /* 0 for three limbs, 1 for four */
   for (int n = 0; n < 200; n++) {
-    double q[3], qd[3], fd[3], fp[3], mp[3], qdd[3], fd2[3], lam[NL];
+    double q[3], qd[3], fd[NA], fp[3], mp[3], qdd[3], fd2[NA], lam[NL];
     static double Q[NW * NL];
     random_state(q, qd, 1);
     random_loads(fd, fp, mp);
@@ -551,14 +611,25 @@ static void test_reactions(void)
       }
     e_HQ = fmax(e_HQ, norm(HQ, 3 * NL) / (norm(H, 3 * NW) * norm(Q, NW * NL)));
 
+    double Jd[3 * NA], dd[NA], ddb[NA], phi[NA], fs[NA];
+    if (prru_ref_jd(&P, q, Jd) || prru_ref_actuator_rates(&P, q, qd, dd, ddb)) { fails++; continue; }
     if (prru_ref_forward_dynamics(&P, W, q, qd, fd, fp, mp, qdd) ||
         prru_ref_inverse_dynamics(&P, W, q, qd, qdd, fp, mp, fd2)) { fails++; continue; }
-    e_trip = fmax(e_trip, tu_relerr(fd2, fd, 3, 1.0));
+    /* The inverse dynamics returns the least-norm fd that gives qdd: fd
+     * itself for three limbs; for four, fd less its part along the null
+     * vector of J_d^T (spec section 12's f = J_d (J_d^T J_d)^-1 tau). */
+    double fexp[NA];
+    memcpy(fexp, fd, sizeof fexp);
+    if (NA == 4) {
+      double nv[NA], t = 0;
+      jdt_null(Jd, nv);
+      for (int i = 0; i < NA; i++) t += nv[i] * fd[i];
+      for (int i = 0; i < NA; i++) fexp[i] -= t * nv[i];
+    }
+    e_trip = fmax(e_trip, tu_relerr(fd2, fexp, NA, 1.0));
 
     /* What slider i receives from its drive (spec section 11), from the
      * qdd above: fd_i - k_i dd_i'' + phi_i, dd'' = J_d qdd + Jd' qd. */
-    double Jd[9], dd[NA], ddb[NA], phi[NA], fs[NA];
-    if (prru_ref_jd(&P, q, Jd) || prru_ref_actuator_rates(&P, q, qd, dd, ddb)) { fails++; continue; }
     drive_friction(&P, dd, phi);
     for (int i = 0; i < NA; i++) {
       double acc = ddb[i] + Jd[3 * i] * qdd[0] + Jd[3 * i + 1] * qdd[1] + Jd[3 * i + 2] * qdd[2];
@@ -601,16 +672,21 @@ static void test_reactions(void)
     e_all = fmax(e_all, rmax / scale);
 
     /* Platform Newton-Euler from the spec's geometry and the lambda labels
-     * alone (R_P, C_i, u, n3, p_P = O' + R_P com recomputed here, the
+     * alone (R_P, C_i, u, n3, n4, p_P = O' + R_P com recomputed here, the
      * accelerations by the rigid-body formulas), not from Q or mu. */
     const double c1 = cos(q[0]), s1 = sin(q[0]), c2 = cos(q[1]), s2 = sin(q[1]);
     const double RP[9] = {c2, 0, s2, s1 * s2, c1, -s1 * c2, -c1 * s2, s1, c1 * c2};
     const double u[3] = {RP[0], RP[3], RP[6]}, wv[3] = {RP[2], RP[5], RP[8]};
     const double gam = atan2(s2, c1 * c2), x3[3] = {cos(gam), 0, -sin(gam)};
-    double n3[3];
+    const double x4[3] = {-x3[0], -x3[1], -x3[2]}; /* limb 4's lower link (spec section 12) */
+    double n3[3], n4[3];
     tu_cross(wv, x3, n3);
-    const double nn = norm(n3, 3);
-    for (int i = 0; i < 3; i++) n3[i] /= nn;
+    tu_cross(wv, x4, n4);
+    const double nn3 = norm(n3, 3), nn4 = norm(n4, 3);
+    for (int i = 0; i < 3; i++) {
+      n3[i] /= nn3;
+      n4[i] /= nn4;
+    }
     const int ip = prru_mech.platform;
     const double mP = P.mass[ip];
     double rc[3], F[3], Mo[3];
@@ -619,15 +695,15 @@ static void test_reactions(void)
       F[i] = fp[i] + mP * P.g[i];
       Mo[i] = mp[i] + fpm[i];
     }
-    for (int l = 0; l < 3; l++) {
+    for (int l = 0; l < PRRU_NLIMB; l++) {
       const double *f = lam + prru_mech.joint[l].lambda_offset;
-      /* C_i - O' = R_P (0, s a_i, 0) for limbs 1, 2; C_3 = O'. */
+      /* C_i - O' = R_P (0, s a_i, 0) for limbs 1, 2; C_3 = C_4 = O'. */
       const double loc[3] = {0, l == 0 ? -P.a[0] : l == 1 ? P.a[1] : 0.0, 0};
       double c[3], r[3], rxf[3];
       tu_matvec3(RP, loc, c);
       for (int i = 0; i < 3; i++) r[i] = c[i] - rc[i];
       tu_cross(r, f, rxf);
-      const double *ax = l < 2 ? u : n3;
+      const double *ax = l < 2 ? u : l == 2 ? n3 : n4;
       for (int i = 0; i < 3; i++) {
         F[i] += f[i];
         Mo[i] += rxf[i] + f[3] * ax[i];
@@ -663,19 +739,203 @@ static void test_reactions(void)
     /* Scales: the largest U-joint force and its largest lever. */
     double fmax_c = 0;
     const double lever = fmax(P.a[0], P.a[1]) + norm(rc, 3);
-    for (int l = 0; l < 3; l++) fmax_c = fmax(fmax_c, norm(lam + prru_mech.joint[l].lambda_offset, 3));
+    for (int l = 0; l < PRRU_NLIMB; l++)
+      fmax_c = fmax(fmax_c, norm(lam + prru_mech.joint[l].lambda_offset, 3));
     e_ne_f = fmax(e_ne_f, tu_relerr(lhsF, F, 3, fmax_c));
     e_ne_m = fmax(e_ne_m, tu_relerr(lhsM, Mo, 3, fmax_c * lever));
+
+    /* The redundant reaction direction (four limbs): the reference's z,
+     * Q z = 0 with the Q of prru_ref_reaction_basis above, lambda . z = 0
+     * (lambda the least-norm solution), and z the internal force the spec
+     * names: limbs 3 and 4 push O' along e2 against each other (the C3 and
+     * C4 forces opposite and along e2, no U-joint moment), closed through
+     * their rails, with nothing in limbs 1 and 2. */
+    double z[NL];
+    int nullity;
+    if (prru_ref_reaction_null(&P, W, q, z, &nullity)) { fails++; continue; }
+    bad_nullity += nullity != redundant;
+    if (nullity == 1) {
+      double Qz[NW], lz = 0, dev = 0;
+      for (int r = 0; r < NW; r++) {
+        Qz[r] = 0;
+        for (int j = 0; j < NL; j++) Qz[r] += Q[NL * r + j] * z[j];
+      }
+      for (int j = 0; j < NL; j++) lz += lam[j] * z[j];
+      e_Qz = fmax(e_Qz, norm(Qz, NW) / norm(Q, NW * NL)); /* |z| = 1 */
+      e_lz = fmax(e_lz, fabs(lz) / norm(lam, NL));
+      for (int jt = 0; jt < PRRU_NJOINT; jt++) {
+        const prru_joint_info *J = &prru_mech.joint[jt];
+        const double *zj = z + J->lambda_offset;
+        if (J->limb < 2)
+          for (int c = 0; c < J->lambda_count; c++) dev = fmax(dev, fabs(zj[c]));
+        if (J->type == 'U' && J->limb >= 2) {
+          const double *z3 = z + prru_mech.joint[2].lambda_offset;
+          dev = fmax(dev, fmax(fabs(zj[0]), fabs(zj[2]))); /* force along e2 only */
+          dev = fmax(dev, fabs(zj[3]));                     /* no moment */
+          dev = fmax(dev, fabs(zj[1] - (J->limb == 2 ? 1 : -1) * z3[1]));
+        }
+      }
+      if (!(fabs(z[prru_mech.joint[2].lambda_offset + 1]) > 0.1)) dev = INFINITY;
+      e_zs = fmax(e_zs, dev);
+    }
   }
   tu_check(fails == 0, "reaction states evaluate", fails, 0);
   tu_check(e_HQ <= 1e-12, "H^T Q = 0 (relative to |H||Q|)", e_HQ, 1e-12);
-  tu_check(e_trip <= 1e-12, "inverse dynamics of forward dynamics returns fd", e_trip, 1e-12);
+  tu_check(e_trip <= 1e-12, NA == 3 ? "inverse dynamics of forward dynamics returns fd"
+                                    : "inverse dynamics of forward dynamics returns fd less its J_d^T-null part",
+           e_trip, 1e-12);
   tu_check(e_all <= 1e-12, "Phi H qdd + K = Fbar + Q lambda (eq. 28), every body, drive forces net",
            e_all, 1e-12);
   tu_check(e_ne_f <= 1e-12, "platform force balance with the C-joint reactions", e_ne_f, 1e-12);
   tu_check(e_ne_m <= 1e-12, "platform moment balance with the C-joint reactions", e_ne_m, 1e-12);
-  printf("reactions (200 states): H^T Q %.1e, fd round trip %.1e, eq. 28 %.1e, platform N-E %.1e / %.1e\n",
+  tu_check(bad_nullity == 0, "Q's numerical null space has dimension NLAMBDA - (6 NBODY - 3)",
+           bad_nullity, 0);
+  if (redundant) {
+    tu_check(e_Qz <= 1e-14, "Q z = 0 for the reference's null direction z (relative to |Q|)", e_Qz, 1e-14);
+    tu_check(e_lz <= 1e-14, "lambda . z = 0: the minimum-norm lambda", e_lz, 1e-14);
+    tu_check(e_zs <= 1e-13, "z: limbs 3 and 4 push O' along e2 against each other, nothing in limbs 1, 2",
+             e_zs, 1e-13);
+  }
+  printf("reactions (200 states): H^T Q %.1e, fd round trip %.1e, eq. 28 %.1e, platform N-E %.1e / %.1e",
          e_HQ, e_trip, e_all, e_ne_f, e_ne_m);
+  if (redundant) printf("; null direction: Q z %.1e, lambda . z %.1e, structure %.1e", e_Qz, e_lz, e_zs);
+  printf("\n");
+}
+
+/* ---- dynamic manipulability ----
+ * w_R written out here from spec section 8 (J_d^-1, three limbs) and
+ * section 12 (J_d^+ = (J_d^T J_d)^-1 J_d^T, any number of limbs), with
+ * cofactor inverses and no SVD: JtR = J_R,P J_d^+ has rank 2 with range
+ * span{e1, u} = n^perp, n = e1 x u = (0, -sin q1, cos q1), so JtR^+ =
+ * JtR^T (JtR JtR^T)^+ = JtR^T ((JtR JtR^T + c n n^T)^-1 - n n^T / c), c > 0
+ * (c = tr(JtR JtR^T) / 2 keeps the 3x3 inverse as well conditioned as
+ * JtR JtR^T is on its range); and the two
+ * non-zero squared singular values of B = Mt JtR^+ are the roots of
+ * x^2 - tr(B^T B) x + c2 (c2 the sum of B^T B's principal 2x2 minors; its
+ * determinant is 0). */
+static double w_r_from(const double *Jp, const double M[9], const double H[3 * NW], const double q[3])
+{
+  double T[3 * NA], Mt[NA * NA], JtR[3 * NA], G[9], Gi[9], Pi[3 * NA], B[3 * NA], BtB[9];
+  const double n[3] = {0, -sin(q[0]), cos(q[0])};
+  const double *JRP = H + 9 * prru_mech.platform;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < NA; j++) {
+      T[NA * i + j] = JtR[NA * i + j] = 0;
+      for (int l = 0; l < 3; l++) {
+        T[NA * i + j] += M[3 * i + l] * Jp[NA * l + j];
+        JtR[NA * i + j] += JRP[3 * i + l] * Jp[NA * l + j];
+      }
+    }
+  for (int i = 0; i < NA; i++)
+    for (int j = 0; j < NA; j++) {
+      Mt[NA * i + j] = 0;
+      for (int l = 0; l < 3; l++) Mt[NA * i + j] += Jp[NA * l + i] * T[NA * l + j];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      G[3 * i + j] = 0;
+      for (int l = 0; l < NA; l++) G[3 * i + j] += JtR[NA * i + l] * JtR[NA * j + l];
+    }
+  const double c = 0.5 * (G[0] + G[4] + G[8]);
+  for (int i = 0; i < 9; i++) G[i] += c * n[i / 3] * n[i % 3];
+  inv3(G, Gi);
+  for (int i = 0; i < 9; i++) Gi[i] -= n[i / 3] * n[i % 3] / c;
+  for (int i = 0; i < NA; i++)
+    for (int j = 0; j < 3; j++) {
+      Pi[3 * i + j] = 0;
+      for (int l = 0; l < 3; l++) Pi[3 * i + j] += JtR[NA * l + i] * Gi[3 * l + j];
+    }
+  for (int i = 0; i < NA; i++)
+    for (int j = 0; j < 3; j++) {
+      B[3 * i + j] = 0;
+      for (int l = 0; l < NA; l++) B[3 * i + j] += Mt[NA * i + l] * Pi[3 * l + j];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      BtB[3 * i + j] = 0;
+      for (int l = 0; l < NA; l++) BtB[3 * i + j] += B[3 * l + i] * B[3 * l + j];
+    }
+  const double tr = BtB[0] + BtB[4] + BtB[8];
+  const double c2 = BtB[0] * BtB[4] - BtB[1] * BtB[3] + BtB[0] * BtB[8] - BtB[2] * BtB[6] +
+                    BtB[4] * BtB[8] - BtB[5] * BtB[7];
+  const double x1 = 0.5 * (tr + sqrt(fmax(tr * tr - 4 * c2, 0.0))), x2 = c2 / x1;
+  return sqrt(x1 / x2);
+}
+
+static void test_w_r(void)
+{
+  double e_pinv = 0, e_inv = 0;
+  int fails = 0;
+  for (int n = 0; n < 300; n++) {
+    double q[3], qd[3], M[9], J[3 * NA], H[3 * NW], wr;
+    random_state(q, qd, 1);
+    if (prru_ref_w_r(&P, W, q, &wr) || prru_ref_mass(&P, W, q, M) || prru_ref_jd(&P, q, J) ||
+        prru_ref_jacobians(&P, W, q, H)) {
+      fails++;
+      continue;
+    }
+    /* J_d^+ = (J_d^T J_d)^-1 J_d^T (3 x NA). */
+    double N[9], Ni[9], Jp[3 * NA];
+    gram(J, N);
+    inv3(N, Ni);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < NA; j++) {
+        Jp[NA * i + j] = 0;
+        for (int l = 0; l < 3; l++) Jp[NA * i + j] += Ni[3 * i + l] * J[3 * j + l];
+      }
+    e_pinv = fmax(e_pinv, fabs(wr - w_r_from(Jp, M, H, q)) / wr);
+    if (NA == 3) {
+      double Ji[9];
+      inv3(J, Ji);
+      e_inv = fmax(e_inv, fabs(wr - w_r_from(Ji, M, H, q)) / wr);
+    }
+  }
+  tu_check(fails == 0, "w_R states evaluate", fails, 0);
+  tu_check(e_pinv <= 1e-12, "w_R = section 12's sigma_1/sigma_2 of Mt JtR^+ with J_d^+ = (J_d^T J_d)^-1 J_d^T",
+           e_pinv, 1e-12);
+  if (NA == 3)
+    tu_check(e_inv <= 1e-12, "w_R = section 8's sigma_1/sigma_2 of Mt JtR^+ with J_d^-1", e_inv, 1e-12);
+  printf("w_R (300 states): J_d^+ route %.1e", e_pinv);
+  if (NA == 3) printf(", J_d^-1 route %.1e", e_inv);
+  printf("\n");
+}
+
+/* ---- limb 4 mirrors limb 3 (spec section 12) ----
+ * Reflecting the machine in the plane x = 0 maps limb 3 onto limb 4 and
+ * R_P = Rx(q1) Ry(q2) onto Rx(q1) Ry(-q2): where limbs 3 and 4 have the
+ * same b, l1 and l2 (read from the descriptor), d_4(q1, q2, q3) =
+ * d_3(q1, -q2, q3), d_3(q) = d_4(q1, -q2, q3), and the rows of J_d follow
+ * with the q2 column negated. */
+static void test_mirror(void)
+{
+  if (PRRU_NLIMB != 4) return;
+  const int l3 = 2, l4 = PRRU_NLIMB - 1;
+  if (!(prru_mech.b[l4] == prru_mech.b[l3] && prru_mech.l1[l4] == prru_mech.l1[l3] &&
+        prru_mech.l2[l4] == prru_mech.l2[l3])) {
+    printf("mirror: limbs 3 and 4 differ in b, l1 or l2; d_4 = d_3 mirrored not checked\n");
+    return;
+  }
+  double e_d = 0, e_j = 0;
+  int fails = 0;
+  for (int n = 0; n < 300; n++) {
+    double q[3], qd[3], d[NA], dm[NA], J[3 * NA], Jm[3 * NA];
+    random_state(q, qd, 0);
+    const double qm[3] = {q[0], -q[1], q[2]};
+    if (prru_ref_ik(&P, q, d) || prru_ref_ik(&P, qm, dm) || prru_ref_jd(&P, q, J) ||
+        prru_ref_jd(&P, qm, Jm)) {
+      fails++;
+      continue;
+    }
+    const double a[2] = {d[l4], d[l3]}, b[2] = {dm[l3], dm[l4]};
+    e_d = fmax(e_d, tu_relerr(a, b, 2, 1e-300));
+    const double ja[6] = {J[3 * l4], J[3 * l4 + 1], J[3 * l4 + 2], J[3 * l3], J[3 * l3 + 1], J[3 * l3 + 2]};
+    const double jb[6] = {Jm[3 * l3], -Jm[3 * l3 + 1], Jm[3 * l3 + 2], Jm[3 * l4], -Jm[3 * l4 + 1], Jm[3 * l4 + 2]};
+    e_j = fmax(e_j, tu_relerr(ja, jb, 6, 1e-300));
+  }
+  tu_check(fails == 0, "mirror states evaluate (q and (q1, -q2, q3) both reachable)", fails, 0);
+  tu_check(e_d <= 1e-15, "d_4(q1, q2, q3) = d_3(q1, -q2, q3) and d_3 = d_4 mirrored", e_d, 1e-15);
+  tu_check(e_j <= 1e-15, "J_d rows 3, 4 mirror each other (q2 column negated)", e_j, 1e-15);
+  printf("mirror (300 states): d %.1e, J_d %.1e\n", e_d, e_j);
 }
 
 static int all_nan(const double *x, int n)
@@ -708,14 +968,14 @@ static void test_unreachable(void)
   for (int axis = 0; axis < 2; axis++)
     if (unreachable_along(axis, bad[nbad])) nbad++;
     else printf("no unreachable q along q%d in (0, pi]\n", axis + 1);
-  const double qd[3] = {0.1, 0.2, 0.3}, f3[3] = {1, 2, 3};
+  const double qd[3] = {0.1, 0.2, 0.3}, f3[4] = {1, 2, 3, 4}; /* f3[0..NA-1]: fd */
   static double big[NW * NL], big2[9 * NB];
   for (int k = 0; k < nbad; k++) {
     const double *q = bad[k];
-    double x[9], y[3], z[3], wr;
-    int ok = 1;
-    ok &= prru_ref_ik(&P, q, x) == GSL_EDOM && all_nan(x, 3);
-    ok &= prru_ref_jd(&P, q, x) == GSL_EDOM && all_nan(x, 9);
+    double x[3 * NA], y[NA], z[NA], wr;
+    int ok = 1, nullity;
+    ok &= prru_ref_ik(&P, q, x) == GSL_EDOM && all_nan(x, NA);
+    ok &= prru_ref_jd(&P, q, x) == GSL_EDOM && all_nan(x, 3 * NA);
     ok &= prru_ref_poses(&P, q, big2, big) == GSL_EDOM && all_nan(big2, 9 * NB) && all_nan(big, 3 * NB);
     ok &= prru_ref_jacobians(&P, W, q, big) == GSL_EDOM && all_nan(big, 3 * NW);
     ok &= prru_ref_bias_terms(&P, W, q, qd, big) == GSL_EDOM && all_nan(big, NW);
@@ -724,12 +984,13 @@ static void test_unreachable(void)
     ok &= prru_ref_gravity(&P, W, q, y) == GSL_EDOM && all_nan(y, 3);
     ok &= prru_ref_dynamics(&P, W, q, qd, x, y, z) == GSL_EDOM && all_nan(x, 9) && all_nan(y, 3) && all_nan(z, 3);
     ok &= prru_ref_energy(&P, W, q, qd, y) == GSL_EDOM && all_nan(y, 2);
-    ok &= prru_ref_actuator_rates(&P, q, qd, y, z) == GSL_EDOM && all_nan(y, 3) && all_nan(z, 3);
+    ok &= prru_ref_actuator_rates(&P, q, qd, y, z) == GSL_EDOM && all_nan(y, NA) && all_nan(z, NA);
     ok &= prru_ref_passive(&P, W, q, qd, y) == GSL_EDOM && all_nan(y, 3);
     ok &= prru_ref_forward_dynamics(&P, W, q, qd, f3, f3, f3, y) == GSL_EDOM && all_nan(y, 3);
-    ok &= prru_ref_inverse_dynamics(&P, W, q, qd, f3, f3, f3, y) == GSL_EDOM && all_nan(y, 3);
+    ok &= prru_ref_inverse_dynamics(&P, W, q, qd, f3, f3, f3, y) == GSL_EDOM && all_nan(y, NA);
     ok &= prru_ref_reaction_basis(&P, W, q, big) == GSL_EDOM && all_nan(big, NW * NL);
     ok &= prru_ref_reactions(&P, W, q, qd, f3, f3, f3, big) == GSL_EDOM && all_nan(big, NL);
+    ok &= prru_ref_reaction_null(&P, W, q, big, &nullity) == GSL_EDOM && all_nan(big, NL) && nullity == -1;
     ok &= prru_ref_w_r(&P, W, q, &wr) == GSL_EDOM && isnan(wr);
     char what[120];
     snprintf(what, sizeof what, "q = (%g, %g, %g) unreachable or not finite: every function GSL_EDOM and NaN",
@@ -749,6 +1010,8 @@ int main(void)
   test_christoffel();
   test_passive();
   test_reactions();
+  test_w_r();
+  test_mirror();
   test_unreachable();
   prru_ref_free(W);
   return tu_finish("test_reference");
