@@ -1,7 +1,8 @@
 /* prru dme, prru map and the fig. 7 part of prru paper: the rotational
  * dynamic manipulability ellipse and w_R at one pose, w_R over a grid, and
  * the paper's workspace study with its gnuplot figures. */
-#define _POSIX_C_SOURCE 200809L /* isatty */
+#define _POSIX_C_SOURCE 200809L /* isatty, open_memstream */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,12 +15,13 @@
 
 #define FIG7_PI 3.14159265358979323846
 /* Fig. 7's practical-singularity tolerance: J_d counts as singular where
- * cond_1(J_d) > 1e3 (the home pose has about 14). With the model's
- * numerical 1e-8 no grid point is flagged, w_R spikes to ~1e2-1e5 next to
- * the locus det J_d = 0 and the global index depends on the resolution
- * (prru_dme.h); with 1e-3 the band around the locus is marked and the
- * index converges. The summary gives both. */
-#define FIG7_RCOND_MIN 1e-3
+ * cond_1 > 250 (of J_d with its rotation columns in units of the model's
+ * length, see prru_check_regular; the paper's home pose has about 4). With
+ * the model's numerical 1e-8 no grid point is flagged, w_R spikes to
+ * ~1e2-1e5 next to the locus det J_d = 0 and the global index depends on
+ * the resolution (prru_dme.h); with 4e-3 the band around the locus is
+ * marked and the index converges. The summary gives both. */
+#define FIG7_RCOND_MIN 4e-3
 
 static const char dme_help[] =
     "usage: prru dme --q q1,q2,q3 [--rcond-min R]\n"
@@ -128,12 +130,19 @@ static const char map_help[] =
     "(name, file, sha256) and the global index: the mean of w_R - 1 over the ok\n"
     "points, with the fraction of the grid that is singular or unreachable (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
-    "and the range of w_R. J_d counts as singular when 1/(|J_d|_1 |J_d^-1|_1) < R\n"
-    "(default: the model's 1e-8). If the grid crosses the singular locus, the\n"
-    "mean of w_R - 1 depends on how close grid points fall to it: compare designs\n"
-    "with a practical tolerance such as --rcond-min 1e-3. Uses N threads\n"
+    "and the range of w_R. J_d counts as singular when 1/(|J|_1 |J^-1|_1) < R,\n"
+    "J = J_d with its rotation columns divided by the mean upper-link length\n"
+    "(default R: 1e-8). If the grid crosses the singular locus, the mean of\n"
+    "w_R - 1 depends on how close grid points fall to it: compare designs with\n"
+    "a practical tolerance such as --rcond-min 4e-3. Uses N threads\n"
     "(default 2); a progress bar goes to stderr for grids over 10000 points when\n"
-    "stderr is a terminal, or always with --progress.\n";
+    "stderr is a terminal, or always with --progress.\n"
+    "FILE is checked before the grid is computed, built as FILE.partial-XXXXXX\n"
+    "and renamed at the end: it keeps its old contents until then. SIGINT,\n"
+    "SIGTERM or SIGHUP (exit 130, 143, 129) stop the computation; the complete\n"
+    "q1 rows computed so far are then written (a second signal stops that too,\n"
+    "at a row boundary) and no summary is printed. A write error exits 1 with\n"
+    "the reason and leaves FILE unchanged.\n";
 
 /* "a:b:n" with finite a < b and an integer 2 <= n <= 1e6; 0 or 2. */
 static int parse_range(const char *name, const char *text, double *lo, double *hi, int *n)
@@ -195,36 +204,42 @@ static int draw_progress(long done, long total, void *ctx)
   return 0;
 }
 
-/* The map's CSV; 0 or 1 with a message naming the file. */
-static int write_map_csv(const char *cmd, const char *path, const prru_map_grid *g,
-                         const double *w, const unsigned char *st)
+/* Grid statuses start as this: prru_map_eval writes a prru_status (small)
+ * for every point it evaluated. */
+#define MAP_NOT_DONE 0xFF
+
+/* The q1 rows of an interrupted map that are complete: prru_map_eval hands
+ * rows out in order and finishes every row it started. */
+static int map_rows_done(const prru_map_grid *g, const unsigned char *st)
 {
-  FILE *f = fopen(path, "w");
-  if (!f) {
-    prru_cli_error(cmd, "%s: cannot open for writing", path);
-    return 1;
-  }
-  static char buf[1 << 16];
-  setvbuf(f, buf, _IOFBF, sizeof buf);
-  prru_cli_csv_comment(f);
-  fputs("q1,q2,q3,w_R,status\n", f);
-  for (int i = 0; i < g->n1; i++) {
+  long n = (long)g->n1 * g->n2, k = 0;
+  while (k < n && st[k] != MAP_NOT_DONE) k++;
+  return (int)(k / g->n2);
+}
+
+/* The map's CSV (comment, header, the first nrows q1 rows) into o;
+ * PRRU_OK, PRRU_EIO (o->err) or PRRU_EINTERRUPTED when a signal arrives
+ * (one more than the signal_count it started with) before the last row. */
+static int write_map_csv(prru_cli_out *o, const prru_map_grid *g, const double *w,
+                         const unsigned char *st, int nrows, int signal_count)
+{
+  prru_cli_out_comment(o);
+  prru_cli_out_printf(o, "q1,q2,q3,w_R,status\n");
+  prru_cli_out_line(o);
+  for (int i = 0; i < nrows; i++) {
     double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
     for (int j = 0; j < g->n2; j++) {
+      if (prru_cli_signal_count != signal_count) return PRRU_EINTERRUPTED;
       long k = (long)i * g->n2 + j;
       double q2 = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
       if (st[k] == PRRU_OK)
-        fprintf(f, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, g->q3, w[k]);
+        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, g->q3, w[k]);
       else
-        fprintf(f, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_dme_status_name(st[k]));
+        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_dme_status_name(st[k]));
+      if (prru_cli_out_row(o)) return PRRU_EIO;
     }
   }
-  int bad = ferror(f);
-  if (fclose(f) != 0 || bad) {
-    prru_cli_error(cmd, "%s: write error", path);
-    return 1;
-  }
-  return 0;
+  return prru_cli_out_flush(o) ? PRRU_EIO : PRRU_OK;
 }
 
 static void print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
@@ -241,7 +256,9 @@ static void print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
             s->w_min_q[0], s->w_min_q[1], s->w_max, s->w_max_q[0], s->w_max_q[1]);
 }
 
-/* Allocates and evaluates a map; 0, 1 (message printed) or 130. */
+/* Allocates and evaluates a map (statuses MAP_NOT_DONE where it did not
+ * get to): PRRU_OK, PRRU_EINTERRUPTED (a signal: the rows done so far are
+ * in w and st) or another status after a message. */
 static int run_map(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
                    int progress, double **w, unsigned char **st, prru_map_summary *sum)
 {
@@ -250,8 +267,9 @@ static int run_map(const char *cmd, const prru_model *m, const prru_map_grid *g,
   *st = malloc(n);
   if (!*w || !*st) {
     prru_cli_error(cmd, "out of memory for %zu grid points", n);
-    return 1;
+    return PRRU_ENOMEM;
   }
+  memset(*st, MAP_NOT_DONE, n);
   prru_map_options o;
   prru_map_options_default(&o);
   o.nthreads = nthreads;
@@ -260,15 +278,13 @@ static int run_map(const char *cmd, const prru_model *m, const prru_map_grid *g,
     o.progress = draw_progress;
     o.ctx = &bar;
   }
-  prru_cli_catch_sigint();
   o.interrupt = &prru_cli_interrupted;
   int rc = prru_map_eval(m, g, &o, *w, *st, sum);
   if (rc != PRRU_OK) {
     if (progress) fputc('\n', stderr);
-    prru_cli_error(cmd, "map: %s", prru_strerror(rc));
-    return prru_cli_exit_for(rc);
+    if (rc != PRRU_EINTERRUPTED) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
   }
-  return 0;
+  return rc;
 }
 
 int prru_cmd_map(int argc, char **argv)
@@ -310,20 +326,46 @@ int prru_cmd_map(int argc, char **argv)
   prru_model m;
   prru_model_default(&m);
   if (parse_rcond("map", rcs, &m)) return 2;
+  if (strcmp(out, "-") == 0) {
+    prru_cli_error("map", "--out -: the summary goes to stdout; give the CSV a file name");
+    return 2;
+  }
   long npts = (long)g.n1 * g.n2;
   int show = progress || (npts > 10000 && isatty(2));
+  /* The output is created (and so checked) before the grid is computed. */
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "map", out)) return 1;
   double *w = NULL;
   unsigned char *st = NULL;
   prru_map_summary sum;
   int rc = run_map("map", &m, &g, nthreads, show, &w, &st, &sum);
-  if (rc == 0) rc = write_map_csv("map", out, &g, w, st);
-  if (rc == 0) {
+  int nrows = rc == PRRU_OK ? g.n1 : rc == PRRU_EINTERRUPTED ? map_rows_done(&g, st) : 0;
+  /* After a first signal the rows computed are still written; a later
+   * one stops that too. */
+  int wst = nrows > 0 ? write_map_csv(&o, &g, w, st, nrows, prru_cli_signal_count) : PRRU_OK;
+  if (wst == PRRU_EINTERRUPTED) rc = PRRU_EINTERRUPTED;
+  long rows = o.rows;
+  int status;
+  if (prru_cli_out_close(&o, !o.err && rows > 0)) {
+    status = 1;
+  } else if (rc == PRRU_EINTERRUPTED) {
+    if (rows > 0)
+      prru_cli_error("map", "interrupted (%s): %ld of %ld grid points written to %s, no summary",
+                     prru_cli_signal_name(), rows, npts, out);
+    else
+      prru_cli_error("map", "interrupted (%s): nothing written, %s is not changed",
+                     prru_cli_signal_name(), out);
+    status = prru_cli_exit_interrupted();
+  } else if (rc != PRRU_OK) {
+    status = 1;
+  } else {
     print_summary(stdout, &sum, m.jd_rcond_min);
-    if (ferror(stdout)) rc = 1;
+    status = 0;
   }
   free(w);
   free(st);
-  return rc;
+  return status;
 }
 
 /* ---- prru paper: fig. 7 ---- */
@@ -344,7 +386,7 @@ static const char fig7_script[] =
     "set yrange [-pi/4:pi/6]\n"
     "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n"
     "set output 'fig7_surface.png'\n"
-    "set title sprintf(\"Rotational dynamic manipulability index w_R over the workspace, q_3 = 0 m (paper fig. 7), model %s\\n201 x 201 grid, w_R from %.3f to %.3g; red: J_d singular, cond_1(J_d) > 10^3\", model, STATS_min, STATS_max)\n"
+    "set title sprintf(\"Rotational dynamic manipulability index w_R over the workspace, q_3 = 0 m (paper fig. 7), model %s\\n201 x 201 grid, w_R from %.3f to %.3g; red: J_d singular, cond_1 > 250\", model, STATS_min, STATS_max)\n"
     "set zlabel 'w_R (-), log scale' rotate by 90\n"
     "set logscale z\n"
     "set logscale cb\n"
@@ -377,7 +419,7 @@ static const char fig7_script[] =
     "unset logscale cb\n"
     "set cbrange [1:2.5]\n"
     "set cbtics auto\n"
-    "set title \"w_R over the workspace, q_3 = 0 m (paper fig. 7), model \".model.\", contours 1.1 to 2.1 by 0.1, then 2.5, 3, 5, 10\\nred: J_d singular, cond_1(J_d) > 10^3 (the corners beyond that band are another assembly mode)\"\n"
+    "set title \"w_R over the workspace, q_3 = 0 m (paper fig. 7), model \".model.\", contours 1.1 to 2.1 by 0.1, then 2.5, 3, 5, 10\\nred: J_d singular, cond_1 > 250 (the corners beyond that band are another assembly mode)\"\n"
     "set size ratio -1\n"
     "set key inside left top textcolor rgb 'white' noopaque nobox\n"
     "set grid front\n"
@@ -415,19 +457,35 @@ static const char fig7_script[] =
 static const double fig7a_poses[][2] = {{0.0, 0.0}, {0.4, 0.0}, {0.0, 0.45}, {0.0, -0.6}, {0.3, -0.5}};
 #define FIG7A_NPOSE ((int)(sizeof fig7a_poses / sizeof fig7a_poses[0]))
 
-static FILE *open_out(const char *dir, const char *name, char *path, size_t len)
+/* Where prru paper builds its files (stage) and where they will be (out,
+ * named in messages). */
+typedef struct {
+  const char *stage, *out;
+} fig7_dirs;
+
+/* stage/name for writing; shown = out/name for messages. */
+static FILE *open_out(const fig7_dirs *dirs, const char *name, char *shown, size_t len)
 {
-  snprintf(path, len, "%s/%s", dir, name);
+  char path[4200];
+  snprintf(path, sizeof path, "%s/%s", dirs->stage, name);
+  snprintf(shown, len, "%s/%s", dirs->out, name);
   FILE *f = fopen(path, "w");
-  if (!f) prru_cli_error("paper", "%s: cannot open for writing", path);
+  if (!f) prru_cli_error("paper", "%s: cannot open for writing: %s", shown, strerror(errno));
   return f;
 }
 
-static int close_out(FILE *f, const char *path)
+static int close_out(FILE *f, const char *shown)
 {
-  int bad = ferror(f);
-  if (fclose(f) != 0 || bad) {
-    prru_cli_error("paper", "%s: write error", path);
+  errno = 0;
+  int bad = ferror(f) != 0, e = 0;
+  if (fflush(f) != 0) bad = 1;
+  e = errno;
+  if (fclose(f) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
+  if (bad) {
+    prru_cli_error("paper", "%s: write error: %s", shown, e ? strerror(e) : "output lost");
     return 1;
   }
   return 0;
@@ -435,13 +493,13 @@ static int close_out(FILE *f, const char *path)
 
 /* Ellipse outlines (a . e1, a . v) and segment half-lengths at the fig. 7a
  * poses; the script needs their count. */
-static int write_fig7a(const char *outdir, const prru_model *m, prru_data *d)
+static int write_fig7a(const fig7_dirs *dirs, const prru_model *m, prru_data *d)
 {
   char path[4200];
-  FILE *fe = open_out(outdir, "fig7a_ellipses.dat", path, sizeof path);
+  FILE *fe = open_out(dirs, "fig7a_ellipses.dat", path, sizeof path);
   if (!fe) return 1;
   char path2[4200];
-  FILE *fs = open_out(outdir, "fig7a_segments.dat", path2, sizeof path2);
+  FILE *fs = open_out(dirs, "fig7a_segments.dat", path2, sizeof path2);
   if (!fs) {
     fclose(fe);
     return 1;
@@ -473,8 +531,15 @@ static int write_fig7a(const char *outdir, const prru_model *m, prru_data *d)
   return rc;
 }
 
-int prru_paper_fig7(const char *outdir, FILE *summary)
+/* The exit status for a map or write status of the fig. 7 part. */
+static int fig7_status(int st)
 {
+  return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
+}
+
+int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
+{
+  const fig7_dirs dirs = {stage, outdir};
   prru_model m;
   prru_model_default(&m);
   const double rcond_numeric = m.jd_rcond_min;
@@ -483,17 +548,21 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   double *w = NULL;
   unsigned char *st = NULL;
   prru_map_summary sum, sum_numeric;
-  int rc = run_map("paper", &m, &g, 2, 0, &w, &st, &sum);
+  int rc = fig7_status(run_map("paper", &m, &g, 2, 0, &w, &st, &sum));
   if (rc == 0) {
     /* The same grid at the numerical tolerance, for the summary only. */
     prru_model mn = m;
     mn.jd_rcond_min = rcond_numeric;
     prru_map_options o;
     prru_map_options_default(&o);
+    o.interrupt = &prru_cli_interrupted;
     double *w2 = malloc((size_t)g.n1 * g.n2 * sizeof *w2);
     unsigned char *st2 = malloc((size_t)g.n1 * g.n2);
-    if (!w2 || !st2 || prru_map_eval(&mn, &g, &o, w2, st2, &sum_numeric) != PRRU_OK) {
-      prru_cli_error("paper", "fig. 7 map at the numerical tolerance failed");
+    int s2 = w2 && st2 ? prru_map_eval(&mn, &g, &o, w2, st2, &sum_numeric) : PRRU_ENOMEM;
+    if (s2 == PRRU_EINTERRUPTED) {
+      rc = prru_cli_exit_interrupted();
+    } else if (s2 != PRRU_OK) {
+      prru_cli_error("paper", "fig. 7 map at the numerical tolerance: %s", prru_strerror(s2));
       rc = 1;
     }
     free(w2);
@@ -501,11 +570,21 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   }
   char path[4200];
   if (rc == 0) {
-    snprintf(path, sizeof path, "%s/fig7_map.csv", outdir);
-    rc = write_map_csv("paper", path, &g, w, st);
+    char shown[4200];
+    prru_cli_out o;
+    snprintf(path, sizeof path, "%s/fig7_map.csv", stage);
+    snprintf(shown, sizeof shown, "%s/fig7_map.csv", outdir);
+    rc = prru_cli_out_open(&o, "paper", path);
+    if (rc == 0) {
+      o.name = shown;
+      /* A signal stops it (and the run: nothing of it is kept). */
+      int ws = write_map_csv(&o, &g, w, st, g.n1, prru_cli_signal_count);
+      rc = prru_cli_out_close(&o, ws == PRRU_OK);
+      if (rc == 0 && ws != PRRU_OK) rc = fig7_status(ws);
+    }
   }
   /* gnuplot's pm3d and image want scans separated by blank lines. */
-  FILE *f = rc == 0 ? open_out(outdir, "fig7_grid.dat", path, sizeof path) : NULL;
+  FILE *f = rc == 0 ? open_out(&dirs, "fig7_grid.dat", path, sizeof path) : NULL;
   if (rc == 0 && !f) rc = 1;
   if (f) {
     prru_cli_csv_comment(f);
@@ -524,7 +603,7 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
     }
     rc = close_out(f, path);
   }
-  f = rc == 0 ? open_out(outdir, "fig7_singular.dat", path, sizeof path) : NULL;
+  f = rc == 0 ? open_out(&dirs, "fig7_singular.dat", path, sizeof path) : NULL;
   if (rc == 0 && !f) rc = 1;
   if (f) {
     prru_cli_csv_comment(f);
@@ -542,9 +621,10 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
   prru_dme home;
   if (rc == 0) {
     prru_dme_eval(&m, d, (const double[3]){0.0, 0.0, 0.0}, &home);
-    rc = write_fig7a(outdir, &m, d);
+    rc = write_fig7a(&dirs, &m, d);
   }
   free(d);
+  if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
   if (rc == 0) {
     char *script = NULL;
     size_t len = 0;
@@ -557,13 +637,14 @@ int prru_paper_fig7(const char *outdir, FILE *summary)
       prru_cli_error("paper", "out of memory for the fig. 7 script");
       rc = 1;
     } else {
-      rc = prru_cli_gnuplot(outdir, "fig7_plots.gp", script);
+      rc = prru_cli_gnuplot(stage, outdir, "fig7_plots.gp", script);
     }
     free(script);
   }
-  if (rc == 0) {
+  /* Without gnuplot the data and the summary are still complete. */
+  if (rc == 0 || rc == PRRU_CLI_NO_GNUPLOT) {
     FILE *outs[2] = {summary, stdout};
-    for (int i = 0; i < 2 && rc == 0; i++) {
+    for (int i = 0; i < 2; i++) {
       FILE *s = outs[i];
       if (!s) continue;
       fprintf(s, "\nWorkspace map (paper fig. 7): q3 = 0, q1 in [-pi/6, pi/6], q2 in [-pi/4, pi/6], "

@@ -126,14 +126,17 @@ int prru_cmd_fk(int argc, char **argv)
 
 /* %s: the output's columns. */
 static const char id_help[] =
-    "usage: prru id --traj FILE.csv [--out FILE.csv]\n"
+    "usage: prru id --traj FILE.csv [--out FILE.csv|-]\n"
     "Inverse dynamics along a trajectory: FILE has a header row and columns\n"
     "t, q1..q3, qd1..qd3, qdd1..qdd3 (any order, other columns ignored) and\n"
     "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); lines starting\n"
     "with '#' are skipped, so `prru simulate` output qualifies. Writes the model\n"
-    "line (# prru ... model ...) and t,%s (N) to --out or stdout. A row\n"
-    "where the pose is unreachable or J_d singular stops with exit 1; the rows\n"
-    "before it are kept. An unreadable or malformed FILE exits 2.\n";
+    "line (# prru ... model ...) and t,%s (N) to --out or stdout (also\n"
+    "--out -); --out FILE keeps its old contents until the first row is ready\n"
+    "(it is built as FILE.partial-XXXXXX and renamed). A row where the pose is\n"
+    "unreachable or J_d singular stops with exit 1, SIGINT/SIGTERM/SIGHUP with\n"
+    "exit 130/143/129; the rows before it are kept. A write error exits 1 with\n"
+    "the reason; an unreadable or malformed FILE exits 2.\n";
 
 int prru_cmd_id(int argc, char **argv)
 {
@@ -168,19 +171,28 @@ int prru_cmd_id(int argc, char **argv)
       return 2;
     }
   for (int k = 0; k < 6; k++) col[10 + k] = prru_table_column(&t, opt[k]);
-  FILE *f = out ? fopen(out, "w") : stdout;
-  if (!f) {
-    prru_cli_error("id", "--out %s: cannot open for writing", out);
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "id", out)) {
     prru_table_free(&t);
     return 1;
   }
+  const char *name = o.name;
+  int in_place = o.tmp_path == NULL;
   prru_model m;
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
   st = d ? PRRU_OK : PRRU_ENOMEM;
-  prru_cli_csv_comment(f);
-  fprintf(f, "t,%s\n", fd_names);
-  for (int i = 0; st == PRRU_OK && i < t.nrows; i++) {
+  prru_cli_out_comment(&o);
+  prru_cli_out_printf(&o, "t,%s\n", fd_names);
+  prru_cli_out_line(&o);
+  char why[700] = "";
+  for (int i = 0; st == PRRU_OK && !o.err && i < t.nrows; i++) {
+    if (prru_cli_interrupted) {
+      st = PRRU_EINTERRUPTED;
+      snprintf(why, sizeof why, "interrupted (%s) before data row %d", prru_cli_signal_name(), i + 1);
+      break;
+    }
     const double *row = t.data + (size_t)i * (size_t)t.ncols;
     double v[16], fd[PRRU_NACT];
     for (int k = 0; k < 16; k++) v[k] = col[k] < 0 ? 0.0 : row[col[k]];
@@ -190,21 +202,27 @@ int prru_cmd_id(int argc, char **argv)
     memcpy(l.mp, v + 13, sizeof l.mp);
     st = prru_inverse_dynamics(&m, d, v + 1, v + 4, v + 7, &l, fd);
     if (st != PRRU_OK) {
-      prru_cli_error("id", "%s: data row %d (t = %g): %s; %d rows written", traj, i + 1, v[0],
-                     prru_strerror(st), i);
+      snprintf(why, sizeof why, "%s: data row %d (t = %g): %s", traj, i + 1, v[0], prru_strerror(st));
       break;
     }
-    fprintf(f, "%.17g", v[0]);
-    for (int k = 0; k < PRRU_NACT; k++) fprintf(f, ",%.17g", fd[k]);
-    fputc('\n', f);
+    prru_cli_out_printf(&o, "%.17g", v[0]);
+    prru_cli_out_numbers(&o, fd, PRRU_NACT);
+    prru_cli_out_printf(&o, "\n");
+    prru_cli_out_row(&o);
   }
-  int bad_io = ferror(f) != 0;
-  if (f != stdout) bad_io |= fclose(f) != 0;
-  if (bad_io && st == PRRU_OK) {
-    prru_cli_error("id", "%s: write error", out ? out : "stdout");
-    st = PRRU_EIO;
-  }
+  long rows = o.rows;
+  int io = o.err != 0;
   free(d);
   prru_table_free(&t);
+  /* The rows before a stop are kept; nothing (and the old file) when the
+   * first row already failed or the output could not be written. */
+  if (prru_cli_out_close(&o, !io && (rows > 0 || st == PRRU_OK))) return 1;
+  if (st != PRRU_OK) {
+    if (rows > 0)
+      prru_cli_error("id", "%s; %ld rows written to %s", why, rows, name);
+    else
+      prru_cli_error("id", "%s; nothing written%s%s%s", why, in_place ? "" : ", ",
+                     in_place ? "" : name, in_place ? "" : " is not changed");
+  }
   return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
 }

@@ -1,12 +1,16 @@
 /* prru paper: the paper's section 4.3 simulation study and its fig. 7
  * workspace map, written as CSVs, gnuplot PNGs and a text summary. */
-#define _POSIX_C_SOURCE 200809L /* mkdir */
+#define _POSIX_C_SOURCE 200809L /* mkdir, mkdtemp, fork, waitpid, nanosleep */
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "commands.h"
 #include "prru.h"
@@ -19,6 +23,11 @@ static const char paper_help[] =
     "Writes DIR/paper_sim.csv (columns as `prru simulate`), fig_q.png, fig_d.png,\n"
     "fig4_u_joint_forces.png, fig6_p_joint_reactions.png, the fig. 7 files and\n"
     "DIR/summary.txt. Needs gnuplot for the PNGs.\n"
+    "The files are built in DIR/paper.partial-XXXXXX and moved into DIR only\n"
+    "when the run is complete: a run that fails or is stopped (SIGINT, SIGTERM,\n"
+    "SIGHUP: exit 130, 143, 129) leaves DIR as it was. Without gnuplot the\n"
+    "CSVs, scripts and summary are moved in, the PNGs of an earlier run removed,\n"
+    "and the exit status is 1. --skip-map leaves earlier fig7_* files alone.\n"
     "Every file names the model the build computes; with a model other than the\n"
     "paper's (models/3prru_paper.json) the study runs on that model and a warning\n"
     "says that the figures are not the paper's results.\n";
@@ -189,36 +198,153 @@ static char *plot_script(void)
 }
 
 /* Runs gnuplot on a script in dir (cd there so outputs land beside it). */
-int prru_cli_gnuplot(const char *dir, const char *script_name, const char *script)
+int prru_cli_gnuplot(const char *dir, const char *shown_dir, const char *script_name,
+                     const char *script)
 {
-  char path[4200], cmd[8600];
+  char path[4200], shown[4200];
   snprintf(path, sizeof path, "%s/%s", dir, script_name);
+  snprintf(shown, sizeof shown, "%s/%s", shown_dir, script_name);
   FILE *f = fopen(path, "w");
-  if (!f || fputs(script, f) < 0 || fclose(f) != 0) {
-    prru_cli_error("paper", "%s: cannot write", path);
+  if (!f) {
+    prru_cli_error("paper", "%s: cannot open for writing: %s", shown, strerror(errno));
     return 1;
   }
-  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    prru_cli_error("paper", "gnuplot not found: CSVs and %s written, PNGs not made "
-                   "(install gnuplot-nox, e.g. with 'make deps')", script_name);
+  errno = 0;
+  int bad = fputs(script, f) < 0 || fflush(f) != 0;
+  int e = errno;
+  if (fclose(f) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
+  if (bad) {
+    prru_cli_error("paper", "%s: write error: %s", shown, e ? strerror(e) : "output lost");
     return 1;
   }
-  snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot '%s'", dir, script_name);
-  if (strchr(dir, '\'') || system(cmd) != 0) {
-    prru_cli_error("paper", "gnuplot failed on %s", path);
+  fflush(NULL); /* nothing buffered is written twice by the child */
+  pid_t pid = fork();
+  if (pid < 0) {
+    prru_cli_error("paper", "cannot start gnuplot: %s", strerror(errno));
+    return 1;
+  }
+  if (pid == 0) {
+    /* The caught signals return to their defaults at exec. */
+    if (chdir(dir) != 0) _exit(126);
+    execlp("gnuplot", "gnuplot", script_name, (char *)NULL);
+    _exit(errno == ENOENT ? 127 : 126);
+  }
+  /* Poll rather than block, so that a signal to prru alone (kill) stops
+   * gnuplot too. */
+  int status = 0, killed = 0;
+  for (;;) {
+    pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) {
+      prru_cli_error("paper", "waiting for gnuplot: %s", strerror(errno));
+      return 1;
+    }
+    if (prru_cli_interrupted && !killed) {
+      kill(pid, SIGTERM);
+      killed = 1;
+    }
+    struct timespec ts = {0, 20 * 1000 * 1000};
+    nanosleep(&ts, NULL);
+  }
+  if (prru_cli_interrupted) return prru_cli_exit_interrupted();
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return PRRU_CLI_NO_GNUPLOT;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    prru_cli_error("paper", "gnuplot failed on %s", shown);
     return 1;
   }
   return 0;
 }
 
-static int make_dir(const char *dir)
+/* Creates dir unless it is there; *created says which. */
+static int make_dir(const char *dir, int *created)
 {
-  if (mkdir(dir, 0777) == 0 || errno == EEXIST) {
-    struct stat st;
-    if (stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) return 0;
+  *created = 0;
+  if (mkdir(dir, 0777) == 0) {
+    *created = 1;
+    return 0;
   }
-  prru_cli_error("paper", "--out %s: cannot create the directory", dir);
+  int e = errno;
+  struct stat st;
+  if (e == EEXIST && stat(dir, &st) == 0) {
+    if (S_ISDIR(st.st_mode)) return 0;
+    e = ENOTDIR;
+  }
+  prru_cli_error("paper", "--out %s: cannot create the directory: %s", dir, strerror(e));
   return 1;
+}
+
+/* Removes the regular files in dir (one level: all prru paper and gnuplot
+ * write) and dir. */
+static void remove_dir(const char *dir)
+{
+  DIR *d = opendir(dir);
+  if (d) {
+    struct dirent *e;
+    char path[4400];
+    while ((e = readdir(d)) != NULL) {
+      if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+      snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+      unlink(path);
+    }
+    closedir(d);
+  }
+  rmdir(dir);
+}
+
+/* Moves every file of stage into out (summary.txt last, so that a summary
+ * never describes files that are not there yet); 0 or 1 with a message. */
+static int move_files(const char *stage, const char *out)
+{
+  DIR *d = opendir(stage);
+  if (!d) {
+    prru_cli_error("paper", "%s: %s", stage, strerror(errno));
+    return 1;
+  }
+  struct dirent *e;
+  char from[4400], to[4400];
+  int rc = 0, has_summary = 0;
+  while ((e = readdir(d)) != NULL) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+    if (strcmp(e->d_name, "summary.txt") == 0) {
+      has_summary = 1;
+      continue;
+    }
+    snprintf(from, sizeof from, "%s/%s", stage, e->d_name);
+    snprintf(to, sizeof to, "%s/%s", out, e->d_name);
+    if (rename(from, to) != 0) {
+      prru_cli_error("paper", "%s: cannot move into place: %s", to, strerror(errno));
+      rc = 1;
+    }
+  }
+  closedir(d);
+  if (has_summary && rc == 0) {
+    snprintf(from, sizeof from, "%s/summary.txt", stage);
+    snprintf(to, sizeof to, "%s/summary.txt", out);
+    if (rename(from, to) != 0) {
+      prru_cli_error("paper", "%s: cannot move into place: %s", to, strerror(errno));
+      rc = 1;
+    }
+  }
+  return rc;
+}
+
+/* What gnuplot makes: without gnuplot, earlier copies are removed so that
+ * DIR never shows figures of another run. */
+static const char *const plot_outputs[] = {"fig_q.png", "fig_d.png", "fig4_u_joint_forces.png",
+                                           "fig6_p_joint_reactions.png"};
+static const char *const fig7_plot_outputs[] = {"fig7_surface.png", "fig7_contour.png",
+                                                "fig7a_ellipses.png", "fig7_contours.dat"};
+
+static void remove_stale(const char *out, const char *const *names, int n)
+{
+  char path[4400];
+  for (int i = 0; i < n; i++) {
+    snprintf(path, sizeof path, "%s/%s", out, names[i]);
+    unlink(path);
+  }
 }
 
 static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, double t_stop,
@@ -247,6 +373,104 @@ static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, doubl
     fprintf(f, "  %-6s %12.4f%s", labels[j], r->max_abs[j], j % 4 == 3 || j == PRRU_NLAMBDA - 1 ? "\n" : "");
 }
 
+/* The whole study into stage; an exit status, or PRRU_CLI_NO_GNUPLOT when
+ * everything but the PNGs is there. */
+static int run_paper(const char *stage, const char *out, int skip_map, int is_paper)
+{
+  char path[4400], shown[4400], msg[600];
+  prru_model m;
+  prru_model_default(&m);
+  prru_scenario s;
+  prru_scenario_paper(&s);
+  paper_run *r = calloc(1, sizeof *r);
+  if (!r) {
+    prru_cli_error("paper", "out of memory");
+    return 1;
+  }
+  prru_cli_out o;
+  snprintf(path, sizeof path, "%s/paper_sim.csv", stage);
+  snprintf(shown, sizeof shown, "%s/paper_sim.csv", out);
+  if (prru_cli_out_open(&o, "paper", path)) {
+    free(r);
+    return 1;
+  }
+  o.name = shown;
+  r->csv.out = &o;
+  r->csv.loads = &s.loads;
+  r->csv.reactions = 1;
+  s.opt.loads = &s.loads;
+  s.opt.reactions = 1;
+  s.opt.on_sample = on_sample;
+  s.opt.ctx = r;
+  s.opt.interrupt = &prru_cli_interrupted;
+  prru_cli_csv_header(&r->csv);
+  double t_stop;
+  int st = prru_simulate(&m, s.q0, s.qd0, &s.opt, &t_stop, msg, sizeof msg);
+  /* A write error is an I/O error, not the "stop" the runtime saw. */
+  int rc = prru_cli_out_close(&o, st == PRRU_OK && !o.err);
+  if (rc == 0 && st != PRRU_OK) {
+    if (st == PRRU_EINTERRUPTED)
+      rc = prru_cli_exit_interrupted();
+    else {
+      prru_cli_error("paper", "simulation: %s", msg);
+      rc = 1;
+    }
+  }
+  FILE *sum = NULL;
+  if (rc == 0) {
+    snprintf(path, sizeof path, "%s/summary.txt", stage);
+    sum = fopen(path, "w");
+    if (!sum) {
+      prru_cli_error("paper", "%s/summary.txt: cannot open for writing: %s", out, strerror(errno));
+      rc = 1;
+    }
+  }
+  if (rc == 0) {
+    summarize(sum, r, &s, t_stop, is_paper);
+    summarize(stdout, r, &s, t_stop, is_paper);
+  }
+  free(r);
+  prru_scenario_free(&s);
+  int no_gnuplot = 0;
+  if (rc == 0) {
+    char *script = plot_script();
+    if (!script) {
+      prru_cli_error("paper", "out of memory for the plot script");
+      rc = 1;
+    } else {
+      rc = prru_cli_gnuplot(stage, out, "paper_plots.gp", script);
+    }
+    free(script);
+    if (rc == PRRU_CLI_NO_GNUPLOT) {
+      no_gnuplot = 1;
+      rc = 0;
+    }
+  }
+  if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
+  if (rc == 0 && !skip_map) {
+    rc = prru_paper_fig7(stage, out, sum);
+    if (rc == PRRU_CLI_NO_GNUPLOT) {
+      no_gnuplot = 1;
+      rc = 0;
+    }
+  }
+  if (sum) {
+    errno = 0;
+    int bad = fflush(sum) != 0 || ferror(sum);
+    int e = errno;
+    if (fclose(sum) != 0 && !bad) {
+      bad = 1;
+      e = errno;
+    }
+    if (bad && rc == 0) {
+      prru_cli_error("paper", "%s/summary.txt: write error: %s", out, e ? strerror(e) : "output lost");
+      rc = 1;
+    }
+  }
+  if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
+  return rc == 0 && no_gnuplot ? PRRU_CLI_NO_GNUPLOT : rc;
+}
+
 int prru_cmd_paper(int argc, char **argv)
 {
   const char *out = NULL;
@@ -261,65 +485,45 @@ int prru_cmd_paper(int argc, char **argv)
     prru_cli_error("paper", "--out DIR is required (see 'prru paper --help')");
     return 2;
   }
-  prru_model m;
-  prru_model_default(&m);
   int is_paper = prru_cli_is_paper_model();
   if (!is_paper)
     prru_cli_error("paper", "warning: model %s is not the paper's; the figures show this model, "
                    "not the paper's results", prru_mech.name);
-  if (make_dir(out)) return 1;
-  char path[4200], msg[600];
-  snprintf(path, sizeof path, "%s/paper_sim.csv", out);
-  FILE *f = fopen(path, "w");
-  if (!f) {
-    prru_cli_error("paper", "%s: cannot open for writing", path);
+  /* Handlers first: no signal leaves the staging directory behind. */
+  prru_cli_catch_signals();
+  int created;
+  if (make_dir(out, &created)) return 1;
+  char stage[4096];
+  snprintf(stage, sizeof stage, "%s/paper.partial-XXXXXX", out);
+  if (strlen(out) > 4000 || !mkdtemp(stage)) {
+    prru_cli_error("paper", "--out %s: cannot create a directory in it: %s", out,
+                   strlen(out) > 4000 ? strerror(ENAMETOOLONG) : strerror(errno));
+    if (created) rmdir(out);
     return 1;
   }
-  prru_scenario s;
-  prru_scenario_paper(&s);
-  paper_run *r = calloc(1, sizeof *r);
-  if (!r) { fclose(f); return 1; }
-  r->csv.f = f;
-  r->csv.loads = &s.loads;
-  r->csv.reactions = 1;
-  s.opt.loads = &s.loads;
-  s.opt.reactions = 1;
-  s.opt.on_sample = on_sample;
-  s.opt.ctx = r;
-  prru_cli_catch_sigint();
-  s.opt.interrupt = &prru_cli_interrupted;
-  prru_cli_csv_header(&r->csv);
-  double t_stop;
-  int st = prru_simulate(&m, s.q0, s.qd0, &s.opt, &t_stop, msg, sizeof msg);
-  if (fclose(f) != 0 && st == PRRU_OK) {
-    prru_cli_error("paper", "%s: write error", path);
-    st = PRRU_EIO;
+  int rc = run_paper(stage, out, skip_map, is_paper);
+  int no_gnuplot = rc == PRRU_CLI_NO_GNUPLOT;
+  if (rc == 0 || no_gnuplot) {
+    if (no_gnuplot) {
+      remove_stale(out, plot_outputs, (int)(sizeof plot_outputs / sizeof plot_outputs[0]));
+      if (!skip_map)
+        remove_stale(out, fig7_plot_outputs, (int)(sizeof fig7_plot_outputs / sizeof fig7_plot_outputs[0]));
+    }
+    rc = move_files(stage, out);
+    if (rc == 0 && no_gnuplot) {
+      prru_cli_error("paper", "gnuplot not found: CSVs, gnuplot scripts and summary written to %s, "
+                     "PNGs not made (install gnuplot-nox, e.g. with 'make deps')", out);
+      rc = 1;
+    }
+  } else if (rc >= 128) {
+    prru_cli_error("paper", "interrupted (%s): %s is not changed", prru_cli_signal_name(), out);
+  } else {
+    prru_cli_error("paper", "%s is not changed", out);
   }
-  if (st != PRRU_OK) {
-    if (st != PRRU_EIO) prru_cli_error("paper", "simulation: %s (samples so far in %s)", msg, path);
-    free(r);
-    prru_scenario_free(&s);
-    return prru_cli_exit_for(st);
-  }
-  snprintf(path, sizeof path, "%s/summary.txt", out);
-  FILE *sum = fopen(path, "w");
-  if (!sum) {
-    prru_cli_error("paper", "%s: cannot open for writing", path);
-    free(r);
-    prru_scenario_free(&s);
-    return 1;
-  }
-  summarize(sum, r, &s, t_stop, is_paper);
-  summarize(stdout, r, &s, t_stop, is_paper);
-  free(r);
-  prru_scenario_free(&s);
-  char *script = plot_script();
-  int rc = script ? prru_cli_gnuplot(out, "paper_plots.gp", script) : 1;
-  if (!script) prru_cli_error("paper", "out of memory for the plot script");
-  free(script);
-  if (rc == 0 && !skip_map) rc = prru_paper_fig7(out, sum);
-  if (fclose(sum) != 0 && rc == 0) rc = 1;
-  if (rc == 0) printf("wrote %s/: paper_sim.csv, fig_q.png, fig_d.png, fig4_u_joint_forces.png, "
-                      "fig6_p_joint_reactions.png, %ssummary.txt\n", out, skip_map ? "" : "fig7_*, ");
+  remove_dir(stage);
+  if (created && rc != 0 && !no_gnuplot) rmdir(out); /* only when empty */
+  if (rc == 0)
+    printf("wrote %s/: paper_sim.csv, fig_q.png, fig_d.png, fig4_u_joint_forces.png, "
+           "fig6_p_joint_reactions.png, %ssummary.txt\n", out, skip_map ? "" : "fig7_*, ");
   return rc;
 }

@@ -16,17 +16,14 @@ void prru_cli_csv_header(prru_cli_csv *c)
 {
   const char *const *labels = prru_mech.lambda_labels;
   char names[256];
-  prru_cli_csv_comment(c->f);
-  fprintf(c->f, "t,q1,q2,q3,qd1,qd2,qd3,%s", prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
+  prru_cli_out_comment(c->out);
+  prru_cli_out_printf(c->out, "t,q1,q2,q3,qd1,qd2,qd3,%s",
+                      prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
   if (c->reactions)
-    for (int i = 0; i < PRRU_NLAMBDA; i++) fprintf(c->f, ",%s", labels[i]);
-  fprintf(c->f, ",qdd1,qdd2,qdd3,%s", prru_cli_names(names, sizeof names, "fd", PRRU_NACT, ","));
-  fputs(",fp1,fp2,fp3,mp1,mp2,mp3,T,V\n", c->f);
-}
-
-static void put(FILE *f, const double *v, int n)
-{
-  for (int i = 0; i < n; i++) fprintf(f, ",%.17g", v[i]);
+    for (int i = 0; i < PRRU_NLAMBDA; i++) prru_cli_out_printf(c->out, ",%s", labels[i]);
+  prru_cli_out_printf(c->out, ",qdd1,qdd2,qdd3,%s", prru_cli_names(names, sizeof names, "fd", PRRU_NACT, ","));
+  prru_cli_out_printf(c->out, ",fp1,fp2,fp3,mp1,mp2,mp3,T,V\n");
+  prru_cli_out_line(c->out);
 }
 
 int prru_cli_csv_row(const prru_sample *s, void *ctx)
@@ -34,20 +31,18 @@ int prru_cli_csv_row(const prru_sample *s, void *ctx)
   prru_cli_csv *c = ctx;
   prru_loads l;
   prru_schedule_eval(c->loads, s->t, &l);
-  fprintf(c->f, "%.17g", s->t);
-  put(c->f, s->q, PRRU_NQ);
-  put(c->f, s->qd, PRRU_NQ);
-  put(c->f, s->d, PRRU_NACT);
-  if (c->reactions) put(c->f, s->lambda, PRRU_NLAMBDA);
-  put(c->f, s->qdd, PRRU_NQ);
-  put(c->f, l.fd, PRRU_NACT);
-  put(c->f, l.fp, 3);
-  put(c->f, l.mp, 3);
-  fprintf(c->f, ",%.17g,%.17g\n", s->T, s->V);
-  c->rows++;
-  /* Flushed often so that a killed run still leaves its rows on disk. */
-  if (c->rows % 64 == 0) fflush(c->f);
-  return ferror(c->f) ? 1 : 0;
+  /* The whole row is formatted before any of it is written. */
+  prru_cli_out_printf(c->out, "%.17g", s->t);
+  prru_cli_out_numbers(c->out, s->q, PRRU_NQ);
+  prru_cli_out_numbers(c->out, s->qd, PRRU_NQ);
+  prru_cli_out_numbers(c->out, s->d, PRRU_NACT);
+  if (c->reactions) prru_cli_out_numbers(c->out, s->lambda, PRRU_NLAMBDA);
+  prru_cli_out_numbers(c->out, s->qdd, PRRU_NQ);
+  prru_cli_out_numbers(c->out, l.fd, PRRU_NACT);
+  prru_cli_out_numbers(c->out, l.fp, 3);
+  prru_cli_out_numbers(c->out, l.mp, 3);
+  prru_cli_out_printf(c->out, ",%.17g,%.17g\n", s->T, s->V);
+  return prru_cli_out_row(c->out) == 0 ? PRRU_OK : PRRU_EIO;
 }
 
 /* %s: d names, %d: PRRU_NLAMBDA, %s: the first label, %s: joint names in
@@ -57,7 +52,7 @@ static const char simulate_help[] =
     "                     [--fp ..] [--mp ..] [--harmonic AMP,OMEGA] [--loads FILE.csv]\n"
     "                     [--t-end S] [--dt S] [--stepper rk8pd|rkf45|rkck|msbdf]\n"
     "                     [--atol X] [--rtol X] [--h0 S] [--no-reactions]\n"
-    "                     [--progress] [--out FILE.csv]\n"
+    "                     [--progress] [--out FILE.csv|-]\n"
     "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive drive\n"
     "forces from (q0, qd0) with GSL's odeiv2 driver and writes a CSV: a first line\n"
     "`# prru VERSION model NAME (FILE, sha256 HASH)`, the header, then one row per\n"
@@ -70,9 +65,15 @@ static const char simulate_help[] =
     "paper's section 4.3 study. `--harmonic A,W` adds fp = A (sin W t, -cos W t, 0);\n"
     "`--loads` reads a table t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
     "Defaults: zero state and loads, 1 s, dt 1 ms, rk8pd, atol = rtol = 1e-10.\n"
-    "A run that leaves the workspace, meets a singular J_d, fails a step or gets\n"
-    "Ctrl-C stops with a message and exit 1 (130 for Ctrl-C), keeping every row\n"
-    "computed so far.\n";
+    "Without --out (or with --out -) the CSV goes to stdout. --out FILE is built\n"
+    "as FILE.partial-XXXXXX beside it and renamed onto FILE at the end, so FILE\n"
+    "keeps its old contents until then, and a run stopped before its first row\n"
+    "(or by a write error) leaves it unchanged.\n"
+    "A run that leaves the workspace, meets a singular J_d or fails a step stops\n"
+    "with a message and exit 1; SIGINT (Ctrl-C), SIGTERM or SIGHUP stop it with\n"
+    "exit 130, 143 or 129. Either way every row computed so far is kept, and the\n"
+    "file ends with a complete row. A write error (disk full) exits 1 with the\n"
+    "reason.\n";
 
 int prru_cmd_simulate(int argc, char **argv)
 {
@@ -174,16 +175,41 @@ int prru_cmd_simulate(int argc, char **argv)
       s.loads = t;
     }
   }
-  /* Check everything the run needs before the output is created. */
+  /* Check everything the run needs before the output is created: the
+   * initial state must be regular and its dynamics and energies finite. */
   prru_model m;
   prru_model_default(&m);
-  prru_data *d = malloc(sizeof *d);
-  if (!bad && d) {
+  prru_data *d = bad ? NULL : malloc(sizeof *d);
+  if (!bad && !d) {
+    prru_cli_error("simulate", "out of memory");
+    bad = 1;
+  }
+  if (!bad) {
     s.opt.loads = &s.loads;
+    char state[200];
+    snprintf(state, sizeof state, "initial state q0 = (%.9g, %.9g, %.9g), qd0 = (%.9g, %.9g, %.9g)",
+             s.q0[0], s.q0[1], s.q0[2], s.qd0[0], s.qd0[1], s.qd0[2]);
     int st = prru_check_regular(&m, d, s.q0, NULL);
     if (st != PRRU_OK) {
       prru_cli_error("simulate", "initial q0 = (%.9g, %.9g, %.9g): %s", s.q0[0], s.q0[1], s.q0[2],
                      prru_strerror(st));
+      bad = 1;
+    }
+    prru_loads l0;
+    double qdd[PRRU_NQ], T, V;
+    prru_schedule_eval(&s.loads, 0.0, &l0);
+    if (!bad && (st = prru_forward_dynamics(&m, d, s.q0, s.qd0, &l0, qdd)) != PRRU_OK) {
+      /* q0 is regular: what fails is the arithmetic (velocities or loads
+       * so large that it overflows). */
+      if (st == PRRU_EINPUT)
+        prru_cli_error("simulate", "%s: the dynamics overflow (velocities or loads too large)",
+                       state);
+      else
+        prru_cli_error("simulate", "%s: %s", state, prru_strerror(st));
+      bad = 1;
+    }
+    if (!bad && prru_energies(&m, s.q0, s.qd0, &T, &V) != PRRU_OK) {
+      prru_cli_error("simulate", "%s: the kinetic energy overflows (velocities too large)", state);
       bad = 1;
     }
   }
@@ -192,31 +218,45 @@ int prru_cmd_simulate(int argc, char **argv)
     prru_scenario_free(&s);
     return bad == 1 ? 1 : 2;
   }
-  FILE *f = out ? fopen(out, "w") : stdout;
-  if (!f) {
-    prru_cli_error("simulate", "--out %s: cannot open for writing", out);
+  /* Handlers first, so that no signal can leave the partial file behind. */
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "simulate", out)) {
     prru_scenario_free(&s);
     return 1;
   }
-  prru_cli_csv csv = {f, &s.loads, !no_reactions, 0};
+  const char *name = o.name;
+  int in_place = o.tmp_path == NULL;
+  prru_cli_csv csv = {&o, &s.loads, !no_reactions};
   s.opt.reactions = !no_reactions;
   s.opt.on_sample = prru_cli_csv_row;
   s.opt.ctx = &csv;
   s.opt.loads = &s.loads;
-  s.opt.progress = progress || (out && isatty(2) && s.opt.t_end / s.opt.dt_out >= 2000);
-  prru_cli_catch_sigint();
+  s.opt.progress = progress || (out && strcmp(out, "-") != 0 && isatty(2) &&
+                                s.opt.t_end / s.opt.dt_out >= 2000);
   s.opt.interrupt = &prru_cli_interrupted;
   prru_cli_csv_header(&csv);
   double t_stop;
   int st = prru_simulate(&m, s.q0, s.qd0, &s.opt, &t_stop, msg, sizeof msg);
-  int io = ferror(f) != 0;
-  if (f != stdout) io |= fclose(f) != 0; else fflush(f);
-  if (io) {
-    prru_cli_error("simulate", "%s: write error", out ? out : "stdout");
-    if (st == PRRU_OK) st = PRRU_EIO;
-  } else if (st != PRRU_OK) {
-    prru_cli_error("simulate", "%s; %ld samples written%s%s", msg, csv.rows, out ? " to " : "",
-                   out ? out : "");
+  long rows = o.rows;
+  /* A write error is reported as such (the runtime only saw the consumer
+   * stop); otherwise every row computed is kept, whatever stopped the run. */
+  int io = o.err != 0;
+  if (prru_cli_out_close(&o, !io && rows > 0)) {
+    prru_scenario_free(&s);
+    return 1;
+  }
+  if (st != PRRU_OK) {
+    char kept[4200];
+    if (rows > 0)
+      snprintf(kept, sizeof kept, "%ld samples written to %s", rows, name);
+    else
+      snprintf(kept, sizeof kept, "nothing written%s%s%s", in_place ? "" : "; ",
+               in_place ? "" : name, in_place ? "" : " is not changed");
+    if (st == PRRU_EINTERRUPTED && prru_cli_interrupted)
+      prru_cli_error("simulate", "%s (%s); %s", msg, prru_cli_signal_name(), kept);
+    else
+      prru_cli_error("simulate", "%s; %s", msg, kept);
   }
   prru_scenario_free(&s);
   return st == PRRU_OK ? 0 : prru_cli_exit_for(st);

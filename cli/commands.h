@@ -1,6 +1,7 @@
 /* Sub-commands of the `prru` tool. Each takes the arguments after its name
  * and returns the process exit status: 0 success, 1 failure (I/O, a state
- * out of the workspace, no convergence), 2 usage error, 130 interrupted. */
+ * out of the workspace, no convergence), 2 usage error, 128 + the signal
+ * number when stopped by SIGINT (130), SIGTERM (143) or SIGHUP (129). */
 #ifndef PRRU_CLI_COMMANDS_H
 #define PRRU_CLI_COMMANDS_H
 
@@ -28,9 +29,12 @@ int prru_cmd_paper(int argc, char **argv);
 int prru_cmd_dme(int argc, char **argv);
 int prru_cmd_map(int argc, char **argv);
 
-/* The fig. 7 part of `prru paper`: map CSV, surface/contour/ellipse PNGs in
- * outdir, summary lines appended to summary. Returns an exit status. */
-int prru_paper_fig7(const char *outdir, FILE *summary);
+/* The fig. 7 part of `prru paper`: map CSV, surface/contour/ellipse PNGs
+ * built in stage (messages name outdir, where they will be moved),
+ * summary lines appended to summary and printed. Returns 0, 1 (message
+ * printed), 128 + signal, or PRRU_CLI_NO_GNUPLOT (everything but the PNGs
+ * made). */
+int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary);
 
 /* Shared helpers (cli/util.c). */
 /* `prru --version`: program version and the model's name, file, format
@@ -51,9 +55,16 @@ void prru_cli_json_string(FILE *f, const char *s);
 /* prefix1<sep>prefix2<sep>...prefixN into buf ("f1,f2,f3"); returns buf. */
 const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, const char *sep);
 void prru_cli_error(const char *cmd, const char *fmt, ...);
-/* Status code of a runtime call turned into an exit status (1, or 130 when
- * interrupted). */
+/* Status code of a runtime call turned into an exit status: 1, or 128 +
+ * the signal caught (130 when none was recorded) for PRRU_EINTERRUPTED. */
 int prru_cli_exit_for(int status);
+/* The exit status of a run stopped by the signal in prru_cli_interrupted. */
+int prru_cli_exit_interrupted(void);
+/* "SIGINT", "SIGTERM", "SIGHUP" for prru_cli_interrupted, "a signal" else. */
+const char *prru_cli_signal_name(void);
+/* At exit: flushes and closes stdout and reports a write error on it
+ * (with the reason): 0, or 1 after "prru CMD: stdout: write error: REASON". */
+int prru_cli_close_stdout(const char *cmd);
 
 /* Options of one sub-command: `--name value` or `--name=value`; flags take
  * no value. Unknown options, missing values, repeats and positional
@@ -76,27 +87,92 @@ int prru_cli_number(const char *cmd, const char *name, const char *text, double 
 void prru_cli_json_number(FILE *f, double v);
 /* JSON array of n numbers; rows > 1 writes n/rows rows as nested arrays. */
 void prru_cli_json_array(FILE *f, const double *v, int n, int rows);
-/* Set by SIGINT once prru_cli_catch_sigint() ran. */
+/* The number of the last SIGINT, SIGTERM or SIGHUP once
+ * prru_cli_catch_signals() ran, 0 before: every long-running command
+ * (simulate, id, map, paper) passes it to the runtime as the interrupt flag
+ * and polls it between rows. The handlers only set it and stay installed
+ * (sigaction, no SA_RESETHAND), so a second signal during the clean-up
+ * changes nothing; SA_RESTART is set so that a signal never turns into a
+ * stdio write error (EINTR); the loops that wait poll instead, and a
+ * write blocked on a full pipe completes its rows first. A signal that
+ * was ignored when prru started (nohup; SIGINT in a background job of a
+ * shell without job control) stays ignored, as in the GNU tools. */
 extern volatile sig_atomic_t prru_cli_interrupted;
-void prru_cli_catch_sigint(void);
+/* How many of those signals arrived: a clean-up that takes a while (map
+ * writing the rows it computed) stops early at a second one. */
+extern volatile sig_atomic_t prru_cli_signal_count;
+void prru_cli_catch_signals(void);
+
+/* An output file that is never left half-written. Text goes to a buffer
+ * (prru_cli_out_printf) and becomes part of the file only when the line is
+ * complete (prru_cli_out_line, prru_cli_out_row); whole lines are written
+ * with a loop that retries after EINTR and short writes. A regular file
+ * (or a new one) is built as FILE.partial-XXXXXX in its directory and
+ * renamed onto FILE by prru_cli_out_close(o, 1): until then FILE keeps its
+ * old contents, and prru_cli_out_close(o, 0) (nothing worth keeping)
+ * removes the partial file. stdout ("-" or NULL), devices, FIFOs and
+ * symbolic links are written in place. The first write error is kept
+ * (errno in err); every later call is then a no-op. */
+typedef struct {
+  const char *cmd;    /* for messages */
+  const char *name;   /* the path as given, or "stdout" */
+  char *final_path, *tmp_path; /* rename target and partial file, or NULL */
+  int fd;
+  int truncate_first; /* in place on a regular file: truncate at the first write */
+  int err;            /* errno of the first failure, 0 */
+  char *buf;
+  size_t len, whole, cap; /* bytes buffered, of them complete lines, allocated */
+  long rows;
+  double flushed_at;  /* CLOCK_MONOTONIC seconds of the last flush */
+} prru_cli_out;
+/* Opens (checks that it can be written: the directory exists and takes a
+ * new file); 0, or 1 after a message with the reason. */
+int prru_cli_out_open(prru_cli_out *o, const char *cmd, const char *path);
+void prru_cli_out_printf(prru_cli_out *o, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* ",%.17g" for each of n numbers. */
+void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n);
+/* Ends a complete line that is not a data row (comment, header); 0 or -1. */
+int prru_cli_out_line(prru_cli_out *o);
+/* Ends a data row (counted in rows); flushes at 64 kB or 0.2 s after the
+ * last flush. 0 or -1 after a write error. */
+int prru_cli_out_row(prru_cli_out *o);
+int prru_cli_out_flush(prru_cli_out *o);
+/* The model comment line, as prru_cli_csv_comment. */
+void prru_cli_out_comment(prru_cli_out *o);
+/* keep = 1: writes the rest, syncs and renames onto the target; keep = 0:
+ * drops what is unwritten and removes the partial file (the target keeps
+ * its old contents). 0, or 1 after "prru CMD: FILE: write error: REASON"
+ * when a write, sync, close or rename failed (the partial file removed). */
+int prru_cli_out_close(prru_cli_out *o, int keep);
 
 /* CSV of simulation samples: the model comment line, then the header
  * t,q1..3,qd1..3,d1..dNACT, the PRRU_NLAMBDA reactions (named by
  * prru_mech.lambda_labels, when computed), qdd1..3, fd1..fdNACT, fp1..3,
  * mp1..3, T, V. */
 typedef struct {
-  FILE *f;
+  prru_cli_out *out;
   const prru_load_schedule *loads;
   int reactions;
-  long rows;
 } prru_cli_csv;
 /* The comment line and the header row. */
 void prru_cli_csv_header(prru_cli_csv *c);
-/* prru_sample_fn: writes one row; non-zero on a write error. */
+/* prru_sample_fn: writes one row; PRRU_EIO (non-zero: the run stops) on a
+ * write error, whose errno stays in c->out->err: prru_simulate reports
+ * the stop as PRRU_EINTERRUPTED, and the caller, seeing out->err, reports
+ * an I/O error instead. */
 int prru_cli_csv_row(const prru_sample *s, void *ctx);
-/* Writes script to dir/script_name and runs gnuplot there; 0 or 1 with a
- * message (gnuplot missing or failing). */
-int prru_cli_gnuplot(const char *dir, const char *script_name, const char *script);
+/* Writes script to dir/script_name and runs gnuplot there (fork and exec,
+ * waiting while polling prru_cli_interrupted: on a signal gnuplot gets
+ * SIGTERM). Messages name shown_dir instead of dir. 0;
+ * PRRU_CLI_NO_GNUPLOT when gnuplot is not installed (no message); 1 when
+ * it fails (message printed); 128 + signal when interrupted. */
+#define PRRU_CLI_NO_GNUPLOT 3
+int prru_cli_gnuplot(const char *dir, const char *shown_dir, const char *script_name,
+                     const char *script);
 /* Writes the line model = '<model name>' (a gnuplot string for titles). */
 void prru_cli_gnuplot_model(FILE *g);
 

@@ -35,7 +35,19 @@ static void usage(FILE *f)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
   fprintf(f, "  %-9s %s\n", "version", "program version and the model (name, file, format, SHA-256)");
   fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
-             "convergence, I/O), 2 usage error, 130 interrupted.\n");
+             "convergence, I/O error: the reason on stderr), 2 usage error or bad input\n"
+             "file, 130/143/129 stopped by SIGINT/SIGTERM/SIGHUP (simulate, id, map,\n"
+             "paper: rows computed so far are kept, every file ends with a whole row).\n"
+             "Output files are built beside their name and renamed when done: a run\n"
+             "that fails before its first row leaves an existing file as it was.\n");
+}
+
+/* Every command's stdout (JSON, summaries, help) is checked once flushed
+ * and closed: "> /dev/full" is an error with the reason, exit 1. */
+static int finish(const char *cmd, int rc)
+{
+  if (prru_cli_close_stdout(cmd)) return rc == 0 ? 1 : rc;
+  return rc;
 }
 
 int main(int argc, char **argv)
@@ -46,7 +58,7 @@ int main(int argc, char **argv)
   }
   if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
     usage(stdout);
-    return 0;
+    return finish("help", 0);
   }
   if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
     if (argc > 2) {
@@ -54,10 +66,11 @@ int main(int argc, char **argv)
       return 2;
     }
     prru_cli_print_version(stdout);
-    return ferror(stdout) ? 1 : 0;
+    return finish("version", 0);
   }
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-    if (strcmp(argv[1], commands[i].name) == 0) return commands[i].run(argc - 2, argv + 2);
+    if (strcmp(argv[1], commands[i].name) == 0)
+      return finish(commands[i].name, commands[i].run(argc - 2, argv + 2));
   fprintf(stderr, "prru: unknown command '%s'\n\n", argv[1]);
   usage(stderr);
   return 2;

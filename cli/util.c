@@ -1,4 +1,6 @@
 /* Argument parsing, messages and JSON output shared by the sub-commands. */
+#define _POSIX_C_SOURCE 200809L /* sigaction */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -8,16 +10,67 @@
 #include "prru.h"
 
 volatile sig_atomic_t prru_cli_interrupted = 0;
+volatile sig_atomic_t prru_cli_signal_count = 0;
 
-static void on_sigint(int sig)
+/* Only records the signal: the loops poll it and stop at a row boundary. */
+static void on_signal(int sig)
 {
-  (void)sig;
-  prru_cli_interrupted = 1;
+  prru_cli_interrupted = sig;
+  /* The three signals are blocked while this runs (sa_mask): no race. */
+  prru_cli_signal_count = prru_cli_signal_count + 1;
 }
 
-void prru_cli_catch_sigint(void)
+void prru_cli_catch_signals(void)
 {
-  signal(SIGINT, on_sigint);
+  static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  for (int i = 0; i < 3; i++) sigaddset(&sa.sa_mask, sigs[i]);
+  /* SA_RESTART: blocking calls (stdio on stdout and stderr, pthread_join,
+   * write) resume instead of failing with EINTR; nothing needs EINTR to
+   * notice the flag, every wait polls it. No SA_RESETHAND: the handler
+   * stays for a second signal. */
+  sa.sa_flags = SA_RESTART;
+  for (int i = 0; i < 3; i++) {
+    struct sigaction old;
+    /* A signal ignored by the parent (nohup, `trap '' INT`) stays ignored. */
+    if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    sigaction(sigs[i], &sa, NULL);
+  }
+}
+
+int prru_cli_exit_interrupted(void)
+{
+  int sig = prru_cli_interrupted;
+  return 128 + (sig > 0 && sig < 64 ? sig : SIGINT);
+}
+
+const char *prru_cli_signal_name(void)
+{
+  switch (prru_cli_interrupted) {
+  case SIGINT: return "SIGINT";
+  case SIGTERM: return "SIGTERM";
+  case SIGHUP: return "SIGHUP";
+  default: return "a signal";
+  }
+}
+
+int prru_cli_close_stdout(const char *cmd)
+{
+  errno = 0;
+  int bad = fflush(stdout) != 0;
+  int e = errno;
+  bad |= ferror(stdout) != 0;
+  errno = 0;
+  if (fclose(stdout) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
+  if (!bad) return 0;
+  prru_cli_error(cmd, "stdout: write error: %s", e ? strerror(e) : "output lost");
+  return 1;
 }
 
 void prru_cli_error(const char *cmd, const char *fmt, ...)
@@ -32,7 +85,7 @@ void prru_cli_error(const char *cmd, const char *fmt, ...)
 
 int prru_cli_exit_for(int status)
 {
-  return status == PRRU_EINTERRUPTED ? 130 : 1;
+  return status == PRRU_EINTERRUPTED ? prru_cli_exit_interrupted() : 1;
 }
 
 static int usage_error(const char *cmd, const char *what, const char *arg)

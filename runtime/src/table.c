@@ -1,4 +1,5 @@
 /* Numeric CSV tables: load schedules and trajectories for `prru id`. */
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -146,7 +147,7 @@ int prru_table_parse(prru_table *t, const char *text, size_t len, const char *na
 char *prru_read_file(const char *path, size_t *len, char *msg, int msglen)
 {
   FILE *f = fopen(path, "rb");
-  if (!f) { prru_fail(msg, msglen, PRRU_EIO, "%s: cannot open for reading", path); return NULL; }
+  if (!f) { prru_fail(msg, msglen, PRRU_EIO, "%s: cannot open for reading: %s", path, strerror(errno)); return NULL; }
   size_t cap = 4096, n = 0;
   char *buf = malloc(cap);
   while (buf) {
@@ -159,10 +160,14 @@ char *prru_read_file(const char *path, size_t *len, char *msg, int msglen)
       if (!nb) { free(buf); buf = NULL; prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", path); break; }
       buf = nb; cap *= 2;
     }
+    errno = 0;
     size_t r = fread(buf + n, 1, cap - n, f);
     n += r;
     if (r == 0) {
-      if (ferror(f)) { prru_fail(msg, msglen, PRRU_EIO, "%s: read error (is it a directory?)", path); free(buf); buf = NULL; }
+      if (ferror(f)) {
+        prru_fail(msg, msglen, PRRU_EIO, "%s: read error: %s", path, errno ? strerror(errno) : "unknown");
+        free(buf); buf = NULL;
+      }
       break;
     }
   }
