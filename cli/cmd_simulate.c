@@ -1,5 +1,6 @@
 /* prru simulate: forward dynamics integrated with GSL, samples as CSV. */
 #define _POSIX_C_SOURCE 200809L /* isatty */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,7 +52,8 @@ static const char simulate_help[] =
     "usage: prru simulate [--scenario paper|FILE] [--q0 ..] [--qd0 ..] [--fd ..]\n"
     "                     [--fp ..] [--mp ..] [--harmonic AMP,OMEGA] [--loads FILE.csv]\n"
     "                     [--t-end S] [--dt S] [--stepper rk8pd|rkf45|rkck|msbdf]\n"
-    "                     [--atol X] [--rtol X] [--h0 S] [--no-reactions]\n"
+    "                     [--atol X] [--rtol X] [--h0 S] [--max-steps N]\n"
+    "                     [--no-reactions]\n"
     "                     [--progress] [--out FILE.csv|-]\n"
     "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive drive\n"
     "forces from (q0, qd0) with GSL's odeiv2 driver and writes a CSV: a first line\n"
@@ -61,10 +63,14 @@ static const char simulate_help[] =
     "the order %s; see 'prru eval --help'),\n"
     "qdd1..3, %s, fp1..3, mp1..3, T, V (J).\n"
     "A scenario file has `key = value` lines (q0 qd0 fd fp mp harmonic loads t_end\n"
-    "dt stepper atol rtol h0); options override it. `--scenario paper` is the\n"
+    "dt stepper atol rtol h0 max_steps); options override it. `--scenario paper` is the\n"
     "paper's section 4.3 study. `--harmonic A,W` adds fp = A (sin W t, -cos W t, 0);\n"
     "`--loads` reads a table t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
     "Defaults: zero state and loads, 1 s, dt 1 ms, rk8pd, atol = rtol = 1e-10.\n"
+    "Each tolerance is 0 (off) or at least 100 DBL_EPSILON (2.2e-14): a smaller one\n"
+    "cannot be met in double precision. --max-steps bounds the integrator's steps\n"
+    "between two samples (default 100000); a run that needs more stops with exit 1,\n"
+    "keeping its rows.\n"
     "Without --out (or with --out -) the CSV goes to stdout. --out FILE is built\n"
     "as FILE.partial-XXXXXX beside it and renamed onto FILE at the end, so FILE\n"
     "keeps its old contents until then, and a run stopped before its first row\n"
@@ -79,7 +85,7 @@ int prru_cmd_simulate(int argc, char **argv)
 {
   const char *scen = NULL, *q0s = NULL, *qd0s = NULL, *fds = NULL, *fps = NULL, *mps = NULL,
              *harm = NULL, *loads = NULL, *tend = NULL, *dts = NULL, *stepper = NULL,
-             *atol = NULL, *rtol = NULL, *h0 = NULL, *out = NULL;
+             *atol = NULL, *rtol = NULL, *h0 = NULL, *out = NULL, *maxs = NULL;
   int help = 0, no_reactions = 0, progress = 0;
   prru_cli_option opts[] = {
       {"scenario", 1, &scen, NULL}, {"q0", 1, &q0s, NULL},        {"qd0", 1, &qd0s, NULL},
@@ -87,6 +93,7 @@ int prru_cmd_simulate(int argc, char **argv)
       {"harmonic", 1, &harm, NULL}, {"loads", 1, &loads, NULL},   {"t-end", 1, &tend, NULL},
       {"dt", 1, &dts, NULL},        {"stepper", 1, &stepper, NULL}, {"atol", 1, &atol, NULL},
       {"rtol", 1, &rtol, NULL},     {"h0", 1, &h0, NULL},         {"out", 1, &out, NULL},
+      {"max-steps", 1, &maxs, NULL},
       {"no-reactions", 0, NULL, &no_reactions}, {"progress", 0, NULL, &progress},
       {"help", 0, NULL, &help}};
   if (prru_cli_parse("simulate", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
@@ -125,6 +132,17 @@ int prru_cmd_simulate(int argc, char **argv)
   if (atol) bad |= prru_cli_number("simulate", "atol", atol, &s.opt.abs_tol);
   if (rtol) bad |= prru_cli_number("simulate", "rtol", rtol, &s.opt.rel_tol);
   if (h0) bad |= prru_cli_number("simulate", "h0", h0, &s.opt.h0);
+  if (maxs) {
+    double v;
+    if (prru_cli_number("simulate", "max-steps", maxs, &v)) {
+      bad = 2;
+    } else if (!(v >= 1 && v <= 1e12 && v == floor(v))) {
+      prru_cli_error("simulate", "--max-steps '%s': must be a whole number from 1 to 1e12", maxs);
+      bad = 2;
+    } else {
+      s.opt.max_steps = (long)v;
+    }
+  }
   if (stepper && prru_stepper_parse(stepper, &s.opt.stepper) != PRRU_OK) {
     prru_cli_error("simulate", "--stepper: '%s' is not one of rk8pd, rkf45, rkck, msbdf", stepper);
     bad = 2;
@@ -143,6 +161,18 @@ int prru_cmd_simulate(int argc, char **argv)
   }
   if (!bad && !(s.opt.abs_tol >= 0 && s.opt.rel_tol >= 0 && s.opt.abs_tol + s.opt.rel_tol > 0)) {
     prru_cli_error("simulate", "--atol/--rtol: must be non-negative and not both zero");
+    bad = 2;
+  }
+  const double tols[2] = {s.opt.abs_tol, s.opt.rel_tol};
+  for (int i = 0; i < 2 && !bad; i++)
+    if (tols[i] != 0 && !(tols[i] >= PRRU_TOL_MIN)) {
+      prru_cli_error("simulate", "--%s: %g is below %.2g (100 DBL_EPSILON), which no double-precision "
+                     "step can resolve: use 0 (off) or at least %.2g", i ? "rtol" : "atol", tols[i],
+                     PRRU_TOL_MIN, PRRU_TOL_MIN);
+      bad = 2;
+    }
+  if (!bad && s.opt.stepper == PRRU_MSBDF && s.opt.abs_tol == 0) {
+    prru_cli_error("simulate", "--atol: msbdf needs a positive absolute tolerance");
     bad = 2;
   }
   if (!bad && !(s.opt.h0 > 0)) {
