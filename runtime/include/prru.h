@@ -30,6 +30,13 @@
 /* Rows of H, Phi, K and the body wrenches: 3 rotational and 3 translational
  * per body (see prru_mechanism.h for the stacking). */
 #define PRRU_NH (6 * PRRU_NBODY)
+/* Redundancy (spec section 12). PRRU_NPRELOAD = PRRU_NACT - 3 is the
+ * dimension of null(J_d^T): actuator forces along it move nothing (an
+ * internal preload). PRRU_NREACTION_NULL = PRRU_NLAMBDA - (PRRU_NH - 3) is
+ * the dimension of null(Q): reaction coordinates that no motion or load
+ * determines. Both are 0 for the 3-PRRU and 1 for the 4-PRRU. */
+#define PRRU_NPRELOAD (PRRU_NACT - 3)
+#define PRRU_NREACTION_NULL (PRRU_NLAMBDA - PRRU_NH + 3)
 
 #ifdef __cplusplus
 extern "C" {
@@ -56,7 +63,8 @@ typedef struct {
    * 1 / (|J|_1 |J^-1|_1) of J = J_d diag(1/L, 1/L, 1) is below this
    * (default 1e-8); L, the mean upper-link length, measures rotations as arc
    * lengths at the robot's own scale, so the test means the same for a
-   * robot of any size. */
+   * robot of any size. With four actuators J is 4x3 and J^-1 is
+   * J^+ = (J^T J)^-1 J^T (prru_check_regular). */
   double jd_rcond_min;
 } prru_model;
 
@@ -71,7 +79,10 @@ typedef struct {
 
 /* Per-call workspace and last results. */
 typedef struct {
-  double d[PRRU_NACT], Jd[PRRU_NACT * 3], Jdinv[9]; /* actuators, J_d, J_d^-1 */
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3]; /* actuators, J_d (NACT x 3) */
+  /* J_d^+ = (J_d^T J_d)^-1 J_d^T (3 x NACT), the left inverse of J_d
+   * (J_d^+ J_d = I): J_d^-1 for three actuators. */
+  double Jdpinv[3 * PRRU_NACT];
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
   double Q[PRRU_NH * PRRU_NLAMBDA]; /* reaction basis */
@@ -79,34 +90,107 @@ typedef struct {
   double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
   double P[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* its factor, arrowhead order */
   double r[PRRU_NLAMBDA];
+  /* The unit null vector z of Q at the last prru_reactions (see
+   * prru_reaction_null); all 0 when PRRU_NREACTION_NULL = 0. */
+  double lambda_null[PRRU_NLAMBDA];
 } prru_data;
 
 /* PRRU_OK, PRRU_EINPUT (non-finite q) or PRRU_EUNREACHABLE; fills d->d. */
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
-/* Reachable and J_d regular; fills d->d, d->Jd, d->Jdinv (when regular);
- * *rcond if non-NULL. */
+/* Reachable and J_d regular (full column rank 3); fills d->d, d->Jd,
+ * d->Jdpinv (when regular); *rcond if non-NULL: 1 / (|J|_1 |J^+|_1) for
+ * J = J_d diag(1/L, 1/L, 1) (see prru_model), which for three actuators is
+ * 1 / (|J|_1 |J^-1|_1). J^+ comes from a Householder QR of J for four. */
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
 
 /* Actuator displacements (inverse kinematics). */
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT]);
-/* Newton's method (gsl_multiroot, hybridsj with J_d) from seed to q with
- * d(q) = act to 1e-14 m; PRRU_ENOCONV when act is out of reach or the
- * iteration meets a singularity. */
+/* q with d(q) = act from seed: three actuators, Newton's method
+ * (gsl_multiroot, hybridsj with J_d; allocates: a set-up call); four,
+ * Gauss-Newton with J_d^+ and step halving (prru_forward_kinematics_lsq,
+ * no allocation). The residual max_i |d_i(q) - act_i| must reach
+ * tol = 100 DBL_EPSILON max(L, |act|_inf) (L the model's length scale;
+ * 10 tol is accepted where the iteration stalls a few ulps short).
+ * PRRU_ENOCONV when act is out of reach, the iteration meets a
+ * singularity, or, with four actuators, act is inconsistent beyond 10 tol:
+ * no pose reproduces all four sliders (the fourth is not where the other
+ * three put it; measured or rounded slider positions: use
+ * prru_forward_kinematics_lsq and judge its residual). PRRU_ESINGULAR when
+ * the solution has a singular J_d. */
 int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                             const double seed[3], double q[3]);
+/* Least squares: Gauss-Newton from seed to a q minimizing |d(q) - act|_2
+ * (with four actuators act need not be consistent: measured sliders), and
+ * *residual = max_i |d_i(q) - act_i| (m) there. PRRU_OK once the iteration
+ * is stationary, whatever the residual: the caller judges it (for
+ * consistent act it is at the tolerance of prru_forward_kinematics);
+ * PRRU_ENOCONV when it does not settle within 200 iterations or leaves
+ * the workspace, PRRU_ESINGULAR at a singular J_d. */
+int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+                                const double seed[3], double q[3], double *residual);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h (Cholesky). */
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3]);
-/* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored). */
+/* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored):
+ * the solution of J_d^T fd = tau = M qdd - (G + J_T,P^T fp + J_R,P^T mp
+ * + passive - h) of least norm, fd = J_d^+T tau (J_d^-T tau for three
+ * actuators). With four actuators every fd + t n (n: prru_actuator_null)
+ * gives the same motion; this one has no preload (fd . n = 0). */
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[PRRU_NACT]);
+/* The same plus the internal preload t (N) along n: fd = J_d^+T tau + t n,
+ * so fd . n = t (to rounding) and the motion is the same for every t. For
+ * models/4prru.json n = (-1, -1, 1, 1)/2 at q1 = q2 = 0 (any q3): a
+ * positive t adds t/2 of upward force on sliders 3 and 4 and t/2 of
+ * downward force on sliders 1 and 2, the two pairs bracing the platform
+ * against each other. PRRU_EINPUT for a
+ * non-finite t, and for a non-zero t on a model without redundant
+ * actuators (PRRU_NPRELOAD = 0); t = 0 is prru_inverse_dynamics. */
+int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const double q[3],
+                                  const double qd[3], const double qdd[3], const prru_loads *l,
+                                  double preload, double fd[PRRU_NACT]);
+/* n: the unit vector spanning null(J_d^T) (J_d^T n = 0, |n| = 1), with
+ * n_NACT > 0 (the largest-magnitude component positive if n_NACT = 0 to
+ * rounding): the actuator-force pattern that is in equilibrium by itself.
+ * Computed from the 3x3 minors of J_d (the generalized cross product of its
+ * columns). Needs a regular q (prru_check_regular's statuses); PRRU_EINPUT
+ * when PRRU_NPRELOAD = 0 (n then does not exist; n is left untouched). */
+int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
+                       double n[PRRU_NACT]);
 /* The joint reaction coordinates (eq. 31, PRRU_NLAMBDA of them) at the
  * state's qdd, which it solves for first and leaves in d->qdd. The sliders
  * receive the actuator forces net of the drives' armature, damping and
- * friction (model format 2). */
+ * friction (model format 2).
+ * With PRRU_NREACTION_NULL = 1 (the 4-PRRU) Q^T Phi^-1 Q is singular: every
+ * lambda + s z (z: prru_reaction_null) satisfies the equations of motion
+ * equally well, and the reactions reported are the solution of least
+ * Euclidean norm, lambda . z = 0 (coordinates in N and N m as they stand).
+ * z is left in d->lambda_null. Three limbs: the plain SPD solve. */
 int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                    const prru_loads *l, double lambda[PRRU_NLAMBDA]);
+/* z: the unit vector spanning null(Q) at q (Q z = 0, |z| = 1), the one
+ * statically indeterminate reaction pattern of the 4-PRRU. Physically: a
+ * lateral force along e2 (normal to the plane y = 0 of limbs 3 and 4,
+ * whose hinges are all parallel to e2, so no joint of theirs is free
+ * along it) that runs rail 3 -> slider 3 -> upper link 3 -> lower link 3
+ * -> platform (at O') -> lower link 4 -> upper link 4 -> slider 4 -> rail 4
+ * and back through the ground.
+ * Limb 3 pushes O' along +e2 and limb 4 along -e2 (C3's force along e2 is
+ * +f, C4's -f: they cancel on the platform), each limb carrying f out of
+ * its own plane y = 0 to its rail, and rails 3 and 4 close the loop
+ * through the ground; every joint of limbs 3 and 4 carries the force f
+ * along e2 (none along e1, e3) and the moments that carry it along the
+ * links; every coordinate of limbs 1 and 2 is 0 (to rounding).
+ * It loads no body and moves nothing, so rigid-body dynamics cannot
+ * determine how much of it is present (that depends on the joints'
+ * compliance and fit; prru_reactions reports none of it). Sign: the first
+ * coordinate (in lambda order) of magnitude at least half the largest is
+ * positive, here C3's force along e2. PRRU_EINPUT when
+ * PRRU_NREACTION_NULL = 0 (z untouched); otherwise the statuses of
+ * prru_reactions at q. */
+int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
+                       double z[PRRU_NLAMBDA]);
 /* T, V (J). */
 int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
                   double *V);

@@ -4,16 +4,22 @@
  *
  * Quantities. With the actuator displacements d(q), J_d = dd/dq, the mass
  * matrix M(q) and the platform Jacobians (omega_P = J_R,P qd, v_P = J_T,P qd):
- *   Mt  = J_d^-T M J_d^-1     inertia seen by the actuators: at rest (no
+ *   Mt  = J_d^+T M J_d^+      inertia seen by the actuators: at rest (no
  *                             velocity terms, no gravity) F_d = Mt dd''
- *   JtR = J_R,P J_d^-1        actuator accelerations -> platform angular
- *   JtT = J_T,P J_d^-1        acceleration, and linear acceleration.
+ *   JtR = J_R,P J_d^+         actuator accelerations -> platform angular
+ *   JtT = J_T,P J_d^+         acceleration, and linear acceleration.
+ * J_d^+ = (J_d^T J_d)^-1 J_d^T is J_d^-1 for the 3-PRRU (every formula
+ * here is then the paper's section 5) and the pseudo-inverse for the
+ * redundant 4-PRRU (spec section 12): J_d is 4x3, Mt 4x4 (the least-norm
+ * drive forces J_d^+T M qdd, F_d = Mt dd'' for dd'' in range(J_d)), JtR
+ * and JtT 3x4. N = PRRU_NACT below.
  * JtR has rank 2: the platform turns only about e1 and v (omega_P =
  * q1' e1 + q2' v, no parasitic motion), so its range is the plane
  * span{e1, v}. JtT has rank 1: O' moves only along e3.
  *
  * Rotational DME. An angular acceleration a in span{e1, v} needs at least
- * the actuator accelerations JtR^+ a and hence the forces B a, B = Mt JtR^+.
+ * the actuator accelerations JtR^+ a and hence the forces B a, B = Mt JtR^+
+ * (N x 3).
  * The ellipse is the set of a reachable with unit actuator-force norm:
  *     a in span{e1, v},  a^T B^T B a = a^T JtR^+T Mt^T Mt JtR^+ a <= 1.
  * (For a with a component normal to the plane, B a ignores it, so the 3-D
@@ -34,19 +40,23 @@
  * direction of range(JtT), which is +-e3 (reported with a positive z).
  *
  * Computation (no SVD routine needed): Q = [q_1 q_2], an orthonormal basis
- * of range(J_R,P) = range(JtR) from J_R,P's columns (Gram-Schmidt with
- * pivoting); JtR = Q C with C = Q^T JtR (2x3, full row rank), so
- * JtR^+ = C^T (C C^T)^-1 Q^T and B = G Q^T with the 3x2 G = Mt C^T (C C^T)^-1.
+ * of range(J_R,P) = range(JtR) (J_d^+ has full row rank) from J_R,P's
+ * columns (Gram-Schmidt with pivoting); JtR = Q C with C = Q^T JtR (2xN,
+ * full row rank), so JtR^+ = C^T (C C^T)^-1 Q^T and B = G Q^T with the
+ * Nx2 G = Mt C^T (C C^T)^-1.
  * One exact Jacobi rotation of G's two columns makes them orthogonal:
  * their norms are sigma_1, sigma_2 (to rounding, without squaring the
  * condition number) and the rotation's columns, mapped by Q, are V_1, V_2.
- * tests/test_dme.c checks this against GSL SVDs built another way.
+ * tests/test_dme.c checks this against GSL SVDs built another way, and
+ * tests/test_redundant.c the 4-PRRU's against GSL SVDs of M, J_d and J_R,P.
  *
  * Singular configurations: a q is PRRU_EUNREACHABLE when the inverse
  * kinematics has no solution (an acos argument outside [-1, 1]) and
  * PRRU_ESINGULAR when J_d's reciprocal 1-norm condition number
- * 1 / (|J|_1 |J^-1|_1), J = J_d with its rotation columns divided by the
- * model's length scale, is below m->jd_rcond_min (prru_check_regular;
+ * 1 / (|J|_1 |J^+|_1), J = J_d with its rotation columns divided by the
+ * model's length scale (J^+ = J^-1 for three actuators; for four, J_d has
+ * rank 3 far beyond the singularities of any three of its limbs), is below
+ * m->jd_rcond_min (prru_check_regular;
  * the model's default 1e-8 flags numerical singularity only, pass a model
  * copy with a larger value for a practical-singularity band, see the
  * global index below), or, as a last guard, when a result is not finite.
@@ -67,7 +77,8 @@ extern "C" {
 
 typedef struct {
   int status;             /* PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESINGULAR, PRRU_EINPUT */
-  double jd_rcond;        /* reciprocal 1-norm condition number of J_d (0 if unreachable) */
+  double jd_rcond;        /* reciprocal 1-norm condition number of J_d, 1 / (|J|_1 |J^+|_1)
+                             with the model's length scale (0 if unreachable) */
   double w_R;             /* sigma[0] / sigma[1]; NaN unless status == PRRU_OK */
   double sigma[2];        /* non-zero singular values of Mt JtR^+, sigma[0] >= sigma[1] (N s^2/rad) */
   double semi_axis[2];    /* 1 / sigma[i]: semi_axis[0] minor, semi_axis[1] major (rad/s^2 per N) */
@@ -76,7 +87,8 @@ typedef struct {
   double sigma_T;         /* the non-zero singular value of Mt JtT^+ (N s^2/m) */
   double half_length_T;   /* 1 / sigma_T: half-length of the translational segment (m/s^2 per N) */
   double dir_T[3];        /* its unit direction in {S} (e3) */
-  double Mt[9], JtR[9], JtT[9]; /* row-major, as defined above */
+  /* Row-major, as defined above: Mt N x N, JtR and JtT 3 x N (N = PRRU_NACT). */
+  double Mt[PRRU_NACT * PRRU_NACT], JtR[3 * PRRU_NACT], JtT[3 * PRRU_NACT];
 } prru_dme;
 
 /* "ok", "singular", "unreachable" or "invalid" (PRRU_EINPUT). */

@@ -1,4 +1,5 @@
 /* Model constants, status strings, reachability and the dynamics calls. */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <string.h>
@@ -41,13 +42,20 @@ static int finite3(const double v[3])
   return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
 }
 
+static int finite_n(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
 {
   (void)m;
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik(q, d->d);
   /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
-  return finite3(d->d) ? PRRU_OK : PRRU_EUNREACHABLE;
+  return finite_n(d->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
 
 double prru_rcond3(const double a[9], double inv[9])
@@ -83,27 +91,102 @@ double prru_length_scale(const prru_mechanism *me)
   return s / PRRU_NLIMB;
 }
 
+#if PRRU_NACT > 3
+/* 1 / (|A|_1 |A^+|_1) of a full-column-rank NACT x 3 matrix A, with
+ * X = A^+ = (A^T A)^-1 A^T = R^-1 Q1^T from a Householder QR A = Q R
+ * (never the normal equations, which would square the condition number);
+ * 0 when A is rank deficient or not finite (X is then unusable). For a
+ * square A this is prru_rcond3's quantity, the 1-norm being the operator
+ * norm of R^NACT -> R^3 for X: 1 = |X A|_1 <= |X|_1 |A|_1, so it lies in
+ * (0, 1] and is unchanged by scaling A. */
+static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
+{
+  enum { N = PRRU_NACT };
+  double W[N][3], V[3][N], beta[3];
+  for (int i = 0; i < N; i++)
+    for (int j = 0; j < 3; j++) W[i][j] = A[3 * i + j];
+  if (!finite_n(A, 3 * N)) return 0.0;
+  double na = 0;
+  for (int j = 0; j < 3; j++) {
+    double s = 0;
+    for (int i = 0; i < N; i++) s += fabs(W[i][j]);
+    if (s > na) na = s;
+  }
+  for (int k = 0; k < 3; k++) {
+    /* H_k = I - beta v v^T maps W[k.., k] to (alpha, 0, ...). Scaled by
+     * the column's largest entry so that no square over- or underflows. */
+    double sc = 0, nx = 0;
+    for (int i = k; i < N; i++) sc = fmax(sc, fabs(W[i][k]));
+    if (!(sc > 0)) return 0.0;
+    for (int i = 0; i < N; i++) V[k][i] = i < k ? 0.0 : W[i][k] / sc;
+    for (int i = k; i < N; i++) nx += V[k][i] * V[k][i];
+    nx = sqrt(nx);
+    double alpha = V[k][k] > 0 ? -nx : nx;
+    V[k][k] -= alpha;
+    double vv = 0;
+    for (int i = k; i < N; i++) vv += V[k][i] * V[k][i];
+    beta[k] = 2.0 / vv;
+    for (int j = k; j < 3; j++) {
+      double s = 0;
+      for (int i = k; i < N; i++) s += V[k][i] * W[i][j];
+      s *= beta[k];
+      for (int i = k; i < N; i++) W[i][j] -= s * V[k][i];
+    }
+    W[k][k] = alpha * sc; /* the rest of column k is 0 */
+  }
+  /* R = W's upper 3x3; rows 0..2 of Q^T = H_2 H_1 H_0 applied to the
+   * identity's columns, then X = R^-1 (Q^T)_{0..2}. */
+  for (int c = 0; c < N; c++) {
+    double e[N];
+    for (int i = 0; i < N; i++) e[i] = i == c ? 1.0 : 0.0;
+    for (int k = 0; k < 3; k++) {
+      double s = 0;
+      for (int i = k; i < N; i++) s += V[k][i] * e[i];
+      s *= beta[k];
+      for (int i = k; i < N; i++) e[i] -= s * V[k][i];
+    }
+    for (int i = 2; i >= 0; i--) {
+      double s = e[i];
+      for (int j = i + 1; j < 3; j++) s -= W[i][j] * X[N * j + c];
+      X[N * i + c] = s / W[i][i];
+    }
+  }
+  double nx = 0;
+  for (int c = 0; c < N; c++) {
+    double s = fabs(X[c]) + fabs(X[N + c]) + fabs(X[2 * N + c]);
+    if (!(s <= nx)) nx = s; /* NaN propagates */
+  }
+  if (!isfinite(nx) || !(nx > 0)) return 0.0;
+  return 1.0 / (na * nx);
+}
+#endif
+
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
 {
   if (rcond) *rcond = 0.0;
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik_jd(q, d->d, d->Jd);
-  if (!finite3(d->d)) return PRRU_EUNREACHABLE;
+  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   /* J_d's rotation columns are lengths per radian, its height column is
    * dimensionless: conditioned as it stands, a model scaled by 1e-7 would
    * be singular everywhere. So the condition number is that of
    * Js = J_d diag(1/L, 1/L, 1) (rotations measured as arc lengths at the
    * model's own scale), the same for a robot of any size; and
-   * J_d^-1 = diag(1/L, 1/L, 1) Js^-1. */
+   * J_d^+ = diag(1/L, 1/L, 1) Js^+ (for three actuators, J_d^-1 =
+   * diag(1/L, 1/L, 1) Js^-1). */
   const double L = prru_length_scale(m->mech);
-  double Js[9];
-  for (int i = 0; i < 3; i++) {
+  double Js[3 * PRRU_NACT];
+  for (int i = 0; i < PRRU_NACT; i++) {
     Js[3 * i] = d->Jd[3 * i] / L;
     Js[3 * i + 1] = d->Jd[3 * i + 1] / L;
     Js[3 * i + 2] = d->Jd[3 * i + 2];
   }
-  double rc = prru_rcond3(Js, d->Jdinv);
-  for (int j = 0; j < 6; j++) d->Jdinv[j] /= L;
+#if PRRU_NACT == 3
+  double rc = prru_rcond3(Js, d->Jdpinv);
+#else
+  double rc = rcond_pinv(Js, d->Jdpinv);
+#endif
+  for (int j = 0; j < 2 * PRRU_NACT; j++) d->Jdpinv[j] /= L;
   if (rcond) *rcond = rc;
   /* rc > 0 also when jd_rcond_min is 0: an exactly singular J_d has no inverse. */
   return rc > 0 && rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
@@ -118,7 +201,7 @@ int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double 
 
 static int loads_finite(const prru_loads *l)
 {
-  return finite3(l->fd) && finite3(l->fp) && finite3(l->mp);
+  return finite_n(l->fd, PRRU_NACT) && finite3(l->fp) && finite3(l->mp);
 }
 
 /* Why prru_eom produced non-finite output from finite inputs: q out of
@@ -127,11 +210,11 @@ static int loads_finite(const prru_loads *l)
  * that the arithmetic overflows at a regular q. */
 static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
 {
-  static const double zero[3] = {0, 0, 0};
+  static const double zero[3] = {0, 0, 0}, zero_fd[PRRU_NACT] = {0};
   int st = prru_check_reachable(m, d, q);
   if (st != PRRU_OK) return st;
   double M[9], b[3];
-  prru_eom(q, zero, zero, zero, zero, M, b);
+  prru_eom(q, zero, zero_fd, zero, zero, M, b);
   return finite3(b) ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
 
@@ -183,20 +266,100 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[PRRU_NACT])
 {
-  static const double zero[3] = {0, 0, 0};
+  static const double zero_fd[PRRU_NACT] = {0};
   if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))
     return PRRU_EINPUT;
   int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
   /* J_d^T fd = M qdd - (G + J_T,P^T fp + J_R,P^T mp - h). */
-  prru_eom(q, qd, zero, l->fp, l->mp, d->M, d->b);
+  prru_eom(q, qd, zero_fd, l->fp, l->mp, d->M, d->b);
   double r[3];
-  const double *inv = d->Jdinv;
+  const double *inv = d->Jdpinv;
+  enum { N = PRRU_NACT };
   for (int i = 0; i < 3; i++)
     r[i] = d->M[3 * i] * qdd[0] + d->M[3 * i + 1] * qdd[1] + d->M[3 * i + 2] * qdd[2] - d->b[i];
-  /* fd = J_d^-T r: row i of J_d^-T is column i of J_d^-1. */
-  for (int i = 0; i < 3; i++) fd[i] = inv[i] * r[0] + inv[3 + i] * r[1] + inv[6 + i] * r[2];
-  return finite3(fd) ? PRRU_OK : PRRU_EINPUT;
+  /* fd = J_d^+T r: row i of J_d^+T is column i of J_d^+ (3 x NACT); the
+   * solution of J_d^T fd = r of least norm (J_d^-T r for three). */
+  for (int i = 0; i < N; i++) fd[i] = inv[i] * r[0] + inv[N + i] * r[1] + inv[2 * N + i] * r[2];
+  return finite_n(fd, N) ? PRRU_OK : PRRU_EINPUT;
+}
+
+/* n from J_d (regular): n_i = (-1)^i det(J_d without row i), the
+ * generalized cross product of J_d's three columns, orthogonal to each of
+ * them. Column scaling (J_d diag(1/L, 1/L, 1)) scales every minor alike,
+ * so the scaled J_d is used: no over- or underflow for any robot size. */
+#if PRRU_NPRELOAD == 1
+static int null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], double n[PRRU_NACT])
+{
+  enum { N = PRRU_NACT };
+  const double L = prru_length_scale(m->mech);
+  double Js[N][3], v[N], nn = 0;
+  for (int i = 0; i < N; i++) {
+    Js[i][0] = Jd[3 * i] / L;
+    Js[i][1] = Jd[3 * i + 1] / L;
+    Js[i][2] = Jd[3 * i + 2];
+  }
+  for (int i = 0; i < N; i++) {
+    const double *r[3];
+    for (int k = 0, j = 0; k < N; k++)
+      if (k != i) r[j++] = Js[k];
+    double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
+                 r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                 r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    v[i] = i % 2 ? -det : det;
+  }
+  double big = 0;
+  for (int i = 0; i < N; i++) big = fmax(big, fabs(v[i]));
+  if (!(big > 0) || !isfinite(big)) return PRRU_ESINGULAR;
+  for (int i = 0; i < N; i++) nn += (v[i] / big) * (v[i] / big);
+  nn = big * sqrt(nn);
+  /* n_NACT > 0; when it is 0 to rounding, the largest component instead. */
+  int k = N - 1;
+  if (!(fabs(v[k]) > 64 * DBL_EPSILON * big))
+    for (int i = 0; i < N; i++)
+      if (fabs(v[i]) > fabs(v[k])) k = i;
+  double sg = v[k] < 0 ? -1.0 : 1.0;
+  for (int i = 0; i < N; i++) n[i] = sg * v[i] / nn;
+  return PRRU_OK;
+}
+#endif
+
+int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
+                       double n[PRRU_NACT])
+{
+#if PRRU_NPRELOAD == 0
+  (void)m, (void)d, (void)q, (void)n;
+  return PRRU_EINPUT;
+#elif PRRU_NPRELOAD == 1
+  int st = prru_check_regular(m, d, q, NULL);
+  if (st != PRRU_OK) return st;
+  return null_from_jd(m, d->Jd, n);
+#else
+#error "more than one redundant actuator is not implemented"
+#endif
+}
+
+int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const double q[3],
+                                  const double qd[3], const double qdd[3], const prru_loads *l,
+                                  double preload, double fd[PRRU_NACT])
+{
+  if (!isfinite(preload)) return PRRU_EINPUT;
+#if PRRU_NPRELOAD == 0
+  if (preload != 0.0) return PRRU_EINPUT;
+  return prru_inverse_dynamics(m, d, q, qd, qdd, l, fd);
+#else
+  double f[PRRU_NACT], n[PRRU_NACT];
+  int st = prru_inverse_dynamics(m, d, q, qd, qdd, l, f);
+  if (st != PRRU_OK) return st;
+  if (preload != 0.0) {
+    st = null_from_jd(m, d->Jd, n);
+    if (st != PRRU_OK) return st;
+    for (int i = 0; i < PRRU_NACT; i++) f[i] += preload * n[i];
+    if (!finite_n(f, PRRU_NACT)) return PRRU_EINPUT;
+  }
+  memcpy(fd, f, sizeof f);
+  return PRRU_OK;
+#endif
 }
 
 int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,

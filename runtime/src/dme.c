@@ -15,17 +15,29 @@ const char *prru_dme_status_name(int status)
   }
 }
 
+/* N = PRRU_NACT: J_d^+ is 3 x N, Mt N x N, JtR and JtT 3 x N. Every sum
+ * below runs left to right from its first term, as the three-term
+ * expressions it generalizes did, so three actuators give the same bits. */
+#define N PRRU_NACT
+
 static double dot3(const double *a, const double *b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* c = a b, 3x3 row-major. */
-static void mul3(const double a[9], const double b[9], double c[9])
+static double dotn(const double *a, const double *b)
+{
+  double s = a[0] * b[0];
+  for (int i = 1; i < N; i++) s += a[i] * b[i];
+  return s;
+}
+
+/* c = a b, a 3x3, b 3xN, row-major. */
+static void mul3n(const double a[9], const double *b, double *c)
 {
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
+    for (int j = 0; j < N; j++)
+      c[N * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[N + j] + a[3 * i + 2] * b[2 * N + j];
 }
 
 /* Sign convention for directions: largest-magnitude component positive, so
@@ -48,7 +60,8 @@ static void set_undefined(prru_dme *out)
     out->axis_dir[i][0] = out->axis_dir[i][1] = out->axis_dir[i][2] = nan;
   }
   for (int i = 0; i < 3; i++) out->dir_T[i] = nan;
-  for (int i = 0; i < 9; i++) out->Mt[i] = out->JtR[i] = out->JtT[i] = nan;
+  for (int i = 0; i < N * N; i++) out->Mt[i] = nan;
+  for (int i = 0; i < 3 * N; i++) out->JtR[i] = out->JtT[i] = nan;
 }
 
 static int fail(prru_dme *out, int status)
@@ -64,22 +77,23 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   int st = prru_check_regular(m, d, q, &out->jd_rcond);
   if (st != PRRU_OK) return fail(out, st);
 
-  const double *jinv = d->Jdinv; /* regular: prru_check_regular inverted J_d */
-  double jp[18], tmp[9];
+  /* regular: prru_check_regular left J_d^+ (J_d^-1 for three actuators) */
+  const double *jinv = d->Jdpinv;
+  double jp[18], tmp[3 * N];
   prru_mass(q, d->M);
   prru_platform_jacobian(q, jp);
   const double *jrp = jp, *jtp = jp + 9;
 
-  /* Mt = Jinv^T M Jinv (symmetrized: it is symmetric in exact arithmetic). */
-  mul3(d->M, jinv, tmp);
-  for (int i = 0; i < 3; i++)
-    for (int j = i; j < 3; j++) {
-      double s = jinv[i] * tmp[j] + jinv[3 + i] * tmp[3 + j] + jinv[6 + i] * tmp[6 + j];
-      double s2 = jinv[j] * tmp[i] + jinv[3 + j] * tmp[3 + i] + jinv[6 + j] * tmp[6 + i];
-      out->Mt[3 * i + j] = out->Mt[3 * j + i] = 0.5 * (s + s2);
+  /* Mt = J^+T M J^+ (symmetrized: it is symmetric in exact arithmetic). */
+  mul3n(d->M, jinv, tmp);
+  for (int i = 0; i < N; i++)
+    for (int j = i; j < N; j++) {
+      double s = jinv[i] * tmp[j] + jinv[N + i] * tmp[N + j] + jinv[2 * N + i] * tmp[2 * N + j];
+      double s2 = jinv[j] * tmp[i] + jinv[N + j] * tmp[N + i] + jinv[2 * N + j] * tmp[2 * N + i];
+      out->Mt[N * i + j] = out->Mt[N * j + i] = 0.5 * (s + s2);
     }
-  mul3(jrp, jinv, out->JtR);
-  mul3(jtp, jinv, out->JtT);
+  mul3n(jrp, jinv, out->JtR);
+  mul3n(jtp, jinv, out->JtT);
 
   /* Orthonormal basis Q of range(J_R,P): the column of largest norm, then
    * the largest remainder of the others after removing it. */
@@ -110,22 +124,23 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   if (!(best > 0)) return fail(out, PRRU_ESINGULAR);
   for (int i = 0; i < 3; i++) q1[i] /= best;
 
-  /* C = Q^T JtR (rows c0, c1), S = C C^T (2x2 SPD), G = Mt C^T S^-1. */
-  double c0[3], c1[3];
-  for (int j = 0; j < 3; j++) {
-    c0[j] = q0[0] * out->JtR[j] + q0[1] * out->JtR[3 + j] + q0[2] * out->JtR[6 + j];
-    c1[j] = q1[0] * out->JtR[j] + q1[1] * out->JtR[3 + j] + q1[2] * out->JtR[6 + j];
+  /* C = Q^T JtR (rows c0, c1: 2 x N), S = C C^T (2x2 SPD),
+   * G = Mt C^T S^-1 (N x 2, columns g0, g1). */
+  double c0[N], c1[N];
+  for (int j = 0; j < N; j++) {
+    c0[j] = q0[0] * out->JtR[j] + q0[1] * out->JtR[N + j] + q0[2] * out->JtR[2 * N + j];
+    c1[j] = q1[0] * out->JtR[j] + q1[1] * out->JtR[N + j] + q1[2] * out->JtR[2 * N + j];
   }
-  double s00 = dot3(c0, c0), s01 = dot3(c0, c1), s11 = dot3(c1, c1);
+  double s00 = dotn(c0, c0), s01 = dotn(c0, c1), s11 = dotn(c1, c1);
   double det = s00 * s11 - s01 * s01;
   if (!(det > 0)) return fail(out, PRRU_ESINGULAR);
   double i00 = s11 / det, i01 = -s01 / det, i11 = s00 / det;
-  double mc0[3], mc1[3], g0[3], g1[3];
-  for (int i = 0; i < 3; i++) {
-    mc0[i] = dot3(out->Mt + 3 * i, c0);
-    mc1[i] = dot3(out->Mt + 3 * i, c1);
+  double mc0[N], mc1[N], g0[N], g1[N];
+  for (int i = 0; i < N; i++) {
+    mc0[i] = dotn(out->Mt + N * i, c0);
+    mc1[i] = dotn(out->Mt + N * i, c1);
   }
-  for (int i = 0; i < 3; i++) {
+  for (int i = 0; i < N; i++) {
     g0[i] = mc0[i] * i00 + mc1[i] * i01;
     g1[i] = mc0[i] * i01 + mc1[i] * i11;
   }
@@ -133,19 +148,19 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   /* One-sided Jacobi: the rotation (c, -s; s, c) that diagonalizes
    * G^T G = [a g; g b] (Golub & Van Loan, sym.schur2) leaves G's columns
    * orthogonal, so their norms are the singular values. */
-  double a = dot3(g0, g0), b = dot3(g1, g1), g = dot3(g0, g1), cs = 1.0, sn = 0.0;
+  double a = dotn(g0, g0), b = dotn(g1, g1), g = dotn(g0, g1), cs = 1.0, sn = 0.0;
   if (g != 0.0) {
     double tau = (b - a) / (2.0 * g);
     double t = (tau >= 0 ? 1.0 : -1.0) / (fabs(tau) + sqrt(1.0 + tau * tau));
     cs = 1.0 / sqrt(1.0 + t * t);
     sn = t * cs;
   }
-  double h0[3], h1[3];
-  for (int i = 0; i < 3; i++) {
+  double h0[N], h1[N];
+  for (int i = 0; i < N; i++) {
     h0[i] = cs * g0[i] - sn * g1[i];
     h1[i] = sn * g0[i] + cs * g1[i];
   }
-  double sa = sqrt(dot3(h0, h0)), sb = sqrt(dot3(h1, h1));
+  double sa = sqrt(dotn(h0, h0)), sb = sqrt(dotn(h1, h1));
   /* Right singular vectors in the (q0, q1) coordinates: (cs, -sn), (sn, cs). */
   double va[3], vb[3];
   for (int i = 0; i < 3; i++) {
@@ -177,24 +192,27 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
    * runs along u, the direction of JtT's largest column. */
   double f2 = 0, mf2 = 0;
   int kt = 0;
-  double cn[3] = {0, 0, 0};
-  for (int j = 0; j < 3; j++) {
+  double cn[N];
+  for (int j = 0; j < N; j++) { /* cn[j] = |column j of JtT|^2 */
+    cn[j] = 0;
     for (int i = 0; i < 3; i++) {
-      double x = out->JtT[3 * i + j];
+      double x = out->JtT[N * i + j];
       cn[j] += x * x;
-      /* (Mt JtT^T)_{ij} = sum_l Mt_il JtT_jl */
-      double y = out->Mt[3 * i] * out->JtT[3 * j] + out->Mt[3 * i + 1] * out->JtT[3 * j + 1] +
-                 out->Mt[3 * i + 2] * out->JtT[3 * j + 2];
-      mf2 += y * y;
     }
     f2 += cn[j];
     if (cn[j] > cn[kt]) kt = j;
   }
+  for (int j = 0; j < 3; j++)
+    for (int i = 0; i < N; i++) {
+      /* (Mt JtT^T)_{ij} = sum_l Mt_il JtT_jl */
+      double y = dotn(out->Mt + N * i, out->JtT + N * j);
+      mf2 += y * y;
+    }
   if (!(f2 > 0) || !(mf2 > 0)) return fail(out, PRRU_ESINGULAR);
   out->sigma_T = sqrt(mf2) / f2;
   out->half_length_T = 1.0 / out->sigma_T;
   double nk = sqrt(cn[kt]);
-  for (int i = 0; i < 3; i++) out->dir_T[i] = out->JtT[3 * i + kt] / nk;
+  for (int i = 0; i < 3; i++) out->dir_T[i] = out->JtT[N * i + kt] / nk;
   canonical_sign(out->dir_T);
 
   if (!isfinite(out->w_R) || !isfinite(out->sigma_T)) return fail(out, PRRU_ESINGULAR);

@@ -1,5 +1,7 @@
 /* Forward kinematics: q with d(q) = act by Newton's method on the closed
- * inverse kinematics, GSL's hybridsj with the exact Jacobian J_d. */
+ * inverse kinematics, GSL's hybridsj with the exact Jacobian J_d (three
+ * actuators); Gauss-Newton on |d(q) - act|^2 with J_d^+ (four, and the
+ * least-squares variant for any number). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -10,6 +12,96 @@
 #include "prru.h"
 #include "internal.h"
 
+/* The residual tolerance is relative: 100 ulps of the larger of the
+ * model's length and the slider heights, whatever the robot's size. */
+static double fk_tol(const prru_model *m, const double act[PRRU_NACT])
+{
+  double scale = prru_length_scale(m->mech);
+  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
+  return 100 * DBL_EPSILON * scale;
+}
+
+static int act_finite(const double act[PRRU_NACT])
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(act[i])) return 0;
+  return 1;
+}
+
+/* Residual r = d - act at the pose prru_check_regular last evaluated
+ * (d->d); returns |r|^2, *rmax = max |r_i|. */
+static double fk_residual(const prru_data *d, const double act[PRRU_NACT], double r[PRRU_NACT],
+                          double *rmax)
+{
+  double f = 0, mx = 0;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    r[i] = d->d[i] - act[i];
+    f += r[i] * r[i];
+    mx = fmax(mx, fabs(r[i]));
+  }
+  *rmax = mx;
+  return f;
+}
+
+int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+                                const double seed[3], double q[3], double *residual)
+{
+  if (residual) *residual = NAN;
+  if (!act_finite(act)) return PRRU_EINPUT;
+  int st = prru_check_regular(m, d, seed, NULL);
+  if (st != PRRU_OK) return st;
+  /* Steps need J_d^+ only to exist; the model's tolerance is applied to
+   * the answer. */
+  prru_model m0 = *m;
+  m0.jd_rcond_min = 0.0;
+  const double tol = fk_tol(m, act), L = prru_length_scale(m->mech);
+  double x[3] = {seed[0], seed[1], seed[2]}, r[PRRU_NACT], rmax;
+  double f = fk_residual(d, act, r, &rmax);
+  int iter, settled = 0;
+  for (iter = 0; iter < 200 && !settled; iter++) {
+    if (rmax <= tol) { settled = 1; break; }
+    /* Gauss-Newton step -J_d^+ r, halved until |r|^2 decreases. */
+    double step[3], xt[3], rt[PRRU_NACT], rmt = 0, ft = f;
+    for (int j = 0; j < 3; j++) {
+      step[j] = 0;
+      for (int i = 0; i < PRRU_NACT; i++) step[j] -= d->Jdpinv[PRRU_NACT * j + i] * r[i];
+    }
+    /* Stationary: the step is below rounding of x (angles in rad, the
+     * height in units of L). */
+    if (fabs(step[0]) <= 4 * DBL_EPSILON * (1 + fabs(x[0])) &&
+        fabs(step[1]) <= 4 * DBL_EPSILON * (1 + fabs(x[1])) &&
+        fabs(step[2]) <= 4 * DBL_EPSILON * (L + fabs(x[2]))) {
+      settled = 1;
+      break;
+    }
+    int accepted = 0;
+    for (double t = 1.0; t > 1e-12 && !accepted; t *= 0.5) {
+      for (int j = 0; j < 3; j++) xt[j] = x[j] + t * step[j];
+      if (prru_check_regular(&m0, d, xt, NULL) != PRRU_OK) continue;
+      ft = fk_residual(d, act, rt, &rmt);
+      accepted = ft < f;
+    }
+    if (!accepted) {
+      /* No decrease along the Gauss-Newton direction: |r|^2 is at a
+       * stationary point to rounding. Back to x (d must describe it). */
+      settled = 1;
+      if (prru_check_regular(&m0, d, x, NULL) != PRRU_OK) return PRRU_ENOCONV;
+      break;
+    }
+    memcpy(x, xt, sizeof x);
+    memcpy(r, rt, sizeof r);
+    f = ft, rmax = rmt;
+  }
+  if (!settled) return PRRU_ENOCONV;
+  st = prru_check_regular(m, d, x, NULL);
+  if (st != PRRU_OK) return st == PRRU_EUNREACHABLE ? PRRU_ENOCONV : st;
+  fk_residual(d, act, r, &rmax);
+  if (residual) *residual = rmax;
+  memcpy(q, x, sizeof x);
+  return PRRU_OK;
+}
+
+#if PRRU_NACT == 3
 typedef struct {
   const double *act;
 } fk_ctx;
@@ -61,11 +153,7 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   prru_gsl_init();
   gsl_multiroot_fdfsolver *s = gsl_multiroot_fdfsolver_alloc(gsl_multiroot_fdfsolver_hybridsj, 3);
   if (!s) return PRRU_ENOMEM;
-  /* The residual tolerance is relative: 100 ulps of the larger of the
-   * model's length and the slider heights, whatever the robot's size. */
-  double scale = prru_length_scale(m->mech);
-  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
-  const double tol = 100 * DBL_EPSILON * scale;
+  const double tol = fk_tol(m, act);
   int gs = gsl_multiroot_fdfsolver_set(s, &fn, &xv.vector);
   int iter = 0, converged = 0;
   while (gs == GSL_SUCCESS && iter++ < 200) {
@@ -84,3 +172,18 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   memcpy(q, sol, sizeof sol);
   return PRRU_OK;
 }
+#else
+/* Four actuators: d(q) = act has a solution only when act is consistent
+ * (the fourth slider where the other three put it). Least squares, then
+ * the same acceptance as hybridsj's above: 10 times the tolerance. */
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+                            const double seed[3], double q[3])
+{
+  double sol[3], res;
+  int st = prru_forward_kinematics_lsq(m, d, act, seed, sol, &res);
+  if (st != PRRU_OK) return st;
+  if (!(res <= 10 * fk_tol(m, act))) return PRRU_ENOCONV;
+  memcpy(q, sol, sizeof sol);
+  return PRRU_OK;
+}
+#endif

@@ -64,12 +64,27 @@ static int take_row(map_job *j, long finished_points)
   return row;
 }
 
+/* The caller's progress report; a non-zero answer stops the map. */
+static void report_progress(map_job *j)
+{
+  const long total = (long)j->g->n1 * j->g->n2;
+  pthread_mutex_lock(&j->lock);
+  long done = j->done;
+  pthread_mutex_unlock(&j->lock);
+  if (j->o->progress(done, total, j->o->ctx)) {
+    pthread_mutex_lock(&j->lock);
+    j->stop = 1;
+    pthread_mutex_unlock(&j->lock);
+  }
+}
+
 static void *map_worker_run(void *arg)
 {
   map_worker *w = arg;
   map_job *j = w->job;
   const prru_map_grid *g = j->g;
-  const long total = (long)g->n1 * g->n2;
+  const int reports = w->is_caller && j->o->progress;
+  int reported = 0;
   prru_dme dme;
   int row = take_row(j, 0);
   while (row >= 0) {
@@ -82,17 +97,15 @@ static void *map_worker_run(void *arg)
       if (j->st) j->st[k] = (unsigned char)s;
     }
     row = take_row(j, g->n2);
-    if (w->is_caller && j->o->progress) {
-      pthread_mutex_lock(&j->lock);
-      long done = j->done;
-      pthread_mutex_unlock(&j->lock);
-      if (j->o->progress(done, total, j->o->ctx)) {
-        pthread_mutex_lock(&j->lock);
-        j->stop = 1;
-        pthread_mutex_unlock(&j->lock);
-      }
+    if (reports) {
+      report_progress(j);
+      reported = 1;
     }
   }
+  /* A caller that got no row at all (the other threads took every row
+   * while it was descheduled) still reports once, so that the callback
+   * can always stop the map. */
+  if (reports && !reported) report_progress(j);
   return NULL;
 }
 

@@ -5,7 +5,19 @@
  * its joint), so Q^T Phi^-1 Q is accumulated body by body over the columns
  * that body sees: the dense 60x60 products of the reference are never
  * formed. The 57x57 system is SPD (Q has full column rank): Cholesky in
- * the arrowhead order below. */
+ * the arrowhead order below.
+ *
+ * The redundant 4-PRRU (spec section 12): 76 coordinates, 78 - 3 = 75
+ * independent equations, so Q has a one-dimensional null space and
+ * Q^T Phi^-1 Q (76x76) is positive semidefinite of rank 75. Its limb
+ * blocks stay SPD (each limb alone is a serial chain from the rail); the
+ * singular part is the Schur complement S of the U-joint block (16x16).
+ * That one is factored by Cholesky with diagonal pivoting, stopped after
+ * rank(S) = 15 steps (the rank is structural: PRRU_NREACTION_NULL); the
+ * pivoting puts the null direction last, so the factor gives one
+ * particular solution and S's null vector, which the limb blocks extend to
+ * the null vector z of the whole matrix; the reactions are then the
+ * particular solution less its component along z (least norm). */
 #include <math.h>
 #include <string.h>
 
@@ -19,6 +31,10 @@
 #define NL PRRU_NLAMBDA
 #define NB PRRU_NBODY
 #define NH PRRU_NH
+
+#if PRRU_NREACTION_NULL < 0 || PRRU_NREACTION_NULL > 1
+#error "the reactions handle at most one redundant reaction direction"
+#endif
 
 /* Body b's six rows of the stacking: 3b..3b+2 rotational, 3 NB + 3b..
  * translational. */
@@ -102,6 +118,7 @@ static void arrowhead_layout(const prru_mechanism *me, arrowhead *a)
   a->nc = at - a->c0;
 }
 
+#if PRRU_NREACTION_NULL == 0
 /* Solves A x = r (x returned in r), A the 57x57 SPD matrix in lambda
  * order, by block Cholesky in the arrowhead order with GSL:
  *   A = [L_k 0; W_k^T L_C] [L_k^T W_k; 0 L_C^T],  A_kk = L_k L_k^T,
@@ -151,23 +168,156 @@ static int solve_arrowhead(const arrowhead *a, const double *A, double *r, doubl
   return PRRU_OK;
 }
 
-int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
-                   const prru_loads *l, double lambda[NL])
-{
-  const prru_mechanism *me = m->mech;
-  double qdd[3];
-  int st = prru_forward_dynamics(m, d, q, qd, l, qdd);
-  if (st != PRRU_OK) return st;
-  prru_gsl_init();
-  double R[9 * NB], p[3 * NB], F[NH], fs[PRRU_NACT];
-  prru_poses(q, R, p);
-  prru_reaction_basis(q, d->Q);
-  prru_wrench_bias(q, qd, d->K);
-  prru_jd(q, d->Jd);
-  slider_forces(me, d, q, qd, l, fs);
-  applied_wrenches(me, fs, l, q, p, F);
-  for (int i = 0; i < NH; i++) d->K[i] -= F[i]; /* K - Fbar */
+#endif
 
+#if PRRU_NREACTION_NULL == 1
+/* Pivots of S below PIVOT_TOL times its largest diagonal entry are rank
+ * loss beyond the structural one (a constraint singularity):
+ * PRRU_ESINGULAR. The one dropped pivot must be below NULL_TOL times it:
+ * otherwise S is not of the structural rank and the system is not what
+ * this solver assumes (PRRU_ESINGULAR too; never seen on a valid model).
+ * Measured on models/4prru.json at the 93444 regular poses of a
+ * 201 x 201 x 3 grid (q1 in [-1.2, 1.2], q2 in [-1.4, 1], q3 = -0.5,
+ * -0.65, -0.8; J_d's rcond down to the default 1e-8): kept pivots (squared
+ * factor entries) at least 1.8e-7 of the largest, the dropped one at most
+ * 2.4e-16. */
+#define PIVOT_TOL 1e-10
+#define NULL_TOL 1e-9
+
+/* As solve_arrowhead, for the singular case: r (NULL: none, z only) is
+ * replaced by the solution of least norm, z by the unit null vector
+ * (lambda order; sign: see prru_reaction_null). */
+static int solve_arrowhead_null(const arrowhead *a, const double *A, double *r, double *P,
+                                double z[NL])
+{
+  const int *pos = a->pos;
+  double y[NL], zz[NL];
+  for (int i = 0; i < NL; i++) {
+    y[pos[i]] = r ? r[i] : 0.0;
+    for (int j = 0; j < NL; j++) P[pos[i] * NL + pos[j]] = A[i * NL + j];
+  }
+  const size_t C0 = (size_t)a->c0, NC = (size_t)a->nc, RK = NC - 1;
+  gsl_matrix_view Pm = gsl_matrix_view_array(P, NL, NL);
+  gsl_matrix_view S = gsl_matrix_submatrix(&Pm.matrix, C0, C0, NC, NC);
+  gsl_vector_view yv = gsl_vector_view_array(y, NL), zv = gsl_vector_view_array(zz, NL);
+  gsl_vector_view yC = gsl_vector_subvector(&yv.vector, C0, NC);
+  gsl_vector_view zC = gsl_vector_subvector(&zv.vector, C0, NC);
+  /* The limbs: A_kk = L_k L_k^T, W_k = L_k^-1 A_kC, S = A_CC - sum W_k^T W_k,
+   * y_k = L_k^-1 r_k, y_C = r_C - sum W_k^T y_k. */
+  for (size_t k = 0; k < PRRU_NLIMB; k++) {
+    const size_t s0 = (size_t)a->start[k], L = (size_t)a->len[k];
+    gsl_matrix_view Lk = gsl_matrix_submatrix(&Pm.matrix, s0, s0, L, L);
+    gsl_matrix_view Wk = gsl_matrix_submatrix(&Pm.matrix, s0, C0, L, NC);
+    gsl_vector_view yk = gsl_vector_subvector(&yv.vector, s0, L);
+    if (gsl_linalg_cholesky_decomp1(&Lk.matrix) != GSL_SUCCESS) return PRRU_ESINGULAR;
+    gsl_blas_dtrsm(CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, 1.0, &Lk.matrix, &Wk.matrix);
+    gsl_blas_dsyrk(CblasLower, CblasTrans, -1.0, &Wk.matrix, 1.0, &S.matrix);
+    gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, &Lk.matrix, &yk.vector);
+    gsl_blas_dgemv(CblasTrans, -1.0, &Wk.matrix, &yk.vector, 1.0, &yC.vector);
+  }
+  /* S (its lower triangle is current) by Cholesky with diagonal pivoting,
+   * in place on the full symmetric block: P S P^T = [L11 0; l21 1] [L11^T
+   * l21^T; 0 s], s the dropped pivot, perm[i] = S's row at position i. */
+  double *Sd = S.matrix.data;
+  const size_t ld = S.matrix.tda;
+#define SE(i, j) Sd[(i) * ld + (j)]
+  for (size_t i = 0; i < NC; i++)
+    for (size_t j = i + 1; j < NC; j++) SE(i, j) = SE(j, i);
+  size_t perm[NL];
+  for (size_t i = 0; i < NC; i++) perm[i] = i;
+  double d0 = 0;
+  for (size_t i = 0; i < NC; i++) d0 = fmax(d0, SE(i, i));
+  if (!(d0 > 0) || !isfinite(d0)) return PRRU_ESINGULAR;
+  for (size_t k = 0; k < NC; k++) {
+    size_t p = k;
+    for (size_t i = k + 1; i < NC; i++)
+      if (SE(i, i) > SE(p, p)) p = i;
+    if (p != k) {
+      for (size_t j = 0; j < NC; j++) {
+        double t = SE(k, j);
+        SE(k, j) = SE(p, j), SE(p, j) = t;
+      }
+      for (size_t i = 0; i < NC; i++) {
+        double t = SE(i, k);
+        SE(i, k) = SE(i, p), SE(i, p) = t;
+      }
+      size_t t = perm[k];
+      perm[k] = perm[p], perm[p] = t;
+    }
+    if (k == RK) break; /* the dropped pivot, s = SE(RK, RK) */
+    double piv = SE(k, k);
+    if (!(piv > PIVOT_TOL * d0)) return PRRU_ESINGULAR;
+    piv = sqrt(piv);
+    SE(k, k) = piv;
+    for (size_t i = k + 1; i < NC; i++) SE(i, k) /= piv;
+    for (size_t j = k + 1; j < NC; j++)
+      for (size_t i = j; i < NC; i++) SE(i, j) = SE(j, i) = SE(i, j) - SE(i, k) * SE(j, k);
+  }
+  if (!(fabs(SE(RK, RK)) <= NULL_TOL * d0)) return PRRU_ESINGULAR;
+  /* Null vector of S, permuted: (-L11^-T l21^T, 1). */
+  gsl_matrix_view L11 = gsl_matrix_submatrix(&S.matrix, 0, 0, RK, RK);
+  double v[NL], x[NL];
+  for (size_t i = 0; i < RK; i++) v[i] = -SE(RK, i);
+  v[RK] = 1.0;
+  gsl_vector_view v1 = gsl_vector_view_array(v, RK);
+  gsl_blas_dtrsv(CblasLower, CblasTrans, CblasNonUnit, &L11.matrix, &v1.vector);
+  /* A particular solution of S x = y_C: L11 L11^T x1 = y1, x2 = 0 (the
+   * equation dropped with the pivot holds to rounding: y_C is in
+   * range(S)). */
+  for (size_t i = 0; i < NC; i++) x[i] = gsl_vector_get(&yC.vector, perm[i]);
+  x[RK] = 0.0;
+  gsl_vector_view x1 = gsl_vector_view_array(x, RK);
+  gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, &L11.matrix, &x1.vector);
+  gsl_blas_dtrsv(CblasLower, CblasTrans, CblasNonUnit, &L11.matrix, &x1.vector);
+  for (size_t i = 0; i < NC; i++) {
+    gsl_vector_set(&yC.vector, perm[i], x[i]);
+    gsl_vector_set(&zC.vector, perm[i], v[i]);
+  }
+#undef SE
+  /* The limbs: x_k = L_k^-T (y_k - W_k x_C), and the null vector of the
+   * whole matrix z_k = -A_kk^-1 A_kC z_C = -L_k^-T W_k z_C. */
+  for (size_t k = 0; k < PRRU_NLIMB; k++) {
+    const size_t s0 = (size_t)a->start[k], L = (size_t)a->len[k];
+    gsl_matrix_view Lk = gsl_matrix_submatrix(&Pm.matrix, s0, s0, L, L);
+    gsl_matrix_view Wk = gsl_matrix_submatrix(&Pm.matrix, s0, C0, L, NC);
+    gsl_vector_view yk = gsl_vector_subvector(&yv.vector, s0, L);
+    gsl_vector_view zk = gsl_vector_subvector(&zv.vector, s0, L);
+    gsl_blas_dgemv(CblasNoTrans, -1.0, &Wk.matrix, &yC.vector, 1.0, &yk.vector);
+    gsl_blas_dtrsv(CblasLower, CblasTrans, CblasNonUnit, &Lk.matrix, &yk.vector);
+    gsl_blas_dgemv(CblasNoTrans, -1.0, &Wk.matrix, &zC.vector, 0.0, &zk.vector);
+    gsl_blas_dtrsv(CblasLower, CblasTrans, CblasNonUnit, &Lk.matrix, &zk.vector);
+  }
+  /* Least norm: y - (z . y / z . z) z; then z to unit length. */
+  double zn = 0, zy = 0, big = 0;
+  for (int i = 0; i < NL; i++) {
+    zn += zz[i] * zz[i];
+    zy += zz[i] * y[i];
+    big = fmax(big, fabs(zz[i]));
+  }
+  if (!(zn > 0) || !isfinite(zn)) return PRRU_ESINGULAR;
+  const double c = zy / zn;
+  zn = sqrt(zn);
+  /* Sign: the first coordinate in lambda order of at least half the largest
+   * magnitude is positive (stable under rounding: ties between equal
+   * magnitudes, as between C3's and P3's force along e2, cannot flip it). */
+  double sg = 1.0;
+  for (int i = 0; i < NL; i++)
+    if (fabs(zz[pos[i]]) >= 0.5 * big) {
+      sg = zz[pos[i]] < 0 ? -1.0 : 1.0;
+      break;
+    }
+  for (int i = 0; i < NL; i++) {
+    if (r) r[i] = y[pos[i]] - c * zz[pos[i]];
+    z[i] = sg * zz[pos[i]] / zn;
+  }
+  return PRRU_OK;
+}
+#endif
+
+/* A = Q^T Phi^-1 Q (and r = Q^T Phi^-1 d->K when rhs) into d->A, d->r,
+ * from d->Q, d->K and the body rotations R. */
+static void assemble(const prru_mechanism *me, prru_data *d, const double *R, int rhs)
+{
   memset(d->A, 0, sizeof d->A);
   memset(d->r, 0, sizeof d->r);
   for (int b = 0; b < NB; b++) {
@@ -195,8 +345,9 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
         W[3 + i][jj] = minv * Qb[3 + i][c];
       }
     }
-    double kb[6];
-    for (int k = 0; k < 6; k++) kb[k] = d->K[body_row(b, k)];
+    double kb[6] = {0, 0, 0, 0, 0, 0};
+    if (rhs)
+      for (int k = 0; k < 6; k++) kb[k] = d->K[body_row(b, k)];
     for (int ii = 0; ii < nc; ii++) {
       int ci = cols[ii];
       double s = 0, qc[6];
@@ -213,9 +364,58 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
       }
     }
   }
+}
+
+int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
+                       double z[PRRU_NLAMBDA])
+{
+#if PRRU_NREACTION_NULL == 0
+  (void)m, (void)d, (void)q, (void)z;
+  return PRRU_EINPUT;
+#else
+  int st = prru_check_regular(m, d, q, NULL);
+  if (st != PRRU_OK) return st;
+  prru_gsl_init();
+  double R[9 * NB], p[3 * NB];
+  prru_poses(q, R, p);
+  prru_reaction_basis(q, d->Q);
+  assemble(m->mech, d, R, 0);
+  arrowhead a;
+  arrowhead_layout(m->mech, &a);
+  st = solve_arrowhead_null(&a, d->A, NULL, d->P, d->lambda_null);
+  if (st != PRRU_OK) return st;
+  memcpy(z, d->lambda_null, sizeof d->lambda_null);
+  return PRRU_OK;
+#endif
+}
+
+int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                   const prru_loads *l, double lambda[NL])
+{
+  const prru_mechanism *me = m->mech;
+  double qdd[3];
+  int st = prru_forward_dynamics(m, d, q, qd, l, qdd);
+  if (st != PRRU_OK) return st;
+  prru_gsl_init();
+  double R[9 * NB], p[3 * NB], F[NH], fs[PRRU_NACT];
+  prru_poses(q, R, p);
+  prru_reaction_basis(q, d->Q);
+  prru_wrench_bias(q, qd, d->K);
+  prru_jd(q, d->Jd);
+  slider_forces(me, d, q, qd, l, fs);
+  applied_wrenches(me, fs, l, q, p, F);
+  for (int i = 0; i < NH; i++) d->K[i] -= F[i]; /* K - Fbar */
+
+  assemble(me, d, R, 1);
   arrowhead a;
   arrowhead_layout(me, &a);
+#if PRRU_NREACTION_NULL == 0
+  memset(d->lambda_null, 0, sizeof d->lambda_null);
   if (solve_arrowhead(&a, d->A, d->r, d->P) != PRRU_OK) return PRRU_ESINGULAR;
+#else
+  if (solve_arrowhead_null(&a, d->A, d->r, d->P, d->lambda_null) != PRRU_OK)
+    return PRRU_ESINGULAR;
+#endif
   for (int i = 0; i < NL; i++)
     if (!isfinite(d->r[i])) return PRRU_EINPUT; /* loads so large the solve overflows */
   memcpy(lambda, d->r, sizeof d->r);
