@@ -12,7 +12,7 @@ DEB_PACKAGES = cmake gcc g++ clang libclang-rt-14-dev valgrind make python3 libg
 FUZZ_SECONDS ?= 60
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build demo test test-asan fuzz check-generated regenerate bench clean
+.PHONY: all deps build demo compare-designs test test-asan fuzz check-generated regenerate bench clean
 
 all: build
 
@@ -32,6 +32,14 @@ build: deps
 
 demo: build
 	$(BUILD)/cli/prru paper --out $(RESULTS)
+	$(MAKE) --no-print-directory compare-designs
+
+# The paper's future work: three limbs (the paper's model) vs four
+# (models/4prru.json), each in its own build directory.
+compare-designs: deps
+	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=build
+	$(MAKE) --no-print-directory build MODEL=models/4prru.json BUILD=build-4prru
+	studies/compare_designs.sh build build-4prru $(RESULTS)/compare
 
 test: build check-generated
 	cd $(BUILD) && ctest --output-on-failure -j 2

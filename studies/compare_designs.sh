@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# The paper's open question (its future work): does a fourth limb, mirroring
+# limb 3 so that q2 is driven by two limbs, bring the rotational dynamic
+# manipulability index w_R closer to 1?
+#
+# usage: studies/compare_designs.sh BUILD3 BUILD4 OUTDIR
+#   BUILD3, BUILD4: build directories of the 3-limb and the 4-limb model
+#   (`make compare-designs` makes both: build/ and build-4prru/).
+# Both prru binaries map w_R over the paper's fig. 7 rectangle (q1 in
+# [-pi/6, pi/6], q2 in [-pi/4, pi/6], q3 = 0, 201 x 201) with the same
+# practical singularity tolerance, and report w_R at q = 0. Writes
+# OUTDIR/{3prru,4prru}_map.csv and _summary.txt, compare_wR.png (the two
+# maps side by side on one colour scale) and summary.txt.
+set -euo pipefail
+[ $# -eq 3 ] || { echo "usage: $0 BUILD3 BUILD4 OUTDIR" >&2; exit 2; }
+b3=$1 b4=$2 out=$3
+for b in "$b3" "$b4"; do
+  [ -x "$b/cli/prru" ] || { echo "$0: $b/cli/prru: not built" >&2; exit 2; }
+done
+mkdir -p "$out"
+PI=3.141592653589793
+Q1="-$(python3 -c "print(repr($PI/6))"):$(python3 -c "print(repr($PI/6))"):201"
+Q2="-$(python3 -c "print(repr($PI/4))"):$(python3 -c "print(repr($PI/6))"):201"
+RCOND=4e-3 # cond_1 > 250 of J_d with rotations in units of the upper link, as fig. 7
+
+field() { grep "^$2:" "$1" | awk '{print $2}'; }
+for n in 3 4; do
+  b=$b3; [ $n = 4 ] && b=$b4
+  "$b/cli/prru" map --q1 "$Q1" --q2 "$Q2" --q3 0 --rcond-min "$RCOND" \
+    --out "$out/${n}prru_map.csv" >"$out/${n}prru_summary.txt"
+  "$b/cli/prru" dme --q 0,0,0 >"$out/${n}prru_dme0.json"
+done
+w0() { python3 -c "import json,sys; print('%.6f' % json.load(open(sys.argv[1]))['w_R'])" "$1"; }
+w3=$(w0 "$out/3prru_dme0.json") w4=$(w0 "$out/4prru_dme0.json")
+i3=$(field "$out/3prru_summary.txt" global_index) i4=$(field "$out/4prru_summary.txt" global_index)
+s3=$(field "$out/3prru_summary.txt" singular_fraction) s4=$(field "$out/4prru_summary.txt" singular_fraction)
+l3=$(field "$out/3prru_summary.txt" index_log) l4=$(field "$out/4prru_summary.txt" index_log)
+{
+  echo "Three vs four limbs: rotational dynamic manipulability w_R over the paper's"
+  echo "fig. 7 rectangle (q1 in [-pi/6, pi/6], q2 in [-pi/4, pi/6], q3 = 0, 201 x 201),"
+  echo "J_d singular where rcond < $RCOND (cond_1 > 250, rotations in units of l1)."
+  head -1 "$out/3prru_summary.txt" | sed 's/^model:/3 limbs, model:/'
+  head -1 "$out/4prru_summary.txt" | sed 's/^model:/4 limbs, model:/'
+  printf '%-34s %14s %14s\n' "" "3 limbs" "4 limbs"
+  printf '%-34s %14s %14s\n' "w_R at q = 0" "$w3" "$w4"
+  printf '%-34s %14.6f %14.6f\n' "global index (mean of w_R - 1)" "$i3" "$i4"
+  printf '%-34s %14.6f %14.6f\n' "mean of ln w_R" "$l3" "$l4"
+  printf '%-34s %13.3f%% %13.3f%%\n' "singular or unreachable" \
+    "$(python3 -c "print(100*$s3)")" "$(python3 -c "print(100*$s4)")"
+} >"$out/summary.txt"
+cat "$out/summary.txt"
+
+if command -v gnuplot >/dev/null 2>&1; then
+  (cd "$out" && gnuplot) <<'GP'
+set datafile separator ','
+set terminal pngcairo size 1400,620 enhanced font 'Sans,11'
+set output 'compare_wR.png'
+set multiplot layout 1,2 title "Rotational dynamic manipulability index w_R, q_3 = 0 (paper fig. 7 rectangle): 3 limbs vs 4 limbs\nwhite: J_d singular (cond_1 > 250) or unreachable; one colour scale"
+set view map
+set xlabel 'q_1 (rad)'
+set ylabel 'q_2 (rad)'
+set cblabel 'w_R'
+set logscale cb
+set cbrange [1:5]
+set cbtics (1, 1.2, 1.5, 2, 3, 5)
+set palette rgbformulae 22,13,-31
+set xrange [-0.5236:0.5236]
+set yrange [-0.7854:0.5236]
+unset key
+ok(w) = (strcol(5) eq 'ok') ? w : NaN
+# pm3d wants a blank line between scans (rows of constant q1)
+scans(f) = sprintf("< awk -F, 'NR > 2 { if (NR > 3 && $1 != p) print \"\"; p = $1; print }' %s", f)
+set title '3 limbs (the paper)'
+splot scans('3prru_map.csv') using 1:2:(ok($4)) with pm3d
+set title '4 limbs (limb 4 mirrors limb 3)'
+splot scans('4prru_map.csv') using 1:2:(ok($4)) with pm3d
+unset multiplot
+GP
+  echo "wrote $out/compare_wR.png"
+else
+  echo "gnuplot not found: compare_wR.png not drawn" >&2
+fi
