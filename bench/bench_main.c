@@ -1,7 +1,10 @@
 /* prru_bench: per-call cost of the generated kernels and the runtime's paths
  * against the straightforward reference (prru_reference) in the same run,
  * the wall time of one simulated second of the paper's scenario on both
- * paths, and the time to regenerate the kernels from the model file.
+ * paths (for a redundantly actuated model that the paper's scenario takes
+ * out of its workspace, the 4-PRRU, of a fallback that stays inside: see
+ * simulated_second), and the time to regenerate the kernels from the model
+ * file.
  *
  * usage: prru_bench [--json] [--reps N] [--quick] [--batch-ms MS]
  *
@@ -69,16 +72,24 @@
 /* What the generated side of the runtime's paths executes (runtime/src/core.c,
  * reactions.c): the generated kernels named, plus the listed numerics. */
 #define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom: " PRRU_OPS_EOM "; + unrolled 3x3 Cholesky"
+#if PRRU_NACT == 3
+#define PRRU_BENCH_OPS_JD_INVERSE "3x3 adjugate solve"
+#define PRRU_BENCH_OPS_JD_ALGEBRA "3x3 algebra"
+#else /* the redundant 4-PRRU: J_d^+ (spec section 12) */
+#define PRRU_BENCH_OPS_JD_INVERSE "J_d^+ by Householder QR of the 4x3 J_d"
+#define PRRU_BENCH_OPS_JD_ALGEBRA "J_d^+ by Householder QR, 4x4 and 3x4 algebra"
+#endif
 #define PRRU_BENCH_OPS_INVERSE_DYNAMICS "ik_jd + eom (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) \
-  " arithmetic) + 3x3 adjugate solve"
+  " arithmetic) + " PRRU_BENCH_OPS_JD_INVERSE
 #define PRRU_BENCH_OPS_REACTIONS "forward_dynamics + poses + reaction_basis + wrench_bias (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_POSES) " + " \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_REACTION_BASIS) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_WRENCH_BIAS) \
   " arithmetic) + per-body Q^T Phi^-1 Q + arrowhead block Cholesky (GSL)"
 #define PRRU_BENCH_OPS_W_R "ik_jd + mass + platform_jacobian (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_MASS) " + " \
-  PRRU_OPS_ARITH_STR(PRRU_ARITH_PLATFORM_JACOBIAN) " arithmetic) + 3x3 algebra, one Jacobi rotation"
+  PRRU_OPS_ARITH_STR(PRRU_ARITH_PLATFORM_JACOBIAN) " arithmetic) + " PRRU_BENCH_OPS_JD_ALGEBRA \
+  ", one Jacobi rotation"
 #define PRRU_OPS_ARITH_STR(x) PRRU_OPS_STR_(x)
 #define PRRU_OPS_STR_(x) #x
 
@@ -237,7 +248,7 @@ typedef int (*eval_fn)(bench_ctx *c, const bench_state *s, double *out);
   BENCH_BATCH(gb_##name, g_##name, nout)   \
   BENCH_BATCH(rb_##name, r_##name, nout)
 
-BENCH_PAIR(jd, 9)
+BENCH_PAIR(jd, 3 * PRRU_NACT)
 BENCH_PAIR(jacobians, 3 * PRRU_NH)
 BENCH_PAIR(bias_terms, PRRU_NH)
 BENCH_PAIR(mass, 9)
@@ -245,7 +256,7 @@ BENCH_PAIR(bias, 3)
 BENCH_PAIR(gravity, 3)
 BENCH_PAIR(dynamics, 15)
 BENCH_PAIR(forward_dynamics, 3)
-BENCH_PAIR(inverse_dynamics, 3)
+BENCH_PAIR(inverse_dynamics, PRRU_NACT)
 BENCH_PAIR(reactions, PRRU_NLAMBDA)
 #ifdef PRRU_BENCH_HAVE_DME
 BENCH_PAIR(w_r, 1)
@@ -266,7 +277,7 @@ typedef struct {
                                  {0, 0, 0}, {0, 0, 0}, 0}
 
 static bench_kernel kernels[] = {
-  KERNEL(jd, 9, PRRU_OPS_JD),
+  KERNEL(jd, 3 * PRRU_NACT, PRRU_OPS_JD),
   KERNEL(jacobians, 3 * PRRU_NH, PRRU_OPS_JACOBIANS),
   KERNEL(bias_terms, PRRU_NH, PRRU_OPS_BIAS_TERMS),
   KERNEL(mass, 9, PRRU_OPS_MASS),
@@ -274,7 +285,7 @@ static bench_kernel kernels[] = {
   KERNEL(gravity, 3, PRRU_OPS_GRAVITY),
   KERNEL(dynamics, 15, PRRU_OPS_DYNAMICS),
   KERNEL(forward_dynamics, 3, PRRU_BENCH_OPS_FORWARD_DYNAMICS),
-  KERNEL(inverse_dynamics, 3, PRRU_BENCH_OPS_INVERSE_DYNAMICS),
+  KERNEL(inverse_dynamics, PRRU_NACT, PRRU_BENCH_OPS_INVERSE_DYNAMICS),
   KERNEL(reactions, PRRU_NLAMBDA, PRRU_BENCH_OPS_REACTIONS),
 #ifdef PRRU_BENCH_HAVE_DME
   KERNEL(w_r, 1, PRRU_BENCH_OPS_W_R),
@@ -295,10 +306,26 @@ static double uniform(double lo, double hi)
   return lo + (hi - lo) * ((double)(r >> 11) / 9007199254740992.0);
 }
 
+/* |det| of rows a, b, c of J (NACT x 3) over the product of their norms:
+ * 1 for orthogonal rows, 0 for dependent ones. */
+static double rows_det(const double *J, int a, int b, int c)
+{
+  const double *x = J + 3 * a, *y = J + 3 * b, *z = J + 3 * c;
+  double det = x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0]) +
+               x[2] * (y[0] * z[1] - y[1] * z[0]);
+  double rows = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) *
+                sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) *
+                sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+  return fabs(det) / rows;
+}
+
 /* Reachable states well away from singular J_d (row-scaled |det| > 0.05,
- * far above the runtime's rcond 1e-8), spread over the region the paper's
- * scenario and workspace map visit, so that no kernel is timed on an error
- * path and the solves are not near-singular. */
+ * far above the runtime's rcond 1e-8; with more than three actuators, of
+ * the best three of J_d's rows, which bounds J_d's rank-3 conditioning
+ * alike), spread over the region the paper's scenario and workspace map
+ * visit, so that no kernel is timed on an error path and the solves are
+ * not near-singular. The draws for the first three actuators come first,
+ * so a 3-limb model gets the same states whatever PRRU_NACT allows. */
 static int make_states(bench_ctx *c)
 {
   int n = 0;
@@ -307,16 +334,17 @@ static int make_states(bench_ctx *c)
     s->q[0] = uniform(-0.35, 0.35);
     s->q[1] = uniform(-0.5, 0.6);
     s->q[2] = uniform(-1.0, 0.2);
-    double d[3], J[9];
+    double d[PRRU_NACT], J[3 * PRRU_NACT];
     prru_ik_jd(s->q, d, J);
-    if (!(isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2])))
+    int reachable = 1;
+    for (int i = 0; i < PRRU_NACT; i++) reachable &= isfinite(d[i]) != 0;
+    if (!reachable)
       continue;
-    double det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) +
-                 J[2] * (J[3] * J[7] - J[4] * J[6]);
-    double rows = 1.0;
-    for (int i = 0; i < 3; i++)
-      rows *= sqrt(J[3 * i] * J[3 * i] + J[3 * i + 1] * J[3 * i + 1] + J[3 * i + 2] * J[3 * i + 2]);
-    if (!(fabs(det) > 0.05 * rows))
+    double best = 0.0;
+    for (int a = 0; a < PRRU_NACT; a++)
+      for (int b = a + 1; b < PRRU_NACT; b++)
+        for (int e = b + 1; e < PRRU_NACT; e++) best = fmax(best, rows_det(J, a, b, e));
+    if (!(best > 0.05))
       continue;
     for (int i = 0; i < 3; i++) {
       s->qd[i] = uniform(-1.0, 1.0);
@@ -325,6 +353,7 @@ static int make_states(bench_ctx *c)
       s->l.fp[i] = uniform(-50.0, 50.0);
       s->l.mp[i] = uniform(-5.0, 5.0);
     }
+    for (int i = 3; i < PRRU_NACT; i++) s->l.fd[i] = uniform(-100.0, 100.0);
     n++;
   }
   return n == NSTATES ? 0 : -1;
@@ -419,8 +448,29 @@ typedef struct {
   double dq, dqd;           /* max |generated - reference| at t_end */
   unsigned long ref_steps;
   double tol, h0;
+  /* The scenario timed: the paper's, or, for a redundantly actuated model
+   * that the paper's takes out of its workspace, the fallback (see
+   * simulated_second); paper_stop says where and why the paper's stopped
+   * then. */
+  int fallback;
+  char paper_stop[256];
 } sim_result;
 
+#define BENCH_SIM_PAPER "paper section 4.3"
+#define BENCH_SIM_FALLBACK "paper section 4.3 with fd_i = fd_3 = 25 N for every actuator beyond the third"
+
+/* One simulated second of the paper's section 4.3 scenario (spec section
+ * 9), generated and reference path. With more than three actuators the
+ * paper's loads leave the fourth at fd4 = 0 (prru_schedule_paper); the
+ * 4-PRRU of models/4prru.json, heavier by a limb and unsupported on that
+ * side, then tips over and leaves its workspace at t = 0.476 s. A model
+ * where that happens times instead the same start, platform load,
+ * tolerances and length with every actuator beyond the third driven like
+ * the third (fd4 = fd3 = 25 N: limb 4 mirrors limb 3), which keeps the
+ * 4-PRRU inside for the whole second (it ends at q = (-0.20, -0.24,
+ * -1.31)). Both paths write those loads themselves, as for the paper's.
+ * Reported as the scenario, with where the paper's stopped; a model that
+ * leaves its workspace either way fails as before. */
 static void simulated_second(const prru_model *m, int reps, sim_result *res)
 {
   double g[MAXREPS], r[MAXREPS];
@@ -439,10 +489,11 @@ static void simulated_second(const prru_model *m, int reps, sim_result *res)
   o.on_sample = capture_sample;
   o.interrupt = NULL;
   o.progress = 0;
-  bench_refsim_options ro = {o.h0, o.abs_tol, o.rel_tol, o.t_end};
+  bench_refsim_options ro = {o.h0, o.abs_tol, o.rel_tol, o.t_end, 0};
   double q0[3], qd0[3], y[6];
   bench_refsim_initial(q0, qd0);
   res->ok = 0;
+  res->fallback = 0;
   res->tol = o.rel_tol;
   res->h0 = o.h0;
   for (int i = 0; i < reps; i++) {
@@ -453,6 +504,15 @@ static void simulated_second(const prru_model *m, int reps, sim_result *res)
     double t0 = bench_now_ns();
     int st = prru_simulate(m, q0, qd0, &o, &t_stop, msg, (int)sizeof msg);
     g[i] = (bench_now_ns() - t0) * 1e-9;
+    if (st != PRRU_OK && i == 0 && !res->fallback && PRRU_NACT > 3) {
+      /* The paper's scenario leaves this model's workspace: the fallback. */
+      snprintf(res->paper_stop, sizeof res->paper_stop, "%s", msg);
+      for (int k = 3; k < PRRU_NACT; k++) sched.base.fd[k] = sched.base.fd[2];
+      ro.mirror_limb3 = 1;
+      res->fallback = 1;
+      i--; /* this repetition again, on the fallback */
+      continue;
+    }
     if (st != PRRU_OK || cap.n == 0 || !(fabs(cap.last.t - o.t_end) <= 1e-12)) {
       fprintf(stderr, "prru_bench: prru_simulate stopped at t = %g s: %s (%s)\n", t_stop,
               prru_strerror(st), msg);
@@ -688,14 +748,20 @@ static void print_json(const bench_options *op, const char *cpu, const sim_resul
 #ifndef PRRU_BENCH_HAVE_DME
   printf(", \"missing\": {\"w_r\": \"runtime/include/prru_dme.h not present at build time\"}");
 #endif
-  if (sim->ok)
-    printf(", \"simulated_second\": {\"generated_s\": %.4g, \"reference_s\": %.4g, "
+  if (sim->ok) {
+    printf(", \"simulated_second\": {\"scenario\": ");
+    json_string(sim->fallback ? BENCH_SIM_FALLBACK : BENCH_SIM_PAPER);
+    if (sim->fallback) {
+      printf(", \"paper_scenario_stopped\": ");
+      json_string(sim->paper_stop);
+    }
+    printf(", \"generated_s\": %.4g, \"reference_s\": %.4g, "
            "\"ratio\": %.4g, \"stepper\": \"rk8pd\", \"rel_tol\": %g, \"abs_tol\": %g, "
            "\"reference_steps\": %lu, \"final_q\": [%.15g, %.15g, %.15g], "
            "\"max_abs_diff_q\": %.3g, \"max_abs_diff_qd\": %.3g}",
            sim->gen_s.median, sim->ref_s.median, sim->ref_s.median / sim->gen_s.median, sim->tol,
            sim->tol, sim->ref_steps, sim->q[0], sim->q[1], sim->q[2], sim->dq, sim->dqd);
-  else
+  } else
     printf(", \"simulated_second\": null");
   if (map->ok) {
     double pts = (double)map->n * map->n, rpts = (double)map->n_ref * map->n_ref;
@@ -738,8 +804,14 @@ static void print_table(const bench_options *op, const char *cpu, const sim_resu
 #endif
   printf("\n");
   if (sim->ok) {
-    printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
-           sim->h0);
+    if (sim->fallback) {
+      printf("simulated second (" BENCH_SIM_FALLBACK ", rk8pd, rel = abs tol %g, h0 %g;\n"
+             "  the paper's scenario, fd beyond the third 0, leaves this model's workspace: %s):\n",
+             sim->tol, sim->h0, sim->paper_stop);
+    } else {
+      printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
+             sim->h0);
+    }
     printf("  generated  %.3f ms [%.3f-%.3f]  (prru_simulate)\n", 1e3 * sim->gen_s.median,
            1e3 * sim->gen_s.min, 1e3 * sim->gen_s.max);
     printf("  reference  %.3f ms [%.3f-%.3f]  (gsl_odeiv2 + prru_ref_forward_dynamics, %lu steps)"

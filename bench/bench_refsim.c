@@ -14,6 +14,7 @@
 typedef struct {
   prru_ref_params p;
   prru_ref_ws *w;
+  double fd[PRRU_NACT];
 } refsim_ctx;
 
 void bench_refsim_initial(double q0[3], double qd0[3])
@@ -27,10 +28,12 @@ void bench_refsim_initial(double q0[3], double qd0[3])
 /* The section 4.3 loads written out here rather than taken from the
  * runtime's prru_schedule_paper, so that the two paths agree only if both
  * implement the spec. */
+static const double paper_fd[3] = {50.0, 40.0, 25.0};
+
 static int refsim_rhs(double t, const double y[], double dydt[], void *params)
 {
   refsim_ctx *c = params;
-  const double fd[3] = {50.0, 40.0, 25.0};
+  const double *fd = c->fd;
   const double fp[3] = {50.0 * sin(4.0 * BENCH_PI * t), -50.0 * cos(4.0 * BENCH_PI * t), 0.0};
   const double mp[3] = {0.0, 0.0, 0.0};
   for (int i = 0; i < 3; i++) dydt[i] = y[3 + i];
@@ -43,6 +46,8 @@ int bench_refsim_paper(const bench_refsim_options *o, double y[6], unsigned long
 {
   refsim_ctx c;
   prru_ref_params_default(&c.p);
+  for (int i = 0; i < PRRU_NACT; i++)
+    c.fd[i] = i < 3 ? paper_fd[i] : o->mirror_limb3 ? paper_fd[2] : 0.0;
   c.w = prru_ref_alloc();
   if (!c.w) {
     fprintf(stderr, "prru_bench: reference simulation: out of memory\n");

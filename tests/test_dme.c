@@ -6,7 +6,11 @@
  * rotation, and the reference's own GSL-SVD w_R. Then the geometry
  * (ellipse in span{e1, v}, segment along z), singular and unreachable
  * poses, and maps: threads vs serial, summary vs a recount. Properties of
- * any model; the paper's claims are in paper_dme.c. */
+ * any model; the paper's claims are in paper_dme.c.
+ * With four actuators (spec section 12) J_d^-1 is J_d^+ throughout (the
+ * independent route takes it from GSL's SVD least squares), Mt is 4x4 and
+ * JtR, JtT 3x4, and the singular locus is sought where the scaled J_d
+ * loses rank (its smallest singular value), not where det changes sign. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +23,8 @@
 #include "testutil.h"
 
 #define PI 3.14159265358979323846
+
+#define NA PRRU_NACT
 
 static prru_model M;
 static prru_data *D;
@@ -54,28 +60,90 @@ static void matmul(const double *A, const double *B, double *C, int n, int k, in
 
 static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+static double dotn(const double *a, const double *b, int n)
+{
+  double s = 0;
+  for (int i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
+}
+
+/* GSL's SVD of an m x n matrix A (row-major), m or n equal to NA or 3:
+ * GSL wants rows >= columns, so a wide A is decomposed as A^T. On return
+ * A = U S V^T with U m x k, V n x k, k = min(m, n), S descending (U, V
+ * row-major with k columns). */
+static void svd(const double *A, int m, int n, double *U, double *S, double *V)
+{
+  const int tr = m < n, r = tr ? n : m, k = tr ? m : n;
+  double a[NA * NA], v[NA * NA], s[NA], wk[NA];
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j < n; j++) a[tr ? j * k + i : i * k + j] = A[i * n + j];
+  gsl_matrix_view av = gsl_matrix_view_array(a, r, k), vv = gsl_matrix_view_array(v, k, k);
+  gsl_vector_view sv = gsl_vector_view_array(s, k), wv = gsl_vector_view_array(wk, k);
+  gsl_linalg_SV_decomp(&av.matrix, &vv.matrix, &sv.vector, &wv.vector);
+  /* a (r x k) holds the left vectors of the decomposed matrix, v its right ones. */
+  memcpy(tr ? V : U, a, (size_t)r * k * sizeof a[0]);
+  memcpy(tr ? U : V, v, (size_t)k * k * sizeof v[0]);
+  memcpy(S, s, (size_t)k * sizeof s[0]);
+}
+
+/* X = A^+ (n x m) from svd() of the m x n A, keeping the first `rank`
+ * singular values. */
+static void pinv(const double *A, int m, int n, int rank, double *X)
+{
+  const int k = m < n ? m : n;
+  double U[NA * NA], V[NA * NA], S[NA];
+  svd(A, m, n, U, S, V);
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < m; j++) {
+      double x = 0;
+      for (int l = 0; l < rank; l++) x += V[i * k + l] * U[j * k + l] / S[l];
+      X[i * m + j] = x;
+    }
+}
+
 typedef struct {
-  double w_R, semi[2], dir[2][3], half_T, Mt[9];
+  double w_R, semi[2], dir[2][3], half_T, Mt[NA * NA];
 } indep;
 
 /* The DME from the reference library, built without the runtime's route.
- * Errors found over the sample: about 5e-14 relative (w_R, lengths), so the
- * 1e-12 bounds below leave a margin of 20 and still catch any real slip. */
+ * Errors found over the sample (w_R, lengths, relative): 3e-13 for the
+ * paper's model, 8e-14 for the prototype, 2e-15 for the 4-PRRU, so the
+ * 1e-12 bounds below leave a margin of at least 3 and still catch any
+ * real slip.
+ * J_d^+ (spec section 12): J_d^-1 by GSL's LU for three actuators; for more,
+ * the least-squares solutions of J_d x = e_i by GSL's SVD, column by column
+ * (the runtime uses a Householder QR of the column-scaled J_d). */
 static int independent(const double q[3], indep *r)
 {
-  double Mref[9], Jd[9], H[3 * PRRU_NH], I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Jinv[9];
+  double Mref[9], Jd[3 * NA], H[3 * PRRU_NH], Jinv[3 * NA];
   if (prru_ref_mass(&P, W, q, Mref) || prru_ref_jd(&P, q, Jd) || prru_ref_jacobians(&P, W, q, H))
     return 1;
-  solve3(Jd, I3, 3, Jinv);
-  double tmp[9], Mt[9], JtR[9], JtT[9];
-  matmul(Mref, Jinv, tmp, 3, 3, 3, 0);
-  matmul(Jinv, tmp, Mt, 3, 3, 3, 1);
-  matmul(H, Jinv, JtR, 3, 3, 3, 0);        /* rows 0-2 of H: J_R,P */
+  if (NA == 3) {
+    const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    solve3(Jd, I3, 3, Jinv);
+  } else {
+    double U[NA * 3], S[3], V[9];
+    svd(Jd, NA, 3, U, S, V);
+    for (int c = 0; c < NA; c++) {
+      double b[NA] = {0}, x[3];
+      b[c] = 1.0;
+      /* x = V S^-1 U^T e_c, GSL's SVD least-squares solve. */
+      gsl_matrix_view Uv = gsl_matrix_view_array(U, NA, 3), Vv = gsl_matrix_view_array(V, 3, 3);
+      gsl_vector_view Sv = gsl_vector_view_array(S, 3), bv = gsl_vector_view_array(b, NA),
+                      xv = gsl_vector_view_array(x, 3);
+      gsl_linalg_SV_solve(&Uv.matrix, &Vv.matrix, &Sv.vector, &bv.vector, &xv.vector);
+      for (int i = 0; i < 3; i++) Jinv[i * NA + c] = x[i];
+    }
+  }
+  double tmp[3 * NA], Mt[NA * NA], JtR[3 * NA], JtT[3 * NA];
+  matmul(Mref, Jinv, tmp, 3, 3, NA, 0);
+  matmul(Jinv, tmp, Mt, NA, 3, NA, 1);
+  matmul(H, Jinv, JtR, 3, 3, NA, 0);        /* rows 0-2 of H: J_R,P */
   /* The translational DME is the tool point's, O' = (0, 0, q3) by the
    * definition of q, so J_T,O' = e3 e3^T whatever the platform's centre of
    * mass (H's J_T,P rows are the centre's). */
   const double JTO[9] = {0, 0, 0, 0, 0, 0, 0, 0, 1};
-  matmul(JTO, Jinv, JtT, 3, 3, 3, 0);
+  matmul(JTO, Jinv, JtT, 3, 3, NA, 0);
 
   /* n: unit normal of range(JtR) = range(J_R,P), from its columns 0 and 1. */
   double c0[3] = {H[0], H[3], H[6]}, c1[3] = {H[1], H[4], H[7]}, n[3], qa[3], qb[3];
@@ -88,11 +156,11 @@ static int independent(const double q[3], indep *r)
   for (int i = 0; i < 3; i++) qa[i] /= t;
   tu_cross(n, qa, qb);
   /* JtR^+ Q = JtR^T (JtR JtR^T + n n^T)^-1 Q (see the header of this file). */
-  double K[9], Q[6], Z[6], X[6], BQ[6];
+  double K[9], Q[6], Z[6], X[2 * NA], BQ[2 * NA];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       double s = 0;
-      for (int l = 0; l < 3; l++) s += JtR[3 * i + l] * JtR[3 * j + l];
+      for (int l = 0; l < NA; l++) s += JtR[NA * i + l] * JtR[NA * j + l];
       K[3 * i + j] = s + n[i] * n[j];
     }
   for (int i = 0; i < 3; i++) {
@@ -100,10 +168,10 @@ static int independent(const double q[3], indep *r)
     Q[2 * i + 1] = qb[i];
   }
   solve3(K, Q, 2, Z);
-  matmul(JtR, Z, X, 3, 3, 2, 1);
-  matmul(Mt, X, BQ, 3, 3, 2, 0);
+  matmul(JtR, Z, X, NA, 3, 2, 1);
+  matmul(Mt, X, BQ, NA, NA, 2, 0);
   double F[4];
-  matmul(BQ, BQ, F, 2, 3, 2, 1);
+  matmul(BQ, BQ, F, 2, NA, 2, 1);
   gsl_matrix_view Fv = gsl_matrix_view_array(F, 2, 2);
   double ev[2], evec[4];
   gsl_vector_view evv = gsl_vector_view_array(ev, 2);
@@ -120,16 +188,10 @@ static int independent(const double q[3], indep *r)
   }
   /* Translational: GSL SVD of JtT, pseudo-inverse from its one singular
    * value, then the largest singular value of Mt JtT^+. */
-  double U[9], V[9], S[3], wk[3], Pi[9], B[9];
-  memcpy(U, JtT, sizeof U);
-  gsl_matrix_view Uv = gsl_matrix_view_array(U, 3, 3), Vv = gsl_matrix_view_array(V, 3, 3);
-  gsl_vector_view Sv = gsl_vector_view_array(S, 3), wkv = gsl_vector_view_array(wk, 3);
-  gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) Pi[3 * i + j] = V[3 * i] * U[3 * j] / S[0];
-  matmul(Mt, Pi, B, 3, 3, 3, 0);
-  memcpy(U, B, sizeof U);
-  gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
+  double Pi[3 * NA], B[3 * NA], U[NA * NA], V[NA * NA], S[NA];
+  pinv(JtT, 3, NA, 1, Pi);
+  matmul(Mt, Pi, B, NA, NA, 3, 0);
+  svd(B, NA, 3, U, S, V);
   r->half_T = 1.0 / S[0];
   return 0;
 }
@@ -151,7 +213,7 @@ static void test_against_independent(void)
     if (!TU_TRUE(independent(q, &x) == 0 && prru_ref_w_r(&P, W, q, &wref) == 0, "reference DME"))
       continue;
     n_ok++;
-    if (k < 20) TU_CLOSE(r.Mt, x.Mt, 9, 1e-12, "Mt vs J_d^-T M J_d^-1 from the reference");
+    if (k < 20) TU_CLOSE(r.Mt, x.Mt, NA * NA, 1e-12, "Mt vs J_d^+T M J_d^+ from the reference");
     const double scale = 1.0;
     double e = rel(r.w_R, x.w_R) / scale;
     if (!(e <= worst_w)) worst_w = e;
@@ -176,6 +238,8 @@ static void test_against_independent(void)
     e = fabs(r.dir_T[0]) + fabs(r.dir_T[1]) + fabs(r.dir_T[2] - 1.0);
     if (!(e <= worst_z)) worst_z = e;
   }
+  printf("DME over %d poses vs independent: w_R %.1e (vs prru_ref_w_r %.1e), semi-axes %.1e, "
+         "directions %.1e, translational %.1e\n", n_ok, worst_w, worst_ref, worst_len, worst_dir, worst_T);
   TU_TRUE(n_ok > 300, "enough regular sample poses");
   tu_check(worst_w <= 1e-12, "w_R vs reference M and 2x2 eigenvalues", worst_w, 1e-12);
   tu_check(worst_ref <= 1e-12, "w_R vs prru_ref_w_r (GSL SVD)", worst_ref, 1e-12);
@@ -188,24 +252,21 @@ static void test_against_independent(void)
 }
 
 /* The ellipse's boundary: |Mt JtR^+ a| = 1 at a = semi_axis_i dir_i, with
- * JtR^+ a found as the minimum-norm solution by GSL's SVD least squares. */
+ * JtR^+ a found as the minimum-norm solution by GSL's SVD least squares
+ * (JtR is 3 x NACT of rank 2: the rounding-level singular value dropped). */
 static void test_boundary(void)
 {
   double q[3] = {0.23, -0.31, -0.2}, worst = 0;
   prru_dme r;
   if (!TU_TRUE(prru_dme_eval(&M, D, q, &r) == PRRU_OK, "regular pose for the boundary test")) return;
+  double X[NA * 3];
+  pinv(r.JtR, 3, NA, 2, X);
   for (int a = 0; a < 2; a++) {
-    double U[9], V[9], S[3], wk[3], x[3], b[3], f[3];
-    memcpy(U, r.JtR, sizeof U);
-    gsl_matrix_view Uv = gsl_matrix_view_array(U, 3, 3), Vv = gsl_matrix_view_array(V, 3, 3);
-    gsl_vector_view Sv = gsl_vector_view_array(S, 3), wkv = gsl_vector_view_array(wk, 3);
-    gsl_linalg_SV_decomp(&Uv.matrix, &Vv.matrix, &Sv.vector, &wkv.vector);
-    S[2] = 0.0; /* rank 2: drop the rounding-level singular value */
+    double x[NA], b[3], f[NA];
     for (int i = 0; i < 3; i++) b[i] = r.semi_axis[a] * r.axis_dir[a][i];
-    gsl_vector_view bv = gsl_vector_view_array(b, 3), xv = gsl_vector_view_array(x, 3);
-    gsl_linalg_SV_solve(&Uv.matrix, &Vv.matrix, &Sv.vector, &bv.vector, &xv.vector);
-    matmul(r.Mt, x, f, 3, 3, 1, 0);
-    double e = fabs(sqrt(dot(f, f)) - 1.0);
+    matmul(X, b, x, NA, 3, 1, 0);
+    matmul(r.Mt, x, f, NA, NA, 1, 0);
+    double e = fabs(sqrt(dotn(f, f, NA)) - 1.0);
     if (e > worst) worst = e;
   }
   tu_check(worst <= 1e-12, "|Mt JtR^+ a| = 1 at the semi-axis tips", worst, 1e-12);
@@ -221,15 +282,75 @@ static int all_nan(const prru_dme *r)
 {
   return isnan(r->w_R) && isnan(r->sigma[0]) && isnan(r->sigma[1]) && isnan(r->semi_axis[1]) &&
          isnan(r->axis_dir[1][2]) && isnan(r->sigma_T) && isnan(r->half_length_T) &&
-         isnan(r->dir_T[2]) && isnan(r->Mt[4]) && isnan(r->JtR[0]) && isnan(r->JtT[8]);
+         isnan(r->dir_T[2]) && isnan(r->Mt[4]) && isnan(r->Mt[NA * NA - 1]) && isnan(r->JtR[0]) &&
+         isnan(r->JtT[3 * NA - 1]);
 }
 
-/* A pose of the model's own singular locus: a sign change of det J_d
- * between two regular grid neighbours, bisected to the last bit. 0 when the
- * grid finds none. */
-static int find_singular(double qs[3])
+/* sigma_3 / sigma_1 of Js = J_d diag(1/L, 1/L, 1) at (q1, q2, 0), L the
+ * mean upper-link length (the runtime's scaling); NaN where unreachable,
+ * and where margin > 0, also when a point at distance margin along q1,
+ * q2 or a diagonal is unreachable. */
+static double sigma_ratio(double q1, double q2, double margin)
 {
-  double prev_det = 0, prev_q1 = 0, Jd[9];
+  for (int di = -1; margin > 0 && di <= 1; di++)
+    for (int dj = -1; dj <= 1; dj++)
+      if ((di || dj) && isnan(sigma_ratio(q1 + di * margin, q2 + dj * margin, 0))) return NAN;
+  double L = 0, J[3 * NA], U[3 * NA], S[3], V[9];
+  for (int i = 0; i < PRRU_NLIMB; i++) L += prru_mech.l1[i] / PRRU_NLIMB;
+  prru_jd((const double[3]){q1, q2, 0}, J);
+  for (int i = 0; i < 3 * NA; i++) {
+    if (!isfinite(J[i])) return NAN;
+    if (i % 3 < 2) J[i] /= L;
+  }
+  svd(J, NA, 3, U, S, V);
+  return S[2] / S[0];
+}
+
+/* A pose of the model's own singular locus in |q1|, |q2| <= pi/3 at
+ * q3 = 0 (J_d does not depend on q3); 0 when the grid finds none.
+ * Three actuators: a sign change of det J_d between two regular grid
+ * neighbours, bisected to the last bit.
+ * More (spec section 12): J_d is NACT x 3 and singular where it loses
+ * rank, i.e. where the smallest singular value of the scaled J_d vanishes.
+ * That does not change sign: the locus (generically isolated points) is
+ * sought as the least sigma_3 / sigma_1 over the 61 x 61 grid, refined by
+ * a shrinking pattern search and accepted below 1e-12, among the points
+ * whose grid neighbours (one spacing, 0.035 rad, away) are all reachable:
+ * at the edge of reach a limb stretches out and a row of J_d grows without
+ * bound, which drives the ratio to 0 without any loss of rank. *best gets
+ * the least ratio found. */
+static int find_singular(double qs[3], double *best)
+{
+  *best = NAN;
+  if (NA > 3) {
+    const int n = 61;
+    static double g[61][61];
+    const double h0 = (PI / 1.5) / (n - 1);
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) g[i][j] = sigma_ratio(-PI / 3 + h0 * i, -PI / 3 + h0 * j, 0);
+    double b = INFINITY, c[2] = {0, 0};
+    for (int i = 1; i < n - 1; i++)
+      for (int j = 1; j < n - 1; j++) {
+        int inner = 1;
+        for (int di = -1; di <= 1; di++)
+          for (int dj = -1; dj <= 1; dj++) inner &= isfinite(g[i + di][j + dj]);
+        if (inner && g[i][j] < b) b = g[i][j], c[0] = -PI / 3 + h0 * i, c[1] = -PI / 3 + h0 * j;
+      }
+    if (!isfinite(b)) return 0;
+    for (double h = h0; h > 1e-17; h *= 0.5) /* pattern search: move while it helps */
+      for (int moved = 1; moved;) {
+        moved = 0;
+        for (int k = 0; k < 4; k++) {
+          double t[2] = {c[0] + (k == 0 ? h : k == 1 ? -h : 0), c[1] + (k == 2 ? h : k == 3 ? -h : 0)};
+          double v = sigma_ratio(t[0], t[1], h0);
+          if (v < b) b = v, c[0] = t[0], c[1] = t[1], moved = 1;
+        }
+      }
+    *best = b;
+    qs[0] = c[0], qs[1] = c[1], qs[2] = 0;
+    return b < 1e-12;
+  }
+  double prev_det = 0, prev_q1 = 0, Jd[3 * NA];
   for (int j = 0; j <= 60; j++) {
     double q2 = -PI / 3 + (PI / 1.5) * j / 60;
     for (int i = 0; i <= 60; i++) {
@@ -273,8 +394,8 @@ static void test_singular(void)
   TU_TRUE(found, "the grid has an unreachable pose");
   TU_TRUE(prru_dme_eval(&M, D, (const double[3]){NAN, 0, 0}, &r) == PRRU_EINPUT && all_nan(&r),
           "NaN pose rejected");
-  double qs[3];
-  if (find_singular(qs)) {
+  double qs[3], best;
+  if (find_singular(qs, &best)) {
     int st = prru_dme_eval(&M, D, qs, &r);
     tu_check(st == PRRU_ESINGULAR && r.jd_rcond < M.jd_rcond_min && all_nan(&r),
              "pose on det J_d = 0 flagged singular, outputs NaN (rcond)", r.jd_rcond, M.jd_rcond_min);
@@ -284,8 +405,26 @@ static void test_singular(void)
     m3.jd_rcond_min = 1e-3;
     TU_TRUE(prru_dme_eval(&m3, D, qn, &r) == PRRU_ESINGULAR && isnan(r.w_R),
             "near the locus: singular with jd_rcond_min = 1e-3");
+  } else if (NA > 3) {
+    printf("no rank-deficient J_d in |q1|, |q2| <= pi/3 away from the edge of reach (least "
+           "sigma_3/sigma_1 of the scaled J_d %.3g at q = (%.6f, %.6f, 0)): singular-pose checks "
+           "skipped\n", best, qs[0], qs[1]);
   } else {
     printf("no singular locus in |q1|, |q2| <= pi/3: singular-pose checks skipped\n");
+  }
+  /* The tolerance itself, at a regular pose: jd_rcond_min just above the
+   * pose's jd_rcond flags it singular (outputs NaN, jd_rcond still
+   * reported), just below leaves it regular. */
+  const double qt[3] = {0.23, -0.31, -0.2};
+  if (TU_TRUE(prru_dme_eval(&M, D, qt, &r) == PRRU_OK, "regular pose for the tolerance test")) {
+    const double rc = r.jd_rcond;
+    prru_model mt = M;
+    mt.jd_rcond_min = rc * (1 + 1e-9);
+    TU_TRUE(prru_dme_eval(&mt, D, qt, &r) == PRRU_ESINGULAR && all_nan(&r) && r.jd_rcond == rc,
+            "jd_rcond_min just above jd_rcond: singular, outputs NaN, jd_rcond reported");
+    mt.jd_rcond_min = rc * (1 - 1e-9);
+    TU_TRUE(prru_dme_eval(&mt, D, qt, &r) == PRRU_OK && isfinite(r.w_R),
+            "jd_rcond_min just below jd_rcond: regular");
   }
   TU_TRUE(strcmp(prru_dme_status_name(PRRU_OK), "ok") == 0 &&
               strcmp(prru_dme_status_name(PRRU_ESINGULAR), "singular") == 0 &&

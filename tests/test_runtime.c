@@ -4,7 +4,13 @@
  * balance, agreement with the dense reference), the integrators against an
  * independent RK4, clean stops, bounded integrator work (tolerance floor,
  * step budget, interrupts inside a step), msbdf at the workspace boundary,
- * parsing. The paper's scenario is checked in paper_runtime.c. */
+ * parsing. The paper's scenario is checked in paper_runtime.c.
+ * Models with 3 or 4 actuators (spec section 12): sizes follow PRRU_NACT;
+ * with a redundant actuator ID(FD(fd)) is fd less its component along the
+ * actuator null vector and FD(ID(qdd)) = qdd, limb 4's U-joint moment axis
+ * is w x x4 (x4 = -R_L4 e1), FK refuses sliders no pose reproduces, and
+ * the simulations' constant loads are built from the model's static
+ * actuator forces. test_redundant.c checks the redundancy itself. */
 #define _XOPEN_SOURCE 700 /* setitimer, sigaction, clock_gettime, write, _exit */
 #include <math.h>
 #include <signal.h>
@@ -39,6 +45,20 @@ static void random_state(double q[3], double qd[3])
   for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
 }
 
+static int all_finite(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+static double dot_n(const double *a, const double *b, int n)
+{
+  double s = 0;
+  for (int i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
+}
+
 /* A pose out of reach: q1 raised until the inverse kinematics fails. */
 static void unreachable_pose(double q[3])
 {
@@ -47,9 +67,12 @@ static void unreachable_pose(double q[3])
   do {
     q[0] += 0.01;
     prru_ik(q, d);
-  } while (isfinite(d[0]) && isfinite(d[1]) && isfinite(d[2]) && q[0] < 3.2);
+  } while (all_finite(d, PRRU_NACT) && q[0] < 3.2);
 }
 
+/* Every actuator force, fp and mp; the draws for the first three
+ * actuators come in the order they always did, so a 3-limb model sees the
+ * same loads as before redundant actuators existed. */
 static void random_loads(prru_loads *l)
 {
   for (int i = 0; i < 3; i++) {
@@ -57,6 +80,7 @@ static void random_loads(prru_loads *l)
     l->fp[i] = tu_uniform(-30, 30);
     l->mp[i] = tu_uniform(-3, 3);
   }
+  for (int i = 3; i < PRRU_NACT; i++) l->fd[i] = tu_uniform(-60, 60);
 }
 
 static void mat3vec(const double *A, int stride, const double x[3], double y[3])
@@ -66,17 +90,35 @@ static void mat3vec(const double *A, int stride, const double x[3], double y[3])
 }
 
 /* ---- forward/inverse dynamics, FK ---- */
+/* ID(FD(fd)) = fd for three actuators. With redundant ones (spec section
+ * 12) every fd + t n (n = prru_actuator_null: J_d^T n = 0) moves the robot
+ * alike and ID returns the one of least norm, so it must return fd's
+ * projection fd - (fd . n) n off the null direction, and FD(ID(qdd)) must
+ * give qdd back. */
 static void test_inverse_of_forward(void)
 {
-  double worst = 0, worst_ref = 0;
+  double worst = 0, worst_ref = 0, worst_fdid = 0;
   for (int k = 0; k < 500; k++) {
-    double q[3], qd[3], qdd[3], fd[3];
+    double q[3], qd[3], qdd[3], fd[PRRU_NACT], want[PRRU_NACT];
     prru_loads l;
     random_state(q, qd);
     random_loads(&l);
     if (prru_forward_dynamics(&model, &data, q, qd, &l, qdd) != PRRU_OK) { TU_TRUE(0, "fd status"); continue; }
     if (prru_inverse_dynamics(&model, &data, q, qd, qdd, &l, fd) != PRRU_OK) { TU_TRUE(0, "id status"); continue; }
-    worst = fmax(worst, tu_relerr(fd, l.fd, 3, 1.0));
+    memcpy(want, l.fd, sizeof want);
+    if (PRRU_NPRELOAD > 0) {
+      double n[PRRU_NACT];
+      if (!TU_TRUE(prru_actuator_null(&model, &data, q, n) == PRRU_OK, "actuator null vector status"))
+        continue;
+      const double t = dot_n(l.fd, n, PRRU_NACT);
+      for (int i = 0; i < PRRU_NACT; i++) want[i] -= t * n[i];
+      prru_loads li = l;
+      double a[3];
+      memcpy(li.fd, fd, sizeof fd);
+      if (TU_TRUE(prru_forward_dynamics(&model, &data, q, qd, &li, a) == PRRU_OK, "FD(ID) status"))
+        worst_fdid = fmax(worst_fdid, tu_relerr(a, qdd, 3, 1.0));
+    }
+    worst = fmax(worst, tu_relerr(fd, want, PRRU_NACT, 1.0));
     /* The runtime's unrolled solve against GSL in the reference. */
     static prru_ref_params p;
     static prru_ref_ws *w;
@@ -85,8 +127,16 @@ static void test_inverse_of_forward(void)
     prru_ref_forward_dynamics(&p, w, q, qd, l.fd, l.fp, l.mp, qdd_ref);
     worst_ref = fmax(worst_ref, tu_relerr(qdd, qdd_ref, 3, 1e-3));
   }
-  printf("ID(FD) %.1e, FD vs reference solve %.1e\n", worst, worst_ref);
-  tu_check(worst <= 1e-10, "inverse dynamics of forward dynamics returns fd", worst, 1e-10);
+  if (PRRU_NPRELOAD == 0) {
+    printf("ID(FD) %.1e, FD vs reference solve %.1e\n", worst, worst_ref);
+    tu_check(worst <= 1e-10, "inverse dynamics of forward dynamics returns fd", worst, 1e-10);
+  } else {
+    printf("ID(FD) vs fd - (fd . n) n %.1e, FD(ID(qdd)) %.1e, FD vs reference solve %.1e\n", worst,
+           worst_fdid, worst_ref);
+    tu_check(worst <= 1e-10, "inverse dynamics of forward dynamics returns fd less its preload along n",
+             worst, 1e-10);
+    tu_check(worst_fdid <= 1e-10, "forward dynamics of inverse dynamics returns qdd", worst_fdid, 1e-10);
+  }
   tu_check(worst_ref <= 1e-10, "forward dynamics agrees with the reference's GSL solve", worst_ref, 1e-10);
 }
 
@@ -95,7 +145,7 @@ static void test_fk(void)
   double worst = 0;
   int fails = 0;
   for (int k = 0; k < 300; k++) {
-    double q[3], qd[3], act[3], seed[3], sol[3];
+    double q[3], qd[3], act[PRRU_NACT], seed[3], sol[3];
     random_state(q, qd);
     prru_ik(q, act);
     for (int i = 0; i < 3; i++) seed[i] = q[i] + tu_uniform(-0.05, 0.05);
@@ -105,17 +155,28 @@ static void test_fk(void)
   tu_check(fails == 0, "FK converges from a nearby seed", fails, 0);
   printf("FK(IK(q)) %.1e\n", worst);
   tu_check(worst <= 1e-12, "FK(IK(q)) = q", worst, 1e-12);
-  /* Out of reach: sliders far apart vertically (limb 1 2 m above limb 2). */
-  double act[3] = {1.0, -1.0, 0.0}, seed[3] = {0, 0, -0.2}, sol[3];
+  /* Out of reach: sliders far apart vertically (limb 1 2 m above limb 2;
+   * any further slider at 0). */
+  double act[PRRU_NACT] = {1.0, -1.0, 0.0}, seed[3] = {0, 0, -0.2}, sol[3];
   TU_TRUE(prru_forward_kinematics(&model, &data, act, seed, sol) == PRRU_ENOCONV,
           "FK of an unreachable d fails with PRRU_ENOCONV");
-  double bad[3] = {NAN, 0, 0};
+  if (PRRU_NPRELOAD > 0) {
+    /* Every slider within reach, but no pose puts all of them there: the
+     * sliders of a reachable pose with the last one moved by 1 cm. */
+    const double q[3] = {0.1, -0.05, -0.8};
+    prru_ik(q, act);
+    act[PRRU_NACT - 1] += 0.01;
+    for (int i = 0; i < 3; i++) seed[i] = q[i];
+    TU_TRUE(prru_forward_kinematics(&model, &data, act, seed, sol) == PRRU_ENOCONV,
+            "FK of sliders no pose reproduces fails with PRRU_ENOCONV");
+  }
+  double bad[PRRU_NACT] = {NAN, 0, 0};
   TU_TRUE(prru_forward_kinematics(&model, &data, bad, seed, sol) == PRRU_EINPUT, "FK of NaN d");
 }
 
 static void test_bad_input(void)
 {
-  double q[3] = {0.1, 0.2, -0.8}, qd[3] = {0, 0, 0}, qdd[3], fd[3];
+  double q[3] = {0.1, 0.2, -0.8}, qd[3] = {0, 0, 0}, qdd[3], fd[PRRU_NACT];
   prru_loads l;
   memset(&l, 0, sizeof l);
   double far[3];
@@ -207,8 +268,10 @@ static void test_reactions(void)
     for (int j = 0; j < PRRU_NJOINT; j++) {
       const prru_joint_info *jt = &me->joint[j];
       if (jt->type != 'U') continue;
-      /* C_1, C_2 at O' -+ a v; the last limb's at O'; moment axis u for
-       * limbs 1, 2 and w x x3 (x3: the lower link's long axis) for limb 3. */
+      /* C_1, C_2 at O' -+ a v; limb 3's (and limb 4's) at O'; moment axis
+       * u for limbs 1, 2, w x x3 for limb 3 (x3 = R_L3 e1: the lower link's
+       * long axis) and w x x4 for limb 4, whose lower link points the
+       * other way (x4 = -R_L4 e1, spec section 12). */
       const double *fj = joint_lambda(lam, j), *RL = R + 9 * me->lower[jt->limb];
       double s = jt->limb == 0 ? -1 : 1, c[3], r[3], rxf[3], axis[3];
       for (int i = 0; i < 3; i++)
@@ -216,7 +279,8 @@ static void test_reactions(void)
       if (jt->limb < 2) {
         memcpy(axis, u, sizeof axis);
       } else {
-        double x3[3] = {RL[0], RL[3], RL[6]};
+        const double sx = jt->limb == 3 ? -1.0 : 1.0;
+        double x3[3] = {sx * RL[0], sx * RL[3], sx * RL[6]};
         tu_cross(wv, x3, axis);
         double nn = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
         for (int i = 0; i < 3; i++) axis[i] /= nn;
@@ -293,6 +357,22 @@ static void work_rhs(const prru_loads *l, const double y[7], double f[7])
   f[6] = p;
 }
 
+/* Constant loads for a run from q0: fp and mp as given in l, the actuator
+ * forces that hold q0 at rest under them and gravity (inverse dynamics at
+ * qd = qdd = 0) plus delta (N, actuators 1-3; an actuator beyond the third
+ * gets delta_3, as limb 4 mirrors limb 3). Taken from the model, so that
+ * every model, also the heavier 4-PRRU, stays in its workspace over the
+ * tests' horizons (they drift it through a fraction of a radian). For the
+ * paper's model these are within 0.5 N of the fixed forces the tests used
+ * before. */
+static void loads_near_rest(const double q0[3], const double delta[3], prru_loads *l)
+{
+  const double zero[3] = {0, 0, 0};
+  TU_TRUE(prru_inverse_dynamics(&model, &data, q0, zero, zero, l, l->fd) == PRRU_OK,
+          "static actuator forces at the start pose");
+  for (int i = 0; i < PRRU_NACT; i++) l->fd[i] += delta[i < 3 ? i : 2];
+}
+
 /* Classical RK4 on (q, qd, W) with n steps to t_end. */
 static void rk4_work(const prru_loads *l, double y[7], double t_end, int n)
 {
@@ -315,8 +395,8 @@ static void test_energy(void)
   prru_loads cases[2];
   memset(cases, 0, sizeof cases);
   /* Free motion, then constant actuator forces and platform loads. */
-  cases[1].fd[0] = 55, cases[1].fd[1] = 45, cases[1].fd[2] = 30;
   cases[1].fp[0] = 4, cases[1].fp[2] = -10, cases[1].mp[1] = 0.5;
+  loads_near_rest(q0, (const double[3]){6, -5, -3}, &cases[1]);
   const char *what[2] = {"free motion", "constant loads"};
   for (int c = 0; c < 2; c++) {
     const double t_end = 0.5;
@@ -362,7 +442,8 @@ static void test_steppers(void)
   const double q0[3] = {0.1, -0.05, -0.8}, qd0[3] = {-0.3, 0.2, 0.1}, t_end = 0.4;
   prru_loads l;
   memset(&l, 0, sizeof l);
-  l.fd[0] = 40, l.fd[1] = 35, l.fd[2] = 30, l.fp[1] = 5;
+  l.fp[1] = 5;
+  loads_near_rest(q0, (const double[3]){-4, -11, -2}, &l);
   prru_load_schedule ls;
   prru_schedule_constant(&ls, &l);
   keep a, b, c;
@@ -678,6 +759,37 @@ static void test_msbdf_boundary(void)
 }
 
 /* ---- schedules, scenarios, parsing ---- */
+/* "t,fd1,...,fdn". */
+static void csv_fd_header(char *buf, size_t len, int n)
+{
+  size_t k = (size_t)snprintf(buf, len, "t");
+  for (int i = 1; i <= n && k < len; i++) k += (size_t)snprintf(buf + k, len - k, ",fd%d", i);
+}
+
+/* item (at most 7 characters) repeated n times, at most 8 ("" for n <= 0);
+ * one of four static buffers in turn, so up to four results live at once. */
+static const char *csv_repeat(const char *item, int n)
+{
+  static char bufs[4][64];
+  static int next;
+  char *b = bufs[next++ % 4];
+  b[0] = '\0';
+  for (int i = 0; i < n && i < 8; i++) strcat(b, item);
+  return b;
+}
+
+/* ",1,2,...,n". */
+static const char *csv_count(int n)
+{
+  static char bufs[4][64];
+  static int next;
+  char *b = bufs[next++ % 4];
+  size_t k = 0;
+  b[0] = '\0';
+  for (int i = 1; i <= n && k < sizeof bufs[0]; i++) k += (size_t)snprintf(b + k, sizeof bufs[0] - k, ",%d", i);
+  return b;
+}
+
 static void test_parsing(void)
 {
   double v[3];
@@ -688,24 +800,48 @@ static void test_parsing(void)
     TU_TRUE(prru_parse_list(bad[i], v, 3) == PRRU_EPARSE, bad[i]);
   char msg[300];
   prru_load_schedule s;
-  const char *csv = "t,fd1,fd2,fd3,fp3\n0,0,10,20,1\n1,10,10,0,3\n";
+  /* The tables have one fd column per actuator (t,fd1..fdN, N =
+   * PRRU_NACT): the texts are built for the model. Actuators beyond the
+   * third run from 5 N to 7 N. */
+  char fdh[128], fdh1[128], csv[512];
+  csv_fd_header(fdh, sizeof fdh, PRRU_NACT);
+  csv_fd_header(fdh1, sizeof fdh1, PRRU_NACT - 1);
+  snprintf(csv, sizeof csv, "%s,fp3\n0,0,10,20%s,1\n1,10,10,0%s,3\n", fdh,
+           csv_repeat(",5", PRRU_NACT - 3), csv_repeat(",7", PRRU_NACT - 3));
   TU_TRUE(prru_schedule_parse_csv(&s, csv, strlen(csv), "mem", msg, 300) == PRRU_OK, "load table parses");
   prru_loads l;
   prru_schedule_eval(&s, 0.25, &l);
-  TU_TRUE(fabs(l.fd[0] - 2.5) < 1e-15 && fabs(l.fd[2] - 15) < 1e-14 && fabs(l.fp[2] - 1.5) < 1e-15,
+  int extra_ok = 1;
+  for (int i = 3; i < PRRU_NACT; i++) extra_ok &= fabs(l.fd[i] - 5.5) < 1e-15;
+  TU_TRUE(fabs(l.fd[0] - 2.5) < 1e-15 && fabs(l.fd[2] - 15) < 1e-14 && fabs(l.fp[2] - 1.5) < 1e-15 &&
+              extra_ok,
           "linear interpolation");
   prru_schedule_eval(&s, 7, &l);
-  TU_TRUE(l.fd[0] == 10 && l.fp[2] == 3, "held after the last row");
+  TU_TRUE(l.fd[0] == 10 && l.fp[2] == 3 && l.fd[PRRU_NACT - 1] == (PRRU_NACT > 3 ? 7 : 0),
+          "held after the last row");
   prru_schedule_free(&s);
+  /* "0,1,2,..,N" (N numbers after t); the header's missing column. */
+  char row[80], row_short[80], missing[64], t_missing[512], t_short[512], t_dup[512], t_zz[512],
+      t_nan[512], t_none[512], t_twice[512];
+  snprintf(row, sizeof row, "0%s", csv_count(PRRU_NACT));
+  snprintf(row_short, sizeof row_short, "0%s", csv_count(PRRU_NACT - 1));
+  snprintf(missing, sizeof missing, "missing column 'fd%d'", PRRU_NACT);
+  snprintf(t_missing, sizeof t_missing, "%s\n%s\n", fdh1, row_short);
+  snprintf(t_short, sizeof t_short, "%s\n%s\n", fdh, row_short);
+  snprintf(t_dup, sizeof t_dup, "%s\n%s\n%s\n", fdh, row, row);
+  snprintf(t_zz, sizeof t_zz, "%s,zz\n%s,%d\n", fdh, row, PRRU_NACT + 1);
+  snprintf(t_nan, sizeof t_nan, "%s\n0,1,nan%s\n", fdh, csv_count(PRRU_NACT) + 4);
+  snprintf(t_none, sizeof t_none, "%s\n", fdh);
+  snprintf(t_twice, sizeof t_twice, "t,t%s\n%s\n", fdh + 5, row); /* t,t,fd2,.. */
   const struct { const char *text, *needle; } bad_csv[] = {
-      {"t,fd1,fd2\n0,1,2\n", "missing column 'fd3'"},
-      {"t,fd1,fd2,fd3\n0,1,2\n", "mem:2"},
-      {"t,fd1,fd2,fd3\n0,1,2,3\n0,1,2,3\n", "does not increase"},
-      {"t,fd1,fd2,fd3,zz\n0,1,2,3,4\n", "unknown column 'zz'"},
-      {"t,fd1,fd2,fd3\n0,1,nan,3\n", "not a finite number"},
-      {"t,fd1,fd2,fd3\n", "no data rows"},
+      {t_missing, missing},
+      {t_short, "mem:2"},
+      {t_dup, "does not increase"},
+      {t_zz, "unknown column 'zz'"},
+      {t_nan, "not a finite number"},
+      {t_none, "no data rows"},
       {"", "no header"},
-      {"t,t,fd2,fd3\n0,1,2,3\n", "appears twice"},
+      {t_twice, "appears twice"},
   };
   for (size_t i = 0; i < sizeof bad_csv / sizeof bad_csv[0]; i++) {
     int st = prru_schedule_parse_csv(&s, bad_csv[i].text, strlen(bad_csv[i].text), "mem", msg, 300);
@@ -713,12 +849,21 @@ static void test_parsing(void)
     if (!(st == PRRU_EPARSE && strstr(msg, bad_csv[i].needle))) fprintf(stderr, "  got: %s\n", msg);
   }
   prru_scenario sc;
-  const char *ok = "# test\nq0 = 0, 0.5, -0.8\nfd = 50,40,25\nharmonic = 50, 12.566370614359172\n"
-                   "t_end = 0.5\ndt = 0.01\nstepper = rkck\n";
+  char ok[512];
+  snprintf(ok, sizeof ok,
+           "# test\nq0 = 0, 0.5, -0.8\nfd = 50,40,25%s\nharmonic = 50, 12.566370614359172\n"
+           "t_end = 0.5\ndt = 0.01\nstepper = rkck\n", csv_repeat(",25", PRRU_NACT - 3));
   TU_TRUE(prru_scenario_parse(&sc, ok, strlen(ok), "mem", NULL, msg, 300) == PRRU_OK &&
-              sc.q0[1] == 0.5 && sc.opt.stepper == PRRU_RKCK && sc.loads.kind == PRRU_LOAD_HARMONIC,
+              sc.q0[1] == 0.5 && sc.opt.stepper == PRRU_RKCK && sc.loads.kind == PRRU_LOAD_HARMONIC &&
+              sc.loads.base.fd[PRRU_NACT - 1] == 25,
           "scenario parses");
   prru_scenario_free(&sc);
+  /* fd takes exactly one number per actuator. */
+  char fd_short[128];
+  snprintf(fd_short, sizeof fd_short, "fd = 1%s\n", csv_repeat(",1", PRRU_NACT - 2));
+  TU_TRUE(prru_scenario_parse(&sc, fd_short, strlen(fd_short), "mem", NULL, msg, 300) == PRRU_EPARSE &&
+              strstr(msg, "mem:1: fd"),
+          "scenario fd with one number fewer than the actuators refused");
   const char *budget = "max_steps = 500\natol = 0\nrtol = 2.3e-14\n";
   TU_TRUE(prru_scenario_parse(&sc, budget, strlen(budget), "mem", NULL, msg, 300) == PRRU_OK &&
               sc.opt.max_steps == 500 && sc.opt.rel_tol == 2.3e-14,
