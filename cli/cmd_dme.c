@@ -23,22 +23,45 @@
  * marked and the index converges. The summary gives both. */
 #define FIG7_RCOND_MIN 4e-3
 
+/* %s: the inverse of J_d and its explanation. */
 static const char dme_help[] =
     "usage: prru dme --q q1,q2,q3 [--rcond-min R]\n"
     "Dynamic manipulability at the pose q (rad, rad, m), paper section 5: with\n"
-    "Mt = J_d^-T M J_d^-1 and JtR = J_R,P J_d^-1, the rotational ellipse is the set\n"
-    "of platform angular accelerations a in span{e1, v} with |Mt JtR^+ a| <= 1 N;\n"
-    "its semi-axes have lengths 1/sigma_i (rad/s^2 per N) along the right singular\n"
-    "vectors of Mt JtR^+ (unit, in {S}); w_R = sigma_1/sigma_2 (>= 1). The\n"
-    "translational segment runs along z with half-length 1/sigma_T (m/s^2 per N).\n"
+    "Mt = J_d^%s M J_d^%s and JtR = J_R,P J_d^%s, the rotational ellipse is the\n"
+    "set of platform angular accelerations a in span{e1, v} with\n"
+    "|Mt JtR^+ a| <= 1 N; its semi-axes have lengths 1/sigma_i (rad/s^2 per N)\n"
+    "along the right singular vectors of Mt JtR^+ (unit, in {S});\n"
+    "w_R = sigma_1/sigma_2 (>= 1). The translational segment runs along z with\n"
+    "half-length 1/sigma_T (m/s^2 per N).\n"
+    "%s"
     "Prints JSON: model (name, file, sha256), q, status (\"ok\", \"singular\" or\n"
     "\"unreachable\"), w_R, Jd_rcond,\n"
     "sigma, semi_axes (minor, major), axis_directions, sigma_T,\n"
-    "translational_half_length, translational_direction, Mt, JtR, JtT. At a\n"
-    "singular or unreachable pose the status says so and every quantity that is\n"
-    "not defined there is null; that is still a valid answer (exit 0).\n"
-    "J_d counts as singular when 1/(|J_d|_1 |J_d^-1|_1) < R (default: the\n"
+    "translational_half_length, translational_direction, Mt (%dx%d), JtR and\n"
+    "JtT (3x%d). At a singular or unreachable pose the status says so and\n"
+    "every quantity that is not defined there is null; that is still a valid\n"
+    "answer (exit 0).\n"
+    "J_d counts as singular when 1/(|J|_1 |J^%s|_1) < R, J = J_d with its\n"
+    "rotation columns divided by the mean upper-link length (default R: the\n"
     "model's 1e-8).\n";
+
+static const char dme_inverse_3[] =
+    "J_d^-1 is the inverse of the 3x3 J_d (three actuators).\n";
+static const char dme_inverse_redundant[] =
+    "This model has %d actuators: J_d is %dx3 and J_d^+ = (J_d^T J_d)^-1 J_d^T,\n"
+    "its pseudo-inverse (for three actuators J_d^-1), so that Mt maps actuator\n"
+    "accelerations in range(J_d) to the least-norm drive forces.\n";
+
+static void print_dme_help(void)
+{
+  char inv[sizeof dme_inverse_redundant + 32];
+  const char *pinv = PRRU_NACT > 3 ? "+" : "-1", *pinvT = PRRU_NACT > 3 ? "+T" : "-T";
+  if (PRRU_NACT > 3)
+    snprintf(inv, sizeof inv, dme_inverse_redundant, PRRU_NACT, PRRU_NACT);
+  else
+    snprintf(inv, sizeof inv, "%s", dme_inverse_3);
+  printf(dme_help, pinvT, pinv, pinv, inv, PRRU_NACT, PRRU_NACT, PRRU_NACT, pinv);
+}
 
 static int parse_rcond(const char *cmd, const char *text, prru_model *m)
 {
@@ -65,7 +88,7 @@ int prru_cmd_dme(int argc, char **argv)
   prru_cli_option opts[] = {{"q", 1, &qs, NULL}, {"rcond-min", 1, &rcs, NULL}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("dme", argc, argv, opts, 3)) return 2;
   if (help) {
-    fputs(dme_help, stdout);
+    print_dme_help();
     return 0;
   }
   if (!qs) {
@@ -130,7 +153,7 @@ static const char map_help[] =
     "(name, file, sha256) and the global index: the mean of w_R - 1 over the ok\n"
     "points, with the fraction of the grid that is singular or unreachable (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
-    "and the range of w_R. J_d counts as singular when 1/(|J|_1 |J^-1|_1) < R,\n"
+    "and the range of w_R. J_d counts as singular when 1/(|J|_1 |J^%s|_1) < R,\n"
     "J = J_d with its rotation columns divided by the mean upper-link length\n"
     "(default R: 1e-8). If the grid crosses the singular locus, the mean of\n"
     "w_R - 1 depends on how close grid points fall to it: compare designs with\n"
@@ -297,7 +320,7 @@ int prru_cmd_map(int argc, char **argv)
                             {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("map", argc, argv, opts, 8)) return 2;
   if (help) {
-    fputs(map_help, stdout);
+    printf(map_help, PRRU_NACT > 3 ? "+" : "-1");
     return 0;
   }
   const char *missing = !q1s ? "--q1" : !q2s ? "--q2" : !out ? "--out" : NULL;
@@ -653,7 +676,8 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
                  "translational half-length %.6g m/s^2 per N\n",
               home.w_R, prru_cli_is_paper_model() ? " (the paper's value: 1.80468)" : "",
               home.semi_axis[0], home.semi_axis[1], home.half_length_T);
-      fprintf(s, "with J_d singular where cond_1(J_d) > 1e3 (rcond < %g):\n", FIG7_RCOND_MIN);
+      fprintf(s, "with J_d singular where cond_1(J_d) > %g (rcond < %g):\n", 1.0 / FIG7_RCOND_MIN,
+              FIG7_RCOND_MIN);
       fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum.index);
       fprintf(s, "  singular fraction = %.6g (%ld singular, %ld unreachable of %ld points)\n",
               sum.singular_fraction, sum.n_singular, sum.n_unreachable, sum.n_points);
@@ -661,9 +685,12 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
               sum.index_log, sum.w_min, sum.w_min_q[0], sum.w_min_q[1], sum.w_max, sum.w_max_q[0],
               sum.w_max_q[1]);
       fprintf(s, "with the numerical tolerance only (rcond < %g): global index = %.10g, singular "
-                 "fraction = %.6g, max w_R = %.6g\n  (no band: the index is dominated by the grid "
-                 "points nearest det J_d = 0 and changes with the resolution)\n",
-              rcond_numeric, sum_numeric.index, sum_numeric.singular_fraction, sum_numeric.w_max);
+                 "fraction = %.6g, max w_R = %.6g\n%s",
+              rcond_numeric, sum_numeric.index, sum_numeric.singular_fraction, sum_numeric.w_max,
+              sum.n_singular + sum.n_unreachable > 0
+                  ? "  (no band: the index is dominated by the grid points nearest det J_d = 0 and "
+                    "changes with the resolution)\n"
+                  : "  (the grid has no singular or unreachable point: both tolerances agree)\n");
     }
   }
   free(w);

@@ -19,7 +19,24 @@ static const char eval_help[] =
     "(N) and moment (N m) components of what each joint's proximal body exerts\n"
     "on the distal one, named in lambda_labels as JOINT_COMPONENT, e.g. %s).\n"
     "Velocities and loads default to 0. Exit 1 when q is unreachable or J_d is\n"
-    "singular there, 2 on bad arguments.\n";
+    "singular there, 2 on bad arguments.\n"
+    "%s";
+
+/* The part of the help that only a model with redundant actuators has. */
+static const char eval_help_redundant[] =
+    "This model has %d actuators for 3 coordinates (redundant actuation):\n"
+    "  actuator_null: n, the unit vector with J_d^T n = 0 and n_%d > 0 (an\n"
+    "    actuator-force pattern in equilibrium by itself: fd and fd + t n move\n"
+    "    the robot identically);\n"
+    "  preload: fd . n (N), the internal preload contained in the given fd;\n"
+    "  reaction_null: z (unit, in lambda_labels order), the one pattern of\n"
+    "    joint reactions that loads no body and moves nothing: a lateral force\n"
+    "    along e2 around the loop rail 3 -> limb 3 -> platform -> limb 4 ->\n"
+    "    rail 4 -> ground. Rigid-body dynamics cannot tell how much of it the\n"
+    "    joints carry (that depends on their compliance and fit): every\n"
+    "    lambda + s z satisfies the equations of motion equally, and lambda is\n"
+    "    the solution of least Euclidean norm (lambda . z = 0, coordinates in\n"
+    "    N and N m as they stand).\n";
 
 /* Reads the --q/--qd/--fd/--fp/--mp family shared by eval-like commands:
  * n numbers, all 0 when the option is absent. */
@@ -47,8 +64,10 @@ int prru_cmd_eval(int argc, char **argv)
   if (prru_cli_parse("eval", argc, argv, opts, 6)) return 2;
   if (help) {
     char fd_names[256];
+    char redundant[sizeof eval_help_redundant + 32] = "";
+    if (PRRU_NACT > 3) snprintf(redundant, sizeof redundant, eval_help_redundant, PRRU_NACT, PRRU_NACT);
     printf(eval_help, prru_cli_names(fd_names, sizeof fd_names, "f", PRRU_NACT, ","), PRRU_NLAMBDA,
-           prru_mech.lambda_labels[0]);
+           prru_mech.lambda_labels[0], redundant);
     return 0;
   }
   if (!qs) {
@@ -77,6 +96,20 @@ int prru_cmd_eval(int argc, char **argv)
     return prru_cli_exit_for(st);
   }
   memcpy(qdd, d->qdd, sizeof qdd);
+  /* Redundant actuation: the actuator null vector n and the reaction null
+   * vector z (left in d->lambda_null by prru_reactions). */
+  double n[PRRU_NACT], z[PRRU_NLAMBDA], preload = 0.0;
+  if (PRRU_NPRELOAD > 0) {
+    memcpy(z, d->lambda_null, sizeof z);
+    st = prru_actuator_null(&m, d, q, n);
+    if (st != PRRU_OK) {
+      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): actuator null vector: %s", q[0], q[1],
+                     q[2], prru_strerror(st));
+      free(d);
+      return prru_cli_exit_for(st);
+    }
+    for (int i = 0; i < PRRU_NACT; i++) preload += l.fd[i] * n[i];
+  }
   prru_dynamics(q, qd, M, h, G);
   prru_passive(q, qd, passive);
   double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ];
@@ -99,7 +132,13 @@ int prru_cmd_eval(int argc, char **argv)
   member(", ", "fp", l.fp, 3);
   member(", ", "mp", l.mp, 3);
   member(",\n ", "qdd", qdd, PRRU_NQ);
+  if (PRRU_NPRELOAD > 0) {
+    member(",\n ", "actuator_null", n, PRRU_NACT);
+    printf(", \"preload\": ");
+    prru_cli_json_number(stdout, preload);
+  }
   member(",\n ", "lambda", lambda, PRRU_NLAMBDA);
+  if (PRRU_NREACTION_NULL > 0) member(",\n ", "reaction_null", z, PRRU_NLAMBDA);
   printf(",\n \"lambda_labels\": [");
   for (int i = 0; i < PRRU_NLAMBDA; i++) {
     if (i) fputs(", ", stdout);

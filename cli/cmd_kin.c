@@ -1,4 +1,5 @@
 /* prru ik, fk and id: kinematics both ways and inverse dynamics. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,8 +12,10 @@ static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
     "Prints JSON with model (name, file, sha256), q, the actuator displacements d\n"
     "(m, slider heights), J_d = dd/dq (actuators x q, row-major), its reciprocal\n"
-    "condition number and whether J_d is singular there. Exit 1 when q is\n"
-    "unreachable.\n";
+    "condition number and whether J_d is singular there; with redundant\n"
+    "actuators (more sliders than coordinates) also actuator_null, the unit n\n"
+    "with J_d^T n = 0 and a positive last component (not at a singular pose).\n"
+    "Exit 1 when q is unreachable.\n";
 
 int prru_cmd_ik(int argc, char **argv)
 {
@@ -51,29 +54,66 @@ int prru_cmd_ik(int argc, char **argv)
   prru_cli_json_array(stdout, d->Jd, PRRU_NACT * PRRU_NQ, 1);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
-  printf(", \"singular\": %s}\n", st == PRRU_ESINGULAR ? "true" : "false");
+  printf(", \"singular\": %s", st == PRRU_ESINGULAR ? "true" : "false");
+  /* Redundant actuation: n spans null(J_d^T) (regular poses only). */
+  double n[PRRU_NACT];
+  if (PRRU_NPRELOAD > 0 && st == PRRU_OK && prru_actuator_null(&m, d, q, n) == PRRU_OK) {
+    printf(", \"actuator_null\": ");
+    prru_cli_json_array(stdout, n, PRRU_NACT, 1);
+  }
+  printf("}\n");
   free(d);
   return ferror(stdout) ? 1 : 0;
 }
 
-/* %s: the --d names. */
+/* %s: the --d names; %s: how fk solves (by the number of actuators). */
 static const char fk_help[] =
-    "usage: prru fk --d %s [--seed q1,q2,q3]\n"
-    "Solves d(q) = d for q by Newton's method (GSL hybridsj with J_d) from the\n"
-    "seed (default: q1 = q2 = 0 and the height that matches the mean of d).\n"
-    "Prints JSON with model (name, file, sha256), d, q and the residual\n"
-    "max |d(q) - d| (m). Exit 1 when d is out of reach or the iteration meets a\n"
-    "singularity.\n";
+    "usage: prru fk --d %s [--seed q1,q2,q3] [--lsq]\n"
+    "Solves d(q) = d for q from the seed (default: q1 = q2 = 0 and the height\n"
+    "that matches the mean of d).\n%s"
+    "The residual max |d(q) - d| (m) must be within 1000 DBL_EPSILON max(L, |d|),\n"
+    "L the model's mean upper-link length, unless --lsq is given.\n"
+    "--lsq: least squares, Gauss-Newton on |d(q) - d|^2 with J_d^+ =\n"
+    "(J_d^T J_d)^-1 J_d^T: the pose of least squared residual is printed\n"
+    "whatever the residual (measured or rounded slider positions), with\n"
+    "consistent: false when the residual exceeds the tolerance.\n"
+    "Prints JSON with model (name, file, sha256), d, q, residual, method\n"
+    "(\"newton\" or \"least-squares\") and, for least squares, consistent.\n"
+    "Exit 1 when d is out of reach or the iteration meets a singularity%s.\n";
+
+static const char fk_method_3[] =
+    "Newton's method (GSL hybridsj with J_d) unless --lsq.\n";
+static const char fk_method_redundant[] =
+    "With more sliders than coordinates, d(q) = d has a solution only when the\n"
+    "sliders are consistent (the extra slider where the others put it): fk fits\n"
+    "q by least squares (as --lsq) and refuses a fit whose residual shows that\n"
+    "no pose reproduces all the sliders (exit 1, the best fit and its residual\n"
+    "in the message).\n";
+
+/* The fk residual accepted without --lsq: 10 times the runtime's 100 ulps
+ * of the larger of the model's length and the slider heights (as
+ * prru_forward_kinematics). */
+static double fk_tolerance(const double act[PRRU_NACT])
+{
+  double scale = prru_cli_length_scale();
+  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
+  return 10 * 100 * DBL_EPSILON * scale;
+}
 
 int prru_cmd_fk(int argc, char **argv)
 {
   const char *ds = NULL, *seeds = NULL;
-  int help = 0;
-  prru_cli_option opts[] = {{"d", 1, &ds, NULL}, {"seed", 1, &seeds, NULL}, {"help", 0, NULL, &help}};
-  if (prru_cli_parse("fk", argc, argv, opts, 3)) return 2;
+  int help = 0, lsq = 0;
+  prru_cli_option opts[] = {{"d", 1, &ds, NULL},
+                            {"seed", 1, &seeds, NULL},
+                            {"lsq", 0, NULL, &lsq},
+                            {"help", 0, NULL, &help}};
+  if (prru_cli_parse("fk", argc, argv, opts, 4)) return 2;
   if (help) {
     char names[256];
-    printf(fk_help, prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
+    printf(fk_help, prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","),
+           PRRU_NACT > 3 ? fk_method_redundant : fk_method_3,
+           PRRU_NACT > 3 ? ",\nand without --lsq when the sliders are inconsistent" : "");
     return 0;
   }
   double act[PRRU_NACT], seed[PRRU_NQ], q[PRRU_NQ];
@@ -96,21 +136,45 @@ int prru_cmd_fk(int argc, char **argv)
     seed[0] = seed[1] = 0.0;
     seed[2] = sum / PRRU_NACT;
   }
-  int st = prru_forward_kinematics(&m, d, act, seed, q);
+  /* Three sliders: Newton unless --lsq; more: always least squares. */
+  int use_lsq = lsq || PRRU_NACT > 3;
+  double res = NAN, tol = fk_tolerance(act);
+  int st = use_lsq ? prru_forward_kinematics_lsq(&m, d, act, seed, q, &res)
+                   : prru_forward_kinematics(&m, d, act, seed, q);
+  char dtext[64 * PRRU_NACT];
+  size_t used = 0;
+  for (int i = 0; i < PRRU_NACT && used < sizeof dtext; i++)
+    used += (size_t)snprintf(dtext + used, sizeof dtext - used, "%s%.17g", i ? ", " : "", act[i]);
   if (st != PRRU_OK) {
-    char dtext[64 * PRRU_NACT];
-    size_t used = 0;
-    for (int i = 0; i < PRRU_NACT; i++)
-      used += (size_t)snprintf(dtext + used, sizeof dtext - used, "%s%.17g", i ? ", " : "", act[i]);
     prru_cli_error("fk", "d = (%s) from seed (%.6g, %.6g, %.6g): %s%s", dtext, seed[0], seed[1],
                    seed[2], prru_strerror(st),
                    st == PRRU_ENOCONV ? " (d out of reach, or a singularity near the path; try another --seed)" : "");
     free(d);
     return 1;
   }
-  double dq[PRRU_NACT], res = 0;
-  prru_ik(q, dq);
-  for (int i = 0; i < PRRU_NACT; i++) res = fmax(res, fabs(dq[i] - act[i]));
+  if (!use_lsq) {
+    double dq[PRRU_NACT];
+    res = 0;
+    prru_ik(q, dq);
+    for (int i = 0; i < PRRU_NACT; i++) res = fmax(res, fabs(dq[i] - act[i]));
+  }
+  /* |d(q) - d|^2 overflows for |d| beyond ~1e154 m: no step of the
+   * least-squares iteration can then be judged and it stops at the seed
+   * as if stationary. Such sliders are out of any robot's reach. */
+  if (use_lsq && !isfinite(res * res * PRRU_NACT)) {
+    prru_cli_error("fk", "d = (%s): out of reach (the squared residual overflows)", dtext);
+    free(d);
+    return 1;
+  }
+  int consistent = res <= tol;
+  if (use_lsq && !lsq && !consistent) {
+    prru_cli_error("fk", "d = (%s): no pose reproduces all %d slider positions, they are "
+                   "inconsistent (or out of reach): the best least-squares fit q = (%.17g, %.17g, "
+                   "%.17g) leaves a residual of %.3g m, tolerance %.3g m; --lsq accepts that fit",
+                   dtext, PRRU_NACT, q[0], q[1], q[2], res, tol);
+    free(d);
+    return 1;
+  }
   putchar('{');
   prru_cli_json_model(stdout);
   printf(",\n \"d\": ");
@@ -119,6 +183,8 @@ int prru_cmd_fk(int argc, char **argv)
   prru_cli_json_array(stdout, q, PRRU_NQ, 1);
   printf(", \"residual\": ");
   prru_cli_json_number(stdout, res);
+  printf(", \"method\": \"%s\"", use_lsq ? "least-squares" : "newton");
+  if (use_lsq) printf(", \"consistent\": %s", consistent ? "true" : "false");
   printf("}\n");
   free(d);
   return ferror(stdout) ? 1 : 0;
@@ -126,32 +192,71 @@ int prru_cmd_fk(int argc, char **argv)
 
 /* %s: the output's columns. */
 static const char id_help[] =
-    "usage: prru id --traj FILE.csv [--out FILE.csv|-]\n"
+    "usage: prru id --traj FILE.csv [--out FILE.csv|-] [--preload T] [--null-vector]\n"
     "Inverse dynamics along a trajectory: FILE has a header row and columns\n"
     "t, q1..q3, qd1..qd3, qdd1..qdd3 (any order, other columns ignored) and\n"
     "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); lines starting\n"
     "with '#' are skipped, so `prru simulate` output qualifies. Writes the model\n"
     "line (# prru ... model ...) and t,%s (N) to --out or stdout (also\n"
     "--out -); --out FILE keeps its old contents until the first row is ready\n"
-    "(it is built as FILE.partial-XXXXXX and renamed). A row where the pose is\n"
-    "unreachable or J_d singular stops with exit 1, SIGINT/SIGTERM/SIGHUP with\n"
-    "exit 130/143/129; the rows before it are kept. A write error exits 1 with\n"
-    "the reason; an unreadable or malformed FILE exits 2.\n";
+    "(it is built as FILE.partial-XXXXXX and renamed). The output is a load\n"
+    "table for `prru simulate --loads` (actuator forces only).\n"
+    "%s"
+    "A row where the pose is unreachable or J_d singular stops with exit 1,\n"
+    "SIGINT/SIGTERM/SIGHUP with exit 130/143/129; the rows before it are kept.\n"
+    "A write error exits 1 with the reason; an unreadable or malformed FILE\n"
+    "exits 2.\n";
+
+/* %d: actuators, %s: the n columns. */
+static const char id_help_redundant[] =
+    "This model has %d actuators for 3 coordinates: many force sets give the\n"
+    "same motion, fd and fd + t n alike, n the unit vector with J_d^T n = 0 and a\n"
+    "positive last component (the pattern that is in equilibrium by itself,\n"
+    "see actuator_null in 'prru eval --help'). The forces written are the\n"
+    "least-norm ones, J_d^+T tau with J_d^+ = (J_d^T J_d)^-1 J_d^T, plus\n"
+    "T n for --preload T (N, default 0): fd . n = T at every row, and\n"
+    "J_d^T fd (what moves the robot) does not depend on T. A second comment\n"
+    "line gives T. --null-vector adds the columns %s (n at each row;\n"
+    "such a file is no longer a load table for simulate).\n";
+
+static const char id_help_3[] =
+    "The forces are unique (J_d^-T tau): --preload and --null-vector need a\n"
+    "model with redundant actuators (e.g. models/4prru.json) and are usage\n"
+    "errors here.\n";
 
 int prru_cmd_id(int argc, char **argv)
 {
-  const char *traj = NULL, *out = NULL;
-  int help = 0;
-  prru_cli_option opts[] = {{"traj", 1, &traj, NULL}, {"out", 1, &out, NULL}, {"help", 0, NULL, &help}};
-  if (prru_cli_parse("id", argc, argv, opts, 3)) return 2;
-  char fd_names[256];
+  const char *traj = NULL, *out = NULL, *pre = NULL;
+  int help = 0, null_vector = 0;
+  prru_cli_option opts[] = {{"traj", 1, &traj, NULL},
+                            {"out", 1, &out, NULL},
+                            {"preload", 1, &pre, NULL},
+                            {"null-vector", 0, NULL, &null_vector},
+                            {"help", 0, NULL, &help}};
+  if (prru_cli_parse("id", argc, argv, opts, 5)) return 2;
+  char fd_names[256], n_names[256];
   prru_cli_names(fd_names, sizeof fd_names, "fd", PRRU_NACT, ",");
+  prru_cli_names(n_names, sizeof n_names, "n", PRRU_NACT, ",");
   if (help) {
-    printf(id_help, fd_names);
+    char extra[sizeof id_help_redundant + 300];
+    if (PRRU_NPRELOAD > 0)
+      snprintf(extra, sizeof extra, id_help_redundant, PRRU_NACT, n_names);
+    else
+      snprintf(extra, sizeof extra, "%s", id_help_3);
+    printf(id_help, fd_names, extra);
     return 0;
   }
   if (!traj) {
     prru_cli_error("id", "--traj is required (see 'prru id --help')");
+    return 2;
+  }
+  double preload = 0.0;
+  if (pre && prru_cli_number("id", "preload", pre, &preload)) return 2;
+  if ((pre || null_vector) && PRRU_NPRELOAD == 0) {
+    prru_cli_error("id", "%s: model %s has %d actuators for 3 coordinates, so the actuator forces "
+                   "are unique and no internal preload exists; it needs a model with a redundant "
+                   "actuator such as models/4prru.json (see 'prru id --help')",
+                   pre ? "--preload" : "--null-vector", prru_mech.name, PRRU_NACT);
     return 2;
   }
   static const char *const need[10] = {"t", "q1", "q2", "q3", "qd1", "qd2", "qd3", "qdd1", "qdd2", "qdd3"};
@@ -184,7 +289,13 @@ int prru_cmd_id(int argc, char **argv)
   prru_data *d = malloc(sizeof *d);
   st = d ? PRRU_OK : PRRU_ENOMEM;
   prru_cli_out_comment(&o);
-  prru_cli_out_printf(&o, "t,%s\n", fd_names);
+  if (PRRU_NPRELOAD > 0) {
+    /* (No "null" in the text: it reads as a JSON null to a checker.) */
+    prru_cli_out_printf(&o, "# fd = least-norm actuator forces + preload %.17g N along n, the unit "
+                            "vector with J_d^T n = 0 (fd . n = %.17g)\n", preload, preload);
+    prru_cli_out_line(&o);
+  }
+  prru_cli_out_printf(&o, "t,%s%s%s\n", fd_names, null_vector ? "," : "", null_vector ? n_names : "");
   prru_cli_out_line(&o);
   char why[700] = "";
   for (int i = 0; st == PRRU_OK && !o.err && i < t.nrows; i++) {
@@ -200,13 +311,16 @@ int prru_cmd_id(int argc, char **argv)
     memset(&l, 0, sizeof l);
     memcpy(l.fp, v + 10, sizeof l.fp);
     memcpy(l.mp, v + 13, sizeof l.mp);
-    st = prru_inverse_dynamics(&m, d, v + 1, v + 4, v + 7, &l, fd);
+    double n[PRRU_NACT];
+    st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
+    if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
     if (st != PRRU_OK) {
       snprintf(why, sizeof why, "%s: data row %d (t = %g): %s", traj, i + 1, v[0], prru_strerror(st));
       break;
     }
     prru_cli_out_printf(&o, "%.17g", v[0]);
     prru_cli_out_numbers(&o, fd, PRRU_NACT);
+    if (null_vector) prru_cli_out_numbers(&o, n, PRRU_NACT);
     prru_cli_out_printf(&o, "\n");
     prru_cli_out_row(&o);
   }

@@ -30,7 +30,20 @@ static const char paper_help[] =
     "and the exit status is 1. --skip-map leaves earlier fig7_* files alone.\n"
     "Every file names the model the build computes; with a model other than the\n"
     "paper's (models/3prru_paper.json) the study runs on that model and a warning\n"
-    "says that the figures are not the paper's results.\n";
+    "says that the figures are not the paper's results.\n"
+    "%s";
+
+/* The loads of a redundant model (also `prru simulate --scenario paper`). */
+static const char paper_help_redundant[] =
+    "This model has %d actuators; the paper's loads name three. Limb 4 mirrors\n"
+    "limb 3 and gets its force: fd = (%s) N. Distributing the paper's\n"
+    "generalized actuation tau = J_d^T (50, 40, 25, 0) over the four sliders\n"
+    "(least-norm or otherwise) is no alternative: every such fd moves the robot\n"
+    "exactly as (50, 40, 25, 0) does, leaving limb 4's own weight unsupported;\n"
+    "for models/4prru.json (3.5 kg in limb 4) the platform then leaves the\n"
+    "workspace at t = 0.48 s, while with fd4 = 25 N it stays inside for the\n"
+    "whole second. The joint reactions are the least-norm solution (see\n"
+    "'prru eval --help').\n";
 
 /* Keeps the samples in memory (for the summary) and writes the CSV. */
 typedef struct {
@@ -359,6 +372,9 @@ static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, doubl
   const double w_pi = s->loads.omega / 3.14159265358979323846;
   fprintf(f, ") N,\nfp = %g (sin %g pi t, -cos %g pi t, 0) N, rk8pd at 1e-10, %ld samples to t = %.3f s\n",
           s->loads.amp, w_pi, w_pi, r->n, t_stop);
+  if (PRRU_NACT > 3)
+    fprintf(f, "%d actuators: the paper's loads name three; limb 4 mirrors limb 3 and gets its force "
+               "(see prru paper --help); reactions are the least-norm solution\n", PRRU_NACT);
   fprintf(f, "q(%.3f)   = (%.10f, %.10f, %.10f) rad, rad, m\n", b->t, b->q[0], b->q[1], b->q[2]);
   fprintf(f, "qd(%.3f)  = (%.10f, %.10f, %.10f)\n", b->t, b->qd[0], b->qd[1], b->qd[2]);
   fprintf(f, "d(%.3f)   = (", b->t);
@@ -381,7 +397,7 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
   prru_model m;
   prru_model_default(&m);
   prru_scenario s;
-  prru_scenario_paper(&s);
+  prru_cli_scenario_paper(&s);
   paper_run *r = calloc(1, sizeof *r);
   if (!r) {
     prru_cli_error("paper", "out of memory");
@@ -478,7 +494,10 @@ int prru_cmd_paper(int argc, char **argv)
   prru_cli_option opts[] = {{"out", 1, &out, NULL}, {"skip-map", 0, NULL, &skip_map}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("paper", argc, argv, opts, 3)) return 2;
   if (help) {
-    fputs(paper_help, stdout);
+    char extra[sizeof paper_help_redundant + 200] = "";
+    if (PRRU_NACT > 3)
+      snprintf(extra, sizeof extra, paper_help_redundant, PRRU_NACT, prru_cli_paper_fd_text());
+    printf(paper_help, extra);
     return 0;
   }
   if (!out) {

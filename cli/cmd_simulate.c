@@ -50,22 +50,26 @@ int prru_cli_csv_row(const prru_sample *s, void *ctx)
  * column order, %s: fd names, %s: fd names. */
 static const char simulate_help[] =
     "usage: prru simulate [--scenario paper|FILE] [--q0 ..] [--qd0 ..] [--fd ..]\n"
-    "                     [--fp ..] [--mp ..] [--harmonic AMP,OMEGA] [--loads FILE.csv]\n"
-    "                     [--t-end S] [--dt S] [--stepper rk8pd|rkf45|rkck|msbdf]\n"
-    "                     [--atol X] [--rtol X] [--h0 S] [--max-steps N]\n"
-    "                     [--no-reactions]\n"
-    "                     [--progress] [--out FILE.csv|-]\n"
+    "                     [--fp ..] [--mp ..] [--harmonic AMP,OMEGA]\n"
+    "                     [--loads FILE.csv] [--t-end S] [--dt S]\n"
+    "                     [--stepper rk8pd|rkf45|rkck|msbdf] [--atol X] [--rtol X]\n"
+    "                     [--h0 S] [--max-steps N] [--no-reactions] [--progress]\n"
+    "                     [--out FILE.csv|-]\n"
     "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive drive\n"
     "forces from (q0, qd0) with GSL's odeiv2 driver and writes a CSV: a first line\n"
     "`# prru VERSION model NAME (FILE, sha256 HASH)`, the header, then one row per\n"
-    "sample (every dt, last at t-end): t,q1,q2,q3,qd1,qd2,qd3,%s, the %d joint\n"
-    "reaction coordinates (columns JOINT_COMPONENT, e.g. %s, joint by joint in\n"
-    "the order %s; see 'prru eval --help'),\n"
-    "qdd1..3, %s, fp1..3, mp1..3, T, V (J).\n"
-    "A scenario file has `key = value` lines (q0 qd0 fd fp mp harmonic loads t_end\n"
-    "dt stepper atol rtol h0 max_steps); options override it. `--scenario paper` is the\n"
-    "paper's section 4.3 study. `--harmonic A,W` adds fp = A (sin W t, -cos W t, 0);\n"
-    "`--loads` reads a table t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
+    "sample (every dt, last at t-end):\n"
+    "  t,q1,q2,q3,qd1,qd2,qd3,%s,\n"
+    "  the %d joint reaction coordinates (columns JOINT_COMPONENT, e.g. %s,\n"
+    "  joint by joint in the order %s;\n"
+    "  see 'prru eval --help'),\n"
+    "  qdd1..3, %s, fp1..3, mp1..3, T, V (J).\n"
+    "A scenario file has `key = value` lines (q0 qd0 fd fp mp harmonic loads\n"
+    "t_end dt stepper atol rtol h0 max_steps); options override it.\n"
+    "`--scenario paper` is the paper's section 4.3 study: q0 = (0, pi/6, -0.8),\n"
+    "fd = (%s) N, fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N%s.\n"
+    "`--harmonic A,W` adds fp = A (sin W t, -cos W t, 0); `--loads` reads a table\n"
+    "t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
     "Defaults: zero state and loads, 1 s, dt 1 ms, rk8pd, atol = rtol = 1e-10.\n"
     "Each tolerance is 0 (off) or at least 100 DBL_EPSILON (2.2e-14): a smaller one\n"
     "cannot be met in double precision. --max-steps bounds the integrator's steps\n"
@@ -106,13 +110,17 @@ int prru_cmd_simulate(int argc, char **argv)
                                prru_mech.joint[j].name);
     prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
     prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
-    printf(simulate_help, dn, PRRU_NLAMBDA, prru_mech.lambda_labels[0], joints, fdn, fdn);
+    printf(simulate_help, dn, PRRU_NLAMBDA, prru_mech.lambda_labels[0], joints, fdn,
+           prru_cli_paper_fd_text(),
+           PRRU_NACT > 3 ? "\n(the redundant actuator gets limb 3's force, see 'prru paper --help')"
+                         : "",
+           fdn);
     return 0;
   }
   prru_scenario s;
   char msg[600];
   if (scen && strcmp(scen, "paper") == 0) {
-    prru_scenario_paper(&s);
+    prru_cli_scenario_paper(&s);
   } else if (scen) {
     if (prru_scenario_read(&s, scen, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error("simulate", "--scenario %s", msg);

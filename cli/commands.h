@@ -37,12 +37,22 @@ int prru_cmd_map(int argc, char **argv);
 int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary);
 
 /* Shared helpers (cli/util.c). */
-/* `prru --version`: program version and the model's name, file, format
- * and SHA-256, one per line. */
+/* `prru --version`: program version and the model's name, file, format,
+ * number of actuators and SHA-256, one per line. */
 void prru_cli_print_version(FILE *f);
 /* 1 when the kernels were generated from the paper's model file
  * (models/3prru_paper.json, by its SHA-256), 0 otherwise. */
 int prru_cli_is_paper_model(void);
+/* The paper's section 4.3 scenario as the CLI runs it (`prru paper`,
+ * `prru simulate --scenario paper`): prru_scenario_paper, and on a model
+ * with redundant actuators every actuator beyond the third gets the third's
+ * force (limb 4 mirrors limb 3): fd = (50, 40, 25, 25) N. */
+void prru_cli_scenario_paper(prru_scenario *s);
+/* The fd list of the paper scenario as text, "50, 40, 25[, 25]". */
+const char *prru_cli_paper_fd_text(void);
+/* The model's length scale L, the mean upper-link length (m), as the
+ * runtime uses it for its tolerances (prru_model). */
+double prru_cli_length_scale(void);
 /* Model identity in outputs. JSON: the member
  * "model": {"name": .., "file": .., "sha256": ..} (no separator around it);
  * CSV: the first line "# prru VERSION model NAME (FILE, sha256 HASH)". */

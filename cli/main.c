@@ -10,11 +10,11 @@ static const struct {
   int (*run)(int, char **);
   const char *help;
 } commands[] = {
-    {"eval", prru_cmd_eval, "M, h, G, drive forces, d, J_d, qdd and the joint reactions at one state (JSON)"},
+    {"eval", prru_cmd_eval, "M, h, G, d, J_d, qdd and the joint reactions at one state (JSON)"},
     {"simulate", prru_cmd_simulate, "integrate the equations of motion, CSV of the samples"},
     {"ik", prru_cmd_ik, "actuator displacements d and J_d for a pose q (JSON)"},
-    {"fk", prru_cmd_fk, "pose q for actuator displacements d (Newton from a seed, JSON)"},
-    {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics)"},
+    {"fk", prru_cmd_fk, "pose q for actuator displacements d (JSON; --lsq: least squares)"},
+    {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics; --preload)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
     {"paper", prru_cmd_paper, "reproduce the paper's simulation study and fig. 7 into a directory"},
@@ -24,16 +24,18 @@ static void usage(FILE *f)
 {
   fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n"
              "       prru --version\n\n"
-             "Dynamics of the 3-PRRU 1T2R parallel manipulator: q = (q1, q2) rad rotations\n"
-             "of the platform about x then y', q3 its height (m); d the %d slider heights (m).\n"
+             "Dynamics of the %d-PRRU 1T2R parallel manipulator%s:\n"
+             "q = (q1, q2) rad rotations of the platform about x then y', q3 its height\n"
+             "(m); d the %d slider heights (m).\n"
              "Model: %s (%s), built in (see prru --version).\n"
              "Every JSON output names it in \"model\", every CSV in its first line\n"
              "(# prru VERSION model NAME (FILE, sha256 HASH)).\n\n"
              "commands:\n",
-          PRRU_NACT, prru_mech.name, prru_mech.model_file);
+          PRRU_NLIMB, PRRU_NACT > 3 ? " (redundantly actuated)" : "", PRRU_NACT, prru_mech.name,
+          prru_mech.model_file);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
-  fprintf(f, "  %-9s %s\n", "version", "program version and the model (name, file, format, SHA-256)");
+  fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
   fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
              "convergence, I/O error: the reason on stderr), 2 usage error or bad input\n"
              "file, 130/143/129 stopped by SIGINT/SIGTERM/SIGHUP (simulate, id, map,\n"

@@ -205,6 +205,31 @@ const char *prru_cli_model_id(void)
   return id;
 }
 
+void prru_cli_scenario_paper(prru_scenario *s)
+{
+  prru_scenario_paper(s);
+  for (int i = 3; i < PRRU_NACT; i++) s->loads.base.fd[i] = s->loads.base.fd[2];
+}
+
+const char *prru_cli_paper_fd_text(void)
+{
+  static char text[32 * PRRU_NACT];
+  prru_scenario s;
+  prru_cli_scenario_paper(&s);
+  size_t used = 0;
+  for (int i = 0; i < PRRU_NACT && used < sizeof text; i++)
+    used += (size_t)snprintf(text + used, sizeof text - used, "%s%g", i ? ", " : "", s.loads.base.fd[i]);
+  prru_scenario_free(&s);
+  return text;
+}
+
+double prru_cli_length_scale(void)
+{
+  double s = 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) s += prru_mech.l1[i];
+  return s / PRRU_NLIMB;
+}
+
 int prru_cli_is_paper_model(void) { return strcmp(prru_mech.sha256, PRRU_PAPER_SHA256) == 0; }
 
 void prru_cli_print_version(FILE *f)
@@ -213,6 +238,7 @@ void prru_cli_print_version(FILE *f)
   fprintf(f, "model: %s\n", prru_mech.name);
   fprintf(f, "model file: %s\n", prru_mech.model_file);
   fprintf(f, "model format: %d\n", prru_mech.format);
+  fprintf(f, "model actuators: %d\n", PRRU_NACT);
   fprintf(f, "model sha256: %s\n", prru_mech.sha256);
 }
 

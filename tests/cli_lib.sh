@@ -25,6 +25,34 @@ prru_version=$(sed -n 's/^project(prru VERSION \([0-9][0-9.]*\).*/\1/p' "$PRRU_S
 csv_comment="# prru $prru_version model $model_name ($model_file, sha256 $model_sha)"
 export model_name model_file model_sha
 
+# The number of actuators (sliders) of the model the binary computes, as
+# `prru --version` says it; 3 for the 3-PRRU, 4 for a redundantly actuated
+# model (spec section 12). Lists of actuator forces and displacements, load
+# tables and CSV columns have that many entries.
+nact=$("$PRRU" --version 2>/dev/null | sed -n 's/^model actuators: //p')
+: "${nact:=3}"
+export nact
+# fdlist A B C: the list A,B,C for the first three actuators, every further
+# (redundant) one getting C, limb 4 mirroring limb 3 as in the paper
+# scenario of `prru paper` (fd = 50,40,25,25 on four sliders).
+fdlist() {
+  local s="$1,$2,$3" i
+  for ((i = 3; i < nact; i++)); do s="$s,$3"; done
+  echo "$s"
+}
+# nlist X: X repeated once per actuator (X,X,X or X,X,X,X).
+nlist() {
+  local s=$1 i
+  for ((i = 1; i < nact; i++)); do s="$s,$1"; done
+  echo "$s"
+}
+# act_names PREFIX: PREFIX1,...,PREFIXn, one per actuator (fd1,fd2,fd3[,fd4]).
+act_names() {
+  local s="" i
+  for ((i = 1; i <= nact; i++)); do s="$s${s:+,}$1$i"; done
+  echo "$s"
+}
+
 # expect STATUS NEEDLE -- ARGS...: exit status and a stderr substring.
 expect() {
   local want=$1 needle=$2; shift 3

@@ -3,46 +3,60 @@
 # output, outputs checked against each other (fk(ik(q)), the equations of
 # motion with eval's own M, h, G, J_d and passive forces, simulate -> id),
 # round trips through the CSV interfaces, and the exit status and message
-# of every kind of bad argument. The paper's numbers are in paper_cli.sh.
+# of every kind of bad argument. Lists of actuator values have as many
+# entries as the model has sliders ($nact, from `prru --version`); a model
+# with a redundant fourth actuator also gets its own checks (null vectors,
+# id --preload, least-squares fk, the paper scenario's fourth force). The
+# paper's numbers are in paper_cli.sh.
 # Needs $PRRU (path to the binary), $PRRU_MODEL, $PRRU_SOURCE_DIR.
 . "$(dirname "$0")/cli_lib.sh"
 
 # A pose every model in models/ reaches with a regular J_d (checked below),
-# and one with velocities.
+# and one with velocities. Actuator lists have $nact entries (cli_lib.sh:
+# fdlist gives a redundant actuator the third one's value).
 Q=0.1,0.2,-0.8
 QD=0.3,-0.4,0.5
+FD=$(fdlist 50 40 25)
 
 # ---- Model identity ----
 [ -n "$prru_version" ] && ok || bad "no project version in $PRRU_SOURCE_DIR/CMakeLists.txt"
 "$PRRU" --version >"$tmp/v.txt" 2>"$tmp/v.err" && ok || bad "--version failed: $(cat "$tmp/v.err")"
-printf 'prru %s\nmodel: %s\nmodel file: %s\nmodel format: %s\nmodel sha256: %s\n' "$prru_version" \
-  "$model_name" "$model_file" "$model_format" "$model_sha" >"$tmp/v.want"
+printf 'prru %s\nmodel: %s\nmodel file: %s\nmodel format: %s\nmodel actuators: %s\nmodel sha256: %s\n' \
+  "$prru_version" "$model_name" "$model_file" "$model_format" "$nact" "$model_sha" >"$tmp/v.want"
 cmp -s "$tmp/v.txt" "$tmp/v.want" && ok || bad "--version: got '$(cat "$tmp/v.txt")', want '$(cat "$tmp/v.want")'"
 "$PRRU" version >"$tmp/v2.txt" && cmp -s "$tmp/v2.txt" "$tmp/v.want" && ok || bad "'prru version' differs from --version"
 expect 2 "takes no arguments" -- --version extra
+# The actuators --version reports are the model file's sliders S1..Sn.
+file_nact=$(python3 -c 'import json, sys; print(sum(1 for b in json.load(open(sys.argv[1]))["bodies"] if b[0] == "S"))' "$PRRU_MODEL")
+[ "$nact" = "$file_nact" ] && ok || bad "--version says $nact actuators, the model file has $file_nact sliders"
 "$PRRU" --help >"$tmp/h.txt" && grep -q -- "--version" "$tmp/h.txt" && grep -qF "$model_name ($model_file)" "$tmp/h.txt" \
   && ok || bad "usage does not mention --version and the model: $(head -c 300 "$tmp/h.txt")"
 # No help text counts reactions or actuators with another model's numbers.
-for c in eval simulate fk id; do
+for c in eval simulate ik fk id dme map paper; do
   "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"
 done
 nl=$(python3 -c "import json, subprocess, sys; print(len(json.loads(subprocess.run([sys.argv[1], 'eval', '--q', '$Q'], capture_output=True, text=True).stdout)['lambda']))" "$PRRU")
 tr '\n' ' ' <"$tmp/help_eval.txt" | grep -q "the $nl joint reaction" && tr '\n' ' ' <"$tmp/help_simulate.txt" | grep -q "the $nl joint reaction" \
   && ok || bad "help texts do not give the model's $nl reaction coordinates"
 grep -qi "spec" "$tmp"/help_*.txt && bad "help text talks of 'spec'" || ok
+grep -qF -- "--fd $(act_names f)" "$tmp/help_eval.txt" && grep -qF -- "--d $(act_names d) " "$tmp/help_fk.txt" \
+  && grep -qF "t,$(act_names fd) (N)" "$tmp/help_id.txt" && ok || bad "help texts do not list the model's $nact actuators"
+# Help lines fit a terminal.
+awk 'length > 80 { print FILENAME ": " $0; bad = 1 } END { exit bad }' "$tmp/h.txt" "$tmp"/help_*.txt >"$tmp/long.txt" \
+  && ok || bad "help lines over 80 characters: $(head -c 300 "$tmp/long.txt")"
 
 # ---- eval: the model object and the equations of motion ----
-"$PRRU" eval --q "$Q" --qd "$QD" --fd 50,40,25 >"$tmp/f.json" || bad "eval with loads failed"
+"$PRRU" eval --q "$Q" --qd "$QD" --fd "$FD" >"$tmp/f.json" || bad "eval with loads failed"
 jcheck "$tmp/f.json" "d['model'] == model" "eval: model object"
 jcheck "$tmp/f.json" "len(d['lambda']) == len(d['lambda_labels']) == len(set(d['lambda_labels'])) > 0" "eval: one unique label per reaction coordinate"
-jcheck "$tmp/f.json" "len(d['d']) == len(d['fd']) and len(d['Jd']) == 3 * len(d['d']) and len(d['passive']) == 3" "eval: sizes"
+jcheck "$tmp/f.json" "len(d['d']) == len(d['fd']) == $nact and len(d['Jd']) == 3 * len(d['d']) and len(d['passive']) == 3" "eval: sizes"
 jcheck "$tmp/f.json" "0 < d['Jd_rcond'] and all(math.isfinite(x) for x in d['lambda'] + d['qdd'])" "eval: regular and finite at $Q"
 # M qdd + h = G + J_d^T fd + passive with the printed M, h, G, J_d, passive.
 r=$(json "$tmp/f.json" "max(abs(sum(d['M'][3*i+j]*d['qdd'][j] for j in range(3)) + d['h'][i] - d['G'][i] - d['passive'][i] - sum(d['Jd'][3*j+i]*d['fd'][j] for j in range(len(d['fd'])))) / (1 + abs(d['G'][i]) + sum(abs(x) for x in d['fd'])) for i in range(3))")
 below "$r" 1e-13 "eval qdd residual (with passive forces)"
 # Passive drive forces: zero at rest for any model; at speed non-zero
 # exactly when the model has damping or Coulomb friction.
-"$PRRU" eval --q "$Q" --fd 50,40,25 >"$tmp/rest.json" || bad "eval at rest failed"
+"$PRRU" eval --q "$Q" --fd "$FD" >"$tmp/rest.json" || bad "eval at rest failed"
 jcheck "$tmp/rest.json" "d['passive'] == [0, 0, 0]" "passive forces at rest"
 drives=$(python3 -c "import json, sys; a = json.load(open(sys.argv[1])).get('actuators', {}); print(int(any(a.get(k) and any(a[k]) for k in ('damping', 'coulomb'))))" "$PRRU_MODEL")
 if [ "$drives" = 1 ]; then
@@ -66,18 +80,36 @@ r=$(json "$tmp/fk0.json" "max(abs(a-b) for a,b in zip(d['q'],[0,0,-0.8]))")
 below "$r" 1e-12 "fk(ik(0, 0, -0.8)) off"
 
 # ---- simulate -> id recovers the constant actuator forces ----
-"$PRRU" simulate --q0 0.05,0.1,-0.8 --fd 55,45,30 --t-end 0.2 --dt 0.01 --out "$tmp/sim.csv" || bad "simulate failed"
+"$PRRU" simulate --q0 0.05,0.1,-0.8 --fd "$(fdlist 55 45 30)" --t-end 0.2 --dt 0.01 --out "$tmp/sim.csv" || bad "simulate failed"
 [ "$(head -1 "$tmp/sim.csv")" = "$csv_comment" ] && ok || bad "CSV comment line: '$(head -1 "$tmp/sim.csv")', want '$csv_comment'"
-[ "$(sed -n 2p "$tmp/sim.csv" | cut -d, -f1-10)" = "t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3" ] && ok || bad "CSV header"
+[ "$(sed -n 2p "$tmp/sim.csv" | cut -d, -f1-$((7 + nact)))" = "t,q1,q2,q3,qd1,qd2,qd3,$(act_names d)" ] && ok || bad "CSV header"
 [ "$(grep -vc '^#' "$tmp/sim.csv")" -eq 22 ] && ok || bad "21 samples expected, got $(($(grep -vc '^#' "$tmp/sim.csv") - 1))"
 [ "$(grep -c '^#' "$tmp/sim.csv")" -eq 1 ] && ok || bad "one comment line expected"
 "$PRRU" id --traj "$tmp/sim.csv" --out "$tmp/id.csv" || bad "id failed"
 [ "$(head -1 "$tmp/id.csv")" = "$csv_comment" ] && ok || bad "id: CSV comment line"
-r=$(python3 - "$tmp/id.csv" <<'PY'
+# Three actuators: id gives back the forces. More: the least-norm forces,
+# which differ from the simulated ones only along the null vector n of
+# J_d^T (id --null-vector writes it), so fd_sim - fd_id = ((fd_sim) . n) n.
+if [ "$nact" -gt 3 ]; then
+  "$PRRU" id --traj "$tmp/sim.csv" --null-vector --out "$tmp/idn.csv" || bad "id --null-vector failed"
+else
+  cp "$tmp/id.csv" "$tmp/idn.csv"
+fi
+r=$(python3 - "$tmp/idn.csv" "$(fdlist 55 45 30)" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
+fsim = [float(x) for x in sys.argv[2].split(',')]
+N = len(fsim)
 assert len(rows) == 21, len(rows)
-print(max(abs(float(r['fd%d' % (i + 1)]) - f) / f for r in rows for i, f in enumerate((55, 45, 30))))
+err = 0
+for r in rows:
+    fd = [float(r['fd%d' % (i + 1)]) for i in range(N)]
+    if 'n1' in r:
+        n = [float(r['n%d' % (i + 1)]) for i in range(N)]
+        t = sum(a * b for a, b in zip(fsim, n))
+        fd = [a + t * b for a, b in zip(fd, n)]
+    err = max(err, max(abs(a - b) / abs(b) for a, b in zip(fd, fsim)))
+print(err)
 PY
 )
 below "$r" 1e-9 "id of simulate: rel err"
@@ -116,13 +148,13 @@ cmp -s "$tmp/paper/paper_sim.csv" "$tmp/paper2/paper_sim.csv" && cmp -s "$tmp/pa
   && ok || bad "paper outputs differ between two runs"
 
 # ---- Scenario files, the paper scenario and load tables ----
-printf 'q0 = 0, 0.5235987755982988, -0.8\nfd = 50, 40, 25\nharmonic = 50, 12.566370614359172\nt_end = 0.05\ndt = 0.01\n' >"$tmp/s.txt"
+printf 'q0 = 0, 0.5235987755982988, -0.8\nfd = %s\nharmonic = 50, 12.566370614359172\nt_end = 0.05\ndt = 0.01\n' "$FD" >"$tmp/s.txt"
 "$PRRU" simulate --scenario "$tmp/s.txt" --out "$tmp/s.csv" || bad "scenario file run"
 "$PRRU" simulate --scenario paper --t-end 0.05 --dt 0.01 --out "$tmp/p.csv" || bad "paper scenario run"
-cmp -s <(cut -d, -f1-10 "$tmp/s.csv") <(cut -d, -f1-10 "$tmp/p.csv") && ok || bad "scenario file = built-in paper scenario"
-printf 't,fd1,fd2,fd3\n0,50,40,25\n1,50,40,25\n' >"$tmp/loads.csv"
+cmp -s "$tmp/s.csv" "$tmp/p.csv" && ok || bad "scenario file (fd = $FD) = built-in paper scenario"
+printf 't,%s\n0,%s\n1,%s\n' "$(act_names fd)" "$FD" "$FD" >"$tmp/loads.csv"
 "$PRRU" simulate --q0 0,0.5235987755982988,-0.8 --loads "$tmp/loads.csv" --t-end 0.05 --dt 0.01 --no-reactions >"$tmp/t.csv" || bad "loads table run"
-"$PRRU" simulate --q0 0,0.5235987755982988,-0.8 --fd 50,40,25 --t-end 0.05 --dt 0.01 --no-reactions >"$tmp/c.csv" || bad "constant run"
+"$PRRU" simulate --q0 0,0.5235987755982988,-0.8 --fd "$FD" --t-end 0.05 --dt 0.01 --no-reactions >"$tmp/c.csv" || bad "constant run"
 cmp -s "$tmp/t.csv" "$tmp/c.csv" && ok || bad "constant table = constant forces"
 # A load table with the comment line `prru id` writes is read too.
 { echo "$csv_comment"; cat "$tmp/loads.csv"; } >"$tmp/loads_c.csv"
@@ -130,16 +162,124 @@ cmp -s "$tmp/t.csv" "$tmp/c.csv" && ok || bad "constant table = constant forces"
 cmp -s "$tmp/tc.csv" "$tmp/c.csv" && ok || bad "commented table = constant forces"
 
 # Runs that leave the workspace keep their rows and exit 1.
-expect 1 "stopped at t =" -- simulate --q0 0,0,-0.8 --fd 200,-100,0 --t-end 2 --dt 0.01 --out "$tmp/stop.csv"
+expect 1 "stopped at t =" -- simulate --q0 0,0,-0.8 --fd "$(fdlist 200 -100 0)" --t-end 2 --dt 0.01 --out "$tmp/stop.csv"
 rows=$(($(grep -vc '^#' "$tmp/stop.csv") - 1))
 [ "$rows" -gt 1 ] && [ "$rows" -lt 201 ] && ok || bad "stopped run kept $rows rows"
 grep -qi nan "$tmp/stop.csv" && bad "NaN in a CSV" || ok
+
+# ---- Redundant actuation (more sliders than coordinates, spec section 12) ----
+if [ "$nact" -gt 3 ]; then
+  # eval: n spans null(J_d^T) (unit, last component positive), preload =
+  # fd . n, z spans the reactions that load nothing (unit), lambda is the
+  # least-norm solution (lambda . z = 0).
+  jcheck "$tmp/f.json" "len(d['actuator_null']) == $nact and abs(sum(x * x for x in d['actuator_null']) - 1) < 1e-14 and d['actuator_null'][-1] > 0" "eval: actuator_null unit, n_N > 0"
+  jcheck "$tmp/f.json" "max(abs(sum(d['Jd'][3 * i + k] * d['actuator_null'][i] for i in range($nact))) for k in range(3)) < 1e-14" "eval: J_d^T n = 0"
+  jcheck "$tmp/f.json" "abs(d['preload'] - sum(a * b for a, b in zip(d['fd'], d['actuator_null']))) < 1e-12" "eval: preload = fd . n"
+  jcheck "$tmp/f.json" "len(d['reaction_null']) == len(d['lambda']) and abs(sum(x * x for x in d['reaction_null']) - 1) < 1e-14" "eval: reaction_null unit"
+  jcheck "$tmp/f.json" "abs(sum(a * b for a, b in zip(d['lambda'], d['reaction_null']))) < 1e-12 * max(abs(x) for x in d['lambda'])" "eval: lambda . reaction_null = 0 (least norm)"
+  # fd and fd + t n move the robot identically.
+  fdt=$(json "$tmp/f.json" "','.join(repr(a + 30 * b) for a, b in zip(d['fd'], d['actuator_null']))")
+  "$PRRU" eval --q "$Q" --qd "$QD" --fd "$fdt" >"$tmp/ft.json" || bad "eval with a preload failed"
+  r=$(python3 -c "import json, sys; a, b = (json.load(open(f)) for f in sys.argv[1:]); print(max(abs(x - y) / (1 + abs(y)) for x, y in zip(a['qdd'], b['qdd'])), abs(a['preload'] - b['preload'] - 30))" "$tmp/ft.json" "$tmp/f.json")
+  below "${r% *}" 1e-12 "eval: fd + 30 n changes qdd"
+  below "${r#* }" 1e-11 "eval: fd + 30 n does not add 30 N of preload"
+  # ik prints the same n.
+  jcheck "$tmp/ik.json" "len(d['actuator_null']) == $nact" "ik: actuator_null"
+  n_ik=$(json "$tmp/ik.json" "d['actuator_null']") n_ev=$(json "$tmp/f.json" "d['actuator_null']")
+  [ "$n_ik" = "$n_ev" ] && ok || bad "ik and eval give different null vectors: $n_ik, $n_ev"
+
+  # id --preload T: the forces move along n by exactly T (fd . n = T), and
+  # J_d^T fd, what moves the robot, stays.
+  "$PRRU" id --traj "$tmp/sim.csv" --preload 12.5 --null-vector --out "$tmp/idp.csv" || bad "id --preload failed"
+  sed -n 2p "$tmp/idp.csv" | grep -q "^# fd = least-norm actuator forces + preload 12.5 N along n" && ok || bad "id: preload comment: $(sed -n 2p "$tmp/idp.csv")"
+  [ "$(grep -v '^#' "$tmp/idp.csv" | head -1)" = "t,$(act_names fd),$(act_names n)" ] && ok || bad "id --null-vector header"
+  python3 - "$tmp/idn.csv" "$tmp/idp.csv" "$tmp/sim.csv" "$PRRU" <<'PY' >"$tmp/idp.txt"
+import csv, json, subprocess, sys
+rd = lambda f: list(csv.DictReader(l for l in open(f) if not l.startswith('#')))
+a, b, sim = rd(sys.argv[1]), rd(sys.argv[2]), rd(sys.argv[3])
+N = sum(1 for k in a[0] if k.startswith('fd'))
+T = 12.5
+shift = dot = jt = 0
+for k, (ra, rb) in enumerate(zip(a, b)):
+    fa = [float(ra['fd%d' % (i + 1)]) for i in range(N)]
+    fb = [float(rb['fd%d' % (i + 1)]) for i in range(N)]
+    n = [float(rb['n%d' % (i + 1)]) for i in range(N)]
+    scale = 1 + max(abs(x) for x in fa) + T
+    shift = max(shift, max(abs(y - x - T * m) for x, y, m in zip(fa, fb, n)) / scale)
+    dot = max(dot, abs(sum(x * m for x, m in zip(fb, n)) - T) / scale)
+    dot = max(dot, abs(sum(x * m for x, m in zip(fa, n))) / scale)
+    if k % 10 == 0:  # J_d^T fd unchanged, with ik's J_d at the row's pose
+        q = ','.join(sim[k][c] for c in ('q1', 'q2', 'q3'))
+        J = json.loads(subprocess.run([sys.argv[4], 'ik', '--q', q], capture_output=True, text=True).stdout)['Jd']
+        jt = max(jt, max(abs(sum(J[3 * i + c] * (y - x) for i, (x, y) in enumerate(zip(fa, fb)))) for c in range(3)) / scale)
+print(shift, dot, jt)
+PY
+  read -r shift dot jt <"$tmp/idp.txt"
+  below "${shift:-1}" 1e-14 "id --preload: fd_T - fd_0 = T n"
+  below "${dot:-1}" 1e-14 "id --preload: fd_T . n = T, fd_0 . n = 0"
+  below "${jt:-1}" 1e-14 "id --preload: J_d^T fd depends on T"
+  # Without --preload: the same forces as --preload 0, and as before.
+  "$PRRU" id --traj "$tmp/sim.csv" --preload 0 --out "$tmp/id0.csv" && cmp -s "$tmp/id0.csv" "$tmp/id.csv" && ok || bad "id --preload 0 differs from id"
+  expect 2 "--preload: 'nan'" -- id --traj "$tmp/sim.csv" --preload nan
+  expect 2 "--preload: '1e400'" -- id --traj "$tmp/sim.csv" --preload 1e400
+  # A table with n columns is not a load table; the forces alone, preload
+  # and all, simulate back to the same motion (sampled densely: simulate
+  # interpolates the table linearly).
+  "$PRRU" simulate --q0 0.05,0.1,-0.8 --loads "$tmp/idp.csv" --t-end 0.2 --dt 0.01 --no-reactions >/dev/null 2>"$tmp/err" \
+    && bad "simulate read a table with n columns as loads" || ok
+  "$PRRU" simulate --q0 0.05,0.1,-0.8 --fd "$(fdlist 55 45 30)" --t-end 0.2 --dt 0.001 --no-reactions --out "$tmp/simf.csv" || bad "simulate, dt 1 ms"
+  "$PRRU" id --traj "$tmp/simf.csv" --preload -40 --out "$tmp/idm.csv" || bad "id --preload -40"
+  "$PRRU" simulate --q0 0.05,0.1,-0.8 --loads "$tmp/idm.csv" --t-end 0.2 --dt 0.001 --no-reactions --out "$tmp/sim2.csv" || bad "simulate with id's forces"
+  r=$(python3 - "$tmp/simf.csv" "$tmp/sim2.csv" <<'PY'
+import csv, sys
+rd = lambda f: list(csv.DictReader(l for l in open(f) if not l.startswith('#')))
+a, b = rd(sys.argv[1]), rd(sys.argv[2])
+print(max(abs(float(x[c]) - float(y[c])) for x, y in zip(a, b) for c in ('q1', 'q2', 'q3')) if len(a) == len(b) == 201 else 1)
+PY
+)
+  below "$r" 1e-7 "simulate with id --preload -40 forces does not retrace the motion"
+
+  # fk: least squares; fk and fk --lsq of ik(q) give q back; inconsistent
+  # sliders are refused without --lsq and fitted with it.
+  for q in 0.1,0.2,-0.8 -0.3,0.4,-0.6 0.25,-0.35,0.05; do
+    "$PRRU" ik --q "$q" >"$tmp/ikq.json" || { bad "ik $q"; continue; }
+    dq=$(json "$tmp/ikq.json" "','.join(repr(x) for x in d['d'])")
+    for lsq in "" --lsq; do
+      "$PRRU" fk --d "$dq" $lsq >"$tmp/fkq.json" || { bad "fk $lsq of ik($q) failed"; continue; }
+      jcheck "$tmp/fkq.json" "d['method'] == 'least-squares' and d['consistent'] is True and d['residual'] < 1e-13 and max(abs(a - b) for a, b in zip(d['q'], [$q])) < 1e-12" "fk $lsq of ik($q)"
+    done
+  done
+  dbad=$(json "$tmp/ik.json" "','.join(repr(x + (1e-4 if i == len(d['d']) - 1 else 0)) for i, x in enumerate(d['d']))")
+  expect 1 "inconsistent" -- fk --d "$dbad"
+  grep -qF -- "--lsq accepts that fit" "$tmp/err" && ok || bad "fk of inconsistent sliders: no hint at --lsq: $(cat "$tmp/err")"
+  [ ! -s "$tmp/out" ] && ok || bad "fk of inconsistent sliders printed a result"
+  "$PRRU" fk --d "$dbad" --lsq >"$tmp/fkl.json" || bad "fk --lsq of inconsistent sliders failed"
+  jcheck "$tmp/fkl.json" "d['consistent'] is False and 1e-6 < d['residual'] < 1e-4 and max(abs(a - b) for a, b in zip(d['q'], [$Q])) < 1e-3" "fk --lsq of inconsistent sliders"
+
+  # prru paper: the fourth actuator's force is said and documented.
+  grep -qF "fd = ($(fdlist 50 40 25 | sed 's/,/, /g')) N" "$tmp/paper/summary.txt" && grep -q "least-norm" "$tmp/paper/summary.txt" \
+    && ok || bad "paper summary: fd or the least-norm reactions not stated: $(head -5 "$tmp/paper/summary.txt")"
+  grep -q "Limb 4 mirrors" "$tmp/help_paper.txt" && ok || bad "paper --help does not say what the fourth actuator gets"
+  grep -qF "J_d^+" "$tmp/help_dme.txt" && ok || bad "dme --help does not name J_d^+"
+else
+  # Three actuators: the forces are unique; no null vectors in the JSON.
+  expect 2 "no internal preload exists" -- id --traj "$tmp/sim.csv" --preload 5
+  expect 2 "--null-vector" -- id --traj "$tmp/sim.csv" --null-vector
+  jcheck "$tmp/f.json" "'actuator_null' not in d and 'reaction_null' not in d and 'preload' not in d" "eval of a 3-actuator model: no null vectors"
+  jcheck "$tmp/ik.json" "'actuator_null' not in d" "ik of a 3-actuator model: no null vector"
+  # fk --lsq agrees with Newton.
+  "$PRRU" fk --d "$(json "$tmp/ik.json" "','.join(repr(x) for x in d['d'])")" --lsq >"$tmp/fkl.json" || bad "fk --lsq failed"
+  jcheck "$tmp/fkl.json" "d['method'] == 'least-squares' and d['consistent'] is True and max(abs(a - b) for a, b in zip(d['q'], [$Q])) < 1e-12" "fk --lsq of ik(q)"
+  jcheck "$tmp/fk.json" "d['method'] == 'newton'" "fk: Newton by default"
+  grep -qF "J_d^-1" "$tmp/help_dme.txt" && ! grep -qF "J_d^+" "$tmp/help_dme.txt" && ok || bad "dme --help of a 3-actuator model: J_d^-1"
+fi
 
 # Bad arguments: exit 2 and a message naming the argument.
 expect 2 "--q" -- eval --q 0.1,0.2
 expect 2 "--q" -- eval --q 0.1,abc,0
 expect 2 "--qd" -- eval --q 0,0,-0.8 --qd nan,0,0
-expect 2 "--fd" -- eval --q 0,0,-0.8 --fd 1,2,3,4
+expect 2 "--fd" -- eval --q 0,0,-0.8 --fd "$(nlist 1),5"
+expect 2 "--fd" -- eval --q 0,0,-0.8 --fd 1,2
 expect 2 "unknown option" -- eval --q 0,0,-0.8 --frobnicate 1
 expect 2 "missing value" -- eval --q
 expect 2 "given twice" -- eval --q 0,0,0 --q 0,0,0
@@ -156,7 +296,12 @@ expect 1 "not reachable" -- eval --q 1.4,0,-0.8
 expect 1 "not reachable" -- ik --q 0,1.5,0
 expect 1 "not reachable" -- simulate --q0 1.4,0,-0.8
 expect 1 "cannot open for writing" -- simulate --t-end 0.01 --out /nonexistent/dir/x.csv
-expect 1 "d out of reach" -- fk --d 1,-1,0
+if [ "$nact" -gt 3 ]; then
+  expect 1 "no pose reproduces all $nact slider positions" -- fk --d "$(fdlist 1 -1 0)"
+else
+  expect 1 "d out of reach" -- fk --d 1,-1,0
+fi
+expect 2 "--d" -- fk --d "$(nlist 0.2),0.2"
 expect 2 "missing column" -- id --traj "$tmp/loads.csv"
 expect 2 "cannot open" -- id --traj "$tmp/nonexistent.csv"
 expect 1 "cannot create" -- paper --out /proc/nope

@@ -17,10 +17,33 @@ check "$tmp/d.json" "abs(d['semi_axes'][1] / d['semi_axes'][0] - d['w_R']) < 1e-
 check "$tmp/d.json" "abs(d['sigma'][0] / d['sigma'][1] - d['w_R']) < 1e-14 * d['w_R']" "w_R = sigma1/sigma2"
 check "$tmp/d.json" "max(abs(a[2]) for a in d['axis_directions']) < 1e-14 and d['translational_direction'] == [0, 0, 1]" "axes at home in span{e1, e2}; segment along z"
 check "$tmp/d.json" "all(abs(sum(x * x for x in a) - 1) < 1e-14 for a in d['axis_directions']) and abs(sum(x * y for x, y in zip(*d['axis_directions']))) < 1e-14" "semi-axis directions orthonormal"
-check "$tmp/d.json" "all(abs(d['Mt'][i][j] - d['Mt'][j][i]) == 0 for i in range(3) for j in range(3))" "Mt symmetric"
+check "$tmp/d.json" "len(d['Mt']) == $nact and all(len(r) == $nact for r in d['Mt'] + d['JtR'] + d['JtT']) and len(d['JtR']) == len(d['JtT']) == 3" "Mt $nact x $nact, JtR and JtT 3 x $nact"
+check "$tmp/d.json" "all(abs(d['Mt'][i][j] - d['Mt'][j][i]) == 0 for i in range($nact) for j in range($nact))" "Mt symmetric"
 # Away from home: the semi-axes stay in span{e1, v}, v = (0, cos q1, sin q1).
 "$PRRU" dme --q 0.3,-0.4,-0.5 >"$tmp/d2.json" || bad "dme failed"
 check "$tmp/d2.json" "max(abs(a[1] * math.sin(0.3) - a[2] * math.cos(0.3)) for a in d['axis_directions']) < 1e-14" "semi-axes in span{e1, v}"
+
+# Mt = J_d^+T M J_d^+ with J_d^+ = (J_d^T J_d)^-1 J_d^T (J_d^-1 for three
+# actuators), from the M and J_d that prru eval prints at the same pose.
+"$PRRU" eval --q 0.3,-0.4,-0.5 >"$tmp/e2.json" || bad "eval failed"
+r=$(python3 - "$tmp/d2.json" "$tmp/e2.json" <<'PY'
+import json, sys
+dm, ev = (json.load(open(f)) for f in sys.argv[1:])
+N = len(ev['d'])
+J = [ev['Jd'][3 * i:3 * i + 3] for i in range(N)]
+M = [ev['M'][3 * i:3 * i + 3] for i in range(3)]
+A = [[sum(J[k][i] * J[k][j] for k in range(N)) for j in range(3)] for i in range(3)]
+det = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0])
+       + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]))
+inv = [[(A[(j + 1) % 3][(i + 1) % 3] * A[(j + 2) % 3][(i + 2) % 3] - A[(j + 1) % 3][(i + 2) % 3] * A[(j + 2) % 3][(i + 1) % 3]) / det
+        for j in range(3)] for i in range(3)]
+P = [[sum(inv[i][k] * J[c][k] for k in range(3)) for c in range(N)] for i in range(3)]  # J_d^+, 3 x N
+Mt = [[sum(P[a][r] * M[a][b] * P[b][c] for a in range(3) for b in range(3)) for c in range(N)] for r in range(N)]
+scale = max(abs(x) for row in Mt for x in row)
+print(max(abs(Mt[r][c] - dm['Mt'][r][c]) for r in range(N) for c in range(N)) / scale)
+PY
+)
+below "$r" 1e-12 "dme Mt differs from J_d^+T M J_d^+ built from eval's M and J_d"
 
 # Unreachable and singular poses: a valid answer (exit 0) with a status and nulls.
 "$PRRU" dme --q 0,2,0 >"$tmp/u.json"; [ $? -eq 0 ] && ok || bad "dme of an unreachable pose should exit 0"

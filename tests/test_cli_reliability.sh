@@ -263,7 +263,7 @@ for t in "--atol 1e-25" "--rtol 1e-25" "--rtol 1e-16 --atol 1e-10"; do
 done
 expect 2 "msbdf needs a positive absolute tolerance" -- simulate --t-end 0.01 --stepper msbdf --atol 0 --rtol 1e-8
 expect 2 "--max-steps '2.5'" -- simulate --t-end 0.01 --max-steps 2.5
-expect 1 "step budget of 3 steps exhausted" -- simulate --q0 0,0,-0.8 --fd 40,40,40 --harmonic 50,200 \
+expect 1 "step budget of 3 steps exhausted" -- simulate --q0 0,0,-0.8 --fd "$(nlist 40)" --harmonic 50,200 \
   --max-steps 3 --dt 0.05 --t-end 0.5 --atol 1e-13 --rtol 1e-13 --out "$tmp/budget.csv"
 [ "$(grep -vc '^#' "$tmp/budget.csv")" -ge 2 ] && ok || bad "step budget: rows before the stop not kept"
 
