@@ -1,10 +1,7 @@
 /* prru_bench: per-call cost of the generated kernels and the runtime's paths
  * against the straightforward reference (prru_reference) in the same run,
  * the wall time of one simulated second of the paper's scenario on both
- * paths (for a redundantly actuated model that the paper's scenario takes
- * out of its workspace, the 4-PRRU, of a fallback that stays inside: see
- * simulated_second), and the time to regenerate the kernels from the model
- * file.
+ * paths, and the time to regenerate the kernels from the model file.
  *
  * usage: prru_bench [--json] [--reps N] [--quick] [--batch-ms MS]
  *
@@ -448,29 +445,11 @@ typedef struct {
   double dq, dqd;           /* max |generated - reference| at t_end */
   unsigned long ref_steps;
   double tol, h0;
-  /* The scenario timed: the paper's, or, for a redundantly actuated model
-   * that the paper's takes out of its workspace, the fallback (see
-   * simulated_second); paper_stop says where and why the paper's stopped
-   * then. */
-  int fallback;
-  char paper_stop[256];
 } sim_result;
 
-#define BENCH_SIM_PAPER "paper section 4.3"
-#define BENCH_SIM_FALLBACK "paper section 4.3 with fd_i = fd_3 = 25 N for every actuator beyond the third"
-
 /* One simulated second of the paper's section 4.3 scenario (spec section
- * 9), generated and reference path. With more than three actuators the
- * paper's loads leave the fourth at fd4 = 0 (prru_schedule_paper); the
- * 4-PRRU of models/4prru.json, heavier by a limb and unsupported on that
- * side, then tips over and leaves its workspace at t = 0.476 s. A model
- * where that happens times instead the same start, platform load,
- * tolerances and length with every actuator beyond the third driven like
- * the third (fd4 = fd3 = 25 N: limb 4 mirrors limb 3), which keeps the
- * 4-PRRU inside for the whole second (it ends at q = (-0.20, -0.24,
- * -1.31)). Both paths write those loads themselves, as for the paper's.
- * Reported as the scenario, with where the paper's stopped; a model that
- * leaves its workspace either way fails as before. */
+ * 9), generated and reference path (a redundant fourth actuator driven
+ * like the third, as prru_schedule_paper does). */
 static void simulated_second(const prru_model *m, int reps, sim_result *res)
 {
   double g[MAXREPS], r[MAXREPS];
@@ -489,11 +468,10 @@ static void simulated_second(const prru_model *m, int reps, sim_result *res)
   o.on_sample = capture_sample;
   o.interrupt = NULL;
   o.progress = 0;
-  bench_refsim_options ro = {o.h0, o.abs_tol, o.rel_tol, o.t_end, 0};
+  bench_refsim_options ro = {o.h0, o.abs_tol, o.rel_tol, o.t_end};
   double q0[3], qd0[3], y[6];
   bench_refsim_initial(q0, qd0);
   res->ok = 0;
-  res->fallback = 0;
   res->tol = o.rel_tol;
   res->h0 = o.h0;
   for (int i = 0; i < reps; i++) {
@@ -504,15 +482,6 @@ static void simulated_second(const prru_model *m, int reps, sim_result *res)
     double t0 = bench_now_ns();
     int st = prru_simulate(m, q0, qd0, &o, &t_stop, msg, (int)sizeof msg);
     g[i] = (bench_now_ns() - t0) * 1e-9;
-    if (st != PRRU_OK && i == 0 && !res->fallback && PRRU_NACT > 3) {
-      /* The paper's scenario leaves this model's workspace: the fallback. */
-      snprintf(res->paper_stop, sizeof res->paper_stop, "%s", msg);
-      for (int k = 3; k < PRRU_NACT; k++) sched.base.fd[k] = sched.base.fd[2];
-      ro.mirror_limb3 = 1;
-      res->fallback = 1;
-      i--; /* this repetition again, on the fallback */
-      continue;
-    }
     if (st != PRRU_OK || cap.n == 0 || !(fabs(cap.last.t - o.t_end) <= 1e-12)) {
       fprintf(stderr, "prru_bench: prru_simulate stopped at t = %g s: %s (%s)\n", t_stop,
               prru_strerror(st), msg);
@@ -749,12 +718,7 @@ static void print_json(const bench_options *op, const char *cpu, const sim_resul
   printf(", \"missing\": {\"w_r\": \"runtime/include/prru_dme.h not present at build time\"}");
 #endif
   if (sim->ok) {
-    printf(", \"simulated_second\": {\"scenario\": ");
-    json_string(sim->fallback ? BENCH_SIM_FALLBACK : BENCH_SIM_PAPER);
-    if (sim->fallback) {
-      printf(", \"paper_scenario_stopped\": ");
-      json_string(sim->paper_stop);
-    }
+    printf(", \"simulated_second\": {\"scenario\": \"paper section 4.3\"");
     printf(", \"generated_s\": %.4g, \"reference_s\": %.4g, "
            "\"ratio\": %.4g, \"stepper\": \"rk8pd\", \"rel_tol\": %g, \"abs_tol\": %g, "
            "\"reference_steps\": %lu, \"final_q\": [%.15g, %.15g, %.15g], "
@@ -804,14 +768,8 @@ static void print_table(const bench_options *op, const char *cpu, const sim_resu
 #endif
   printf("\n");
   if (sim->ok) {
-    if (sim->fallback) {
-      printf("simulated second (" BENCH_SIM_FALLBACK ", rk8pd, rel = abs tol %g, h0 %g;\n"
-             "  the paper's scenario, fd beyond the third 0, leaves this model's workspace: %s):\n",
-             sim->tol, sim->h0, sim->paper_stop);
-    } else {
-      printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
-             sim->h0);
-    }
+    printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
+           sim->h0);
     printf("  generated  %.3f ms [%.3f-%.3f]  (prru_simulate)\n", 1e3 * sim->gen_s.median,
            1e3 * sim->gen_s.min, 1e3 * sim->gen_s.max);
     printf("  reference  %.3f ms [%.3f-%.3f]  (gsl_odeiv2 + prru_ref_forward_dynamics, %lu steps)"

@@ -47,7 +47,7 @@ int bench_refsim_paper(const bench_refsim_options *o, double y[6], unsigned long
   refsim_ctx c;
   prru_ref_params_default(&c.p);
   for (int i = 0; i < PRRU_NACT; i++)
-    c.fd[i] = i < 3 ? paper_fd[i] : o->mirror_limb3 ? paper_fd[2] : 0.0;
+    c.fd[i] = paper_fd[i < 3 ? i : 2]; /* as prru_schedule_paper */
   c.w = prru_ref_alloc();
   if (!c.w) {
     fprintf(stderr, "prru_bench: reference simulation: out of memory\n");

@@ -9,12 +9,6 @@
 typedef struct {
   double h0, abs_tol, rel_tol; /* same meaning as prru_sim_options */
   double t_end;                /* s; the state is only sampled at t_end */
-  /* 0: the paper's fd = (50, 40, 25) N, 0 for any further actuator (as
-   * prru_schedule_paper); 1: every actuator beyond the third driven like
-   * the third, fd_i = 25 N (the 4-PRRU's limb 4 mirrors limb 3), the
-   * scenario prru_bench falls back to for a redundantly actuated model that
-   * the paper's takes out of its workspace. */
-  int mirror_limb3;
 } bench_refsim_options;
 
 /* The paper's initial state: q = (0, pi/6, -0.8), qd = 0. */

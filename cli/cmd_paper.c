@@ -397,7 +397,7 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
   prru_model m;
   prru_model_default(&m);
   prru_scenario s;
-  prru_cli_scenario_paper(&s);
+  prru_scenario_paper(&s);
   paper_run *r = calloc(1, sizeof *r);
   if (!r) {
     prru_cli_error("paper", "out of memory");

@@ -120,7 +120,7 @@ int prru_cmd_simulate(int argc, char **argv)
   prru_scenario s;
   char msg[600];
   if (scen && strcmp(scen, "paper") == 0) {
-    prru_cli_scenario_paper(&s);
+    prru_scenario_paper(&s);
   } else if (scen) {
     if (prru_scenario_read(&s, scen, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error("simulate", "--scenario %s", msg);

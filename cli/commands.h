@@ -47,7 +47,6 @@ int prru_cli_is_paper_model(void);
  * `prru simulate --scenario paper`): prru_scenario_paper, and on a model
  * with redundant actuators every actuator beyond the third gets the third's
  * force (limb 4 mirrors limb 3): fd = (50, 40, 25, 25) N. */
-void prru_cli_scenario_paper(prru_scenario *s);
 /* The fd list of the paper scenario as text, "50, 40, 25[, 25]". */
 const char *prru_cli_paper_fd_text(void);
 /* The model's length scale L, the mean upper-link length (m), as the

@@ -205,17 +205,11 @@ const char *prru_cli_model_id(void)
   return id;
 }
 
-void prru_cli_scenario_paper(prru_scenario *s)
-{
-  prru_scenario_paper(s);
-  for (int i = 3; i < PRRU_NACT; i++) s->loads.base.fd[i] = s->loads.base.fd[2];
-}
-
 const char *prru_cli_paper_fd_text(void)
 {
   static char text[32 * PRRU_NACT];
   prru_scenario s;
-  prru_cli_scenario_paper(&s);
+  prru_scenario_paper(&s);
   size_t used = 0;
   for (int i = 0; i < PRRU_NACT && used < sizeof text; i++)
     used += (size_t)snprintf(text + used, sizeof text - used, "%s%g", i ? ", " : "", s.loads.base.fd[i]);

@@ -210,7 +210,8 @@ typedef struct {
 
 void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l);
 /* The paper's section 4.3 loads: fd = (50, 40, 25) N, fp = 50 (sin 4pi t,
- * -cos 4pi t, 0) N, mp = 0. */
+ * -cos 4pi t, 0) N, mp = 0; a fourth actuator (the redundant limb, which
+ * mirrors limb 3) gets limb 3's 25 N. */
 void prru_schedule_paper(prru_load_schedule *s);
 /* Reads a CSV with header t,fd1..fdN[,fp1,fp2,fp3[,mp1,mp2,mp3]] (N =
  * PRRU_NACT); times strictly increasing. On error fills msg (file:line:

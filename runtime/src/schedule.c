@@ -32,6 +32,10 @@ void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l)
 void prru_schedule_paper(prru_load_schedule *s)
 {
   prru_loads l = {{50.0, 40.0, 25.0}, {0, 0, 0}, {0, 0, 0}};
+  /* A redundant limb mirrors limb 3 (spec 12) and is driven like it:
+   * with no force it would leave its share of the weight to the others and
+   * the 4-PRRU leaves its workspace at t = 0.48 s. */
+  for (int i = 3; i < PRRU_NACT; i++) l.fd[i] = l.fd[2];
   prru_schedule_constant(s, &l);
   s->kind = PRRU_LOAD_HARMONIC;
   s->amp = 50.0;
