@@ -582,6 +582,11 @@ static void test_fk(void)
   TU_TRUE(prru_forward_kinematics(&model, &data, nan_act, seed, sol) == PRRU_EINPUT &&
               prru_forward_kinematics_lsq(&model, &data, nan_act, seed, sol, &res) == PRRU_EINPUT,
           "FK of a NaN d (last slider)");
+  /* Finite but so far out that |r|^2 overflows: refused, not "fitted". */
+  double huge[NA];
+  for (int i = 0; i < NA; i++) huge[i] = i == 0 ? 1e200 : 0.0;
+  TU_TRUE(prru_forward_kinematics_lsq(&model, &data, huge, seed, sol, &res) == PRRU_EINPUT,
+          "least-squares FK of a d whose residual overflows is refused");
 }
 
 /* ---- DME with J_d^+ ---- */

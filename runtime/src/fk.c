@@ -57,6 +57,9 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
   const double tol = fk_tol(m, act), L = prru_length_scale(m->mech);
   double x[3] = {seed[0], seed[1], seed[2]}, r[PRRU_NACT], rmax;
   double f = fk_residual(d, act, r, &rmax);
+  /* Slider positions so far out that |r|^2 overflows: no step could ever
+   * be accepted, and the seed would come back as a "fit". */
+  if (!isfinite(f)) return PRRU_EINPUT;
   int iter, settled = 0;
   for (iter = 0; iter < 200 && !settled; iter++) {
     if (rmax <= tol) { settled = 1; break; }
