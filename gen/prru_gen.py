@@ -11,7 +11,6 @@ Writes DIR/<prefix>_kernels.{h,c} (the kernels) and DIR/<prefix>_mechanism.{h,c}
 import argparse
 import os
 import re
-import signal
 import sys
 import time
 
@@ -59,14 +58,7 @@ def main(argv=None):
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
-    output.handle_termination()
-    try:
-        return _run(args)
-    except (KeyboardInterrupt, output.Terminated) as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
-        print("prru_gen: stopped by signal %d: %s left as it was"
-              % (signum, args.out), file=sys.stderr)
-        return 128 + signum
+    return output.run_stoppable("prru_gen", args.out, lambda: _run(args))
 
 
 def _run(args):

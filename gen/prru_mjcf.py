@@ -27,7 +27,6 @@ import argparse
 import math
 import os
 import re
-import signal
 import string
 import sys
 
@@ -431,14 +430,7 @@ def main(argv=None):
     parser.add_argument("--out", required=True, metavar="FILE",
                         help="MJCF file to write")
     args = parser.parse_args(argv)
-    output.handle_termination()
-    try:
-        return _run(args)
-    except (KeyboardInterrupt, output.Terminated) as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
-        print("prru_mjcf: stopped by signal %d: %s left as it was"
-              % (signum, args.out), file=sys.stderr)
-        return 128 + signum
+    return output.run_stoppable("prru_mjcf", args.out, lambda: _run(args))
 
 
 def _run(args):

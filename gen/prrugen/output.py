@@ -11,6 +11,7 @@ hidden `.<name>.XXXX` file, never a mixed set of visible ones.)
 
 import os
 import signal
+import sys
 import tempfile
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -33,6 +34,19 @@ def handle_termination():
     points; a library caller keeps its own handlers)."""
     for s in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(s, _raise_terminated)
+
+
+def run_stoppable(prog, out, run):
+    """run() for a command-line entry point writing to out: a stop by
+    SIGINT, SIGTERM or SIGHUP becomes one message and exit 128 + signal."""
+    handle_termination()
+    try:
+        return run()
+    except (KeyboardInterrupt, Terminated) as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print("%s: stopped by signal %d: %s left as it was" % (prog, signum, out),
+              file=sys.stderr)
+        return 128 + signum
 
 
 def write_files_atomically(out_dir, files):
