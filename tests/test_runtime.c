@@ -182,6 +182,10 @@ static void test_bad_input(void)
   double far[3];
   unreachable_pose(far);
   TU_TRUE(prru_forward_dynamics(&model, &data, far, qd, &l, qdd) == PRRU_EUNREACHABLE, "FD unreachable q");
+  double T, V, huge_qd[3] = {1e200, 0, 0};
+  TU_TRUE(prru_energies(&model, far, qd, &T, &V) == PRRU_EUNREACHABLE, "energies at an unreachable q");
+  TU_TRUE(prru_energies(&model, q, huge_qd, &T, &V) == PRRU_EINPUT,
+          "energies overflowing at a reachable q: bad input, not unreachable");
   double nanq[3] = {NAN, 0, -0.8};
   TU_TRUE(prru_forward_dynamics(&model, &data, nanq, qd, &l, qdd) == PRRU_EINPUT, "FD NaN q");
   double infqd[3] = {0, INFINITY, 0};

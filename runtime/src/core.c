@@ -369,7 +369,13 @@ int prru_energies(const prru_model *m, const double q[3], const double qd[3], do
   if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
   double E[2];
   prru_energy(q, qd, E);
-  if (!isfinite(E[0]) || !isfinite(E[1])) return PRRU_EUNREACHABLE;
+  if (!isfinite(E[0]) || !isfinite(E[1])) {
+    /* NaN where q is out of reach; at a reachable q only an overflow of
+     * huge velocities (bad input) makes the energy infinite. */
+    double act[PRRU_NACT];
+    prru_ik(q, act);
+    return isfinite(act[0]) ? PRRU_EINPUT : PRRU_EUNREACHABLE;
+  }
   *T = E[0];
   *V = E[1];
   return PRRU_OK;
