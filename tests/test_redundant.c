@@ -30,6 +30,7 @@
 
 #include "prru.h"
 #include "prru_dme.h"
+#include "testsim.h"
 #include "testutil.h"
 
 #define NA PRRU_NACT
@@ -40,19 +41,7 @@
 static prru_model model;
 static prru_data data;
 
-/* A regular pose around q1 = q2 = 0 (as in test_runtime). */
-static void random_state(double q[3], double qd[3])
-{
-  double span = 1.0;
-  for (int tries = 1;; tries++) {
-    q[0] = span * tu_uniform(-0.4, 0.4);
-    q[1] = span * tu_uniform(-0.5, 0.4);
-    q[2] = tu_uniform(-1.0, -0.5);
-    if (prru_check_regular(&model, &data, q, NULL) == PRRU_OK) break;
-    if (tries % 100 == 0) span *= 0.5;
-  }
-  for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
-}
+static void random_state(double q[3], double qd[3]) { ts_random_state(&model, &data, q, qd); }
 
 static void random_loads(prru_loads *l)
 {

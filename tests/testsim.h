@@ -1,10 +1,27 @@
-/* Simulation helpers shared by the runtime tests: keep the first and last
- * samples of a run, optionally stop after n of them. */
+/* Helpers shared by the runtime tests: random regular states; keep the
+ * first and last samples of a run, optionally stop after n of them. */
 #ifndef PRRU_TESTSIM_H
 #define PRRU_TESTSIM_H
 #include <string.h>
 
 #include "prru.h"
+#include "testutil.h"
+
+/* A regular pose around q1 = q2 = 0 (every valid model assembles there;
+ * reachability does not depend on the height q3), the range halved
+ * whenever a model rejects too many draws; velocities in [-1, 1]. */
+static inline void ts_random_state(const prru_model *m, prru_data *d, double q[3], double qd[3])
+{
+  double span = 1.0;
+  for (int tries = 1;; tries++) {
+    q[0] = span * tu_uniform(-0.4, 0.4);
+    q[1] = span * tu_uniform(-0.5, 0.4);
+    q[2] = tu_uniform(-1.0, -0.5);
+    if (prru_check_regular(m, d, q, NULL) == PRRU_OK) break;
+    if (tries % 100 == 0) span *= 0.5;
+  }
+  for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
+}
 
 typedef struct {
   prru_sample first, last;
