@@ -14,19 +14,7 @@ import unittest
 from unittest import mock
 
 from prrugen import output
-
-GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ROOT = os.path.dirname(GEN_DIR)
-PAPER = os.path.join(ROOT, "models", "3prru_paper.json")
-ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
-
-
-def listing(d):
-    out = {}
-    for name in sorted(os.listdir(d)):
-        with open(os.path.join(d, name), "rb") as f:
-            out[name] = f.read()
-    return out
+from tests.test_generator import ENTRY, MODEL as PAPER, read_dir as listing
 
 
 class AtomicWrites(unittest.TestCase):
