@@ -102,6 +102,13 @@ int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
  * J = J_d diag(1/L, 1/L, 1) (see prru_model), which for three actuators is
  * 1 / (|J|_1 |J^-1|_1). J^+ comes from a Householder QR of J for four. */
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
+/* The regularity test of prru_check_regular on a given J_d (finite), for a
+ * mechanism of length scale L (m) and tolerance rcond_min: PRRU_OK and
+ * Jdpinv = J_d^+, or PRRU_ESINGULAR; *rcond as there. prru_check_regular is
+ * this with the model's L and jd_rcond_min; the design optimiser calls it
+ * with a candidate design's own L, so both judge regularity alike. */
+int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
+                    double Jdpinv[3 * PRRU_NACT], double *rcond);
 
 /* Actuator displacements (inverse kinematics). */
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT]);

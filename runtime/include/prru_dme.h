@@ -99,6 +99,16 @@ const char *prru_dme_status_name(int status);
  * NaN. */
 int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme *out);
 
+/* The one computation of the DME behind prru_dme_eval, from its
+ * ingredients at a pose already found regular: M (3x3), J_d^+ (3 x N, as
+ * prru_jd_regular leaves it) and the platform Jacobian [J_R,P; J_T,P]
+ * (6x3, row-major, as prru_platform_jacobian). The design optimiser
+ * (prru_design.h) calls it with a candidate design's matrices, so w_R has
+ * one definition. Returns out->status (PRRU_ESINGULAR when a result is not
+ * finite); out->jd_rcond is left as it is. */
+int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
+                  prru_dme *out);
+
 /* ---- Maps over a rectangle of (q1, q2) at fixed q3 ---- */
 
 /* n1 values q1_i = (q1_lo (n1-1-i) + q1_hi i) / (n1-1), i = 0..n1-1 (the

@@ -161,12 +161,9 @@ static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
 }
 #endif
 
-int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
+int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
+                    double Jdpinv[3 * PRRU_NACT], double *rcond)
 {
-  if (rcond) *rcond = 0.0;
-  if (!finite3(q)) return PRRU_EINPUT;
-  prru_ik_jd(q, d->d, d->Jd);
-  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   /* J_d's rotation columns are lengths per radian, its height column is
    * dimensionless: conditioned as it stands, a model scaled by 1e-7 would
    * be singular everywhere. So the condition number is that of
@@ -174,22 +171,30 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
    * model's own scale), the same for a robot of any size; and
    * J_d^+ = diag(1/L, 1/L, 1) Js^+ (for three actuators, J_d^-1 =
    * diag(1/L, 1/L, 1) Js^-1). */
-  const double L = prru_length_scale(m->mech);
   double Js[3 * PRRU_NACT];
   for (int i = 0; i < PRRU_NACT; i++) {
-    Js[3 * i] = d->Jd[3 * i] / L;
-    Js[3 * i + 1] = d->Jd[3 * i + 1] / L;
-    Js[3 * i + 2] = d->Jd[3 * i + 2];
+    Js[3 * i] = Jd[3 * i] / L;
+    Js[3 * i + 1] = Jd[3 * i + 1] / L;
+    Js[3 * i + 2] = Jd[3 * i + 2];
   }
 #if PRRU_NACT == 3
-  double rc = prru_rcond3(Js, d->Jdpinv);
+  double rc = prru_rcond3(Js, Jdpinv);
 #else
-  double rc = rcond_pinv(Js, d->Jdpinv);
+  double rc = rcond_pinv(Js, Jdpinv);
 #endif
-  for (int j = 0; j < 2 * PRRU_NACT; j++) d->Jdpinv[j] /= L;
+  for (int j = 0; j < 2 * PRRU_NACT; j++) Jdpinv[j] /= L;
   if (rcond) *rcond = rc;
-  /* rc > 0 also when jd_rcond_min is 0: an exactly singular J_d has no inverse. */
-  return rc > 0 && rc >= m->jd_rcond_min ? PRRU_OK : PRRU_ESINGULAR;
+  /* rc > 0 also when rcond_min is 0: an exactly singular J_d has no inverse. */
+  return rc > 0 && rc >= rcond_min ? PRRU_OK : PRRU_ESINGULAR;
+}
+
+int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
+{
+  if (rcond) *rcond = 0.0;
+  if (!finite3(q)) return PRRU_EINPUT;
+  prru_ik_jd(q, d->d, d->Jd);
+  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
 
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT])

@@ -78,14 +78,21 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   if (st != PRRU_OK) return fail(out, st);
 
   /* regular: prru_check_regular left J_d^+ (J_d^-1 for three actuators) */
-  const double *jinv = d->Jdpinv;
-  double jp[18], tmp[3 * N];
+  double jp[18];
   prru_mass(q, d->M);
   prru_platform_jacobian(q, jp);
-  const double *jrp = jp, *jtp = jp + 9;
+  return prru_dme_from(d->M, d->Jdpinv, jp, out);
+}
+
+int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
+                  prru_dme *out)
+{
+  const double *jinv = Jdpinv;
+  double tmp[3 * N];
+  const double *jrp = JP, *jtp = JP + 9;
 
   /* Mt = J^+T M J^+ (symmetrized: it is symmetric in exact arithmetic). */
-  mul3n(d->M, jinv, tmp);
+  mul3n(M, jinv, tmp);
   for (int i = 0; i < N; i++)
     for (int j = i; j < N; j++) {
       double s = jinv[i] * tmp[j] + jinv[N + i] * tmp[N + j] + jinv[2 * N + i] * tmp[2 * N + j];
