@@ -1,6 +1,6 @@
 /* prru paper: the paper's section 4.3 simulation study and its fig. 7
  * workspace map, written as CSVs, gnuplot PNGs and a text summary. */
-#define _POSIX_C_SOURCE 200809L /* mkdir, mkdtemp, fork, waitpid, nanosleep */
+#define _POSIX_C_SOURCE 200809L /* mkdir, mkdtemp */
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
@@ -8,11 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "commands.h"
+#include "paper.h"
+#include "plot.h"
 #include "prru.h"
 
 static const char paper_help[] =
@@ -92,183 +92,6 @@ static int on_sample(const prru_sample *s, void *ctx)
     if (fabs(s->lambda[i]) > r->max_abs[i]) r->max_abs[i] = fabs(s->lambda[i]);
   r->n++;
   return prru_cli_csv_row(s, &r->csv);
-}
-
-/* The model's name as the gnuplot string variable `model` (single quotes
- * doubled, underscores escaped for enhanced text). */
-void prru_cli_gnuplot_model(FILE *g)
-{
-  fputs("model = '", g);
-  for (const char *c = prru_mech.name; *c; c++) {
-    if (*c == '\'')
-      fputs("''", g);
-    else if (*c == '_' || *c == '^' || *c == '{' || *c == '}' || *c == '@' || *c == '&' || *c == '~')
-      fprintf(g, "\\%c", *c);
-    else if ((unsigned char)*c >= 0x20)
-      fputc(*c, g);
-  }
-  fputs("'\n", g);
-}
-
-/* "C1" -> "C_1" (letters, then the rest as a subscript) for gnuplot labels. */
-static void put_subscripted(FILE *g, const char *name)
-{
-  const char *c = name;
-  while (*c && !(*c >= '0' && *c <= '9')) fputc(*c++, g);
-  if (*c) fprintf(g, "_{%s}", c);
-}
-
-/* One plot command of joint j's reaction components whose name (after the
- * '_') starts with kind ('f' forces, 'm' moments). */
-static void plot_components(FILE *g, int j, char kind)
-{
-  const prru_joint_info *jt = &prru_mech.joint[j];
-  int first = 1;
-  for (int k = 0; k < jt->lambda_count; k++) {
-    const char *label = prru_mech.lambda_labels[jt->lambda_offset + k];
-    const char *comp = strchr(label, '_');
-    comp = comp ? comp + 1 : label;
-    if (comp[0] != kind) continue;
-    fprintf(g, "%s'%s' w l lw 2 t '%c_%s'", first ? "plot f using 't':" : ", '' using 't':", label,
-            comp[0], comp[0] ? comp + 1 : "");
-    first = 0;
-  }
-  fputs(first ? "plot 0 notitle\n" : "\n", g);
-}
-
-/* The gnuplot script for paper_sim.csv, written from the mechanism's
- * actuators and joints; NULL when out of memory. */
-static char *plot_script(void)
-{
-  char *buf = NULL;
-  size_t len = 0;
-  FILE *g = open_memstream(&buf, &len);
-  if (!g) return NULL;
-  int nu = 0, np = 0;
-  for (int j = 0; j < PRRU_NJOINT; j++) {
-    nu += prru_mech.joint[j].type == 'U';
-    np += prru_mech.joint[j].type == 'P';
-  }
-  prru_cli_gnuplot_model(g);
-  fputs("set datafile separator ','\n"
-        "set terminal pngcairo size 1000,700 enhanced font 'Sans,11'\n"
-        "set grid\n"
-        "set key outside right\n"
-        "f = 'paper_sim.csv'\n"
-        "set output 'fig_q.png'\n"
-        "set multiplot layout 2,1 title 'Generalized coordinates, paper scenario (section 4.3), model '.model\n"
-        "set ylabel 'rotation (rad)'\n"
-        "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
-        "set xlabel 'time t (s)'\n"
-        "set ylabel 'height (m)'\n"
-        "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
-        "unset multiplot\n"
-        "set output 'fig_d.png'\n"
-        "set title 'Actuator displacements (slider heights), model '.model\n"
-        "set xlabel 'time t (s)'\n"
-        "set ylabel 'd_i (m)'\n"
-        "plot ", g);
-  for (int i = 1; i <= PRRU_NACT; i++)
-    fprintf(g, "%s't':'d%d' with lines lw 2 title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i);
-  fputs("\nunset title\n"
-        "set output 'fig4_u_joint_forces.png'\n", g);
-  fprintf(g, "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", 100 + 200 * (nu ? nu : 1));
-  fprintf(g, "set multiplot layout %d,1 title 'Reaction forces in the U joints (force of the lower "
-             "link on the platform, base frame S; paper fig. 4), model '.model\n", nu ? nu : 1);
-  for (int j = 0, u = 0; j < PRRU_NJOINT; j++) {
-    if (prru_mech.joint[j].type != 'U') continue;
-    fprintf(g, "set xlabel '%s'\n", ++u == nu ? "time t (s)" : "");
-    fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
-    fputs(" force (N)'\n", g);
-    plot_components(g, j, 'f');
-  }
-  if (!nu) fputs("plot 0 notitle\n", g);
-  fputs("unset multiplot\n"
-        "set output 'fig6_p_joint_reactions.png'\n", g);
-  fprintf(g, "set terminal pngcairo size 1200,%d enhanced font 'Sans,11'\n", 200 + 200 * (np ? np : 1));
-  fprintf(g, "set multiplot layout %d,2 title 'Reactions in the prismatic joints (rail on slider, "
-             "base frame S; paper fig. 6), model '.model\n", np ? np : 1);
-  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
-    if (prru_mech.joint[j].type != 'P') continue;
-    fprintf(g, "set xlabel '%s'\n", ++p == np ? "time t (s)" : "");
-    fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
-    fputs(" force (N)'\n", g);
-    plot_components(g, j, 'f');
-    fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
-    fputs(" moment (N m)'\n", g);
-    plot_components(g, j, 'm');
-  }
-  if (!np) fputs("plot 0 notitle\n", g);
-  fputs("unset multiplot\n", g);
-  if (fclose(g) != 0) {
-    free(buf);
-    return NULL;
-  }
-  return buf;
-}
-
-/* Runs gnuplot on a script in dir (cd there so outputs land beside it). */
-int prru_cli_gnuplot(const char *dir, const char *shown_dir, const char *script_name,
-                     const char *script)
-{
-  char path[4200], shown[4200];
-  snprintf(path, sizeof path, "%s/%s", dir, script_name);
-  snprintf(shown, sizeof shown, "%s/%s", shown_dir, script_name);
-  FILE *f = fopen(path, "w");
-  if (!f) {
-    prru_cli_error("paper", "%s: cannot open for writing: %s", shown, strerror(errno));
-    return 1;
-  }
-  errno = 0;
-  int bad = fputs(script, f) < 0 || fflush(f) != 0;
-  int e = errno;
-  if (fclose(f) != 0 && !bad) {
-    bad = 1;
-    e = errno;
-  }
-  if (bad) {
-    prru_cli_error("paper", "%s: write error: %s", shown, e ? strerror(e) : "output lost");
-    return 1;
-  }
-  fflush(NULL); /* nothing buffered is written twice by the child */
-  pid_t pid = fork();
-  if (pid < 0) {
-    prru_cli_error("paper", "cannot start gnuplot: %s", strerror(errno));
-    return 1;
-  }
-  if (pid == 0) {
-    /* The caught signals return to their defaults at exec. */
-    if (chdir(dir) != 0) _exit(126);
-    execlp("gnuplot", "gnuplot", script_name, (char *)NULL);
-    _exit(errno == ENOENT ? 127 : 126);
-  }
-  /* Poll rather than block, so that a signal to prru alone (kill) stops
-   * gnuplot too. */
-  int status = 0, killed = 0;
-  for (;;) {
-    pid_t r = waitpid(pid, &status, WNOHANG);
-    if (r == pid) break;
-    if (r < 0 && errno != EINTR) {
-      prru_cli_error("paper", "waiting for gnuplot: %s", strerror(errno));
-      return 1;
-    }
-    if (prru_cli_interrupted && !killed) {
-      kill(pid, SIGTERM);
-      killed = 1;
-    }
-    struct timespec ts = {0, 20 * 1000 * 1000};
-    nanosleep(&ts, NULL);
-  }
-  if (prru_cli_interrupted) return prru_cli_exit_interrupted();
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return PRRU_CLI_NO_GNUPLOT;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    prru_cli_error("paper", "gnuplot failed on %s", shown);
-    return 1;
-  }
-  return 0;
 }
 
 /* Creates dir unless it is there; *created says which. */
@@ -389,7 +212,7 @@ static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, doubl
     fprintf(f, "  %-6s %12.4f%s", labels[j], r->max_abs[j], j % 4 == 3 || j == PRRU_NLAMBDA - 1 ? "\n" : "");
 }
 
-/* The whole study into stage; an exit status, or PRRU_CLI_NO_GNUPLOT when
+/* The whole study into stage; an exit status, or PRRU_PLOT_NO_GNUPLOT when
  * everything but the PNGs is there. */
 static int run_paper(const char *stage, const char *out, int skip_map, int is_paper)
 {
@@ -449,15 +272,15 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
   prru_scenario_free(&s);
   int no_gnuplot = 0;
   if (rc == 0) {
-    char *script = plot_script();
+    char *script = prru_plot_paper_sim_script("paper_sim.csv");
     if (!script) {
       prru_cli_error("paper", "out of memory for the plot script");
       rc = 1;
     } else {
-      rc = prru_cli_gnuplot(stage, out, "paper_plots.gp", script);
+      rc = prru_plot_run("paper", stage, out, "paper_plots.gp", script);
     }
     free(script);
-    if (rc == PRRU_CLI_NO_GNUPLOT) {
+    if (rc == PRRU_PLOT_NO_GNUPLOT) {
       no_gnuplot = 1;
       rc = 0;
     }
@@ -465,7 +288,7 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
   if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
   if (rc == 0 && !skip_map) {
     rc = prru_paper_fig7(stage, out, sum);
-    if (rc == PRRU_CLI_NO_GNUPLOT) {
+    if (rc == PRRU_PLOT_NO_GNUPLOT) {
       no_gnuplot = 1;
       rc = 0;
     }
@@ -484,7 +307,7 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
     }
   }
   if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
-  return rc == 0 && no_gnuplot ? PRRU_CLI_NO_GNUPLOT : rc;
+  return rc == 0 && no_gnuplot ? PRRU_PLOT_NO_GNUPLOT : rc;
 }
 
 int prru_cmd_paper(int argc, char **argv)
@@ -521,7 +344,7 @@ int prru_cmd_paper(int argc, char **argv)
     return 1;
   }
   int rc = run_paper(stage, out, skip_map, is_paper);
-  int no_gnuplot = rc == PRRU_CLI_NO_GNUPLOT;
+  int no_gnuplot = rc == PRRU_PLOT_NO_GNUPLOT;
   if (rc == 0 || no_gnuplot) {
     if (no_gnuplot) {
       remove_stale(out, plot_outputs, (int)(sizeof plot_outputs / sizeof plot_outputs[0]));

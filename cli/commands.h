@@ -29,13 +29,6 @@ int prru_cmd_paper(int argc, char **argv);
 int prru_cmd_dme(int argc, char **argv);
 int prru_cmd_map(int argc, char **argv);
 
-/* The fig. 7 part of `prru paper`: map CSV, surface/contour/ellipse PNGs
- * built in stage (messages name outdir, where they will be moved),
- * summary lines appended to summary and printed. Returns 0, 1 (message
- * printed), 128 + signal, or PRRU_CLI_NO_GNUPLOT (everything but the PNGs
- * made). */
-int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary);
-
 /* Shared helpers (cli/util.c). */
 /* `prru --version`: program version and the model's name, file, format,
  * number of actuators and SHA-256, one per line. */
@@ -174,15 +167,5 @@ void prru_cli_csv_header(prru_cli_csv *c);
  * the stop as PRRU_EINTERRUPTED, and the caller, seeing out->err, reports
  * an I/O error instead. */
 int prru_cli_csv_row(const prru_sample *s, void *ctx);
-/* Writes script to dir/script_name and runs gnuplot there (fork and exec,
- * waiting while polling prru_cli_interrupted: on a signal gnuplot gets
- * SIGTERM). Messages name shown_dir instead of dir. 0;
- * PRRU_CLI_NO_GNUPLOT when gnuplot is not installed (no message); 1 when
- * it fails (message printed); 128 + signal when interrupted. */
-#define PRRU_CLI_NO_GNUPLOT 3
-int prru_cli_gnuplot(const char *dir, const char *shown_dir, const char *script_name,
-                     const char *script);
-/* Writes the line model = '<model name>' (a gnuplot string for titles). */
-void prru_cli_gnuplot_model(FILE *g);
 
 #endif

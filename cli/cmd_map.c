@@ -1,0 +1,118 @@
+/* prru map: w_R over a (q1, q2) grid as CSV, and the global index. */
+#define _POSIX_C_SOURCE 200809L /* isatty */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "mapgrid.h"
+#include "prru.h"
+#include "prru_dme.h"
+
+static const char map_help[] =
+    "usage: prru map --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"
+    "                --out FILE.csv [--rcond-min R] [--threads N] [--progress]\n"
+    "w_R (see 'prru dme --help') at every grid point q1 = START..STOP (COUNT\n"
+    "equally spaced values, rad, COUNT >= 2, START < STOP), q2 likewise, q3 = Z\n"
+    "(m, default 0). Writes FILE.csv: the model line (# prru ... model ...), then\n"
+    "the columns q1,q2,q3,w_R,status (q1 outer); where the pose is singular or\n"
+    "unreachable w_R is NaN and status says which. Prints to stdout the model\n"
+    "(name, file, sha256) and the global index: the mean of w_R - 1 over the ok\n"
+    "points, with the fraction of the grid that is singular or unreachable (the\n"
+    "index alone favours a design that loses workspace); also the mean of ln w_R\n"
+    "and the range of w_R. J_d counts as singular when 1/(|J|_1 |J^%s|_1) < R,\n"
+    "J = J_d with its rotation columns divided by the mean upper-link length\n"
+    "(default R: 1e-8). If the grid crosses the singular locus, the mean of\n"
+    "w_R - 1 depends on how close grid points fall to it: compare designs with\n"
+    "a practical tolerance such as --rcond-min 4e-3. Uses N threads\n"
+    "(default 2); a progress bar goes to stderr for grids over 10000 points when\n"
+    "stderr is a terminal, or always with --progress.\n"
+    "FILE is checked before the grid is computed, built as FILE.partial-XXXXXX\n"
+    "and renamed at the end: it keeps its old contents until then. SIGINT,\n"
+    "SIGTERM or SIGHUP (exit 130, 143, 129) stop the computation; the complete\n"
+    "q1 rows computed so far are then written (a second signal stops that too,\n"
+    "at a row boundary) and no summary is printed. A write error exits 1 with\n"
+    "the reason and leaves FILE unchanged.\n";
+
+int prru_cmd_map(int argc, char **argv)
+{
+  const char *q1s = NULL, *q2s = NULL, *q3s = NULL, *out = NULL, *rcs = NULL, *ths = NULL;
+  int help = 0, progress = 0;
+  prru_cli_option opts[] = {{"q1", 1, &q1s, NULL},        {"q2", 1, &q2s, NULL},
+                            {"q3", 1, &q3s, NULL},        {"out", 1, &out, NULL},
+                            {"rcond-min", 1, &rcs, NULL}, {"threads", 1, &ths, NULL},
+                            {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
+  if (prru_cli_parse("map", argc, argv, opts, 8)) return 2;
+  if (help) {
+    printf(map_help, PRRU_NACT > 3 ? "+" : "-1");
+    return 0;
+  }
+  const char *missing = !q1s ? "--q1" : !q2s ? "--q2" : !out ? "--out" : NULL;
+  if (missing) {
+    prru_cli_error("map", "%s is required (see 'prru map --help')", missing);
+    return 2;
+  }
+  prru_map_grid g = {0, 0, 0, 0, 0.0, 0, 0};
+  if (prru_cli_parse_range("map", "q1", q1s, &g.q1_lo, &g.q1_hi, &g.n1)) return 2;
+  if (prru_cli_parse_range("map", "q2", q2s, &g.q2_lo, &g.q2_hi, &g.n2)) return 2;
+  if (q3s && prru_cli_number("map", "q3", q3s, &g.q3)) return 2;
+  if ((double)g.n1 * (double)g.n2 > 5e7) {
+    prru_cli_error("map", "--q1/--q2: %d x %d points is more than the limit of 5e7", g.n1, g.n2);
+    return 2;
+  }
+  int nthreads = 2;
+  if (ths) {
+    char *end;
+    long v = strtol(ths, &end, 10);
+    if (!*ths || *end || v < 1 || v > 256) {
+      prru_cli_error("map", "--threads '%s': must be an integer from 1 to 256", ths);
+      return 2;
+    }
+    nthreads = (int)v;
+  }
+  prru_model m;
+  prru_model_default(&m);
+  if (prru_cli_parse_rcond("map", rcs, &m)) return 2;
+  if (strcmp(out, "-") == 0) {
+    prru_cli_error("map", "--out -: the summary goes to stdout; give the CSV a file name");
+    return 2;
+  }
+  long npts = (long)g.n1 * g.n2;
+  int show = progress || (npts > 10000 && isatty(2));
+  /* The output is created (and so checked) before the grid is computed. */
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "map", out)) return 1;
+  double *w = NULL;
+  unsigned char *st = NULL;
+  prru_map_summary sum;
+  int rc = prru_cli_map_run("map", &m, &g, nthreads, show, &w, &st, &sum);
+  int nrows = rc == PRRU_OK ? g.n1 : rc == PRRU_EINTERRUPTED ? prru_cli_map_rows_done(&g, st) : 0;
+  /* After a first signal the rows computed are still written; a later
+   * one stops that too. */
+  int wst = nrows > 0 ? prru_cli_map_write_csv(&o, &g, w, st, nrows, prru_cli_signal_count) : PRRU_OK;
+  if (wst == PRRU_EINTERRUPTED) rc = PRRU_EINTERRUPTED;
+  long rows = o.rows;
+  int status;
+  if (prru_cli_out_close(&o, !o.err && rows > 0)) {
+    status = 1;
+  } else if (rc == PRRU_EINTERRUPTED) {
+    if (rows > 0)
+      prru_cli_error("map", "interrupted (%s): %ld of %ld grid points written to %s, no summary",
+                     prru_cli_signal_name(), rows, npts, out);
+    else
+      prru_cli_error("map", "interrupted (%s): nothing written, %s is not changed",
+                     prru_cli_signal_name(), out);
+    status = prru_cli_exit_interrupted();
+  } else if (rc != PRRU_OK) {
+    status = 1;
+  } else {
+    prru_cli_map_print_summary(stdout, &sum, m.jd_rcond_min);
+    status = 0;
+  }
+  free(w);
+  free(st);
+  return status;
+}
+

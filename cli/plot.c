@@ -1,0 +1,316 @@
+/* Every gnuplot script of the `prru` tool and the one place that runs
+ * gnuplot (see plot.h). Scripts are written from the mechanism descriptor
+ * (joints, actuators, reaction labels), never for a fixed limb count. */
+#define _POSIX_C_SOURCE 200809L /* fork, waitpid, nanosleep, open_memstream */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "plot.h"
+#include "prru.h"
+
+/* s as a single-quoted gnuplot string; escape_enhanced: with the
+ * enhanced-text specials escaped (titles and labels, not file names). */
+static void put_string(FILE *g, const char *s, int escape_enhanced)
+{
+  fputc('\'', g);
+  for (const char *c = s; *c; c++) {
+    if (*c == '\'')
+      fputs("''", g);
+    else if (escape_enhanced && strchr("_^{}@&~", *c))
+      fprintf(g, "\\%c", *c);
+    else if ((unsigned char)*c >= 0x20)
+      fputc(*c, g);
+  }
+  fputc('\'', g);
+}
+
+void prru_plot_string(FILE *g, const char *s) { put_string(g, s, 0); }
+
+void prru_plot_label(FILE *g, const char *s) { put_string(g, s, 1); }
+
+void prru_plot_model_var(FILE *g)
+{
+  fputs("model = ", g);
+  prru_plot_label(g, prru_mech.name);
+  fputc('\n', g);
+}
+
+/* Writes script to path; 0 or 1 after a message naming shown. */
+static int write_script(const char *cmd, const char *path, const char *shown, const char *script)
+{
+  FILE *f = fopen(path, "w");
+  if (!f) {
+    prru_cli_error(cmd, "%s: cannot open for writing: %s", shown, strerror(errno));
+    return 1;
+  }
+  errno = 0;
+  int bad = fputs(script, f) < 0 || fflush(f) != 0;
+  int e = errno;
+  if (fclose(f) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
+  if (bad) {
+    prru_cli_error(cmd, "%s: write error: %s", shown, e ? strerror(e) : "output lost");
+    return 1;
+  }
+  return 0;
+}
+
+int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
+                  const char *script_name, const char *script)
+{
+  char path[4200], shown[4200];
+  snprintf(path, sizeof path, "%s/%s", dir, script_name);
+  snprintf(shown, sizeof shown, "%s/%s", shown_dir, script_name);
+  if (write_script(cmd, path, shown, script)) return 1;
+  fflush(NULL); /* nothing buffered is written twice by the child */
+  pid_t pid = fork();
+  if (pid < 0) {
+    prru_cli_error(cmd, "cannot start gnuplot: %s", strerror(errno));
+    return 1;
+  }
+  if (pid == 0) {
+    /* The caught signals return to their defaults at exec. */
+    if (chdir(dir) != 0) _exit(126);
+    execlp("gnuplot", "gnuplot", script_name, (char *)NULL);
+    _exit(errno == ENOENT ? 127 : 126);
+  }
+  /* Poll rather than block, so that a signal to prru alone (kill) stops
+   * gnuplot too. */
+  int status = 0, killed = 0;
+  for (;;) {
+    pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) {
+      prru_cli_error(cmd, "waiting for gnuplot: %s", strerror(errno));
+      return 1;
+    }
+    if (prru_cli_interrupted && !killed) {
+      kill(pid, SIGTERM);
+      killed = 1;
+    }
+    struct timespec ts = {0, 20 * 1000 * 1000};
+    nanosleep(&ts, NULL);
+  }
+  if (prru_cli_interrupted) return prru_cli_exit_interrupted();
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return PRRU_PLOT_NO_GNUPLOT;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    prru_cli_error(cmd, "gnuplot failed on %s", shown);
+    return 1;
+  }
+  return 0;
+}
+
+/* ---- simulation figures ---- */
+
+/* "C1" -> "C_1" (letters, then the rest as a subscript) for gnuplot labels. */
+static void put_subscripted(FILE *g, const char *name)
+{
+  const char *c = name;
+  while (*c && !(*c >= '0' && *c <= '9')) fputc(*c++, g);
+  if (*c) fprintf(g, "_{%s}", c);
+}
+
+/* One plot command of joint j's reaction components whose name (after the
+ * '_') starts with kind ('f' forces, 'm' moments). */
+static void plot_components(FILE *g, int j, char kind)
+{
+  const prru_joint_info *jt = &prru_mech.joint[j];
+  int first = 1;
+  for (int k = 0; k < jt->lambda_count; k++) {
+    const char *label = prru_mech.lambda_labels[jt->lambda_offset + k];
+    const char *comp = strchr(label, '_');
+    comp = comp ? comp + 1 : label;
+    if (comp[0] != kind) continue;
+    fprintf(g, "%s'%s' w l lw 2 t '%c_%s'", first ? "plot f using 't':" : ", '' using 't':", label,
+            comp[0], comp[0] ? comp + 1 : "");
+    first = 0;
+  }
+  fputs(first ? "plot 0 notitle\n" : "\n", g);
+}
+
+/* Closes the memory stream g over *buf: the script's text (malloc'ed),
+ * or NULL when out of memory. *buf is only final after fclose. */
+static char *close_script(FILE *g, char **buf)
+{
+  if (fclose(g) != 0) {
+    free(*buf);
+    return NULL;
+  }
+  return *buf;
+}
+
+char *prru_plot_paper_sim_script(const char *csv)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return NULL;
+  int nu = 0, np = 0;
+  for (int j = 0; j < PRRU_NJOINT; j++) {
+    nu += prru_mech.joint[j].type == 'U';
+    np += prru_mech.joint[j].type == 'P';
+  }
+  prru_plot_model_var(g);
+  fputs("set datafile separator ','\n"
+        "set terminal pngcairo size 1000,700 enhanced font 'Sans,11'\n"
+        "set grid\n"
+        "set key outside right\n"
+        "f = ", g);
+  prru_plot_string(g, csv);
+  fputs("\nset output 'fig_q.png'\n"
+        "set multiplot layout 2,1 title 'Generalized coordinates, paper scenario (section 4.3), model '.model\n"
+        "set ylabel 'rotation (rad)'\n"
+        "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
+        "set xlabel 'time t (s)'\n"
+        "set ylabel 'height (m)'\n"
+        "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
+        "unset multiplot\n"
+        "set output 'fig_d.png'\n"
+        "set title 'Actuator displacements (slider heights), model '.model\n"
+        "set xlabel 'time t (s)'\n"
+        "set ylabel 'd_i (m)'\n"
+        "plot ", g);
+  for (int i = 1; i <= PRRU_NACT; i++)
+    fprintf(g, "%s't':'d%d' with lines lw 2 title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i);
+  fputs("\nunset title\n"
+        "set output 'fig4_u_joint_forces.png'\n", g);
+  fprintf(g, "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", 100 + 200 * (nu ? nu : 1));
+  fprintf(g, "set multiplot layout %d,1 title 'Reaction forces in the U joints (force of the lower "
+             "link on the platform, base frame S; paper fig. 4), model '.model\n", nu ? nu : 1);
+  for (int j = 0, u = 0; j < PRRU_NJOINT; j++) {
+    if (prru_mech.joint[j].type != 'U') continue;
+    fprintf(g, "set xlabel '%s'\n", ++u == nu ? "time t (s)" : "");
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" force (N)'\n", g);
+    plot_components(g, j, 'f');
+  }
+  if (!nu) fputs("plot 0 notitle\n", g);
+  fputs("unset multiplot\n"
+        "set output 'fig6_p_joint_reactions.png'\n", g);
+  fprintf(g, "set terminal pngcairo size 1200,%d enhanced font 'Sans,11'\n", 200 + 200 * (np ? np : 1));
+  fprintf(g, "set multiplot layout %d,2 title 'Reactions in the prismatic joints (rail on slider, "
+             "base frame S; paper fig. 6), model '.model\n", np ? np : 1);
+  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
+    if (prru_mech.joint[j].type != 'P') continue;
+    fprintf(g, "set xlabel '%s'\n", ++p == np ? "time t (s)" : "");
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" force (N)'\n", g);
+    plot_components(g, j, 'f');
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fputs(" moment (N m)'\n", g);
+    plot_components(g, j, 'm');
+  }
+  if (!np) fputs("plot 0 notitle\n", g);
+  fputs("unset multiplot\n", g);
+  return close_script(g, &buf);
+}
+
+/* ---- fig. 7 ---- */
+
+/* The surface and the contour map of w_R, singular points in red, and the
+ * ellipses of fig. 7a. Run in the output directory. */
+static const char fig7_script[] =
+    "# Written by prru paper (cli/plot.c); run in the output directory.\n"
+    "# Fig. 7 surface: log z so that both the 1.0-2.2 landscape and the rise to\n"
+    "# ~15 at the edge of the singular band (red, on the base plane) show.\n"
+    "set terminal pngcairo size 1100,800 enhanced font 'Sans,11'\n"
+    "grid = 'fig7_grid.dat'\n"
+    "sing = 'fig7_singular.dat'\n"
+    "stats grid using 3 nooutput\n"
+    "set xlabel 'q_1 (rad)'\n"
+    "set ylabel 'q_2 (rad)'\n"
+    "set xrange [-pi/6:pi/6]\n"
+    "set yrange [-pi/4:pi/6]\n"
+    "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n"
+    "set output 'fig7_surface.png'\n"
+    "set title sprintf(\"Rotational dynamic manipulability index w_R over the workspace, q_3 = 0 m (paper fig. 7), model %s\\n201 x 201 grid, w_R from %.3f to %.3g; red: J_d singular, cond_1 > %s\", model, STATS_min, STATS_max, cond)\n"
+    "set zlabel 'w_R (-), log scale' rotate by 90\n"
+    "set logscale z\n"
+    "set logscale cb\n"
+    "set zrange [1:20]\n"
+    "set cbrange [1:20]\n"
+    "set ztics (1, 1.2, 1.5, 2, 3, 5, 10, 20)\n"
+    "set cbtics (1, 1.2, 1.5, 2, 3, 5, 10, 20)\n"
+    "set cblabel 'w_R = {/Symbol s}_1/{/Symbol s}_2 (-)'\n"
+    "set xyplane at 1\n"
+    "set view 55, 35\n"
+    "set pm3d depthorder border lc rgb '#303030' lw 0.2\n"
+    "set key at screen 0.98, screen 0.90 box opaque\n"
+    "set grid\n"
+    "splot grid using 1:2:3 every 2:2 with pm3d title 'w_R(q_1, q_2)', \\\n"
+    "      sing using 1:2:(1) with points pt 7 ps 0.5 lc rgb 'red' title 'singular / unreachable (base plane)'\n"
+    "# Fig. 7 contour map: contours via a table, linear colours to 2.5 (the\n"
+    "# band next to the singular points saturates).\n"
+    "set output 'fig7_contour.png'\n"
+    "set terminal pngcairo size 1000,850 enhanced font 'Sans,11'\n"
+    "set contour base\n"
+    "set cntrparam levels discrete 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0, 2.1, 2.5, 3, 5, 10\n"
+    "unset surface\n"
+    "unset logscale z\n"
+    "set zrange [*:*]\n"
+    "set table 'fig7_contours.dat'\n"
+    "splot grid using 1:2:3 with lines notitle\n"
+    "unset table\n"
+    "unset contour\n"
+    "set surface\n"
+    "unset logscale cb\n"
+    "set cbrange [1:2.5]\n"
+    "set cbtics auto\n"
+    "set title \"w_R over the workspace, q_3 = 0 m (paper fig. 7), model \".model.\", contours 1.1 to 2.1 by 0.1, then 2.5, 3, 5, 10\\nred: J_d singular, cond_1 > \".cond.\" (the corners beyond that band are another assembly mode)\"\n"
+    "set size ratio -1\n"
+    "set key inside left top textcolor rgb 'white' noopaque nobox\n"
+    "set grid front\n"
+    "plot grid using 1:2:(($3 > 2.5) ? 2.5 : $3) with image notitle, \\\n"
+    "     'fig7_contours.dat' using 1:2 with lines lc rgb 'white' lw 1 title 'w_R contours', \\\n"
+    "     sing using 1:2 with points pt 7 ps 0.35 lc rgb 'red' title 'singular / unreachable grid points'\n"
+    "# Fig. 7a: ellipse outlines in (a.e1, a.v) and segment half-lengths.\n"
+    "set output 'fig7a_ellipses.png'\n"
+    "set terminal pngcairo size 1300,650 enhanced font 'Sans,11'\n"
+    "set key default\n"
+    "unset colorbox\n"
+    "unset logscale\n"
+    "set size noratio\n"
+    "set key outside bottom center horizontal\n"
+    "set multiplot layout 1,2 title 'Dynamic manipulability at a few poses, q_3 = 0 m: accelerations reachable with 1 N of actuator force (paper fig. 7a), model '.model\n"
+    "set title 'Rotational DME (in the plane of e_1 and v)'\n"
+    "set xlabel 'angular acceleration along e_1 (rad s^{-2} per N)'\n"
+    "set ylabel 'angular acceleration along v (rad s^{-2} per N)'\n"
+    "set size ratio -1\n"
+    "set xrange [-1:1]\n"
+    "set yrange [-2:2]\n"
+    "set xtics 0.5\n"
+    "plot for [i=0:NCONF-1] 'fig7a_ellipses.dat' index i using 1:2 with lines lw 2 lc i+1 title columnheader(1)\n"
+    "set size noratio\n"
+    "set title 'Translational DME (a segment along z)'\n"
+    "set xlabel 'pose (q_1, q_2) (rad)'\n"
+    "set ylabel 'linear acceleration along z (m s^{-2} per N)'\n"
+    "set xrange [-0.5:NCONF-0.5]\n"
+    "set yrange [*:*]\n"
+    "set xtics 1\n"
+    "set key off\n"
+    "plot 'fig7a_segments.dat' using 1:(-$2):(0):(2*$2):($1+1):xtic(3) with vectors nohead lw 8 lc variable\n"
+    "unset multiplot\n";
+
+char *prru_plot_fig7_script(int nposes, double rcond_min)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return NULL;
+  prru_plot_model_var(g);
+  fprintf(g, "NCONF = %d\ncond = '%g'\n%s", nposes, 1.0 / rcond_min, fig7_script);
+  return close_script(g, &buf);
+}
