@@ -1,0 +1,79 @@
+# Installation: `cmake --install BUILD [--prefix DIR]` writes
+#   bin/prru                                   the command-line tool
+#   lib/libprru.so*                            runtime + kernels, shared   (prru::prru)
+#   lib/libprru_runtime.a, libprru_kernels.a   the same, static            (prru::prru_static)
+#                                              the kernels alone, only libm (prru::kernels)
+#   include/prru/*.h                           runtime and generated headers
+#   lib/cmake/prru/                            find_package(prru) config, version, targets
+#   lib/pkgconfig/prru.pc                      pkg-config (the shared library)
+#   share/prru/MODEL.json                      the model file the kernels come from
+# (lib is GNUInstallDirs' CMAKE_INSTALL_LIBDIR.)
+#
+# The kernels, and with them the array sizes in the runtime's structs
+# (PRRU_NACT, PRRU_NLAMBDA), belong to one model: an install is of one
+# model, named in the package by prru_MODEL_FILE / prru_MODEL_SHA256 and in
+# prru.pc by the variables model_file / model_sha256.
+include(CMakePackageConfigHelpers)
+
+set(PRRU_INSTALL_INCLUDEDIR "${CMAKE_INSTALL_INCLUDEDIR}/prru")
+set(PRRU_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/prru")
+get_filename_component(PRRU_MODEL_BASENAME "${PRRU_MODEL}" NAME)
+
+# Exported names: prru::prru (shared), prru::prru_static, prru::kernels;
+# the same names are aliases in the build tree, so a parent project that
+# does add_subdirectory(prru) writes what a find_package(prru) user writes.
+set_target_properties(prru_shared PROPERTIES EXPORT_NAME prru)
+set_target_properties(prru_runtime PROPERTIES EXPORT_NAME prru_static)
+set_target_properties(prru_kernels PROPERTIES EXPORT_NAME kernels)
+add_library(prru::prru ALIAS prru_shared)
+add_library(prru::prru_static ALIAS prru_runtime)
+add_library(prru::kernels ALIAS prru_kernels)
+
+install(TARGETS prru_shared prru_runtime prru_kernels EXPORT prruTargets
+        RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}"
+        LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}"
+        ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
+        INCLUDES DESTINATION "${PRRU_INSTALL_INCLUDEDIR}")
+# Whole directories, so that a header added to runtime/include or a file
+# pair added to the generator's output is installed without a change here.
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/runtime/include/"
+        DESTINATION "${PRRU_INSTALL_INCLUDEDIR}" FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY "${PRRU_GEN_DIR}/"
+        DESTINATION "${PRRU_INSTALL_INCLUDEDIR}" FILES_MATCHING PATTERN "*.h")
+install(FILES "${PRRU_MODEL}" DESTINATION "${CMAKE_INSTALL_DATADIR}/prru")
+
+install(EXPORT prruTargets NAMESPACE prru:: FILE prruTargets.cmake
+        DESTINATION "${PRRU_INSTALL_CMAKEDIR}")
+configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/prruConfig.cmake.in"
+  "${PROJECT_BINARY_DIR}/prruConfig.cmake"
+  INSTALL_DESTINATION "${PRRU_INSTALL_CMAKEDIR}")
+# 0.x: a new minor version may change the API.
+write_basic_package_version_file("${PROJECT_BINARY_DIR}/prruConfigVersion.cmake"
+  COMPATIBILITY SameMinorVersion)
+install(FILES "${PROJECT_BINARY_DIR}/prruConfig.cmake"
+              "${PROJECT_BINARY_DIR}/prruConfigVersion.cmake"
+        DESTINATION "${PRRU_INSTALL_CMAKEDIR}")
+
+# prru.pc carries absolute paths, and the prefix is only known when
+# installing (cmake --install --prefix DIR overrides CMAKE_INSTALL_PREFIX):
+# everything but the prefix is filled in now, the prefix by the install
+# script.
+foreach(kind LIB INCLUDE)
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_${kind}DIR}")
+    set(PRRU_PC_${kind}DIR "${CMAKE_INSTALL_${kind}DIR}")
+  else()
+    set(PRRU_PC_${kind}DIR "\${prefix}/${CMAKE_INSTALL_${kind}DIR}")
+  endif()
+endforeach()
+set(PRRU_PC_PREFIX "@PRRU_PC_PREFIX@") # left for the install step
+configure_file("${CMAKE_CURRENT_LIST_DIR}/prru.pc.in" "${PROJECT_BINARY_DIR}/prru.pc.in" @ONLY)
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  set(prru_pc_destination "${CMAKE_INSTALL_LIBDIR}/pkgconfig")
+else()
+  set(prru_pc_destination "\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR}/pkgconfig")
+endif()
+# file(INSTALL) adds DESTDIR, the manifest entry and the "Installing:" line.
+install(CODE "
+  set(PRRU_PC_PREFIX \"\${CMAKE_INSTALL_PREFIX}\")
+  configure_file(\"${PROJECT_BINARY_DIR}/prru.pc.in\" \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" @ONLY)
+  file(INSTALL \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" DESTINATION \"${prru_pc_destination}\")")
