@@ -1,0 +1,102 @@
+"""Arguments in, results out.
+
+Inputs are any sequence of real numbers (list, tuple, array.array, a 1-D
+NumPy array, ...); strings and wrong lengths are refused, and so are NaN
+and infinities, with the argument's name in the message. NumPy is never
+imported here for inputs: a NumPy array is read through its tolist().
+
+Outputs are plain Python lists (matrices as lists of rows) unless the model
+was made with numpy=True, in which case they are NumPy arrays (matrices
+2-D); NumPy is imported only then.
+"""
+
+import ctypes
+import math
+import numbers
+
+
+def vector(name, value, n):
+    """value as a ctypes array of n finite doubles; ValueError/TypeError naming name."""
+    if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__len__"):
+        raise TypeError("%s must be a sequence of %d numbers, got %s"
+                        % (name, n, type(value).__name__))
+    ndim = getattr(value, "ndim", 1)
+    if ndim != 1:
+        raise ValueError("%s must be a sequence of %d numbers (1-D), got an array of shape %s"
+                         % (name, n, tuple(getattr(value, "shape", ()))))
+    if len(value) != n:
+        raise ValueError("%s must have %d elements, got %d" % (name, n, len(value)))
+    items = value.tolist() if hasattr(value, "tolist") else list(value)
+    out = (ctypes.c_double * n)()
+    for i, v in enumerate(items):
+        if isinstance(v, bool) or not isinstance(v, numbers.Real):
+            raise TypeError("%s[%d] must be a real number, got %s" % (name, i, type(v).__name__))
+        f = float(v)
+        if not math.isfinite(f):
+            raise ValueError("%s[%d] must be finite, got %r" % (name, i, f))
+        out[i] = f
+    return out
+
+
+def optional_vector(name, value, n):
+    """vector(), or n zeros when value is None."""
+    return (ctypes.c_double * n)() if value is None else vector(name, value, n)
+
+
+def scalar(name, value, positive=False, allow_zero=True):
+    """value as a finite float; ValueError naming name."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError("%s must be a real number, got %s" % (name, type(value).__name__))
+    f = float(value)
+    if not math.isfinite(f):
+        raise ValueError("%s must be finite, got %r" % (name, f))
+    if positive and not (f > 0 or (allow_zero and f == 0)):
+        raise ValueError("%s must be %s, got %r" % (name, "non-negative" if allow_zero
+                                                    else "positive", f))
+    return f
+
+
+def integer(name, value, minimum):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError("%s must be an integer, got %s" % (name, type(value).__name__))
+    if value < minimum:
+        raise ValueError("%s must be at least %d, got %d" % (name, minimum, value))
+    return int(value)
+
+
+class Output:
+    """Builds results as lists or NumPy arrays."""
+
+    def __init__(self, use_numpy):
+        self.np = None
+        if use_numpy:
+            try:
+                import numpy
+            except ImportError:
+                raise ImportError("numpy=True needs NumPy, which is not installed "
+                                  "(apt-get install python3-numpy); the default "
+                                  "numpy=False returns plain lists") from None
+            self.np = numpy
+
+    def vec(self, values, n=None):
+        items = list(values) if n is None else list(values[:n])
+        return self.np.array(items, dtype=float) if self.np else items
+
+    def mat(self, values, rows, cols):
+        flat = list(values[:rows * cols])
+        if self.np:
+            return self.np.array(flat, dtype=float).reshape(rows, cols)
+        return [flat[r * cols:(r + 1) * cols] for r in range(rows)]
+
+    def columns(self, flat, width, start, count, nrows):
+        """Columns start..start+count of a row-major table of nrows rows of
+        width doubles (flat: a memoryview of doubles): a list of rows (a
+        list of floats per row, or a plain float per row when count is 1),
+        or a NumPy array (nrows,) or (nrows, count)."""
+        if self.np:
+            a = self.np.frombuffer(flat, dtype=float).reshape(nrows, width)
+            block = a[:, start:start + count].copy()
+            return block[:, 0] if count == 1 else block
+        if count == 1:
+            return [flat[r * width + start] for r in range(nrows)]
+        return [list(flat[r * width + start:r * width + start + count]) for r in range(nrows)]

@@ -1,0 +1,415 @@
+"""Finding and loading libprru.so, and the ctypes mirror of its headers.
+
+The C structs (runtime/include/prru.h, prru_dme.h, the generated
+prru_mechanism.h) have arrays sized by the model: PRRU_NACT actuators,
+PRRU_NBODY bodies, PRRU_NLAMBDA reaction coordinates. Their sizes are read
+from the library's own descriptor prru_mech, whose leading fields (four
+strings, then seven ints) do not depend on them, and every struct is then
+laid out for that library. ctypes applies the C ABI's alignment rules, so
+mirroring a struct field by field reproduces the compiler's layout.
+
+There is no library call that returns sizeof a struct, so a header change
+the mirror does not follow would go unnoticed by the C compiler; Library
+therefore checks the layout when it loads (_self_check: fields the library
+fills must hold what independent calls compute, a pointer the library
+stores must point where the mirror puts its target, and guard bytes after
+each struct must stay untouched), and the Python tests compare the mirror
+with the struct definitions in prru.h field by field.
+"""
+
+import ctypes
+import ctypes.util
+import math
+import os
+
+from . import errors
+
+ENV_VAR = "PRRU_LIB"
+LIB_NAME = "libprru.so"
+
+c_double_p = ctypes.POINTER(ctypes.c_double)
+c_int_p = ctypes.POINTER(ctypes.c_int)
+
+
+def _arr(ctype, n):
+    return ctype * n
+
+
+class _JointInfo(ctypes.Structure):
+    _fields_ = [("name", ctypes.c_char_p), ("type", ctypes.c_char), ("limb", ctypes.c_int),
+                ("proximal", ctypes.c_int), ("distal", ctypes.c_int),
+                ("lambda_offset", ctypes.c_int), ("lambda_count", ctypes.c_int)]
+
+
+# The descriptor's leading fields, identical for every model.
+_MECH_HEAD = [("name", ctypes.c_char_p), ("description", ctypes.c_char_p),
+              ("model_file", ctypes.c_char_p), ("sha256", ctypes.c_char_p),
+              ("format", ctypes.c_int), ("nq", ctypes.c_int), ("nact", ctypes.c_int),
+              ("nlimb", ctypes.c_int), ("nbody", ctypes.c_int), ("nlambda", ctypes.c_int),
+              ("njoint", ctypes.c_int)]
+
+
+class _MechHead(ctypes.Structure):
+    _fields_ = _MECH_HEAD
+
+
+class _Model(ctypes.Structure):
+    """prru_model: a pointer to the descriptor and the singularity tolerance."""
+    _fields_ = [("mech", ctypes.c_void_p), ("jd_rcond_min", ctypes.c_double)]
+
+
+class _MapGrid(ctypes.Structure):
+    _fields_ = [("q1_lo", ctypes.c_double), ("q1_hi", ctypes.c_double),
+                ("q2_lo", ctypes.c_double), ("q2_hi", ctypes.c_double),
+                ("q3", ctypes.c_double), ("n1", ctypes.c_int), ("n2", ctypes.c_int)]
+
+
+class _MapSummary(ctypes.Structure):
+    _fields_ = [("n_points", ctypes.c_long), ("n_ok", ctypes.c_long),
+                ("n_singular", ctypes.c_long), ("n_unreachable", ctypes.c_long),
+                ("index", ctypes.c_double), ("index_log", ctypes.c_double),
+                ("singular_fraction", ctypes.c_double),
+                ("w_min", ctypes.c_double), ("w_max", ctypes.c_double),
+                ("w_min_q", _arr(ctypes.c_double, 2)), ("w_max_q", _arr(ctypes.c_double, 2))]
+
+
+MAP_PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_long, ctypes.c_long, ctypes.c_void_p)
+
+
+class _MapOptions(ctypes.Structure):
+    # volatile sig_atomic_t is int with glibc on every Linux ABI.
+    _fields_ = [("nthreads", ctypes.c_int), ("progress", MAP_PROGRESS_FN),
+                ("ctx", ctypes.c_void_p), ("interrupt", c_int_p)]
+
+
+# prru_stepper and prru_load_kind values.
+STEPPERS = ("rk8pd", "rkf45", "rkck", "msbdf")
+LOAD_CONSTANT, LOAD_HARMONIC, LOAD_TABLE = 0, 1, 2
+
+
+def _guarded(struct, guard_bytes):
+    """A struct followed by guard bytes: a library whose struct is larger
+    than the mirror writes into the guard instead of foreign memory."""
+    return type("_Guarded" + struct.__name__, (ctypes.Structure,),
+                {"_fields_": [("s", struct), ("guard", ctypes.c_ubyte * guard_bytes)]})
+
+
+GUARD_BYTE = 0xA5
+
+
+def fill_guard(g):
+    ctypes.memset(ctypes.addressof(g.guard), GUARD_BYTE, ctypes.sizeof(g.guard))
+
+
+def guard_intact(g):
+    return bytes(g.guard) == bytes([GUARD_BYTE]) * ctypes.sizeof(g.guard)
+
+
+class Types:
+    """The struct types of one library, sized from its descriptor."""
+
+    def __init__(self, nact, nbody, nlimb, nlambda, njoint):
+        nh = 6 * nbody
+        d = ctypes.c_double
+        self.nact, self.nh, self.nlambda = nact, nh, nlambda
+        self.Mechanism = type("prru_mechanism", (ctypes.Structure,), {"_fields_": _MECH_HEAD + [
+            ("body_names", _arr(ctypes.c_char_p, nbody)), ("body_limb", _arr(ctypes.c_int, nbody)),
+            ("platform", ctypes.c_int), ("lower", _arr(ctypes.c_int, nlimb)),
+            ("upper", _arr(ctypes.c_int, nlimb)), ("slider", _arr(ctypes.c_int, nlimb)),
+            ("gravity", _arr(d, 3)), ("mass", _arr(d, nbody)), ("total_mass", d),
+            ("com", _arr(_arr(d, 3), nbody)), ("inertia", _arr(_arr(d, 9), nbody)),
+            ("inertia_inv", _arr(_arr(d, 9), nbody)),
+            ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
+            ("a", _arr(d, nlimb)),
+            ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
+            ("coulomb_velocity", d),
+            ("joint", _arr(_JointInfo, njoint)), ("lambda_labels", _arr(ctypes.c_char_p, nlambda))]})
+        self.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": [
+            ("fd", _arr(d, nact)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
+        self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [
+            ("d", _arr(d, nact)), ("Jd", _arr(d, nact * 3)), ("Jdpinv", _arr(d, 3 * nact)),
+            ("M", _arr(d, 9)), ("b", _arr(d, 3)), ("qdd", _arr(d, 3)),
+            ("Q", _arr(d, nh * nlambda)), ("K", _arr(d, nh)),
+            ("A", _arr(d, nlambda * nlambda)), ("P", _arr(d, nlambda * nlambda)),
+            ("r", _arr(d, nlambda)), ("lambda_null", _arr(d, nlambda))]})
+        self.Schedule = type("prru_load_schedule", (ctypes.Structure,), {"_fields_": [
+            ("kind", ctypes.c_int), ("base", self.Loads), ("amp", d), ("omega", d),
+            ("nrows", ctypes.c_int), ("rows", c_double_p)]})
+        self.Sample = type("prru_sample", (ctypes.Structure,), {"_fields_": [
+            ("t", d), ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("qdd", _arr(d, 3)),
+            ("d", _arr(d, nact)), ("lambda_", _arr(d, nlambda)), ("T", d), ("V", d)]})
+        self.SampleFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.Sample), ctypes.c_void_p)
+        self.SimOptions = type("prru_sim_options", (ctypes.Structure,), {"_fields_": [
+            ("stepper", ctypes.c_int), ("t_end", d), ("dt_out", d), ("abs_tol", d),
+            ("rel_tol", d), ("h0", d), ("reactions", ctypes.c_int),
+            ("loads", ctypes.POINTER(self.Schedule)), ("on_sample", self.SampleFn),
+            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("progress", ctypes.c_int),
+            ("max_steps", ctypes.c_long)]})
+        self.Scenario = type("prru_scenario", (ctypes.Structure,), {"_fields_": [
+            ("q0", _arr(d, 3)), ("qd0", _arr(d, 3)), ("loads", self.Schedule),
+            ("opt", self.SimOptions)]})
+        self.Dme = type("prru_dme", (ctypes.Structure,), {"_fields_": [
+            ("status", ctypes.c_int), ("jd_rcond", d), ("w_R", d), ("sigma", _arr(d, 2)),
+            ("semi_axis", _arr(d, 2)), ("axis_dir", _arr(_arr(d, 3), 2)), ("sigma_T", d),
+            ("half_length_T", d), ("dir_T", _arr(d, 3)), ("Mt", _arr(d, nact * nact)),
+            ("JtR", _arr(d, 3 * nact)), ("JtT", _arr(d, 3 * nact))]})
+        # Sample columns as doubles: the struct is all doubles, no padding.
+        self.sample_columns = {}
+        col = 0
+        for name, width in (("t", 1), ("q", 3), ("qd", 3), ("qdd", 3), ("d", nact),
+                            ("lambda", nlambda), ("T", 1), ("V", 1)):
+            self.sample_columns[name] = (col, width)
+            col += width
+        self.sample_width = col
+        self.GuardedData = _guarded(self.Data, ctypes.sizeof(self.Data) // 2 + 4096)
+        self.GuardedDme = _guarded(self.Dme, 4096)
+        self.GuardedScenario = _guarded(self.Scenario, 4096)
+
+
+def _declare(dll, name, restype, *argtypes):
+    f = getattr(dll, name)
+    f.restype = restype
+    f.argtypes = list(argtypes)
+    return f
+
+
+class Library:
+    """One loaded libprru.so: its functions, struct types and descriptor.
+
+    Use load_library() to get one; libraries are cached by path, and
+    libraries built from different models can be loaded side by side.
+    """
+
+    def __init__(self, path):
+        self.path = path
+        self.dll = ctypes.CDLL(path)
+        try:
+            head = _MechHead.in_dll(self.dll, "prru_mech")
+        except ValueError as e:
+            raise errors.LibraryNotFound(
+                "%s: not a prru library (no prru_mech descriptor: %s)" % (path, e)) from None
+        self.types = Types(head.nact, head.nbody, head.nlimb, head.nlambda, head.njoint)
+        self.mech = self.types.Mechanism.in_dll(self.dll, "prru_mech")
+        self._declare_functions()
+        self._self_check()
+
+    def _declare_functions(self):
+        t, dll, i, d = self.types, self.dll, ctypes.c_int, ctypes.c_double
+        mp, dp = ctypes.POINTER(_Model), ctypes.POINTER(t.Data)
+        lp, vp = ctypes.POINTER(t.Loads), c_double_p
+        self.strerror = _declare(dll, "prru_strerror", ctypes.c_char_p, i)
+        self.model_default = _declare(dll, "prru_model_default", None, mp)
+        self.check_reachable = _declare(dll, "prru_check_reachable", i, mp, dp, vp)
+        self.check_regular = _declare(dll, "prru_check_regular", i, mp, dp, vp, vp)
+        self.actuators = _declare(dll, "prru_actuators", i, mp, dp, vp, vp)
+        self.forward_kinematics = _declare(dll, "prru_forward_kinematics", i, mp, dp, vp, vp, vp)
+        self.forward_kinematics_lsq = _declare(dll, "prru_forward_kinematics_lsq", i,
+                                               mp, dp, vp, vp, vp, vp)
+        self.forward_dynamics = _declare(dll, "prru_forward_dynamics", i, mp, dp, vp, vp, lp, vp)
+        self.inverse_dynamics_preload = _declare(dll, "prru_inverse_dynamics_preload", i,
+                                                 mp, dp, vp, vp, vp, lp, d, vp)
+        self.actuator_null = _declare(dll, "prru_actuator_null", i, mp, dp, vp, vp)
+        self.reactions = _declare(dll, "prru_reactions", i, mp, dp, vp, vp, lp, vp)
+        self.reaction_null = _declare(dll, "prru_reaction_null", i, mp, dp, vp, vp)
+        self.energies = _declare(dll, "prru_energies", i, mp, vp, vp, vp, vp)
+        # Generated kernels (prru_kernels.h): NaN outputs where q is unreachable.
+        self.ik_jd = _declare(dll, "prru_ik_jd", None, vp, vp, vp)
+        self.dynamics = _declare(dll, "prru_dynamics", None, vp, vp, vp, vp, vp)
+        self.passive = _declare(dll, "prru_passive", None, vp, vp, vp)
+        self.platform_jacobian = _declare(dll, "prru_platform_jacobian", None, vp, vp)
+        self.poses = _declare(dll, "prru_poses", None, vp, vp, vp)
+        # Simulation and scenarios.
+        sp, op = ctypes.POINTER(t.Scenario), ctypes.POINTER(t.SimOptions)
+        self.sim_options_default = _declare(dll, "prru_sim_options_default", None, op)
+        self.simulate = _declare(dll, "prru_simulate", i, mp, vp, vp, op, vp,
+                                 ctypes.c_char_p, i)
+        self.scenario_paper = _declare(dll, "prru_scenario_paper", None, sp)
+        self.scenario_read = _declare(dll, "prru_scenario_read", i, sp, ctypes.c_char_p,
+                                      ctypes.c_char_p, i)
+        self.scenario_free = _declare(dll, "prru_scenario_free", None, sp)
+        # Manipulability and maps (prru_dme.h).
+        self.dme_eval = _declare(dll, "prru_dme_eval", i, mp, dp, vp, ctypes.POINTER(t.Dme))
+        self.map_axis = _declare(dll, "prru_map_axis", d, d, d, i, i)
+        self.map_check = _declare(dll, "prru_map_check", i, ctypes.POINTER(_MapGrid))
+        self.map_options_default = _declare(dll, "prru_map_options_default", None,
+                                            ctypes.POINTER(_MapOptions))
+        self.map_eval = _declare(dll, "prru_map_eval", i, mp, ctypes.POINTER(_MapGrid),
+                                 ctypes.POINTER(_MapOptions), vp,
+                                 ctypes.POINTER(ctypes.c_ubyte), ctypes.POINTER(_MapSummary))
+
+    def status_text(self, status):
+        return self.strerror(status).decode()
+
+    def new_model(self, jd_rcond_min=None):
+        m = _Model()
+        self.model_default(ctypes.byref(m))
+        if jd_rcond_min is not None:
+            m.jd_rcond_min = jd_rcond_min
+        return m
+
+    def new_data(self):
+        g = self.types.GuardedData()
+        fill_guard(g)
+        return g
+
+    # ---- layout self-check ----
+    def _layout_error(self, what):
+        return errors.LayoutError(
+            "%s does not match this Python package's mirror of prru.h / prru_mechanism.h (%s): "
+            "the package and the library come from different versions of prru; use the "
+            "python/ directory of the tree the library was built from" % (self.path, what))
+
+    def _self_check(self):
+        self._check_mechanism()
+        self._check_scenario()
+        self._check_data_and_dme()
+
+    def _check_mechanism(self):
+        me = self.mech
+        if me.nq != 3 or me.nact < 3 or me.nbody != 1 + 3 * me.nlimb or me.njoint != 4 * me.nlimb:
+            raise self._layout_error("descriptor sizes nq=%d nact=%d nlimb=%d nbody=%d njoint=%d"
+                                     % (me.nq, me.nact, me.nlimb, me.nbody, me.njoint))
+        offset = 0
+        for k in range(me.njoint):
+            j = me.joint[k]
+            if j.lambda_offset != offset or j.lambda_count <= 0:
+                raise self._layout_error("joint %d's reaction offset" % k)
+            offset += j.lambda_count
+        if offset != me.nlambda:
+            raise self._layout_error("joint reaction counts do not add up to nlambda")
+        for k in range(me.nbody):
+            a, b = me.inertia[k], me.inertia_inv[k]
+            for r in range(3):
+                for c in range(3):
+                    v = sum(a[3 * r + s] * b[3 * s + c] for s in range(3))
+                    if not abs(v - (r == c)) <= 1e-9:
+                        raise self._layout_error("body %d's inertia times its inverse" % k)
+        last = me.joint[me.njoint - 1]
+        label = me.lambda_labels[me.nlambda - 1]
+        if not label or not label.decode().startswith(last.name.decode() + "_"):
+            raise self._layout_error("the last reaction label")
+
+    def _check_scenario(self):
+        t = self.types
+        g = t.GuardedScenario()
+        fill_guard(g)
+        self.scenario_paper(ctypes.byref(g.s))
+        s = g.s
+        loads_at = ctypes.addressof(s) + t.Scenario.loads.offset
+        if ctypes.cast(s.opt.loads, ctypes.c_void_p).value != loads_at:
+            raise self._layout_error("prru_scenario.opt.loads")
+        if (list(s.q0) != [0.0, math.pi / 6, -0.8] or s.opt.t_end != 1.0 or s.opt.dt_out != 1e-3
+                or s.loads.kind != LOAD_HARMONIC or s.loads.amp != 50.0
+                or s.opt.max_steps != 0 or s.loads.nrows != 0):
+            raise self._layout_error("prru_scenario_paper's fields")
+        if not guard_intact(g):
+            raise self._layout_error("sizeof(prru_scenario)")
+        self.scenario_free(ctypes.byref(s))
+
+    def _check_data_and_dme(self):
+        """At q = 0 (every valid model assembles there; when J_d happens to
+        be singular the data checks are skipped), the fields prru_reactions
+        leaves in prru_data and prru_dme_eval's outputs against independent
+        calls."""
+        t, n = self.types, self.types.nact
+        m, g = self.new_model(), self.new_data()
+        q = (ctypes.c_double * 3)()
+        zero3 = (ctypes.c_double * 3)()
+        if self.check_regular(ctypes.byref(m), ctypes.byref(g.s), q, None) != errors.OK:
+            return
+        lam = (ctypes.c_double * t.nlambda)()
+        loads = t.Loads()
+        if self.reactions(ctypes.byref(m), ctypes.byref(g.s), q, zero3, ctypes.byref(loads),
+                          lam) != errors.OK:
+            return
+        d_ref, jd_ref = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
+        self.ik_jd(q, d_ref, jd_ref)
+        qdd_ref = (ctypes.c_double * 3)()
+        g2 = self.new_data()
+        self.forward_dynamics(ctypes.byref(m), ctypes.byref(g2.s), q, zero3, ctypes.byref(loads),
+                              qdd_ref)
+        s = g.s
+        if list(s.d) != list(d_ref) or list(s.Jd) != list(jd_ref):
+            raise self._layout_error("prru_data.d, prru_data.Jd")
+        if list(s.qdd) != list(qdd_ref) or list(s.r) != list(lam):
+            raise self._layout_error("prru_data.qdd, prru_data.r")
+        if self.mech.nlambda - (t.nh - 3) == 0 and any(s.lambda_null):
+            raise self._layout_error("prru_data.lambda_null")
+        if not guard_intact(g):
+            raise self._layout_error("sizeof(prru_data)")
+        gd = t.GuardedDme()
+        fill_guard(gd)
+        if self.dme_eval(ctypes.byref(m), ctypes.byref(g.s), q, ctypes.byref(gd.s)) != errors.OK:
+            return
+        o = gd.s
+        if (o.status != errors.OK or o.w_R != o.sigma[0] / o.sigma[1]
+                or o.semi_axis[0] != 1 / o.sigma[0] or o.half_length_T != 1 / o.sigma_T
+                or abs(sum(x * x for x in o.dir_T) - 1) > 1e-12 or not guard_intact(gd)):
+            raise self._layout_error("prru_dme")
+
+
+_cache = {}
+
+
+def _candidates(explicit):
+    """(source, path) pairs to try, in order."""
+    if explicit is not None:
+        return [("argument", os.fspath(explicit))]
+    out = []
+    env = os.environ.get(ENV_VAR)
+    if env:
+        out.append(("$" + ENV_VAR, env))
+        return out
+    here = os.path.dirname(os.path.abspath(__file__))
+    out.append(("beside the package", os.path.join(here, LIB_NAME)))
+    root = os.path.dirname(os.path.dirname(here))
+    out.append(("the source tree's build/", os.path.join(root, "build", "runtime", LIB_NAME)))
+    out.append(("the system's library path", ctypes.util.find_library("prru")))
+    return out
+
+
+def _resolve(path):
+    """A build directory stands for its runtime/libprru.so."""
+    if os.path.isdir(path):
+        for sub in (os.path.join(path, "runtime", LIB_NAME), os.path.join(path, LIB_NAME)):
+            if os.path.exists(sub):
+                return sub
+        return os.path.join(path, "runtime", LIB_NAME)
+    return path
+
+
+def load_library(path=None):
+    """The prru library at path (a file, or a build directory holding
+    runtime/libprru.so); without a path, $PRRU_LIB, then libprru.so beside
+    this package, then build/runtime/libprru.so of the source tree the
+    package sits in, then the system's library path.
+
+    Raises LibraryNotFound naming every place tried and why it failed, and
+    LayoutError when the library's structs differ from this package's."""
+    tried = []
+    for source, cand in _candidates(path):
+        if cand is None:
+            tried.append("libprru (%s): not found" % source)
+            continue
+        if cand in _cache:
+            return _cache[cand]
+        full = cand if source == "the system's library path" else _resolve(cand)
+        if source != "the system's library path" and not os.path.exists(full):
+            tried.append("%s (%s): no such file" % (full, source))
+            continue
+        key = os.path.realpath(full) if os.path.exists(full) else full
+        if key in _cache:
+            return _cache[key]
+        try:
+            lib = Library(full)
+        except OSError as e:
+            if isinstance(e, errors.PrruError):
+                raise
+            tried.append("%s (%s): %s" % (full, source, e))
+            continue
+        _cache[key] = _cache[cand] = lib
+        return lib
+    raise errors.LibraryNotFound(
+        "prru: cannot load libprru.so (build it with `cmake --build BUILD --target prru_shared`, "
+        "then pass its path, or set %s=BUILD/runtime/libprru.so); tried:\n  %s"
+        % (ENV_VAR, "\n  ".join(tried)))

@@ -1,0 +1,79 @@
+"""w_R over a (q1, q2) grid (prru_map_eval): a method of Model."""
+
+import collections
+import ctypes
+
+from . import _convert, _lib, errors
+
+STATUS_NAMES = {errors.OK: "ok", errors.ESINGULAR: "singular",
+                errors.EUNREACHABLE: "unreachable", errors.EINPUT: "invalid"}
+
+MapResult = collections.namedtuple("MapResult", "q1 q2 q3 w_R status summary")
+MapResult.__doc__ = """A w_R map: axes q1 (n1 values) and q2 (n2), the height q3;
+w_R[i][j] at (q1[i], q2[j]) (NaN where not ok; a NumPy array (n1, n2) for a
+model with numpy=True); status[i][j] "ok", "singular" or "unreachable";
+summary: a dict with n_points, n_ok, n_singular, n_unreachable, index (mean
+of w_R - 1 over the ok points, the paper's global index), index_log (mean
+of ln w_R), singular_fraction, w_min, w_max and their (q1, q2) w_min_q,
+w_max_q."""
+
+
+def _axis(name, value):
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+        raise ValueError("%s must be (start, stop, count), got %r" % (name, value))
+    lo = _convert.scalar(name + " start", value[0])
+    hi = _convert.scalar(name + " stop", value[1])
+    n = _convert.integer(name + " count", value[2], 2)
+    if not lo < hi:
+        raise ValueError("%s: start must be below stop, got %r and %r" % (name, lo, hi))
+    return lo, hi, n
+
+
+def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
+    """w_R at every point of a grid: q1 = (start, stop, count) gives count
+    equally spaced values from start to stop (rad, count >= 2), q2 alike,
+    at height q3 (m). jd_rcond_min overrides the model's singularity
+    tolerance for this map (e.g. 4e-3 for a practical-singularity band, so
+    that the global index converges with the resolution); threads: worker
+    threads (the C library's, outside the GIL). Returns a MapResult.
+    Ctrl-C stops the map between grid rows (KeyboardInterrupt)."""
+    lo1, hi1, n1 = _axis("q1", q1)
+    lo2, hi2, n2 = _axis("q2", q2)
+    g = _lib._MapGrid(lo1, hi1, lo2, hi2, _convert.scalar("q3", q3), n1, n2)
+    threads = _convert.integer("threads", threads, 1)
+    m = self._m
+    if jd_rcond_min is not None:
+        m = self.lib.new_model(_convert.scalar("jd_rcond_min", jd_rcond_min, positive=True))
+    o = _lib._MapOptions()
+    self.lib.map_options_default(ctypes.byref(o))
+    o.nthreads = threads
+    pending = []
+
+    def progress(done, total, ctx):
+        # Runs in the calling thread, where Python's SIGINT handler can raise.
+        try:
+            return 0
+        except BaseException as e:
+            pending.append(e)
+            return 1
+
+    o.progress = _lib.MAP_PROGRESS_FN(progress)
+    w = (ctypes.c_double * (n1 * n2))()
+    st = (ctypes.c_ubyte * (n1 * n2))()
+    s = _lib._MapSummary()
+    rc = self.lib.map_eval(ctypes.byref(m), ctypes.byref(g), ctypes.byref(o), w, st,
+                           ctypes.byref(s))
+    if pending:
+        raise pending[0]
+    if rc != errors.OK:
+        raise errors.make_error(rc, "map: %s" % self.lib.status_text(rc))
+    axis1 = [self.lib.map_axis(lo1, hi1, n1, i) for i in range(n1)]
+    axis2 = [self.lib.map_axis(lo2, hi2, n2, j) for j in range(n2)]
+    names = [STATUS_NAMES.get(v, "invalid") for v in st]
+    summary = {k: getattr(s, k) for k in ("n_points", "n_ok", "n_singular", "n_unreachable",
+                                          "index", "index_log", "singular_fraction",
+                                          "w_min", "w_max")}
+    summary["w_min_q"], summary["w_max_q"] = tuple(s.w_min_q), tuple(s.w_max_q)
+    out = self._out
+    return MapResult(out.vec(axis1), out.vec(axis2), g.q3, out.mat(w, n1, n2),
+                     [names[i * n2:(i + 1) * n2] for i in range(n1)], summary)

@@ -1,0 +1,307 @@
+"""Model: the mechanism libprru.so was built for, and its dynamics calls."""
+
+import collections
+import ctypes
+import threading
+
+from . import _convert, _lib, errors
+from ._convert import optional_vector, vector
+
+Joint = collections.namedtuple(
+    "Joint", "name type limb proximal distal lambda_offset lambda_count")
+Joint.__doc__ = """One joint: type 'U', 'R' or 'P'; limb 0-based; proximal and
+distal body indexes (proximal -1 for the rail); its reaction coordinates are
+lambda[lambda_offset : lambda_offset + lambda_count]."""
+
+Dme = collections.namedtuple(
+    "Dme", "w_R jd_rcond sigma semi_axis axis_dir sigma_T half_length_T dir_T Mt JtR JtT")
+Dme.__doc__ = """Dynamic manipulability at one pose (see prru_dme.h):
+w_R = sigma[0] / sigma[1] >= 1; sigma (N s^2/rad) and semi_axis = 1/sigma
+(rad/s^2 per N, [minor, major]) of the rotational ellipse, axis_dir its unit
+axis directions in {S}; sigma_T, half_length_T and dir_T of the
+translational segment; Mt (nact x nact), JtR and JtT (3 x nact)."""
+
+
+def _fmt(v):
+    return "(" + ", ".join("%.17g" % x for x in v) + ")"
+
+
+class Model:
+    """The robot model compiled into one libprru.so.
+
+    Model(lib=None, *, numpy=False, jd_rcond_min=None)
+
+    lib: a path to libprru.so or to a build directory, or a Library from
+    load_library(); None searches $PRRU_LIB, beside the package, the source
+    tree's build/runtime/ and the system's library path (load_library).
+    numpy: return NumPy arrays (matrices 2-D) instead of lists (matrices as
+    lists of rows). Inputs are any sequences of numbers, NumPy arrays
+    included, either way.
+    jd_rcond_min: the reciprocal condition number of the scaled J_d below
+    which a pose counts as singular (library default 1e-8).
+
+    Sizes and the model's identity and numbers come from the library's
+    descriptor: nact actuators (3, or 4 for the redundant robot), nbody
+    bodies named body_names, nlambda reaction coordinates named
+    lambda_labels. Calls are serialised per Model (each Model owns the
+    library's per-call workspace), so a Model may be shared by threads;
+    use one Model per thread for parallel calls.
+
+    Failures raise PrruError subclasses carrying the library's message:
+    Unreachable, Singular, NoConvergence, InputError (also a ValueError).
+    """
+
+    def __init__(self, lib=None, *, numpy=False, jd_rcond_min=None):
+        self.lib = lib if isinstance(lib, _lib.Library) else _lib.load_library(lib)
+        self._out = _convert.Output(numpy)
+        if jd_rcond_min is not None:
+            jd_rcond_min = _convert.scalar("jd_rcond_min", jd_rcond_min, positive=True)
+        self._m = self.lib.new_model(jd_rcond_min)
+        self._g = self.lib.new_data()
+        self._lock = threading.Lock()
+        self._read_descriptor()
+
+    # ---- the descriptor ----
+    def _read_descriptor(self):
+        me, out = self.lib.mech, self._out
+        s = lambda b: b.decode("utf-8", "replace")
+        self.name, self.description = s(me.name), s(me.description)
+        self.model_file, self.sha256, self.format = s(me.model_file), s(me.sha256), me.format
+        self.nq, self.nact, self.nlimb = me.nq, me.nact, me.nlimb
+        self.nbody, self.nlambda, self.njoint = me.nbody, me.nlambda, me.njoint
+        self.body_names = tuple(s(me.body_names[i]) for i in range(me.nbody))
+        self.body_limb = tuple(me.body_limb)
+        self.platform = me.platform
+        self.lower, self.upper, self.slider = tuple(me.lower), tuple(me.upper), tuple(me.slider)
+        self.gravity = out.vec(me.gravity)
+        self.mass, self.total_mass = out.vec(me.mass), me.total_mass
+        self.com = [out.vec(c) for c in me.com]
+        self.inertia = [out.mat(i, 3, 3) for i in me.inertia]
+        self.b, self.l1, self.l2, self.a = (out.vec(me.b), out.vec(me.l1), out.vec(me.l2),
+                                            out.vec(me.a))
+        self.armature, self.damping = out.vec(me.armature), out.vec(me.damping)
+        self.coulomb, self.coulomb_velocity = out.vec(me.coulomb), me.coulomb_velocity
+        self.joints = tuple(Joint(s(j.name), s(j.type), j.limb, j.proximal, j.distal,
+                                  j.lambda_offset, j.lambda_count) for j in me.joint)
+        self.lambda_labels = tuple(s(me.lambda_labels[i]) for i in range(me.nlambda))
+        self.npreload = self.nact - 3
+        self.nreaction_null = self.nlambda - (6 * self.nbody - 3)
+
+    @property
+    def jd_rcond_min(self):
+        return self._m.jd_rcond_min
+
+    @property
+    def numpy(self):
+        return self._out.np is not None
+
+    def __repr__(self):
+        return "<prru.Model %s (%s, sha256 %s): %d actuators, library %s>" % (
+            self.name, self.model_file, self.sha256[:12], self.nact, self.lib.path)
+
+    # ---- helpers ----
+    def _fail(self, status, what):
+        raise errors.make_error(status, "%s: %s" % (what, self.lib.status_text(status)))
+
+    def _call(self, what, fn, *args):
+        with self._lock:
+            st = fn(ctypes.byref(self._m), ctypes.byref(self._g.s), *args)
+        if st != errors.OK:
+            self._fail(st, what)
+
+    def _loads(self, fd, fp, mp):
+        t = self.lib.types
+        l = t.Loads()
+        l.fd[:] = list(optional_vector("fd", fd, self.nact))
+        l.fp[:] = list(optional_vector("fp", fp, 3))
+        l.mp[:] = list(optional_vector("mp", mp, 3))
+        return l
+
+    def _reachable(self, what, q):
+        self._call("%s: q = %s" % (what, _fmt(q)), self.lib.check_reachable, q)
+
+    # ---- kinematics ----
+    def check(self, q):
+        """The scaled reciprocal condition number of J_d at q (1 / (|J|_1 |J^+|_1),
+        J = J_d diag(1/L, 1/L, 1), L the mean upper-link length); raises
+        Unreachable, or Singular below jd_rcond_min."""
+        q = vector("q", q, 3)
+        rc = ctypes.c_double()
+        self._call("check: q = %s" % _fmt(q), self.lib.check_regular, q, ctypes.byref(rc))
+        return rc.value
+
+    def ik(self, q):
+        """Inverse kinematics: (d, Jd), the slider heights (m, nact) and
+        J_d = dd/dq (nact x 3). Raises Unreachable."""
+        q = vector("q", q, 3)
+        self._reachable("ik", q)
+        n = self.nact
+        d, jd = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
+        self.lib.ik_jd(q, d, jd)
+        return self._out.vec(d), self._out.mat(jd, n, 3)
+
+    def _fk_seed(self, act, seed):
+        if seed is not None:
+            return vector("seed", seed, 3)
+        # At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0): the height matching the mean.
+        zero, d0 = (ctypes.c_double * 3)(), (ctypes.c_double * self.nact)()
+        jd = (ctypes.c_double * (3 * self.nact))()
+        self.lib.ik_jd(zero, d0, jd)
+        s = (ctypes.c_double * 3)()
+        s[2] = sum(act[i] - d0[i] for i in range(self.nact)) / self.nact
+        return s
+
+    def fk(self, d, seed=None):
+        """Forward kinematics: q with d(q) = d, from seed (default q1 = q2 = 0
+        and the height matching the mean of d). Three sliders: Newton's
+        method; four: least squares that refuses inconsistent sliders.
+        Raises NoConvergence (out of reach, inconsistent, or a singularity
+        on the way) or Singular."""
+        act = vector("d", d, self.nact)
+        seed = self._fk_seed(act, seed)
+        q = (ctypes.c_double * 3)()
+        self._call("fk: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
+                   self.lib.forward_kinematics, act, seed, q)
+        return self._out.vec(q)
+
+    def fk_lsq(self, d, seed=None):
+        """Least-squares forward kinematics: (q, residual), q minimizing
+        |d(q) - d|_2 and residual = max_i |d_i(q) - d_i| (m), whatever the
+        residual (measured sliders); the caller judges it."""
+        act = vector("d", d, self.nact)
+        seed = self._fk_seed(act, seed)
+        q, res = (ctypes.c_double * 3)(), ctypes.c_double()
+        self._call("fk_lsq: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
+                   self.lib.forward_kinematics_lsq, act, seed, q, ctypes.byref(res))
+        return self._out.vec(q), res.value
+
+    def platform_jacobian(self, q):
+        """(J_R,P, J_T,O'): the platform's angular velocity and the velocity
+        of O' are J qd (3x3 each, {S}). Raises Unreachable."""
+        q = vector("q", q, 3)
+        self._reachable("platform_jacobian", q)
+        jp = (ctypes.c_double * 18)()
+        self.lib.platform_jacobian(q, jp)
+        return self._out.mat(jp, 3, 3), self._out.mat(jp[9:], 3, 3)
+
+    def poses(self, q):
+        """(R, p): each body's rotation (3x3) and centre (3) in {S}, in
+        body_names order. Raises Unreachable."""
+        q = vector("q", q, 3)
+        self._reachable("poses", q)
+        nb = self.nbody
+        r, p = (ctypes.c_double * (9 * nb))(), (ctypes.c_double * (3 * nb))()
+        self.lib.poses(q, r, p)
+        return ([self._out.mat(r[9 * b:9 * b + 9], 3, 3) for b in range(nb)],
+                [self._out.vec(p[3 * b:3 * b + 3]) for b in range(nb)])
+
+    # ---- dynamics ----
+    def dynamics(self, q, qd=None):
+        """(M, h, G): M(q) qdd + h(q, qd) = G(q) + J_d^T fd + ... (M 3x3 with
+        the drives' armature; h without their damping and friction, see
+        passive). qd defaults to 0. Raises Unreachable."""
+        q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
+        self._reachable("dynamics", q)
+        M, h, G = (ctypes.c_double * 9)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+        self.lib.dynamics(q, qd, M, h, G)
+        return self._out.mat(M, 3, 3), self._out.vec(h), self._out.vec(G)
+
+    def passive(self, q, qd):
+        """The drives' viscous damping and smoothed Coulomb friction as
+        generalized forces (3; zero for a model without drives)."""
+        q, qd = vector("q", q, 3), vector("qd", qd, 3)
+        self._reachable("passive", q)
+        out = (ctypes.c_double * 3)()
+        self.lib.passive(q, qd, out)
+        return self._out.vec(out)
+
+    def forward_dynamics(self, q, qd=None, fd=None, fp=None, mp=None):
+        """qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive - h:
+        fd actuator forces (N, nact), fp force (N) and mp moment (N m) on the
+        platform at O' in {S}; all default to 0. Raises Unreachable."""
+        q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
+        l = self._loads(fd, fp, mp)
+        qdd = (ctypes.c_double * 3)()
+        self._call("forward_dynamics: q = %s" % _fmt(q), self.lib.forward_dynamics,
+                   q, qd, ctypes.byref(l), qdd)
+        return self._out.vec(qdd)
+
+    def inverse_dynamics(self, q, qd, qdd, fp=None, mp=None, preload=0.0):
+        """Actuator forces fd (N, nact) producing qdd under fp, mp: the
+        least-norm solution of J_d^T fd = tau, plus preload (N) along the
+        actuator null vector for a redundant robot (InputError for a
+        non-zero preload with three actuators). Raises Unreachable, Singular."""
+        q, qd, qdd = vector("q", q, 3), vector("qd", qd, 3), vector("qdd", qdd, 3)
+        preload = _convert.scalar("preload", preload)
+        l = self._loads(None, fp, mp)
+        fd = (ctypes.c_double * self.nact)()
+        self._call("inverse_dynamics: q = %s" % _fmt(q), self.lib.inverse_dynamics_preload,
+                   q, qd, qdd, ctypes.byref(l), preload, fd)
+        return self._out.vec(fd)
+
+    def actuator_null(self, q):
+        """n: the unit actuator-force pattern in equilibrium by itself
+        (J_d^T n = 0); only for a redundant robot (InputError otherwise)."""
+        q = vector("q", q, 3)
+        if self.npreload == 0:
+            raise errors.InputError("actuator_null: this model has %d actuators for 3 "
+                                    "coordinates, no actuator null vector" % self.nact,
+                                    errors.EINPUT)
+        n = (ctypes.c_double * self.nact)()
+        self._call("actuator_null: q = %s" % _fmt(q), self.lib.actuator_null, q, n)
+        return self._out.vec(n)
+
+    def reactions(self, q, qd=None, fd=None, fp=None, mp=None, labelled=False):
+        """The nlambda joint reaction coordinates (N, N m) at the state's
+        accelerations, in lambda_labels order (a dict label -> value when
+        labelled); for a redundant robot the least-norm solution. Raises
+        Unreachable, Singular."""
+        q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
+        l = self._loads(fd, fp, mp)
+        lam = (ctypes.c_double * self.nlambda)()
+        self._call("reactions: q = %s" % _fmt(q), self.lib.reactions, q, qd,
+                   ctypes.byref(l), lam)
+        if labelled:
+            return dict(zip(self.lambda_labels, lam))
+        return self._out.vec(lam)
+
+    def reaction_null(self, q):
+        """z: the unit reaction pattern that loads no body (Q z = 0); only for
+        a model with one (the 4-PRRU; InputError otherwise)."""
+        q = vector("q", q, 3)
+        if self.nreaction_null == 0:
+            raise errors.InputError("reaction_null: this model's reactions are determined, "
+                                    "no null vector", errors.EINPUT)
+        z = (ctypes.c_double * self.nlambda)()
+        self._call("reaction_null: q = %s" % _fmt(q), self.lib.reaction_null, q, z)
+        return self._out.vec(z)
+
+    def energy(self, q, qd=None):
+        """(T, V): kinetic (with the armature) and potential energy (J)."""
+        q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
+        T, V = ctypes.c_double(), ctypes.c_double()
+        st = self.lib.energies(ctypes.byref(self._m), q, qd, ctypes.byref(T), ctypes.byref(V))
+        if st != errors.OK:
+            self._fail(st, "energy: q = %s, qd = %s" % (_fmt(q), _fmt(qd)))
+        return T.value, V.value
+
+    # ---- manipulability ----
+    def dme(self, q):
+        """The dynamic manipulability at q (a Dme). Raises Unreachable or
+        Singular (w_R is not defined there)."""
+        q = vector("q", q, 3)
+        g = self.lib.types.GuardedDme()
+        self._call("dme: q = %s" % _fmt(q), self.lib.dme_eval, q, ctypes.byref(g.s))
+        o, out, n = g.s, self._out, self.nact
+        return Dme(o.w_R, o.jd_rcond, out.vec(o.sigma), out.vec(o.semi_axis),
+                   [out.vec(o.axis_dir[0]), out.vec(o.axis_dir[1])], o.sigma_T,
+                   o.half_length_T, out.vec(o.dir_T), out.mat(o.Mt, n, n),
+                   out.mat(o.JtR, 3, n), out.mat(o.JtT, 3, n))
+
+    def w_R(self, q):
+        """The rotational dynamic-manipulability index at q (>= 1)."""
+        return self.dme(q).w_R
+
+    # Simulation and maps live in their own modules.
+    from .simulation import simulate, paper_scenario, read_scenario  # noqa: E402
+    from .maps import map  # noqa: E402
