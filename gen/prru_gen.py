@@ -3,8 +3,9 @@
 
 usage: python3 gen/prru_gen.py MODEL.json --out DIR [--quiet]
 
-Writes DIR/<prefix>_kernels.{h,c} (the kernels) and DIR/<prefix>_mechanism.{h,c}
-(the mechanism descriptor), where <prefix> is the model's "name" unless
+Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
+(the mechanism descriptor) and DIR/<prefix>_param_kernels.{h,c} (the kernels
+with the model's numbers as a run-time argument), where <prefix> is the model's "name" unless
 --prefix says otherwise. Nothing in DIR changes unless generation succeeds.
 """
 
@@ -18,7 +19,7 @@ sys.setrecursionlimit(20000)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
-from prrugen import mechanism, dynamics, output, render, sym  # noqa: E402
+from prrugen import mechanism, dynamics, output, params, render, sym  # noqa: E402
 
 TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates")
@@ -30,10 +31,23 @@ def generate(model_path, templates_dir=TEMPLATES, prefix=None):
 
 
 def generate_model(model, templates_dir=TEMPLATES, prefix=None):
-    """(files {name: text}, emitted kernels) for a loaded model."""
+    """(files {name: text}, emitted kernels) for a loaded model: the
+    constant kernels, the mechanism descriptor and the runtime-parameter
+    kernels (emitted names param_*)."""
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
-    return render.render(model, deriv, templates_dir, prefix)
+    files, emitted = render.render(model, deriv, templates_dir, prefix)
+    # A fresh start, so the parameter kernels never depend on the constant
+    # ones' creation order (and the constant kernels are as before).
+    sym.reset()
+    pmodel = params.ParamModel(model)
+    pderiv = dynamics.Derivation(mechanism.build(pmodel), pmodel)
+    pfiles, pemitted = render.render_params(model, pmodel, pderiv,
+                                            templates_dir, prefix)
+    files.update(pfiles)
+    for e in pemitted:
+        e.name = "param_" + e.name
+    return files, emitted + pemitted
 
 
 def _prefix(text):

@@ -13,6 +13,7 @@
 
 #include "prru_kernels.h"
 #include "prru_mechanism.h"
+#include "prru_param_kernels.h"
 
 static int failures = 0;
 
@@ -92,6 +93,11 @@ static void check_nan_everywhere(const char *label, const double q[3], const dou
   NAN_CHECK(prru_dynamics(q, qd, M, h, G), M, 9);
   check_all_nan("  dynamics h", h, 3);
   check_all_nan("  dynamics G", G, 3);
+  NAN_CHECK(prru_param_dynamics(&prru_params_model, q, qd, M, h, G), M, 9);
+  check_all_nan("  param_dynamics h", h, 3);
+  check_all_nan("  param_dynamics G", G, 3);
+  NAN_CHECK(prru_param_eom(&prru_params_model, q, qd, f, f, f, M, b), b, 3);
+  check_all_nan("  param_eom M", M, 9);
 #undef NAN_CHECK
 }
 
@@ -138,6 +144,14 @@ int main(void)
   check_array("prru_eom b (no loads)", b, b_ref, 3, 1e-12);
   prru_ik(q0, d);
   check_array("prru_ik d at q = 0", d, d0_ref, 3, 1e-12);
+  /* The runtime-parameter kernels with the model's own numbers. */
+  prru_param_dynamics(&prru_params_model, q, qd, M, h, G);
+  check_array("prru_param_dynamics M", M, M_ref, 9, 1e-12);
+  check_array("prru_param_dynamics h", h, h_ref, 3, 1e-12);
+  check_array("prru_param_dynamics G", G, G_ref, 3, 1e-12);
+  prru_param_ik_jd(&prru_params_model, q, d, Jd);
+  check_array("prru_param_ik_jd d", d, d_ref, 3, 1e-12);
+  check_array("prru_param_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
   /* The descriptor describes these kernels: the paper's model, its sizes. */
   if (!(prru_mech.total_mass == M_ref[8]) || strcmp(prru_mech.name, "prru") != 0 ||
       prru_mech.nlambda != PRRU_NLAMBDA || prru_mech.nbody != PRRU_NBODY ||

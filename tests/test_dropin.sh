@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Drop-in quality of the committed generated kernels: a user copies
-# generated/ into their own controller and builds it with their compiler and
+# generated/ (the kernels, the descriptor, the runtime-parameter kernels)
+# into their own controller and builds it with their compiler and
 # their warning flags. So copy ONLY generated/ (plus tests/dropin_main.c as
 # main.c) into an empty directory, build with nothing but -lm under strict
 # warnings as C99 and C11 with gcc and clang and as C++ with g++, and run
@@ -22,11 +23,11 @@ cd "$work" || exit 1
 fail=0
 skipped=()
 
-# The header promises "depends only on <math.h>" (the descriptor only on the
-# kernels' header): any other include would be a dependency the user has to
+# The header promises "depends only on <math.h>" (the descriptor and the
+# runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"'
+  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then

@@ -147,11 +147,39 @@ class Graph:
 class Kernel:
     """One C function: inputs (C array, symbol names), outputs (C array, exprs)."""
 
-    def __init__(self, name, doc, inputs, outputs, guards=()):
+    def __init__(self, name, doc, inputs, outputs, guards=(), params=None):
         self.name, self.doc = name, doc
         self.inputs = inputs          # [(array name, [symbol names])]
         self.outputs = outputs        # [(array name, [Expr])]
         self.guards = list(guards)    # Exprs required to lie in [-1, 1]
+        self.params = params          # ParamsArg, or None
+
+
+class ParamsArg:
+    """A leading `const TYPE *p` argument whose members are symbols: each
+    member a kernel uses is loaded once into a local (local(name)) at the
+    top, so the CSE graph treats it as an input like q1."""
+
+    def __init__(self, ctype, order, local, access):
+        self.ctype = ctype            # C struct type name
+        self.order = order            # symbol names, in struct order
+        self.local = local            # symbol name -> C local name
+        self.access = access          # symbol name -> C expression
+        self.order_set = frozenset(order)
+
+
+class _Names(dict):
+    """Input symbol -> C local; parameter symbols are looked up on use."""
+
+    def __init__(self, params):
+        super().__init__()
+        self.params = params
+
+    def __missing__(self, key):
+        if self.params is None or key not in self.params.order_set:
+            raise KeyError(key)
+        self[key] = self.params.local(key)
+        return self[key]
 
 
 def _uses(roots):
@@ -194,7 +222,8 @@ class Emitted:
 
 
 def emit(kernel, prefix):
-    names = {}
+    params = kernel.params
+    names = _Names(params)
     for arr, syms in kernel.inputs:
         for i, s in enumerate(syms):
             names[s] = "%s%d" % (arr, i + 1)
@@ -257,6 +286,9 @@ def emit(kernel, prefix):
         for i, s in enumerate(syms):
             lines.append("const double %s%d = %s[%d];" % (arr, i + 1, arr, i))
     used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
+    if params is not None:
+        lines += ["const double %s = %s;" % (params.local(s), params.access(s))
+                  for s in params.order]
     lines = [l for l in lines if l.split()[2] in used_inputs]
 
     def emit_temps(indices):
@@ -288,11 +320,15 @@ def emit(kernel, prefix):
         if not any(("%s%d" % (arr, i + 1)) in used_inputs
                    for i in range(len(syms))):
             lines.insert(0, "(void)%s;" % arr)
-
-    params = ["const double %s[%d]" % (arr, len(syms))
-              for arr, syms in kernel.inputs]
-    params += ["double %s[%d]" % (arr, len(ns)) for arr, ns in out_nodes]
-    signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(params))
+    args = []
+    if params is not None:
+        args.append("const %s *p" % params.ctype)
+        if not any(params.local(s) in used_inputs for s in params.order):
+            lines.insert(0, "(void)p;")
+    args += ["const double %s[%d]" % (arr, len(syms))
+             for arr, syms in kernel.inputs]
+    args += ["double %s[%d]" % (arr, len(ns)) for arr, ns in out_nodes]
+    signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(args))
     body = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
     return Emitted(kernel.name, signature, body, counts, kernel.doc)
 

@@ -134,8 +134,9 @@ def build(model):
 
 
 def _tensor(entries):
-    """(Ixx, Iyy, Izz, Ixy, Ixz, Iyz) -> symmetric 3x3 of constants."""
-    xx, yy, zz, xy, xz, yz = (sym.const(v) for v in entries)
+    """(Ixx, Iyy, Izz, Ixy, Ixz, Iyz) -> symmetric 3x3 of constants (or of
+    parameter symbols, for the runtime-parameter kernels)."""
+    xx, yy, zz, xy, xz, yz = (sym.as_expr(v) for v in entries)
     return [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
 
 

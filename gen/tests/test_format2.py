@@ -283,7 +283,9 @@ class Determinism(unittest.TestCase):
     def test_prefix_option(self):
         files, _ = prru_gen.generate(PROTO, prefix="prru")
         self.assertEqual(sorted(files), ["prru_kernels.c", "prru_kernels.h",
-                                         "prru_mechanism.c", "prru_mechanism.h"])
+                                         "prru_mechanism.c", "prru_mechanism.h",
+                                         "prru_param_kernels.c",
+                                         "prru_param_kernels.h"])
         self.assertIn('/* .name = */ "proto"', files["prru_mechanism.c"])
         own, _ = prru_gen.generate(PROTO)
         self.assertIn("void proto_dynamics(", own["proto_kernels.c"])

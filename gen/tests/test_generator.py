@@ -124,7 +124,9 @@ class CommandLine(unittest.TestCase):
         self.assertEqual(outs[0], outs[1])
         self.assertEqual(sorted(outs[0]), ["prru_kernels.c", "prru_kernels.h",
                                            "prru_mechanism.c",
-                                           "prru_mechanism.h"])
+                                           "prru_mechanism.h",
+                                           "prru_param_kernels.c",
+                                           "prru_param_kernels.h"])
 
     def test_help_and_summary(self):
         r = run_gen("--help")

@@ -1,0 +1,114 @@
+"""Runtime-parameter kernels: the model's numbers as symbols.
+
+The mechanism (mechanism.py) and the derivation (dynamics.py) read every
+number of a model from one place, the Model's fields. A ParamModel has the
+same fields, but holding symbols named after the C struct member that will
+carry them at run time (`b[0]`, `inertia[3][5]`, ...), so the same
+derivation yields expressions in q, qd and the parameters. Only the
+structure stays fixed by the model: the number of limbs, and a = 0 for
+limbs 3 and 4 (their U joint is O' itself). Every value is a symbol, so no
+simplification that depends on a value (a zero centre of mass, zero
+products of inertia, no drives, gravity along -z, b1 = b2 in format 1) is
+taken: the kernels are right for any parameter values.
+"""
+
+import re
+from fractions import Fraction
+
+from . import sym
+from .cgen import Kernel, ParamsArg
+from .kernels import kernels
+from .model import Limb, c_double
+
+# Kernels generated in the parameter form, in header order: those an
+# optimizer or a sensitivity study evaluates (kinematics, dynamics, energy),
+# not the per-body layout tables (poses, jacobians, reaction_basis, ...).
+PARAM_KERNELS = ("ik", "jd", "ik_jd", "mass", "bias", "gravity", "dynamics",
+                 "eom", "platform_jacobian", "energy", "actuator_rates",
+                 "passive")
+
+# Symbol names carry this prefix so that they can never meet an input's
+# name (q1, qd2, fd3, ...).
+_PREFIX = "p->"
+
+
+def member(name):
+    """The parameter symbol of the struct member `name`, e.g. 'com[2][0]'."""
+    return sym.sym(_PREFIX + name)
+
+
+def local_name(symbol_name):
+    """C local that holds a parameter inside a kernel: 'p->com[2][0]' ->
+    'p_com_2_0'."""
+    return "p_" + re.sub(r"[^A-Za-z0-9]+", "_",
+                         symbol_name[len(_PREFIX):]).strip("_")
+
+
+class ParamModel:
+    """The fields of a Model that the derivation reads, as symbols."""
+
+    def __init__(self, model):
+        n, nb = model.nlimb, len(model.body_names)
+        vec = lambda key: tuple(member("%s[%d]" % (key, i))  # noqa: E731
+                                for i in range(n))
+        b, l1, l2, a = vec("b"), vec("l1"), vec("l2"), vec("a")
+        self.limbs = tuple(Limb(b[i], l1[i], l2[i],
+                                a[i] if i < 2 else Fraction(0))
+                           for i in range(n))
+        self.gravity = tuple(member("gravity[%d]" % k) for k in range(3))
+        self.masses = tuple(member("mass[%d]" % j) for j in range(nb))
+        self.coms = tuple(tuple(member("com[%d][%d]" % (j, k))
+                                for k in range(3)) for j in range(nb))
+        self.inertias = tuple(tuple(member("inertia[%d][%d]" % (j, k))
+                                    for k in range(6)) for j in range(nb))
+        self.armature = vec("armature")
+        self.damping = vec("damping")
+        self.coulomb = vec("coulomb")
+        self.coulomb_velocity = member("coulomb_velocity")
+        self.body_names = model.body_names
+        self.nlimb = n
+        self.order = [x.args[0] for x in
+                      b + l1 + l2 + a + self.gravity + self.masses
+                      + sum(self.coms, ()) + sum(self.inertias, ())
+                      + self.armature + self.damping + self.coulomb
+                      + (self.coulomb_velocity,)]
+
+
+def is_param(name):
+    return name.startswith(_PREFIX)
+
+
+def model_values(model):
+    """The model's own numbers in struct order, as (member, C literal) rows
+    of the initializer of <prefix>_params_model. A model without Coulomb
+    friction has no smoothing velocity; 1 m/s stands in for it, so that
+    f tanh(dd / v_s) is 0, not 0 * NaN, at f = 0."""
+    num = lambda v: c_double(v)  # noqa: E731
+    limbs = model.limbs
+    vs = model.coulomb_velocity if model.coulomb_velocity else Fraction(1)
+    return [
+        ("b", [num(l.b) for l in limbs]),
+        ("l1", [num(l.l1) for l in limbs]),
+        ("l2", [num(l.l2) for l in limbs]),
+        ("a", [num(l.a) for l in limbs]),
+        ("gravity", [num(g) for g in model.gravity]),
+        ("mass", [num(m) for m in model.masses]),
+        ("com", [[num(x) for x in c] for c in model.coms]),
+        ("inertia", [[num(x) for x in i] for i in model.inertias]),
+        ("armature", [num(x) for x in model.armature]),
+        ("damping", [num(x) for x in model.damping]),
+        ("coulomb", [num(x) for x in model.coulomb]),
+        ("coulomb_velocity", num(vs)),
+    ]
+
+
+def _access(symbol_name):
+    return symbol_name.replace(_PREFIX, "p->", 1)
+
+
+def param_kernels(deriv, pmodel, prefix):
+    """The PARAM_KERNELS of deriv, the derivation of ParamModel pmodel, each
+    with the leading `const <prefix>_params *p` argument."""
+    arg = ParamsArg("%s_params" % prefix, pmodel.order, local_name, _access)
+    return [Kernel(k.name, k.doc, k.inputs, k.outputs, k.guards, arg)
+            for k in kernels(deriv) if k.name in PARAM_KERNELS]
