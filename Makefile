@@ -1,5 +1,6 @@
 # The two set-up commands of the README:  make demo   and   make test
-# Both install what is missing (Debian packages), configure and build.
+# Both install the Debian packages they need that are missing, configure
+# and build.
 PAPER_MODEL = models/3prru_paper.json
 MODEL   ?= $(PAPER_MODEL)
 # Each model builds in its own directory: build/ for the paper's, build-<file>
@@ -7,26 +8,44 @@ MODEL   ?= $(PAPER_MODEL)
 BUILD   ?= $(if $(filter $(abspath $(MODEL)),$(abspath $(PAPER_MODEL))),build,build-$(basename $(notdir $(MODEL))))
 RESULTS ?= results
 PYTHON  ?= python3
-DEB_PACKAGES = cmake gcc g++ clang libclang-rt-14-dev valgrind make python3 libgsl-dev \
-               gnuplot-nox libmujoco-dev
 FUZZ_SECONDS ?= 60
-SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: all deps build demo compare-designs test test-asan fuzz check-generated regenerate bench clean
+# Debian packages, per target: each installs only what it uses.
+#   demo (and build, bench, compare-designs): the build and the plots;
+#   test: + g++ and clang (tests/test_dropin.sh), pkg-config
+#         (tests/test_install.sh), MuJoCo (validation/);
+#   test-asan: + valgrind (gcc's own sanitizers need nothing more);
+#   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
+# cmake/debian_deps.sh installs the missing ones with apt-get as root or
+# through sudo, else lists them with the command to run (exit 2).
+# DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
+DEPS_DEMO = cmake gcc make python3 libgsl-dev gnuplot-nox
+DEPS_TEST = $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev
+DEPS_ASAN = $(DEPS_TEST) valgrind
+DEPS_FUZZ = clang clang-runtime libgsl-dev
+DEPS_DRY_RUN ?=
+SKIP_DEPS ?=
+DEPS = PRRU_DEPS_DRY_RUN=$(DEPS_DRY_RUN) PRRU_SKIP_DEPS=$(SKIP_DEPS) bash cmake/debian_deps.sh
+
+.PHONY: all deps deps-demo deps-test deps-asan deps-fuzz build demo compare-designs test \
+        test-asan fuzz check-generated regenerate bench clean
+# Two package installations must never run at once (dpkg's lock); the
+# compilers run in parallel inside cmake --build.
+.NOTPARALLEL:
 
 all: build
 
-deps:
-	@missing=""; for p in $(DEB_PACKAGES); do \
-	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
-	done; \
-	if [ -n "$$missing" ]; then \
-	  echo "installing:$$missing"; \
-	  $(SUDO) apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
-	fi
+deps: deps-demo
+deps-demo:
+	@$(DEPS) demo $(DEPS_DEMO)
+deps-test:
+	@$(DEPS) test $(DEPS_TEST)
+deps-asan:
+	@$(DEPS) test-asan $(DEPS_ASAN)
+deps-fuzz:
+	@$(DEPS) fuzz $(DEPS_FUZZ)
 
-build: deps
+build: deps-demo
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPRRU_MODEL=$(abspath $(MODEL))
 	cmake --build $(BUILD) -j 2
 
@@ -36,21 +55,21 @@ demo: build
 
 # The paper's future work: three limbs (the paper's model) vs four
 # (models/4prru.json), each in its own build directory.
-compare-designs: deps
+compare-designs: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=build
 	$(MAKE) --no-print-directory build MODEL=models/4prru.json BUILD=build-4prru
 	studies/compare_designs.sh build build-4prru $(RESULTS)/compare
 
-test: build check-generated
+test: deps-test build check-generated
 	cd $(BUILD) && ctest --output-on-failure -j 2
 
 # AddressSanitizer + UBSan build and ctest, fuzz corpus replay, valgrind on
 # `prru paper` (own build directories; `make test` first for the Release one).
-test-asan: build
+test-asan: deps-asan build
 	RELEASE_BUILD=$(abspath $(BUILD)) tests/sanitize.sh
 
 # libFuzzer over the number, table, load-schedule and scenario parsers.
-fuzz: deps
+fuzz: deps-fuzz
 	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run.sh
 
 # Fails when the committed generated/ (the paper model's kernels) is not
