@@ -1,0 +1,131 @@
+/* prru_bench's parts and what they share:
+ *   bench_kernels.c  one call of each kernel, generated and reference side,
+ *                    the batch loops around them and the kernel table;
+ *   bench_states.c   the input states and the agreement of both sides;
+ *   bench_harness.c  calibrated, interleaved batch timing;
+ *   bench_paths.c    the simulated second and the w_R map throughput;
+ *   bench_regen.c    the time to regenerate the kernels;
+ *   bench_report.c   the table and the JSON object;
+ *   bench_main.c     options and the order of the run. */
+#ifndef PRRU_BENCH_H
+#define PRRU_BENCH_H
+
+#include <stdio.h>
+
+#include "bench_timer.h"
+#include "prru.h"
+#include "prru_ref.h"
+
+#define PRRU_BENCH_PI 3.14159265358979323846
+
+/* Set by bench/CMakeLists.txt; the fallbacks keep a hand build honest. */
+#ifndef PRRU_BENCH_FLAGS
+#define PRRU_BENCH_FLAGS "unknown (built outside CMake)"
+#endif
+#ifndef PRRU_BENCH_BUILD_TYPE
+#define PRRU_BENCH_BUILD_TYPE "unknown"
+#endif
+#ifndef PRRU_BENCH_SOURCE_DIR
+#define PRRU_BENCH_SOURCE_DIR "."
+#endif
+#ifndef PRRU_BENCH_MODEL
+#define PRRU_BENCH_MODEL PRRU_BENCH_SOURCE_DIR "/models/3prru_paper.json"
+#endif
+#ifndef PRRU_BENCH_PYTHON
+#define PRRU_BENCH_PYTHON "python3"
+#endif
+
+#if defined(__clang__)
+#define BENCH_COMPILER "clang " __clang_version__
+#elif defined(__GNUC__)
+#define BENCH_COMPILER "gcc " __VERSION__
+#else
+#define BENCH_COMPILER "unknown C compiler"
+#endif
+
+/* A power of two, so the state index is a mask, not a division. */
+#define NSTATES 64
+#define MAXOUT (3 * PRRU_NH) /* largest output of one call: H, 6 NBODY x 3 */
+#define MAXREPS 1000
+
+typedef struct {
+  double q[3], qd[3], qdd[3];
+  prru_loads l;
+} bench_state;
+
+typedef struct {
+  bench_state st[NSTATES];
+  prru_model m;
+  prru_data *d;
+  prru_ref_params p;
+  prru_ref_ws *w;
+  long failures; /* calls that returned an error while being timed */
+} bench_ctx;
+
+/* Everything every timed call produced ends here, so no call is dead code. */
+extern volatile double bench_sink;
+
+typedef void (*batch_fn)(bench_ctx *c, long n);
+typedef int (*eval_fn)(bench_ctx *c, const bench_state *s, double *out);
+
+typedef struct {
+  const char *name; /* the JSON key (issue 5) */
+  int nout;
+  eval_fn gen_eval, ref_eval;
+  batch_fn gen_batch, ref_batch;
+  const char *ops; /* what the generated side executes */
+  /* results */
+  bench_stats gen, ref;
+  double max_rel_diff;
+} bench_kernel;
+
+/* bench_kernels.c: the table, in report order. */
+extern bench_kernel bench_kernels[];
+extern const int bench_nkernels;
+/* Calls of the generated fused dynamics kernel, to busy the core. */
+void bench_warm_up(bench_ctx *c, long n);
+
+/* bench_states.c */
+int bench_make_states(bench_ctx *c);
+int bench_agreement(bench_ctx *c, bench_kernel *k, int *bad_state);
+
+/* bench_harness.c */
+void bench_time_kernel(bench_ctx *c, bench_kernel *k, int reps, double target_ns);
+
+/* bench_paths.c */
+typedef struct {
+  int ok;
+  bench_stats gen_s, ref_s; /* wall seconds */
+  double q[3], qd[3];       /* generated path's final state */
+  double dq, dqd;           /* max |generated - reference| at t_end */
+  unsigned long ref_steps;
+  double tol, h0;
+} sim_result;
+
+typedef struct {
+  int ok, n, n_ref;
+  bench_stats gen2_s, gen1_s, ref_s; /* wall seconds: 2 threads, 1 thread, reference */
+  double max_rel_diff;               /* generated vs reference w_R on the reference grid */
+} map_result;
+
+void bench_simulated_second(const prru_model *m, int reps, sim_result *res);
+#ifdef PRRU_BENCH_HAVE_DME
+void bench_map_throughput(const prru_model *m, int quick, map_result *res);
+#endif
+
+/* bench_regen.c */
+int bench_time_regeneration(int reps, bench_stats *out);
+
+/* bench_report.c */
+typedef struct {
+  int json, reps, quick;
+  double batch_ms;
+} bench_options;
+
+void bench_cpu_model(char *buf, size_t len);
+void bench_print_json(const bench_options *op, const char *cpu, const sim_result *sim,
+                      const map_result *map, int regen_ok, const bench_stats *regen);
+void bench_print_table(const bench_options *op, const char *cpu, const sim_result *sim,
+                       const map_result *map, int regen_ok, const bench_stats *regen);
+
+#endif

@@ -1,0 +1,67 @@
+/* The time a user waits for the kernels to be regenerated from the model
+ * file. */
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "bench.h"
+
+static void remove_tree_flat(const char *dir)
+{
+  DIR *dp = opendir(dir);
+  if (dp) {
+    struct dirent *e;
+    char path[4096];
+    while ((e = readdir(dp)) != NULL) {
+      if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+      snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+      if (remove(path) != 0)
+        fprintf(stderr, "prru_bench: cannot remove %s: %s\n", path, strerror(errno));
+    }
+    closedir(dp);
+  }
+  if (rmdir(dir) != 0)
+    fprintf(stderr, "prru_bench: cannot remove %s: %s\n", dir, strerror(errno));
+}
+
+/* Wall seconds of `python3 gen/prru_gen.py MODEL --out TMP --quiet`, the
+ * whole process including the interpreter's start, as a user pays it.
+ * Returns 0 or -1 (with the reason on stderr). */
+int bench_time_regeneration(int reps, bench_stats *out)
+{
+  const char *paths[] = {PRRU_BENCH_PYTHON, PRRU_BENCH_SOURCE_DIR, PRRU_BENCH_MODEL};
+  for (int i = 0; i < 3; i++)
+    if (strchr(paths[i], '\'')) {
+      fprintf(stderr, "prru_bench: regeneration: path %s contains a quote\n", paths[i]);
+      return -1;
+    }
+  const char *tmp = getenv("TMPDIR");
+  char dir[1024];
+  snprintf(dir, sizeof dir, "%s/prru_bench_gen_XXXXXX", tmp && *tmp ? tmp : "/tmp");
+  if (!mkdtemp(dir)) {
+    fprintf(stderr, "prru_bench: regeneration: cannot create %s: %s\n", dir, strerror(errno));
+    return -1;
+  }
+  char cmd[8192];
+  /* The generator's stdout goes to stderr so it cannot corrupt --json. */
+  snprintf(cmd, sizeof cmd, "'%s' '%s/gen/prru_gen.py' '%s' --out '%s' --quiet 1>&2",
+           PRRU_BENCH_PYTHON, PRRU_BENCH_SOURCE_DIR, PRRU_BENCH_MODEL, dir);
+  double s[MAXREPS];
+  int rc = 0;
+  for (int i = 0; i < reps && rc == 0; i++) {
+    double t0 = bench_now_ns();
+    rc = system(cmd);
+    s[i] = (bench_now_ns() - t0) * 1e-9;
+  }
+  remove_tree_flat(dir);
+  if (rc != 0) {
+    fprintf(stderr, "prru_bench: regeneration failed (status %d): %s\n", rc, cmd);
+    return -1;
+  }
+  *out = bench_stats_of(s, reps);
+  return 0;
+}
+

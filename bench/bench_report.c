@@ -1,0 +1,168 @@
+/* prru_bench's output: the human-readable table and the JSON object
+ * (bench/check_json.py reads the latter). */
+#include <stdio.h>
+#include <string.h>
+
+#include "bench.h"
+
+void bench_cpu_model(char *buf, size_t len)
+{
+  snprintf(buf, len, "unknown");
+  FILE *f = fopen("/proc/cpuinfo", "r");
+  if (!f) return;
+  char line[512];
+  while (fgets(line, sizeof line, f)) {
+    if (strncmp(line, "model name", 10) != 0) continue;
+    char *v = strchr(line, ':');
+    if (!v) continue;
+    v++;
+    while (*v == ' ' || *v == '\t') v++;
+    v[strcspn(v, "\n")] = '\0';
+    snprintf(buf, len, "%s", v);
+    break;
+  }
+  fclose(f);
+}
+
+static void json_string(const char *s)
+{
+  putchar('"');
+  for (; *s; s++) {
+    unsigned char ch = (unsigned char)*s;
+    if (ch == '"' || ch == '\\') printf("\\%c", ch);
+    else if (ch < 0x20) printf("\\u%04x", ch);
+    else putchar(ch);
+  }
+  putchar('"');
+}
+
+void bench_print_json(const bench_options *op, const char *cpu, const sim_result *sim,
+                      const map_result *map, int regen_ok, const bench_stats *regen)
+{
+  printf("{\"kernels\": {");
+  for (int i = 0; i < bench_nkernels; i++) {
+    const bench_kernel *k = &bench_kernels[i];
+    printf("%s\"%s\": {\"generated_ns\": %.4g, \"reference_ns\": %.4g, \"ratio\": %.4g}",
+           i ? ", " : "", k->name, k->gen.median, k->ref.median, k->ref.median / k->gen.median);
+  }
+  printf("}, \"model\": {\"name\": ");
+  json_string(prru_mech.name);
+  printf(", \"file\": ");
+  json_string(prru_mech.model_file);
+  printf(", \"sha256\": ");
+  json_string(prru_mech.sha256);
+  printf("}, \"cpu\": ");
+  json_string(cpu);
+  printf(", \"compiler\": ");
+  json_string(BENCH_COMPILER);
+  printf(", \"flags\": ");
+  json_string(PRRU_BENCH_FLAGS);
+  printf(", \"build_type\": ");
+  json_string(PRRU_BENCH_BUILD_TYPE);
+  printf(", \"reps\": %d, \"states\": %d, \"quick\": %s", op->reps, NSTATES,
+         op->quick ? "true" : "false");
+  printf(", \"spread_ns\": {");
+  for (int i = 0; i < bench_nkernels; i++) {
+    const bench_kernel *k = &bench_kernels[i];
+    printf("%s\"%s\": {\"generated\": [%.4g, %.4g], \"reference\": [%.4g, %.4g]}", i ? ", " : "",
+           k->name, k->gen.min, k->gen.max, k->ref.min, k->ref.max);
+  }
+  printf("}, \"max_rel_diff\": {");
+  for (int i = 0; i < bench_nkernels; i++)
+    printf("%s\"%s\": %.3g", i ? ", " : "", bench_kernels[i].name, bench_kernels[i].max_rel_diff);
+  printf("}, \"ops\": {");
+  for (int i = 0; i < bench_nkernels; i++) {
+    printf("%s\"%s\": ", i ? ", " : "", bench_kernels[i].name);
+    json_string(bench_kernels[i].ops);
+  }
+  printf("}");
+#ifndef PRRU_BENCH_HAVE_DME
+  printf(", \"missing\": {\"w_r\": \"runtime/include/prru_dme.h not present at build time\"}");
+#endif
+  if (sim->ok) {
+    printf(", \"simulated_second\": {\"scenario\": \"paper section 4.3\"");
+    printf(", \"generated_s\": %.4g, \"reference_s\": %.4g, "
+           "\"ratio\": %.4g, \"stepper\": \"rk8pd\", \"rel_tol\": %g, \"abs_tol\": %g, "
+           "\"reference_steps\": %lu, \"final_q\": [%.15g, %.15g, %.15g], "
+           "\"max_abs_diff_q\": %.3g, \"max_abs_diff_qd\": %.3g}",
+           sim->gen_s.median, sim->ref_s.median, sim->ref_s.median / sim->gen_s.median, sim->tol,
+           sim->tol, sim->ref_steps, sim->q[0], sim->q[1], sim->q[2], sim->dq, sim->dqd);
+  } else
+    printf(", \"simulated_second\": null");
+  if (map->ok) {
+    double pts = (double)map->n * map->n, rpts = (double)map->n_ref * map->n_ref;
+    printf(", \"map\": {\"grid\": %d, \"seconds_2_threads\": %.4g, \"seconds_1_thread\": %.4g, "
+           "\"generated_points_per_s\": %.4g, \"generated_points_per_s_1_thread\": %.4g, "
+           "\"reference_points_per_s\": %.4g, \"ratio_1_thread\": %.4g, \"max_rel_diff\": %.3g}",
+           map->n, map->gen2_s.median, map->gen1_s.median, pts / map->gen2_s.median,
+           pts / map->gen1_s.median, rpts / map->ref_s.median,
+           (pts / map->gen1_s.median) / (rpts / map->ref_s.median), map->max_rel_diff);
+  } else {
+    printf(", \"map\": null");
+  }
+  if (regen_ok)
+    printf(", \"regeneration_s\": %.4g", regen->median);
+  else
+    printf(", \"regeneration_s\": null");
+  printf("}\n");
+}
+
+void bench_print_table(const bench_options *op, const char *cpu, const sim_result *sim,
+                       const map_result *map, int regen_ok, const bench_stats *regen)
+{
+  printf("prru_bench: ns per call, median [min-max] of %d repetitions, %d input states\n",
+         op->reps, NSTATES);
+  printf("model: %s (%s, sha256 %s)\n", prru_mech.name, prru_mech.model_file, prru_mech.sha256);
+  printf("cpu: %s | compiler: %s | flags: %s (%s)\n\n", cpu, BENCH_COMPILER, PRRU_BENCH_FLAGS,
+         PRRU_BENCH_BUILD_TYPE);
+  printf("%-17s %-26s %-32s %8s %9s  %s\n", "kernel", "generated ns", "reference ns", "ratio",
+         "rel diff", "generated: operations");
+  for (int i = 0; i < bench_nkernels; i++) {
+    const bench_kernel *k = &bench_kernels[i];
+    char gs[64], rs[64];
+    snprintf(gs, sizeof gs, "%.1f [%.1f-%.1f]", k->gen.median, k->gen.min, k->gen.max);
+    snprintf(rs, sizeof rs, "%.1f [%.1f-%.1f]", k->ref.median, k->ref.min, k->ref.max);
+    printf("%-17s %-26s %-32s %7.1fx %9.1e  %s\n", k->name, gs, rs, k->ref.median / k->gen.median,
+           k->max_rel_diff, k->ops);
+  }
+#ifndef PRRU_BENCH_HAVE_DME
+  printf("%-17s not timed: runtime/include/prru_dme.h was not present at build time\n", "w_r");
+#endif
+  printf("\n");
+  if (sim->ok) {
+    printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
+           sim->h0);
+    printf("  generated  %.3f ms [%.3f-%.3f]  (prru_simulate)\n", 1e3 * sim->gen_s.median,
+           1e3 * sim->gen_s.min, 1e3 * sim->gen_s.max);
+    printf("  reference  %.3f ms [%.3f-%.3f]  (gsl_odeiv2 + prru_ref_forward_dynamics, %lu steps)"
+           "\n", 1e3 * sim->ref_s.median, 1e3 * sim->ref_s.min, 1e3 * sim->ref_s.max,
+           sim->ref_steps);
+    printf("  ratio %.1fx; final q = (%.12f, %.12f, %.12f); max |diff| q %.2e, qd %.2e\n",
+           sim->ref_s.median / sim->gen_s.median, sim->q[0], sim->q[1], sim->q[2], sim->dq,
+           sim->dqd);
+  } else {
+    printf("simulated second: failed (see above)\n");
+  }
+  if (map->ok) {
+    double pts = (double)map->n * map->n, rpts = (double)map->n_ref * map->n_ref;
+    printf("w_R map over the fig. 7 rectangle (q3 = 0):\n");
+    printf("  generated  %dx%d in %.3f s [%.3f-%.3f] with 2 threads (%.3g points/s), %.3f s with 1"
+           "\n", map->n, map->n, map->gen2_s.median, map->gen2_s.min, map->gen2_s.max,
+           pts / map->gen2_s.median, map->gen1_s.median);
+    printf("  reference  %dx%d in %.3f s, 1 thread (%.3g points/s); per-thread ratio %.1fx; "
+           "max rel diff %.1e\n", map->n_ref, map->n_ref, map->ref_s.median,
+           rpts / map->ref_s.median, (pts / map->gen1_s.median) / (rpts / map->ref_s.median),
+           map->max_rel_diff);
+  } else {
+    printf("w_R map: not measured\n");
+  }
+  if (regen_ok)
+    printf("regeneration of every kernel from %s: %.3f s [%.3f-%.3f] (target < 2 s)\n",
+           PRRU_BENCH_MODEL, regen->median, regen->min, regen->max);
+  else
+    printf("regeneration: failed (see above)\n");
+  if (strcmp(PRRU_BENCH_BUILD_TYPE, "Release") != 0)
+    printf("note: build type %s, not Release: these are not the documented numbers\n",
+           PRRU_BENCH_BUILD_TYPE);
+}
+
