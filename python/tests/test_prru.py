@@ -1,0 +1,635 @@
+"""The Python binding against the prru CLI, which links the same runtime
+statically and prints every number with 17 significant digits: the values
+must agree bit for bit. Plus round trips (FK(IK), ID(FD)), the error
+mapping, argument checks, the library search, and the ctypes mirror
+against the struct definitions in the C headers.
+
+Environment: PRRU_LIB (libprru.so), PRRU (the CLI; default: cli/prru of
+the library's build directory), PRRU_SOURCE_DIR (default: this file's
+tree). Works for any model the library was built for (3 or 4 actuators).
+"""
+
+import ctypes
+import json
+import math
+import os
+import random
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import prru
+from prru import _lib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE_DIR = os.environ.get("PRRU_SOURCE_DIR") or os.path.dirname(os.path.dirname(HERE))
+LIB = os.environ.get("PRRU_LIB")
+if not LIB:
+    sys.exit("test_prru: set PRRU_LIB to the libprru.so under test")
+CLI = os.environ.get("PRRU") or os.path.join(
+    os.path.dirname(os.path.dirname(os.path.abspath(LIB))), "cli", "prru")
+
+try:
+    import numpy
+except ImportError:
+    numpy = None
+
+
+def cli(*args, ok=True):
+    """Runs the CLI: its JSON on success, (exit status, stderr) when ok=False."""
+    p = subprocess.run([CLI] + [str(a) for a in args], capture_output=True, text=True)
+    if not ok:
+        return p.returncode, p.stderr
+    if p.returncode != 0:
+        raise AssertionError("%s %s: exit %d: %s" % (CLI, " ".join(map(str, args)),
+                                                     p.returncode, p.stderr))
+    return p.stdout
+
+
+def read(path):
+    with open(path) as f:
+        return f.read()
+
+
+def arg(v):
+    return ",".join(repr(float(x)) for x in v)
+
+
+def flat(m):
+    """Row-major elements of a matrix given as rows or flat (JSON either way)."""
+    out = []
+    for x in m:
+        out.extend(flat(x) if isinstance(x, (list, tuple)) else [x])
+    return out
+
+
+def bits(x):
+    """A float's identity: equal bits compare equal, NaN too."""
+    if isinstance(x, (int, float)):
+        return float(x).hex()
+    return [bits(v) for v in x]
+
+
+def parse(text):
+    """JSON with every number a float ("-0" stays -0.0)."""
+    return json.loads(text, parse_int=float)
+
+
+MODEL = prru.Model(LIB)
+
+
+def random_states(n, seed):
+    """n regular states (q, qd, fd, fp, mp) near q1 = q2 = 0, where every
+    valid model assembles."""
+    rng, out = random.Random(seed), []
+    while len(out) < n:
+        q = [rng.uniform(-0.3, 0.3), rng.uniform(-0.35, 0.3), rng.uniform(-1.0, -0.5)]
+        try:
+            MODEL.check(q)
+        except (prru.Unreachable, prru.Singular):
+            continue
+        out.append((q, [rng.uniform(-1, 1) for _ in range(3)],
+                    [rng.uniform(-60, 60) for _ in range(MODEL.nact)],
+                    [rng.uniform(-30, 30) for _ in range(3)],
+                    [rng.uniform(-3, 3) for _ in range(3)]))
+    return out
+
+
+class TestIdentity(unittest.TestCase):
+    def test_descriptor_matches_cli(self):
+        out = parse(cli("eval", "--q", "0,0,-0.8"))
+        self.assertEqual(out["model"], {"name": MODEL.name, "file": MODEL.model_file,
+                                        "sha256": MODEL.sha256})
+        self.assertEqual(list(MODEL.lambda_labels), out["lambda_labels"])
+        self.assertEqual(len(out["d"]), MODEL.nact)
+        version = cli("--version")
+        self.assertIn("model actuators: %d\n" % MODEL.nact, version)
+        self.assertIn("model format: %d\n" % MODEL.format, version)
+
+    def test_descriptor_is_consistent(self):
+        m = MODEL
+        self.assertEqual(m.nbody, 1 + 3 * m.nlimb)
+        self.assertEqual(len(m.body_names), m.nbody)
+        self.assertEqual(m.body_names[m.platform], "P")
+        self.assertEqual([m.body_names[i] for i in m.slider],
+                         ["S%d" % (i + 1) for i in range(m.nlimb)])
+        self.assertLessEqual(abs(m.total_mass - sum(m.mass)), 1e-14 * m.total_mass)
+        self.assertEqual(sum(j.lambda_count for j in m.joints), m.nlambda)
+        for j in m.joints:
+            for k in range(j.lambda_offset, j.lambda_offset + j.lambda_count):
+                self.assertTrue(m.lambda_labels[k].startswith(j.name + "_"))
+        self.assertEqual(len(m.sha256), 64)
+        self.assertEqual(m.npreload, m.nact - 3)
+
+    def test_model_file_numbers(self):
+        """Masses and gravity against the model file itself."""
+        path = os.path.join(SOURCE_DIR, "models", MODEL.model_file)
+        if not os.path.exists(path):
+            self.skipTest("model file %s not in the source tree" % path)
+        with open(path) as f:
+            spec = json.load(f)
+        named = [n for n in spec["bodies"] if n in MODEL.body_names]
+        self.assertGreater(len(named), 0)
+        for name in named:
+            self.assertEqual(MODEL.mass[MODEL.body_names.index(name)],
+                             spec["bodies"][name]["mass"])
+        g = spec["gravity"]
+        self.assertEqual(list(MODEL.gravity), g if isinstance(g, list) else [0.0, 0.0, -g])
+
+
+class TestAgainstCli(unittest.TestCase):
+    """Every value bit for bit as `prru eval`, `ik`, `fk`, `dme` print it."""
+
+    def test_eval(self):
+        for q, qd, fd, fp, mp in random_states(6, 1):
+            out = parse(cli("eval", "--q", arg(q), "--qd", arg(qd), "--fd", arg(fd),
+                                 "--fp", arg(fp), "--mp", arg(mp)))
+            M, h, G = MODEL.dynamics(q, qd)
+            self.assertEqual(bits(flat(M)), bits(flat(out["M"])))
+            self.assertEqual(bits(h), bits(out["h"]))
+            self.assertEqual(bits(G), bits(out["G"]))
+            self.assertEqual(bits(MODEL.passive(q, qd)), bits(out["passive"]))
+            d, Jd = MODEL.ik(q)
+            self.assertEqual(bits(d), bits(out["d"]))
+            self.assertEqual(bits(flat(Jd)), bits(flat(out["Jd"])))
+            self.assertEqual(bits(MODEL.check(q)), bits(out["Jd_rcond"]))
+            self.assertEqual(bits(MODEL.forward_dynamics(q, qd, fd, fp, mp)), bits(out["qdd"]))
+            lam = MODEL.reactions(q, qd, fd, fp, mp)
+            self.assertEqual(bits(lam), bits(out["lambda"]))
+            self.assertEqual(MODEL.reactions(q, qd, fd, fp, mp, labelled=True),
+                             dict(zip(out["lambda_labels"], out["lambda"])))
+            if MODEL.npreload:
+                n = MODEL.actuator_null(q)
+                self.assertEqual(bits(n), bits(out["actuator_null"]))
+            if MODEL.nreaction_null:
+                self.assertEqual(bits(MODEL.reaction_null(q)), bits(out["reaction_null"]))
+
+    def test_ik_fk_dme(self):
+        for q, _, _, _, _ in random_states(4, 2):
+            out = parse(cli("ik", "--q", arg(q)))
+            d, Jd = MODEL.ik(q)
+            self.assertEqual(bits(d), bits(out["d"]))
+            self.assertEqual(bits(flat(Jd)), bits(flat(out["Jd"])))
+            fk = parse(cli("fk", "--d", arg(d)))
+            if MODEL.nact == 3:
+                self.assertEqual(bits(MODEL.fk(d)), bits(fk["q"]))
+            qq, res = MODEL.fk_lsq(d)
+            if fk["method"] == "least-squares":
+                self.assertEqual(bits(qq), bits(fk["q"]))
+                self.assertEqual(bits(res), bits(fk["residual"]))
+            lsq = parse(cli("fk", "--d", arg(d), "--lsq", "--seed", arg(q)))
+            qq, res = MODEL.fk_lsq(d, seed=q)
+            self.assertEqual(bits(qq), bits(lsq["q"]))
+            self.assertEqual(bits(res), bits(lsq["residual"]))
+            dme = parse(cli("dme", "--q", arg(q)))
+            o = MODEL.dme(q)
+            self.assertEqual(bits(o.w_R), bits(dme["w_R"]))
+            self.assertEqual(bits(MODEL.w_R(q)), bits(dme["w_R"]))
+            self.assertEqual(bits(o.jd_rcond), bits(dme["Jd_rcond"]))
+            self.assertEqual(bits(o.sigma), bits(dme["sigma"]))
+            self.assertEqual(bits(o.semi_axis), bits(dme["semi_axes"]))
+            self.assertEqual(bits(flat(o.axis_dir)), bits(flat(dme["axis_directions"])))
+            self.assertEqual(bits(o.sigma_T), bits(dme["sigma_T"]))
+            self.assertEqual(bits(o.half_length_T), bits(dme["translational_half_length"]))
+            self.assertEqual(bits(o.dir_T), bits(dme["translational_direction"]))
+            self.assertEqual(bits(flat(o.Mt)), bits(flat(dme["Mt"])))
+            self.assertEqual(bits(flat(o.JtR)), bits(flat(dme["JtR"])))
+            self.assertEqual(bits(flat(o.JtT)), bits(flat(dme["JtT"])))
+
+    def test_simulate_paper(self):
+        """The paper scenario's first 0.05 s, every sample and column, with
+        the CLI's default reactions."""
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "run.csv")
+            cli("simulate", "--scenario", "paper", "--t-end", "0.05", "--out", path)
+            lines = [l for l in read(path).splitlines() if not l.startswith("#")]
+        header = lines[0].split(",")
+        rows = [[float(x) for x in l.split(",")] for l in lines[1:]]
+        run = MODEL.simulate(scenario="paper", t_end=0.05, reactions=True)
+        self.assertEqual(len(run), len(rows))
+        col = {name: i for i, name in enumerate(header)}
+        n = MODEL.nact
+        for k, row in enumerate(rows):
+            def pick(names):
+                return [row[col[c]] for c in names]
+            self.assertEqual(bits(run.t[k]), bits(row[col["t"]]))
+            self.assertEqual(bits(run.q[k]), bits(pick(["q1", "q2", "q3"])))
+            self.assertEqual(bits(run.qd[k]), bits(pick(["qd1", "qd2", "qd3"])))
+            self.assertEqual(bits(run.qdd[k]), bits(pick(["qdd1", "qdd2", "qdd3"])))
+            self.assertEqual(bits(run.d[k]), bits(pick(["d%d" % (i + 1) for i in range(n)])))
+            self.assertEqual(bits(run.lambda_[k]), bits(pick(MODEL.lambda_labels)))
+            self.assertEqual(bits([run.T[k], run.V[k]]), bits(pick(["T", "V"])))
+
+    def test_map(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "map.csv")
+            text = cli("map", "--q1", "-0.5:0.5:5", "--q2", "-0.7:0.5:4", "--q3", "-0.1",
+                       "--rcond-min", "4e-3", "--out", path)
+            lines = [l for l in read(path).splitlines() if not l.startswith("#")]
+        rows = [l.split(",") for l in lines[1:]]
+        r = MODEL.map((-0.5, 0.5, 5), (-0.7, 0.5, 4), -0.1, jd_rcond_min=4e-3)
+        self.assertEqual(len(rows), 20)
+        for k, row in enumerate(rows):
+            i, j = divmod(k, 4)
+            self.assertEqual(bits([r.q1[i], r.q2[j], r.q3]), bits([float(x) for x in row[:3]]))
+            self.assertEqual(bits(r.w_R[i][j]), bits(float(row[3])))
+            self.assertEqual(r.status[i][j], row[4])
+        index = float(re.search(r"global_index: (\S+)", text).group(1))
+        self.assertEqual("%.10g" % r.summary["index"], "%.10g" % index)
+        self.assertEqual(r.summary["n_points"], 20)
+
+
+class TestRoundTrips(unittest.TestCase):
+    def test_fk_of_ik(self):
+        for q, _, _, _, _ in random_states(20, 3):
+            d, _ = MODEL.ik(q)
+            back = MODEL.fk(d)
+            for a, b in zip(back, q):
+                self.assertLessEqual(abs(a - b), 1e-12)
+
+    def test_inverse_of_forward_dynamics(self):
+        for q, qd, fd, fp, mp in random_states(20, 4):
+            qdd = MODEL.forward_dynamics(q, qd, fd, fp, mp)
+            if MODEL.npreload:
+                n = MODEL.actuator_null(q)
+                preload = sum(a * b for a, b in zip(fd, n))
+                back = MODEL.inverse_dynamics(q, qd, qdd, fp, mp, preload=preload)
+                fd0 = MODEL.inverse_dynamics(q, qd, qdd, fp, mp)
+                self.assertLessEqual(abs(sum(a * b for a, b in zip(fd0, n))), 1e-9)
+            else:
+                back = MODEL.inverse_dynamics(q, qd, qdd, fp, mp)
+            scale = max(abs(x) for x in fd)
+            for a, b in zip(back, fd):
+                self.assertLessEqual(abs(a - b), 1e-10 * scale)
+            again = MODEL.forward_dynamics(q, qd, back, fp, mp)
+            for a, b in zip(again, qdd):
+                self.assertLessEqual(abs(a - b), 1e-10 * max(1.0, max(map(abs, qdd))))
+
+    def test_equations_of_motion(self):
+        """M qdd + h = G + J_d^T fd + passive from the separate dynamics,
+        ik, passive and forward-dynamics calls (platform loads 0)."""
+        for q, qd, fd, _, _ in random_states(10, 5):
+            M, h, G = MODEL.dynamics(q, qd)
+            _, Jd = MODEL.ik(q)
+            p = MODEL.passive(q, qd)
+            qdd = MODEL.forward_dynamics(q, qd, fd)
+            for i in range(3):
+                terms = ([M[i][j] * qdd[j] for j in range(3)] + [h[i], -G[i], -p[i]]
+                         + [-Jd[k][i] * fd[k] for k in range(MODEL.nact)])
+                self.assertLessEqual(abs(math.fsum(terms)), 1e-13 * max(map(abs, terms)))
+
+    def test_first_sample_is_the_initial_state(self):
+        q, qd, fd, _, _ = random_states(1, 6)[0]
+        run = MODEL.simulate(q, qd, fd=fd, t_end=0.01, dt=0.005)
+        T, V = MODEL.energy(q, qd)
+        self.assertEqual(bits([run.T[0], run.V[0]]), bits([T, V]))
+        self.assertEqual(bits(run.q[0]), bits(q))
+
+
+class TestSimulation(unittest.TestCase):
+    def test_scenario_paper_fields(self):
+        s = MODEL.paper_scenario()
+        self.assertEqual(s.q0, (0.0, math.pi / 6, -0.8))
+        self.assertEqual(s.fd[:3], (50.0, 40.0, 25.0))
+        self.assertEqual(s.harmonic, (50.0, 4 * math.pi))
+        self.assertEqual((s.t_end, s.dt, s.stepper), (1.0, 1e-3, "rk8pd"))
+
+    def test_table_equals_constant_loads(self):
+        q, qd, fd, fp, mp = random_states(1, 7)[0]
+        fd = [x / 10 for x in fd]
+        a = MODEL.simulate(q, qd, fd=fd, fp=fp, mp=mp, t_end=0.02, dt=0.005)
+        rows = [[0.0] + fd + fp + mp, [1.0] + fd + fp + mp]
+        b = MODEL.simulate(q, qd, table=rows, t_end=0.02, dt=0.005)
+        self.assertEqual(bits(a.q), bits(b.q))
+        self.assertEqual(bits(a.qdd), bits(b.qdd))
+        self.assertIsNone(a.lambda_)
+
+    def test_scenario_file(self):
+        q, qd, fd, _, _ = random_states(1, 8)[0]
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "s.scn")
+            with open(path, "w") as f:
+                f.write("q0 = %s\nqd0 = %s\nfd = %s\nt_end = 0.03\ndt = 0.01\nstepper = rkf45\n"
+                        % (arg(q), arg(qd), arg(fd)))
+            s = MODEL.read_scenario(path)
+            self.assertEqual((s.t_end, s.dt, s.stepper), (0.03, 0.01, "rkf45"))
+            run = MODEL.simulate(scenario=s)
+            csv = os.path.join(tmp, "run.csv")
+            cli("simulate", "--scenario", path, "--no-reactions", "--out", csv)
+            lines = [l for l in read(csv).splitlines() if not l.startswith("#")]
+            with open(path, "a") as f:
+                f.write("bogus = 1\n")
+            with self.assertRaises(prru.ParseError) as e:
+                MODEL.read_scenario(path)
+            self.assertIn("s.scn:7", str(e.exception))
+        last = [float(x) for x in lines[-1].split(",")]
+        self.assertEqual(len(run), 4)
+        self.assertEqual(bits(run.q[-1]), bits(last[1:4]))
+
+    def test_on_sample_stops_and_sees_every_sample(self):
+        seen = []
+        run = MODEL.simulate(scenario="paper", t_end=0.1, dt=0.01,
+                             on_sample=lambda s: seen.append(s) or s.t >= 0.05)
+        self.assertTrue(run.stopped)
+        self.assertEqual(len(run), 6)
+        self.assertEqual([s.t for s in seen], run.t)
+        self.assertEqual(list(seen[-1].q), run.q[-1])
+
+    def test_callback_exception_propagates_with_samples(self):
+        class Stop(Exception):
+            pass
+
+        def cb(s):
+            if s.t > 0.015:
+                raise Stop()
+        with self.assertRaises(Stop) as e:
+            MODEL.simulate(scenario="paper", t_end=0.1, dt=0.01, on_sample=cb)
+        self.assertEqual(e.exception.trajectory.t, [0.0, 0.01, 0.02])
+
+    def test_leaving_the_workspace_keeps_the_samples(self):
+        f = [5000.0, -5000.0] + [0.0] * (MODEL.nact - 2)
+        with self.assertRaises((prru.Singular, prru.Unreachable)) as e:
+            MODEL.simulate([0, 0, -0.8], fd=f, t_end=1, dt=0.01)
+        err = e.exception
+        self.assertRegex(str(err), r"^simulate: stopped at t = ")
+        self.assertGreater(len(err.trajectory), 0)
+        self.assertEqual(err.t_stop, err.trajectory.t[-1])
+
+    def test_bad_settings(self):
+        with self.assertRaisesRegex(prru.InputError, "abs_tol = 1e-20 is below"):
+            MODEL.simulate(atol=1e-20, t_end=0.01)
+        with self.assertRaisesRegex(ValueError, "stepper"):
+            MODEL.simulate(stepper="euler")
+        with self.assertRaisesRegex(ValueError, "t_end"):
+            MODEL.simulate(t_end=-1)
+        with self.assertRaisesRegex(TypeError, "unknown setting"):
+            MODEL.simulate(tend=1)
+        with self.assertRaisesRegex(ValueError, r"table\[1\]: times must increase"):
+            MODEL.simulate(table=[[0.0] + [1.0] * MODEL.nact, [0.0] + [1.0] * MODEL.nact])
+        with self.assertRaisesRegex(ValueError, r"table\[0\] must have"):
+            MODEL.simulate(table=[[0.0, 1.0]])
+
+
+class TestErrors(unittest.TestCase):
+    def test_unreachable_like_the_cli(self):
+        q = [1.55, 0.0, 0.0]
+        status, err = cli("ik", "--q", arg(q), ok=False)
+        self.assertEqual(status, 1)
+        text = MODEL.lib.status_text(prru.Unreachable.status)
+        self.assertIn(text, err)
+        for call in (MODEL.ik, MODEL.dynamics, MODEL.forward_dynamics, MODEL.check,
+                     MODEL.dme, MODEL.poses, MODEL.energy):
+            with self.assertRaises(prru.Unreachable) as e:
+                call(q)
+            self.assertIn(text, str(e.exception))
+            self.assertEqual(e.exception.status, 2)
+
+    def test_singular(self):
+        strict = prru.Model(MODEL.lib, jd_rcond_min=1.0)
+        q = [0.0, 0.0, -0.8]
+        with self.assertRaisesRegex(prru.Singular, "singular configuration"):
+            strict.check(q)
+        with self.assertRaises(prru.Singular):
+            strict.dme(q)
+        with self.assertRaises(prru.Singular):
+            strict.inverse_dynamics(q, [0] * 3, [0] * 3)
+        self.assertGreater(MODEL.check(q), 0)
+
+    def test_no_convergence(self):
+        d = [10.0, -10.0] + [0.0] * (MODEL.nact - 2)
+        self.assertEqual(cli("fk", "--d", arg(d), ok=False)[0], 1)
+        with self.assertRaisesRegex(prru.NoConvergence, "did not converge"):
+            MODEL.fk(d)
+
+    def test_input_errors(self):
+        q = [0.0, 0.0, -0.8]
+        if MODEL.npreload == 0:
+            with self.assertRaises(prru.InputError):
+                MODEL.inverse_dynamics(q, [0] * 3, [0] * 3, preload=1.0)
+            with self.assertRaises(ValueError):  # InputError is a ValueError
+                MODEL.actuator_null(q)
+        if MODEL.nreaction_null == 0:
+            with self.assertRaises(prru.InputError):
+                MODEL.reaction_null(q)
+        with self.assertRaisesRegex(prru.InputError, "invalid input"):
+            MODEL.energy(q, [1e200, 0, 0])
+
+    def test_argument_checks(self):
+        with self.assertRaisesRegex(ValueError, "^q must have 3 elements, got 2$"):
+            MODEL.ik([0, 0])
+        with self.assertRaisesRegex(ValueError, r"^qd\[1\] must be finite, got nan$"):
+            MODEL.dynamics([0, 0, -0.8], [0, float("nan"), 0])
+        with self.assertRaisesRegex(ValueError, r"^fd must have %d elements" % MODEL.nact):
+            MODEL.forward_dynamics([0, 0, -0.8], fd=[1.0] * (MODEL.nact + 1))
+        with self.assertRaisesRegex(ValueError, r"^fp\[2\] must be finite, got inf$"):
+            MODEL.reactions([0, 0, -0.8], fp=[0, 0, math.inf])
+        with self.assertRaisesRegex(TypeError, "^q must be a sequence"):
+            MODEL.ik("0,0,0")
+        with self.assertRaisesRegex(TypeError, r"^q\[0\] must be a real number"):
+            MODEL.ik([None, 0, 0])
+        with self.assertRaisesRegex(ValueError, "preload must be finite"):
+            MODEL.inverse_dynamics([0, 0, -0.8], [0] * 3, [0] * 3, preload=math.nan)
+        with self.assertRaisesRegex(ValueError, "^d must have"):
+            MODEL.fk([0.0] * (MODEL.nact - 1))
+        with self.assertRaisesRegex(ValueError, "q1: start must be below stop"):
+            MODEL.map((0.5, -0.5, 3), (0, 1, 3))
+        with self.assertRaisesRegex(ValueError, "q2 count must be at least 2"):
+            MODEL.map((-0.5, 0.5, 3), (0, 1, 1))
+
+    def test_sequences_of_any_kind(self):
+        import array
+        q = [0.05, -0.1, -0.7]
+        ref = MODEL.dynamics(q)
+        self.assertEqual(MODEL.dynamics(tuple(q)), ref)
+        self.assertEqual(MODEL.dynamics(array.array("d", q)), ref)
+
+        class ArrayLike:  # what the binding reads of a NumPy array
+            ndim = 1
+
+            def __len__(self):
+                return 3
+
+            def tolist(self):
+                return list(q)
+        self.assertEqual(MODEL.dynamics(ArrayLike()), ref)
+        with self.assertRaisesRegex(TypeError, "^q must be a sequence of 3 numbers, got generator"):
+            MODEL.dynamics(x for x in q)
+
+
+class TestLibrarySearch(unittest.TestCase):
+    def test_explicit_file_directory_and_env(self):
+        build = os.path.dirname(os.path.dirname(os.path.abspath(LIB)))
+        self.assertIs(prru.load_library(LIB), MODEL.lib)
+        self.assertIs(prru.load_library(build), MODEL.lib)
+        self.assertIs(prru.Model().lib, MODEL.lib)  # via $PRRU_LIB
+
+    def test_not_found_names_what_was_tried(self):
+        missing = os.path.join(tempfile.gettempdir(), "no-such-dir-prru", "libprru.so")
+        with self.assertRaises(prru.LibraryNotFound) as e:
+            prru.Model(missing)
+        self.assertIn(missing + " (argument): no such file", str(e.exception))
+        self.assertIsInstance(e.exception, OSError)
+        env = dict(os.environ, PRRU_LIB=missing, PYTHONPATH=os.path.dirname(HERE))
+        p = subprocess.run([sys.executable, "-c", "import prru; prru.Model()"],
+                           capture_output=True, text=True, env=env)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn(missing + " ($PRRU_LIB): no such file", p.stderr)
+        self.assertIn("LibraryNotFound", p.stderr)
+
+    def test_not_a_prru_library(self):
+        import _ctypes  # a shared object that is not prru's
+        if not getattr(_ctypes, "__file__", None):
+            self.skipTest("_ctypes is built into this Python")
+        with self.assertRaisesRegex(prru.LibraryNotFound, "not a prru library"):
+            prru.load_library(_ctypes.__file__)
+
+
+def c_struct_fields(text, name):
+    """(field, element type, element count) of `typedef struct {...} name;`."""
+    text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+    m = re.search(r"typedef struct \{([^{}]*)\} %s;" % name, text)
+    if not m:
+        raise AssertionError("struct %s not found" % name)
+    body = m.group(1)
+    out = []
+    for decl in body.split(";"):
+        decl = " ".join(decl.split())
+        if not decl:
+            continue
+        if "(" in decl:  # a function pointer: prru_sample_fn etc. are typedefs here
+            raise AssertionError("unexpected declaration %r" % decl)
+        first = re.match(r"((?:(?:const|volatile|unsigned)\s+)*[A-Za-z_]\w*)\s*(.*)$", decl)
+        ctype, rest = first.group(1), first.group(2)
+        for part in rest.split(","):
+            part = part.strip()
+            ptr = part.startswith("*")
+            fname = re.match(r"\**\s*([A-Za-z_][A-Za-z_0-9]*)", part).group(1)
+            dims = re.findall(r"\[([^\]]+)\]", part)
+            out.append((fname, ctype + (" *" if ptr else ""), dims))
+    return out
+
+
+class TestLayout(unittest.TestCase):
+    """The ctypes mirror against the C headers, field by field: names in
+    order, element sizes and counts (array sizes evaluated with this
+    model's sizes)."""
+
+    def sizes(self):
+        m = MODEL
+        return {"PRRU_NACT": m.nact, "PRRU_NBODY": m.nbody, "PRRU_NLIMB": m.nlimb,
+                "PRRU_NLAMBDA": m.nlambda, "PRRU_NJOINT": m.njoint, "PRRU_NH": 6 * m.nbody,
+                "PRRU_NQ": 3}
+
+    def check(self, header, cname, pytype):
+        text = read(os.path.join(SOURCE_DIR, header))
+        cfields = c_struct_fields(text, cname)
+        pyfields = pytype._fields_
+        self.assertEqual([f for f, _, _ in cfields],
+                         [("lambda" if f == "lambda_" else f) for f, _ in pyfields],
+                         "%s: field names" % cname)
+        env = self.sizes()
+        csize = {"double": 8, "int": 4, "long": 8, "char": 1, "const char *": 8,
+                 "unsigned char": 1, "prru_stepper": 4, "prru_load_kind": 4}  # enums: int
+        for (fname, ctype, dims), (_, pyt) in zip(cfields, pyfields):
+            count = 1
+            for d in dims:
+                count *= eval(d, {"__builtins__": {}}, env)
+            elem = pyt
+            while issubclass(elem, ctypes.Array):
+                elem = elem._type_
+            n = ctypes.sizeof(pyt) // ctypes.sizeof(elem)
+            self.assertEqual(n, count, "%s.%s: element count" % (cname, fname))
+            base = ctype.replace("volatile ", "")
+            if base in csize:
+                self.assertEqual(ctypes.sizeof(elem), csize[base], "%s.%s: type" % (cname, fname))
+            elif base.endswith("*") or base.endswith("_fn"):
+                self.assertEqual(ctypes.sizeof(elem), 8, "%s.%s: pointer" % (cname, fname))
+
+    def test_headers(self):
+        t = MODEL.lib.types
+        for header, cname, pytype in (
+                ("runtime/include/prru.h", "prru_model", _lib._Model),
+                ("runtime/include/prru.h", "prru_loads", t.Loads),
+                ("runtime/include/prru.h", "prru_data", t.Data),
+                ("runtime/include/prru.h", "prru_load_schedule", t.Schedule),
+                ("runtime/include/prru.h", "prru_sample", t.Sample),
+                ("runtime/include/prru.h", "prru_sim_options", t.SimOptions),
+                ("runtime/include/prru.h", "prru_scenario", t.Scenario),
+                ("runtime/include/prru_dme.h", "prru_dme", t.Dme),
+                ("runtime/include/prru_dme.h", "prru_map_grid", _lib._MapGrid),
+                ("runtime/include/prru_dme.h", "prru_map_summary", _lib._MapSummary),
+                ("runtime/include/prru_dme.h", "prru_map_options", _lib._MapOptions),
+                ("generated/prru_mechanism.h", "prru_joint_info", _lib._JointInfo),
+                ("generated/prru_mechanism.h", "prru_mechanism", t.Mechanism)):
+            with self.subTest(struct=cname):
+                self.check(header, cname, pytype)
+
+    def test_samples_are_rows_of_doubles(self):
+        t = MODEL.lib.types
+        self.assertEqual(ctypes.sizeof(t.Sample), 8 * t.sample_width)
+
+    def test_self_check_detects_a_wrong_mirror(self):
+        """A mirror with one actuator too many fails the load-time check."""
+        class Shifted(_lib.Library):
+            def __init__(self, path):
+                self.path = path
+                self.dll = ctypes.CDLL(path)
+                head = _lib._MechHead.in_dll(self.dll, "prru_mech")
+                self.types = _lib.Types(head.nact + 1, head.nbody, head.nlimb, head.nlambda,
+                                        head.njoint)
+                self.mech = self.types.Mechanism.in_dll(self.dll, "prru_mech")
+                self._declare_functions()
+                self._check_data_and_dme()
+        with self.assertRaises(prru.LayoutError):
+            Shifted(LIB)
+
+
+@unittest.skipIf(numpy is None, "NumPy is not installed (the list path is tested)")
+class TestNumpy(unittest.TestCase):
+    def test_arrays_in_and_out(self):
+        mn = prru.Model(MODEL.lib, numpy=True)
+        for q, qd, fd, fp, mp in random_states(3, 9):
+            qa, qda, fda = numpy.array(q), numpy.array(qd), numpy.array(fd)
+            M, h, G = mn.dynamics(qa, qda)
+            self.assertEqual(M.shape, (3, 3))
+            self.assertEqual(bits(M.tolist()), bits(MODEL.dynamics(q, qd)[0]))
+            d, Jd = mn.ik(qa)
+            self.assertEqual(Jd.shape, (MODEL.nact, 3))
+            self.assertEqual(bits(mn.forward_dynamics(qa, qda, fda).tolist()),
+                             bits(MODEL.forward_dynamics(q, qd, fd)))
+            self.assertEqual(bits(MODEL.forward_dynamics(qa, qda, fda)),
+                             bits(MODEL.forward_dynamics(q, qd, fd)))
+        run = mn.simulate(scenario="paper", t_end=0.01, reactions=True)
+        ref = MODEL.simulate(scenario="paper", t_end=0.01, reactions=True)
+        self.assertEqual(run.q.shape, (11, 3))
+        self.assertEqual(run.lambda_.shape, (11, MODEL.nlambda))
+        self.assertEqual(run.t.shape, (11,))
+        self.assertEqual(bits(run.q.tolist()), bits(ref.q))
+        self.assertEqual(bits(run.T.tolist()), bits(ref.T))
+        with self.assertRaisesRegex(ValueError, r"shape \(3, 1\)"):
+            MODEL.ik(numpy.zeros((3, 1)))
+        r = mn.map((-0.2, 0.2, 3), (-0.2, 0.2, 4))
+        self.assertEqual(r.w_R.shape, (3, 4))
+
+
+class TestWithoutNumpy(unittest.TestCase):
+    def test_numpy_output_needs_numpy(self):
+        """With NumPy unimportable (blocked in a child process if installed):
+        plain lists, and numpy=True refused with the reason."""
+        code = ("import sys; sys.modules['numpy'] = None\n"
+                "import prru\n"
+                "m = prru.Model()\n"
+                "M, h, G = m.dynamics([0, 0, -0.8])\n"
+                "assert type(M) is list and type(M[0]) is list and type(h) is list\n"
+                "assert type(m.simulate(t_end=0.002, q0=[0, 0, -0.8]).q) is list\n"
+                "prru.Model(numpy=True)\n")
+        env = dict(os.environ, PRRU_LIB=LIB, PYTHONPATH=os.path.dirname(HERE))
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("ImportError: numpy=True needs NumPy, which is not installed", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
