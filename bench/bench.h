@@ -74,6 +74,10 @@ typedef struct {
   eval_fn gen_eval, ref_eval;
   batch_fn gen_batch, ref_batch;
   const char *ops; /* what the generated side executes */
+  /* A runtime-parameter kernel: the constant kernel it is compared with
+   * (a row of the table), and the arithmetic of both; NULL, 0, 0 else. */
+  const char *constant;
+  int arith, constant_arith;
   /* results */
   bench_stats gen, ref;
   double max_rel_diff;
@@ -82,6 +86,8 @@ typedef struct {
 /* bench_kernels.c: the table, in report order. */
 extern bench_kernel bench_kernels[];
 extern const int bench_nkernels;
+/* The row named name, or NULL. */
+const bench_kernel *bench_kernel_named(const char *name);
 /* Calls of the generated fused dynamics kernel, to busy the core. */
 void bench_warm_up(bench_ctx *c, long n);
 

@@ -1,7 +1,10 @@
 /* The kernel table of prru_bench: one evaluation of each kernel, generated
  * (g_) and reference (r_) side, the timed batch loops around them, and
  * what the generated side executes (operation counts). */
+#include <string.h>
+
 #include "bench.h"
+#include "prru_param_kernels.h"
 #ifdef PRRU_BENCH_HAVE_DME
 #include "prru_dme.h"
 #endif
@@ -46,6 +49,16 @@ static inline int g_jd(bench_ctx *c, const bench_state *s, double *out)
 static inline int r_jd(bench_ctx *c, const bench_state *s, double *out)
 {
   return prru_ref_jd(&c->p, s->q, out);
+}
+static inline int g_ik_jd(bench_ctx *c, const bench_state *s, double *out)
+{
+  (void)c;
+  prru_ik_jd(s->q, out, out + PRRU_NACT);
+  return 0;
+}
+static inline int r_ik_jd(bench_ctx *c, const bench_state *s, double *out)
+{
+  return prru_ref_ik(&c->p, s->q, out) | prru_ref_jd(&c->p, s->q, out + PRRU_NACT);
 }
 static inline int g_jacobians(bench_ctx *c, const bench_state *s, double *out)
 {
@@ -131,6 +144,38 @@ static inline int r_reactions(bench_ctx *c, const bench_state *s, double *out)
 {
   return prru_ref_reactions(&c->p, c->w, s->q, s->qd, s->l.fd, s->l.fp, s->l.mp, out);
 }
+/* The runtime-parameter kernels with the model's own numbers, against the
+ * same reference as their constant-folded namesakes. */
+static inline int g_param_ik_jd(bench_ctx *c, const bench_state *s, double *out)
+{
+  (void)c;
+  prru_param_ik_jd(&prru_params_model, s->q, out, out + PRRU_NACT);
+  return 0;
+}
+static inline int r_param_ik_jd(bench_ctx *c, const bench_state *s, double *out)
+{
+  return r_ik_jd(c, s, out);
+}
+static inline int g_param_mass(bench_ctx *c, const bench_state *s, double *out)
+{
+  (void)c;
+  prru_param_mass(&prru_params_model, s->q, out);
+  return 0;
+}
+static inline int r_param_mass(bench_ctx *c, const bench_state *s, double *out)
+{
+  return r_mass(c, s, out);
+}
+static inline int g_param_dynamics(bench_ctx *c, const bench_state *s, double *out)
+{
+  (void)c;
+  prru_param_dynamics(&prru_params_model, s->q, s->qd, out, out + 9, out + 12);
+  return 0;
+}
+static inline int r_param_dynamics(bench_ctx *c, const bench_state *s, double *out)
+{
+  return r_dynamics(c, s, out);
+}
 #ifdef PRRU_BENCH_HAVE_DME
 /* prru_dme_eval computes the whole ellipse (w_R, axes, the translational
  * segment): that is what the runtime offers for w_R, so that is timed. */
@@ -168,12 +213,16 @@ static inline int r_w_r(bench_ctx *c, const bench_state *s, double *out)
   BENCH_BATCH(rb_##name, r_##name, nout)
 
 BENCH_PAIR(jd, 3 * PRRU_NACT)
+BENCH_PAIR(ik_jd, 4 * PRRU_NACT)
+BENCH_PAIR(param_ik_jd, 4 * PRRU_NACT)
 BENCH_PAIR(jacobians, 3 * PRRU_NH)
 BENCH_PAIR(bias_terms, PRRU_NH)
 BENCH_PAIR(mass, 9)
+BENCH_PAIR(param_mass, 9)
 BENCH_PAIR(bias, 3)
 BENCH_PAIR(gravity, 3)
 BENCH_PAIR(dynamics, 15)
+BENCH_PAIR(param_dynamics, 15)
 BENCH_PAIR(forward_dynamics, 3)
 BENCH_PAIR(inverse_dynamics, PRRU_NACT)
 BENCH_PAIR(reactions, PRRU_NLAMBDA)
@@ -182,16 +231,26 @@ BENCH_PAIR(w_r, 1)
 #endif
 
 #define KERNEL(name, nout, ops) {#name, nout, g_##name, r_##name, gb_##name, rb_##name, ops, \
-                                 {0, 0, 0}, {0, 0, 0}, 0}
+                                 NULL, 0, 0, {0, 0, 0}, {0, 0, 0}, 0}
+/* A runtime-parameter kernel, listed after the constant kernel it is
+ * compared with. */
+#define PARAM_KERNEL(name, NAME, nout)                                                       \
+  {"param_" #name, nout, g_param_##name, r_param_##name, gb_param_##name, rb_param_##name, \
+   PRRU_PARAM_OPS_##NAME, #name, PRRU_PARAM_ARITH_##NAME, PRRU_ARITH_##NAME,                 \
+   {0, 0, 0}, {0, 0, 0}, 0}
 
 bench_kernel bench_kernels[] = {
   KERNEL(jd, 3 * PRRU_NACT, PRRU_OPS_JD),
+  KERNEL(ik_jd, 4 * PRRU_NACT, PRRU_OPS_IK_JD),
+  PARAM_KERNEL(ik_jd, IK_JD, 4 * PRRU_NACT),
   KERNEL(jacobians, 3 * PRRU_NH, PRRU_OPS_JACOBIANS),
   KERNEL(bias_terms, PRRU_NH, PRRU_OPS_BIAS_TERMS),
   KERNEL(mass, 9, PRRU_OPS_MASS),
+  PARAM_KERNEL(mass, MASS, 9),
   KERNEL(bias, 3, PRRU_OPS_BIAS),
   KERNEL(gravity, 3, PRRU_OPS_GRAVITY),
   KERNEL(dynamics, 15, PRRU_OPS_DYNAMICS),
+  PARAM_KERNEL(dynamics, DYNAMICS, 15),
   KERNEL(forward_dynamics, 3, PRRU_BENCH_OPS_FORWARD_DYNAMICS),
   KERNEL(inverse_dynamics, PRRU_NACT, PRRU_BENCH_OPS_INVERSE_DYNAMICS),
   KERNEL(reactions, PRRU_NLAMBDA, PRRU_BENCH_OPS_REACTIONS),
@@ -202,3 +261,10 @@ bench_kernel bench_kernels[] = {
 const int bench_nkernels = (int)(sizeof bench_kernels / sizeof bench_kernels[0]);
 
 void bench_warm_up(bench_ctx *c, long n) { gb_dynamics(c, n); }
+
+const bench_kernel *bench_kernel_named(const char *name)
+{
+  for (int i = 0; i < bench_nkernels; i++)
+    if (!strcmp(bench_kernels[i].name, name)) return &bench_kernels[i];
+  return NULL;
+}

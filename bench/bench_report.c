@@ -75,6 +75,14 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
     printf("%s\"%s\": ", i ? ", " : "", bench_kernels[i].name);
     json_string(bench_kernels[i].ops);
   }
+  printf("}, \"param_cost\": {");
+  for (int i = 0, n = 0; i < bench_nkernels; i++) {
+    const bench_kernel *k = &bench_kernels[i], *c = k->constant ? bench_kernel_named(k->constant) : NULL;
+    if (!c) continue;
+    printf("%s\"%s\": {\"param_ns\": %.4g, \"constant_ns\": %.4g, \"ratio\": %.4g, "
+           "\"param_arith\": %d, \"constant_arith\": %d}", n++ ? ", " : "", c->name, k->gen.median,
+           c->gen.median, k->gen.median / c->gen.median, k->arith, k->constant_arith);
+  }
   printf("}");
 #ifndef PRRU_BENCH_HAVE_DME
   printf(", \"missing\": {\"w_r\": \"runtime/include/prru_dme.h not present at build time\"}");
@@ -107,6 +115,20 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
   printf("}\n");
 }
 
+/* What reading the model's numbers at run time costs: each param_ row
+ * against its constant-folded namesake, same run. */
+static void print_param_cost(void)
+{
+  printf("runtime-parameter kernels (numbers from a prru_params) against the constant-folded ones:\n");
+  for (int i = 0; i < bench_nkernels; i++) {
+    const bench_kernel *k = &bench_kernels[i], *c = k->constant ? bench_kernel_named(k->constant) : NULL;
+    if (!c) continue;
+    printf("  %-17s %5.2fx the time of %-9s (%d vs %d arithmetic)\n", k->name,
+           k->gen.median / c->gen.median, c->name, k->arith, k->constant_arith);
+  }
+  printf("\n");
+}
+
 void bench_print_table(const bench_options *op, const char *cpu, const sim_result *sim,
                        const map_result *map, int regen_ok, const bench_stats *regen)
 {
@@ -129,6 +151,7 @@ void bench_print_table(const bench_options *op, const char *cpu, const sim_resul
   printf("%-17s not timed: runtime/include/prru_dme.h was not present at build time\n", "w_r");
 #endif
   printf("\n");
+  print_param_cost();
   if (sim->ok) {
     printf("simulated second (paper scenario, rk8pd, rel = abs tol %g, h0 %g):\n", sim->tol,
            sim->h0);

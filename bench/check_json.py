@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Smoke test of prru_bench: `prru_bench --quick --json` exits 0 and prints
-one JSON object with every kernel of issue 5 and the build description.
+one JSON object with every kernel of issue 5, the runtime-parameter kernels
+and their cost against the constant ones, and the build description.
 
 Timings are checked only for being positive and finite, never against
 targets: this runs on a shared machine under ctest -j.
@@ -12,8 +13,12 @@ import math
 import subprocess
 import sys
 
-KERNELS = ["jd", "jacobians", "bias_terms", "mass", "bias", "gravity",
-           "dynamics", "forward_dynamics", "inverse_dynamics", "reactions"]
+KERNELS = ["jd", "ik_jd", "param_ik_jd", "jacobians", "bias_terms", "mass",
+           "param_mass", "bias", "gravity", "dynamics", "param_dynamics",
+           "forward_dynamics", "inverse_dynamics", "reactions"]
+# Runtime-parameter kernels and the constant kernel each is compared with.
+PARAM_COST = {"ik_jd": "param_ik_jd", "mass": "param_mass",
+              "dynamics": "param_dynamics"}
 
 
 def fail(msg):
@@ -76,6 +81,25 @@ def main():
     for name, diff in doc.get("max_rel_diff", {}).items():
         if not (isinstance(diff, (int, float)) and diff <= 1e-9):
             fail("kernel %r: generated and reference differ by %r" % (name, diff))
+    cost = doc.get("param_cost")
+    if not isinstance(cost, dict) or set(cost) != set(PARAM_COST):
+        fail("'param_cost' must list %s: %r" % (sorted(PARAM_COST), cost))
+    for const, param in PARAM_COST.items():
+        c = cost[const]
+        if set(c) != {"param_ns", "constant_ns", "ratio", "param_arith",
+                      "constant_arith"}:
+            fail("param_cost %r has keys %s" % (const, sorted(c)))
+        if c["param_ns"] != kernels[param]["generated_ns"] or \
+                c["constant_ns"] != kernels[const]["generated_ns"]:
+            fail("param_cost %r does not repeat the kernels' times" % const)
+        want = c["param_ns"] / c["constant_ns"]
+        if not positive(c["ratio"]) or abs(c["ratio"] - want) > 2e-3 * want:
+            fail("param_cost %r: ratio %r is not param/constant = %g"
+                 % (const, c["ratio"], want))
+        if not (isinstance(c["param_arith"], int) and
+                isinstance(c["constant_arith"], int) and
+                c["param_arith"] >= c["constant_arith"] > 0):
+            fail("param_cost %r: operation counts %r" % (const, c))
     sim = doc.get("simulated_second")
     if not isinstance(sim, dict) or not positive(sim.get("generated_s")):
         fail("simulated_second missing")
