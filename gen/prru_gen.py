@@ -93,8 +93,9 @@ def _run(args):
               % (args.out, exc.strerror), file=sys.stderr)
         return 1
     if not args.quiet:
+        width = max(18, max(len(e.name) for e in emitted))
         for e in emitted:
-            print("%-18s %s" % (e.name, e.summary()))
+            print("%-*s %s" % (width, e.name, e.summary()))
         print("wrote %s in %.2f s" % (", ".join(os.path.join(args.out, n)
                                                 for n in sorted(files)),
                                        time.perf_counter() - start))
