@@ -39,6 +39,8 @@ except ImportError:
 
 def cli(*args, ok=True):
     """Runs the CLI: its JSON on success, (exit status, stderr) when ok=False."""
+    if not os.access(CLI, os.X_OK):
+        raise AssertionError("the prru CLI %s is missing: build it, or set PRRU" % CLI)
     p = subprocess.run([CLI] + [str(a) for a in args], capture_output=True, text=True)
     if not ok:
         return p.returncode, p.stderr
