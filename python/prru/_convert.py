@@ -11,30 +11,43 @@ was made with numpy=True, in which case they are NumPy arrays (matrices
 """
 
 import ctypes
-import math
 import numbers
+from math import isfinite
+
+
+def _check_item(name, i, v):
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise TypeError("%s[%d] must be a real number, got %s" % (name, i, type(v).__name__))
 
 
 def vector(name, value, n):
     """value as a ctypes array of n finite doubles; ValueError/TypeError naming name."""
-    if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__len__"):
-        raise TypeError("%s must be a sequence of %d numbers, got %s"
-                        % (name, n, type(value).__name__))
-    ndim = getattr(value, "ndim", 1)
-    if ndim != 1:
-        raise ValueError("%s must be a sequence of %d numbers (1-D), got an array of shape %s"
-                         % (name, n, tuple(getattr(value, "shape", ()))))
-    if len(value) != n:
-        raise ValueError("%s must have %d elements, got %d" % (name, n, len(value)))
-    items = value.tolist() if hasattr(value, "tolist") else list(value)
-    out = (ctypes.c_double * n)()
+    kind = type(value)
+    if kind is list or kind is tuple:  # the common case, checked without ABCs
+        items = value
+    else:
+        if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__len__"):
+            raise TypeError("%s must be a sequence of %d numbers, got %s"
+                            % (name, n, kind.__name__))
+        ndim = getattr(value, "ndim", 1)
+        if ndim != 1:
+            raise ValueError("%s must be a sequence of %d numbers (1-D), got an array of "
+                             "shape %s" % (name, n, tuple(getattr(value, "shape", ()))))
+        items = value.tolist() if hasattr(value, "tolist") else list(value)
+    if len(items) != n:
+        raise ValueError("%s must have %d elements, got %d" % (name, n, len(items)))
     for i, v in enumerate(items):
-        if isinstance(v, bool) or not isinstance(v, numbers.Real):
-            raise TypeError("%s[%d] must be a real number, got %s" % (name, i, type(v).__name__))
-        f = float(v)
-        if not math.isfinite(f):
-            raise ValueError("%s[%d] must be finite, got %r" % (name, i, f))
-        out[i] = f
+        kind = type(v)
+        if kind is not float and kind is not int:
+            _check_item(name, i, v)
+    try:
+        out = (ctypes.c_double * n)(*items)
+    except OverflowError:
+        raise ValueError("%s must be finite, got an integer beyond the double range" % name) \
+            from None
+    for i in range(n):
+        if not isfinite(out[i]):
+            raise ValueError("%s[%d] must be finite, got %r" % (name, i, out[i]))
     return out
 
 
@@ -48,7 +61,7 @@ def scalar(name, value, positive=False, allow_zero=True):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError("%s must be a real number, got %s" % (name, type(value).__name__))
     f = float(value)
-    if not math.isfinite(f):
+    if not isfinite(f):
         raise ValueError("%s must be finite, got %r" % (name, f))
     if positive and not (f > 0 or (allow_zero and f == 0)):
         raise ValueError("%s must be %s, got %r" % (name, "non-negative" if allow_zero

@@ -122,8 +122,8 @@ class Types:
             ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
             ("a", _arr(d, nlimb)),
             ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
-            ("coulomb_velocity", d),
-            ("joint", _arr(_JointInfo, njoint)), ("lambda_labels", _arr(ctypes.c_char_p, nlambda))]})
+            ("coulomb_velocity", d), ("joint", _arr(_JointInfo, njoint)),
+            ("lambda_labels", _arr(ctypes.c_char_p, nlambda))]})
         self.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": [
             ("fd", _arr(d, nact)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
         self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [

@@ -101,6 +101,9 @@ class Model:
 
     # ---- helpers ----
     def _fail(self, status, what):
+        """what: the call's description, or a function making it (built
+        only on failure: formatting costs more than the call)."""
+        what = what() if callable(what) else what
         raise errors.make_error(status, "%s: %s" % (what, self.lib.status_text(status)))
 
     def _call(self, what, fn, *args):
@@ -110,15 +113,11 @@ class Model:
             self._fail(st, what)
 
     def _loads(self, fd, fp, mp):
-        t = self.lib.types
-        l = t.Loads()
-        l.fd[:] = list(optional_vector("fd", fd, self.nact))
-        l.fp[:] = list(optional_vector("fp", fp, 3))
-        l.mp[:] = list(optional_vector("mp", mp, 3))
-        return l
+        return self.lib.types.Loads(optional_vector("fd", fd, self.nact),
+                                    optional_vector("fp", fp, 3), optional_vector("mp", mp, 3))
 
     def _reachable(self, what, q):
-        self._call("%s: q = %s" % (what, _fmt(q)), self.lib.check_reachable, q)
+        self._call(lambda: "%s: q = %s" % (what, _fmt(q)), self.lib.check_reachable, q)
 
     # ---- kinematics ----
     def check(self, q):
@@ -127,7 +126,8 @@ class Model:
         Unreachable, or Singular below jd_rcond_min."""
         q = vector("q", q, 3)
         rc = ctypes.c_double()
-        self._call("check: q = %s" % _fmt(q), self.lib.check_regular, q, ctypes.byref(rc))
+        self._call(lambda: "check: q = %s" % _fmt(q), self.lib.check_regular, q,
+                   ctypes.byref(rc))
         return rc.value
 
     def ik(self, q):
@@ -160,7 +160,7 @@ class Model:
         act = vector("d", d, self.nact)
         seed = self._fk_seed(act, seed)
         q = (ctypes.c_double * 3)()
-        self._call("fk: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
+        self._call(lambda: "fk: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
                    self.lib.forward_kinematics, act, seed, q)
         return self._out.vec(q)
 
@@ -171,7 +171,7 @@ class Model:
         act = vector("d", d, self.nact)
         seed = self._fk_seed(act, seed)
         q, res = (ctypes.c_double * 3)(), ctypes.c_double()
-        self._call("fk_lsq: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
+        self._call(lambda: "fk_lsq: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
                    self.lib.forward_kinematics_lsq, act, seed, q, ctypes.byref(res))
         return self._out.vec(q), res.value
 
@@ -222,7 +222,7 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         qdd = (ctypes.c_double * 3)()
-        self._call("forward_dynamics: q = %s" % _fmt(q), self.lib.forward_dynamics,
+        self._call(lambda: "forward_dynamics: q = %s" % _fmt(q), self.lib.forward_dynamics,
                    q, qd, ctypes.byref(l), qdd)
         return self._out.vec(qdd)
 
@@ -235,8 +235,8 @@ class Model:
         preload = _convert.scalar("preload", preload)
         l = self._loads(None, fp, mp)
         fd = (ctypes.c_double * self.nact)()
-        self._call("inverse_dynamics: q = %s" % _fmt(q), self.lib.inverse_dynamics_preload,
-                   q, qd, qdd, ctypes.byref(l), preload, fd)
+        self._call(lambda: "inverse_dynamics: q = %s" % _fmt(q),
+                   self.lib.inverse_dynamics_preload, q, qd, qdd, ctypes.byref(l), preload, fd)
         return self._out.vec(fd)
 
     def actuator_null(self, q):
@@ -248,7 +248,7 @@ class Model:
                                     "coordinates, no actuator null vector" % self.nact,
                                     errors.EINPUT)
         n = (ctypes.c_double * self.nact)()
-        self._call("actuator_null: q = %s" % _fmt(q), self.lib.actuator_null, q, n)
+        self._call(lambda: "actuator_null: q = %s" % _fmt(q), self.lib.actuator_null, q, n)
         return self._out.vec(n)
 
     def reactions(self, q, qd=None, fd=None, fp=None, mp=None, labelled=False):
@@ -259,7 +259,7 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         lam = (ctypes.c_double * self.nlambda)()
-        self._call("reactions: q = %s" % _fmt(q), self.lib.reactions, q, qd,
+        self._call(lambda: "reactions: q = %s" % _fmt(q), self.lib.reactions, q, qd,
                    ctypes.byref(l), lam)
         if labelled:
             return dict(zip(self.lambda_labels, lam))
@@ -273,7 +273,7 @@ class Model:
             raise errors.InputError("reaction_null: this model's reactions are determined, "
                                     "no null vector", errors.EINPUT)
         z = (ctypes.c_double * self.nlambda)()
-        self._call("reaction_null: q = %s" % _fmt(q), self.lib.reaction_null, q, z)
+        self._call(lambda: "reaction_null: q = %s" % _fmt(q), self.lib.reaction_null, q, z)
         return self._out.vec(z)
 
     def energy(self, q, qd=None):
@@ -291,7 +291,7 @@ class Model:
         Singular (w_R is not defined there)."""
         q = vector("q", q, 3)
         g = self.lib.types.GuardedDme()
-        self._call("dme: q = %s" % _fmt(q), self.lib.dme_eval, q, ctypes.byref(g.s))
+        self._call(lambda: "dme: q = %s" % _fmt(q), self.lib.dme_eval, q, ctypes.byref(g.s))
         o, out, n = g.s, self._out, self.nact
         return Dme(o.w_R, o.jd_rcond, out.vec(o.sigma), out.vec(o.semi_axis),
                    [out.vec(o.axis_dir[0]), out.vec(o.axis_dir[1])], o.sigma_T,
