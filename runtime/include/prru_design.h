@@ -1,0 +1,218 @@
+/* Design optimisation of the rotational dynamic manipulability w_R (paper
+ * section 5: choose geometry and inertia so that the w_R surface drops
+ * toward the plane w_R = 1 over the workspace) and the sensitivity of the
+ * global index to every parameter.
+ *
+ * A design is a prru_params (prru_param_kernels.h): every number of the
+ * model, which the runtime-parameter kernels take at run time, so that a
+ * candidate costs no code generation. A design is judged exactly as a
+ * model's map is: w_R by prru_dme_from, regularity by prru_jd_regular
+ * (with the design's own length scale, the mean upper link), the global
+ * index by prru_map_summarize; a design evaluated here and the same
+ * design written as a model file, regenerated and mapped by `prru map`
+ * give the same index (to the kernels' 1e-13 agreement).
+ *
+ * Parameter names (one number each):
+ *   b_i, l1_i, l2_i        rail offset, upper link, lower link of limb i (m)
+ *   a_1, a_2               U-joint offsets of limbs 1 and 2 (m)
+ *   m_B                    mass of body B (kg), B one of P L1.. U1.. S1..
+ *   com_B_x, com_B_y, com_B_z            its centre of mass (m, body frame)
+ *   I_B_xx, I_B_yy, I_B_zz, I_B_xy, I_B_xz, I_B_yz
+ *                          its inertia about the centre of mass (kg m^2)
+ *   armature_i             reflected drive inertia of actuator i (kg)
+ * Design variables tie parameters together (they move by the same amount;
+ * the variable's value and bounds are those of the first one listed):
+ *   b, l1, l2              every limb's; a: limbs 1 and 2 (a_1, a_2)
+ *   b_12, l1_3, a_1, ...   the limbs listed by their digits: b_12 is b_1
+ *                          and b_2 tied; b and a also without the
+ *                          underscore (b12, b3, a1), as the paper names them
+ *   m_B, com_B_x, I_B_xx   with B a body, or a body kind L, U or S for that
+ *                          body of every limb (m_U: every upper link's mass)
+ *   armature, armature_i   every actuator's, or actuator i's.
+ * Gravity, damping and Coulomb friction do not change w_R and are no
+ * design variables.
+ *
+ * Threading: the calls write only into their prru_design_data and
+ * outputs; use one prru_design_data per thread. prru_design_evaluate does
+ * not allocate. */
+#ifndef PRRU_DESIGN_H
+#define PRRU_DESIGN_H
+
+#include <stddef.h>
+
+#include "prru_dme.h"
+#include "prru_param_kernels.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The most parameters one design variable can tie (every body of a kind,
+ * every limb). */
+#define PRRU_DESIGN_MAX_TIE (PRRU_NBODY)
+
+typedef struct {
+  char name[24];                       /* as parsed, e.g. "b12", "I_U_xx" */
+  int n;                               /* parameters tied */
+  size_t offset[PRRU_DESIGN_MAX_TIE];  /* byte offsets of the doubles in prru_params */
+  double lo, hi;                       /* bounds of the value (the first parameter's) */
+} prru_design_var;
+
+/* Parses a parameter or variable name (grammar above) into v (bounds not
+ * set): PRRU_OK, or PRRU_EINPUT with msg saying why. */
+int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen);
+/* The number of single parameters, and the k-th (0-based, order of the
+ * list above: geometry by limb, then every body's m, com, I, then the
+ * armatures) as a one-parameter variable named canonically ("b_1"). */
+int prru_design_param_count(void);
+int prru_design_param(int k, prru_design_var *v);
+/* The variable's value in p (its first parameter's). */
+double prru_design_get(const prru_params *p, const prru_design_var *v);
+/* Sets the variable to x: every tied parameter moves by x minus the
+ * first one's value in base (p and base may be the same). */
+void prru_design_set(prru_params *p, const prru_params *base, const prru_design_var *v, double x);
+/* A natural scale of the variable at p, for difference steps and scaled
+ * sensitivities: |value|, or where the value may be 0, the body's mean
+ * principal moment (products of inertia), the design's length scale
+ * (centres of mass), the mean slider mass (armature). */
+double prru_design_scale(const prru_params *p, const prru_design_var *v);
+
+/* The design's length scale: the mean upper link (prru_length_scale). */
+double prru_design_length_scale(const prru_params *p);
+
+/* Is p a buildable robot, by the rules a model file must follow: lengths
+ * and masses positive, armature not negative, every number 0 or of
+ * magnitude in [1e-9, 1e6], inertia tensors positive definite with
+ * principal moments obeying the triangle inequality, and every limb
+ * assembled at q = 0 (horizontal gap |b - a - l2| shorter than l1).
+ * PRRU_OK, or PRRU_EINPUT with msg naming the parameter and the rule. */
+int prru_design_check(const prru_params *p, char *msg, int msglen);
+
+typedef enum {
+  PRRU_OBJ_MEAN = 0, /* global index: mean of w_R - 1 over the regular grid points */
+  PRRU_OBJ_MAX = 1,  /* the largest w_R on the grid */
+  PRRU_OBJ_LOG = 2   /* mean of ln w_R over the regular grid points */
+} prru_objective;
+
+/* "mean", "max", "log"; PRRU_OK or PRRU_EINPUT. */
+int prru_objective_parse(const char *s, prru_objective *o);
+const char *prru_objective_name(prru_objective o);
+
+/* The optimisation problem: where and how a design is judged. */
+typedef struct {
+  prru_map_grid grid;     /* the workspace rectangle (prru_map_check) */
+  double rcond_min;       /* J_d regular where rcond >= this, in (0, 1) */
+  prru_objective objective;
+  int stroke;             /* non-zero: every slider within [stroke_lo, stroke_hi] */
+  double stroke_lo, stroke_hi; /* m */
+  /* The constraints enter as a penalty: merit = objective + weight *
+   * (regularity violation + stroke violation), both 0 exactly when the
+   * design is feasible. */
+  double penalty_weight;
+} prru_design_problem;
+
+/* Fig. 7-like defaults for a grid: rcond_min 4e-3 (cond_1 <= 250), mean,
+ * no stroke limits, weight 1000. */
+void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g);
+/* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
+int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
+
+/* Per-grid-point workspace, allocated once per problem. */
+typedef struct {
+  long n;
+  double *w_R;           /* n, NaN where status != PRRU_OK */
+  unsigned char *status; /* n, a prru_status per point */
+} prru_design_data;
+
+/* PRRU_OK or PRRU_ENOMEM. */
+int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g);
+void prru_design_data_free(prru_design_data *dd);
+
+typedef struct {
+  int valid;                 /* prru_design_check passed (otherwise only merit is set) */
+  prru_map_summary sum;      /* the map's summary of the grid */
+  double objective;          /* the chosen measure; NaN when no point is regular */
+  /* Regularity violation: the mean over the grid points of
+   * min(C, ln(rcond_min / rcond)) where rcond < rcond_min, C =
+   * ln(rcond_min / DBL_EPSILON) where unreachable (J_d's conditioning
+   * falls to 0 at the reach boundary, so it is continuous there). */
+  double reg_violation;
+  /* Stroke violation: the mean over the reachable points of the sum over
+   * the sliders of the distance outside [lo, hi], in units of the length
+   * scale (0 without stroke limits). */
+  double stroke_violation;
+  double d_min, d_max;       /* slider range over the reachable points (m) */
+  double merit;              /* what the optimiser minimizes */
+  int feasible;              /* valid, every point regular, strokes kept */
+} prru_design_eval;
+
+/* Evaluates p on the problem's grid into dd and ev. The design is checked
+ * first (prru_design_check); an invalid one gets merit = 1e30 and
+ * ev->valid = 0. Returns PRRU_OK, or PRRU_EINPUT for an invalid design. */
+int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
+                         prru_design_data *dd, prru_design_eval *ev);
+
+/* ---- Optimisation ---- */
+
+/* Called once per iteration; a non-zero return stops the run. */
+typedef int (*prru_design_progress_fn)(int iter, int evals, const prru_design_eval *best,
+                                       double size, void *ctx);
+
+typedef struct {
+  int max_iter;          /* Nelder-Mead iterations over all restarts (default 600) */
+  double tol;            /* simplex size at which a run stops (default 1e-5) */
+  int restarts;          /* fresh simplices from the best point (default 2) */
+  prru_design_progress_fn progress; void *ctx;
+} prru_design_options;
+
+void prru_design_options_default(prru_design_options *o);
+
+typedef struct {
+  prru_params best;      /* the best design found */
+  prru_design_eval start_eval, best_eval;
+  double x0[64], x[64];  /* the variables at the start and at the best design */
+  int iterations, evaluations, restarts_done;
+  int converged;         /* the last run stopped at tol (not at max_iter) */
+} prru_design_result;
+
+/* The most design variables. */
+#define PRRU_DESIGN_MAX_VARS 64
+
+/* Minimizes the merit over the variables within their bounds (GSL
+ * nmsimplex2 on x = lo + (hi - lo) (1 + sin u) / 2, which keeps every
+ * candidate inside the box without clipping), from start, then restarts
+ * from the best point. Deterministic: the same inputs give the same bits.
+ * PRRU_OK; PRRU_EINPUT (bad bounds: lo >= hi, a start outside them, more
+ * than PRRU_DESIGN_MAX_VARS, msg says which); PRRU_EINTERRUPTED (the
+ * progress callback stopped it; r holds the best so far); PRRU_ENOMEM. */
+int prru_design_optimize(const prru_design_problem *pr, const prru_params *start,
+                         const prru_design_var *vars, int nvar, const prru_design_options *o,
+                         prru_design_result *r, char *msg, int msglen);
+
+/* ---- Sensitivity ---- */
+
+typedef struct {
+  double value;          /* the parameter at the design */
+  double step;           /* h = rel_step * scale */
+  double scale;          /* prru_design_scale */
+  double f_plus, f_minus; /* objective at value + h and value - h */
+  double derivative;     /* (f_plus - f_minus) / (2 h) */
+  /* The regular set changed between value - h and value + h (a grid point
+   * crossed the singularity tolerance or the reach): the difference then
+   * mixes the derivative with a jump; the derivative is still reported. */
+  int set_changed;
+} prru_design_sens;
+
+/* Central difference of the objective with respect to v at p. Perturbed
+ * designs are evaluated without prru_design_check (a parameter at 0, such
+ * as an armature, is differentiated through 0); p itself must be valid.
+ * PRRU_OK, PRRU_EINPUT (p invalid, rel_step not in (0, 0.5)) or PRRU_ESINGULAR (no
+ * regular grid point at value +- h). */
+int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
+                            const prru_design_var *v, double rel_step, prru_design_data *dd,
+                            prru_design_sens *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PRRU_DESIGN_H */

@@ -1,0 +1,677 @@
+/* Design variables, validity, the global-index objective over a grid with
+ * the runtime-parameter kernels, Nelder-Mead optimisation and finite
+ * difference sensitivity; definitions in prru_design.h. */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_multimin.h>
+
+#include "internal.h"
+#include "prru_design.h"
+
+/* ---- Names ---- */
+
+static const char *const axis_names[3] = {"x", "y", "z"};
+static const char *const inertia_names[6] = {"xx", "yy", "zz", "xy", "xz", "yz"};
+
+#define OFF(member) offsetof(prru_params, member)
+
+static double *at(prru_params *p, size_t off)
+{
+  return (double *)(void *)((char *)p + off);
+}
+
+static double get(const prru_params *p, size_t off)
+{
+  return *(const double *)(const void *)((const char *)p + off);
+}
+
+static int body_index(const char *s, size_t len)
+{
+  for (int b = 0; b < PRRU_NBODY; b++)
+    if (strlen(prru_mech.body_names[b]) == len && strncmp(prru_mech.body_names[b], s, len) == 0)
+      return b;
+  return -1;
+}
+
+/* Bodies named by s[0..len): a body, or the kind L, U, S of every limb. */
+static int bodies_of(const char *s, size_t len, int bodies[PRRU_NBODY])
+{
+  int b = body_index(s, len);
+  if (b >= 0) {
+    bodies[0] = b;
+    return 1;
+  }
+  if (len != 1) return 0;
+  const int *kind = s[0] == 'L' ? prru_mech.lower : s[0] == 'U' ? prru_mech.upper
+                                : s[0] == 'S' ? prru_mech.slider : NULL;
+  if (!kind) return 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) bodies[i] = kind[i];
+  return PRRU_NLIMB;
+}
+
+static void add(prru_design_var *v, size_t off)
+{
+  v->offset[v->n++] = off;
+}
+
+/* Limbs from a digit string ("12"): each once, within 1..nmax. */
+static int limbs_of(const char *digits, int nmax, int limbs[PRRU_NLIMB])
+{
+  int n = 0, seen[10] = {0};
+  if (!*digits) return 0;
+  for (const char *c = digits; *c; c++) {
+    if (*c < '1' || *c > '9') return 0;
+    int l = *c - '0';
+    if (l > nmax || seen[l] || n >= PRRU_NLIMB) return 0;
+    seen[l] = 1;
+    limbs[n++] = l - 1;
+  }
+  return n;
+}
+
+static int parse_geometry(const char *name, prru_design_var *v)
+{
+  static const struct {
+    const char *base;
+    size_t off;
+    int bare_digits; /* b12, a1: digits may follow without '_' */
+  } geo[] = {{"b", OFF(b), 1}, {"l1", OFF(l1), 0}, {"l2", OFF(l2), 0}, {"a", OFF(a), 1}};
+  for (size_t g = 0; g < sizeof geo / sizeof geo[0]; g++) {
+    size_t bl = strlen(geo[g].base);
+    if (strncmp(name, geo[g].base, bl) != 0) continue;
+    const char *rest = name + bl;
+    int nmax = geo[g].off == OFF(a) ? 2 : PRRU_NLIMB, limbs[PRRU_NLIMB], n;
+    if (!*rest) {
+      n = nmax;
+      for (int i = 0; i < n; i++) limbs[i] = i;
+    } else if (*rest == '_') {
+      n = limbs_of(rest + 1, nmax, limbs);
+    } else if (geo[g].bare_digits) {
+      n = limbs_of(rest, nmax, limbs);
+    } else {
+      continue;
+    }
+    if (n == 0) return 0;
+    for (int i = 0; i < n; i++) add(v, geo[g].off + (size_t)limbs[i] * sizeof(double));
+    return 1;
+  }
+  return 0;
+}
+
+static int parse_inertial(const char *name, prru_design_var *v)
+{
+  int bodies[PRRU_NBODY], nb;
+  if (strncmp(name, "m_", 2) == 0) {
+    nb = bodies_of(name + 2, strlen(name + 2), bodies);
+    for (int i = 0; i < nb; i++) add(v, OFF(mass) + (size_t)bodies[i] * sizeof(double));
+    return nb > 0;
+  }
+  int is_com = strncmp(name, "com_", 4) == 0, is_i = strncmp(name, "I_", 2) == 0;
+  if (!is_com && !is_i) return 0;
+  const char *s = name + (is_com ? 4 : 2), *us = strrchr(s, '_');
+  if (!us) return 0;
+  nb = bodies_of(s, (size_t)(us - s), bodies);
+  int comp = -1;
+  for (int c = 0; c < (is_com ? 3 : 6); c++)
+    if (strcmp(us + 1, is_com ? axis_names[c] : inertia_names[c]) == 0) comp = c;
+  if (nb == 0 || comp < 0) return 0;
+  for (int i = 0; i < nb; i++)
+    add(v, is_com ? OFF(com) + ((size_t)bodies[i] * 3 + (size_t)comp) * sizeof(double)
+                  : OFF(inertia) + ((size_t)bodies[i] * 6 + (size_t)comp) * sizeof(double));
+  return 1;
+}
+
+static int parse_armature(const char *name, prru_design_var *v)
+{
+  if (strcmp(name, "armature") == 0) {
+    for (int i = 0; i < PRRU_NACT; i++) add(v, OFF(armature) + (size_t)i * sizeof(double));
+    return 1;
+  }
+  if (strncmp(name, "armature_", 9) != 0) return 0;
+  int acts[PRRU_NLIMB], n = limbs_of(name + 9, PRRU_NACT, acts);
+  for (int i = 0; i < n; i++) add(v, OFF(armature) + (size_t)acts[i] * sizeof(double));
+  return n > 0;
+}
+
+int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen)
+{
+  memset(v, 0, sizeof *v);
+  if (strlen(name) >= sizeof v->name)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "'%.30s...': not a design parameter (too long)", name);
+  snprintf(v->name, sizeof v->name, "%s", name);
+  if (parse_geometry(name, v) || parse_inertial(name, v) || parse_armature(name, v)) return PRRU_OK;
+  return prru_fail(msg, msglen, PRRU_EINPUT,
+                   "'%s': not a design parameter (b, l1, l2, a with limb digits such as b12, "
+                   "l1_2; m_B, com_B_x, I_B_xy with B a body (P L1 U1 S1 ...) or L, U, S; "
+                   "armature[_i])",
+                   name);
+}
+
+/* Single parameters in order: geometry by limb, then every body's mass,
+ * com, inertia, then the armatures. */
+#define NGEO (3 * PRRU_NLIMB + 2)
+#define NPERBODY 10
+
+int prru_design_param_count(void)
+{
+  return NGEO + NPERBODY * PRRU_NBODY + PRRU_NACT;
+}
+
+int prru_design_param(int k, prru_design_var *v)
+{
+  memset(v, 0, sizeof *v);
+  if (k < 0 || k >= prru_design_param_count()) return PRRU_EINPUT;
+  if (k < NGEO) {
+    static const char *const base[3] = {"b", "l1", "l2"};
+    static const size_t off[3] = {OFF(b), OFF(l1), OFF(l2)};
+    int g = k < 3 * PRRU_NLIMB ? k / PRRU_NLIMB : -1, i = g >= 0 ? k % PRRU_NLIMB : k - 3 * PRRU_NLIMB;
+    snprintf(v->name, sizeof v->name, "%s_%d", g >= 0 ? base[g] : "a", i + 1);
+    add(v, (g >= 0 ? off[g] : OFF(a)) + (size_t)i * sizeof(double));
+    return PRRU_OK;
+  }
+  k -= NGEO;
+  if (k < NPERBODY * PRRU_NBODY) {
+    int b = k / NPERBODY, c = k % NPERBODY;
+    const char *bn = prru_mech.body_names[b];
+    if (c == 0) {
+      snprintf(v->name, sizeof v->name, "m_%s", bn);
+      add(v, OFF(mass) + (size_t)b * sizeof(double));
+    } else if (c < 4) {
+      snprintf(v->name, sizeof v->name, "com_%s_%s", bn, axis_names[c - 1]);
+      add(v, OFF(com) + ((size_t)b * 3 + (size_t)(c - 1)) * sizeof(double));
+    } else {
+      snprintf(v->name, sizeof v->name, "I_%s_%s", bn, inertia_names[c - 4]);
+      add(v, OFF(inertia) + ((size_t)b * 6 + (size_t)(c - 4)) * sizeof(double));
+    }
+    return PRRU_OK;
+  }
+  k -= NPERBODY * PRRU_NBODY;
+  snprintf(v->name, sizeof v->name, "armature_%d", k + 1);
+  add(v, OFF(armature) + (size_t)k * sizeof(double));
+  return PRRU_OK;
+}
+
+double prru_design_get(const prru_params *p, const prru_design_var *v)
+{
+  return get(p, v->offset[0]);
+}
+
+void prru_design_set(prru_params *p, const prru_params *base, const prru_design_var *v, double x)
+{
+  double shift = x - get(base, v->offset[0]);
+  double vals[PRRU_DESIGN_MAX_TIE];
+  for (int i = 0; i < v->n; i++) vals[i] = get(base, v->offset[i]); /* p may be base */
+  for (int i = 0; i < v->n; i++) *at(p, v->offset[i]) = i == 0 ? x : vals[i] + shift;
+}
+
+double prru_design_length_scale(const prru_params *p)
+{
+  /* The same sum as prru_length_scale, so that a design and its
+   * regenerated model use the same bits. */
+  double s = 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) s += p->l1[i];
+  return s / PRRU_NLIMB;
+}
+
+double prru_design_scale(const prru_params *p, const prru_design_var *v)
+{
+  size_t off = v->offset[0];
+  double x = fabs(get(p, off));
+  if (off >= OFF(com) && off < OFF(com) + sizeof p->com) return prru_design_length_scale(p);
+  if (off >= OFF(inertia) && off < OFF(inertia) + sizeof p->inertia) {
+    size_t e = (off - OFF(inertia)) / sizeof(double);
+    if (e % 6 < 3) return x;
+    const double *t = p->inertia[e / 6];
+    return (fabs(t[0]) + fabs(t[1]) + fabs(t[2])) / 3.0;
+  }
+  if (off >= OFF(armature) && off < OFF(armature) + sizeof p->armature && !(x > 0)) {
+    double s = 0;
+    for (int i = 0; i < PRRU_NLIMB; i++) s += p->mass[prru_mech.slider[i]];
+    return s / PRRU_NLIMB;
+  }
+  return x;
+}
+
+/* ---- Validity ---- */
+
+static int in_file_range(double x)
+{
+  return isfinite(x) && (x == 0.0 || (fabs(x) >= 1e-9 && fabs(x) <= 1e6));
+}
+
+/* Leading minors (strict) or all principal minors (non-strict) of a
+ * symmetric 3x3, as the model loader's Sylvester test. */
+static int minors_ok(const double m[3][3], int strict)
+{
+  double d01 = m[0][0] * m[1][1] - m[0][1] * m[0][1], d02 = m[0][0] * m[2][2] - m[0][2] * m[0][2];
+  double d12 = m[1][1] * m[2][2] - m[1][2] * m[1][2];
+  double d3 = m[0][0] * d12 - m[0][1] * (m[0][1] * m[2][2] - m[1][2] * m[0][2]) +
+              m[0][2] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
+  if (strict) return m[0][0] > 0 && d01 > 0 && d3 > 0;
+  return m[0][0] >= 0 && m[1][1] >= 0 && m[2][2] >= 0 && d01 >= 0 && d02 >= 0 && d12 >= 0 &&
+         d3 >= 0;
+}
+
+static int inertia_ok(const double e[6], const char *body, char *msg, int msglen)
+{
+  const double t[3][3] = {{e[0], e[3], e[4]}, {e[3], e[1], e[5]}, {e[4], e[5], e[2]}};
+  if (!minors_ok(t, 1))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "I_%s: the inertia tensor is not positive definite",
+                     body);
+  /* tr(I)/2 E - I = the second moment of the mass, positive semidefinite:
+   * the triangle inequality of the principal moments. */
+  double h = (e[0] + e[1] + e[2]) / 2;
+  const double s[3][3] = {{h - e[0], -e[3], -e[4]}, {-e[3], h - e[1], -e[5]}, {-e[4], -e[5], h - e[2]}};
+  if (!minors_ok(s, 0))
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "I_%s: the principal moments violate the triangle inequality (no rigid body)",
+                     body);
+  return PRRU_OK;
+}
+
+static int numbers_ok(const prru_params *p, char *msg, int msglen)
+{
+  for (int k = 0; k < prru_design_param_count(); k++) {
+    prru_design_var v;
+    prru_design_param(k, &v);
+    double x = prru_design_get(p, &v);
+    if (!in_file_range(x))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "%s = %.17g: not 0 and not of magnitude in [1e-9, 1e6]",
+                       v.name, x);
+  }
+  return PRRU_OK;
+}
+
+static int limb_ok(const prru_params *p, int i, char *msg, int msglen)
+{
+  if (!(p->b[i] > 0) || !(p->l1[i] > 0) || !(p->l2[i] > 0))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "limb %d: b, l1, l2 must be positive (%g, %g, %g)",
+                     i + 1, p->b[i], p->l1[i], p->l2[i]);
+  double a = i < 2 ? p->a[i] : 0.0;
+  if (i < 2 && !(a > 0))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "a_%d = %g: must be positive", i + 1, a);
+  double gap = p->b[i] - a - p->l2[i];
+  if (!(fabs(gap) < p->l1[i]))
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "limb %d cannot be assembled at q = 0: the horizontal gap b - a - l2 = %g m "
+                     "must be shorter than l1 = %g m",
+                     i + 1, gap, p->l1[i]);
+  return PRRU_OK;
+}
+
+int prru_design_check(const prru_params *p, char *msg, int msglen)
+{
+  int st = numbers_ok(p, msg, msglen);
+  for (int i = 0; i < PRRU_NLIMB && st == PRRU_OK; i++) st = limb_ok(p, i, msg, msglen);
+  for (int b = 0; b < PRRU_NBODY && st == PRRU_OK; b++) {
+    if (!(p->mass[b] > 0))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "m_%s = %g: must be positive",
+                       prru_mech.body_names[b], p->mass[b]);
+    st = inertia_ok(p->inertia[b], prru_mech.body_names[b], msg, msglen);
+  }
+  for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++)
+    if (!(p->armature[i] >= 0))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "armature_%d = %g: must not be negative", i + 1,
+                       p->armature[i]);
+  return st;
+}
+
+/* ---- Objective ---- */
+
+int prru_objective_parse(const char *s, prru_objective *o)
+{
+  for (int k = 0; k < 3; k++)
+    if (strcmp(s, prru_objective_name((prru_objective)k)) == 0) {
+      *o = (prru_objective)k;
+      return PRRU_OK;
+    }
+  return PRRU_EINPUT;
+}
+
+const char *prru_objective_name(prru_objective o)
+{
+  return o == PRRU_OBJ_MAX ? "max" : o == PRRU_OBJ_LOG ? "log" : "mean";
+}
+
+void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g)
+{
+  pr->grid = *g;
+  pr->rcond_min = 4e-3;
+  pr->objective = PRRU_OBJ_MEAN;
+  pr->stroke = 0;
+  pr->stroke_lo = pr->stroke_hi = 0.0;
+  pr->penalty_weight = 1000.0;
+}
+
+int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen)
+{
+  if (prru_map_check(&pr->grid) != PRRU_OK)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "the grid is not valid (finite ranges lo < hi, "
+                                               "at least 2 points per axis)");
+  if (!(pr->rcond_min > 0 && pr->rcond_min < 1))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "rcond_min %g: must be in (0, 1)", pr->rcond_min);
+  if (pr->stroke && !(isfinite(pr->stroke_lo) && isfinite(pr->stroke_hi) &&
+                      pr->stroke_lo < pr->stroke_hi))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "stroke %g:%g: needs finite lo < hi", pr->stroke_lo,
+                     pr->stroke_hi);
+  if (!(pr->penalty_weight > 0 && isfinite(pr->penalty_weight)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "penalty weight %g: must be positive",
+                     pr->penalty_weight);
+  return PRRU_OK;
+}
+
+int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g)
+{
+  dd->n = (long)g->n1 * g->n2;
+  dd->w_R = malloc((size_t)dd->n * sizeof *dd->w_R);
+  dd->status = malloc((size_t)dd->n);
+  if (dd->w_R && dd->status) return PRRU_OK;
+  prru_design_data_free(dd);
+  return PRRU_ENOMEM;
+}
+
+void prru_design_data_free(prru_design_data *dd)
+{
+  free(dd->w_R);
+  free(dd->status);
+  dd->w_R = NULL;
+  dd->status = NULL;
+  dd->n = 0;
+}
+
+/* Distance of the sliders outside [lo, hi], summed. */
+static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_NACT])
+{
+  double e = 0;
+  for (int i = 0; i < PRRU_NACT; i++) e += fmax(0.0, pr->stroke_lo - d[i]) + fmax(0.0, d[i] - pr->stroke_hi);
+  return e;
+}
+
+/* w_R at one grid point exactly as prru_dme_eval does it with the model's
+ * kernels, here with the design's; *viol is the point's regularity
+ * violation (0 when it is regular). */
+static int point_w(const prru_design_problem *pr, const prru_params *p, double L, const double q[3],
+                   double d[PRRU_NACT], double *w, double *viol)
+{
+  const double cap = log(pr->rcond_min / DBL_EPSILON);
+  double Jd[PRRU_NACT * 3], Jdpinv[3 * PRRU_NACT], rc = 0.0;
+  prru_dme dme;
+  *w = NAN;
+  prru_param_ik_jd(p, q, d, Jd);
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(d[i])) {
+      *viol = cap;
+      return PRRU_EUNREACHABLE;
+    }
+  int st = prru_jd_regular(Jd, L, pr->rcond_min, Jdpinv, &rc);
+  if (st == PRRU_OK) {
+    double M[9], JP[18];
+    prru_param_mass(p, q, M);
+    prru_param_platform_jacobian(p, q, JP);
+    st = prru_dme_from(M, Jdpinv, JP, &dme);
+    *w = dme.w_R;
+  }
+  *viol = st == PRRU_OK ? 0.0 : rc > 0 && rc < pr->rcond_min ? fmin(cap, log(pr->rcond_min / rc)) : cap;
+  return st;
+}
+
+static double objective_of(const prru_design_problem *pr, const prru_map_summary *s)
+{
+  if (s->n_ok == 0) return NAN;
+  return pr->objective == PRRU_OBJ_MAX ? s->w_max : pr->objective == PRRU_OBJ_LOG ? s->index_log
+                                                                                  : s->index;
+}
+
+/* The merit of an invalid design: above any valid design's. */
+#define INVALID_MERIT 1e30
+
+int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
+                         prru_design_data *dd, prru_design_eval *ev)
+{
+  memset(ev, 0, sizeof *ev);
+  ev->objective = ev->d_min = ev->d_max = NAN;
+  ev->merit = INVALID_MERIT;
+  if (prru_design_check(p, NULL, 0) != PRRU_OK) return PRRU_EINPUT;
+  ev->valid = 1;
+  const prru_map_grid *g = &pr->grid;
+  const double L = prru_design_length_scale(p);
+  double viol = 0, stroke = 0, dmin = INFINITY, dmax = -INFINITY;
+  long nreach = 0;
+  for (int i = 0; i < g->n1; i++) {
+    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3}, d[PRRU_NACT], v;
+    for (int j = 0; j < g->n2; j++) {
+      long k = (long)i * g->n2 + j;
+      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
+      int st = point_w(pr, p, L, q, d, &dd->w_R[k], &v);
+      dd->status[k] = (unsigned char)st;
+      viol += v;
+      if (st == PRRU_EUNREACHABLE) continue;
+      nreach++;
+      for (int a = 0; a < PRRU_NACT; a++) {
+        dmin = fmin(dmin, d[a]);
+        dmax = fmax(dmax, d[a]);
+      }
+      if (pr->stroke) stroke += stroke_excess(pr, d) / L;
+    }
+  }
+  prru_map_summarize(g, dd->w_R, dd->status, &ev->sum);
+  ev->objective = objective_of(pr, &ev->sum);
+  ev->reg_violation = viol / (double)dd->n;
+  ev->stroke_violation = nreach ? stroke / (double)nreach : 0.0;
+  if (nreach) {
+    ev->d_min = dmin;
+    ev->d_max = dmax;
+  }
+  double f = isfinite(ev->objective) ? ev->objective : 0.0;
+  ev->merit = f + pr->penalty_weight * (ev->reg_violation + ev->stroke_violation);
+  ev->feasible = ev->sum.n_ok == ev->sum.n_points && ev->stroke_violation == 0.0;
+  return PRRU_OK;
+}
+
+/* ---- Optimisation ---- */
+
+void prru_design_options_default(prru_design_options *o)
+{
+  o->max_iter = 600;
+  o->tol = 1e-5;
+  o->restarts = 2;
+  o->progress = NULL;
+  o->ctx = NULL;
+}
+
+typedef struct {
+  const prru_design_problem *pr;
+  const prru_params *start;
+  const prru_design_var *vars;
+  int nvar, evals;
+  prru_design_data *dd;
+  prru_params cand;
+  prru_design_eval ev;
+  prru_design_result *r;
+} opt_ctx;
+
+/* The box transform: every u maps inside [lo, hi]. */
+static double x_of_u(const prru_design_var *v, double u)
+{
+  return v->lo + (v->hi - v->lo) * 0.5 * (1.0 + sin(u));
+}
+
+static double u_of_x(const prru_design_var *v, double x)
+{
+  double s = 2.0 * (x - v->lo) / (v->hi - v->lo) - 1.0;
+  return asin(fmax(-1.0, fmin(1.0, s)));
+}
+
+static void design_at(opt_ctx *c, const gsl_vector *u, double *x)
+{
+  c->cand = *c->start;
+  for (int i = 0; i < c->nvar; i++) {
+    x[i] = x_of_u(&c->vars[i], gsl_vector_get(u, (size_t)i));
+    prru_design_set(&c->cand, &c->cand, &c->vars[i], x[i]);
+  }
+}
+
+/* The merit at u; keeps the best design seen (strictly lower merit, so
+ * ties keep the first: the run is deterministic). */
+static double merit_at(const gsl_vector *u, void *params)
+{
+  opt_ctx *c = params;
+  double x[PRRU_DESIGN_MAX_VARS];
+  design_at(c, u, x);
+  prru_design_evaluate(c->pr, &c->cand, c->dd, &c->ev);
+  c->evals++;
+  if (c->ev.merit < c->r->best_eval.merit) {
+    c->r->best = c->cand;
+    c->r->best_eval = c->ev;
+    memcpy(c->r->x, x, sizeof(double) * (size_t)c->nvar);
+  }
+  return c->ev.merit;
+}
+
+static int check_vars(const prru_params *start, const prru_design_var *vars, int nvar, char *msg,
+                      int msglen)
+{
+  if (nvar < 1 || nvar > PRRU_DESIGN_MAX_VARS)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "%d design variables: 1 to %d allowed", nvar,
+                     PRRU_DESIGN_MAX_VARS);
+  for (int i = 0; i < nvar; i++) {
+    const prru_design_var *v = &vars[i];
+    double x = prru_design_get(start, v);
+    if (!(isfinite(v->lo) && isfinite(v->hi) && v->lo < v->hi))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "%s: infeasible bounds %.17g:%.17g (need lo < hi)",
+                       v->name, v->lo, v->hi);
+    if (!(x >= v->lo && x <= v->hi))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "%s: the start value %.17g is outside its bounds "
+                       "%.17g:%.17g", v->name, x, v->lo, v->hi);
+    for (int j = 0; j < i; j++)
+      for (int a = 0; a < v->n; a++)
+        for (int b = 0; b < vars[j].n; b++)
+          if (v->offset[a] == vars[j].offset[b])
+            return prru_fail(msg, msglen, PRRU_EINPUT, "%s and %s: a parameter appears in both",
+                             vars[j].name, v->name);
+  }
+  return PRRU_OK;
+}
+
+/* One Nelder-Mead run from the result's best point; PRRU_OK or
+ * PRRU_EINTERRUPTED / PRRU_ENOMEM. */
+static int nm_run(opt_ctx *c, const prru_design_options *o, int *iter_left)
+{
+  const size_t n = (size_t)c->nvar;
+  gsl_multimin_fminimizer *s = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2, n);
+  gsl_vector *u = gsl_vector_alloc(n), *step = gsl_vector_alloc(n);
+  int rc = s && u && step ? PRRU_OK : PRRU_ENOMEM;
+  if (rc == PRRU_OK) {
+    for (size_t i = 0; i < n; i++) {
+      double u0 = u_of_x(&c->vars[i], c->r->x[i]);
+      gsl_vector_set(u, i, u0);
+      /* 0.2 rad: about 10 % of a variable's range near the middle; the
+       * step points into the box at a bound (where sin is flat). */
+      gsl_vector_set(step, i, u0 > 1.2 ? -0.4 : 0.2);
+    }
+    gsl_multimin_function f = {merit_at, n, c};
+    if (gsl_multimin_fminimizer_set(s, &f, u, step) != GSL_SUCCESS) rc = PRRU_ENOMEM;
+  }
+  int status = GSL_CONTINUE;
+  while (rc == PRRU_OK && status == GSL_CONTINUE && *iter_left > 0) {
+    if (gsl_multimin_fminimizer_iterate(s) != GSL_SUCCESS) break; /* cannot improve */
+    (*iter_left)--;
+    c->r->iterations++;
+    double size = gsl_multimin_fminimizer_size(s);
+    status = gsl_multimin_test_size(size, o->tol);
+    if (o->progress && o->progress(c->r->iterations, c->evals, &c->r->best_eval, size, o->ctx))
+      rc = PRRU_EINTERRUPTED;
+  }
+  c->r->converged = status == GSL_SUCCESS;
+  gsl_vector_free(u);
+  gsl_vector_free(step);
+  gsl_multimin_fminimizer_free(s);
+  return rc;
+}
+
+int prru_design_optimize(const prru_design_problem *pr, const prru_params *start,
+                         const prru_design_var *vars, int nvar, const prru_design_options *o,
+                         prru_design_result *r, char *msg, int msglen)
+{
+  prru_gsl_init();
+  memset(r, 0, sizeof *r);
+  int st = prru_design_problem_check(pr, msg, msglen);
+  if (st == PRRU_OK) st = check_vars(start, vars, nvar, msg, msglen);
+  if (st != PRRU_OK) return st;
+  prru_design_data dd;
+  if (prru_design_data_alloc(&dd, &pr->grid) != PRRU_OK)
+    return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory for the grid");
+  opt_ctx c = {pr, start, vars, nvar, 0, &dd, *start, {0}, r};
+  r->best = *start;
+  prru_design_evaluate(pr, start, &dd, &r->start_eval);
+  r->best_eval = r->start_eval;
+  for (int i = 0; i < nvar; i++) r->x0[i] = r->x[i] = prru_design_get(start, &vars[i]);
+  int iter_left = o->max_iter;
+  double before = r->best_eval.merit;
+  st = nm_run(&c, o, &iter_left);
+  /* Restarts: a fresh simplex at the best point escapes the collapse that
+   * Nelder-Mead can suffer on a constraint's edge; stop once one gains
+   * nothing. */
+  while (st == PRRU_OK && r->restarts_done < o->restarts && iter_left > 0 &&
+         r->best_eval.merit < before) {
+    before = r->best_eval.merit;
+    r->restarts_done++;
+    st = nm_run(&c, o, &iter_left);
+  }
+  r->evaluations = c.evals;
+  prru_design_data_free(&dd);
+  if (st == PRRU_ENOMEM) return prru_fail(msg, msglen, st, "out of memory for the optimiser");
+  return st;
+}
+
+/* ---- Sensitivity ---- */
+
+/* The objective of q on the grid; with compare, sets *changed when a
+ * point's regularity differs from the statuses left in dd by the previous
+ * call (which this one then replaces). */
+static double objective_unchecked(const prru_design_problem *pr, const prru_params *q,
+                                  prru_design_data *dd, int compare, int *changed)
+{
+  const prru_map_grid *g = &pr->grid;
+  const double L = prru_design_length_scale(q);
+  for (int i = 0; i < g->n1; i++) {
+    double qq[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3}, d[PRRU_NACT], viol;
+    for (int j = 0; j < g->n2; j++) {
+      long k = (long)i * g->n2 + j;
+      qq[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
+      int st = point_w(pr, q, L, qq, d, &dd->w_R[k], &viol);
+      if (compare && (st == PRRU_OK) != (dd->status[k] == PRRU_OK)) *changed = 1;
+      dd->status[k] = (unsigned char)st;
+    }
+  }
+  prru_map_summary sum;
+  prru_map_summarize(g, dd->w_R, dd->status, &sum);
+  return objective_of(pr, &sum);
+}
+
+int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
+                            const prru_design_var *v, double rel_step, prru_design_data *dd,
+                            prru_design_sens *s)
+{
+  memset(s, 0, sizeof *s);
+  if (!(rel_step > 0 && rel_step < 0.5) || prru_design_check(p, NULL, 0) != PRRU_OK)
+    return PRRU_EINPUT;
+  s->value = prru_design_get(p, v);
+  s->scale = prru_design_scale(p, v);
+  s->step = rel_step * s->scale;
+  /* Without the validity check: the difference may reach past a
+   * parameter's limit (an armature of 0). */
+  prru_params q = *p;
+  prru_design_set(&q, p, v, s->value + s->step);
+  s->f_plus = objective_unchecked(pr, &q, dd, 0, &s->set_changed);
+  prru_design_set(&q, p, v, s->value - s->step);
+  s->f_minus = objective_unchecked(pr, &q, dd, 1, &s->set_changed);
+  if (!isfinite(s->f_plus) || !isfinite(s->f_minus)) return PRRU_ESINGULAR;
+  s->derivative = (s->f_plus - s->f_minus) / (2.0 * s->step);
+  return PRRU_OK;
+}

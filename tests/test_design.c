@@ -1,0 +1,290 @@
+/* Design optimisation (prru_design.h) on any model: the objective through
+ * the runtime-parameter kernels at the model's own numbers is the map's
+ * global index through the constant kernels; finite-difference
+ * sensitivities agree between two steps; invalid designs and variables
+ * are refused with reasons; the optimiser keeps its bounds, never worsens
+ * the start and is deterministic. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "prru_design.h"
+#include "testutil.h"
+
+#define PI 3.14159265358979323846
+
+/* Fig. 7's rectangle: every model's generic tests use it; points that a
+ * model cannot reach are counted as such by both paths. */
+static const prru_map_grid fig7 = {-PI / 6, PI / 6, -PI / 4, PI / 6, 0.0, 61, 57};
+/* A small rectangle around home, regular for any buildable model. */
+static const prru_map_grid home = {-0.15, 0.15, -0.12, 0.14, 0.0, 17, 15};
+
+static void objective_equals_map(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &fig7);
+  prru_design_data dd;
+  TU_TRUE(prru_design_data_alloc(&dd, &fig7) == PRRU_OK, "alloc");
+  prru_design_eval ev;
+  TU_TRUE(prru_design_evaluate(&pr, &prru_params_model, &dd, &ev) == PRRU_OK, "evaluate model");
+
+  prru_model m;
+  prru_model_default(&m);
+  m.jd_rcond_min = pr.rcond_min;
+  long n = (long)fig7.n1 * fig7.n2;
+  double *w = malloc((size_t)n * sizeof *w);
+  unsigned char *st = malloc((size_t)n);
+  prru_map_options o;
+  prru_map_options_default(&o);
+  prru_map_summary sum;
+  TU_TRUE(prru_map_eval(&m, &fig7, &o, w, st, &sum) == PRRU_OK, "map");
+  TU_TRUE(sum.n_ok > 0, "the rectangle has regular points");
+  TU_TRUE(sum.n_ok == ev.sum.n_ok && sum.n_singular == ev.sum.n_singular &&
+              sum.n_unreachable == ev.sum.n_unreachable,
+          "same statuses counted");
+  int same_status = 1;
+  double werr = 0;
+  for (long k = 0; k < n; k++) {
+    if (st[k] != dd.status[k]) same_status = 0;
+    if (st[k] == PRRU_OK) werr = fmax(werr, fabs(w[k] - dd.w_R[k]) / w[k]);
+  }
+  TU_TRUE(same_status, "the same status at every grid point");
+  tu_check(werr <= 1e-12, "w_R per point, parameter vs constant kernels", werr, 1e-12);
+  TU_CLOSE(&ev.sum.index, &sum.index, 1, 1e-12, "global index (mean w_R - 1)");
+  TU_CLOSE(&ev.sum.index_log, &sum.index_log, 1, 1e-12, "mean ln w_R");
+  TU_CLOSE(&ev.sum.w_max, &sum.w_max, 1, 1e-12, "max w_R");
+  TU_CLOSE(&ev.objective, &sum.index, 1, 1e-12, "objective mean = index");
+  TU_TRUE(ev.feasible == (sum.n_ok == sum.n_points), "feasible iff every point regular");
+  TU_TRUE((ev.reg_violation > 0) == (sum.n_ok < sum.n_points), "violation iff a point is not ok");
+  pr.objective = PRRU_OBJ_LOG;
+  prru_design_evaluate(&pr, &prru_params_model, &dd, &ev);
+  TU_CLOSE(&ev.objective, &sum.index_log, 1, 1e-12, "objective log = mean ln w_R");
+  pr.objective = PRRU_OBJ_MAX;
+  prru_design_evaluate(&pr, &prru_params_model, &dd, &ev);
+  TU_CLOSE(&ev.objective, &sum.w_max, 1, 1e-12, "objective max = max w_R");
+  free(w);
+  free(st);
+  prru_design_data_free(&dd);
+}
+
+static void stroke_limits(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_data dd;
+  prru_design_data_alloc(&dd, &home);
+  prru_design_eval ev;
+  prru_design_evaluate(&pr, &prru_params_model, &dd, &ev);
+  TU_TRUE(ev.feasible && ev.stroke_violation == 0 && ev.d_min < ev.d_max, "home rectangle regular");
+  pr.stroke = 1;
+  pr.stroke_lo = ev.d_min;
+  pr.stroke_hi = ev.d_max;
+  prru_design_eval ev2;
+  prru_design_evaluate(&pr, &prru_params_model, &dd, &ev2);
+  TU_TRUE(ev2.feasible && ev2.stroke_violation == 0, "stroke exactly the range used: feasible");
+  pr.stroke_hi = ev.d_max - 0.01 * (ev.d_max - ev.d_min);
+  prru_design_evaluate(&pr, &prru_params_model, &dd, &ev2);
+  TU_TRUE(!ev2.feasible && ev2.stroke_violation > 0 && ev2.merit > ev.merit,
+          "a shorter stroke is violated and penalized");
+  prru_design_data_free(&dd);
+}
+
+static void sensitivity_two_steps(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_data dd;
+  prru_design_data_alloc(&dd, &home);
+  const char *names[] = {"b_1", "b3", "l1", "l2_2", "a", "m_P", "I_P_xx", "I_U_zz", "com_P_x",
+                         "I_P_xy", "m_S", "armature"};
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+    prru_design_var v;
+    TU_TRUE(prru_design_var_parse(names[i], &v, NULL, 0) == PRRU_OK, names[i]);
+    prru_design_sens s1, s2;
+    int r1 = prru_design_sensitivity(&pr, &prru_params_model, &v, 1e-3, &dd, &s1);
+    int r2 = prru_design_sensitivity(&pr, &prru_params_model, &v, 5e-4, &dd, &s2);
+    char what[96];
+    snprintf(what, sizeof what, "d index / d %s: both steps ok, no status change", names[i]);
+    TU_TRUE(r1 == PRRU_OK && r2 == PRRU_OK && !s1.set_changed && !s2.set_changed, what);
+    /* Central differences: error O(h^2), so halving h changes the result
+     * by 3/4 of the first one's error. Scaled by the parameter's scale so
+     * that a derivative of ~0 is compared in the index's own units. */
+    double a = s1.derivative * s1.scale, b = s2.derivative * s2.scale;
+    double err = fabs(a - b) / fmax(fabs(b), 1e-3 * fabs(s1.f_plus));
+    snprintf(what, sizeof what, "d index / d %s with h and h/2", names[i]);
+    tu_check(err <= 1e-5, what, err, 1e-5);
+    snprintf(what, sizeof what, "step of %s = 1e-3 scale", names[i]);
+    TU_CLOSE(&s1.step, &(double){1e-3 * s1.scale}, 1, 1e-15, what);
+  }
+  /* Every single parameter is reachable by name and perturbs the
+   * objective only through itself. */
+  int np = prru_design_param_count(), ok = 1;
+  TU_TRUE(np == 3 * PRRU_NLIMB + 2 + 10 * PRRU_NBODY + PRRU_NACT, "parameter count");
+  for (int k = 0; k < np; k++) {
+    prru_design_var v, w;
+    prru_design_param(k, &v);
+    if (prru_design_var_parse(v.name, &w, NULL, 0) != PRRU_OK || w.n != 1 ||
+        w.offset[0] != v.offset[0])
+      ok = 0;
+  }
+  TU_TRUE(ok, "every canonical parameter name parses to itself");
+  prru_design_data_free(&dd);
+}
+
+static void variables(void)
+{
+  static const struct {
+    const char *name;
+    int n;
+  } good[] = {{"b12", 2},   {"b_12", 2}, {"b3", 1},    {"b", PRRU_NLIMB}, {"l1", PRRU_NLIMB},
+              {"l1_2", 1},  {"l2_13", 2}, {"a", 2},    {"a1", 1},         {"m_P", 1},
+              {"m_U", PRRU_NLIMB}, {"m_L2", 1}, {"com_S_z", PRRU_NLIMB}, {"I_P_xy", 1},
+              {"I_U1_zz", 1}, {"armature", PRRU_NACT}, {"armature_2", 1}};
+  for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) {
+    prru_design_var v;
+    char what[64];
+    snprintf(what, sizeof what, "variable %s ties %d", good[i].name, good[i].n);
+    TU_TRUE(prru_design_var_parse(good[i].name, &v, NULL, 0) == PRRU_OK && v.n == good[i].n, what);
+  }
+  const char *bad[] = {"", "b0", "b_", "b11", "l1_9", "l13", "a3", "foo", "I_P_xw", "m_Q", "com_P",
+                       "m_", "armature_0", "l1_12345", "gravity", "damping"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    prru_design_var v;
+    char msg[512] = "", what[64];
+    snprintf(what, sizeof what, "'%s' refused with its name in the message", bad[i]);
+    TU_TRUE(prru_design_var_parse(bad[i], &v, msg, sizeof msg) == PRRU_EINPUT &&
+                strstr(msg, bad[i]) && strstr(msg, "not a design parameter"),
+            what);
+  }
+  /* Tied parameters move by the same amount. */
+  prru_params p = prru_params_model;
+  p.l1[1] += 0.01;
+  prru_design_var v;
+  prru_design_var_parse("l1", &v, NULL, 0);
+  prru_design_set(&p, &p, &v, p.l1[0] + 0.002);
+  TU_TRUE(p.l1[0] == prru_params_model.l1[0] + 0.002 &&
+              fabs(p.l1[1] - (prru_params_model.l1[1] + 0.012)) < 1e-15,
+          "tied variable shifts every member");
+}
+
+static void check_refuses(const prru_params *p, const char *needle, const char *what)
+{
+  char msg[512] = "";
+  int st = prru_design_check(p, msg, sizeof msg);
+  if (!TU_TRUE(st == PRRU_EINPUT && strstr(msg, needle), what))
+    fprintf(stderr, "  message: %s\n", msg);
+}
+
+static void validity(void)
+{
+  char msg[512] = "";
+  TU_TRUE(prru_design_check(&prru_params_model, msg, sizeof msg) == PRRU_OK, "the model is valid");
+  prru_params p = prru_params_model;
+  p.l1[0] = -0.1;
+  check_refuses(&p, "limb 1", "negative l1");
+  p = prru_params_model;
+  p.b[PRRU_NLIMB - 1] = 10.0;
+  check_refuses(&p, "cannot be assembled", "a rail too far away");
+  p = prru_params_model;
+  p.mass[0] = 0;
+  check_refuses(&p, "m_P", "zero mass");
+  p = prru_params_model;
+  p.inertia[0][3] = 10 * (p.inertia[0][0] + p.inertia[0][1]);
+  check_refuses(&p, "not positive definite", "indefinite inertia");
+  p = prru_params_model;
+  p.inertia[0][2] = 1.5 * (p.inertia[0][0] + p.inertia[0][1]);
+  check_refuses(&p, "triangle", "triangle inequality");
+  p = prru_params_model;
+  p.com[1][0] = 1e-12;
+  check_refuses(&p, "com_", "a number the model file cannot hold");
+  p = prru_params_model;
+  p.armature[0] = -1;
+  check_refuses(&p, "armature_1", "negative armature");
+  p = prru_params_model;
+  p.l1[0] = NAN;
+  check_refuses(&p, "l1_1", "NaN");
+  /* An invalid design gets the invalid merit, not an evaluation. */
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_data dd;
+  prru_design_data_alloc(&dd, &home);
+  prru_design_eval ev;
+  p = prru_params_model;
+  p.mass[0] = -1;
+  TU_TRUE(prru_design_evaluate(&pr, &p, &dd, &ev) == PRRU_EINPUT && !ev.valid && ev.merit >= 1e30,
+          "invalid design evaluates to the invalid merit");
+  prru_design_data_free(&dd);
+}
+
+static void optimizer(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_var vars[2];
+  prru_design_var_parse("b", &vars[0], NULL, 0);
+  prru_design_var_parse("l2", &vars[1], NULL, 0);
+  for (int i = 0; i < 2; i++) {
+    double x = prru_design_get(&prru_params_model, &vars[i]);
+    vars[i].lo = 0.95 * x;
+    vars[i].hi = 1.05 * x;
+  }
+  prru_design_options o;
+  prru_design_options_default(&o);
+  o.max_iter = 60;
+  prru_design_result r1, r2;
+  char msg[512];
+  TU_TRUE(prru_design_optimize(&pr, &prru_params_model, vars, 2, &o, &r1, msg, sizeof msg) == PRRU_OK,
+          "optimize");
+  TU_TRUE(prru_design_optimize(&pr, &prru_params_model, vars, 2, &o, &r2, msg, sizeof msg) == PRRU_OK,
+          "optimize again");
+  TU_TRUE(memcmp(&r1.best, &r2.best, sizeof r1.best) == 0 &&
+              r1.best_eval.merit == r2.best_eval.merit && r1.evaluations == r2.evaluations,
+          "deterministic: the same design, merit and evaluations");
+  TU_TRUE(r1.best_eval.merit <= r1.start_eval.merit, "never worse than the start");
+  TU_TRUE(r1.best_eval.merit < r1.start_eval.merit, "improves on this rectangle");
+  int inside = 1;
+  for (int i = 0; i < 2; i++) {
+    double x = prru_design_get(&r1.best, &vars[i]);
+    if (!(x >= vars[i].lo && x <= vars[i].hi) || x != r1.x[i]) inside = 0;
+  }
+  TU_TRUE(inside, "the best design keeps its bounds");
+  /* Re-evaluated independently: the reported evaluation is the design's. */
+  prru_design_data dd;
+  prru_design_data_alloc(&dd, &home);
+  prru_design_eval ev;
+  prru_design_evaluate(&pr, &r1.best, &dd, &ev);
+  TU_TRUE(ev.merit == r1.best_eval.merit && ev.sum.index == r1.best_eval.sum.index,
+          "re-evaluation gives the same bits");
+  prru_design_data_free(&dd);
+  /* Bad bounds and variables. */
+  prru_design_var bad = vars[0];
+  bad.lo = bad.hi + 1;
+  TU_TRUE(prru_design_optimize(&pr, &prru_params_model, &bad, 1, &o, &r1, msg, sizeof msg) ==
+                  PRRU_EINPUT &&
+              strstr(msg, "infeasible bounds"),
+          "lo > hi refused");
+  bad = vars[0];
+  bad.lo = 2 * bad.hi;
+  bad.hi = 3 * bad.hi;
+  TU_TRUE(prru_design_optimize(&pr, &prru_params_model, &bad, 1, &o, &r1, msg, sizeof msg) ==
+                  PRRU_EINPUT &&
+              strstr(msg, "outside its bounds"),
+          "start outside the bounds refused");
+  prru_design_var dup[2] = {vars[0], vars[0]};
+  TU_TRUE(prru_design_optimize(&pr, &prru_params_model, dup, 2, &o, &r1, msg, sizeof msg) ==
+                  PRRU_EINPUT &&
+              strstr(msg, "appears in both"),
+          "a parameter in two variables refused");
+}
+
+int main(void)
+{
+  objective_equals_map();
+  stroke_limits();
+  sensitivity_two_steps();
+  variables();
+  validity();
+  optimizer();
+  return tu_finish("test_design");
+}
