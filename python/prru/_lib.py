@@ -380,9 +380,10 @@ def _resolve(path):
 
 def load_library(path=None):
     """The prru library at path (a file, or a build directory holding
-    runtime/libprru.so); without a path, $PRRU_LIB, then libprru.so beside
-    this package, then build/runtime/libprru.so of the source tree the
-    package sits in, then the system's library path.
+    runtime/libprru.so); without a path, $PRRU_LIB (when set, the only
+    place tried: a wrong setting is an error, not a fallback), then
+    libprru.so beside this package, then build/runtime/libprru.so of the
+    source tree the package sits in, then the system's library path.
 
     Raises LibraryNotFound naming every place tried and why it failed, and
     LayoutError when the library's structs differ from this package's."""
