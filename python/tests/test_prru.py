@@ -290,6 +290,45 @@ class TestRoundTrips(unittest.TestCase):
         self.assertEqual(bits(run.q[0]), bits(q))
 
 
+class TestPoses(unittest.TestCase):
+    def test_poses_energy_and_platform_jacobian(self):
+        """Rotations orthonormal; V = -sum m_b g . p_b from the poses and the
+        descriptor's masses and gravity equals energy()'s; the platform
+        Jacobians against central differences of R_P and of O' = p_P -
+        R_P com_P (the descriptor's centre of mass)."""
+        m, h = MODEL, 1e-6
+        P = m.platform
+        for q, qd, _, _, _ in random_states(5, 10):
+            R, p = m.poses(q)
+            self.assertEqual((len(R), len(p)), (m.nbody, m.nbody))
+            for Rb in R:
+                for i in range(3):
+                    for j in range(3):
+                        dot = sum(Rb[k][i] * Rb[k][j] for k in range(3))
+                        self.assertLessEqual(abs(dot - (i == j)), 1e-14)
+            V = -math.fsum(m.mass[b] * m.gravity[k] * p[b][k]
+                           for b in range(m.nbody) for k in range(3))
+            self.assertLessEqual(abs(V - m.energy(q)[1]), 1e-13 * abs(V))
+
+            def origin(qq):
+                Rq, pq = m.poses(qq)
+                return [pq[P][i] - sum(Rq[P][i][k] * m.com[P][k] for k in range(3))
+                        for i in range(3)]
+            qp = [a + h * b for a, b in zip(q, qd)]
+            qm = [a - h * b for a, b in zip(q, qd)]
+            Rp, Rm = m.poses(qp)[0][P], m.poses(qm)[0][P]
+            dR = [[(Rp[i][j] - Rm[i][j]) / (2 * h) for j in range(3)] for i in range(3)]
+            W = [[sum(dR[i][k] * R[P][j][k] for k in range(3)) for j in range(3)]
+                 for i in range(3)]  # dR R^T, skew: omega's cross matrix
+            omega = [W[2][1], W[0][2], W[1][0]]
+            v = [(a - b) / (2 * h) for a, b in zip(origin(qp), origin(qm))]
+            JR, JT = m.platform_jacobian(q)
+            for i in range(3):
+                self.assertLessEqual(abs(sum(JR[i][j] * qd[j] for j in range(3)) - omega[i]),
+                                     1e-8)
+                self.assertLessEqual(abs(sum(JT[i][j] * qd[j] for j in range(3)) - v[i]), 1e-8)
+
+
 class TestSimulation(unittest.TestCase):
     def test_scenario_paper_fields(self):
         s = MODEL.paper_scenario()
@@ -308,16 +347,26 @@ class TestSimulation(unittest.TestCase):
         self.assertEqual(bits(a.qdd), bits(b.qdd))
         self.assertIsNone(a.lambda_)
 
-    def test_scenario_file(self):
-        q, qd, fd, _, _ = random_states(1, 8)[0]
+    def test_scenario_file_with_a_load_table(self):
+        """A scenario file whose loads come from a CSV table: read here and
+        simulated, against `prru simulate --scenario` on the same file."""
+        q, qd, fd, fp, _ = random_states(1, 8)[0]
+        n = MODEL.nact
+        names = ["t"] + ["fd%d" % (i + 1) for i in range(n)] + ["fp1", "fp2", "fp3"]
+        table = [[0.0] + fd + fp, [0.012] + [-x for x in fd] + fp, [0.02] + fd + [0.0] * 3]
         with tempfile.TemporaryDirectory() as tmp:
             path = os.path.join(tmp, "s.scn")
+            with open(os.path.join(tmp, "loads.csv"), "w") as f:
+                f.write(",".join(names) + "\n")
+                f.writelines(arg(row) + "\n" for row in table)
             with open(path, "w") as f:
-                f.write("q0 = %s\nqd0 = %s\nfd = %s\nt_end = 0.03\ndt = 0.01\nstepper = rkf45\n"
-                        % (arg(q), arg(qd), arg(fd)))
+                f.write("q0 = %s\nqd0 = %s\nloads = loads.csv\nt_end = 0.03\ndt = 0.01\n"
+                        "stepper = rkf45\n" % (arg(q), arg(qd)))
             s = MODEL.read_scenario(path)
             self.assertEqual((s.t_end, s.dt, s.stepper), (0.03, 0.01, "rkf45"))
+            self.assertEqual([list(r) for r in s.table], [r + [0.0] * 3 for r in table])
             run = MODEL.simulate(scenario=s)
+            again = MODEL.simulate(q, qd, table=table, t_end=0.03, dt=0.01, stepper="rkf45")
             csv = os.path.join(tmp, "run.csv")
             cli("simulate", "--scenario", path, "--no-reactions", "--out", csv)
             lines = [l for l in read(csv).splitlines() if not l.startswith("#")]
@@ -326,9 +375,15 @@ class TestSimulation(unittest.TestCase):
             with self.assertRaises(prru.ParseError) as e:
                 MODEL.read_scenario(path)
             self.assertIn("s.scn:7", str(e.exception))
-        last = [float(x) for x in lines[-1].split(",")]
+            with self.assertRaises(prru.PrruIOError):
+                MODEL.read_scenario(os.path.join(tmp, "missing.scn"))
         self.assertEqual(len(run), 4)
-        self.assertEqual(bits(run.q[-1]), bits(last[1:4]))
+        self.assertEqual(len(lines), 5)
+        for k, line in enumerate(lines[1:]):
+            row = [float(x) for x in line.split(",")]
+            self.assertEqual(bits(run.q[k]), bits(row[1:4]))
+            self.assertEqual(bits(run.qd[k]), bits(row[4:7]))
+        self.assertEqual(bits(again.q), bits(run.q))
 
     def test_on_sample_stops_and_sees_every_sample(self):
         seen = []
