@@ -51,7 +51,7 @@ static void print_dme_help(void)
 
 static void json_vec(FILE *f, const double *v, int n)
 {
-  prru_cli_json_array(f, v, n, 1);
+  prru_cli_json_array(f, v, n);
 }
 
 int prru_cmd_dme(int argc, char **argv)
@@ -96,7 +96,7 @@ int prru_cmd_dme(int argc, char **argv)
   fputs(", \"semi_axes\": ", f);
   json_vec(f, r.semi_axis, 2);
   fputs(", \"axis_directions\": ", f);
-  prru_cli_json_array(f, &r.axis_dir[0][0], 6, 2);
+  prru_cli_json_matrix(f, &r.axis_dir[0][0], 2, 3);
   fputs(", \"sigma_T\": ", f);
   prru_cli_json_number(f, r.sigma_T);
   fputs(", \"translational_half_length\": ", f);
@@ -104,11 +104,11 @@ int prru_cmd_dme(int argc, char **argv)
   fputs(", \"translational_direction\": ", f);
   json_vec(f, r.dir_T, 3);
   fputs(", \"Mt\": ", f);
-  prru_cli_json_array(f, r.Mt, PRRU_NACT * PRRU_NACT, PRRU_NACT);
+  prru_cli_json_matrix(f, r.Mt, PRRU_NACT, PRRU_NACT);
   fputs(", \"JtR\": ", f);
-  prru_cli_json_array(f, r.JtR, 3 * PRRU_NACT, 3);
+  prru_cli_json_matrix(f, r.JtR, 3, PRRU_NACT);
   fputs(", \"JtT\": ", f);
-  prru_cli_json_array(f, r.JtT, 3 * PRRU_NACT, 3);
+  prru_cli_json_matrix(f, r.JtT, 3, PRRU_NACT);
   fputs("}\n", f);
   return ferror(f) ? 1 : 0;
 }

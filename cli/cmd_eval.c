@@ -11,8 +11,9 @@ static const char eval_help[] =
     "usage: prru eval --q q1,q2,q3 [--qd qd1,qd2,qd3] [--fd %s]\n"
     "                 [--fp fx,fy,fz] [--mp mx,my,mz]\n"
     "Prints JSON with model (name, file, sha256 of the model the build computes),\n"
-    "q, qd, M (3x3), h, G, passive (the drives' damping and friction as\n"
-    "generalized forces; zero for a model without them), d, Jd (actuators x q),\n"
+    "q, qd, M (3x3: a list of rows), h, G, passive (the drives' damping and friction as\n"
+    "generalized forces; zero for a model without them), d, Jd (one row\n"
+    "per actuator, one column per coordinate),\n"
     "qdd (under the given actuator forces fd (N), platform force fp (N) and\n"
     "moment mp (N m) at O', in {S}: M qdd + h = G + Jd^T fd + J_T,P^T fp +\n"
     "J_R,P^T mp + passive) and lambda (the %d joint reaction coordinates: force\n"
@@ -52,7 +53,14 @@ static int read_vec(const char *cmd, const char *name, const char *text, double 
 static void member(const char *sep, const char *name, const double *v, int n)
 {
   printf("%s\"%s\": ", sep, name);
-  prru_cli_json_array(stdout, v, n, 1);
+  prru_cli_json_array(stdout, v, n);
+}
+
+/* A rows x cols row-major matrix as nested row arrays. */
+static void member_matrix(const char *sep, const char *name, const double *v, int rows, int cols)
+{
+  printf("%s\"%s\": ", sep, name);
+  prru_cli_json_matrix(stdout, v, rows, cols);
 }
 
 int prru_cmd_eval(int argc, char **argv)
@@ -120,12 +128,12 @@ int prru_cmd_eval(int argc, char **argv)
   prru_cli_json_model(stdout);
   member(",\n ", "q", q, PRRU_NQ);
   member(", ", "qd", qd, PRRU_NQ);
-  member(",\n ", "M", M, PRRU_NQ * PRRU_NQ);
+  member_matrix(",\n ", "M", M, PRRU_NQ, PRRU_NQ);
   member(",\n ", "h", h, PRRU_NQ);
   member(", ", "G", G, PRRU_NQ);
   member(", ", "passive", passive, PRRU_NQ);
   member(",\n ", "d", act, PRRU_NACT);
-  member(", ", "Jd", Jd, PRRU_NACT * PRRU_NQ);
+  member_matrix(", ", "Jd", Jd, PRRU_NACT, PRRU_NQ);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   member(",\n ", "fd", l.fd, PRRU_NACT);

@@ -11,7 +11,8 @@
 static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
     "Prints JSON with model (name, file, sha256), q, the actuator displacements d\n"
-    "(m, slider heights), J_d = dd/dq (actuators x q, row-major), its reciprocal\n"
+    "(m, slider heights), J_d = dd/dq (a list of rows: one per actuator, one\n"
+    "column per coordinate), its reciprocal\n"
     "condition number and whether J_d is singular there; with redundant\n"
     "actuators (more sliders than coordinates) also actuator_null, the unit n\n"
     "with J_d^T n = 0 and a positive last component (not at a singular pose).\n"
@@ -47,11 +48,11 @@ int prru_cmd_ik(int argc, char **argv)
   putchar('{');
   prru_cli_json_model(stdout);
   printf(",\n \"q\": ");
-  prru_cli_json_array(stdout, q, PRRU_NQ, 1);
+  prru_cli_json_array(stdout, q, PRRU_NQ);
   printf(", \"d\": ");
-  prru_cli_json_array(stdout, d->d, PRRU_NACT, 1);
+  prru_cli_json_array(stdout, d->d, PRRU_NACT);
   printf(", \"Jd\": ");
-  prru_cli_json_array(stdout, d->Jd, PRRU_NACT * PRRU_NQ, 1);
+  prru_cli_json_matrix(stdout, d->Jd, PRRU_NACT, PRRU_NQ);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   printf(", \"singular\": %s", st == PRRU_ESINGULAR ? "true" : "false");
@@ -59,7 +60,7 @@ int prru_cmd_ik(int argc, char **argv)
   double n[PRRU_NACT];
   if (PRRU_NPRELOAD > 0 && st == PRRU_OK && prru_actuator_null(&m, d, q, n) == PRRU_OK) {
     printf(", \"actuator_null\": ");
-    prru_cli_json_array(stdout, n, PRRU_NACT, 1);
+    prru_cli_json_array(stdout, n, PRRU_NACT);
   }
   printf("}\n");
   free(d);
@@ -178,9 +179,9 @@ int prru_cmd_fk(int argc, char **argv)
   putchar('{');
   prru_cli_json_model(stdout);
   printf(",\n \"d\": ");
-  prru_cli_json_array(stdout, act, PRRU_NACT, 1);
+  prru_cli_json_array(stdout, act, PRRU_NACT);
   printf(", \"q\": ");
-  prru_cli_json_array(stdout, q, PRRU_NQ, 1);
+  prru_cli_json_array(stdout, q, PRRU_NQ);
   printf(", \"residual\": ");
   prru_cli_json_number(stdout, res);
   printf(", \"method\": \"%s\"", use_lsq ? "least-squares" : "newton");

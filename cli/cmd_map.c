@@ -1,33 +1,38 @@
 /* prru map: w_R over a (q1, q2) grid as CSV, and the global index. */
-#define _POSIX_C_SOURCE 200809L /* isatty */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "commands.h"
 #include "mapgrid.h"
+#include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
 
 static const char map_help[] =
     "usage: prru map --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"
-    "                --out FILE.csv [--rcond-min R] [--threads N] [--progress]\n"
+    "                --out FILE.csv|- [--rcond-min R] [--threads N] [--progress]\n"
     "w_R (see 'prru dme --help') at every grid point q1 = START..STOP (COUNT\n"
-    "equally spaced values, rad, COUNT >= 2, START < STOP), q2 likewise, q3 = Z\n"
-    "(m, default 0). Writes FILE.csv: the model line (# prru ... model ...), then\n"
-    "the columns q1,q2,q3,w_R,status (q1 outer); where the pose is singular or\n"
-    "unreachable w_R is NaN and status says which. Prints to stdout the model\n"
-    "(name, file, sha256) and the global index: the mean of w_R - 1 over the ok\n"
-    "points, with the fraction of the grid that is singular or unreachable (the\n"
+    "equally spaced values, rad, COUNT >= 2, START < STOP; START and STOP may be\n"
+    "multiples of pi: -pi/6:pi/6:201), q2 likewise, q3 = Z (m, default 0).\n"
+    "Writes FILE.csv (--out -: stdout): the model line (# prru ... model ...),\n"
+    "then the columns q1,q2,q3,w_R,status (q1 outer). status is ok, singular,\n"
+    "unreachable, or other_mode: a regular pose of the other assembly mode, where\n"
+    "det J_d has the opposite sign to the home pose's (q1 = q2 = 0 at this q3),\n"
+    "cut off from it by the singular locus, so the robot cannot get there\n"
+    "without passing a singularity%s. w_R is NaN unless the status is ok.\n"
+    "Prints the model (name, file, sha256) and the global index: the mean of\n"
+    "w_R - 1 over the ok points, with the share of the grid that is not ok (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
-    "and the range of w_R. J_d counts as singular when 1/(|J|_1 |J^%s|_1) < R,\n"
-    "J = J_d with its rotation columns divided by the mean upper-link length\n"
-    "(default R: 1e-8). If the grid crosses the singular locus, the mean of\n"
-    "w_R - 1 depends on how close grid points fall to it: compare designs with\n"
-    "a practical tolerance such as --rcond-min 4e-3. Uses N threads\n"
-    "(default 2); a progress bar goes to stderr for grids over 10000 points when\n"
-    "stderr is a terminal, or always with --progress.\n"
+    "and the range of w_R; to stdout, or to stderr when the CSV goes to stdout.\n"
+    "J_d counts as singular when 1/(|J|_1 |J^%s|_1) < R, J = J_d with its\n"
+    "rotation columns divided by the mean upper-link length; the default R =\n"
+    "%g (cond_1 > %g), the tolerance of prru paper's fig. 7, marks a band\n"
+    "around the singular locus, so that the index does not depend on how close\n"
+    "grid points happen to fall to it (--rcond-min 1e-8: numerical singularity\n"
+    "only). Uses N threads (default 2). Progress: a bar on stderr when it is a\n"
+    "terminal, for grids over 10000 points or with --progress; with --progress\n"
+    "and stderr not a terminal (a log), a line per 10 %%.\n"
     "FILE is checked before the grid is computed, built as FILE.partial-XXXXXX\n"
     "and renamed at the end: it keeps its old contents until then. SIGINT,\n"
     "SIGTERM or SIGHUP (exit 130, 143, 129) stop the computation; the complete\n"
@@ -45,7 +50,8 @@ int prru_cmd_map(int argc, char **argv)
                             {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("map", argc, argv, opts, 8)) return 2;
   if (help) {
-    printf(map_help, PRRU_NACT > 3 ? "+" : "-1");
+    printf(map_help, PRRU_NACT > 3 ? " (not tested with more actuators than\ncoordinates: J_d is not square)" : "",
+           PRRU_NACT > 3 ? "+" : "-1", PRRU_CLI_MAP_RCOND_MIN, 1.0 / PRRU_CLI_MAP_RCOND_MIN);
     return 0;
   }
   const char *missing = !q1s ? "--q1" : !q2s ? "--q2" : !out ? "--out" : NULL;
@@ -73,21 +79,21 @@ int prru_cmd_map(int argc, char **argv)
   }
   prru_model m;
   prru_model_default(&m);
+  m.jd_rcond_min = PRRU_CLI_MAP_RCOND_MIN;
   if (prru_cli_parse_rcond("map", rcs, &m)) return 2;
-  if (strcmp(out, "-") == 0) {
-    prru_cli_error("map", "--out -: the summary goes to stdout; give the CSV a file name");
-    return 2;
-  }
+  /* With the CSV on stdout the summary goes to stderr. */
+  FILE *summary = strcmp(out, "-") == 0 ? stderr : stdout;
   long npts = (long)g.n1 * g.n2;
-  int show = progress || (npts > 10000 && isatty(2));
+  prru_cli_progress bar;
+  prru_cli_progress_init(&bar, "map", "points", progress, npts > 10000);
   /* The output is created (and so checked) before the grid is computed. */
   prru_cli_catch_signals();
   prru_cli_out o;
   if (prru_cli_out_open(&o, "map", out)) return 1;
   double *w = NULL;
   unsigned char *st = NULL;
-  prru_map_summary sum;
-  int rc = prru_cli_map_run("map", &m, &g, nthreads, show, &w, &st, &sum);
+  prru_cli_map_summary sum;
+  int rc = prru_cli_map_run("map", &m, &g, nthreads, &bar, &w, &st, &sum);
   int nrows = rc == PRRU_OK ? g.n1 : rc == PRRU_EINTERRUPTED ? prru_cli_map_rows_done(&g, st) : 0;
   /* After a first signal the rows computed are still written; a later
    * one stops that too. */
@@ -108,7 +114,7 @@ int prru_cmd_map(int argc, char **argv)
   } else if (rc != PRRU_OK) {
     status = 1;
   } else {
-    prru_cli_map_print_summary(stdout, &sum, m.jd_rcond_min);
+    prru_cli_map_print_summary(summary, &sum, m.jd_rcond_min);
     status = 0;
   }
   free(w);

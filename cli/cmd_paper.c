@@ -327,6 +327,12 @@ int prru_cmd_paper(int argc, char **argv)
     prru_cli_error("paper", "--out DIR is required (see 'prru paper --help')");
     return 2;
   }
+  /* "-" means stdout for every other command; a directory cannot be. */
+  if (strcmp(out, "-") == 0) {
+    prru_cli_error("paper", "--out -: the study is a directory of files (CSVs, PNGs, summary.txt), "
+                   "it cannot go to stdout; give a directory name (./- for a directory named -)");
+    return 2;
+  }
   int is_paper = prru_cli_is_paper_model();
   if (!is_paper)
     prru_cli_error("paper", "warning: model %s is not the paper's; the figures show this model, "

@@ -1,12 +1,11 @@
 /* prru simulate: forward dynamics integrated with GSL, samples as CSV. */
-#define _POSIX_C_SOURCE 200809L /* isatty */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "commands.h"
+#include "progress.h"
 #include "prru.h"
 
 /* The runtime's samples and loads carry one d and fd per actuator. */
@@ -46,6 +45,21 @@ int prru_cli_csv_row(const prru_sample *s, void *ctx)
   return prru_cli_out_row(c->out) == 0 ? PRRU_OK : PRRU_EIO;
 }
 
+/* The CSV writer and the progress report, per sample. */
+typedef struct {
+  prru_cli_csv csv;
+  prru_cli_progress bar;
+  double t_end;
+} sim_output;
+
+static int on_sample(const prru_sample *s, void *ctx)
+{
+  sim_output *so = ctx;
+  int rc = prru_cli_csv_row(s, &so->csv);
+  prru_cli_progress_update(&so->bar, s->t, so->t_end);
+  return rc;
+}
+
 /* %s: d names, %d: PRRU_NLAMBDA, %s: the first label, %s: joint names in
  * column order, %s: fd names, %s: fd names. */
 static const char simulate_help[] =
@@ -79,6 +93,9 @@ static const char simulate_help[] =
     "as FILE.partial-XXXXXX beside it and renamed onto FILE at the end, so FILE\n"
     "keeps its old contents until then, and a run stopped before its first row\n"
     "(or by a write error) leaves it unchanged.\n"
+    "Progress: a bar on stderr when it is a terminal, for --progress or a run of\n"
+    "2000 samples or more into a file; with --progress and stderr not a terminal\n"
+    "(a log), a line per 10 %%.\n"
     "A run that leaves the workspace, meets a singular J_d or fails a step stops\n"
     "with a message and exit 1; SIGINT (Ctrl-C), SIGTERM or SIGHUP stop it with\n"
     "exit 130, 143 or 129. Either way every row computed so far is kept, and the\n"
@@ -265,17 +282,20 @@ int prru_cmd_simulate(int argc, char **argv)
   }
   const char *name = o.name;
   int in_place = o.tmp_path == NULL;
-  prru_cli_csv csv = {&o, &s.loads, !no_reactions};
+  sim_output so = {{&o, &s.loads, !no_reactions}, {0}, s.opt.t_end};
+  /* A bar by default only when the CSV does not go to the same terminal. */
+  prru_cli_progress_init(&so.bar, "simulate", NULL, progress,
+                         out && strcmp(out, "-") != 0 && s.opt.t_end / s.opt.dt_out >= 2000);
   s.opt.reactions = !no_reactions;
-  s.opt.on_sample = prru_cli_csv_row;
-  s.opt.ctx = &csv;
+  s.opt.on_sample = on_sample;
+  s.opt.ctx = &so;
   s.opt.loads = &s.loads;
-  s.opt.progress = progress || (out && strcmp(out, "-") != 0 && isatty(2) &&
-                                s.opt.t_end / s.opt.dt_out >= 2000);
+  s.opt.progress = 0;
   s.opt.interrupt = &prru_cli_interrupted;
-  prru_cli_csv_header(&csv);
+  prru_cli_csv_header(&so.csv);
   double t_stop;
   int st = prru_simulate(&m, s.q0, s.qd0, &s.opt, &t_stop, msg, sizeof msg);
+  if (st != PRRU_OK) prru_cli_progress_end(&so.bar);
   long rows = o.rows;
   /* A write error is reported as such (the runtime only saw the consumer
    * stop); otherwise every row computed is kept, whatever stopped the run. */

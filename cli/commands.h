@@ -87,8 +87,11 @@ int prru_cli_numbers(const char *cmd, const char *name, const char *text, double
 int prru_cli_number(const char *cmd, const char *name, const char *text, double *out);
 /* Writes a JSON number (%.17g) or null when not finite. */
 void prru_cli_json_number(FILE *f, double v);
-/* JSON array of n numbers; rows > 1 writes n/rows rows as nested arrays. */
-void prru_cli_json_array(FILE *f, const double *v, int n, int rows);
+/* JSON array of n numbers (a vector). */
+void prru_cli_json_array(FILE *f, const double *v, int n);
+/* Every matrix in the CLI's JSON: a list of rows, [[a11, a12, ..], [a21,
+ * ..], ..], from the row-major rows x cols array v (even for one row). */
+void prru_cli_json_matrix(FILE *f, const double *v, int rows, int cols);
 /* The number of the last SIGINT, SIGTERM or SIGHUP once
  * prru_cli_catch_signals() ran, 0 before: every long-running command
  * (simulate, id, map, paper) passes it to the runtime as the interrupt flag

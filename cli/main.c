@@ -14,7 +14,7 @@ static const struct {
     {"simulate", prru_cmd_simulate, "integrate the equations of motion, CSV of the samples"},
     {"ik", prru_cmd_ik, "actuator displacements d and J_d for a pose q (JSON)"},
     {"fk", prru_cmd_fk, "pose q for actuator displacements d (JSON; --lsq: least squares)"},
-    {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics; --preload)"},
+    {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
     {"paper", prru_cmd_paper, "reproduce the paper's simulation study and fig. 7 into a directory"},

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "mapgrid.h"
+#include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
 
@@ -31,17 +32,17 @@ int prru_cli_parse_range(const char *cmd, const char *name, const char *text, do
   char buf[256];
   const char *c1 = strchr(text, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
   if (!c1 || !c2 || strchr(c2 + 1, ':') || strlen(text) >= sizeof buf) {
-    prru_cli_error(cmd, "--%s '%s': expected START:STOP:COUNT (e.g. -0.5:0.5:101)", name, text);
+    prru_cli_error(cmd, "--%s '%s': expected START:STOP:COUNT (e.g. -0.5:0.5:101 or -pi/6:pi/6:201)", name, text);
     return 2;
   }
   strcpy(buf, text);
   char *a = buf, *b = buf + (c1 - text) + 1, *cnt = buf + (c2 - text) + 1;
   b[-1] = cnt[-1] = '\0';
-  if (prru_parse_double(a, lo) != PRRU_OK) {
+  if (prru_parse_value(a, lo) != PRRU_OK) {
     prru_cli_error(cmd, "--%s '%s': START '%s' is not a finite number", name, text, a);
     return 2;
   }
-  if (prru_parse_double(b, hi) != PRRU_OK) {
+  if (prru_parse_value(b, hi) != PRRU_OK) {
     prru_cli_error(cmd, "--%s '%s': STOP '%s' is not a finite number", name, text, b);
     return 2;
   }
@@ -64,24 +65,9 @@ int prru_cli_parse_range(const char *cmd, const char *name, const char *text, do
   return 0;
 }
 
-typedef struct {
-  int last; /* last percentage drawn */
-} progress_bar;
-
-static int draw_progress(long done, long total, void *ctx)
+static int report_progress(long done, long total, void *ctx)
 {
-  progress_bar *p = ctx;
-  int pct = (int)(100.0 * (double)done / (double)total);
-  if (pct != p->last) {
-    char bar[41];
-    int fill = pct * 40 / 100;
-    for (int i = 0; i < 40; i++) bar[i] = i < fill ? '#' : '.';
-    bar[40] = '\0';
-    fprintf(stderr, "\rmap [%s] %3d%% (%ld/%ld points)", bar, pct, done, total);
-    if (done == total) fputc('\n', stderr);
-    fflush(stderr);
-    p->last = pct;
-  }
+  prru_cli_progress_update(ctx, (double)done, (double)total);
   return 0;
 }
 
@@ -112,32 +98,91 @@ int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double
       if (st[k] == PRRU_OK)
         prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, g->q3, w[k]);
       else
-        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_dme_status_name(st[k]));
+        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_cli_map_status_name(st[k]));
       if (prru_cli_out_row(o)) return PRRU_EIO;
     }
   }
   return prru_cli_out_flush(o) ? PRRU_EIO : PRRU_OK;
 }
 
-void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
+const char *prru_cli_map_status_name(int status)
 {
+  return status == PRRU_CLI_MAP_OTHER_MODE ? "other_mode" : prru_dme_status_name(status);
+}
+
+void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *c, double rcond_min)
+{
+  const prru_map_summary *s = &c->s;
   fprintf(f, "model: %s\n", prru_cli_model_id());
-  fprintf(f, "points: %ld (ok %ld, singular %ld, unreachable %ld; J_d singular below rcond %g)\n",
-          s->n_points, s->n_ok, s->n_singular, s->n_unreachable, rcond_min);
+  fprintf(f, "points: %ld (ok %ld, singular %ld, unreachable %ld, other assembly mode %ld; J_d "
+             "singular below rcond %g)\n",
+          s->n_points, s->n_ok, s->n_singular - c->n_other_mode, s->n_unreachable, c->n_other_mode,
+          rcond_min);
   fprintf(f, "global_index: %.10g (mean of w_R - 1 over the ok points)\n", s->index);
-  fprintf(f, "singular_fraction: %.10g (singular or unreachable share of the grid)\n",
-          s->singular_fraction);
+  fprintf(f, "singular_fraction: %.10g (share of the grid that is singular, unreachable or in the "
+             "other assembly mode)\n", s->singular_fraction);
   fprintf(f, "index_log: %.10g (mean of ln w_R over the ok points)\n", s->index_log);
   if (s->n_ok)
     fprintf(f, "w_R range: %.10g at (q1, q2) = (%.6f, %.6f) to %.10g at (%.6f, %.6f)\n", s->w_min,
             s->w_min_q[0], s->w_min_q[1], s->w_max, s->w_max_q[0], s->w_max_q[1]);
 }
 
+/* The sign of det J_d at q: +1, -1, or 0 when it is zero, not finite
+ * (unreachable) or not defined (more actuators than coordinates). */
+static int jd_det_sign(const double q[3])
+{
+  if (PRRU_NACT != 3) return 0;
+  double d[PRRU_NACT], J[PRRU_NACT * 3];
+  prru_ik_jd(q, d, J);
+  double det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) +
+               J[2] * (J[3] * J[7] - J[4] * J[6]);
+  return det > 0 ? 1 : det < 0 ? -1 : 0;
+}
+
+/* Marks the ok poses whose det J_d sign is not the home pose's; returns
+ * how many, or -1 when the test does not apply. */
+static long mark_other_mode(const prru_map_grid *g, double *w, unsigned char *st)
+{
+  const int home = jd_det_sign((const double[3]){0.0, 0.0, g->q3});
+  if (home == 0) return -1;
+  long n = 0;
+  for (int i = 0; i < g->n1; i++) {
+    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3};
+    for (int j = 0; j < g->n2; j++) {
+      long k = (long)i * g->n2 + j;
+      if (st[k] != PRRU_OK) continue;
+      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
+      if (jd_det_sign(q) != home) {
+        st[k] = PRRU_CLI_MAP_OTHER_MODE;
+        w[k] = NAN;
+        n++;
+      }
+    }
+  }
+  return n;
+}
+
+/* The summary with the other assembly mode counted as not ok. */
+static int summarize(const prru_map_grid *g, const double *w, const unsigned char *st, long n_other,
+                     prru_cli_map_summary *sum)
+{
+  size_t n = (size_t)g->n1 * (size_t)g->n2;
+  unsigned char *tmp = malloc(n);
+  if (!tmp) return PRRU_ENOMEM;
+  for (size_t k = 0; k < n; k++) tmp[k] = st[k] == PRRU_CLI_MAP_OTHER_MODE ? PRRU_ESINGULAR : st[k];
+  prru_map_summarize(g, w, tmp, &sum->s);
+  free(tmp);
+  sum->n_other_mode = n_other > 0 ? n_other : 0;
+  sum->modes_checked = n_other >= 0;
+  return PRRU_OK;
+}
+
 /* Allocates and evaluates a map (statuses PRRU_CLI_MAP_NOT_DONE where it did not
  * get to): PRRU_OK, PRRU_EINTERRUPTED (a signal: the rows done so far are
  * in w and st) or another status after a message. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
-                   int progress, double **w, unsigned char **st, prru_map_summary *sum)
+                   prru_cli_progress *progress, double **w, unsigned char **st,
+                   prru_cli_map_summary *sum)
 {
   size_t n = (size_t)g->n1 * (size_t)g->n2;
   *w = malloc(n * sizeof **w);
@@ -150,15 +195,18 @@ int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *
   prru_map_options o;
   prru_map_options_default(&o);
   o.nthreads = nthreads;
-  progress_bar bar = {-1};
-  if (progress) {
-    o.progress = draw_progress;
-    o.ctx = &bar;
+  if (progress && progress->mode != PRRU_PROGRESS_OFF) {
+    o.progress = report_progress;
+    o.ctx = progress;
   }
   o.interrupt = &prru_cli_interrupted;
-  int rc = prru_map_eval(m, g, &o, *w, *st, sum);
+  int rc = prru_map_eval(m, g, &o, *w, *st, NULL);
+  if (rc == PRRU_OK || rc == PRRU_EINTERRUPTED) {
+    long n_other = mark_other_mode(g, *w, *st);
+    if (rc == PRRU_OK) rc = summarize(g, *w, *st, n_other, sum);
+  }
   if (rc != PRRU_OK) {
-    if (progress) fputc('\n', stderr);
+    if (progress) prru_cli_progress_end(progress);
     if (rc != PRRU_EINTERRUPTED) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
   }
   return rc;

@@ -6,12 +6,42 @@
 #include <stdio.h>
 
 #include "commands.h"
+#include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
 
 /* Grid statuses start as this: prru_map_eval writes a prru_status (small)
  * for every point it evaluated. */
 #define PRRU_CLI_MAP_NOT_DONE 0xFF
+/* A regular pose of the other assembly mode: det J_d has the opposite sign
+ * to the home pose's (q1 = q2 = 0 at the map's q3). det J_d changes sign
+ * only through det J_d = 0, so such a pose is cut off from the home pose by
+ * the singular locus: the robot assembled at home cannot reach it without
+ * crossing a singularity. w_R is NaN there and it is not counted as ok.
+ * Only for three actuators (a square J_d); with more, J_d has no sign. */
+#define PRRU_CLI_MAP_OTHER_MODE 0xFE
+
+/* The singularity tolerance of every w_R map the CLI computes (prru map's
+ * default, prru paper's fig. 7): J_d counts as singular where cond_1 > 250
+ * (of J_d with its rotation columns in units of the model's length, see
+ * prru_check_regular; the paper's home pose has about 4). With the model's
+ * numerical 1e-8 almost no grid point is flagged, w_R spikes to ~1e2-1e5
+ * next to the locus det J_d = 0 and the global index depends on the
+ * resolution (prru_dme.h); with 4e-3 the band around the locus is marked
+ * and the index converges. */
+#define PRRU_CLI_MAP_RCOND_MIN 4e-3
+
+/* A map's summary as the CLI reports it: the runtime's, with the poses of
+ * the other assembly mode counted as not ok (in s.n_singular and
+ * s.singular_fraction) and also on their own. */
+typedef struct {
+  prru_map_summary s;
+  long n_other_mode; /* of s.n_singular */
+  int modes_checked; /* 0: no sign test (redundant actuators, home pose not regular) */
+} prru_cli_map_summary;
+
+/* "ok", "singular", "unreachable", "other_mode" for a grid status. */
+const char *prru_cli_map_status_name(int status);
 
 /* --NAME "START:STOP:COUNT": finite START < STOP, an integer 2 <= COUNT <=
  * 1e6. 0, or 2 after a message naming cmd and the option. */
@@ -22,12 +52,14 @@ int prru_cli_parse_range(const char *cmd, const char *name, const char *text, do
 int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m);
 
 /* Allocates *w and *st (statuses PRRU_CLI_MAP_NOT_DONE where the run did
- * not get to) and evaluates the map with nthreads threads, a progress bar
- * on stderr when progress, stopping at prru_cli_interrupted. PRRU_OK,
+ * not get to) and evaluates the map with nthreads threads, reporting to
+ * progress (NULL: none), stopping at prru_cli_interrupted; then marks the
+ * poses of the other assembly mode (PRRU_CLI_MAP_OTHER_MODE). PRRU_OK,
  * PRRU_EINTERRUPTED (the rows done so far are in w and st) or another
  * status after a message. The caller frees *w and *st. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
-                     int progress, double **w, unsigned char **st, prru_map_summary *sum);
+                     prru_cli_progress *progress, double **w, unsigned char **st,
+                     prru_cli_map_summary *sum);
 /* The number of complete q1 rows of an interrupted map (prru_map_eval
  * hands rows out in order and finishes every row it started). */
 int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
@@ -38,7 +70,7 @@ int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
 int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double *w,
                            const unsigned char *st, int nrows, int signal_count);
 /* The summary `prru map` prints: model, point counts, global index,
- * singular fraction, mean ln w_R, range. */
-void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min);
+ * singular fraction, mean ln w_R, range (key: value lines). */
+void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *s, double rcond_min);
 
 #endif

@@ -16,14 +16,9 @@
 #include "prru_dme.h"
 
 #define FIG7_PI 3.14159265358979323846
-/* Fig. 7's practical-singularity tolerance: J_d counts as singular where
- * cond_1 > 250 (of J_d with its rotation columns in units of the model's
- * length, see prru_check_regular; the paper's home pose has about 4). With
- * the model's numerical 1e-8 no grid point is flagged, w_R spikes to
- * ~1e2-1e5 next to the locus det J_d = 0 and the global index depends on
- * the resolution (prru_dme.h); with 4e-3 the band around the locus is
- * marked and the index converges. The summary gives both. */
-#define FIG7_RCOND_MIN 4e-3
+/* The CLI's map tolerance (mapgrid.h); the summary also gives the grid at
+ * the model's numerical 1e-8 to show why. */
+#define FIG7_RCOND_MIN PRRU_CLI_MAP_RCOND_MIN
 
 static const double fig7a_poses[][2] = {{0.0, 0.0}, {0.4, 0.0}, {0.0, 0.45}, {0.0, -0.6}, {0.3, -0.5}};
 #define FIG7A_NPOSE ((int)(sizeof fig7a_poses / sizeof fig7a_poses[0]))
@@ -118,27 +113,19 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
   prru_map_grid g = {-FIG7_PI / 6, FIG7_PI / 6, -FIG7_PI / 4, FIG7_PI / 6, 0.0, 201, 201};
   double *w = NULL;
   unsigned char *st = NULL;
-  prru_map_summary sum, sum_numeric;
-  int rc = fig7_status(prru_cli_map_run("paper", &m, &g, 2, 0, &w, &st, &sum));
+  prru_cli_map_summary csum, csum_numeric;
+  int rc = fig7_status(prru_cli_map_run("paper", &m, &g, 2, NULL, &w, &st, &csum));
   if (rc == 0) {
     /* The same grid at the numerical tolerance, for the summary only. */
     prru_model mn = m;
     mn.jd_rcond_min = rcond_numeric;
-    prru_map_options o;
-    prru_map_options_default(&o);
-    o.interrupt = &prru_cli_interrupted;
-    double *w2 = malloc((size_t)g.n1 * g.n2 * sizeof *w2);
-    unsigned char *st2 = malloc((size_t)g.n1 * g.n2);
-    int s2 = w2 && st2 ? prru_map_eval(&mn, &g, &o, w2, st2, &sum_numeric) : PRRU_ENOMEM;
-    if (s2 == PRRU_EINTERRUPTED) {
-      rc = prru_cli_exit_interrupted();
-    } else if (s2 != PRRU_OK) {
-      prru_cli_error("paper", "fig. 7 map at the numerical tolerance: %s", prru_strerror(s2));
-      rc = 1;
-    }
+    double *w2 = NULL;
+    unsigned char *st2 = NULL;
+    rc = fig7_status(prru_cli_map_run("paper", &mn, &g, 2, NULL, &w2, &st2, &csum_numeric));
     free(w2);
     free(st2);
   }
+  const prru_map_summary *sum = &csum.s, *sum_numeric = &csum_numeric.s;
   char path[4200];
   if (rc == 0) {
     char shown[4200];
@@ -159,7 +146,7 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
   if (rc == 0 && !f) rc = 1;
   if (f) {
     prru_cli_csv_comment(f);
-    fputs("# q1 (rad) q2 (rad) w_R (NaN: singular or unreachable)\n", f);
+    fputs("# q1 (rad) q2 (rad) w_R (NaN: singular, unreachable or other assembly mode)\n", f);
     for (int i = 0; i < g.n1; i++) {
       for (int j = 0; j < g.n2; j++) {
         long k = (long)i * g.n2 + j;
@@ -178,13 +165,16 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
   if (rc == 0 && !f) rc = 1;
   if (f) {
     prru_cli_csv_comment(f);
-    fputs("# q1 (rad) q2 (rad) of the singular or unreachable grid points\n", f);
+    fputs("# q1 (rad) q2 (rad) kind (0 singular or unreachable, 1 other assembly mode) of the\n"
+          "# grid points that are not ok\n", f);
     for (long k = 0; k < (long)g.n1 * g.n2; k++)
       if (st[k] != PRRU_OK)
-        fprintf(f, "%.9g %.9g\n", prru_map_axis(g.q1_lo, g.q1_hi, g.n1, (int)(k / g.n2)),
-                prru_map_axis(g.q2_lo, g.q2_hi, g.n2, (int)(k % g.n2)));
-    /* gnuplot refuses an empty file: one point outside the plotted range. */
-    if (sum.n_ok == sum.n_points) fputs("1e3 1e3\n", f);
+        fprintf(f, "%.9g %.9g %d\n", prru_map_axis(g.q1_lo, g.q1_hi, g.n1, (int)(k / g.n2)),
+                prru_map_axis(g.q2_lo, g.q2_hi, g.n2, (int)(k % g.n2)),
+                st[k] == PRRU_CLI_MAP_OTHER_MODE);
+    /* gnuplot refuses a selection without points: one of each kind outside
+     * the plotted range. */
+    fputs("1e3 1e3 0\n1e3 1e3 1\n", f);
     rc = close_out(f, path);
   }
   prru_data *d = rc == 0 ? malloc(sizeof *d) : NULL;
@@ -220,16 +210,21 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
               home.semi_axis[0], home.semi_axis[1], home.half_length_T);
       fprintf(s, "with J_d singular where cond_1(J_d) > %g (rcond < %g):\n", 1.0 / FIG7_RCOND_MIN,
               FIG7_RCOND_MIN);
-      fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum.index);
-      fprintf(s, "  singular fraction = %.6g (%ld singular, %ld unreachable of %ld points)\n",
-              sum.singular_fraction, sum.n_singular, sum.n_unreachable, sum.n_points);
+      fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum->index);
+      fprintf(s, "  singular fraction = %.6g (%ld singular, %ld unreachable, %ld in the other assembly "
+                 "mode of %ld points)\n",
+              sum->singular_fraction, sum->n_singular - csum.n_other_mode, sum->n_unreachable,
+              csum.n_other_mode, sum->n_points);
       fprintf(s, "  mean ln w_R = %.10g; w_R from %.6g at (%.4f, %.4f) to %.6g at (%.4f, %.4f)\n",
-              sum.index_log, sum.w_min, sum.w_min_q[0], sum.w_min_q[1], sum.w_max, sum.w_max_q[0],
-              sum.w_max_q[1]);
-      fprintf(s, "with the numerical tolerance only (rcond < %g): global index = %.10g, singular "
+              sum->index_log, sum->w_min, sum->w_min_q[0], sum->w_min_q[1], sum->w_max,
+              sum->w_max_q[0], sum->w_max_q[1]);
+      if (csum.modes_checked)
+        fputs("  other assembly mode: det J_d of the opposite sign to the home pose's, beyond the "
+              "singular locus\n", s);
+      fprintf(s, "with the numerical tolerance only (rcond < %g): global index = %.10g, not-ok "
                  "fraction = %.6g, max w_R = %.6g\n%s",
-              rcond_numeric, sum_numeric.index, sum_numeric.singular_fraction, sum_numeric.w_max,
-              sum.n_singular + sum.n_unreachable > 0
+              rcond_numeric, sum_numeric->index, sum_numeric->singular_fraction, sum_numeric->w_max,
+              sum->n_singular + sum->n_unreachable > 0
                   ? "  (no band: the index is dominated by the grid points nearest det J_d = 0 and "
                     "changes with the resolution)\n"
                   : "  (the grid has no singular or unreachable point: both tolerances agree)\n");

@@ -121,11 +121,13 @@ int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option
 
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n)
 {
-  if (prru_parse_list(text, out, n) == PRRU_OK) return 0;
+  if (prru_parse_values(text, out, n) == PRRU_OK) return 0;
   if (n == 1)
-    prru_cli_error(cmd, "--%s: '%s' is not a finite number", name, text);
+    prru_cli_error(cmd, "--%s: '%s' is not a finite number (decimal, or a multiple of pi such as "
+                   "-pi/6)", name, text);
   else
-    prru_cli_error(cmd, "--%s: '%s' is not %d comma-separated finite numbers", name, text, n);
+    prru_cli_error(cmd, "--%s: '%s' is not %d comma-separated finite numbers (decimal, or multiples "
+                   "of pi such as -pi/6)", name, text, n);
   return 2;
 }
 
@@ -142,19 +144,14 @@ void prru_cli_json_number(FILE *f, double v)
     fputs("null", f);
 }
 
-void prru_cli_json_array(FILE *f, const double *v, int n, int rows)
+void prru_cli_json_array(FILE *f, const double *v, int n)
 {
-  int per = rows > 1 ? n / rows : n;
-  if (rows > 1) fputc('[', f);
-  for (int r = 0; r < (rows > 1 ? rows : 1); r++) {
-    fputs(r ? ", [" : "[", f);
-    for (int i = 0; i < per; i++) {
-      if (i) fputs(", ", f);
-      prru_cli_json_number(f, v[r * per + i]);
-    }
-    fputc(']', f);
+  fputc('[', f);
+  for (int i = 0; i < n; i++) {
+    if (i) fputs(", ", f);
+    prru_cli_json_number(f, v[i]);
   }
-  if (rows > 1) fputc(']', f);
+  fputc(']', f);
 }
 
 const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, const char *sep)
@@ -250,4 +247,14 @@ void prru_cli_json_model(FILE *f)
 void prru_cli_csv_comment(FILE *f)
 {
   fprintf(f, "# prru %s model %s\n", PRRU_VERSION, prru_cli_model_id());
+}
+
+void prru_cli_json_matrix(FILE *f, const double *v, int rows, int cols)
+{
+  fputc('[', f);
+  for (int r = 0; r < rows; r++) {
+    if (r) fputs(", ", f);
+    prru_cli_json_array(f, v + (size_t)r * (size_t)cols, cols);
+  }
+  fputc(']', f);
 }

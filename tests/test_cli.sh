@@ -49,10 +49,10 @@ awk 'length > 80 { print FILENAME ": " $0; bad = 1 } END { exit bad }' "$tmp/h.t
 "$PRRU" eval --q "$Q" --qd "$QD" --fd "$FD" >"$tmp/f.json" || bad "eval with loads failed"
 jcheck "$tmp/f.json" "d['model'] == model" "eval: model object"
 jcheck "$tmp/f.json" "len(d['lambda']) == len(d['lambda_labels']) == len(set(d['lambda_labels'])) > 0" "eval: one unique label per reaction coordinate"
-jcheck "$tmp/f.json" "len(d['d']) == len(d['fd']) == $nact and len(d['Jd']) == 3 * len(d['d']) and len(d['passive']) == 3" "eval: sizes"
+jcheck "$tmp/f.json" "len(d['d']) == len(d['fd']) == $nact and len(d['Jd']) == len(d['d']) and all(len(r) == 3 for r in d['Jd']) and len(d['M']) == 3 and all(len(r) == 3 for r in d['M']) and len(d['passive']) == 3" "eval: sizes"
 jcheck "$tmp/f.json" "0 < d['Jd_rcond'] and all(math.isfinite(x) for x in d['lambda'] + d['qdd'])" "eval: regular and finite at $Q"
 # M qdd + h = G + J_d^T fd + passive with the printed M, h, G, J_d, passive.
-r=$(json "$tmp/f.json" "max(abs(sum(d['M'][3*i+j]*d['qdd'][j] for j in range(3)) + d['h'][i] - d['G'][i] - d['passive'][i] - sum(d['Jd'][3*j+i]*d['fd'][j] for j in range(len(d['fd'])))) / (1 + abs(d['G'][i]) + sum(abs(x) for x in d['fd'])) for i in range(3))")
+r=$(json "$tmp/f.json" "max(abs(sum(d['M'][i][j]*d['qdd'][j] for j in range(3)) + d['h'][i] - d['G'][i] - d['passive'][i] - sum(d['Jd'][j][i]*d['fd'][j] for j in range(len(d['fd'])))) / (1 + abs(d['G'][i]) + sum(abs(x) for x in d['fd'])) for i in range(3))")
 below "$r" 1e-13 "eval qdd residual (with passive forces)"
 # Passive drive forces: zero at rest for any model; at speed non-zero
 # exactly when the model has damping or Coulomb friction.
@@ -173,7 +173,7 @@ if [ "$nact" -gt 3 ]; then
   # fd . n, z spans the reactions that load nothing (unit), lambda is the
   # least-norm solution (lambda . z = 0).
   jcheck "$tmp/f.json" "len(d['actuator_null']) == $nact and abs(sum(x * x for x in d['actuator_null']) - 1) < 1e-14 and d['actuator_null'][-1] > 0" "eval: actuator_null unit, n_N > 0"
-  jcheck "$tmp/f.json" "max(abs(sum(d['Jd'][3 * i + k] * d['actuator_null'][i] for i in range($nact))) for k in range(3)) < 1e-14" "eval: J_d^T n = 0"
+  jcheck "$tmp/f.json" "max(abs(sum(d['Jd'][i][k] * d['actuator_null'][i] for i in range($nact))) for k in range(3)) < 1e-14" "eval: J_d^T n = 0"
   jcheck "$tmp/f.json" "abs(d['preload'] - sum(a * b for a, b in zip(d['fd'], d['actuator_null']))) < 1e-12" "eval: preload = fd . n"
   jcheck "$tmp/f.json" "len(d['reaction_null']) == len(d['lambda']) and abs(sum(x * x for x in d['reaction_null']) - 1) < 1e-14" "eval: reaction_null unit"
   jcheck "$tmp/f.json" "abs(sum(a * b for a, b in zip(d['lambda'], d['reaction_null']))) < 1e-12 * max(abs(x) for x in d['lambda'])" "eval: lambda . reaction_null = 0 (least norm)"
@@ -211,7 +211,7 @@ for k, (ra, rb) in enumerate(zip(a, b)):
     if k % 10 == 0:  # J_d^T fd unchanged, with ik's J_d at the row's pose
         q = ','.join(sim[k][c] for c in ('q1', 'q2', 'q3'))
         J = json.loads(subprocess.run([sys.argv[4], 'ik', '--q', q], capture_output=True, text=True).stdout)['Jd']
-        jt = max(jt, max(abs(sum(J[3 * i + c] * (y - x) for i, (x, y) in enumerate(zip(fa, fb)))) for c in range(3)) / scale)
+        jt = max(jt, max(abs(sum(J[i][c] * (y - x) for i, (x, y) in enumerate(zip(fa, fb)))) for c in range(3)) / scale)
 print(shift, dot, jt)
 PY
   read -r shift dot jt <"$tmp/idp.txt"
@@ -307,5 +307,27 @@ expect 2 "cannot open" -- id --traj "$tmp/nonexistent.csv"
 expect 1 "cannot create" -- paper --out /proc/nope
 expect 0 "" -- --help
 expect 0 "" -- simulate --help
+
+# ---- one number syntax: multiples of pi wherever numbers are read ----
+"$PRRU" eval --q 0,pi/6,-0.8 --qd -pi/4,2pi,0.5pi >"$tmp/pi.json" || bad "eval with pi failed"
+"$PRRU" eval --q 0,0.52359877559829882,-0.8 --qd -0.78539816339744828,6.2831853071795862,1.5707963267948966 \
+  >"$tmp/dec.json" || bad "eval failed"
+cmp -s "$tmp/pi.json" "$tmp/dec.json" && ok || bad "eval: pi/6, -pi/4, 2pi, 0.5pi are not the decimal values"
+"$PRRU" ik --q 0.1,2*pi/30,-0.8 >"$tmp/pi.json" && "$PRRU" ik --q 0.1,0.20943951023931953,-0.8 >"$tmp/dec.json" \
+  && cmp -s "$tmp/pi.json" "$tmp/dec.json" && ok || bad "ik: 2*pi/30 is not 0.20943951023931953"
+for v in "2 pi" "pi/-6" "pi/0" "pix" "--pi" "pi*2" "2pi/" "/6" "p" "1e400pi" "pi/6pi" "nanpi" "0xpi"; do
+  expect 2 "is not 3 comma-separated finite numbers" -- ik --q "0,$v,-0.8"
+done
+# ---- one JSON matrix layout: a list of rows ----
+"$PRRU" ik --q 0.1,0.2,-0.8 >"$tmp/ik.json" || bad "ik failed"
+"$PRRU" dme --q 0.1,0.2,-0.8 >"$tmp/dme.json" || bad "dme failed"
+jcheck "$tmp/ik.json" "len(d['Jd']) == $nact and all(isinstance(r, list) and len(r) == 3 for r in d['Jd'])" "ik: Jd is $nact rows of 3"
+jcheck "$tmp/f.json" "[len(r) for r in d['M']] == [3, 3, 3] and len(d['Jd']) == $nact" "eval: M and Jd as rows"
+jcheck "$tmp/dme.json" "[len(r) for r in d['Mt']] == [$nact] * $nact and [len(r) for r in d['JtR']] == [$nact] * 3 and [len(r) for r in d['axis_directions']] == [3, 3]" "dme: Mt, JtR, axes as rows"
+"$PRRU" ik --q "$Q" >"$tmp/ikq.json" || bad "ik failed"
+jcheck "$tmp/f.json" "d['Jd'] == json.load(open('$tmp/ikq.json'))['Jd']" "eval and ik print the same Jd rows"
+# ---- --out - means stdout; a command that writes a directory refuses it ----
+expect 2 "--out -: the study is a directory of files" -- paper --out -
+[ ! -e ./- ] && ok || bad "paper --out - created a directory named -"
 
 finish test_cli

@@ -30,8 +30,7 @@ r=$(python3 - "$tmp/d2.json" "$tmp/e2.json" <<'PY'
 import json, sys
 dm, ev = (json.load(open(f)) for f in sys.argv[1:])
 N = len(ev['d'])
-J = [ev['Jd'][3 * i:3 * i + 3] for i in range(N)]
-M = [ev['M'][3 * i:3 * i + 3] for i in range(3)]
+J, M = ev['Jd'], ev['M']  # lists of rows
 A = [[sum(J[k][i] * J[k][j] for k in range(N)) for j in range(3)] for i in range(3)]
 det = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0])
        + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]))
@@ -68,7 +67,7 @@ for r in rows:
     w = float(r[3])
     st[r[4]] = st.get(r[4], 0) + 1
     if r[4] == 'ok' and not (math.isfinite(w) and w >= 1): errs.append('ok row %s' % r)
-    if r[4] != 'ok' and (r[3] != 'NaN' or r[4] not in ('singular', 'unreachable')): errs.append('bad row %s' % r)
+    if r[4] != 'ok' and (r[3] != 'NaN' or r[4] not in ('singular', 'unreachable', 'other_mode')): errs.append('bad row %s' % r)
 if not st.get('ok'): errs.append('statuses %s' % st)
 ok = [float(r[3]) - 1 for r in rows if r[4] == 'ok']
 idx = sum(ok) / len(ok)
@@ -91,11 +90,63 @@ PY
 "$PRRU" map --q1 -0.5235987755982988:0.5235987755982988:31 --q2 -0.7853981633974483:1.2:25 \
   --rcond-min 4e-3 --threads 1 --out "$tmp/m1.csv" >/dev/null 2>&1 || bad "map --threads 1 failed"
 cmp -s "$tmp/m.csv" "$tmp/m1.csv" && ok || bad "map with 1 and 2 threads differ"
-# Progress bar on request.
+# The other assembly mode: a regular grid point is other_mode exactly when
+# det J_d (from the J_d that prru ik prints there) has the opposite sign to
+# its value at the home pose q1 = q2 = 0 (three actuators: J_d is square).
+if [ "$nact" -eq 3 ]; then
+  r=$(python3 - "$tmp/m.csv" "$PRRU" <<'PY'
+import csv, json, subprocess, sys
+def det(q):
+    J = json.loads(subprocess.run([sys.argv[2], 'ik', '--q', ','.join(q)], capture_output=True, text=True, check=True).stdout)['Jd']
+    return (J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
+            + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]))
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith('#'))][1:]
+home = det(['0', '0', rows[0][2]]) > 0
+errs, n = [], {'ok': 0, 'other_mode': 0}
+# every other_mode point, and the ok points of every fourth row and column
+for i, r in enumerate(rows):
+    if r[4] == 'other_mode' or (r[4] == 'ok' and (i // 25) % 4 == 0 and (i % 25) % 4 == 0):
+        n[r[4]] += 1
+        if (det(r[:3]) > 0) != (home == (r[4] == 'ok')): errs.append('%s at %s' % (r[4], r[:2]))
+print('; '.join(errs[:3]) if errs else 'ok' if min(n.values()) > 0 else 'counts %s' % n)
+PY
+)
+  [ "$r" = ok ] && ok || bad "map: other_mode is not the opposite sign of det J_d: $r"
+fi
+# Progress: a bar only when stderr is a terminal (long grids, or any with
+# --progress); in a log only with --progress, as plain lines (no carriage
+# return), ending at 100 %.
 "$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out "$tmp/p.csv" --progress >/dev/null 2>"$tmp/p.err" || bad "map --progress"
-grep -q '100%' "$tmp/p.err" && ok || bad "no progress bar with --progress: $(cat "$tmp/p.err")"
-"$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out "$tmp/p.csv" >/dev/null 2>"$tmp/p.err" || bad "map"
-[ ! -s "$tmp/p.err" ] && ok || bad "small map, stderr not a TTY: no progress expected"
+grep -q '^map: 100% (121/121 points)$' "$tmp/p.err" && ! grep -q $'\r' "$tmp/p.err" && ok \
+  || bad "map --progress into a file: not plain lines ending at 100 %: $(cat -A "$tmp/p.err")"
+"$PRRU" map --q1 -0.5:0.5:201 --q2 -0.5:0.5:101 --out "$tmp/p.csv" >/dev/null 2>"$tmp/p.err" || bad "map"
+[ ! -s "$tmp/p.err" ] && ok || bad "large map, stderr not a terminal: no progress expected: $(head -c 200 "$tmp/p.err")"
+if command -v script >/dev/null; then
+  # script(1) gives the command a terminal.
+  script -qec "$PRRU map --q1 -0.5:0.5:201 --q2 -0.5:0.5:101 --out $tmp/p.csv" /dev/null >"$tmp/tty.txt" 2>&1
+  grep -q $'\rmap \[#' "$tmp/tty.txt" && grep -q '100% (20301/20301 points)' "$tmp/tty.txt" && ok \
+    || bad "map on a terminal: no progress bar: $(head -c 300 "$tmp/tty.txt")"
+  script -qec "$PRRU map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out $tmp/p.csv" /dev/null >"$tmp/tty.txt" 2>&1
+  grep -q 'map \[' "$tmp/tty.txt" && bad "small map on a terminal drew a bar" || ok
+  script -qec "$PRRU simulate --t-end 2 --out $tmp/s.csv" /dev/null >"$tmp/tty.txt" 2>&1
+  grep -q $'\rsimulate \[#' "$tmp/tty.txt" && ok || bad "simulate of 2001 samples on a terminal: no bar: $(head -c 300 "$tmp/tty.txt")"
+fi
+"$PRRU" simulate --t-end 2 --out "$tmp/s.csv" 2>"$tmp/p.err" || bad "simulate"
+[ ! -s "$tmp/p.err" ] && ok || bad "simulate, stderr not a terminal: no progress expected: $(head -c 200 "$tmp/p.err")"
+"$PRRU" simulate --t-end 0.05 --progress --out "$tmp/s.csv" 2>"$tmp/p.err" || bad "simulate --progress"
+[ "$(grep -c '^simulate: [0-9]*%$' "$tmp/p.err")" -eq 11 ] && ! grep -q $'\r' "$tmp/p.err" && ok \
+  || bad "simulate --progress into a file: not 11 plain lines: $(cat -A "$tmp/p.err" | head -c 300)"
+# pi in ranges: -pi/6:pi/6:5 is the grid of the decimal range.
+"$PRRU" map --q1 -pi/6:pi/6:5 --q2 -pi/4:0.5pi:3 --out "$tmp/pi.csv" >/dev/null 2>&1 || bad "map with pi ranges failed"
+"$PRRU" map --q1 -0.52359877559829882:0.52359877559829882:5 --q2 -0.78539816339744828:1.5707963267948966:3 \
+  --out "$tmp/dec.csv" >/dev/null 2>&1 || bad "map failed"
+cmp -s "$tmp/pi.csv" "$tmp/dec.csv" && ok || bad "map: -pi/6:pi/6 and the decimal range differ"
+expect 2 "--q1 'pi/0:1:5': START 'pi/0' is not a finite number" -- map --q1 pi/0:1:5 --q2 0:1:3 --out "$tmp/x.csv"
+# --out -: the CSV on stdout, the summary on stderr.
+"$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out "$tmp/p.csv" >"$tmp/p.txt" 2>/dev/null || bad "map"
+"$PRRU" map --q1 -0.5:0.5:11 --q2 -0.5:0.5:11 --out - >"$tmp/dash.csv" 2>"$tmp/dash.txt" || bad "map --out -"
+cmp -s "$tmp/p.csv" "$tmp/dash.csv" && cmp -s "$tmp/p.txt" "$tmp/dash.txt" && ok \
+  || bad "map --out -: stdout is not the CSV or stderr not the summary: $(head -c 200 "$tmp/dash.txt")"
 
 # Bad grids and arguments: exit 2, message naming the argument.
 q2ok="--q2 -0.5:0.5:11"

@@ -58,7 +58,7 @@ def det(q):
     r = subprocess.run([sys.argv[1], 'ik', '--q', ','.join(repr(x) for x in q)], capture_output=True, text=True)
     if r.returncode:
         return None
-    J = json.loads(r.stdout)['Jd']
+    J = [x for row in json.loads(r.stdout)['Jd'] for x in row]
     return (J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6])
             + J[2] * (J[3] * J[7] - J[4] * J[6]))
 for q1 in (0.0, 0.3, -0.3, 0.5, -0.5):

@@ -344,6 +344,11 @@ int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
 int prru_parse_list(const char *s, double *out, int n);
 /* One finite double, nothing else. */
 int prru_parse_double(const char *s, double *out);
+/* As prru_parse_double and prru_parse_list, also accepting multiples of
+ * pi (angles on the command line): [+|-][K[*]]pi[/N] with K and N decimal
+ * numbers, N > 0, e.g. pi, -pi/4, 2pi, 0.5pi, 2*pi/3. */
+int prru_parse_value(const char *s, double *out);
+int prru_parse_values(const char *s, double *out, int n);
 
 #ifdef __cplusplus
 }
