@@ -55,7 +55,8 @@ fi
 # ---- 2. fuzz corpus and regressions replayed under the sanitizers ----
 echo "== fuzz corpus and regression replay (gcc, ASan/UBSan)"
 rt_objs=()
-for src in "$SRC"/runtime/src/*.c "$SRC/generated/prru_kernels.c" "$SRC/generated/prru_mechanism.c"; do
+for src in "$SRC"/runtime/src/*.c "$SRC/generated/prru_kernels.c" "$SRC/generated/prru_mechanism.c" \
+  "$SRC/generated/prru_param_kernels.c"; do
   obj="$asan/replay_$(basename "$src" .c).o"
   # shellcheck disable=SC2086
   gcc -std=c99 -O1 -g $san_flags -I"$SRC/generated" -I"$SRC/runtime/include" \
