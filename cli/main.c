@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "design_cli.h"
 #include "prru.h"
 
 static const struct {
@@ -17,6 +18,9 @@ static const struct {
     {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
+    {"optimize", prru_cmd_optimize, "choose geometry/inertia so w_R is nearest 1 over a workspace"},
+    {"sensitivity", prru_cmd_sensitivity, "d(global index)/d(parameter) for every parameter, CSV"},
+    {"merge", prru_cmd_merge, "join the --shard K/N outputs of map or sensitivity"},
     {"paper", prru_cmd_paper, "reproduce the paper's simulation study and fig. 7 into a directory"},
 };
 
@@ -34,8 +38,8 @@ static void usage(FILE *f)
           PRRU_NLIMB, PRRU_NACT > 3 ? " (redundantly actuated)" : "", PRRU_NACT, prru_mech.name,
           prru_mech.model_file);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-    fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
-  fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
+    fprintf(f, "  %-11s %s\n", commands[i].name, commands[i].help);
+  fprintf(f, "  %-11s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
   fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
              "convergence, I/O error: the reason on stderr), 2 usage error or bad input\n"
              "file, 130/143/129 stopped by SIGINT/SIGTERM/SIGHUP (simulate, id, map,\n"

@@ -117,6 +117,34 @@ static void sensitivity_two_steps(void)
     snprintf(what, sizeof what, "step of %s = 1e-3 scale", names[i]);
     TU_CLOSE(&s1.step, &(double){1e-3 * s1.scale}, 1, 1e-15, what);
   }
+  /* Physics as an independent check: a slider only translates along its
+   * rail, so its mass and the drive's armature enter M the same way (equal
+   * derivatives), and its centre of mass and inertia not at all. */
+  for (int i = 0; i < PRRU_NLIMB; i++) {
+    char nm[32], na[32], what[96];
+    prru_design_var vm, va, vc, vi;
+    snprintf(nm, sizeof nm, "m_S%d", i + 1);
+    snprintf(na, sizeof na, "armature_%d", i + 1);
+    prru_design_var_parse(nm, &vm, NULL, 0);
+    prru_design_var_parse(na, &va, NULL, 0);
+    snprintf(nm, sizeof nm, "com_S%d_y", i + 1);
+    prru_design_var_parse(nm, &vc, NULL, 0);
+    snprintf(nm, sizeof nm, "I_S%d_zz", i + 1);
+    prru_design_var_parse(nm, &vi, NULL, 0);
+    prru_design_sens sm, sa, sc, si;
+    prru_design_sensitivity(&pr, &prru_params_model, &vm, 1e-3, &dd, &sm);
+    /* the same step h for both */
+    double ascale = prru_design_scale(&prru_params_model, &va);
+    prru_design_sensitivity(&pr, &prru_params_model, &va, 1e-3 * sm.scale / ascale, &dd, &sa);
+    snprintf(what, sizeof what, "d/d m_S%d = d/d armature_%d", i + 1, i + 1);
+    TU_CLOSE(&sa.derivative, &sm.derivative, 1, 1e-6, what);
+    TU_TRUE(fabs(sm.derivative) > 0, "a slider's mass matters");
+    prru_design_sensitivity(&pr, &prru_params_model, &vc, 1e-3, &dd, &sc);
+    prru_design_sensitivity(&pr, &prru_params_model, &vi, 1e-3, &dd, &si);
+    snprintf(what, sizeof what, "slider %d's com and inertia do not change w_R", i + 1);
+    tu_check(fabs(sc.derivative * sc.scale) <= 1e-12 && fabs(si.derivative * si.scale) <= 1e-12, what,
+             fmax(fabs(sc.derivative * sc.scale), fabs(si.derivative * si.scale)), 1e-12);
+  }
   /* Every single parameter is reachable by name and perturbs the
    * objective only through itself. */
   int np = prru_design_param_count(), ok = 1;

@@ -1,0 +1,1135 @@
+/* prru optimize, prru sensitivity (with shards) and prru merge:
+ * design optimisation of w_R over a workspace rectangle with the
+ * runtime-parameter kernels (runtime/include/prru_design.h). */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, isatty, open_memstream */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "design_cli.h"
+#include "mapgrid.h"
+#include "plot.h"
+#include "prru.h"
+#include "prru_design.h"
+#include "prru_dme.h"
+
+/* ---- Options shared by optimize and sensitivity ---- */
+
+typedef struct {
+  const char *q1, *q2, *q3, *rcond, *stroke, *objective, *set;
+} problem_text;
+
+/* "LO:HI" with finite LO < HI; 0 or 2. */
+static int parse_pair(const char *cmd, const char *opt, const char *text, double *lo, double *hi)
+{
+  char buf[256];
+  const char *c = strchr(text, ':');
+  if (!c || strchr(c + 1, ':') || strlen(text) >= sizeof buf) {
+    prru_cli_error(cmd, "--%s '%s': expected LO:HI", opt, text);
+    return 2;
+  }
+  memcpy(buf, text, strlen(text) + 1);
+  buf[c - text] = '\0';
+  if (prru_parse_double(buf, lo) != PRRU_OK || prru_parse_double(buf + (c - text) + 1, hi) != PRRU_OK) {
+    prru_cli_error(cmd, "--%s '%s': LO and HI must be finite numbers", opt, text);
+    return 2;
+  }
+  if (!(*lo < *hi)) {
+    prru_cli_error(cmd, "--%s '%s': infeasible, LO must be less than HI", opt, text);
+    return 2;
+  }
+  return 0;
+}
+
+/* --set NAME=VALUE[,NAME=VALUE...]: changes to the model's numbers that
+ * make the start design (every tied parameter set to VALUE). 0 or 2. */
+static int parse_set(const char *cmd, const char *text, prru_params *p)
+{
+  char buf[4096];
+  if (strlen(text) >= sizeof buf) {
+    prru_cli_error(cmd, "--set: too long");
+    return 2;
+  }
+  memcpy(buf, text, strlen(text) + 1);
+  for (char *save = NULL, *item = strtok_r(buf, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+    char *eq = strchr(item, '=');
+    char msg[512];
+    prru_design_var v;
+    double x;
+    if (!eq) {
+      prru_cli_error(cmd, "--set '%s': expected NAME=VALUE", item);
+      return 2;
+    }
+    *eq = '\0';
+    if (prru_design_var_parse(item, &v, msg, sizeof msg) != PRRU_OK) {
+      prru_cli_error(cmd, "--set: %s", msg);
+      return 2;
+    }
+    if (prru_parse_double(eq + 1, &x) != PRRU_OK) {
+      prru_cli_error(cmd, "--set %s='%s': not a finite number", item, eq + 1);
+      return 2;
+    }
+    for (int i = 0; i < v.n; i++) *(double *)(void *)((char *)p + v.offset[i]) = x;
+  }
+  return 0;
+}
+
+static int parse_problem(const char *cmd, const problem_text *t, prru_design_problem *pr,
+                         prru_params *start)
+{
+  prru_map_grid g = {0, 0, 0, 0, 0.0, 0, 0};
+  if (prru_cli_parse_range(cmd, "q1", t->q1, &g.q1_lo, &g.q1_hi, &g.n1)) return 2;
+  if (prru_cli_parse_range(cmd, "q2", t->q2, &g.q2_lo, &g.q2_hi, &g.n2)) return 2;
+  if (t->q3 && prru_cli_number(cmd, "q3", t->q3, &g.q3)) return 2;
+  if ((double)g.n1 * (double)g.n2 > 1e7) {
+    prru_cli_error(cmd, "--q1/--q2: %d x %d points is more than the limit of 1e7", g.n1, g.n2);
+    return 2;
+  }
+  prru_design_problem_default(pr, &g);
+  if (t->rcond) {
+    if (prru_cli_number(cmd, "rcond-min", t->rcond, &pr->rcond_min)) return 2;
+    if (!(pr->rcond_min > 0 && pr->rcond_min < 1)) {
+      prru_cli_error(cmd, "--rcond-min '%s': must be in (0, 1)", t->rcond);
+      return 2;
+    }
+  }
+  if (t->stroke) {
+    if (parse_pair(cmd, "stroke", t->stroke, &pr->stroke_lo, &pr->stroke_hi)) return 2;
+    pr->stroke = 1;
+  }
+  if (t->objective && prru_objective_parse(t->objective, &pr->objective) != PRRU_OK) {
+    prru_cli_error(cmd, "--objective '%s': one of mean, max, log", t->objective);
+    return 2;
+  }
+  *start = prru_params_model;
+  if (t->set && parse_set(cmd, t->set, start)) return 2;
+  char msg[512];
+  if (prru_design_check(start, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error(cmd, "the start design is not a buildable robot: %s", msg);
+    return 2;
+  }
+  return 0;
+}
+
+/* The settings that define a result, one line: shards of one sweep must
+ * agree on it. */
+static void problem_line(char *buf, size_t len, const prru_design_problem *pr, const char *extra)
+{
+  const prru_map_grid *g = &pr->grid;
+  int n = snprintf(buf, len, "q1=%.17g:%.17g:%d q2=%.17g:%.17g:%d q3=%.17g rcond_min=%.17g objective=%s",
+                   g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3, pr->rcond_min,
+                   prru_objective_name(pr->objective));
+  if (n > 0 && (size_t)n < len && extra) snprintf(buf + n, len - (size_t)n, " %s", extra);
+}
+
+static const char *objective_text(prru_objective o)
+{
+  return o == PRRU_OBJ_MAX ? "the largest w_R" : o == PRRU_OBJ_LOG ? "mean of ln w_R"
+                                                                    : "mean of w_R - 1";
+}
+
+/* "K/N" with 1 <= K <= N <= 100000; 0 or 2. */
+int prru_cli_parse_shard(const char *cmd, const char *text, int *k, int *n)
+{
+  char *end;
+  long a = strtol(text, &end, 10);
+  if (end == text || *end != '/') goto bad;
+  const char *s = end + 1;
+  long b = strtol(s, &end, 10);
+  if (end == s || *end || a < 1 || b < 1 || a > b || b > 100000) goto bad;
+  *k = (int)a;
+  *n = (int)b;
+  return 0;
+bad:
+  prru_cli_error(cmd, "--shard '%s': expected K/N with 1 <= K <= N (e.g. 3/8: the third of 8)", text);
+  return 2;
+}
+
+/* Items [begin, end) of count for shard k of n: contiguous, in order. */
+static void shard_range(long count, int k, int n, long *begin, long *end)
+{
+  *begin = count * (k - 1) / n;
+  *end = count * k / n;
+}
+
+/* One map row as prru map writes it. */
+static void map_row(prru_cli_out *o, double q1, double q2, double q3, double w, int st)
+{
+  if (st == PRRU_OK)
+    prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, q3, w);
+  else
+    prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, q3, prru_dme_status_name(st));
+}
+
+/* ---- Sensitivity rows (shared by sensitivity and merge) ---- */
+
+typedef struct {
+  char name[24];
+  double value, scale, step, f_plus, f_minus, derivative, scaled;
+  int changed;
+} sens_row;
+
+static const char sens_header[] =
+    "parameter,value,scale,step,objective_plus,objective_minus,derivative,scaled,set_changed\n";
+
+static void sens_write_row(prru_cli_out *o, const sens_row *r)
+{
+  prru_cli_out_printf(o, "%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", r->name, r->value,
+                      r->scale, r->step, r->f_plus, r->f_minus, r->derivative, r->scaled, r->changed);
+}
+
+static int cmp_scaled(const void *a, const void *b)
+{
+  const sens_row *x = *(const sens_row *const *)a, *y = *(const sens_row *const *)b;
+  double fx = fabs(x->scaled), fy = fabs(y->scaled);
+  if (fx != fy) return fx < fy ? 1 : -1;
+  return strcmp(x->name, y->name); /* a total order: the same table every time */
+}
+
+/* The table on stdout, largest |scaled| first. */
+static int sens_print(const sens_row *rows, long n, const char *settings)
+{
+  const sens_row **ord = malloc((size_t)(n ? n : 1) * sizeof *ord);
+  if (!ord) return 1;
+  for (long i = 0; i < n; i++) ord[i] = &rows[i];
+  qsort(ord, (size_t)n, sizeof *ord, cmp_scaled);
+  printf("model: %s\nsettings: %s\n", prru_cli_model_id(), settings);
+  printf("%-12s %14s %14s %14s %14s %s\n", "parameter", "value", "d obj/d p", "scale",
+         "scaled", "(scaled = d obj/d p x scale; * = a grid point changed status)");
+  for (long i = 0; i < n; i++)
+    printf("%-12s %14.7g %14.7g %14.7g %14.7g%s\n", ord[i]->name, ord[i]->value, ord[i]->derivative,
+           ord[i]->scale, ord[i]->scaled, ord[i]->changed ? " *" : "");
+  free(ord);
+  return 0;
+}
+
+/* The bar chart of the largest scaled sensitivities into png (built in a
+ * directory beside it, renamed when gnuplot is done). */
+static int sens_plot(const char *cmd, const sens_row *rows, long n, const char *png)
+{
+  char stage[4200];
+  snprintf(stage, sizeof stage, "%s.partial-XXXXXX", png);
+  if (strlen(png) > 4000 || !mkdtemp(stage)) {
+    prru_cli_error(cmd, "%s: cannot create a directory beside it: %s", png, strerror(errno));
+    return 1;
+  }
+  char path[4300];
+  snprintf(path, sizeof path, "%s/sens.dat", stage);
+  FILE *f = fopen(path, "w");
+  int rc = f ? 0 : 1;
+  if (f) {
+    const sens_row **ord = malloc((size_t)(n ? n : 1) * sizeof *ord);
+    if (!ord) rc = 1;
+    for (long i = 0; ord && i < n; i++) ord[i] = &rows[i];
+    if (ord) qsort(ord, (size_t)n, sizeof *ord, cmp_scaled);
+    for (long i = 0; ord && i < n && i < 30; i++)
+      fprintf(f, "%ld %s%s %.9g\n", i, ord[i]->name, ord[i]->changed ? "*" : "", ord[i]->scaled);
+    free(ord);
+    if (fclose(f) != 0) rc = 1;
+  }
+  char *script = rc ? NULL : prru_plot_sensitivity_script("sens.dat", "sens.png");
+  if (!rc && !script) rc = 1;
+  if (!rc) rc = prru_plot_run(cmd, stage, stage, "sens.gp", script);
+  free(script);
+  if (!rc) {
+    snprintf(path, sizeof path, "%s/sens.png", stage);
+    if (rename(path, png) != 0) {
+      prru_cli_error(cmd, "%s: %s", png, strerror(errno));
+      rc = 1;
+    }
+  }
+  if (rc == PRRU_PLOT_NO_GNUPLOT) prru_cli_error(cmd, "gnuplot is not installed: %s not drawn", png);
+  const char *names[] = {"sens.dat", "sens.png", "sens.gp"};
+  for (int i = 0; i < 3; i++) {
+    snprintf(path, sizeof path, "%s/%s", stage, names[i]);
+    remove(path);
+  }
+  rmdir(stage);
+  return rc;
+}
+
+/* ---- prru sensitivity ---- */
+
+static const char sens_help[] =
+    "usage: prru sensitivity --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"
+    "                        --out FILE.csv [--params NAME,...] [--step H]\n"
+    "                        [--objective mean|max|log] [--rcond-min R]\n"
+    "                        [--set NAME=VALUE,...] [--shard K/N] [--plot FILE.png]\n"
+    "The derivative of the global index (the objective: mean of w_R - 1 over the\n"
+    "regular grid points, or max w_R, or mean ln w_R) with respect to every\n"
+    "parameter of the design (the paper's influence of the kinematic and inertial\n"
+    "parameters on w_R), by central differences with the step h = H x scale\n"
+    "(default H 1e-4; scale: the parameter's magnitude, or where it may be 0 the\n"
+    "body's mean principal moment, the mean upper link, the mean slider mass).\n"
+    "The design is the model's numbers with the --set changes (names as in\n"
+    "'prru optimize --help'); the grid as in 'prru map'; J_d regular where\n"
+    "1/(|J|_1 |J^-1|_1) >= R (default 4e-3). --params: the parameters (default:\n"
+    "every one: b_i l1_i l2_i a_i, m_B com_B_x.. I_B_xx.. for every body B,\n"
+    "armature_i).\n"
+    "Writes FILE.csv: the model line, a settings line, the columns\n"
+    "parameter,value,scale,step,objective_plus,objective_minus,derivative,scaled,\n"
+    "set_changed (scaled = derivative x scale: the change of the objective for a\n"
+    "change of the parameter by its scale; set_changed = 1 when a grid point\n"
+    "crossed the singularity tolerance between the two evaluations, so that the\n"
+    "difference includes a jump). Prints the table, largest |scaled| first.\n"
+    "--plot: a bar chart of the 30 largest |scaled|.\n"
+    "--shard K/N: only the K-th of N contiguous parts of the parameter list (a\n"
+    "cluster job array runs one part per task); 'prru merge' joins the parts into\n"
+    "exactly the file one run writes.\n";
+
+typedef struct {
+  int nparam;
+  prru_design_var *vars;
+} param_list;
+
+static int parse_params(const char *cmd, const char *text, param_list *pl)
+{
+  int cap = prru_design_param_count() + 64;
+  pl->vars = calloc((size_t)cap, sizeof *pl->vars);
+  pl->nparam = 0;
+  if (!pl->vars) return 1;
+  if (!text) {
+    for (int k = 0; k < prru_design_param_count(); k++) prru_design_param(k, &pl->vars[pl->nparam++]);
+    return 0;
+  }
+  char *buf = strdup(text);
+  if (!buf) return 1;
+  int rc = 0;
+  for (char *save = NULL, *it = strtok_r(buf, ",", &save); it && !rc; it = strtok_r(NULL, ",", &save)) {
+    char msg[512];
+    if (pl->nparam >= cap) {
+      prru_cli_error(cmd, "--params: more than %d parameters", cap);
+      rc = 2;
+    } else if (prru_design_var_parse(it, &pl->vars[pl->nparam], msg, sizeof msg) != PRRU_OK) {
+      prru_cli_error(cmd, "--params: %s", msg);
+      rc = 2;
+    } else {
+      pl->nparam++;
+    }
+  }
+  free(buf);
+  if (!rc && pl->nparam == 0) {
+    prru_cli_error(cmd, "--params: no parameter given");
+    rc = 2;
+  }
+  return rc;
+}
+
+/* The evaluation at the design, or exit status 1 with a message when no
+ * grid point is regular. */
+static int base_eval(const char *cmd, const prru_design_problem *pr, const prru_params *p,
+                     prru_design_data *dd, prru_design_eval *ev)
+{
+  prru_design_evaluate(pr, p, dd, ev);
+  if (ev->sum.n_ok > 0) return 0;
+  prru_cli_error(cmd, "no grid point of the workspace is regular (%ld singular, %ld unreachable "
+                      "of %ld): the objective is not defined there",
+                 ev->sum.n_singular, ev->sum.n_unreachable, ev->sum.n_points);
+  return 1;
+}
+
+int prru_cmd_sensitivity(int argc, char **argv)
+{
+  const char *cmd = "sensitivity";
+  problem_text t = {0};
+  const char *out = NULL, *params = NULL, *steps = NULL, *shards = NULL, *plot = NULL;
+  int help = 0;
+  prru_cli_option opts[] = {
+      {"q1", 1, &t.q1, NULL},         {"q2", 1, &t.q2, NULL},       {"q3", 1, &t.q3, NULL},
+      {"rcond-min", 1, &t.rcond, NULL}, {"objective", 1, &t.objective, NULL},
+      {"set", 1, &t.set, NULL},       {"out", 1, &out, NULL},       {"params", 1, &params, NULL},
+      {"step", 1, &steps, NULL},      {"shard", 1, &shards, NULL},  {"plot", 1, &plot, NULL},
+      {"help", 0, NULL, &help}};
+  if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  if (help) {
+    fputs(sens_help, stdout);
+    return 0;
+  }
+  const char *missing = !t.q1 ? "--q1" : !t.q2 ? "--q2" : !out ? "--out" : NULL;
+  if (missing) {
+    prru_cli_error(cmd, "%s is required (see 'prru sensitivity --help')", missing);
+    return 2;
+  }
+  prru_design_problem pr;
+  prru_params p;
+  if (parse_problem(cmd, &t, &pr, &p)) return 2;
+  double h = 1e-4;
+  if (steps && prru_cli_number(cmd, "step", steps, &h)) return 2;
+  if (!(h > 0 && h < 0.5)) {
+    prru_cli_error(cmd, "--step '%s': must be in (0, 0.5)", steps);
+    return 2;
+  }
+  int k = 1, n = 1;
+  if (shards && prru_cli_parse_shard(cmd, shards, &k, &n)) return 2;
+  if (shards && plot) {
+    prru_cli_error(cmd, "--plot with --shard: plot the merged file ('prru merge --plot')");
+    return 2;
+  }
+  param_list pl;
+  int rc = parse_params(cmd, params, &pl);
+  if (rc) {
+    free(pl.vars);
+    return rc;
+  }
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, cmd, out)) {
+    free(pl.vars);
+    return 1;
+  }
+  prru_design_data dd;
+  prru_design_eval ev;
+  sens_row *rows = calloc((size_t)pl.nparam, sizeof *rows);
+  rc = rows && prru_design_data_alloc(&dd, &pr.grid) == PRRU_OK ? 0 : 1;
+  if (rc) prru_cli_error(cmd, "out of memory");
+  else rc = base_eval(cmd, &pr, &p, &dd, &ev);
+  char extra[128], settings[1024];
+  snprintf(extra, sizeof extra, "step=%.17g params=%d base=%.17g", h, pl.nparam, ev.objective);
+  problem_line(settings, sizeof settings, &pr, extra);
+  long b0 = 0, b1 = 0;
+  shard_range(pl.nparam, k, n, &b0, &b1);
+  for (long i = b0; i < b1 && !rc; i++) {
+    if (prru_cli_interrupted) {
+      rc = prru_cli_exit_interrupted();
+      break;
+    }
+    prru_design_sens s;
+    sens_row *r = &rows[i - b0];
+    int st = prru_design_sensitivity(&pr, &p, &pl.vars[i], h, &dd, &s);
+    snprintf(r->name, sizeof r->name, "%s", pl.vars[i].name);
+    r->value = s.value;
+    r->scale = s.scale;
+    r->step = s.step;
+    r->f_plus = s.f_plus;
+    r->f_minus = s.f_minus;
+    r->derivative = st == PRRU_OK ? s.derivative : NAN;
+    r->scaled = r->derivative * s.scale;
+    r->changed = s.set_changed;
+  }
+  if (!rc) {
+    prru_cli_out_comment(&o);
+    if (shards) prru_cli_out_printf(&o, "# shard %d/%d sensitivity %s\n", k, n, settings);
+    else prru_cli_out_printf(&o, "# sensitivity %s\n", settings);
+    prru_cli_out_line(&o);
+    prru_cli_out_printf(&o, "%s", sens_header);
+    prru_cli_out_line(&o);
+    for (long i = 0; i < b1 - b0; i++) {
+      sens_write_row(&o, &rows[i]);
+      prru_cli_out_row(&o);
+    }
+  }
+  if (prru_cli_out_close(&o, rc == 0 && !o.err) && !rc) rc = 1;
+  if (rc > 1) prru_cli_error(cmd, "interrupted (%s): %s is not changed", prru_cli_signal_name(), out);
+  if (!rc && plot) rc = sens_plot(cmd, rows, b1 - b0, plot);
+  if (!rc && !shards) rc = sens_print(rows, b1 - b0, settings);
+  if (!rc && shards)
+    printf("model: %s\nshard %d/%d: parameters %ld to %ld of %d written to %s\n", prru_cli_model_id(),
+           k, n, b0 + 1, b1, pl.nparam, out);
+  free(rows);
+  free(pl.vars);
+  prru_design_data_free(&dd);
+  return rc;
+}
+
+/* ---- prru merge ---- */
+
+static const char merge_help[] =
+    "usage: prru merge --in SHARD1,SHARD2,... --out FILE [--plot FILE.png]\n"
+    "Joins the shard files of one 'prru sensitivity --shard K/N' sweep (all N of them, in any order; file names without\n"
+    "commas) into FILE, byte for byte what one run without --shard writes, and\n"
+    "prints what that run prints. Every shard must come from this model and\n"
+    "program version with the same settings (checked), each K from 1 to N\n"
+    "exactly once. --plot: the sensitivity bar chart. FILE is written only when\n"
+    "every check passes.\n";
+
+typedef struct {
+  char *text;       /* whole file */
+  size_t len;
+  int k, n;
+  char *kind_line;  /* after "# shard K/N " */
+  char *header, *rows; /* third line, the rest */
+} shard_file;
+
+static char *next_line(char *s)
+{
+  char *e = strchr(s, '\n');
+  if (!e) return NULL;
+  *e = '\0';
+  return e + 1;
+}
+
+/* Reads and splits one shard; 0 or 2 after a message naming the file. */
+static int read_shard(const char *path, const char *model_line, shard_file *s)
+{
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    prru_cli_error("merge", "%s: cannot open: %s", path, strerror(errno));
+    return 2;
+  }
+  size_t cap = 1 << 16;
+  s->text = malloc(cap);
+  s->len = 0;
+  size_t got;
+  while (s->text && (got = fread(s->text + s->len, 1, cap - s->len - 1, f)) > 0) {
+    s->len += got;
+    if (s->len + 1 == cap) {
+      char *t = realloc(s->text, cap *= 2);
+      if (!t) free(s->text);
+      s->text = t;
+    }
+  }
+  int err = ferror(f);
+  fclose(f);
+  if (!s->text || err) {
+    prru_cli_error("merge", "%s: cannot read", path);
+    return 2;
+  }
+  s->text[s->len] = '\0';
+  char *l2 = next_line(s->text), *l3 = l2 ? next_line(l2) : NULL, *l4 = l3 ? next_line(l3) : NULL;
+  if (!l4 || strcmp(s->text, model_line) != 0) {
+    prru_cli_error("merge", "%s: not a shard of this model and program version (first line must be '%s')",
+                   path, model_line);
+    return 2;
+  }
+  int used = 0;
+  if (sscanf(l2, "# shard %d/%d %n", &s->k, &s->n, &used) != 2 || used == 0) {
+    prru_cli_error("merge", "%s: line 2 is not '# shard K/N ...': not a shard file", path);
+    return 2;
+  }
+  s->kind_line = l2 + used;
+  s->header = l3;
+  s->rows = l4;
+  return 0;
+}
+
+static int parse_sens_rows(const char *path, char *rows, sens_row *out, long max, long *count)
+{
+  long k = 0;
+  for (char *line = rows, *next; *line; line = next) {
+    next = next_line(line);
+    if (!next) next = line + strlen(line);
+    char *comma = strchr(line, ',');
+    sens_row *r = &out[k];
+    if (k >= max || !comma || (size_t)(comma - line) >= sizeof r->name ||
+        sscanf(comma + 1, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d", &r->value, &r->scale, &r->step, &r->f_plus,
+               &r->f_minus, &r->derivative, &r->scaled, &r->changed) != 8) {
+      prru_cli_error("merge", "%s: row %ld is not a sensitivity row", path, k + 1);
+      return 2;
+    }
+    memcpy(r->name, line, (size_t)(comma - line));
+    r->name[comma - line] = '\0';
+    k++;
+  }
+  *count = k;
+  return 0;
+}
+
+static int merge_sensitivity(shard_file *sh, char **paths, int n, const char *out, const char *plot)
+{
+  const char *settings = sh[0].kind_line + strlen("sensitivity ");
+  const char *pp = strstr(settings, " params=");
+  long np = pp ? strtol(pp + 8, NULL, 10) : 0;
+  if (np < 1 || np > 100000) {
+    prru_cli_error("merge", "%s: malformed sensitivity settings line", paths[0]);
+    return 2;
+  }
+  sens_row *rows = calloc((size_t)np, sizeof *rows);
+  if (!rows) return 1;
+  int rc = 0;
+  for (int i = 0; i < n && !rc; i++) {
+    long b0, b1, got = 0;
+    shard_range(np, sh[i].k, n, &b0, &b1);
+    rc = parse_sens_rows(paths[i], sh[i].rows, rows + b0, b1 - b0, &got);
+    if (!rc && got != b1 - b0) {
+      prru_cli_error("merge", "%s: %ld rows, the shard has %ld (incomplete file)", paths[i], got, b1 - b0);
+      rc = 2;
+    }
+  }
+  prru_cli_out o;
+  if (!rc && prru_cli_out_open(&o, "merge", out)) rc = 1;
+  if (!rc) {
+    prru_cli_out_comment(&o);
+    prru_cli_out_printf(&o, "# sensitivity %s\n", settings);
+    prru_cli_out_line(&o);
+    prru_cli_out_printf(&o, "%s", sens_header);
+    prru_cli_out_line(&o);
+    for (long i = 0; i < np; i++) {
+      sens_write_row(&o, &rows[i]);
+      prru_cli_out_row(&o);
+    }
+    if (prru_cli_out_close(&o, !o.err)) rc = 1;
+  }
+  if (!rc && plot) rc = sens_plot("merge", rows, np, plot);
+  if (!rc) rc = sens_print(rows, np, settings);
+  free(rows);
+  return rc;
+}
+
+int prru_cmd_merge(int argc, char **argv)
+{
+  const char *ins = NULL, *out = NULL, *plot = NULL;
+  int help = 0;
+  prru_cli_option opts[] = {{"in", 1, &ins, NULL}, {"out", 1, &out, NULL}, {"plot", 1, &plot, NULL},
+                            {"help", 0, NULL, &help}};
+  if (prru_cli_parse("merge", argc, argv, opts, 4)) return 2;
+  if (help) {
+    fputs(merge_help, stdout);
+    return 0;
+  }
+  if (!ins || !out) {
+    prru_cli_error("merge", "%s is required (see 'prru merge --help')", !ins ? "--in" : "--out");
+    return 2;
+  }
+  char *list = strdup(ins);
+  char *paths[4096];
+  int n = 0;
+  for (char *save = NULL, *it = list ? strtok_r(list, ",", &save) : NULL; it; it = strtok_r(NULL, ",", &save)) {
+    if (n == 4096) {
+      prru_cli_error("merge", "--in: more than 4096 files");
+      free(list);
+      return 2;
+    }
+    paths[n++] = it;
+  }
+  if (n == 0) {
+    prru_cli_error("merge", "--in: no file given");
+    free(list);
+    return 2;
+  }
+  char model_line[2048];
+  snprintf(model_line, sizeof model_line, "# prru %s model %s", PRRU_VERSION, prru_cli_model_id());
+  shard_file *sh = calloc((size_t)n, sizeof *sh);
+  int rc = sh ? 0 : 1;
+  for (int i = 0; i < n && !rc; i++) rc = read_shard(paths[i], model_line, &sh[i]);
+  /* One sweep: the same N, settings and header everywhere, each K once;
+   * then sorted by K. */
+  for (int i = 0; i < n && !rc; i++) {
+    if (sh[i].n != n || strcmp(sh[i].kind_line, sh[0].kind_line) != 0 ||
+        strcmp(sh[i].header, sh[0].header) != 0) {
+      prru_cli_error("merge", "%s: shard %d/%d does not belong with %s (shard %d/%d, %d files given): "
+                              "another sweep or settings",
+                     paths[i], sh[i].k, sh[i].n, paths[0], sh[0].k, sh[0].n, n);
+      rc = 2;
+    }
+    for (int j = 0; j < i && !rc; j++)
+      if (sh[j].k == sh[i].k) {
+        prru_cli_error("merge", "%s and %s: both are shard %d/%d", paths[j], paths[i], sh[i].k, n);
+        rc = 2;
+      }
+  }
+  for (int i = 1; i < n && !rc; i++) /* insertion sort by K */
+    for (int j = i; j > 0 && sh[j - 1].k > sh[j].k; j--) {
+      shard_file t = sh[j];
+      sh[j] = sh[j - 1];
+      sh[j - 1] = t;
+      char *p = paths[j];
+      paths[j] = paths[j - 1];
+      paths[j - 1] = p;
+    }
+  if (!rc) {
+    if (strncmp(sh[0].kind_line, "sensitivity ", 12) == 0) {
+      rc = merge_sensitivity(sh, paths, n, out, plot);
+    } else {
+      prru_cli_error("merge", "%s: unknown kind of shard", paths[0]);
+      rc = 2;
+    }
+  }
+  for (int i = 0; sh && i < n; i++) free(sh[i].text);
+  free(sh);
+  free(list);
+  return rc;
+}
+
+/* ---- prru optimize ---- */
+
+static const char opt_help[] =
+    "usage: prru optimize --vars SPEC[,SPEC...] --q1 START:STOP:COUNT --q2 START:STOP:COUNT\n"
+    "                     [--q3 Z] --out MODEL.json --report DIR [--range PCT]\n"
+    "                     [--objective mean|max|log] [--rcond-min R] [--stroke LO:HI]\n"
+    "                     [--set NAME=VALUE,...] [--max-iter N] [--penalty W]\n"
+    "                     [--name NAME] [--progress]\n"
+    "Chooses the design variables within their bounds so that the rotational\n"
+    "dynamic manipulability w_R comes as close to 1 (isotropy) as it can over the\n"
+    "workspace rectangle (grid as in 'prru map'), the paper's purpose for w_R.\n"
+    "Objective (--objective): mean (default) the global index, the mean of w_R - 1\n"
+    "over the grid; max the largest w_R; log the mean of ln w_R.\n"
+    "Constraints: every grid point reachable and regular (J_d's scaled\n"
+    "1/(|J|_1 |J^-1|_1) >= R, default 4e-3, i.e. cond_1 <= 250, the test of\n"
+    "'prru map --rcond-min'), and with --stroke every slider height d_i within\n"
+    "[LO, HI] (m) on the grid. They enter as a penalty W x violation (default W\n"
+    "1000), continuous so that an infeasible start (singular points in the\n"
+    "rectangle) can move into feasibility; the result is accepted only when it\n"
+    "is feasible.\n"
+    "SPEC: NAME (bounds: the start value -+ PCT %%, default 20) or NAME=LO:HI.\n"
+    "NAME: b l1 l2 (every limb), a (limbs 1, 2), or for some limbs b12 b3 a1\n"
+    "l1_2 l2_13 ...; m_B com_B_x I_B_xx (I_B_yy I_B_zz I_B_xy I_B_xz I_B_yz) with\n"
+    "B a body (P L1 U1 S1 ...) or L, U, S (that body of every limb); armature,\n"
+    "armature_i. Tied parameters move by the same amount. --set: the start design\n"
+    "is the model's numbers with these changes.\n"
+    "Optimiser: GSL's Nelder-Mead simplex (nmsimplex2) on a sine transform of\n"
+    "each variable onto its bounds, restarted from the best point while that\n"
+    "helps, at most N iterations in all (default 600); deterministic: the same\n"
+    "command gives the same bits. Progress on stderr (--progress, or a terminal).\n"
+    "Writes MODEL.json, the optimised design as a format-2 model file (name NAME,\n"
+    "default the model's name + _opt) for 'python3 gen/prru_gen.py' or a build\n"
+    "with -DPRRU_MODEL=MODEL.json, and DIR/ with report.txt (before and after:\n"
+    "global index, mean ln w_R, max w_R, singular fraction, slider range; every\n"
+    "variable before, after and its bounds; iterations), before_map.csv and\n"
+    "after_map.csv (as 'prru map' writes them) and optimize_maps.png (both w_R\n"
+    "maps side by side). Nothing is written unless a feasible design is found\n"
+    "(exit 1 otherwise); the files are built aside and renamed. Bad options, a\n"
+    "start design that is not a buildable robot, bounds with LO >= HI or not\n"
+    "around the start: exit 2. No regular grid point at the start: exit 1.\n";
+
+/* Bounds -+ pct % of the start value (of the variable's scale at 0). */
+static void default_bounds(const prru_params *p, prru_design_var *v, double pct)
+{
+  double x = prru_design_get(p, v), r = fabs(x) > 0 ? fabs(x) : prru_design_scale(p, v);
+  v->lo = x - pct / 100 * r;
+  v->hi = x + pct / 100 * r;
+}
+
+static int parse_vars(const char *cmd, const char *text, double pct, const prru_params *p,
+                      prru_design_var *vars, int *n)
+{
+  char *buf = strdup(text);
+  int rc = buf ? 0 : 1;
+  *n = 0;
+  for (char *save = NULL, *it = buf ? strtok_r(buf, ",", &save) : NULL; it && !rc;
+       it = strtok_r(NULL, ",", &save)) {
+    char msg[512], *eq = strchr(it, '=');
+    if (eq) *eq = '\0';
+    if (*n >= PRRU_DESIGN_MAX_VARS) {
+      prru_cli_error(cmd, "--vars: more than %d variables", PRRU_DESIGN_MAX_VARS);
+      rc = 2;
+    } else if (prru_design_var_parse(it, &vars[*n], msg, sizeof msg) != PRRU_OK) {
+      prru_cli_error(cmd, "--vars: %s", msg);
+      rc = 2;
+    } else if (eq) {
+      char opt[64];
+      snprintf(opt, sizeof opt, "vars %s=", it);
+      rc = parse_pair(cmd, opt, eq + 1, &vars[*n].lo, &vars[*n].hi);
+      (*n)++;
+    } else {
+      default_bounds(p, &vars[(*n)++], pct);
+    }
+  }
+  free(buf);
+  if (!rc && *n == 0) {
+    prru_cli_error(cmd, "--vars: no variable given");
+    rc = 2;
+  }
+  return rc;
+}
+
+typedef struct {
+  int show;
+  long last_ms;
+} opt_progress;
+
+static int on_iteration(int iter, int evals, const prru_design_eval *best, double size, void *ctx)
+{
+  opt_progress *p = ctx;
+  if (p->show)
+    fprintf(stderr, "\roptimize: iteration %4d, %5d evaluations, merit %.10g, index %.8g, "
+                    "singular %.3g %%, simplex %.2g   ",
+            iter, evals, best->merit, best->sum.index, 100 * best->sum.singular_fraction, size);
+  return prru_cli_interrupted != 0;
+}
+
+/* The design as a format-2 model file. */
+static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *desc)
+{
+  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n  \"description\": \"%s\",\n", name,
+                      desc);
+  prru_cli_out_printf(o, "  \"gravity\": [%.17g, %.17g, %.17g],\n  \"geometry\": {\n", p->gravity[0],
+                      p->gravity[1], p->gravity[2]);
+  const char *keys[3] = {"b", "l1", "l2"};
+  const double *vals[3] = {p->b, p->l1, p->l2};
+  for (int g = 0; g < 3; g++) {
+    prru_cli_out_printf(o, "    \"%s\": [", keys[g]);
+    for (int i = 0; i < PRRU_NLIMB; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", vals[g][i]);
+    prru_cli_out_printf(o, "],\n");
+  }
+  prru_cli_out_printf(o, "    \"a\": [%.17g, %.17g]\n  },\n  \"bodies\": {\n", p->a[0], p->a[1]);
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": [%.17g, %.17g, %.17g],\n", prru_mech.body_names[b],
+                        p->mass[b], p->com[b][0], p->com[b][1], p->com[b][2]);
+    prru_cli_out_printf(o, "      \"inertia\": [");
+    for (int e = 0; e < 6; e++) prru_cli_out_printf(o, "%s%.17g", e ? ", " : "", p->inertia[b][e]);
+    prru_cli_out_printf(o, "]}%s\n", b + 1 < PRRU_NBODY ? "," : "");
+  }
+  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n");
+  const char *akeys[3] = {"armature", "damping", "coulomb"};
+  const double *avals[3] = {p->armature, p->damping, p->coulomb};
+  int has_vs = p->coulomb_velocity > 0;
+  for (int g = 0; g < 3; g++) {
+    prru_cli_out_printf(o, "    \"%s\": [", akeys[g]);
+    for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", avals[g][i]);
+    prru_cli_out_printf(o, "]%s\n", g < 2 || has_vs ? "," : "");
+  }
+  if (has_vs) prru_cli_out_printf(o, "    \"coulomb_velocity\": %.17g\n", p->coulomb_velocity);
+  prru_cli_out_printf(o, "  }\n}\n");
+  prru_cli_out_line(o);
+}
+
+/* A map CSV as prru map writes it (after a second comment line saying
+ * which design it is). */
+static int write_map_file(const char *cmd, const char *path, const char *shown, const char *design,
+                          const prru_map_grid *g, const prru_design_data *dd)
+{
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, cmd, path)) return 1;
+  o.name = shown;
+  prru_cli_out_comment(&o);
+  prru_cli_out_printf(&o, "# design: %s\nq1,q2,q3,w_R,status\n", design);
+  prru_cli_out_line(&o);
+  for (int i = 0; i < g->n1; i++)
+    for (int j = 0; j < g->n2; j++) {
+      long k = (long)i * g->n2 + j;
+      map_row(&o, prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j),
+              g->q3, dd->w_R[k], dd->status[k]);
+      prru_cli_out_row(&o);
+    }
+  return prru_cli_out_close(&o, !o.err);
+}
+
+/* gnuplot's image plots want scans separated by blank lines. */
+static int write_grid_dat(const char *path, const prru_map_grid *g, const prru_design_data *dd)
+{
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  for (int i = 0; i < g->n1; i++) {
+    for (int j = 0; j < g->n2; j++) {
+      long k = (long)i * g->n2 + j;
+      fprintf(f, "%.9g %.9g ", prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i),
+              prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j));
+      if (dd->status[k] == PRRU_OK)
+        fprintf(f, "%.9g\n", dd->w_R[k]);
+      else
+        fputs("NaN\n", f);
+    }
+    fputc('\n', f);
+  }
+  int bad = ferror(f) != 0;
+  return (fclose(f) != 0 || bad) ? 1 : 0;
+}
+
+static void report_eval_rows(FILE *f, const prru_design_eval *a, const prru_design_eval *b)
+{
+  fprintf(f, "%-34s %22s %22s\n", "", "before", "after");
+  fprintf(f, "%-34s %22.12g %22.12g\n", "global index (mean of w_R - 1)", a->sum.index, b->sum.index);
+  fprintf(f, "%-34s %22.12g %22.12g\n", "mean of ln w_R", a->sum.index_log, b->sum.index_log);
+  fprintf(f, "%-34s %22.12g %22.12g\n", "min w_R", a->sum.w_min, b->sum.w_min);
+  fprintf(f, "%-34s %22.12g %22.12g\n", "max w_R", a->sum.w_max, b->sum.w_max);
+  fprintf(f, "%-34s %21.6f%% %21.6f%%\n", "singular or unreachable", 100 * a->sum.singular_fraction,
+          100 * b->sum.singular_fraction);
+  fprintf(f, "%-34s %22ld %22ld\n", "singular / unreachable points", a->sum.n_singular + a->sum.n_unreachable,
+          b->sum.n_singular + b->sum.n_unreachable);
+  fprintf(f, "%-34s %10.6f..%-10.6f %10.6f..%-10.6f\n", "slider heights d (m)", a->d_min, a->d_max, b->d_min,
+          b->d_max);
+  fprintf(f, "%-34s %22.12g %22.12g\n", "objective", a->objective, b->objective);
+  fprintf(f, "%-34s %22.12g %22.12g\n", "merit (objective + penalty)", a->merit, b->merit);
+}
+
+typedef struct {
+  const prru_design_problem *pr;
+  const prru_design_var *vars;
+  int nvar;
+  const prru_design_result *r;
+  const prru_params *start;
+  const char *out, *name;
+  const char *set;
+} opt_report;
+
+static int write_report(const char *path, const opt_report *rp)
+{
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  const prru_design_problem *pr = rp->pr;
+  const prru_map_grid *g = &pr->grid;
+  const prru_design_result *r = rp->r;
+  fprintf(f, "prru optimize: design optimisation of the rotational dynamic manipulability w_R\n");
+  fprintf(f, "model: %s%s%s\n", prru_cli_model_id(), rp->set ? ", start changed by --set " : "",
+          rp->set ? rp->set : "");
+  fprintf(f, "workspace: q1 in [%.17g, %.17g] (%d points), q2 in [%.17g, %.17g] (%d points), q3 = %.17g m\n",
+          g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3);
+  fprintf(f, "regular: J_d's scaled rcond >= %g (cond_1 <= %g) at every grid point", pr->rcond_min,
+          1 / pr->rcond_min);
+  if (pr->stroke) fprintf(f, "; sliders within [%.17g, %.17g] m", pr->stroke_lo, pr->stroke_hi);
+  fprintf(f, "\nobjective: %s (%s), penalty weight %g\n", prru_objective_name(pr->objective),
+          objective_text(pr->objective), pr->penalty_weight);
+  fprintf(f, "optimiser: GSL nmsimplex2 on sine-transformed bounds, %d iterations, %d evaluations, "
+             "%d restarts, %s\n\n",
+          r->iterations, r->evaluations, r->restarts_done,
+          r->converged ? "converged (simplex below tolerance)" : "stopped at the iteration limit");
+  report_eval_rows(f, &r->start_eval, &r->best_eval);
+  fprintf(f, "\n%-12s %22s %22s %22s %22s\n", "variable", "before", "after", "lower bound", "upper bound");
+  for (int i = 0; i < rp->nvar; i++) {
+    const prru_design_var *v = &rp->vars[i];
+    fprintf(f, "%-12s %22.17g %22.17g %22.17g %22.17g%s\n", v->name, r->x0[i], r->x[i], v->lo, v->hi,
+            r->x[i] <= v->lo + 1e-9 * (v->hi - v->lo) || r->x[i] >= v->hi - 1e-9 * (v->hi - v->lo)
+                ? "  (at its bound)" : "");
+  }
+  fprintf(f, "\nbefore_index: %.17g\nafter_index: %.17g\n", r->start_eval.sum.index, r->best_eval.sum.index);
+  fprintf(f, "before_objective: %.17g\nafter_objective: %.17g\n", r->start_eval.objective,
+          r->best_eval.objective);
+  fprintf(f, "before_singular_fraction: %.17g\nafter_singular_fraction: %.17g\n",
+          r->start_eval.sum.singular_fraction, r->best_eval.sum.singular_fraction);
+  fprintf(f, "after_max_w_R: %.17g\nafter_index_log: %.17g\n", r->best_eval.sum.w_max, r->best_eval.sum.index_log);
+  fprintf(f, "model_file: %s (name %s)\n", rp->out, rp->name);
+  int bad = ferror(f) != 0;
+  return (fclose(f) != 0 || bad) ? 1 : 0;
+}
+
+static int is_dir(const char *p)
+{
+  struct stat s;
+  return stat(p, &s) == 0 && S_ISDIR(s.st_mode);
+}
+
+static const char *const report_files[] = {"report.txt", "before_map.csv", "after_map.csv", "before.dat",
+                                           "after.dat", "optimize_maps.gp", "optimize_maps.png"};
+#define NREPORT ((int)(sizeof report_files / sizeof report_files[0]))
+
+static void remove_stage(const char *stage)
+{
+  char path[4400];
+  for (int i = 0; i < NREPORT; i++) {
+    snprintf(path, sizeof path, "%s/%s", stage, report_files[i]);
+    remove(path);
+  }
+  rmdir(stage);
+}
+
+/* The staged report becomes dir: renamed when dir is new, else its files
+ * moved in (the data files, not the gnuplot inputs). */
+static int publish_report(const char *cmd, const char *stage, const char *dir)
+{
+  if (!is_dir(dir)) {
+    if (rename(stage, dir) == 0) return 0;
+    prru_cli_error(cmd, "%s: %s", dir, strerror(errno));
+    return 1;
+  }
+  char from[4400], to[4400];
+  for (int i = 0; i < NREPORT; i++) {
+    snprintf(from, sizeof from, "%s/%s", stage, report_files[i]);
+    snprintf(to, sizeof to, "%s/%s", dir, report_files[i]);
+    if (access(from, F_OK) == 0 && rename(from, to) != 0) {
+      prru_cli_error(cmd, "%s: %s", to, strerror(errno));
+      return 1;
+    }
+  }
+  rmdir(stage);
+  return 0;
+}
+
+/* Report files into stage; 0, 1 or 128 + signal (PNG missing without
+ * gnuplot: a note, still 0). */
+static int stage_report(const char *cmd, const char *stage, const char *dir, const opt_report *rp)
+{
+  const prru_design_problem *pr = rp->pr;
+  prru_design_data a, b;
+  prru_design_eval ea, eb;
+  if (prru_design_data_alloc(&a, &pr->grid) != PRRU_OK) return 1;
+  if (prru_design_data_alloc(&b, &pr->grid) != PRRU_OK) {
+    prru_design_data_free(&a);
+    return 1;
+  }
+  prru_design_evaluate(pr, rp->start, &a, &ea);
+  prru_design_evaluate(pr, &rp->r->best, &b, &eb);
+  char path[4400], shown[4400], design[512];
+  int rc = 0;
+  snprintf(path, sizeof path, "%s/report.txt", stage);
+  if (write_report(path, rp)) {
+    prru_cli_error(cmd, "%s/report.txt: write error", dir);
+    rc = 1;
+  }
+  const char *names[2] = {"before_map.csv", "after_map.csv"};
+  for (int s = 0; s < 2 && !rc; s++) {
+    snprintf(path, sizeof path, "%s/%s", stage, names[s]);
+    snprintf(shown, sizeof shown, "%s/%s", dir, names[s]);
+    if (s == 0) snprintf(design, sizeof design, "start%s%s", rp->set ? " --set " : "", rp->set ? rp->set : "");
+    else snprintf(design, sizeof design, "optimised, %s (name %s)", rp->out, rp->name);
+    rc = write_map_file(cmd, path, shown, design, &pr->grid, s ? &b : &a);
+  }
+  const prru_design_data *dds[2] = {&a, &b};
+  const char *dats[2] = {"before.dat", "after.dat"};
+  for (int s = 0; s < 2 && !rc; s++) {
+    snprintf(path, sizeof path, "%s/%s", stage, dats[s]);
+    if (write_grid_dat(path, &pr->grid, dds[s])) {
+      prru_cli_error(cmd, "%s/%s: write error", dir, dats[s]);
+      rc = 1;
+    }
+  }
+  if (!rc) {
+    char *script = prru_plot_optimize_script(&pr->grid, pr->rcond_min, ea.sum.index, eb.sum.index,
+                                             ea.sum.singular_fraction, eb.sum.singular_fraction, rp->name);
+    rc = script ? prru_plot_run(cmd, stage, dir, "optimize_maps.gp", script) : 1;
+    free(script);
+    if (rc == PRRU_PLOT_NO_GNUPLOT) {
+      fprintf(stderr, "prru %s: gnuplot is not installed: %s/optimize_maps.png not drawn\n", cmd, dir);
+      rc = 0;
+    }
+  }
+  prru_design_data_free(&a);
+  prru_design_data_free(&b);
+  return rc;
+}
+
+static int check_name(const char *cmd, const char *name)
+{
+  size_t n = strlen(name);
+  int ok = n >= 1 && n <= 16 && name[0] >= 'a' && name[0] <= 'z';
+  for (size_t i = 0; ok && i < n; i++)
+    ok = (name[i] >= 'a' && name[i] <= 'z') || (name[i] >= '0' && name[i] <= '9') || name[i] == '_';
+  if (!ok) prru_cli_error(cmd, "--name '%s': a lower-case C identifier of at most 16 characters", name);
+  return ok ? 0 : 2;
+}
+
+/* The model file's description: one line of at most 400 characters. */
+static void describe(char *buf, size_t len, const prru_design_problem *pr, const prru_design_var *vars,
+                     int nvar)
+{
+  const prru_map_grid *g = &pr->grid;
+  int n = snprintf(buf, len, "%s optimised by prru optimize (%s over q1 in [%.4g, %.4g], q2 in [%.4g, %.4g], "
+                             "q3 = %.4g; variables",
+                   prru_mech.name, objective_text(pr->objective), g->q1_lo, g->q1_hi, g->q2_lo, g->q2_hi, g->q3);
+  for (int i = 0; i < nvar && n > 0 && (size_t)n < len - 40; i++)
+    n += snprintf(buf + n, len - (size_t)n, " %s", vars[i].name);
+  if (n > 0 && (size_t)n < len - 2) snprintf(buf + n, len - (size_t)n, ")");
+}
+
+int prru_cmd_optimize(int argc, char **argv)
+{
+  const char *cmd = "optimize";
+  problem_text t = {0};
+  const char *vars_s = NULL, *out = NULL, *report = NULL, *range = NULL, *iters = NULL, *pen = NULL,
+             *name_s = NULL;
+  int help = 0, progress = 0;
+  prru_cli_option opts[] = {
+      {"vars", 1, &vars_s, NULL},      {"q1", 1, &t.q1, NULL},       {"q2", 1, &t.q2, NULL},
+      {"q3", 1, &t.q3, NULL},          {"out", 1, &out, NULL},       {"report", 1, &report, NULL},
+      {"range", 1, &range, NULL},      {"objective", 1, &t.objective, NULL},
+      {"rcond-min", 1, &t.rcond, NULL}, {"stroke", 1, &t.stroke, NULL}, {"set", 1, &t.set, NULL},
+      {"max-iter", 1, &iters, NULL},   {"penalty", 1, &pen, NULL},   {"name", 1, &name_s, NULL},
+      {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
+  if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  if (help) {
+    printf(opt_help);
+    return 0;
+  }
+  const char *missing = !vars_s ? "--vars" : !t.q1 ? "--q1" : !t.q2 ? "--q2" : !out ? "--out"
+                        : !report ? "--report" : NULL;
+  if (missing) {
+    prru_cli_error(cmd, "%s is required (see 'prru optimize --help')", missing);
+    return 2;
+  }
+  prru_design_problem pr;
+  prru_params start;
+  if (parse_problem(cmd, &t, &pr, &start)) return 2;
+  double pct = 20;
+  if (range && (prru_cli_number(cmd, "range", range, &pct) || !(pct > 0 && pct < 100))) {
+    if (pct > 0 && pct < 100) return 2;
+    prru_cli_error(cmd, "--range '%s': a percentage in (0, 100)", range);
+    return 2;
+  }
+  prru_design_options o;
+  prru_design_options_default(&o);
+  if (iters) {
+    char *end;
+    long v = strtol(iters, &end, 10);
+    if (!*iters || *end || v < 1 || v > 1000000) {
+      prru_cli_error(cmd, "--max-iter '%s': an integer from 1 to 1000000", iters);
+      return 2;
+    }
+    o.max_iter = (int)v;
+  }
+  if (pen && (prru_cli_number(cmd, "penalty", pen, &pr.penalty_weight) || !(pr.penalty_weight > 0))) {
+    if (pr.penalty_weight > 0) return 2;
+    prru_cli_error(cmd, "--penalty '%s': must be positive", pen);
+    return 2;
+  }
+  char name[32];
+  if (name_s) {
+    if (check_name(cmd, name_s)) return 2;
+    snprintf(name, sizeof name, "%s", name_s);
+  } else {
+    snprintf(name, sizeof name, "%.12s_opt", prru_mech.name);
+  }
+  prru_design_var vars[PRRU_DESIGN_MAX_VARS];
+  int nvar = 0, rc = parse_vars(cmd, vars_s, pct, &start, vars, &nvar);
+  if (rc) return rc;
+  char msg[512];
+  for (int i = 0; i < nvar; i++) {
+    double x = prru_design_get(&start, &vars[i]);
+    if (!(x >= vars[i].lo && x <= vars[i].hi)) {
+      prru_cli_error(cmd, "--vars %s: the start value %.17g is outside the bounds %.17g:%.17g", vars[i].name,
+                     x, vars[i].lo, vars[i].hi);
+      return 2;
+    }
+  }
+  /* Both outputs are checked before the optimisation runs. */
+  prru_cli_catch_signals();
+  prru_cli_out jo;
+  if (prru_cli_out_open(&jo, cmd, out)) return 1;
+  char stage[4200];
+  snprintf(stage, sizeof stage, "%s.partial-XXXXXX", report);
+  if (strlen(report) > 4000 || !mkdtemp(stage)) {
+    prru_cli_error(cmd, "--report %s: cannot create a directory beside it: %s", report, strerror(errno));
+    prru_cli_out_close(&jo, 0);
+    return 1;
+  }
+  prru_design_data dd;
+  prru_design_eval ev0;
+  rc = prru_design_data_alloc(&dd, &pr.grid) == PRRU_OK ? 0 : 1;
+  if (!rc) rc = base_eval(cmd, &pr, &start, &dd, &ev0);
+  prru_design_data_free(&dd);
+  opt_progress prog = {progress || isatty(2), 0};
+  o.progress = on_iteration;
+  o.ctx = &prog;
+  prru_design_result *r = malloc(sizeof *r);
+  if (!rc && !r) rc = 1;
+  if (!rc) {
+    int st = prru_design_optimize(&pr, &start, vars, nvar, &o, r, msg, sizeof msg);
+    if (prog.show) fputc('\n', stderr);
+    if (st == PRRU_EINTERRUPTED) {
+      prru_cli_error(cmd, "interrupted (%s): nothing written", prru_cli_signal_name());
+      rc = prru_cli_exit_interrupted();
+    } else if (st != PRRU_OK) {
+      prru_cli_error(cmd, "%s", msg);
+      rc = st == PRRU_EINPUT ? 2 : 1;
+    } else if (!r->best_eval.feasible) {
+      prru_cli_error(cmd, "no feasible design found: the best has %.4g %% of the grid singular or "
+                          "unreachable and a stroke violation of %.3g; nothing written (widen the bounds, "
+                          "shrink the rectangle or loosen --rcond-min / --stroke)",
+                     100 * r->best_eval.sum.singular_fraction, r->best_eval.stroke_violation);
+      rc = 1;
+    }
+  }
+  char desc[420];
+  if (!rc) {
+    describe(desc, sizeof desc, &pr, vars, nvar);
+    write_model(&jo, &r->best, name, desc);
+    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set};
+    rc = stage_report(cmd, stage, report, &rp);
+  }
+  if (prru_cli_out_close(&jo, rc == 0 && !jo.err) && !rc) rc = 1;
+  if (!rc) rc = publish_report(cmd, stage, report);
+  if (rc) remove_stage(stage);
+  if (!rc) {
+    printf("model: %s\n", prru_cli_model_id());
+    report_eval_rows(stdout, &r->start_eval, &r->best_eval);
+    for (int i = 0; i < nvar; i++)
+      printf("%-12s %.10g -> %.10g  [%.10g, %.10g]\n", vars[i].name, r->x0[i], r->x[i], vars[i].lo, vars[i].hi);
+    printf("before_index: %.17g\nafter_index: %.17g\nwrote %s and %s/\n", r->start_eval.sum.index,
+           r->best_eval.sum.index, out, report);
+  }
+  free(r);
+  return rc;
+}
