@@ -33,6 +33,10 @@
  * length <= 0, a non-positive-definite inertia) gives NaN or meaningless
  * numbers, so the caller validates designs. coulomb_velocity must be
  * positive even where coulomb is 0 (f tanh(dd / v_s) with v_s = 0 is NaN).
+ * Structurally, a link turns about its hinge only, so only its moment about
+ * that axis enters any output (Ixx for limbs 1 and 2, Iyy for limbs 3 and
+ * 4), a slider's inertia enters none, and a[2], a[3] are ignored: their
+ * derivatives are exactly 0.
  * Each kernel reads every member it uses once; no globals are written, no
  * allocation, re-entrant; depends only on <math.h>. */
 #include "prru_kernels.h"
@@ -73,11 +77,12 @@ typedef struct {
      platform (limbs 1 and 2 only: C1 at v = -a[0], C2 at v = +a[1]; the
      other entries are ignored). */
   double b[PRRU_NLIMB], l1[PRRU_NLIMB], l2[PRRU_NLIMB], a[PRRU_NLIMB];
-  double gravity[3];                      /* m/s^2 in {S} */
-  double mass[PRRU_NBODY];               /* kg, body order */
-  double com[PRRU_NBODY][3];             /* centre of mass in the body frame, m */
-  double inertia[PRRU_NBODY][6];         /* Ixx Iyy Izz Ixy Ixz Iyz about the
-                                             centre of mass, body axes, kg m^2 */
+  /* Gravity in {S}, m/s^2. */
+  double gravity[3];
+  /* Per body, in body order: mass (kg), centre of mass in the body frame
+     (m), inertia tensor Ixx Iyy Izz Ixy Ixz Iyz about the centre of mass in
+     body axes (kg m^2). */
+  double mass[PRRU_NBODY], com[PRRU_NBODY][3], inertia[PRRU_NBODY][6];
   /* Drives: armature (kg), viscous damping (N s/m), Coulomb force (N) per
      actuator, and the Coulomb smoothing velocity v_s (m/s, > 0). */
   double armature[PRRU_NACT], damping[PRRU_NACT], coulomb[PRRU_NACT], coulomb_velocity;
