@@ -3,7 +3,7 @@
 import collections
 import ctypes
 
-from . import _convert, _lib, errors
+from . import _convert, _interrupt, _lib, errors
 
 STATUS_NAMES = {errors.OK: "ok", errors.ESINGULAR: "singular",
                 errors.EUNREACHABLE: "unreachable", errors.EINPUT: "invalid"}
@@ -47,24 +47,18 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
     o = _lib._MapOptions()
     self.lib.map_options_default(ctypes.byref(o))
     o.nthreads = threads
-    pending = []
-
-    def progress(done, total, ctx):
-        # Runs in the calling thread, where Python's SIGINT handler can raise.
-        try:
-            return 0
-        except BaseException as e:
-            pending.append(e)
-            return 1
-
-    o.progress = _lib.MAP_PROGRESS_FN(progress)
+    # The progress report runs Python in the calling thread now and then,
+    # which is when a SIGINT handler can run (see _interrupt).
+    o.progress = _lib.MAP_PROGRESS_FN(lambda done, total, ctx: 0)
     w = (ctypes.c_double * (n1 * n2))()
     st = (ctypes.c_ubyte * (n1 * n2))()
     s = _lib._MapSummary()
-    rc = self.lib.map_eval(ctypes.byref(m), ctypes.byref(g), ctypes.byref(o), w, st,
-                           ctypes.byref(s))
-    if pending:
-        raise pending[0]
+    with _interrupt.SigintFlag() as sigint:
+        o.interrupt = sigint.pointer
+        rc = self.lib.map_eval(ctypes.byref(m), ctypes.byref(g), ctypes.byref(o), w, st,
+                               ctypes.byref(s))
+    if sigint.raised:
+        raise KeyboardInterrupt()
     if rc != errors.OK:
         raise errors.make_error(rc, "map: %s" % self.lib.status_text(rc))
     axis1 = [self.lib.map_axis(lo1, hi1, n1, i) for i in range(n1)]

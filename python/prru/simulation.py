@@ -12,7 +12,7 @@ import math
 import os
 from typing import Optional, Sequence, Tuple
 
-from . import _convert, _lib, errors
+from . import _convert, _interrupt, _lib, errors
 from ._convert import optional_vector, vector
 
 
@@ -221,7 +221,7 @@ class _Collector:
                     self.stopped = True
                     return 1
             return 0
-        except BaseException as e:  # KeyboardInterrupt too: stop, re-raise after the call
+        except BaseException as e:  # stop; simulate re-raises it after the call
             self.error = e
             return 1
 
@@ -240,7 +240,9 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     reactions: also compute the joint reactions of every sample (lambda_).
     on_sample(sample): called with every Sample as it is computed; a true
     return value stops the run (the Trajectory then has stopped = True);
-    an exception it raises (Ctrl-C too) stops the run and is re-raised.
+    an exception it raises stops the run and is re-raised. Ctrl-C stops
+    the run at the next sample with KeyboardInterrupt. Either exception
+    carries .trajectory, the samples computed until then.
 
     When the state leaves the workspace or the integrator fails, raises
     Unreachable, Singular or NoConvergence with the library's message;
@@ -271,10 +273,14 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     col = _Collector(self, q0, qd0, on_sample, reactions)
     opts.on_sample = col.fn
     t_stop, msg = ctypes.c_double(math.nan), ctypes.create_string_buffer(512)
-    st = self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
-                           ctypes.byref(t_stop), msg, len(msg))
+    with _interrupt.SigintFlag() as sigint:
+        opts.interrupt = sigint.pointer
+        st = self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
+                               ctypes.byref(t_stop), msg, len(msg))
     del keep  # the table rows stayed alive for the call
     traj = Trajectory(self, b"".join(col.chunks), len(col.chunks), reactions, col.stopped)
+    if sigint.raised and col.error is None:
+        col.error = KeyboardInterrupt()
     if col.error is not None:
         try:
             col.error.trajectory = traj
