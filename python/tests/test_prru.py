@@ -331,6 +331,34 @@ class TestPoses(unittest.TestCase):
                 self.assertLessEqual(abs(sum(JT[i][j] * qd[j] for j in range(3)) - v[i]), 1e-8)
 
 
+class TestThreads(unittest.TestCase):
+    def test_one_model_shared_by_threads(self):
+        """Calls from several threads on one Model (its workspace is locked
+        per call) give the serial results."""
+        import threading
+        states = random_states(8, 11)
+        serial = [MODEL.reactions(q, qd, fd, fp, mp) for q, qd, fd, fp, mp in states]
+        results, errors_seen = {}, []
+
+        def work(k):
+            try:
+                for r in range(1000):
+                    i = (k + r) % len(states)
+                    q, qd, fd, fp, mp = states[i]
+                    lam = MODEL.reactions(q, qd, fd, fp, mp)
+                    if bits(lam) != bits(serial[i]):
+                        results[(k, r)] = (i, lam)
+            except Exception as e:  # reported below, not lost in the thread
+                errors_seen.append(e)
+        threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        self.assertEqual(errors_seen, [])
+        self.assertEqual(results, {}, "results that differ from the serial ones")
+
+
 class TestSimulation(unittest.TestCase):
     def test_scenario_paper_fields(self):
         s = MODEL.paper_scenario()
