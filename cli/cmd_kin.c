@@ -12,10 +12,10 @@ static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
     "Prints JSON with model (name, file, sha256), q, the actuator displacements d\n"
     "(m, slider heights), J_d = dd/dq (a list of rows: one per actuator, one\n"
-    "column per coordinate), its reciprocal\n"
-    "condition number and whether J_d is singular there; with redundant\n"
-    "actuators (more sliders than coordinates) also actuator_null, the unit n\n"
-    "with J_d^T n = 0 and a positive last component (not at a singular pose).\n"
+    "column per coordinate), its reciprocal condition number and whether J_d\n"
+    "is singular there; with redundant actuators (more sliders than\n"
+    "coordinates) also actuator_null, the unit n with J_d^T n = 0 and a\n"
+    "positive last component (not at a singular pose).\n"
     "Exit 1 when q is unreachable.\n";
 
 int prru_cmd_ik(int argc, char **argv)

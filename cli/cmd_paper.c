@@ -20,8 +20,10 @@ static const char paper_help[] =
     "Reproduces the paper's studies (Chen et al. 2017, section 4.3 and fig. 7):\n"
     "1 s from q(0) = (0, pi/6, -0.8) m/rad at rest under fd = (50, 40, 25) N and\n"
     "the platform force fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N, then the w_R map.\n"
-    "Writes DIR/paper_sim.csv (columns as `prru simulate`), fig_q.png, fig_d.png,\n"
-    "fig4_u_joint_forces.png, fig6_p_joint_reactions.png, the fig. 7 files and\n"
+    "Writes DIR/paper_sim.csv (columns as `prru simulate`), fig_q.png, fig_d.png\n"
+    "(q and d over time), the paper's figs. 4-6: fig4_u_joint_forces.png,\n"
+    "fig5_p_joint_forces.png, fig6_p_joint_moments.png (joint reactions), its\n"
+    "fig. 7: fig7_surface.png, fig7_contour.png, fig7a_ellipses.png (w_R), and\n"
     "DIR/summary.txt. Needs gnuplot for the PNGs.\n"
     "The files are built in DIR/paper.partial-XXXXXX and moved into DIR only\n"
     "when the run is complete: a run that fails or is stopped (SIGINT, SIGTERM,\n"
@@ -170,7 +172,7 @@ static int move_files(const char *stage, const char *out)
 /* What gnuplot makes: without gnuplot, earlier copies are removed so that
  * DIR never shows figures of another run. */
 static const char *const plot_outputs[] = {"fig_q.png", "fig_d.png", "fig4_u_joint_forces.png",
-                                           "fig6_p_joint_reactions.png"};
+                                           "fig5_p_joint_forces.png", "fig6_p_joint_moments.png"};
 static const char *const fig7_plot_outputs[] = {"fig7_surface.png", "fig7_contour.png",
                                                 "fig7a_ellipses.png", "fig7_contours.dat"};
 
@@ -372,6 +374,7 @@ int prru_cmd_paper(int argc, char **argv)
   if (created && rc != 0 && !no_gnuplot) rmdir(out); /* only when empty */
   if (rc == 0)
     printf("wrote %s/: paper_sim.csv, fig_q.png, fig_d.png, fig4_u_joint_forces.png, "
-           "fig6_p_joint_reactions.png, %ssummary.txt\n", out, skip_map ? "" : "fig7_*, ");
+           "fig5_p_joint_forces.png, fig6_p_joint_moments.png, %ssummary.txt\n", out,
+           skip_map ? "" : "fig7_*, ");
   return rc;
 }

@@ -138,6 +138,27 @@ static void plot_components(FILE *g, int j, char kind)
   fputs(first ? "plot 0 notitle\n" : "\n", g);
 }
 
+/* One figure of the reactions of kind ('f' forces, 'm' moments) in the np
+ * prismatic joints, one panel per joint: the paper's figure number fig. */
+static void p_joint_figure(FILE *g, int np, char kind, const char *png, const char *what,
+                           const char *unit, int fig)
+{
+  fprintf(g, "set output '%s'\n", png);
+  fprintf(g, "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", 100 + 200 * (np ? np : 1));
+  fprintf(g, "set multiplot layout %d,1 title 'Reaction %s in the prismatic joints (of the rail on the "
+             "slider, base frame S; paper fig. %d), model '.model\n", np ? np : 1, what, fig);
+  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
+    if (prru_mech.joint[j].type != 'P') continue;
+    fprintf(g, "set xlabel '%s'\n", ++p == np ? "time t (s)" : "");
+    fputs("set ylabel '", g);
+    put_subscripted(g, prru_mech.joint[j].name);
+    fprintf(g, " %s'\n", unit);
+    plot_components(g, j, kind);
+  }
+  if (!np) fputs("plot 0 notitle\n", g);
+  fputs("unset multiplot\n", g);
+}
+
 /* Closes the memory stream g over *buf: the script's text (malloc'ed),
  * or NULL when out of memory. *buf is only final after fclose. */
 static char *close_script(FILE *g, char **buf)
@@ -168,7 +189,7 @@ char *prru_plot_paper_sim_script(const char *csv)
         "f = ", g);
   prru_plot_string(g, csv);
   fputs("\nset output 'fig_q.png'\n"
-        "set multiplot layout 2,1 title 'Generalized coordinates, paper scenario (section 4.3), model '.model\n"
+        "set multiplot layout 2,1 title 'Generalized coordinates in the paper''s simulation study (section 4.3; not one of its figures), model '.model\n"
         "set ylabel 'rotation (rad)'\n"
         "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
         "set xlabel 'time t (s)'\n"
@@ -176,7 +197,7 @@ char *prru_plot_paper_sim_script(const char *csv)
         "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
         "unset multiplot\n"
         "set output 'fig_d.png'\n"
-        "set title 'Actuator displacements (slider heights), model '.model\n"
+        "set title 'Actuator displacements (slider heights) in the paper''s simulation study (section 4.3; not one of its figures), model '.model\n"
         "set xlabel 'time t (s)'\n"
         "set ylabel 'd_i (m)'\n"
         "plot ", g);
@@ -196,25 +217,9 @@ char *prru_plot_paper_sim_script(const char *csv)
     plot_components(g, j, 'f');
   }
   if (!nu) fputs("plot 0 notitle\n", g);
-  fputs("unset multiplot\n"
-        "set output 'fig6_p_joint_reactions.png'\n", g);
-  fprintf(g, "set terminal pngcairo size 1200,%d enhanced font 'Sans,11'\n", 200 + 200 * (np ? np : 1));
-  fprintf(g, "set multiplot layout %d,2 title 'Reactions in the prismatic joints (rail on slider, "
-             "base frame S; paper fig. 6), model '.model\n", np ? np : 1);
-  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
-    if (prru_mech.joint[j].type != 'P') continue;
-    fprintf(g, "set xlabel '%s'\n", ++p == np ? "time t (s)" : "");
-    fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
-    fputs(" force (N)'\n", g);
-    plot_components(g, j, 'f');
-    fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
-    fputs(" moment (N m)'\n", g);
-    plot_components(g, j, 'm');
-  }
-  if (!np) fputs("plot 0 notitle\n", g);
   fputs("unset multiplot\n", g);
+  p_joint_figure(g, np, 'f', "fig5_p_joint_forces.png", "forces", "force (N)", 5);
+  p_joint_figure(g, np, 'm', "fig6_p_joint_moments.png", "moments", "moment (N m)", 6);
   return close_script(g, &buf);
 }
 

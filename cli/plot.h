@@ -35,7 +35,8 @@ void prru_plot_label(FILE *g, const char *s);
 
 /* The figures of a simulation CSV named csv (relative to the directory the
  * script runs in; columns as `prru simulate` writes them, with reactions):
- * fig_q.png, fig_d.png, fig4_u_joint_forces.png, fig6_p_joint_reactions.png.
+ * fig_q.png, fig_d.png, fig4_u_joint_forces.png, fig5_p_joint_forces.png and
+ * fig6_p_joint_moments.png (the paper's figs. 4-6).
  * A malloc'ed script, NULL when out of memory. */
 char *prru_plot_paper_sim_script(const char *csv);
 

@@ -142,6 +142,16 @@ fi
 grep -qF "Model: $model_name ($model_file, sha256 $model_sha)" "$tmp/paper/summary.txt" && ok || bad "summary.txt lacks the model"
 [ "$(head -1 "$tmp/paper/paper_sim.csv")" = "$csv_comment" ] && ok || bad "paper_sim.csv: comment line"
 [ "$(grep -vc '^#' "$tmp/paper/paper_sim.csv")" -eq 1002 ] && ok || bad "paper_sim.csv: 1001 samples expected"
+# Each figure says which of the paper's figures it is, or that it is none.
+if [ $rc -eq 0 ]; then
+  for f in fig_q fig_d fig4_u_joint_forces fig5_p_joint_forces fig6_p_joint_moments; do
+    [ "$(head -c 8 "$tmp/paper/$f.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] && ok || bad "paper: $f.png is not a PNG"
+  done
+  for label in "fig4_u_joint_forces.png.*paper fig. 4" "fig5_p_joint_forces.png.*paper fig. 5" \
+               "fig6_p_joint_moments.png.*paper fig. 6" "fig_q.png.*not one of its figures" "fig_d.png.*not one of its figures"; do
+    tr '\n' ' ' <"$tmp/paper/paper_plots.gp" | sed 's/set output/\n/g' | grep -q "$label" && ok || bad "paper_plots.gp: no '$label'"
+  done
+fi
 # Deterministic: a second run writes the same files (no timestamps).
 "$PRRU" paper --out "$tmp/paper2" --skip-map >/dev/null 2>&1
 cmp -s "$tmp/paper/paper_sim.csv" "$tmp/paper2/paper_sim.csv" && cmp -s "$tmp/paper/summary.txt" "$tmp/paper2/summary.txt" \
