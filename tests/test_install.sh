@@ -33,8 +33,8 @@ CC_BUILD=$(cache CMAKE_C_COMPILER)
 BUILD_TYPE=$(cache CMAKE_BUILD_TYPE)
 C_FLAGS=$(cache CMAKE_C_FLAGS)
 LD_FLAGS=$(cache CMAKE_EXE_LINKER_FLAGS)
-consumer_cmake=(-DCMAKE_C_COMPILER="$CC_BUILD" -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}"
-                -DCMAKE_C_FLAGS="$C_FLAGS" -DCMAKE_EXE_LINKER_FLAGS="$LD_FLAGS")
+consumer_cmake=(-DCMAKE_C_COMPILER="$CC_BUILD" -DCMAKE_C_FLAGS="$C_FLAGS"
+                -DCMAKE_EXE_LINKER_FLAGS="$LD_FLAGS")
 
 # ---- 1. install ----
 prefix="$tmp/prefix"
@@ -163,7 +163,8 @@ target_compile_definitions(use_kernels PRIVATE KERNELS_ONLY)
 target_link_libraries(use_kernels PRIVATE prru::kernels)
 EOF
 # No package registry, no system prru: only the temporary prefix.
-if cmake -S "$tmp/fp" -B "$tmp/fp/build" "${consumer_cmake[@]}" -DCMAKE_PREFIX_PATH="$prefix" \
+if cmake -S "$tmp/fp" -B "$tmp/fp/build" "${consumer_cmake[@]}" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" \
+     -DCMAKE_PREFIX_PATH="$prefix" \
      -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DEXPECTED_SHA256="$sha" >"$tmp/fp.log" 2>&1 &&
    cmake --build "$tmp/fp/build" >>"$tmp/fp.log" 2>&1; then
   ok "find_package(prru): configured, three programs built"
@@ -210,6 +211,8 @@ else
 fi
 
 # ---- 3. add_subdirectory(prru) ----
+# No build type: the parent's choice, which prru must leave alone (and no
+# optimisation keeps the kernels' compilation short).
 mkdir -p "$tmp/sub"
 cp "$tmp/consumer.c" "$tmp/sub/consumer.c"
 cat >"$tmp/sub/CMakeLists.txt" <<EOF
@@ -229,6 +232,9 @@ if cmake -S "$tmp/sub" -B "$tmp/sub/build" "${consumer_cmake[@]}" -DPRRU_MODEL="
   else
     fail "add_subdirectory: use_sub exits $?"; cat "$tmp/use_sub.out"
   fi
+  bt=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$tmp/sub/build/CMakeCache.txt")
+  [ -z "$bt" ] && ok "add_subdirectory: the parent's build type left unset" ||
+    fail "add_subdirectory: prru set the parent's CMAKE_BUILD_TYPE to $bt"
   # prru's tests stay out of the parent's ctest unless asked for.
   ntests=$(cd "$tmp/sub/build" && ctest -N | sed -n 's/^Total Tests: //p')
   [ "$ntests" = 0 ] && ok "add_subdirectory: the parent's ctest has none of prru's tests" ||
