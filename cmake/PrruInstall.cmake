@@ -1,12 +1,12 @@
 # Installation: `cmake --install BUILD [--prefix DIR]` writes
-#   bin/prru                                   the command-line tool
-#   lib/libprru.so*                            runtime + kernels, shared   (prru::prru)
-#   lib/libprru_runtime.a, libprru_kernels.a   the same, static            (prru::prru_static)
-#                                              the kernels alone, only libm (prru::kernels)
-#   include/prru/*.h                           runtime and generated headers
-#   lib/cmake/prru/                            find_package(prru) config, version, targets
-#   lib/pkgconfig/prru.pc                      pkg-config (the shared library)
-#   share/prru/MODEL.json                      the model file the kernels come from
+#   bin/prru                  the command-line tool
+#   lib/libprru.so*           runtime + kernels, shared            (prru::prru)
+#   lib/libprru_runtime.a     the runtime, static, with the next   (prru::prru_static)
+#   lib/libprru_kernels.a     the generated kernels alone, libm    (prru::kernels)
+#   include/prru/*.h          runtime and generated headers
+#   lib/cmake/prru/           find_package(prru): config, version, targets
+#   lib/pkgconfig/prru.pc     pkg-config, for the shared library
+#   share/prru/MODEL.json     the model file the kernels come from
 # (lib is GNUInstallDirs' CMAKE_INSTALL_LIBDIR.)
 #
 # The kernels, and with them the array sizes in the runtime's structs
