@@ -70,6 +70,7 @@ EOF
 }
 installed() { printf '%s\n' "$@" >>"$sb/installed"; }
 add_clang() {
+  # shellcheck disable=SC2016  # $v belongs to the stand-in
   printf '#!%s\nread -r v <"%s/clang.version"; echo "$v"\n' "$BASH_BIN" "$sb" >"$sb/bin/clang"
   chmod +x "$sb/bin/clang"
 }
