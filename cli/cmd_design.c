@@ -831,6 +831,7 @@ static void report_eval_rows(FILE *f, const prru_design_eval *a, const prru_desi
           100 * b->sum.singular_fraction);
   fprintf(f, "%-34s %22ld %22ld\n", "singular / unreachable points", a->sum.n_singular + a->sum.n_unreachable,
           b->sum.n_singular + b->sum.n_unreachable);
+  fprintf(f, "%-34s %22ld %22ld\n", "  of them in the other assembly mode", a->n_other_mode, b->n_other_mode);
   fprintf(f, "%-34s %10.6f..%-10.6f %10.6f..%-10.6f\n", "slider heights d (m)", a->d_min, a->d_max, b->d_min,
           b->d_max);
   fprintf(f, "%-34s %22.12g %22.12g\n", "objective", a->objective, b->objective);

@@ -6,11 +6,14 @@
  * A design is a prru_params (prru_param_kernels.h): every number of the
  * model, which the runtime-parameter kernels take at run time, so that a
  * candidate costs no code generation. A design is judged exactly as a
- * model's map is: w_R by prru_dme_from, regularity by prru_jd_regular
- * (with the design's own length scale, the mean upper link), the global
- * index by prru_map_summarize; a design evaluated here and the same
- * design written as a model file, regenerated and mapped by `prru map`
- * give the same index (to the kernels' 1e-13 agreement).
+ * model's map is by `prru map`: w_R by prru_dme_from, regularity by
+ * prru_jd_regular (with the design's own length scale, the mean upper
+ * link), a regular pose whose det J_d has the other sign than at home
+ * (0, 0, q3) counted as singular (the other assembly mode, cut off from
+ * home by the singular locus; three actuators only), the global index by
+ * prru_map_summarize; a design evaluated here and the same design written
+ * as a model file, regenerated and mapped by `prru map` give the same
+ * index (to the kernels' 1e-13 agreement).
  *
  * Parameter names (one number each):
  *   b_i, l1_i, l2_i        rail offset, upper link, lower link of limb i (m)
@@ -132,10 +135,13 @@ typedef struct {
   int valid;                 /* prru_design_check passed (otherwise only merit is set) */
   prru_map_summary sum;      /* the map's summary of the grid */
   double objective;          /* the chosen measure; NaN when no point is regular */
-  /* Regularity violation: the mean over the grid points of
-   * min(C, ln(rcond_min / rcond)) where rcond < rcond_min, C =
-   * ln(rcond_min / DBL_EPSILON) where unreachable (J_d's conditioning
-   * falls to 0 at the reach boundary, so it is continuous there). */
+  long n_other_mode;          /* of sum.n_singular: regular, but in the other assembly mode */
+  /* Regularity violation: the mean over the grid points of, with r =
+   * rcond_min, C = ln(r / DBL_EPSILON) and s = rcond (home's mode) or
+   * -rcond (the other): 0 for s >= r, min(C, ln(r / s)) for 0 < s < r,
+   * C + ln(1 + |s| / r) for s <= 0, C where unreachable (J_d's
+   * conditioning falls to 0 at the reach boundary and at the mode change,
+   * so it is continuous there). */
   double reg_violation;
   /* Stroke violation: the mean over the reachable points of the sum over
    * the sliders of the distance outside [lo, hi], in units of the length

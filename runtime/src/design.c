@@ -392,13 +392,45 @@ static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_N
   return e;
 }
 
-/* w_R at one grid point exactly as prru_dme_eval does it with the model's
- * kernels, here with the design's; *viol is the point's regularity
- * violation (0 when it is regular). */
-static int point_w(const prru_design_problem *pr, const prru_params *p, double L, const double q[3],
-                   double d[PRRU_NACT], double *w, double *viol)
+/* point_w's status for a point in the other assembly mode (stored and
+ * summarized as PRRU_ESINGULAR). */
+#define OTHER_MODE 0xFE
+
+/* The sign of det J_d (three actuators; 0 when it is 0 or not finite, and
+ * always with more actuators, where J_d has no determinant). */
+static int det_sign(const double Jd[PRRU_NACT * 3])
 {
-  const double cap = log(pr->rcond_min / DBL_EPSILON);
+  if (PRRU_NACT != 3) return 0;
+  double det = Jd[0] * (Jd[4] * Jd[8] - Jd[5] * Jd[7]) - Jd[1] * (Jd[3] * Jd[8] - Jd[5] * Jd[6]) +
+               Jd[2] * (Jd[3] * Jd[7] - Jd[4] * Jd[6]);
+  return det > 0 ? 1 : det < 0 ? -1 : 0;
+}
+
+/* The assembly mode of the design at home, (0, 0, q3): det J_d's sign, or
+ * 0 when it cannot be told (then no point is in "the other" mode). */
+static int home_mode(const prru_params *p, double q3)
+{
+  const double q[3] = {0.0, 0.0, q3};
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3];
+  prru_param_ik_jd(p, q, d, Jd);
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(d[i])) return 0;
+  return det_sign(Jd);
+}
+
+/* w_R at one grid point exactly as `prru map` gets it with the model's
+ * kernels, here with the design's: unreachable, singular (rcond below the
+ * tolerance), or regular but in the other assembly mode (det J_d's sign
+ * not home's: cut off from home by the singular locus; counted as
+ * singular, like the map does) are not ok. *viol, the point's share of the
+ * regularity violation, is continuous in the signed conditioning
+ * s = +-rcond (sign: home's mode or not), r = rcond_min, C = ln(r / eps):
+ *   s >= r: 0;  0 < s < r: min(C, ln(r / s));  s <= 0: C + ln(1 + |s| / r);
+ * unreachable points get C (rcond falls to 0 at the reach boundary). */
+static int point_w(const prru_design_problem *pr, const prru_params *p, double L, int home,
+                   const double q[3], double d[PRRU_NACT], double *w, double *viol)
+{
+  const double r = pr->rcond_min, cap = log(r / DBL_EPSILON);
   double Jd[PRRU_NACT * 3], Jdpinv[3 * PRRU_NACT], rc = 0.0;
   prru_dme dme;
   *w = NAN;
@@ -408,7 +440,11 @@ static int point_w(const prru_design_problem *pr, const prru_params *p, double L
       *viol = cap;
       return PRRU_EUNREACHABLE;
     }
-  int st = prru_jd_regular(Jd, L, pr->rcond_min, Jdpinv, &rc);
+  int st = prru_jd_regular(Jd, L, r, Jdpinv, &rc);
+  if (home != 0 && det_sign(Jd) != home) {
+    *viol = cap + log1p(rc / r);
+    return st == PRRU_OK ? OTHER_MODE : st;
+  }
   if (st == PRRU_OK) {
     double M[9], JP[18];
     prru_param_mass(p, q, M);
@@ -416,7 +452,7 @@ static int point_w(const prru_design_problem *pr, const prru_params *p, double L
     st = prru_dme_from(M, Jdpinv, JP, &dme);
     *w = dme.w_R;
   }
-  *viol = st == PRRU_OK ? 0.0 : rc > 0 && rc < pr->rcond_min ? fmin(cap, log(pr->rcond_min / rc)) : cap;
+  *viol = st == PRRU_OK ? 0.0 : rc > 0 && rc < r ? fmin(cap, log(r / rc)) : cap;
   return st;
 }
 
@@ -440,6 +476,7 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
   ev->valid = 1;
   const prru_map_grid *g = &pr->grid;
   const double L = prru_design_length_scale(p);
+  const int home = home_mode(p, g->q3);
   double viol = 0, stroke = 0, dmin = INFINITY, dmax = -INFINITY;
   long nreach = 0;
   for (int i = 0; i < g->n1; i++) {
@@ -447,7 +484,11 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
     for (int j = 0; j < g->n2; j++) {
       long k = (long)i * g->n2 + j;
       q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
-      int st = point_w(pr, p, L, q, d, &dd->w_R[k], &v);
+      int st = point_w(pr, p, L, home, q, d, &dd->w_R[k], &v);
+      if (st == OTHER_MODE) {
+        ev->n_other_mode++;
+        st = PRRU_ESINGULAR;
+      }
       dd->status[k] = (unsigned char)st;
       viol += v;
       if (st == PRRU_EUNREACHABLE) continue;
@@ -639,12 +680,14 @@ static double objective_unchecked(const prru_design_problem *pr, const prru_para
 {
   const prru_map_grid *g = &pr->grid;
   const double L = prru_design_length_scale(q);
+  const int home = home_mode(q, g->q3);
   for (int i = 0; i < g->n1; i++) {
     double qq[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3}, d[PRRU_NACT], viol;
     for (int j = 0; j < g->n2; j++) {
       long k = (long)i * g->n2 + j;
       qq[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
-      int st = point_w(pr, q, L, qq, d, &dd->w_R[k], &viol);
+      int st = point_w(pr, q, L, home, qq, d, &dd->w_R[k], &viol);
+      if (st == OTHER_MODE) st = PRRU_ESINGULAR;
       if (compare && (st == PRRU_OK) != (dd->status[k] == PRRU_OK)) *changed = 1;
       dd->status[k] = (unsigned char)st;
     }
