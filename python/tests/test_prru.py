@@ -177,8 +177,7 @@ class TestAgainstCli(unittest.TestCase):
             self.assertEqual(bits(d), bits(out["d"]))
             self.assertEqual(bits(flat(Jd)), bits(flat(out["Jd"])))
             fk = parse(cli("fk", "--d", arg(d)))
-            if MODEL.nact == 3:
-                self.assertEqual(bits(MODEL.fk(d)), bits(fk["q"]))
+            self.assertEqual(bits(MODEL.fk(d)), bits(fk["q"]))
             qq, res = MODEL.fk_lsq(d)
             if fk["method"] == "least-squares":
                 self.assertEqual(bits(qq), bits(fk["q"]))
@@ -201,6 +200,24 @@ class TestAgainstCli(unittest.TestCase):
             self.assertEqual(bits(flat(o.Mt)), bits(flat(dme["Mt"])))
             self.assertEqual(bits(flat(o.JtR)), bits(flat(dme["JtR"])))
             self.assertEqual(bits(flat(o.JtT)), bits(flat(dme["JtT"])))
+
+    def test_inconsistent_sliders(self):
+        """More sliders than coordinates: a fourth slider 1 mm off where the
+        others put it has no exact pose (fk: NoConvergence, CLI exit 1);
+        fk_lsq gives the CLI's least-squares fit and residual."""
+        if MODEL.nact == 3:
+            self.skipTest("three sliders are always consistent")
+        q = random_states(1, 12)[0][0]
+        d = MODEL.ik(q)[0]
+        d[-1] += 1e-3
+        self.assertEqual(cli("fk", "--d", arg(d), ok=False)[0], 1)
+        with self.assertRaisesRegex(prru.NoConvergence, "did not converge"):
+            MODEL.fk(d)
+        out = parse(cli("fk", "--d", arg(d), "--lsq"))
+        qq, res = MODEL.fk_lsq(d)
+        self.assertEqual(bits(qq), bits(out["q"]))
+        self.assertEqual(bits(res), bits(out["residual"]))
+        self.assertGreater(res, 1e-4)
 
     def test_simulate_paper(self):
         """The paper scenario's first 0.05 s, every sample and column, with
