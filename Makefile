@@ -27,7 +27,7 @@ DEPS_DRY_RUN ?=
 SKIP_DEPS ?=
 DEPS = PRRU_DEPS_DRY_RUN=$(DEPS_DRY_RUN) PRRU_SKIP_DEPS=$(SKIP_DEPS) bash cmake/debian_deps.sh
 
-.PHONY: all deps deps-demo deps-test deps-asan deps-fuzz build demo compare-designs test \
+.PHONY: all deps deps-demo deps-test deps-asan deps-fuzz build demo compare-designs optimize-design test \
         test-asan fuzz check-generated regenerate bench clean
 # Two package installations must never run at once (dpkg's lock); the
 # compilers run in parallel inside cmake --build.
@@ -51,6 +51,7 @@ build: deps-demo
 
 demo: build
 	$(BUILD)/cli/prru paper --out $(RESULTS)
+	$(BUILD)/cli/prru animate $(RESULTS)/paper_sim.csv --out $(RESULTS)/paper_run.gif
 	$(MAKE) --no-print-directory compare-designs
 
 # The paper's future work: three limbs (the paper's model) vs four
@@ -59,6 +60,14 @@ compare-designs: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=build
 	$(MAKE) --no-print-directory build MODEL=models/4prru.json BUILD=build-4prru
 	studies/compare_designs.sh build build-4prru $(RESULTS)/compare
+
+# The paper's purpose for w_R: optimise its b12, b3, l1, l2, a (+-20 %) over
+# fig. 7's rectangle, re-evaluate the written model by regenerating the
+# kernels in a separate build, and the sensitivities (about a minute).
+PAPER_BUILD ?= build
+optimize-design: deps-demo
+	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=$(PAPER_BUILD)
+	studies/optimize_paper.sh $(PAPER_BUILD) $(RESULTS)/optimize
 
 test: deps-test build check-generated
 	cd $(BUILD) && ctest --output-on-failure -j 2

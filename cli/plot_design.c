@@ -61,7 +61,7 @@ char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, dou
   fputs("set terminal pngcairo size 1400,640 enhanced font 'Sans,11'\n"
         "set output 'optimize_maps.png'\n"
         "set multiplot layout 1,2 title sprintf(\"Rotational dynamic manipulability w_R over the workspace, q_3 = %g m: \"."
-        "\"before and after prru optimize\\nwhite: J_d singular (cond_1 > %g) or unreachable; one colour scale\", q3, cond)\n"
+        "\"before and after prru optimize\\nwhite: J_d singular (cond_1 > %g), other assembly mode or unreachable; one colour scale, w_R > 5 drawn as 5\", q3, cond)\n"
         "set xlabel 'q_1 (rad)'\n"
         "set ylabel 'q_2 (rad)'\n"
         "set cblabel 'w_R = {/Symbol s}_1/{/Symbol s}_2'\n"

@@ -187,7 +187,10 @@ typedef struct {
 /* Minimizes the merit over the variables within their bounds (GSL
  * nmsimplex2 on x = lo + (hi - lo) (1 + sin u) / 2, which keeps every
  * candidate inside the box without clipping), from start, then restarts
- * from the best point. Deterministic: the same inputs give the same bits.
+ * from the best point while that improves it. The best design is the
+ * feasible one of lowest merit, or without any feasible evaluation the
+ * lowest merit (r->best_eval.feasible says which). Deterministic: the
+ * same inputs give the same bits.
  * PRRU_OK; PRRU_EINPUT (bad bounds: lo >= hi, a start outside them, more
  * than PRRU_DESIGN_MAX_VARS, msg says which); PRRU_EINTERRUPTED (the
  * progress callback stopped it; r holds the best so far); PRRU_ENOMEM. */

@@ -557,8 +557,17 @@ static void design_at(opt_ctx *c, const gsl_vector *u, double *x)
   }
 }
 
-/* The merit at u; keeps the best design seen (strictly lower merit, so
- * ties keep the first: the run is deterministic). */
+/* Is a better than b: feasible before infeasible (an exact penalty puts
+ * the optimum on a constraint's edge, which Nelder-Mead approaches from
+ * both sides: the best merit may lie a hair outside), then lower merit;
+ * ties keep b, the first found, so the run is deterministic. */
+static int better(const prru_design_eval *a, const prru_design_eval *b)
+{
+  if (a->feasible != b->feasible) return a->feasible;
+  return a->merit < b->merit;
+}
+
+/* The merit at u; keeps the best design seen. */
 static double merit_at(const gsl_vector *u, void *params)
 {
   opt_ctx *c = params;
@@ -566,7 +575,7 @@ static double merit_at(const gsl_vector *u, void *params)
   design_at(c, u, x);
   prru_design_evaluate(c->pr, &c->cand, c->dd, &c->ev);
   c->evals++;
-  if (c->ev.merit < c->r->best_eval.merit) {
+  if (better(&c->ev, &c->r->best_eval)) {
     c->r->best = c->cand;
     c->r->best_eval = c->ev;
     memcpy(c->r->x, x, sizeof(double) * (size_t)c->nvar);
@@ -653,14 +662,14 @@ int prru_design_optimize(const prru_design_problem *pr, const prru_params *start
   r->best_eval = r->start_eval;
   for (int i = 0; i < nvar; i++) r->x0[i] = r->x[i] = prru_design_get(start, &vars[i]);
   int iter_left = o->max_iter;
-  double before = r->best_eval.merit;
+  prru_design_eval before = r->best_eval;
   st = nm_run(&c, o, &iter_left);
   /* Restarts: a fresh simplex at the best point escapes the collapse that
    * Nelder-Mead can suffer on a constraint's edge; stop once one gains
    * nothing. */
   while (st == PRRU_OK && r->restarts_done < o->restarts && iter_left > 0 &&
-         r->best_eval.merit < before) {
-    before = r->best_eval.merit;
+         better(&r->best_eval, &before)) {
+    before = r->best_eval;
     r->restarts_done++;
     st = nm_run(&c, o, &iter_left);
   }
