@@ -28,6 +28,8 @@ int prru_cmd_id(int argc, char **argv);
 int prru_cmd_paper(int argc, char **argv);
 int prru_cmd_dme(int argc, char **argv);
 int prru_cmd_map(int argc, char **argv);
+int prru_cmd_plot(int argc, char **argv);
+int prru_cmd_animate(int argc, char **argv);
 
 /* Shared helpers (cli/util.c). */
 /* `prru --version`: program version and the model's name, file, format,
@@ -80,6 +82,11 @@ typedef struct {
 /* 0 on success, else 2 after printing the reason and `prru CMD --help`. */
 int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
                    int nopts);
+/* The same for a command that takes one file argument besides its options
+ * (plot, animate): *file is it, or NULL when none was given; a second one
+ * is a usage error. */
+int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
+                        int nopts, const char **file);
 /* Exactly n comma-separated finite numbers for option `name`: 0, else 2
  * after printing what was wrong. */
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n);
@@ -138,6 +145,9 @@ void prru_cli_out_printf(prru_cli_out *o, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
+/* n raw bytes (a picture): part of the file at the next
+ * prru_cli_out_line. */
+void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n);
 /* ",%.17g" for each of n numbers. */
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n);
 /* Ends a complete line that is not a data row (comment, header); 0 or -1. */

@@ -18,6 +18,8 @@ static const struct {
     {"id", prru_cmd_id, "actuator forces along a CSV trajectory (inverse dynamics)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
+    {"plot", prru_cmd_plot, "PNG of a simulation CSV (time series) or map CSV (w_R contours)"},
+    {"animate", prru_cmd_animate, "animated GIF of the mechanism moving through a simulated run"},
     {"optimize", prru_cmd_optimize, "choose geometry/inertia so w_R is nearest 1 over a workspace"},
     {"sensitivity", prru_cmd_sensitivity, "d(global index)/d(parameter) for every parameter, CSV"},
     {"merge", prru_cmd_merge, "join the --shard K/N outputs of map or sensitivity"},

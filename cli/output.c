@@ -102,6 +102,13 @@ void prru_cli_out_printf(prru_cli_out *o, const char *fmt, ...)
   }
 }
 
+void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n)
+{
+  if (o->err || reserve(o, n)) return;
+  memcpy(o->buf + o->len, data, n);
+  o->len += n;
+}
+
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)
 {
   for (int i = 0; i < n; i++) prru_cli_out_printf(o, ",%.17g", v[i]);

@@ -3,6 +3,7 @@
  * (joints, actuators, reaction labels), never for a fixed limb count. */
 #define _POSIX_C_SOURCE 200809L /* fork, waitpid, nanosleep, open_memstream */
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,6 +44,23 @@ void prru_plot_model_var(FILE *g)
   fputc('\n', g);
 }
 
+/* The end of gnuplot's messages (the error is last) on stderr. */
+static void show_messages(const char *log)
+{
+  FILE *f = fopen(log, "r");
+  if (!f) return;
+  char buf[2048];
+  fseek(f, 0, SEEK_END);
+  long size = ftell(f);
+  fseek(f, size > (long)sizeof buf - 1 ? size - (long)sizeof buf + 1 : 0, SEEK_SET);
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  if (n) fprintf(stderr, "gnuplot said:\n%s%s", buf, buf[n - 1] == '\n' ? "" : "\n");
+}
+
+static int wait_gnuplot(const char *cmd, pid_t pid, const char *shown);
+
 /* Writes script to path; 0 or 1 after a message naming shown. */
 static int write_script(const char *cmd, const char *path, const char *shown, const char *script)
 {
@@ -72,18 +90,38 @@ int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
   snprintf(path, sizeof path, "%s/%s", dir, script_name);
   snprintf(shown, sizeof shown, "%s/%s", shown_dir, script_name);
   if (write_script(cmd, path, shown, script)) return 1;
+  /* gnuplot's messages go to a file, shown only when it fails: a run that
+   * works says nothing ("50 frames in animation sequence" and the like). */
+  char log[4200];
+  snprintf(log, sizeof log, "%s/.gnuplot-messages", dir);
+  int logfd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0600);
   fflush(NULL); /* nothing buffered is written twice by the child */
   pid_t pid = fork();
   if (pid < 0) {
     prru_cli_error(cmd, "cannot start gnuplot: %s", strerror(errno));
+    if (logfd >= 0) {
+      close(logfd);
+      unlink(log);
+    }
     return 1;
   }
   if (pid == 0) {
     /* The caught signals return to their defaults at exec. */
     if (chdir(dir) != 0) _exit(126);
+    if (logfd >= 0) dup2(logfd, STDERR_FILENO);
     execlp("gnuplot", "gnuplot", script_name, (char *)NULL);
     _exit(errno == ENOENT ? 127 : 126);
   }
+  if (logfd >= 0) close(logfd);
+  int rc = wait_gnuplot(cmd, pid, shown);
+  if (rc == 1) show_messages(log);
+  unlink(log);
+  return rc;
+}
+
+/* Waits for gnuplot; the exit status as prru_plot_run returns it. */
+static int wait_gnuplot(const char *cmd, pid_t pid, const char *shown)
+{
   /* Poll rather than block, so that a signal to prru alone (kill) stops
    * gnuplot too. */
   int status = 0, killed = 0;
@@ -322,5 +360,135 @@ char *prru_plot_fig7_script(int nposes, double rcond_min)
   if (!g) return NULL;
   prru_plot_model_var(g);
   fprintf(g, "NCONF = %d\ncond = '%g'\n%s", nposes, 1.0 / rcond_min, fig7_script);
+  return close_script(g, &buf);
+}
+
+/* ---- prru plot ---- */
+
+/* Opens a memory stream for a script; NULL when out of memory. */
+static FILE *open_script(char **buf, size_t *len)
+{
+  *buf = NULL;
+  return open_memstream(buf, len);
+}
+
+char *prru_plot_map_script(const char *dat, const char *png, const char *subtitle,
+                           const prru_plot_map_info *m)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  /* Colours up to 3 at most (said in the colour box), so that a steep rise
+   * next to a singular band does not flatten the rest of the map. */
+  double cbmax = m->w_max < 3.0 ? (m->w_max > 1.001 ? m->w_max : 1.001) : 3.0;
+  fputs("set terminal pngcairo size 1000,850 enhanced font 'Sans,11'\nset output ", g);
+  prru_plot_string(g, png);
+  fputs("\ngrid = ", g);
+  prru_plot_string(g, dat);
+  fputs("\nsub = ", g);
+  prru_plot_label(g, subtitle);
+  fprintf(g, "\nCBMAX = %.17g\nWMAX = %.17g\n", cbmax, m->w_max);
+  fputs("stats grid using 1 nooutput\nX0 = STATS_min\nX1 = STATS_max\n"
+        "stats grid using 2 nooutput\nY0 = STATS_min\nY1 = STATS_max\n"
+        "set xrange [X0:X1]\nset yrange [Y0:Y1]\n"
+        "set xlabel 'q_1 (rad)'\nset ylabel 'q_2 (rad)'\n"
+        "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', 1 '#fde725')\n"
+        "set contour base\nset cntrparam levels incremental 1.1, 0.1, CBMAX\nunset surface\n"
+        "set table 'contours.dat'\nsplot grid using 1:2:3 with lines notitle\nunset table\n"
+        "unset contour\nset surface\nset cbrange [1:CBMAX]\n", g);
+  fputs("set cblabel (WMAX > CBMAX ? sprintf('w_R (-); colours clipped at %g, w_R reaches %.3g', "
+        "CBMAX, WMAX) : 'w_R (-)')\n", g);
+  fprintf(g, "set title sprintf(\"w_R over (q_1, q_2) at q_3 = %%g m, %ld x %ld grid; contours "
+             "every 0.1 from 1.1\\n%%s\", %.17g, sub)\n", m->n1, m->n2, m->q3);
+  fputs("set size ratio -1\nset key outside bottom center horizontal\nset grid front\n"
+        "plot grid using 1:2:(($3 > CBMAX) ? CBMAX : $3) with image notitle, \\\n"
+        "     'contours.dat' using 1:2 with lines lc rgb 'white' lw 1 title 'w_R contours'", g);
+  if (m->n_other)
+    fputs(", \\\n     grid using 1:($4 == 2 ? $2 : NaN) with points pt 5 ps 0.45 lc rgb '#a0a0a0' "
+          "title 'other assembly mode'", g);
+  if (m->n_sing)
+    fputs(", \\\n     grid using 1:($4 == 1 ? $2 : NaN) with points pt 7 ps 0.35 lc rgb 'red' "
+          "title 'singular or unreachable'", g);
+  fputc('\n', g);
+  return close_script(g, &buf);
+}
+
+char *prru_plot_series_script(const char *csv, const char *png, const char *subtitle, int nact,
+                              int energies)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  int panels = 3 + (energies != 0);
+  fprintf(g, "set datafile separator ','\n"
+             "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\nset output ", 120 + 220 * panels);
+  prru_plot_string(g, png);
+  fputs("\nf = ", g);
+  prru_plot_string(g, csv);
+  fputs("\nsub = ", g);
+  prru_plot_label(g, subtitle);
+  fprintf(g, "\nset multiplot layout %d,1 title \"Simulation: coordinates, sliders%s over time\\n\".sub\n",
+          panels, energies ? " and energies" : "");
+  fputs("set grid\nset key outside right\n"
+        "set ylabel 'rotation (rad)'\n"
+        "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
+        "set ylabel 'height (m)'\n"
+        "plot f using 't':'q3' with lines lw 2 title 'q_3'\n", g);
+  if (!energies) fputs("set xlabel 'time t (s)'\n", g);
+  fputs("set ylabel 'slider height (m)'\nplot ", g);
+  for (int i = 1; i <= nact; i++)
+    fprintf(g, "%s't':'d%d' with lines lw 2 title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i);
+  fputc('\n', g);
+  if (energies)
+    fputs("set xlabel 'time t (s)'\nset ylabel 'energy (J)'\n"
+          "plot f using 't':'T' with lines lw 2 title 'T', '' using 't':'V' with lines lw 2 title 'V', "
+          "'' using 't':(column('T') + column('V')) with lines lw 2 dt 2 title 'T + V'\n", g);
+  fputs("unset multiplot\n", g);
+  return close_script(g, &buf);
+}
+
+/* ---- prru animate ---- */
+
+char *prru_plot_animation_script(const char *dat, const char *gif, const char *title, long n,
+                                 const double *times, long fps, const double lo[3],
+                                 const double hi[3])
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  /* gif's delay is in 1/100 s. */
+  fprintf(g, "set terminal gif animate delay %ld loop 0 optimize size 800,700 font 'Sans,10'\nset output ",
+          (100 + fps / 2) / fps);
+  prru_plot_string(g, gif);
+  fputs("\nf = ", g);
+  prru_plot_string(g, dat);
+  fputs("\nmodel = ", g);
+  prru_plot_label(g, title);
+  fputs("\nset linetype 1 lc rgb '#9a9a9a'\nset linetype 2 lc rgb '#202020'\n"
+        "set linetype 3 lc rgb '#1f77b4'\nset linetype 4 lc rgb '#ff7f0e'\n"
+        "set linetype 5 lc rgb '#2ca02c'\n", g);
+  /* One scale on all axes, the box a little larger than the mechanism. */
+  double c[3], half = 0.0;
+  for (int k = 0; k < 3; k++) {
+    c[k] = 0.5 * (lo[k] + hi[k]);
+    if (0.5 * (hi[k] - lo[k]) > half) half = 0.5 * (hi[k] - lo[k]);
+  }
+  half *= 1.05;
+  fprintf(g, "set xrange [%.6g:%.6g]\nset yrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\n", c[0] - half,
+          c[0] + half, c[1] - half, c[1] + half, lo[2], lo[2] + 2 * half);
+  fprintf(g, "set view equal xyz\nset view 65, 35\nset xyplane at %.6g\n", lo[2]);
+  fputs("set xlabel 'x (m)'\nset ylabel 'y (m)'\nset zlabel 'z (m)'\nset grid\nunset key\n"
+        "set tics font ',8'\n", g);
+  fprintf(g, "array T[%ld] = [", n);
+  for (long i = 0; i < n; i++) fprintf(g, "%s%.9g", i ? ", " : "", times[i]);
+  fputs("]\n", g);
+  fprintf(g, "do for [i = 0:%ld] {\n"
+             "  set title sprintf(\"%%s\\nt = %%.3f s (rails grey, sliders black, upper links blue, "
+             "lower links orange, platform green)\", model, T[i + 1])\n"
+             "  splot f index i using 1:2:3:4:5:6:7 with vectors nohead lc variable lw 3 notitle\n"
+             "}\n", n - 1);
   return close_script(g, &buf);
 }

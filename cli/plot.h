@@ -10,9 +10,13 @@
 #ifndef PRRU_CLI_PLOT_H
 #define PRRU_CLI_PLOT_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 #define PRRU_PLOT_NO_GNUPLOT 3
+
+/* Room for a path (scratch directories, default output names). */
+#define PRRU_PLOT_PATH 4096
 
 /* Writes script to dir/script_name and runs gnuplot in dir, so that the
  * script's relative file names (data and PNGs) are dir's. Messages name
@@ -46,5 +50,48 @@ char *prru_plot_paper_sim_script(const char *csv);
  * the singularity tolerance the map used (stated in the titles). A
  * malloc'ed script, NULL when out of memory. */
 char *prru_plot_fig7_script(int nposes, double rcond_min);
+
+/* ---- prru plot and prru animate (cli/plot_file.c, cli/cmd_plot.c) ---- */
+
+/* A PNG of a CSV written by prru simulate or prru map (recognised by its
+ * header; '#' lines go into the title) at out ("-": stdout; a file is
+ * replaced only when the picture is complete). 0; 2 when the file cannot
+ * be read or is not such a CSV (message with the line); 1 when gnuplot is
+ * missing or fails. */
+int prru_plot_csv(const char *cmd, const char *in, const char *out);
+
+/* A map CSV as prru_plot_map_script draws it. */
+typedef struct {
+  double q3, w_max;       /* the map's q3; the largest ok w_R */
+  long n1, n2;            /* grid size */
+  long n_sing, n_other;   /* singular or unreachable points; other assembly mode */
+} prru_plot_map_info;
+
+/* The w_R contour map of dat (columns q1 q2 w_R kind, kind 0 ok, 1 singular
+ * or unreachable, 2 other assembly mode; blank lines between q1 blocks)
+ * into png; subtitle: the CSV's comment lines. Malloc'ed; NULL: no memory. */
+char *prru_plot_map_script(const char *dat, const char *png, const char *subtitle,
+                           const prru_plot_map_info *info);
+/* Time series panels of a simulation CSV (absolute path csv): q1, q2; q3;
+ * d1..d<nact>; T, V and T + V when energies. Malloc'ed, NULL: no memory. */
+char *prru_plot_series_script(const char *csv, const char *png, const char *subtitle, int nact,
+                              int energies);
+
+/* The animated GIF gif of dat: n frames (data blocks), one segment per
+ * row: x y z dx dy dz colour (1..5 = rail, slider, upper link, lower
+ * link, platform); frame i at time times[i], fps frames per
+ * second, box lo..hi (m). title: the model. Malloc'ed, NULL: no memory. */
+char *prru_plot_animation_script(const char *dat, const char *gif, const char *title, long n,
+                                 const double *times, long fps, const double lo[3],
+                                 const double hi[3]);
+
+/* A new scratch directory $TMPDIR/prru-plot-XXXXXX (or /tmp) into dir;
+ * 0, or 1 after a message. */
+int prru_plot_scratch(const char *cmd, char *dir, size_t len);
+/* Copies the picture file png to out ("-": stdout) through the CLI's
+ * output file (never half-written); 0 or 1 after a message. */
+int prru_plot_deliver(const char *cmd, const char *png, const char *out);
+/* The default output name: FILE.csv -> FILE<ext>, other names + ext. */
+void prru_plot_default_out(const char *in, const char *ext, char *out, size_t len);
 
 #endif

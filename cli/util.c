@@ -94,12 +94,19 @@ static int usage_error(const char *cmd, const char *what, const char *arg)
   return 2;
 }
 
-int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
-                   int nopts)
+/* The options, and when file is not NULL one positional argument. */
+static int parse_args(const char *cmd, int argc, char **argv, const prru_cli_option *opts, int nopts,
+                      const char **file)
 {
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
-    if (strncmp(a, "--", 2) != 0 || a[2] == '\0') return usage_error(cmd, "unexpected argument", a);
+    if (strncmp(a, "--", 2) != 0 || a[2] == '\0') {
+      if (file && !*file) {
+        *file = a;
+        continue;
+      }
+      return usage_error(cmd, "unexpected argument", a);
+    }
     const char *name = a + 2, *eq = strchr(name, '=');
     size_t len = eq ? (size_t)(eq - name) : strlen(name);
     const prru_cli_option *o = NULL;
@@ -117,6 +124,19 @@ int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option
     }
   }
   return 0;
+}
+
+int prru_cli_parse(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
+                   int nopts)
+{
+  return parse_args(cmd, argc, argv, opts, nopts, NULL);
+}
+
+int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_option *opts,
+                        int nopts, const char **file)
+{
+  *file = NULL;
+  return parse_args(cmd, argc, argv, opts, nopts, file);
 }
 
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n)

@@ -1,0 +1,345 @@
+/* prru plot: a PNG of a CSV that prru wrote. A simulation CSV (header
+ * t,q1,q2,q3,qd1,qd2,qd3,d1,...) becomes time series panels, a map CSV
+ * (q1,q2,q3,w_R,status) a w_R contour map; the '#' lines (the model the
+ * file came from) go into the title. The file is checked before gnuplot
+ * sees it, so that a bad file is a message with its line, not a gnuplot
+ * error. */
+#define _XOPEN_SOURCE 700 /* getline, mkdtemp, realpath */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "plot.h"
+#include "prru.h"
+
+/* What a CSV holds, from its header. */
+enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP };
+
+static const char map_header[] = "q1,q2,q3,w_R,status";
+static const char sim_header[] = "t,q1,q2,q3,qd1,qd2,qd3,d1,";
+
+/* The '#' lines of a file, joined for a title (at most 3, 400 bytes). */
+typedef struct {
+  char text[400];
+  int count;
+} csv_comments;
+
+static void add_comment(csv_comments *c, const char *line)
+{
+  if (c->count++ >= 3) return;
+  size_t used = strlen(c->text);
+  while (*line == '#' || *line == ' ') line++;
+  snprintf(c->text + used, sizeof c->text - used, "%s%s", used ? "; " : "", line);
+}
+
+/* Strips the line end (LF or CRLF). */
+static void chomp(char *s)
+{
+  size_t n = strlen(s);
+  while (n > 0 && (s[n - 1] == '\n' || s[n - 1] == '\r')) s[--n] = '\0';
+}
+
+/* Reads the comment lines and the header of f; the kind by the header. */
+static int read_head(FILE *f, csv_comments *c, char **header, long *line_no)
+{
+  size_t cap = 0;
+  memset(c, 0, sizeof *c);
+  *header = NULL;
+  while (getline(header, &cap, f) > 0) {
+    ++*line_no;
+    chomp(*header);
+    if ((*header)[0] == '#') {
+      add_comment(c, *header);
+      continue;
+    }
+    if (strcmp(*header, map_header) == 0) return CSV_MAP;
+    if (strncmp(*header, sim_header, sizeof sim_header - 1) == 0) return CSV_SIMULATION;
+    return CSV_UNKNOWN;
+  }
+  return CSV_UNKNOWN;
+}
+
+/* ---- map CSVs ---- */
+
+/* One map row "q1,q2,q3,w,status": 0 and the fields, else -1. kind: 0 ok,
+ * 1 singular or unreachable, 2 other assembly mode. */
+static int parse_map_row(char *line, double q[3], double *w, int *kind)
+{
+  char *field[5], *save = NULL;
+  int n = 0;
+  for (char *tok = strtok_r(line, ",", &save); tok && n < 6; tok = strtok_r(NULL, ",", &save))
+    if (n++ < 5) field[n - 1] = tok;
+  if (n != 5) return -1;
+  for (int i = 0; i < 3; i++)
+    if (prru_parse_double(field[i], &q[i]) != PRRU_OK) return -1;
+  const char *st = field[4];
+  if (strcmp(st, "ok") == 0) {
+    *kind = 0;
+    return prru_parse_double(field[3], w) == PRRU_OK && *w >= 1.0 ? 0 : -1;
+  }
+  if (strcmp(field[3], "NaN") != 0) return -1;
+  *w = NAN;
+  if (strcmp(st, "singular") == 0 || strcmp(st, "unreachable") == 0 || strcmp(st, "invalid") == 0)
+    *kind = 1;
+  else if (strcmp(st, "other_mode") == 0)
+    *kind = 2;
+  else
+    return -1;
+  return 0;
+}
+
+/* The grid as read: q1 blocks (q1 outer, increasing) of n2 rows with the
+ * first block's increasing q2 values, one q3. */
+typedef struct {
+  long rows, n1, n2, cur, n_sing, n_other; /* cur: rows in the current block */
+  double q3, q1_last;
+  double *q2; /* the first block's q2 values */
+  double w_max;
+} map_scan;
+
+/* Checks one row against the grid read so far; NULL or the reason. */
+static const char *scan_row(map_scan *m, const double q[3], double w, int kind)
+{
+  if (m->rows == 0) {
+    m->q3 = q[2];
+    m->q1_last = q[0];
+    m->n1 = 1;
+  } else if (q[2] != m->q3) {
+    return "q3 differs from the first row's (a map has one q3)";
+  } else if (q[0] != m->q1_last) {
+    if (!(q[0] > m->q1_last)) return "q1 does not increase from block to block";
+    if (m->n1 == 1) m->n2 = m->cur;
+    if (m->cur != m->n2) return "the previous q1 block is shorter than the first";
+    m->n1++;
+    m->q1_last = q[0];
+    m->cur = 0;
+  }
+  if (m->n1 == 1) {
+    if (m->cur > 0 && !(q[1] > m->q2[m->cur - 1])) return "q2 does not increase within a q1 block";
+    double *q2 = realloc(m->q2, (size_t)(m->cur + 1) * sizeof *q2);
+    if (!q2) return "out of memory";
+    m->q2 = q2;
+    m->q2[m->cur] = q[1];
+  } else if (m->cur >= m->n2 || q[1] != m->q2[m->cur]) {
+    return "the q2 values differ from the first q1 block's (not a grid)";
+  }
+  if (kind == 0 && w > m->w_max) m->w_max = w;
+  m->n_sing += kind == 1;
+  m->n_other += kind == 2;
+  m->cur++;
+  m->rows++;
+  return NULL;
+}
+
+/* Converts the map rows of f into dat (gnuplot's grid format: blank lines
+ * between q1 blocks; columns q1 q2 w_R kind); 0, or 2 after a message
+ * naming path and line. */
+static int convert_map(const char *cmd, const char *path, FILE *f, long line_no, FILE *dat,
+                       map_scan *m)
+{
+  char *line = NULL;
+  size_t cap = 0;
+  int rc = 0;
+  memset(m, 0, sizeof *m);
+  m->w_max = 1.0;
+  while (getline(&line, &cap, f) > 0) {
+    ++line_no;
+    chomp(line);
+    if (line[0] == '#') continue;
+    double q[3], w;
+    int kind;
+    const char *why = parse_map_row(line, q, &w, &kind) ? "expected q1,q2,q3,w_R,status with numbers, "
+                                                          "w_R >= 1 where ok and NaN elsewhere" :
+                                                          NULL;
+    long n1_before = m->n1;
+    if (!why) why = scan_row(m, q, w, kind);
+    if (why) {
+      prru_cli_error(cmd, "%s:%ld: %s", path, line_no, why);
+      rc = 2;
+      break;
+    }
+    if (m->n1 != n1_before && n1_before > 0) fputc('\n', dat); /* a new q1 block */
+    fprintf(dat, "%.17g %.17g %.17g %d\n", q[0], q[1], w, kind);
+  }
+  free(line);
+  if (rc == 0 && ferror(f)) {
+    prru_cli_error(cmd, "%s: read error: %s", path, strerror(errno));
+    rc = 2;
+  }
+  if (rc == 0 && m->n1 == 1) m->n2 = m->cur;
+  if (rc == 0 && (m->n1 < 2 || m->n2 < 2 || m->cur != m->n2)) {
+    prru_cli_error(cmd, "%s: %s", path,
+                   m->rows == 0 ? "no data rows" :
+                   "not a complete grid of at least 2 x 2 points (the last q1 block is short)");
+    rc = 2;
+  }
+  return rc;
+}
+
+/* ---- simulation CSVs ---- */
+
+/* Checks a simulation CSV (every row as long as the header, finite
+ * numbers) with the runtime's table reader; 0, or 2 after its message. */
+static int check_simulation(const char *cmd, const char *path, int *nact, int *energies)
+{
+  prru_table t;
+  char msg[600];
+  if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error(cmd, "%s", msg);
+    return 2;
+  }
+  int rc = 0;
+  if (t.nrows < 2) {
+    prru_cli_error(cmd, "%s: a simulation CSV with fewer than 2 rows has nothing to plot", path);
+    rc = 2;
+  }
+  *nact = 0;
+  char name[16];
+  for (;;) {
+    snprintf(name, sizeof name, "d%d", *nact + 1);
+    if (prru_table_column(&t, name) < 0) break;
+    ++*nact;
+  }
+  *energies = prru_table_column(&t, "T") >= 0 && prru_table_column(&t, "V") >= 0;
+  prru_table_free(&t);
+  return rc;
+}
+
+/* ---- the command's work ---- */
+
+/* Removes dir and the files in it (a scratch directory of ours). */
+static void remove_scratch(const char *dir, const char *const *names, int n)
+{
+  char path[PRRU_PLOT_PATH + 64];
+  for (int i = 0; i < n; i++) {
+    snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+    unlink(path);
+  }
+  rmdir(dir);
+}
+
+int prru_plot_deliver(const char *cmd, const char *png, const char *out)
+{
+  FILE *f = fopen(png, "rb");
+  if (!f) {
+    prru_cli_error(cmd, "gnuplot wrote no picture (%s): %s", png, strerror(errno));
+    return 1;
+  }
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, cmd, out)) {
+    fclose(f);
+    return 1;
+  }
+  char buf[65536];
+  size_t n, total = 0;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+    prru_cli_out_write(&o, buf, n);
+    total += n;
+  }
+  int read_bad = ferror(f);
+  fclose(f);
+  if (read_bad) {
+    prru_cli_out_close(&o, 0);
+    prru_cli_error(cmd, "%s: read error", png);
+    return 1;
+  }
+  prru_cli_out_line(&o);
+  return prru_cli_out_close(&o, total > 0);
+}
+
+int prru_plot_scratch(const char *cmd, char *dir, size_t len)
+{
+  const char *base = getenv("TMPDIR");
+  if (!base || !*base) base = "/tmp";
+  if ((size_t)snprintf(dir, len, "%s/prru-plot-XXXXXX", base) >= len || !mkdtemp(dir)) {
+    prru_cli_error(cmd, "cannot create a scratch directory in %s: %s", base, strerror(errno));
+    return 1;
+  }
+  return 0;
+}
+
+/* The default output: FILE.csv -> FILE.png (ext given), else FILE.ext. */
+void prru_plot_default_out(const char *in, const char *ext, char *out, size_t len)
+{
+  size_t n = strlen(in);
+  if (n > 4 && strcmp(in + n - 4, ".csv") == 0) n -= 4;
+  snprintf(out, len, "%.*s%s", (int)n, in, ext);
+}
+
+int prru_plot_csv(const char *cmd, const char *in, const char *out)
+{
+  FILE *f = fopen(in, "r");
+  if (!f) {
+    prru_cli_error(cmd, "%s: cannot open: %s", in, strerror(errno));
+    return 2;
+  }
+  csv_comments com;
+  char *header = NULL;
+  long line_no = 0;
+  int kind = read_head(f, &com, &header, &line_no);
+  if (kind == CSV_UNKNOWN) {
+    prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate (header t,q1,q2,q3,qd1,qd2,qd3,d1,...) "
+                   "or prru map (header %s)%s%.60s%s", in, line_no, map_header,
+                   header && *header ? ": the header is '" : "", header ? header : "",
+                   header && *header ? "'" : ": no header line");
+    free(header);
+    fclose(f);
+    return 2;
+  }
+  free(header);
+  char dir[PRRU_PLOT_PATH], path[PRRU_PLOT_PATH + 64], abs_in[PRRU_PLOT_PATH];
+  static const char *const scratch[] = {"map.dat", "contours.dat", "plot.gp", "plot.png"};
+  if (prru_plot_scratch(cmd, dir, sizeof dir)) {
+    fclose(f);
+    return 1;
+  }
+  int rc = 0;
+  char *script = NULL;
+  if (kind == CSV_MAP) {
+    snprintf(path, sizeof path, "%s/map.dat", dir);
+    FILE *dat = fopen(path, "w");
+    map_scan m = {0};
+    rc = dat ? convert_map(cmd, in, f, line_no, dat, &m) : 1;
+    if (!dat) prru_cli_error(cmd, "%s: %s", path, strerror(errno));
+    if (dat && fclose(dat) != 0 && rc == 0) {
+      prru_cli_error(cmd, "%s: write error: %s", path, strerror(errno));
+      rc = 1;
+    }
+    if (rc == 0) {
+      prru_plot_map_info info = {m.q3, m.w_max, m.n1, m.n2, m.n_sing, m.n_other};
+      script = prru_plot_map_script("map.dat", "plot.png", com.text, &info);
+      if (!script) rc = 1;
+    }
+    free(m.q2);
+    fclose(f);
+  } else {
+    fclose(f);
+    int nact, energies;
+    rc = check_simulation(cmd, in, &nact, &energies);
+    if (rc == 0 && !realpath(in, abs_in)) {
+      prru_cli_error(cmd, "%s: %s", in, strerror(errno));
+      rc = 2;
+    }
+    if (rc == 0) {
+      script = prru_plot_series_script(abs_in, "plot.png", com.text, nact, energies);
+      if (!script) rc = 1;
+    }
+  }
+  if (rc == 0) rc = prru_plot_run(cmd, dir, dir, "plot.gp", script);
+  if (rc == PRRU_PLOT_NO_GNUPLOT) {
+    prru_cli_error(cmd, "gnuplot not found: install gnuplot-nox (e.g. with 'make deps')");
+    rc = 1;
+  }
+  if (rc == 0) {
+    snprintf(path, sizeof path, "%s/plot.png", dir);
+    rc = prru_plot_deliver(cmd, path, out);
+  }
+  free(script);
+  remove_scratch(dir, scratch, (int)(sizeof scratch / sizeof scratch[0]));
+  return rc;
+}

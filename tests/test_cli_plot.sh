@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# prru plot and prru animate: pictures of the CSVs prru writes, recognised
+# by their headers; bad files are exit 2 with the line and the reason, and
+# leave no output behind.
+. "$(dirname "$0")/cli_lib.sh"
+
+# png_size FILE: "WIDTH HEIGHT" from the IHDR chunk, or "not a PNG".
+png_size() {
+  python3 - "$1" <<'PY'
+import struct, sys
+b = open(sys.argv[1], 'rb').read(24)
+print('%d %d' % struct.unpack('>II', b[16:24]) if b[:8] == b'\x89PNG\r\n\x1a\n' and b[12:16] == b'IHDR' else 'not a PNG')
+PY
+}
+# gif_frames FILE: the number of images of a GIF and whether the first and
+# the last differ ("N differ" / "N same"), or "not a GIF".
+gif_frames() {
+  python3 - "$1" <<'PY'
+import struct, sys
+b = open(sys.argv[1], 'rb').read()
+if b[:6] != b'GIF89a': print('not a GIF'); sys.exit()
+flags = b[10]; p = 13 + (3 * (2 << (flags & 7)) if flags & 0x80 else 0)
+images = []
+while p < len(b) and b[p] != 0x3B:
+    t = b[p]; p += 1
+    if t == 0x21:
+        p += 1
+        while b[p]: p += 1 + b[p]
+        p += 1
+    elif t == 0x2C:
+        fl = b[p + 8]; p += 9
+        if fl & 0x80: p += 3 * (2 << (fl & 7))
+        p += 1; start = p
+        while b[p]: p += 1 + b[p]
+        p += 1
+        images.append(b[start:p])
+    else: print('bad block'); sys.exit()
+print(len(images), 'differ' if images[0] != images[-1] else 'same')
+PY
+}
+
+if ! command -v gnuplot >/dev/null; then
+  echo "test_cli_plot: gnuplot not installed, pictures not checked"
+  expect 1 "gnuplot not found" -- plot "$PRRU_SOURCE_DIR/tests/test_cli_plot.sh"
+  finish test_cli_plot
+  exit
+fi
+
+"$PRRU" simulate --scenario paper --t-end 0.2 --dt 0.01 --out "$tmp/run.csv" || bad "simulate failed"
+"$PRRU" map --q1 -pi/6:pi/6:41 --q2 -pi/4:pi/6:31 --out "$tmp/map.csv" >/dev/null || bad "map failed"
+
+# ---- plot: the natural figure by the header ----
+"$PRRU" plot "$tmp/run.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/run.png")" = "1000 1000" ] && [ ! -s "$tmp/err" ] \
+  && ok || bad "plot of a simulation CSV: $(png_size "$tmp/run.png") $(head -c 300 "$tmp/err")"
+"$PRRU" plot "$tmp/map.csv" --out "$tmp/m.png" 2>"$tmp/err" && [ "$(png_size "$tmp/m.png")" = "1000 850" ] \
+  && ok || bad "plot of a map CSV: $(png_size "$tmp/m.png") $(head -c 300 "$tmp/err")"
+[ ! -e "$tmp/map.png" ] && ok || bad "plot --out also wrote the default name"
+"$PRRU" plot "$tmp/map.csv" --out - >"$tmp/dash.png" && [ "$(png_size "$tmp/dash.png")" = "1000 850" ] \
+  && ok || bad "plot --out -: no PNG on stdout"
+"$PRRU" plot "$tmp/run.csv" --out - >/dev/full 2>"$tmp/err"
+[ $? -eq 1 ] && grep -q "stdout: write error" "$tmp/err" && ok || bad "plot --out - >/dev/full: $(head -c 200 "$tmp/err")"
+# A map of the 4-limb kind (no singular point) and one with only one status.
+awk -F, 'BEGIN { OFS = "," } /^#/ || NR == 2 { print; next } { if ($5 != "ok") { $4 = 1.5; $5 = "ok" } print }' \
+  "$tmp/map.csv" >"$tmp/allok.csv"
+"$PRRU" plot "$tmp/allok.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/allok.png")" = "1000 850" ] && [ ! -s "$tmp/err" ] \
+  && ok || bad "plot of an all-ok map: $(head -c 300 "$tmp/err")"
+
+# ---- plot: bad files, exit 2 with the reason, no picture ----
+bad_file() { # NAME CONTENT NEEDLE
+  printf '%b' "$2" >"$tmp/$1.csv"
+  expect 2 "$3" -- plot "$tmp/$1.csv"
+  [ ! -e "$tmp/$1.png" ] && ok || bad "plot of the bad $1.csv left $1.png"
+}
+bad_file empty "" "no header line"
+bad_file other "# x\na,b\n1,2\n" "$tmp/other.csv:2: not a CSV of prru simulate"
+bad_file maprow "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0,x,ok\n" "$tmp/maprow.csv:3: expected q1,q2,q3,w_R,status"
+bad_file mapnan "q1,q2,q3,w_R,status\n0,0,0,NaN,ok\n" "$tmp/mapnan.csv:2:"
+bad_file mapstatus "q1,q2,q3,w_R,status\n0,0,0,NaN,broken\n" "$tmp/mapstatus.csv:2:"
+bad_file mapgrid "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0,1.5,ok\n1,0,0,1.5,ok\n1,2,0,1.5,ok\n" "q2 values differ"
+bad_file mapshort "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0,1.5,ok\n1,0,0,1.5,ok\n" "the last q1 block is short"
+bad_file mapq3 "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0.1,1.5,ok\n" "q3 differs"
+bad_file mapone "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0,1.5,ok\n" "not a complete grid"
+bad_file simshort "t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3\n0,0,0,-0.8,0,0,0,-0.6,-0.6,-0.6\n1,0,0\n" "simshort.csv:3"
+bad_file simone "t,q1,q2,q3,qd1,qd2,qd3,d1,d2,d3\n0,0,0,-0.8,0,0,0,-0.6,-0.6,-0.6\n" "fewer than 2 rows"
+expect 2 "cannot open: No such file or directory" -- plot "$tmp/none.csv"
+expect 2 "a CSV file is required" -- plot
+expect 2 "unexpected argument" -- plot "$tmp/run.csv" "$tmp/map.csv"
+expect 2 "that is the input file" -- plot "$tmp/run.csv" --out "$tmp/run.csv"
+# An existing picture is replaced only by a complete new one.
+echo "old" >"$tmp/keep.png"
+cp "$tmp/maprow.csv" "$tmp/keep.csv"
+expect 2 "keep.csv:3" -- plot "$tmp/keep.csv"
+[ "$(cat "$tmp/keep.png")" = old ] && ok || bad "a failed plot changed the old picture"
+# Without gnuplot: exit 1 and the package to install.
+PATH=/nonexistent "$PRRU" plot "$tmp/run.csv" --out "$tmp/ng.png" 2>"$tmp/err"
+[ $? -eq 1 ] && grep -q "gnuplot not found: install gnuplot-nox" "$tmp/err" && [ ! -e "$tmp/ng.png" ] \
+  && ok || bad "plot without gnuplot: $(head -c 200 "$tmp/err")"
+
+# ---- animate: a GIF of the mechanism moving ----
+"$PRRU" animate "$tmp/run.csv" --frames 7 --fps 10 2>"$tmp/err" && [ "$(gif_frames "$tmp/run.gif")" = "7 differ" ] \
+  && [ ! -s "$tmp/err" ] && ok || bad "animate --frames 7: $(gif_frames "$tmp/run.gif") $(head -c 300 "$tmp/err")"
+"$PRRU" animate "$tmp/run.csv" --out - --frames 3 >"$tmp/dash.gif" && [ "$(gif_frames "$tmp/dash.gif")" = "3 differ" ] \
+  && ok || bad "animate --out -: $(gif_frames "$tmp/dash.gif")"
+# More frames than rows: one per row (21 rows).
+"$PRRU" animate "$tmp/run.csv" --out "$tmp/all.gif" --frames 500 && [ "$(gif_frames "$tmp/all.gif" | cut -d' ' -f1)" = 21 ] \
+  && ok || bad "animate --frames 500 of 21 rows: $(gif_frames "$tmp/all.gif")"
+expect 2 "--frames '1': must be an integer from 2 to 1000" -- animate "$tmp/run.csv" --frames 1
+expect 2 "--fps '0'" -- animate "$tmp/run.csv" --fps 0
+expect 2 "no column 't': not a CSV of prru simulate" -- animate "$tmp/other.csv"
+expect 2 "fewer than 2 rows" -- animate "$tmp/simone.csv"
+# A run of another model is refused: the poses would be this model's.
+sed '1s/sha256 [0-9a-f]*/sha256 0000000000000000000000000000000000000000000000000000000000000000/' "$tmp/run.csv" >"$tmp/alien.csv"
+expect 2 "was computed with another model" -- animate "$tmp/alien.csv"
+[ ! -e "$tmp/alien.gif" ] && ok || bad "animate of another model's run wrote a GIF"
+# A pose out of reach (q2 = 1.5 rad tilts the platform beyond the links'
+# reach) is exit 1, no GIF.
+awk -F, 'BEGIN { OFS = "," } /^#/ || /^t,/ { print; next } { $3 = 1.5; print }' "$tmp/run.csv" >"$tmp/far.csv"
+expect 1 "out of reach" -- animate "$tmp/far.csv"
+[ ! -e "$tmp/far.gif" ] && ok || bad "animate of unreachable poses wrote a GIF"
+
+finish test_cli_plot
