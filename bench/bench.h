@@ -81,6 +81,9 @@ typedef struct {
   /* results */
   bench_stats gen, ref;
   double max_rel_diff;
+  /* A runtime-parameter kernel's cost (bench_time_cost): its and the
+   * constant kernel's per-call ns, and their ratio per repetition. */
+  bench_stats cost_param, cost_constant, cost;
 } bench_kernel;
 
 /* bench_kernels.c: the table, in report order. */
@@ -97,6 +100,8 @@ int bench_agreement(bench_ctx *c, bench_kernel *k, int *bad_state);
 
 /* bench_harness.c */
 void bench_time_kernel(bench_ctx *c, bench_kernel *k, int reps, double target_ns);
+void bench_time_cost(bench_ctx *c, bench_kernel *p, const bench_kernel *k, int reps,
+                     double target_ns);
 
 /* bench_paths.c */
 typedef struct {

@@ -40,3 +40,25 @@ void bench_time_kernel(bench_ctx *c, bench_kernel *k, int reps, double target_ns
   k->ref = bench_stats_of(r, reps);
 }
 
+
+/* The cost of a runtime-parameter kernel p against its constant-folded
+ * namesake k: batches of the two interleaved, and per repetition the ratio
+ * of their per-call times, so that a load that comes and goes during the
+ * run (the machine is shared) scales both sides of each ratio alike. */
+void bench_time_cost(bench_ctx *c, bench_kernel *p, const bench_kernel *k, int reps,
+                     double target_ns)
+{
+  double tp[MAXREPS], tk[MAXREPS], ratio[MAXREPS];
+  long np = calibrate(p->gen_batch, c, target_ns);
+  long nk = calibrate(k->gen_batch, c, target_ns);
+  batch_ns(p->gen_batch, c, np);
+  batch_ns(k->gen_batch, c, nk);
+  for (int i = 0; i < reps; i++) {
+    tp[i] = batch_ns(p->gen_batch, c, np) / (double)np;
+    tk[i] = batch_ns(k->gen_batch, c, nk) / (double)nk;
+    ratio[i] = tp[i] / tk[i];
+  }
+  p->cost_param = bench_stats_of(tp, reps);
+  p->cost_constant = bench_stats_of(tk, reps);
+  p->cost = bench_stats_of(ratio, reps);
+}

@@ -231,13 +231,14 @@ BENCH_PAIR(w_r, 1)
 #endif
 
 #define KERNEL(name, nout, ops) {#name, nout, g_##name, r_##name, gb_##name, rb_##name, ops, \
-                                 NULL, 0, 0, {0, 0, 0}, {0, 0, 0}, 0}
+                                 NULL, 0, 0, {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}, {0, 0, 0}, \
+                                 {0, 0, 0}}
 /* A runtime-parameter kernel, listed after the constant kernel it is
  * compared with. */
 #define PARAM_KERNEL(name, NAME, nout)                                                       \
   {"param_" #name, nout, g_param_##name, r_param_##name, gb_param_##name, rb_param_##name, \
    PRRU_PARAM_OPS_##NAME, #name, PRRU_PARAM_ARITH_##NAME, PRRU_ARITH_##NAME,                 \
-   {0, 0, 0}, {0, 0, 0}, 0}
+   {0, 0, 0}, {0, 0, 0}, 0, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}}
 
 bench_kernel bench_kernels[] = {
   KERNEL(jd, 3 * PRRU_NACT, PRRU_OPS_JD),

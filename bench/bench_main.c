@@ -134,6 +134,12 @@ int main(int argc, char **argv)
       return 1;
     }
   }
+  for (int i = 0; i < bench_nkernels; i++) {
+    bench_kernel *k = &bench_kernels[i];
+    if (!k->constant) continue;
+    if (!op.json) fprintf(stderr, "timing %s against %s...\n", k->name, k->constant);
+    bench_time_cost(&c, k, bench_kernel_named(k->constant), op.reps, op.batch_ms * 1e6);
+  }
   if (!op.json) fprintf(stderr, "simulating...\n");
   sim_result sim;
   memset(&sim, 0, sizeof sim);

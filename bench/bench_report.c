@@ -80,8 +80,9 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
     const bench_kernel *k = &bench_kernels[i], *c = k->constant ? bench_kernel_named(k->constant) : NULL;
     if (!c) continue;
     printf("%s\"%s\": {\"param_ns\": %.4g, \"constant_ns\": %.4g, \"ratio\": %.4g, "
-           "\"param_arith\": %d, \"constant_arith\": %d}", n++ ? ", " : "", c->name, k->gen.median,
-           c->gen.median, k->gen.median / c->gen.median, k->arith, k->constant_arith);
+           "\"ratio_spread\": [%.4g, %.4g], \"param_arith\": %d, \"constant_arith\": %d}",
+           n++ ? ", " : "", c->name, k->cost_param.median, k->cost_constant.median,
+           k->cost.median, k->cost.min, k->cost.max, k->arith, k->constant_arith);
   }
   printf("}");
 #ifndef PRRU_BENCH_HAVE_DME
@@ -116,15 +117,18 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
 }
 
 /* What reading the model's numbers at run time costs: each param_ row
- * against its constant-folded namesake, same run. */
+ * against its constant-folded namesake, batches interleaved. */
 static void print_param_cost(void)
 {
-  printf("runtime-parameter kernels (numbers from a prru_params) against the constant-folded ones:\n");
+  printf("runtime-parameter kernels (numbers from a prru_params) against the constant-folded ones,\n"
+         "batches interleaved, median [min-max] of the per-repetition time ratio:\n");
   for (int i = 0; i < bench_nkernels; i++) {
     const bench_kernel *k = &bench_kernels[i], *c = k->constant ? bench_kernel_named(k->constant) : NULL;
     if (!c) continue;
-    printf("  %-17s %5.2fx the time of %-9s (%d vs %d arithmetic)\n", k->name,
-           k->gen.median / c->gen.median, c->name, k->arith, k->constant_arith);
+    char rs[64];
+    snprintf(rs, sizeof rs, "%.2fx [%.2f-%.2f]", k->cost.median, k->cost.min, k->cost.max);
+    printf("  %-17s %-20s the time of %-9s (%.1f vs %.1f ns; %d vs %d arithmetic)\n", k->name, rs,
+           c->name, k->cost_param.median, k->cost_constant.median, k->arith, k->constant_arith);
   }
   printf("\n");
 }
