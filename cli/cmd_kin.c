@@ -72,8 +72,9 @@ static const char fk_help[] =
     "usage: prru fk --d %s [--seed q1,q2,q3] [--lsq]\n"
     "Solves d(q) = d for q from the seed (default: q1 = q2 = 0 and the height\n"
     "that matches the mean of d).\n%s"
-    "The residual max |d(q) - d| (m) must be within 1000 DBL_EPSILON max(L, |d|),\n"
-    "L the model's mean upper-link length, unless --lsq is given.\n"
+    "The residual max |d(q) - d| (m) must be within 1000 eps max(L, |d|), eps =\n"
+    "2.2e-16 the double-precision rounding unit and L the model's mean\n"
+    "upper-link length, unless --lsq is given.\n"
     "--lsq: least squares, Gauss-Newton on |d(q) - d|^2 with J_d^+ =\n"
     "(J_d^T J_d)^-1 J_d^T: the pose of least squared residual is printed\n"
     "whatever the residual (measured or rounded slider positions), with\n"
@@ -83,7 +84,7 @@ static const char fk_help[] =
     "Exit 1 when d is out of reach or the iteration meets a singularity%s.\n";
 
 static const char fk_method_3[] =
-    "Newton's method (GSL hybridsj with J_d) unless --lsq.\n";
+    "Newton's method (a Powell hybrid solver with the exact J_d) unless --lsq.\n";
 static const char fk_method_redundant[] =
     "With more sliders than coordinates, d(q) = d has a solution only when the\n"
     "sliders are consistent (the extra slider where the others put it): fk fits\n"

@@ -70,9 +70,11 @@ static const char simulate_help[] =
     "                     [--h0 S] [--max-steps N] [--no-reactions] [--progress]\n"
     "                     [--out FILE.csv|-]\n"
     "Integrates M qdd + h = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp + passive drive\n"
-    "forces from (q0, qd0) with GSL's odeiv2 driver and writes a CSV: a first line\n"
-    "`# prru VERSION model NAME (FILE, sha256 HASH)`, the header, then one row per\n"
-    "sample (every dt, last at t-end):\n"
+    "forces from (q0, qd0) with an adaptive integrator (--stepper: rk8pd, the\n"
+    "Runge-Kutta Prince-Dormand 8(9) pair; rkf45 Fehlberg 4(5); rkck Cash-Karp\n"
+    "4(5); msbdf, a multistep BDF method for stiff runs) and writes a CSV: a\n"
+    "first line `# prru VERSION model NAME (FILE, sha256 HASH)`, the header,\n"
+    "then one row per sample (every dt, last at t-end):\n"
     "  t,q1,q2,q3,qd1,qd2,qd3,%s,\n"
     "  the %d joint reaction coordinates (columns JOINT_COMPONENT, e.g. %s,\n"
     "  joint by joint in the order %s;\n"
@@ -85,7 +87,8 @@ static const char simulate_help[] =
     "`--harmonic A,W` adds fp = A (sin W t, -cos W t, 0); `--loads` reads a table\n"
     "t,%s[,fp1..3[,mp1..3]] (linear interpolation).\n"
     "Defaults: zero state and loads, 1 s, dt 1 ms, rk8pd, atol = rtol = 1e-10.\n"
-    "Each tolerance is 0 (off) or at least 100 DBL_EPSILON (2.2e-14): a smaller one\n"
+    "Each tolerance is 0 (off) or at least 100 eps = 2.2e-14 (eps the double-\n"
+    "precision rounding unit): a smaller one\n"
     "cannot be met in double precision. --max-steps bounds the integrator's steps\n"
     "between two samples (default 100000); a run that needs more stops with exit 1,\n"
     "keeping its rows.\n"
@@ -191,8 +194,8 @@ int prru_cmd_simulate(int argc, char **argv)
   const double tols[2] = {s.opt.abs_tol, s.opt.rel_tol};
   for (int i = 0; i < 2 && !bad; i++)
     if (tols[i] != 0 && !(tols[i] >= PRRU_TOL_MIN)) {
-      prru_cli_error("simulate", "--%s: %g is below %.2g (100 DBL_EPSILON), which no double-precision "
-                     "step can resolve: use 0 (off) or at least %.2g", i ? "rtol" : "atol", tols[i],
+      prru_cli_error("simulate", "--%s: %g is below %.2g (100 times the rounding unit of a double), which no "
+                     "double-precision step can resolve: use 0 (off) or at least %.2g", i ? "rtol" : "atol", tols[i],
                      PRRU_TOL_MIN, PRRU_TOL_MIN);
       bad = 2;
     }
