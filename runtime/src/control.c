@@ -1,0 +1,349 @@
+/* Computed-torque tracking in closed loop (prru_control.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+
+#include "prru_control.h"
+#include "internal.h"
+
+void prru_track_options_default(prru_track_options *o)
+{
+  memset(o, 0, sizeof *o);
+  for (int i = 0; i < 3; i++) {
+    o->kp[i] = 400.0;
+    o->kd[i] = 40.0;
+  }
+  o->dt_out = 1e-3;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    o->f_max[i] = INFINITY;
+    o->d_min[i] = -INFINITY;
+    o->d_max[i] = INFINITY;
+  }
+  o->seed = 1;
+  o->plant = prru_params_model;
+  o->abs_tol = 1e-12;
+  o->rel_tol = 1e-12;
+}
+
+/* Solves M x = b for symmetric positive definite M (Cholesky, unrolled);
+ * 0, or -1 when M is not positive definite (or not finite). */
+static int spd3_solve(const double M[9], const double b[3], double x[3])
+{
+  double l00 = M[0];
+  if (!(l00 > 0.0)) return -1;
+  l00 = sqrt(l00);
+  double l10 = M[3] / l00, l20 = M[6] / l00;
+  double l11 = M[4] - l10 * l10;
+  if (!(l11 > 0.0)) return -1;
+  l11 = sqrt(l11);
+  double l21 = (M[7] - l20 * l10) / l11;
+  double l22 = M[8] - l20 * l20 - l21 * l21;
+  if (!(l22 > 0.0)) return -1;
+  l22 = sqrt(l22);
+  double y0 = b[0] / l00, y1 = (b[1] - l10 * y0) / l11, y2 = (b[2] - l20 * y0 - l21 * y1) / l22;
+  x[2] = y2 / l22;
+  x[1] = (y1 - l21 * x[2]) / l11;
+  x[0] = (y0 - l10 * x[1] - l20 * x[2]) / l00;
+  return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) ? 0 : -1;
+}
+
+int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
+                     const double fd[PRRU_NACT], double qdd[3])
+{
+  static const double zero[3] = {0.0, 0.0, 0.0};
+  double M[9], b[3];
+  prru_param_eom(p, q, qd, fd, zero, zero, M, b);
+  for (int i = 0; i < 9; i++)
+    if (!isfinite(M[i])) return PRRU_EUNREACHABLE;
+  if (!isfinite(b[0]) || !isfinite(b[1]) || !isfinite(b[2])) return PRRU_EUNREACHABLE;
+  return spd3_solve(M, b, qdd) == 0 ? PRRU_OK : PRRU_ESINGULAR;
+}
+
+int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
+                         const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
+                         const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
+                         double fd[PRRU_NACT], int sat[PRRU_NACT])
+{
+  double qdd_c[3];
+  for (int i = 0; i < 3; i++)
+    qdd_c[i] = qdd_ref[i] + o->kd[i] * (qd_ref[i] - qd[i]) + o->kp[i] * (q_ref[i] - q[i]);
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  int st = prru_inverse_dynamics(m, d, q, qd, qdd_c, &l, fd_cmd);
+  if (st != PRRU_OK) return st;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    double lim = o->f_max[i];
+    sat[i] = fabs(fd_cmd[i]) > lim;
+    fd[i] = sat[i] ? copysign(lim, fd_cmd[i]) : fd_cmd[i];
+  }
+  return PRRU_OK;
+}
+
+static int finite_all(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+static int track_options_check(const prru_track_options *o, char *msg, int msglen)
+{
+  for (int i = 0; i < 3; i++) {
+    if (!(o->kp[i] >= 0.0 && isfinite(o->kp[i])))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "kp: gain %d must be finite and >= 0", i + 1);
+    if (!(o->kd[i] >= 0.0 && isfinite(o->kd[i])))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "kd: gain %d must be finite and >= 0", i + 1);
+  }
+  if (!(o->control_period >= 0.0 && isfinite(o->control_period)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "control period must be finite and >= 0");
+  if (o->control_period == 0.0 && !(o->dt_out > 0.0 && isfinite(o->dt_out)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "dt_out must be finite and > 0");
+  for (int i = 0; i < PRRU_NACT; i++) {
+    if (!(o->f_max[i] > 0.0))
+      return prru_fail(msg, msglen, PRRU_EINPUT,
+                       "force limit of actuator %d must be > 0 (or infinite), got %g", i + 1,
+                       o->f_max[i]);
+    if (!(o->d_min[i] < o->d_max[i]))
+      return prru_fail(msg, msglen, PRRU_EINPUT,
+                       "stroke of slider %d: minimum %g must be below maximum %g", i + 1,
+                       o->d_min[i], o->d_max[i]);
+  }
+  if (!(o->noise_q >= 0.0 && isfinite(o->noise_q)) || !(o->noise_qd >= 0.0 && isfinite(o->noise_qd)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "sensor noise must be finite and >= 0");
+  if ((o->noise_q > 0.0 || o->noise_qd > 0.0) && o->control_period == 0.0)
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "sensor noise needs a sampled controller (control period > 0): a "
+                     "continuous controller inside the integrator cannot read noisy samples");
+  if (!finite_all(o->q0_offset, 3))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "initial offset must be finite");
+  if (!(o->abs_tol >= PRRU_TOL_MIN) || !(o->rel_tol >= PRRU_TOL_MIN) || !isfinite(o->abs_tol) ||
+      !isfinite(o->rel_tol))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "tolerances must be finite and >= %g",
+                     PRRU_TOL_MIN);
+  return PRRU_OK;
+}
+
+typedef struct {
+  const prru_model *m;
+  const prru_quintic *ref;
+  const prru_track_options *o;
+  prru_data *d;
+  int continuous;
+  double fd_hold[PRRU_NACT];
+  int status; /* why the right-hand side last failed */
+} track_ctx;
+
+/* The integrator may probe a few ulps past the reference's end. */
+static double clamp_time(const prru_quintic *ref, double t)
+{
+  return fmin(fmax(t, prru_quintic_t_begin(ref)), prru_quintic_t_end(ref));
+}
+
+/* As in simulate.c: GSL_EBADFUNC makes every stepper return at once. */
+static int track_rhs(double t, const double y[], double f[], void *p)
+{
+  track_ctx *c = p;
+  if (c->o->interrupt && *c->o->interrupt) {
+    c->status = PRRU_EINTERRUPTED;
+    return GSL_EBADFUNC;
+  }
+  double fd[PRRU_NACT], fd_cmd[PRRU_NACT];
+  int sat[PRRU_NACT], st = PRRU_OK;
+  if (c->continuous) {
+    double qr[3], qdr[3], qddr[3];
+    prru_quintic_eval(c->ref, clamp_time(c->ref, t), qr, qdr, qddr);
+    st = prru_computed_torque(c->m, c->d, c->o, qr, qdr, qddr, y, y + 3, fd_cmd, fd, sat);
+  } else {
+    memcpy(fd, c->fd_hold, sizeof fd);
+  }
+  if (st == PRRU_OK) st = prru_plant_accel(&c->o->plant, y, y + 3, fd, f + 3);
+  if (st != PRRU_OK) {
+    c->status = st;
+    return GSL_EBADFUNC;
+  }
+  memcpy(f, y + 3, 3 * sizeof y[0]);
+  return GSL_SUCCESS;
+}
+
+/* The controller at tick t: fills s (reference, true state, forces) from
+ * the measured state (true + noise when rng). */
+static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
+                      prru_track_sample *s)
+{
+  const prru_track_options *o = c->o;
+  s->t = t;
+  prru_quintic_eval(c->ref, clamp_time(c->ref, t), s->q_ref, s->qd_ref, s->qdd_ref);
+  double meas[6];
+  memcpy(meas, y, sizeof meas);
+  if (rng)
+    for (int i = 0; i < 6; i++) meas[i] += gsl_ran_gaussian(rng, i < 3 ? o->noise_q : o->noise_qd);
+  for (int i = 0; i < 3; i++) {
+    s->q[i] = y[i];
+    s->qd[i] = y[3 + i];
+    s->e[i] = s->q_ref[i] - y[i];
+  }
+  int st = prru_computed_torque(c->m, c->d, o, s->q_ref, s->qd_ref, s->qdd_ref, meas, meas + 3,
+                                s->fd_cmd, s->fd, s->saturated);
+  if (st != PRRU_OK) return st;
+  memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
+  prru_param_ik(&o->plant, y, s->d);
+  return finite_all(s->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
+}
+
+/* The first slider outside its stroke, or -1. */
+static int stroke_violation(const prru_track_options *o, const double d[PRRU_NACT])
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (d[i] < o->d_min[i] || d[i] > o->d_max[i]) return i;
+  return -1;
+}
+
+static void summary_add(prru_track_summary *sum, const prru_track_sample *s)
+{
+  sum->samples++;
+  sum->t_end = s->t;
+  int any = 0;
+  for (int i = 0; i < 3; i++) {
+    sum->rms_e[i] += s->e[i] * s->e[i]; /* a sum of squares until the end */
+    sum->max_e[i] = fmax(sum->max_e[i], fabs(s->e[i]));
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    sum->max_fd[i] = fmax(sum->max_fd[i], fabs(s->fd[i]));
+    sum->saturated[i] += s->saturated[i];
+    any |= s->saturated[i];
+  }
+  sum->any_saturated += any;
+}
+
+static void summary_finish(prru_track_summary *sum)
+{
+  for (int i = 0; i < 3; i++)
+    sum->rms_e[i] = sum->samples > 0 ? sqrt(sum->rms_e[i] / (double)sum->samples) : 0.0;
+}
+
+/* Tick k's time: t_0 + k step, the last one exactly the reference's end. */
+static double tick_time(const prru_quintic *ref, double step, long k, long nticks)
+{
+  return k == nticks ? prru_quintic_t_end(ref) : prru_quintic_t_begin(ref) + (double)k * step;
+}
+
+static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk, double y[6],
+                      char *msg, int msglen)
+{
+  c->status = PRRU_OK;
+  gsl_odeiv2_driver_reset(drv);
+  int gs = gsl_odeiv2_driver_apply(drv, t, tk, y);
+  if (gs == GSL_SUCCESS) return PRRU_OK;
+  int st = gs == GSL_EBADFUNC && c->status != PRRU_OK ? c->status : PRRU_ENOCONV;
+  if (st == PRRU_EINTERRUPTED)
+    return prru_fail(msg, msglen, st, "interrupted at t = %.9g s", *t);
+  if (st == PRRU_ENOCONV)
+    return prru_fail(msg, msglen, st, "integrator failed at t = %.9g s: %s", *t, gsl_strerror(gs));
+  return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)%s", *t,
+                   prru_strerror(st), y[0], y[1], y[2],
+                   st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
+}
+
+static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_track_sample *s,
+                     prru_track_summary *sum, char *msg, int msglen)
+{
+  const prru_track_options *o = c->o;
+  const double t0 = prru_quintic_t_begin(c->ref), t1 = prru_quintic_t_end(c->ref);
+  const double step = c->continuous ? o->dt_out : o->control_period;
+  const long nticks = (long)ceil((t1 - t0) / step - 1e-9);
+  double y[6], t = t0, qd0[3];
+  prru_quintic_eval(c->ref, t0, y, qd0, NULL);
+  for (int i = 0; i < 3; i++) {
+    y[i] -= o->q0_offset[i];
+    y[3 + i] = qd0[i];
+  }
+  for (long k = 0; k <= nticks; k++) {
+    double tk = tick_time(c->ref, step, k, nticks);
+    if (k > 0) {
+      int st = track_step(drv, c, &t, tk, y, msg, msglen);
+      if (st != PRRU_OK) return st;
+    }
+    int st = track_tick(c, rng, tk, y, s);
+    if (st != PRRU_OK)
+      return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)%s",
+                       tk, prru_strerror(st), y[0], y[1], y[2],
+                       st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
+    int bad = stroke_violation(o, s->d);
+    if (bad >= 0)
+      return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
+                       "stopped at t = %.9g s: slider %d at d = %.9g m left its stroke [%g, %g]",
+                       tk, bad + 1, s->d[bad], o->d_min[bad], o->d_max[bad]);
+    summary_add(sum, s);
+    if (o->on_sample && o->on_sample(s, o->ctx) != 0)
+      return prru_fail(msg, msglen, PRRU_EINTERRUPTED,
+                       "stopped at t = %.9g s by the sample consumer", tk);
+    if (o->interrupt && *o->interrupt)
+      return prru_fail(msg, msglen, PRRU_EINTERRUPTED, "interrupted at t = %.9g s", tk);
+  }
+  return PRRU_OK;
+}
+
+int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+               prru_track_summary *sum, char *msg, int msglen)
+{
+  memset(sum, 0, sizeof *sum);
+  if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
+  int st = track_options_check(o, msg, msglen);
+  if (st != PRRU_OK) return st;
+  prru_gsl_init();
+  track_ctx c = {m, ref, o, malloc(sizeof(prru_data)), o->control_period == 0.0, {0}, PRRU_OK};
+  prru_track_sample *s = malloc(sizeof *s);
+  gsl_odeiv2_system sys = {track_rhs, NULL, 6, &c};
+  double h0 = fmin(1e-4, c.continuous ? o->dt_out : o->control_period);
+  gsl_odeiv2_driver *drv =
+      gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, h0, o->abs_tol, o->rel_tol);
+  int noisy = o->noise_q > 0.0 || o->noise_qd > 0.0;
+  gsl_rng *rng = noisy ? gsl_rng_alloc(gsl_rng_mt19937) : NULL;
+  if (!c.d || !s || !drv || (noisy && !rng)) {
+    st = prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
+  } else {
+    if (rng) gsl_rng_set(rng, o->seed);
+    gsl_odeiv2_driver_set_nmax(drv, (unsigned long)PRRU_MAX_STEPS_DEFAULT);
+    memset(s, 0, sizeof *s);
+    st = track_run(&c, drv, rng, s, sum, msg, msglen);
+  }
+  summary_finish(sum);
+  if (drv) gsl_odeiv2_driver_free(drv);
+  if (rng) gsl_rng_free(rng);
+  free(c.d);
+  free(s);
+  if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
+  return st;
+}
+
+static void scale_n(double *v, int n, double f)
+{
+  for (int i = 0; i < n; i++) v[i] *= f;
+}
+
+int prru_params_scale(prru_params *p, const char *key, double factor)
+{
+  if (!key || !(factor > 0.0) || !isfinite(factor)) return PRRU_EINPUT;
+  if (strcmp(key, "mass") == 0) {
+    scale_n(p->mass, PRRU_NBODY, factor);
+    scale_n(&p->inertia[0][0], PRRU_NBODY * 6, factor);
+  } else if (strcmp(key, "inertia") == 0) {
+    scale_n(&p->inertia[0][0], PRRU_NBODY * 6, factor);
+  } else if (strcmp(key, "armature") == 0) {
+    scale_n(p->armature, PRRU_NACT, factor);
+  } else if (strcmp(key, "damping") == 0) {
+    scale_n(p->damping, PRRU_NACT, factor);
+  } else if (strcmp(key, "coulomb") == 0) {
+    scale_n(p->coulomb, PRRU_NACT, factor);
+  } else if (strcmp(key, "gravity") == 0) {
+    scale_n(p->gravity, 3, factor);
+  } else {
+    return PRRU_EINPUT;
+  }
+  return PRRU_OK;
+}
