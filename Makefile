@@ -62,8 +62,9 @@ compare-designs: deps-demo
 	studies/compare_designs.sh build build-4prru $(RESULTS)/compare
 
 # The paper's purpose for w_R: optimise its b12, b3, l1, l2, a (+-20 %) over
-# fig. 7's rectangle, re-evaluate the written model by regenerating the
-# kernels in a separate build, and the sensitivities (about a minute).
+# fig. 7's rectangle (also with the paper's slider travel, and with limb 3's
+# lower link free), re-evaluate each written model by regenerating the
+# kernels in a separate build, and the sensitivities (about three minutes).
 PAPER_BUILD ?= build
 optimize-design: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=$(PAPER_BUILD)

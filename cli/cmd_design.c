@@ -1075,6 +1075,11 @@ int prru_cmd_optimize(int argc, char **argv)
       return 2;
     }
   }
+  /* "DIR/" names DIR: its staging directory is a sibling. */
+  char report_dir[4100];
+  snprintf(report_dir, sizeof report_dir, "%s", report);
+  for (size_t l = strlen(report_dir); l > 1 && report_dir[l - 1] == '/'; l--) report_dir[l - 1] = '\0';
+  report = report_dir;
   /* Both outputs are checked before the optimisation runs. */
   prru_cli_catch_signals();
   prru_cli_out jo;

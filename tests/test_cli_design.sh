@@ -21,7 +21,7 @@ opt() { "$PRRU" optimize --vars l2,b12 --range 5 --q1 "$Q1" --q2 "$Q2" --max-ite
 mkdir "$tmp/o1" "$tmp/o2"
 opt --out "$tmp/o1/m.json" --report "$tmp/o1/rep" >"$tmp/o1/stdout" 2>"$tmp/o1/stderr" \
   || bad "optimize failed: $(head -c 400 "$tmp/o1/stderr")"
-opt --out "$tmp/o2/m.json" --report "$tmp/o2/rep" >"$tmp/o2/stdout" 2>/dev/null || bad "optimize again failed"
+opt --out "$tmp/o2/m.json" --report "$tmp/o2/rep/" >"$tmp/o2/stdout" 2>/dev/null || bad "optimize again failed"
 # (report.txt and after_map.csv name the model file: o1 or o2)
 for f in m.json rep/report.txt rep/before_map.csv rep/after_map.csv; do
   cmp -s <(sed 's|/o[12]/|/oX/|g' "$tmp/o1/$f") <(sed 's|/o[12]/|/oX/|g' "$tmp/o2/$f") \
