@@ -1,0 +1,754 @@
+/* prru traj (quintic point-to-point trajectories) and prru track
+ * (computed-torque tracking simulated in closed loop). */
+#define _XOPEN_SOURCE 700 /* realpath, open_memstream */
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "plot.h"
+#include "prru.h"
+#include "prru_control.h"
+#include "prru_traj.h"
+
+#define MAX_WAYPOINTS 1000
+
+/* Up to max comma-separated numbers (multiples of pi allowed) into out;
+ * *n the count. 0, or 2 after a message naming the option. */
+static int parse_number_list(const char *cmd, const char *name, const char *text, double *out,
+                             int max, int *n)
+{
+  *n = 0;
+  const char *p = text;
+  for (;;) {
+    const char *end = strchr(p, ',');
+    size_t len = end ? (size_t)(end - p) : strlen(p);
+    char tok[128];
+    if (*n >= max) {
+      prru_cli_error(cmd, "--%s: more than %d numbers", name, max);
+      return 2;
+    }
+    if (len == 0 || len >= sizeof tok) {
+      prru_cli_error(cmd, "--%s: '%s': item %d is %s", name, text, *n + 1,
+                     len == 0 ? "empty" : "too long");
+      return 2;
+    }
+    memcpy(tok, p, len);
+    tok[len] = '\0';
+    if (prru_parse_value(tok, &out[*n]) != PRRU_OK) {
+      prru_cli_error(cmd, "--%s: item %d, '%s', is not a finite number (decimal, or a multiple "
+                     "of pi such as -pi/6)", name, *n + 1, tok);
+      return 2;
+    }
+    (*n)++;
+    if (!end) return 0;
+    p = end + 1;
+  }
+}
+
+/* Waypoints "q1,q2,q3;q1,q2,q3;..." into q (n x 3). 0 or 2. */
+static int parse_waypoints(const char *cmd, const char *text, double *q, int *n)
+{
+  *n = 0;
+  const char *p = text;
+  for (;;) {
+    const char *end = strchr(p, ';');
+    size_t len = end ? (size_t)(end - p) : strlen(p);
+    char tok[400];
+    if (*n >= MAX_WAYPOINTS) {
+      prru_cli_error(cmd, "--waypoints: more than %d waypoints", MAX_WAYPOINTS);
+      return 2;
+    }
+    if (len >= sizeof tok) {
+      prru_cli_error(cmd, "--waypoints: waypoint %d is too long", *n + 1);
+      return 2;
+    }
+    memcpy(tok, p, len);
+    tok[len] = '\0';
+    if (prru_parse_values(tok, q + 3 * *n, 3) != PRRU_OK) {
+      prru_cli_error(cmd, "--waypoints: waypoint %d, '%s', is not 3 comma-separated finite "
+                     "numbers q1,q2,q3 (waypoints are separated by ';')", *n + 1, tok);
+      return 2;
+    }
+    (*n)++;
+    if (!end) return 0;
+    p = end + 1;
+  }
+}
+
+/* The reference from --waypoints and --durations. 0, or 2 after a message. */
+static int waypoint_reference(const char *cmd, const char *wps, const char *durs,
+                              prru_quintic *tr)
+{
+  static double q[3 * MAX_WAYPOINTS], dur[MAX_WAYPOINTS];
+  int n, nd;
+  if (!durs) {
+    prru_cli_error(cmd, "--waypoints needs --durations (one per segment, s)");
+    return 2;
+  }
+  if (parse_waypoints(cmd, wps, q, &n) || parse_number_list(cmd, "durations", durs, dur, MAX_WAYPOINTS, &nd))
+    return 2;
+  if (n < 2) {
+    prru_cli_error(cmd, "--waypoints: %d waypoint given, at least 2 needed", n);
+    return 2;
+  }
+  if (nd != n - 1) {
+    prru_cli_error(cmd, "--durations: %d given for %d waypoints, need %d (one per segment)", nd, n,
+                   n - 1);
+    return 2;
+  }
+  char msg[300];
+  if (prru_quintic_waypoints(tr, n, q, dur, 0.0, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error(cmd, "--waypoints/--durations: %s", msg);
+    return 2;
+  }
+  return 0;
+}
+
+/* Where a pose is not usable: "unreachable" or "J_d singular (...)". */
+static const char *pose_problem(int st)
+{
+  return st == PRRU_EUNREACHABLE ? "outside the workspace (unreachable)"
+         : st == PRRU_ESINGULAR  ? "at a singularity (J_d singular)"
+                                 : prru_strerror(st);
+}
+
+/* ---- prru traj ---- */
+
+static const char traj_help[] =
+    "usage: prru traj [--quintic] --waypoints 'q1,q2,q3;q1,q2,q3;...' --durations T1,T2,...\n"
+    "                 [--dt S] [--out FILE.csv|-]\n"
+    "A point-to-point trajectory: from each waypoint to the next in the given\n"
+    "time, along the straight line in q with the quintic time law\n"
+    "s = 10 u^3 - 15 u^4 + 6 u^5 (u the fraction of the segment's time), which\n"
+    "starts and ends every segment at rest (zero velocity and acceleration);\n"
+    "the peak speed is 1.875 |dq| / T, the peak acceleration 5.77 |dq| / T^2.\n"
+    "(--quintic names this profile, the only one.) Angles may be written as\n"
+    "multiples of pi (pi/12). Writes the model line, a line naming the\n"
+    "waypoints, and the columns\n"
+    "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n"
+    "(d the slider heights, dd their velocities) every dt (default 1 ms; the\n"
+    "last row at the end). The file is a trajectory for 'prru id --traj' and\n"
+    "'prru track --ref'. Every sample is checked: a pose outside the workspace\n"
+    "or at a singularity (J_d singular to the model's tolerance) stops with a\n"
+    "message naming the sample, its time, segment and pose, and exit 1; the rows\n"
+    "before it are kept. Bad options exit 2 with nothing written; --out FILE is\n"
+    "built as FILE.partial-XXXXXX and renamed.\n";
+
+static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *why, size_t whylen)
+{
+  prru_model m;
+  prru_model_default(&m);
+  prru_data *d = malloc(sizeof *d);
+  if (!d) {
+    snprintf(why, whylen, "out of memory");
+    return PRRU_ENOMEM;
+  }
+  const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
+  const long n = (long)ceil((t1 - t0) / dt - 1e-9);
+  int st = PRRU_OK;
+  for (long k = 0; k <= n && !o->err; k++) {
+    double t = k == n ? t1 : t0 + (double)k * dt, q[3], qd[3], qdd[3], dd[PRRU_NACT],
+           ddb[PRRU_NACT], rc;
+    if (prru_cli_interrupted) {
+      st = PRRU_EINTERRUPTED;
+      snprintf(why, whylen, "interrupted (%s) before sample %ld", prru_cli_signal_name(), k + 1);
+      break;
+    }
+    prru_quintic_eval(tr, t, q, qd, qdd);
+    st = prru_traj_pose_ok(&m, d, q, &rc);
+    if (st != PRRU_OK) {
+      int seg = 0;
+      while (seg + 2 < tr->n && tr->t[seg + 1] <= t) seg++;
+      snprintf(why, whylen, "sample %ld (t = %.9g s, segment %d: waypoint %d to %d): q = (%.9g, "
+               "%.9g, %.9g) is %s", k + 1, t, seg + 1, seg + 1, seg + 2, q[0], q[1], q[2],
+               pose_problem(st));
+      break;
+    }
+    prru_actuator_rates(q, qd, dd, ddb);
+    prru_cli_out_printf(o, "%.17g", t);
+    prru_cli_out_numbers(o, q, 3);
+    prru_cli_out_numbers(o, qd, 3);
+    prru_cli_out_numbers(o, qdd, 3);
+    prru_cli_out_numbers(o, d->d, PRRU_NACT);
+    prru_cli_out_numbers(o, dd, PRRU_NACT);
+    prru_cli_out_printf(o, "\n");
+    prru_cli_out_row(o);
+  }
+  free(d);
+  return st;
+}
+
+int prru_cmd_traj(int argc, char **argv)
+{
+  const char *wps = NULL, *durs = NULL, *dts = NULL, *out = NULL;
+  int help = 0, quintic = 0;
+  prru_cli_option opts[] = {{"quintic", 0, NULL, &quintic}, {"waypoints", 1, &wps, NULL},
+                            {"durations", 1, &durs, NULL},  {"dt", 1, &dts, NULL},
+                            {"out", 1, &out, NULL},         {"help", 0, NULL, &help}};
+  if (prru_cli_parse("traj", argc, argv, opts, 6)) return 2;
+  char dn[256], ddn[256];
+  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+  prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
+  if (help) {
+    printf(traj_help, dn, ddn);
+    return 0;
+  }
+  if (!wps) {
+    prru_cli_error("traj", "--waypoints is required (see 'prru traj --help')");
+    return 2;
+  }
+  double dt = 1e-3;
+  if (dts && prru_cli_number("traj", "dt", dts, &dt)) return 2;
+  if (!(dt > 0)) {
+    prru_cli_error("traj", "--dt: %g is not a positive time step (s)", dt);
+    return 2;
+  }
+  prru_quintic tr;
+  if (waypoint_reference("traj", wps, durs, &tr)) return 2;
+  double span = prru_quintic_t_end(&tr) - prru_quintic_t_begin(&tr);
+  if (!(span / dt <= 1e8)) {
+    prru_cli_error("traj", "--dt: %g s gives more than 1e8 samples over %g s", dt, span);
+    prru_quintic_free(&tr);
+    return 2;
+  }
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "traj", out)) {
+    prru_quintic_free(&tr);
+    return 1;
+  }
+  const char *name = o.name;
+  int in_place = o.tmp_path == NULL;
+  prru_cli_out_comment(&o);
+  prru_cli_out_printf(&o, "# quintic point-to-point: %d waypoints, %.17g s\n", tr.n, span);
+  prru_cli_out_line(&o);
+  prru_cli_out_printf(&o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n", dn, ddn);
+  prru_cli_out_line(&o);
+  char why[600] = "";
+  int st = traj_rows(&o, &tr, dt, why, sizeof why);
+  prru_quintic_free(&tr);
+  long rows = o.rows;
+  int io = o.err != 0;
+  if (prru_cli_out_close(&o, !io && (rows > 0 || st == PRRU_OK))) return 1;
+  if (st != PRRU_OK) {
+    if (rows > 0)
+      prru_cli_error("traj", "%s; the %ld rows before it written to %s", why, rows, name);
+    else
+      prru_cli_error("traj", "%s; nothing written%s%s%s", why, in_place ? "" : ", ",
+                     in_place ? "" : name, in_place ? "" : " is not changed");
+  }
+  return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
+}
+
+/* ---- prru track ---- */
+
+static const char track_help[] =
+    "usage: prru track (--ref FILE.csv | --waypoints 'q;q;..' --durations T1,..)\n"
+    "                  [--bandwidth W | --kp K1,K2,K3 --kd D1,D2,D3] [--period S]\n"
+    "                  [--dt S] [--mismatch KEY=F[,KEY=F..]] [--noise SQ,SQD]\n"
+    "                  [--seed N] [--fmax F|%s] [--stroke LO,HI|LO1,HI1,..]\n"
+    "                  [--q0-offset E1,E2,E3] [--atol X] [--rtol X]\n"
+    "                  [--out FILE.csv|-] [--summary FILE.json] [--plot FILE.png]\n"
+    "Simulates the robot following a reference trajectory under computed-torque\n"
+    "control: the model's inverse dynamics at the measured state with the\n"
+    "commanded acceleration qdd_c = qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q),\n"
+    "  fd = J_d^-T (M qdd_c + h - G - passive)%s,\n"
+    "each force clipped to --fmax (saturation). With the model exact and no\n"
+    "saturation each error e = q_ref - q obeys e'' + Kd e' + Kp e = 0.\n"
+    "Reference: --ref, a CSV with t, q1..3 and qd1..3, qdd1..3 (as 'prru traj'\n"
+    "writes; interpolated by quintics matching q, qd, qdd at every row), or\n"
+    "--waypoints and --durations as for 'prru traj'.\n"
+    "Gains: --bandwidth W (rad/s, default 20) sets Kp = W^2, Kd = 2 W (critically\n"
+    "damped); --kp and --kd set them per coordinate (1/s^2, 1/s).\n"
+    "Timing: --period 0 (default) evaluates the controller continuously, inside\n"
+    "the integrator, with rows every --dt (default 1 ms); --period S > 0 is a\n"
+    "digital controller that samples the state every S seconds and holds its\n"
+    "forces until the next sample (zero-order hold), one row per sample.\n"
+    "Plant: the same equations of motion, with --mismatch scaling its parameters\n"
+    "against the controller's model: mass (every body's mass and inertia),\n"
+    "inertia, armature, damping, coulomb, gravity, e.g. --mismatch mass=1.1.\n"
+    "--noise SQ,SQD: Gaussian sensor noise on q and qd (standard deviations,\n"
+    "rad or m, and per s; needs --period > 0), from a generator seeded by\n"
+    "--seed (default 1): the same seed gives the same run.\n"
+    "Limits: --fmax, one force limit (N) for every actuator or one each;\n"
+    "--stroke, the slider range (m), for all sliders or per slider. The\n"
+    "reference must stay inside the workspace, away from singularities and in\n"
+    "the stroke at every row time (else exit 2, nothing written); a plant\n"
+    "that leaves its stroke stops the run (exit 1, rows kept).\n"
+    "Output: the model line, a line with the settings, then\n"
+    "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s\n"
+    "(qr the reference, fdc the controller's forces before clipping, sat 1 where\n"
+    "clipped, d the slider heights) to --out or stdout; a JSON summary (RMS and\n"
+    "largest error per coordinate, largest force and saturated fraction of the\n"
+    "samples per actuator, the feed-forward force peak along the reference) to\n"
+    "--summary, else to stdout, or stderr when the CSV goes to stdout. --plot\n"
+    "FILE.png draws the errors and forces (needs --out FILE and gnuplot).\n"
+    "SIGINT/SIGTERM/SIGHUP stop with exit 130/143/129, the rows kept.\n";
+
+typedef struct {
+  prru_cli_out *out;
+} track_output;
+
+static int track_row(const prru_track_sample *s, void *ctx)
+{
+  track_output *to = ctx;
+  prru_cli_out *o = to->out;
+  prru_cli_out_printf(o, "%.17g", s->t);
+  prru_cli_out_numbers(o, s->q_ref, 3);
+  prru_cli_out_numbers(o, s->q, 3);
+  prru_cli_out_numbers(o, s->e, 3);
+  prru_cli_out_numbers(o, s->qd, 3);
+  prru_cli_out_numbers(o, s->fd, PRRU_NACT);
+  prru_cli_out_numbers(o, s->fd_cmd, PRRU_NACT);
+  for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, ",%d", s->saturated[i]);
+  prru_cli_out_numbers(o, s->d, PRRU_NACT);
+  prru_cli_out_printf(o, "\n");
+  return prru_cli_out_row(o) == 0 ? PRRU_OK : PRRU_EIO;
+}
+
+/* --mismatch KEY=F[,KEY=F..] applied to p; text kept for the settings. */
+static int parse_mismatch(const char *text, prru_params *p)
+{
+  const char *s = text;
+  for (;;) {
+    const char *end = strchr(s, ',');
+    size_t len = end ? (size_t)(end - s) : strlen(s);
+    char tok[128];
+    const char *eq = memchr(s, '=', len);
+    if (!eq || len >= sizeof tok) {
+      prru_cli_error("track", "--mismatch: '%.*s' is not KEY=FACTOR (keys: mass, inertia, "
+                     "armature, damping, coulomb, gravity)", (int)len, s);
+      return 2;
+    }
+    memcpy(tok, s, len);
+    tok[len] = '\0';
+    tok[eq - s] = '\0';
+    double f;
+    if (prru_parse_double(tok + (eq - s) + 1, &f) != PRRU_OK || !(f > 0)) {
+      prru_cli_error("track", "--mismatch %s: factor '%s' is not a number > 0", tok,
+                     tok + (eq - s) + 1);
+      return 2;
+    }
+    if (prru_params_scale(p, tok, f) != PRRU_OK) {
+      prru_cli_error("track", "--mismatch: unknown key '%s' (keys: mass, inertia, armature, "
+                     "damping, coulomb, gravity)", tok);
+      return 2;
+    }
+    if (!end) return 0;
+    s = end + 1;
+  }
+}
+
+/* The reference from --ref (t, q, qd, qdd columns). 0 or 2. */
+static int csv_reference(const char *path, prru_quintic *tr)
+{
+  static const char *const need[10] = {"t", "q1", "q2", "q3", "qd1", "qd2", "qd3", "qdd1", "qdd2", "qdd3"};
+  char msg[600];
+  prru_table t;
+  if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error("track", "--ref %s", msg);
+    return 2;
+  }
+  int col[10];
+  for (int k = 0; k < 10; k++)
+    if ((col[k] = prru_table_column(&t, need[k])) < 0) {
+      prru_cli_error("track", "--ref %s: missing column '%s' (need t, q1..3, qd1..3, qdd1..3, "
+                     "as 'prru traj' writes)", path, need[k]);
+      prru_table_free(&t);
+      return 2;
+    }
+  double *v = malloc((size_t)(t.nrows > 0 ? t.nrows : 1) * 10 * sizeof *v);
+  if (!v) {
+    prru_table_free(&t);
+    prru_cli_error("track", "out of memory");
+    return 1;
+  }
+  int n = t.nrows;
+  double *tt = v, *q = v + n, *qd = v + 4 * n, *qdd = v + 7 * n;
+  for (int i = 0; i < n; i++) {
+    const double *row = t.data + (size_t)i * (size_t)t.ncols;
+    tt[i] = row[col[0]];
+    for (int c = 0; c < 3; c++) {
+      q[3 * i + c] = row[col[1 + c]];
+      qd[3 * i + c] = row[col[4 + c]];
+      qdd[3 * i + c] = row[col[7 + c]];
+    }
+  }
+  prru_table_free(&t);
+  int st = prru_quintic_samples(tr, n, tt, q, qd, qdd, msg, sizeof msg);
+  free(v);
+  if (st != PRRU_OK) {
+    prru_cli_error("track", "--ref %s: %s", path, msg);
+    return 2;
+  }
+  return 0;
+}
+
+/* Every row time of the run: the reference's pose regular and inside the
+ * stroke; *ff_peak the largest feed-forward force. 0, or 2 after a
+ * message naming the first bad time. */
+static int check_reference(const prru_quintic *tr, const prru_track_options *o, double step,
+                           double *ff_peak)
+{
+  prru_model m;
+  prru_model_default(&m);
+  prru_data *d = malloc(sizeof *d);
+  if (!d) return 1;
+  const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
+  const long n = (long)ceil((t1 - t0) / step - 1e-9);
+  int rc = 0;
+  *ff_peak = 0;
+  for (long k = 0; k <= n && !rc; k++) {
+    double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
+    prru_quintic_eval(tr, t, q, qd, qdd);
+    int st = prru_traj_pose_ok(&m, d, q, &rcond);
+    if (st != PRRU_OK) {
+      prru_cli_error("track", "reference at sample %ld (t = %.9g s): q = (%.9g, %.9g, %.9g) is %s; "
+                     "nothing written", k + 1, t, q[0], q[1], q[2], pose_problem(st));
+      rc = 2;
+      break;
+    }
+    for (int i = 0; i < PRRU_NACT && !rc; i++)
+      if (d->d[i] < o->d_min[i] || d->d[i] > o->d_max[i]) {
+        prru_cli_error("track", "reference at sample %ld (t = %.9g s): slider %d at d = %.9g m is "
+                       "outside its --stroke [%g, %g]; nothing written", k + 1, t, i + 1,
+                       d->d[i], o->d_min[i], o->d_max[i]);
+        rc = 2;
+      }
+    prru_loads l;
+    memset(&l, 0, sizeof l);
+    if (!rc && prru_inverse_dynamics(&m, d, q, qd, qdd, &l, fd) == PRRU_OK)
+      for (int i = 0; i < PRRU_NACT; i++) *ff_peak = fmax(*ff_peak, fabs(fd[i]));
+  }
+  free(d);
+  return rc;
+}
+
+static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_options *o,
+                         const char *mismatch, double ff_peak, const char *status)
+{
+  fputc('{', f);
+  prru_cli_json_model(f);
+  fprintf(f, ",\n \"control\": \"%s\", \"period\": ", o->control_period > 0 ? "zero-order hold" : "continuous");
+  prru_cli_json_number(f, o->control_period);
+  fputs(", \"kp\": ", f);
+  prru_cli_json_array(f, o->kp, 3);
+  fputs(", \"kd\": ", f);
+  prru_cli_json_array(f, o->kd, 3);
+  fputs(",\n \"mismatch\": ", f);
+  prru_cli_json_string(f, mismatch ? mismatch : "");
+  fputs(", \"noise\": ", f);
+  double nz[2] = {o->noise_q, o->noise_qd};
+  prru_cli_json_array(f, nz, 2);
+  fprintf(f, ", \"seed\": %lu,\n \"samples\": %ld, \"t_end\": ", o->seed, s->samples);
+  prru_cli_json_number(f, s->t_end);
+  fputs(", \"rms_error\": ", f);
+  prru_cli_json_array(f, s->rms_e, 3);
+  fputs(", \"max_error\": ", f);
+  prru_cli_json_array(f, s->max_e, 3);
+  fputs(",\n \"max_fd\": ", f);
+  prru_cli_json_array(f, s->max_fd, PRRU_NACT);
+  double frac[PRRU_NACT];
+  for (int i = 0; i < PRRU_NACT; i++)
+    frac[i] = s->samples ? (double)s->saturated[i] / (double)s->samples : 0.0;
+  fputs(", \"saturated_fraction\": ", f);
+  prru_cli_json_array(f, frac, PRRU_NACT);
+  fputs(", \"any_saturated_fraction\": ", f);
+  prru_cli_json_number(f, s->samples ? (double)s->any_saturated / (double)s->samples : 0.0);
+  fputs(",\n \"feedforward_peak\": ", f);
+  prru_cli_json_number(f, ff_peak);
+  fputs(", \"status\": ", f);
+  prru_cli_json_string(f, status);
+  fputs("}\n", f);
+}
+
+/* The summary to --summary (never half-written), else to stdout, or to
+ * stderr when the CSV went to stdout. 0 or 1 after a message. */
+static int write_summary(const char *sums, const char *out, const prru_track_summary *s,
+                         const prru_track_options *o, const char *mismatch, double ff_peak,
+                         const char *status)
+{
+  if (!sums) {
+    json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, mismatch, ff_peak, status);
+    return 0;
+  }
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return 1;
+  json_summary(g, s, o, mismatch, ff_peak, status);
+  fclose(g);
+  prru_cli_out so;
+  int rc = prru_cli_out_open(&so, "track", sums);
+  if (rc == 0) {
+    prru_cli_out_write(&so, buf, len);
+    prru_cli_out_line(&so);
+    rc = prru_cli_out_close(&so, 1);
+  }
+  free(buf);
+  return rc;
+}
+
+/* The tracking figure: errors, and applied forces with the limits. */
+static int track_plot(const char *csv, const char *png, const prru_track_options *o)
+{
+  char abs_csv[PATH_MAX], dir[PRRU_PLOT_PATH], path[PRRU_PLOT_PATH + 32];
+  if (!realpath(csv, abs_csv)) {
+    prru_cli_error("track", "--plot: %s: cannot resolve the CSV's path", csv);
+    return 1;
+  }
+  if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return 1;
+  prru_plot_model_var(g);
+  fputs("set datafile separator ','\n"
+        "set terminal pngcairo size 1000,800 enhanced font 'Sans,11'\n"
+        "set output 'track.png'\nf = ", g);
+  prru_plot_string(g, abs_csv);
+  fputs("\nset multiplot layout 2,1 title 'Computed-torque tracking, model '.model\n"
+        "set grid\nset key outside right\nset lmargin 12\nset offsets 0, 0, graph 0.05, graph 0.05\n"
+        "set ylabel 'error q_{ref} - q (rad, m)'\n"
+        "plot f using 't':'e1' with lines lw 2 title 'e_1', '' using 't':'e2' with lines lw 2 "
+        "title 'e_2', '' using 't':'e3' with lines lw 2 title 'e_3'\n"
+        "set xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\nplot ", g);
+  for (int i = 1; i <= PRRU_NACT; i++)
+    fprintf(g, "%s't':'fd%d' with lines lw 2 title 'f_{d%d}'", i == 1 ? "f using " : ", '' using ", i, i);
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (isfinite(o->f_max[i]))
+      fprintf(g, ", %.17g with lines dt 2 lc 'black' notitle, %.17g with lines dt 2 lc 'black' notitle",
+              o->f_max[i], -o->f_max[i]);
+  fputs("\nunset multiplot\n", g);
+  fclose(g);
+  int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
+  free(buf);
+  if (rc == PRRU_PLOT_NO_GNUPLOT) {
+    prru_cli_error("track", "--plot: gnuplot not found: install gnuplot-nox (e.g. with 'make deps')");
+    rc = 1;
+  }
+  snprintf(path, sizeof path, "%s/track.png", dir);
+  if (rc == 0) rc = prru_plot_deliver("track", path, png);
+  unlink(path);
+  snprintf(path, sizeof path, "%s/track.gp", dir);
+  unlink(path);
+  rmdir(dir);
+  return rc;
+}
+
+/* --fmax and --stroke into o. 0 or 2. */
+static int parse_limits(const char *fmaxs, const char *strokes, prru_track_options *o)
+{
+  double v[2 * PRRU_NACT];
+  int n;
+  if (fmaxs) {
+    if (parse_number_list("track", "fmax", fmaxs, v, PRRU_NACT, &n)) return 2;
+    if (n != 1 && n != PRRU_NACT) {
+      prru_cli_error("track", "--fmax: give 1 limit or %d (one per actuator), not %d", PRRU_NACT, n);
+      return 2;
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      o->f_max[i] = v[n == 1 ? 0 : i];
+      if (!(o->f_max[i] > 0)) {
+        prru_cli_error("track", "--fmax: limit %g of actuator %d is not > 0", o->f_max[i], i + 1);
+        return 2;
+      }
+    }
+  }
+  if (strokes) {
+    if (parse_number_list("track", "stroke", strokes, v, 2 * PRRU_NACT, &n)) return 2;
+    if (n != 2 && n != 2 * PRRU_NACT) {
+      prru_cli_error("track", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per "
+                     "slider), not %d", 2 * PRRU_NACT, n);
+      return 2;
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      o->d_min[i] = v[n == 2 ? 0 : 2 * i];
+      o->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
+      if (!(o->d_min[i] < o->d_max[i])) {
+        prru_cli_error("track", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)",
+                       i + 1, o->d_min[i], o->d_max[i]);
+        return 2;
+      }
+    }
+  }
+  return 0;
+}
+
+/* Gains, timing, noise and tolerances into o. 0 or 2. */
+static int parse_track_settings(const char **a, prru_track_options *o)
+{
+  /* a: bandwidth kp kd period dt noise seed q0-offset atol rtol */
+  double w = 20, v[3];
+  if (a[0] && prru_cli_number("track", "bandwidth", a[0], &w)) return 2;
+  if (!(w > 0)) {
+    prru_cli_error("track", "--bandwidth: %g is not > 0 (rad/s)", w);
+    return 2;
+  }
+  for (int i = 0; i < 3; i++) {
+    o->kp[i] = w * w;
+    o->kd[i] = 2 * w;
+  }
+  if (a[0] && (a[1] || a[2])) {
+    prru_cli_error("track", "--bandwidth excludes --kp and --kd");
+    return 2;
+  }
+  if (a[1] && prru_cli_numbers("track", "kp", a[1], o->kp, 3)) return 2;
+  if (a[2] && prru_cli_numbers("track", "kd", a[2], o->kd, 3)) return 2;
+  for (int i = 0; i < 3; i++)
+    if (!(o->kp[i] >= 0 && o->kd[i] >= 0)) {
+      prru_cli_error("track", "--kp/--kd: gains must be >= 0");
+      return 2;
+    }
+  if (a[3] && prru_cli_number("track", "period", a[3], &o->control_period)) return 2;
+  if (!(o->control_period >= 0)) {
+    prru_cli_error("track", "--period: %g is not >= 0 (s)", o->control_period);
+    return 2;
+  }
+  if (a[4] && prru_cli_number("track", "dt", a[4], &o->dt_out)) return 2;
+  if (!(o->dt_out > 0)) {
+    prru_cli_error("track", "--dt: %g is not > 0 (s)", o->dt_out);
+    return 2;
+  }
+  if (a[4] && o->control_period > 0) {
+    prru_cli_error("track", "--dt: with --period > 0 there is one row per control period");
+    return 2;
+  }
+  if (a[5]) {
+    double nz[2];
+    if (prru_cli_numbers("track", "noise", a[5], nz, 2)) return 2;
+    if (!(nz[0] >= 0 && nz[1] >= 0)) {
+      prru_cli_error("track", "--noise: standard deviations must be >= 0");
+      return 2;
+    }
+    if (o->control_period == 0 && (nz[0] > 0 || nz[1] > 0)) {
+      prru_cli_error("track", "--noise needs --period > 0: a continuous controller inside the "
+                     "integrator cannot read noisy samples");
+      return 2;
+    }
+    o->noise_q = nz[0];
+    o->noise_qd = nz[1];
+  }
+  if (a[6]) {
+    double s;
+    if (prru_cli_number("track", "seed", a[6], &s)) return 2;
+    if (!(s >= 0 && s <= 4294967295.0 && s == floor(s))) {
+      prru_cli_error("track", "--seed: '%s' is not a whole number from 0 to 4294967295", a[6]);
+      return 2;
+    }
+    o->seed = (unsigned long)s;
+  }
+  if (a[7] && prru_cli_numbers("track", "q0-offset", a[7], v, 3)) return 2;
+  if (a[7]) memcpy(o->q0_offset, v, sizeof v);
+  if (a[8] && prru_cli_number("track", "atol", a[8], &o->abs_tol)) return 2;
+  if (a[9] && prru_cli_number("track", "rtol", a[9], &o->rel_tol)) return 2;
+  if (!(o->abs_tol >= PRRU_TOL_MIN && o->rel_tol >= PRRU_TOL_MIN)) {
+    prru_cli_error("track", "--atol/--rtol: must be at least %.2g", PRRU_TOL_MIN);
+    return 2;
+  }
+  return 0;
+}
+
+int prru_cmd_track(int argc, char **argv)
+{
+  const char *refs = NULL, *wps = NULL, *durs = NULL, *mism = NULL, *fmaxs = NULL,
+             *strokes = NULL, *out = NULL, *sums = NULL, *plot = NULL;
+  const char *a[10] = {NULL};
+  int help = 0;
+  prru_cli_option opts[] = {
+      {"ref", 1, &refs, NULL},        {"waypoints", 1, &wps, NULL},  {"durations", 1, &durs, NULL},
+      {"bandwidth", 1, &a[0], NULL},  {"kp", 1, &a[1], NULL},        {"kd", 1, &a[2], NULL},
+      {"period", 1, &a[3], NULL},     {"dt", 1, &a[4], NULL},        {"mismatch", 1, &mism, NULL},
+      {"noise", 1, &a[5], NULL},      {"seed", 1, &a[6], NULL},      {"fmax", 1, &fmaxs, NULL},
+      {"stroke", 1, &strokes, NULL},  {"q0-offset", 1, &a[7], NULL}, {"atol", 1, &a[8], NULL},
+      {"rtol", 1, &a[9], NULL},       {"out", 1, &out, NULL},        {"summary", 1, &sums, NULL},
+      {"plot", 1, &plot, NULL},       {"help", 0, NULL, &help}};
+  if (prru_cli_parse("track", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  char fdn[256], fdcn[256], satn[256], dn[256];
+  prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
+  prru_cli_names(fdcn, sizeof fdcn, "fdc", PRRU_NACT, ",");
+  prru_cli_names(satn, sizeof satn, "sat", PRRU_NACT, ",");
+  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+  if (help) {
+    char fl[256];
+    printf(track_help, prru_cli_names(fl, sizeof fl, "F", PRRU_NACT, ","),
+           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "",
+           fdn, fdcn, satn, dn);
+    return 0;
+  }
+  if (!refs == !wps) {
+    prru_cli_error("track", "give the reference as --ref FILE or as --waypoints and --durations "
+                   "(one of them; see 'prru track --help')");
+    return 2;
+  }
+  if (refs && durs) {
+    prru_cli_error("track", "--durations belongs to --waypoints, not --ref");
+    return 2;
+  }
+  if (plot && (!out || strcmp(out, "-") == 0)) {
+    prru_cli_error("track", "--plot needs --out FILE.csv (the figure is drawn from it)");
+    return 2;
+  }
+  prru_track_options o;
+  prru_track_options_default(&o);
+  if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;
+  if (mism && parse_mismatch(mism, &o.plant)) return 2;
+  prru_quintic tr;
+  int rc = refs ? csv_reference(refs, &tr) : waypoint_reference("track", wps, durs, &tr);
+  if (rc) return rc;
+  double step = o.control_period > 0 ? o.control_period : o.dt_out, ff_peak;
+  double span = prru_quintic_t_end(&tr) - prru_quintic_t_begin(&tr);
+  if (!(span / step <= 1e8)) {
+    prru_cli_error("track", "more than 1e8 samples (span %g s, step %g s)", span, step);
+    prru_quintic_free(&tr);
+    return 2;
+  }
+  if ((rc = check_reference(&tr, &o, step, &ff_peak)) != 0) {
+    prru_quintic_free(&tr);
+    return rc;
+  }
+  prru_cli_catch_signals();
+  prru_cli_out co;
+  if (prru_cli_out_open(&co, "track", out)) {
+    prru_quintic_free(&tr);
+    return 1;
+  }
+  const char *name = co.name;
+  prru_cli_out_comment(&co);
+  prru_cli_out_printf(&co, "# computed torque, %s%.9g s, kp %g %g %g, kd %g %g %g, mismatch '%s', "
+                      "noise %g %g, seed %lu\n",
+                      o.control_period > 0 ? "zero-order hold every " : "continuous, rows every ",
+                      step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], mism ? mism : "",
+                      o.noise_q, o.noise_qd, o.seed);
+  prru_cli_out_line(&co);
+  prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s\n", fdn, fdcn,
+                      satn, dn);
+  prru_cli_out_line(&co);
+  track_output to = {&co};
+  o.on_sample = track_row;
+  o.ctx = &to;
+  o.interrupt = &prru_cli_interrupted;
+  prru_track_summary sum;
+  char msg[600];
+  prru_model m;
+  prru_model_default(&m);
+  int st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
+  prru_quintic_free(&tr);
+  long rows = co.rows;
+  int io = co.err != 0;
+  if (prru_cli_out_close(&co, !io && rows > 0)) return 1;
+  if (st != PRRU_OK) {
+    if (st == PRRU_EINTERRUPTED && prru_cli_interrupted)
+      prru_cli_error("track", "%s (%s); %ld rows written to %s", msg, prru_cli_signal_name(), rows, name);
+    else
+      prru_cli_error("track", "%s; %ld rows written to %s", msg, rows, name);
+  }
+  if (write_summary(sums, out, &sum, &o, mism, ff_peak, st == PRRU_OK ? "complete" : msg)) return 1;
+  if (st != PRRU_OK) return prru_cli_exit_for(st);
+  if (plot) return track_plot(out, plot, &o);
+  return 0;
+}
