@@ -1,8 +1,10 @@
 /* The runtime-parameter kernels (prru_param_kernels.h) of whatever model
  * the build uses:
  *  - at prru_params_model they agree with the constant-folded kernels of
- *    the same name to 1e-13 at 2000 random regular states (each output
- *    array norm-wise: max |param - const| / max |const|);
+ *    the same name to 1e-13 at 2000 random regular states around q = 0 and
+ *    at 2000 anywhere in the reachable set at least 0.1 from a singular
+ *    boundary (each output array norm-wise: max |param - const| /
+ *    max |const|);
  *  - the parameters really flow: for random designs that perturb every
  *    member of prru_params (geometry, gravity vector, masses, centres of
  *    mass, full inertia tensors, drives), each kernel agrees with the
@@ -175,6 +177,45 @@ static void test_model_params(void)
   for (int o = 0; o < O_COUNT; o++) {
     char what[96];
     snprintf(what, sizeof what, "param %s = constant %s at prru_params_model", names[o], names[o]);
+    tu_check(worst[o] <= 1e-13, what, worst[o], 1e-13);
+    printf("  %-18s %.1e\n", names[o], worst[o]);
+  }
+}
+
+/* The same over the whole reachable set: q1, q2 anywhere in a half turn,
+ * any height within twice the longest limb, at least MARGIN from a
+ * singular boundary (nearer, both sides are only defined to ~eps / margin^2
+ * and neither is the better answer). */
+static void test_model_params_wide(void)
+{
+  prru_ref_params r;
+  prru_ref_params_default(&r);
+  double L = 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) L = fmax(L, r.l1[i] + r.l2[i]);
+  double worst[O_COUNT] = {0};
+  for (int n = 0; n < NSTATE; n++) {
+    state s;
+    do {
+      s.q[0] = tu_uniform(-1.57, 1.57);
+      s.q[1] = tu_uniform(-1.57, 1.57);
+      s.q[2] = tu_uniform(-2 * L, 2 * L);
+    } while (!(ref_margin(&r, s.q) >= MARGIN));
+    for (int i = 0; i < 3; i++) s.qd[i] = tu_uniform(-1.15, 1.15) * (n % 3 ? 1 : 1e-3);
+    random_loads(&s);
+    static outputs got, want;
+    eval_param(&prru_params_model, &s, &got);
+    eval_const(&s, &want);
+    double R[9 * NB], pos[3 * NB], floor[O_COUNT];
+    prru_poses(s.q, R, pos);
+    for (int o = 0; o < O_COUNT; o++) floor[o] = 1e-300;
+    floor[O_EN] = potential_terms(prru_mech.mass, prru_mech.gravity, pos);
+    note_all(&got, &want, floor, worst);
+  }
+  printf("the same at %d reachable states anywhere (margin >= %.2g):\n", NSTATE, MARGIN);
+  for (int o = 0; o < O_COUNT; o++) {
+    char what[112];
+    snprintf(what, sizeof what, "param %s = constant %s at prru_params_model, whole workspace",
+             names[o], names[o]);
     tu_check(worst[o] <= 1e-13, what, worst[o], 1e-13);
     printf("  %-18s %.1e\n", names[o], worst[o]);
   }
@@ -436,6 +477,7 @@ int main(void)
 {
   gsl_set_error_handler_off();
   test_model_params();
+  test_model_params_wide();
   test_designs();
   test_linearity();
   test_nan();
