@@ -48,7 +48,7 @@ build() { # harness
   local name=$1 objs=() src obj
   if [ ! -f "$work/runtime.stamp" ]; then
     for src in "$root"/runtime/src/*.c "$root/generated/prru_kernels.c" "$root/generated/prru_mechanism.c" \
-        "$root/generated/prru_param_kernels.c"; do
+        "$root/generated/prru_param_kernels.c" "$root/generated/prru_regressor.c"; do
       obj="$work/obj_$(basename "$src" .c).o"
       # fuzzer-no-link: coverage instrumentation without a second main()
       "$CC" "${cflags[@]}" -fsanitize=fuzzer-no-link,address,undefined \

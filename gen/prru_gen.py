@@ -5,7 +5,9 @@ usage: python3 gen/prru_gen.py MODEL.json --out DIR [--quiet]
 
 Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
 (the mechanism descriptor) and DIR/<prefix>_param_kernels.{h,c} (the kernels
-with the model's numbers as a run-time argument), where <prefix> is the model's "name" unless
+with the model's numbers as a run-time argument) and DIR/<prefix>_regressor.{h,c}
+(the dynamics as a linear function of the inertial and drive parameters, for
+identification), where <prefix> is the model's "name" unless
 --prefix says otherwise. Nothing in DIR changes unless generation succeeds.
 """
 
@@ -19,7 +21,8 @@ sys.setrecursionlimit(20000)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
-from prrugen import mechanism, dynamics, output, params, render, sym  # noqa: E402
+from prrugen import mechanism, dynamics, output, params, regressor, \
+    render, sym  # noqa: E402
 
 TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))), "templates")
@@ -32,8 +35,8 @@ def generate(model_path, templates_dir=TEMPLATES, prefix=None):
 
 def generate_model(model, templates_dir=TEMPLATES, prefix=None):
     """(files {name: text}, emitted kernels) for a loaded model: the
-    constant kernels, the mechanism descriptor and the runtime-parameter
-    kernels (emitted names param_*)."""
+    constant kernels, the mechanism descriptor, the runtime-parameter
+    kernels (emitted names param_*) and the regressor."""
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
     files, emitted = render.render(model, deriv, templates_dir, prefix)
@@ -47,7 +50,13 @@ def generate_model(model, templates_dir=TEMPLATES, prefix=None):
     files.update(pfiles)
     for e in pemitted:
         e.name = "param_" + e.name
-    return files, emitted + pemitted
+    sym.reset()
+    rmodel = regressor.RegressorModel(model)
+    rderiv = dynamics.Derivation(mechanism.build(rmodel), rmodel)
+    rfiles, remitted = render.render_regressor(model, rmodel, rderiv,
+                                               templates_dir, prefix)
+    files.update(rfiles)
+    return files, emitted + pemitted + remitted
 
 
 def _prefix(text):

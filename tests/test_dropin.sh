@@ -27,7 +27,7 @@ skipped=()
 # runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"'
+  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then

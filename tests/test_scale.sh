@@ -26,7 +26,7 @@ PY
   python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru --quiet || return 1
   gcc -std=c99 -O2 -I"$dir" -I"$SRC/runtime/include" -I"$SRC/runtime/src" \
     "$SRC/tests/scale_main.c" "$SRC"/runtime/src/*.c "$dir/prru_kernels.c" "$dir/prru_mechanism.c" \
-    "$dir/prru_param_kernels.c" \
+    "$dir/prru_param_kernels.c" "$dir/prru_regressor.c" \
     -lgsl -lgslcblas -lm -lpthread -o "$tmp/scale_$s"
 }
 

@@ -4,7 +4,7 @@ import os
 import re
 from string import Template
 
-from . import cgen, params
+from . import cgen, params, regressor
 from .kernels import kernels, lambda_labels
 from .model import c_double
 
@@ -177,6 +177,35 @@ def render_params(model, pmodel, deriv, templates_dir, prefix=None):
     files = {}
     for tmpl, out in (("param_kernels.h.in", "%s_param_kernels.h" % prefix),
                       ("param_kernels.c.in", "%s_param_kernels.c" % prefix)):
+        files[out] = _template(templates_dir, tmpl).substitute(values)
+    return files, emitted
+
+
+def render_regressor(model, rmodel, deriv, templates_dir, prefix=None):
+    """{file name: text} for the regressor kernel of model, whose derivation
+    deriv was built from rmodel = regressor.RegressorModel(model), and the
+    emitted kernels."""
+    prefix = prefix or model.name
+    upper = prefix.upper()
+    emitted = [cgen.emit(regressor.regressor_kernel(model, deriv, rmodel),
+                         prefix)]
+    names = regressor.param_names(model)
+    macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
+              % (upper, e.name.upper(), e.arithmetic) for e in emitted]
+    macros += ['#define %s_OPS_%s "%s"' % (upper, e.name.upper(), e.summary())
+               for e in emitted]
+    decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
+                         for e in emitted)
+    bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
+                          for e in emitted)
+    values = dict(banner=_banner(_head(model), emitted), prefix=prefix,
+                  PREFIX=upper, nreg=len(names), macros="\n".join(macros),
+                  declarations=decls, functions=bodies,
+                  names=_block(['"%s"' % n for n in names], "  "),
+                  values=_block(regressor.model_values(model), "  "))
+    files = {}
+    for tmpl, out in (("regressor.h.in", "%s_regressor.h" % prefix),
+                      ("regressor.c.in", "%s_regressor.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
     return files, emitted
 

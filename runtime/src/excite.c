@@ -1,0 +1,348 @@
+/* Periodic (Fourier) excitation trajectories for identification
+ * (prru_ident.h): coefficients chosen for a well-conditioned stacked base
+ * regressor inside the workspace and the actuator force limits. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multimin.h>
+
+#include "internal.h"
+#include "prru_ident.h"
+
+void prru_excite_options_default(prru_excite_options *o)
+{
+  memset(o, 0, sizeof *o);
+  for (int i = 0; i < PRRU_NACT; i++) o->fd_max[i] = 500.0;
+  o->rcond_min = 1e-2;
+  o->amplitude_max[0] = o->amplitude_max[1] = 0.25;
+  o->amplitude_max[2] = -0.1; /* negative: that many length scales L */
+  o->samples = 100;
+  o->check_samples = 2000;
+  o->max_evals = 3000;
+  o->seed = 1;
+}
+
+void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3], double qdd[3])
+{
+  const double w = 2 * PRRU_PI / f->period;
+  for (int k = 0; k < 3; k++) {
+    double x = f->centre[k], v = 0, a = 0;
+    for (int l = 1; l <= f->harmonics; l++) {
+      const double wl = w * l, s = sin(wl * t), c = cos(wl * t);
+      const double A = f->a[k][l - 1], B = f->b[k][l - 1];
+      x += A * s + B * c;
+      v += wl * (A * c - B * s);
+      a -= wl * wl * (A * s + B * c);
+    }
+    q[k] = x;
+    if (qd) qd[k] = v;
+    if (qdd) qdd[k] = a;
+  }
+}
+
+static double amplitude_bound(const prru_model *m, const prru_excite_options *o, int k)
+{
+  const double v = o->amplitude_max[k];
+  return v < 0 ? -v * prru_length_scale(m->mech) : v;
+}
+
+/* The assembly mode: det J_d's sign (three actuators; four have no second
+ * mode in reach). d holds J_d of the pose. */
+static int pose_mode(const prru_data *d)
+{
+#if PRRU_NACT == 3
+  const double *a = d->Jd;
+  const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                     a[2] * (a[3] * a[7] - a[4] * a[6]);
+  return det > 0 ? 1 : -1;
+#else
+  (void)d;
+  return 1;
+#endif
+}
+
+/* One point: 0 when usable (reachable, regular, in mode, within the
+ * limits), with fd and rcond; else the status and *excess, a continuous
+ * measure of how far the point is outside (for the penalty). */
+static int point(const prru_model *m, prru_data *d, const prru_excite_options *o, int mode,
+                 const double q[3], const double qd[3], const double qdd[3], double fd[PRRU_NACT],
+                 double *rcond, double *excess)
+{
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  *excess = 0;
+  int st = prru_check_regular(m, d, q, rcond);
+  if (st == PRRU_ESINGULAR || (st == PRRU_OK && (*rcond < o->rcond_min || pose_mode(d) != mode))) {
+    /* Continuous through the mode change: the other mode counts as
+     * negative rcond. */
+    const double s = st == PRRU_OK && pose_mode(d) != mode ? -*rcond : st == PRRU_OK ? *rcond : 0;
+    *excess = 1 + (o->rcond_min - s) / o->rcond_min;
+    return PRRU_ESINGULAR;
+  }
+  if (st != PRRU_OK) {
+    *excess = 10;
+    return st;
+  }
+  st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
+  if (st != PRRU_OK) {
+    *excess = 10;
+    return st;
+  }
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (fabs(fd[i]) > o->fd_max[i]) *excess += fabs(fd[i]) / o->fd_max[i] - 1;
+  return *excess > 0 ? PRRU_EINPUT : PRRU_OK;
+}
+
+int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
+                      int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad)
+{
+  prru_data *d = malloc(sizeof *d);
+  if (!d) return PRRU_ENOMEM;
+  int st = prru_check_regular(m, d, f->centre, NULL);
+  const int mode = st == PRRU_OK ? pose_mode(d) : 1;
+  for (int i = 0; i < PRRU_NACT; i++) fd_peak[i] = 0;
+  *rcond_worst = INFINITY;
+  for (int s = 0; s < n && st == PRRU_OK; s++) {
+    double t = f->period * s / n, q[3], qd[3], qdd[3], fd[PRRU_NACT], rc, ex;
+    prru_fourier_eval(f, t, q, qd, qdd);
+    st = point(m, d, o, mode, q, qd, qdd, fd, &rc, &ex);
+    if (st != PRRU_OK) {
+      *t_bad = t;
+      break;
+    }
+    if (rc < *rcond_worst) *rcond_worst = rc;
+    for (int i = 0; i < PRRU_NACT; i++)
+      if (fabs(fd[i]) > fd_peak[i]) fd_peak[i] = fabs(fd[i]);
+  }
+  free(d);
+  return st;
+}
+
+typedef struct {
+  const prru_model *m;
+  const prru_base *b;
+  const prru_excite_options *o;
+  prru_fourier f;
+  prru_data *d;
+  gsl_matrix *W, *V;
+  gsl_vector *sv, *work;
+  int mode, evals;
+  double bound[3];
+  volatile sig_atomic_t *stop;
+} excite_ctx;
+
+/* Coefficients from the optimiser's variables: x -> bound tanh-free
+ * clipping keeps the sum of |a|, |b| of a coordinate within its bound, so
+ * that |q_k - c_k| never exceeds it. */
+static void unpack(excite_ctx *c, const gsl_vector *x)
+{
+  const int L = c->f.harmonics;
+  for (int k = 0; k < 3; k++) {
+    double sum = 0;
+    for (int l = 0; l < L; l++) sum += fabs(gsl_vector_get(x, (size_t)(2 * L * k + l))) +
+                                      fabs(gsl_vector_get(x, (size_t)(2 * L * k + L + l)));
+    const double scale = sum > 1 ? c->bound[k] / sum : c->bound[k];
+    for (int l = 0; l < L; l++) {
+      c->f.a[k][l] = scale * gsl_vector_get(x, (size_t)(2 * L * k + l));
+      c->f.b[k][l] = scale * gsl_vector_get(x, (size_t)(2 * L * k + L + l));
+    }
+  }
+}
+
+/* The inverse of unpack for coefficients within their bounds. */
+static void pack(excite_ctx *c, const prru_fourier *f, gsl_vector *x)
+{
+  const int L = c->f.harmonics;
+  for (int k = 0; k < 3; k++)
+    for (int l = 0; l < L; l++) {
+      gsl_vector_set(x, (size_t)(2 * L * k + l), f->a[k][l] / c->bound[k]);
+      gsl_vector_set(x, (size_t)(2 * L * k + L + l), f->b[k][l] / c->bound[k]);
+    }
+}
+
+/* 2-norm condition number of the column-scaled stacked base regressor at
+ * the optimisation samples, or a penalty above 1e6 growing with how far
+ * the trajectory leaves the feasible set. */
+static double merit(const gsl_vector *x, void *ctx)
+{
+  excite_ctx *c = ctx;
+  c->evals++;
+  unpack(c, x);
+  const int n = c->o->samples, p = c->b->nbase;
+  double excess = 0;
+  for (int s = 0; s < n; s++) {
+    double q[3], qd[3], qdd[3], fd[PRRU_NACT], rc, ex, Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG];
+    prru_fourier_eval(&c->f, c->f.period * s / n, q, qd, qdd);
+    if (point(c->m, c->d, c->o, c->mode, q, qd, qdd, fd, &rc, &ex) != PRRU_OK) {
+      excess += ex;
+      continue;
+    }
+    prru_regressor(q, qd, qdd, &c->b->vs, Y);
+    prru_base_regressor(c->b, Y, 3, Yb);
+    for (int r = 0; r < 3; r++)
+      for (int j = 0; j < p; j++) gsl_matrix_set(c->W, 3 * (size_t)s + (size_t)r, (size_t)j, Yb[r * p + j]);
+  }
+  if (excess > 0) return 1e6 * (1 + excess);
+  for (int j = 0; j < p; j++) {
+    gsl_vector_view col = gsl_matrix_column(c->W, (size_t)j);
+    double nrm = gsl_blas_dnrm2(&col.vector);
+    if (!(nrm > 0)) return 1e6;
+    gsl_vector_scale(&col.vector, 1.0 / nrm);
+  }
+  gsl_linalg_SV_decomp(c->W, c->V, c->sv, c->work);
+  const double smin = gsl_vector_get(c->sv, (size_t)p - 1);
+  return smin > 0 ? fmin(gsl_vector_get(c->sv, 0) / smin, 1e6) : 1e6;
+}
+
+static int check_options(const prru_model *m, const prru_base *b, const prru_excite_options *o,
+                         const prru_fourier *f, char *msg, int msglen)
+{
+  if (!(f->period > 0) || !isfinite(f->period)) {
+    snprintf(msg, (size_t)msglen, "period must be a positive number of seconds");
+    return PRRU_EINPUT;
+  }
+  if (f->harmonics < 1 || f->harmonics > PRRU_EXCITE_MAX_HARMONICS) {
+    snprintf(msg, (size_t)msglen, "harmonics must be 1..%d", PRRU_EXCITE_MAX_HARMONICS);
+    return PRRU_EINPUT;
+  }
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(o->fd_max[i] > 0) || !isfinite(o->fd_max[i])) {
+      snprintf(msg, (size_t)msglen, "force limit of actuator %d must be positive", i + 1);
+      return PRRU_EINPUT;
+    }
+  if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
+    snprintf(msg, (size_t)msglen, "rcond_min must lie in (0, 1)");
+    return PRRU_EINPUT;
+  }
+  for (int k = 0; k < 3; k++)
+    if (!(amplitude_bound(m, o, k) > 0) || !isfinite(amplitude_bound(m, o, k))) {
+      snprintf(msg, (size_t)msglen, "amplitude bound of q%d must be positive", k + 1);
+      return PRRU_EINPUT;
+    }
+  if (3 * o->samples < b->nbase + 1 || o->check_samples < o->samples || o->max_evals < 1) {
+    snprintf(msg, (size_t)msglen, "need samples >= %d (3 rows each for %d base parameters), "
+             "check samples >= samples and at least one evaluation", b->nbase / 3 + 1, b->nbase);
+    return PRRU_EINPUT;
+  }
+  prru_data d;
+  double rc;
+  int st = prru_check_regular(m, &d, f->centre, &rc);
+  if (st != PRRU_OK || rc < o->rcond_min) {
+    snprintf(msg, (size_t)msglen, "centre (%g, %g, %g) is %s", f->centre[0], f->centre[1], f->centre[2],
+             st == PRRU_OK ? "too close to a singularity (rcond below the limit)" : prru_strerror(st));
+    return PRRU_EINPUT;
+  }
+  return PRRU_OK;
+}
+
+/* A small random start: every coefficient uniform in +-bound / (4 L). */
+static void start_point(excite_ctx *c, gsl_vector *x, unsigned long seed)
+{
+  unsigned long long s = 0xD1B54A32D192ED03ULL ^ (unsigned long long)seed;
+  if (!s) s = 1;
+  for (size_t i = 0; i < x->size; i++) {
+    s ^= s >> 12, s ^= s << 25, s ^= s >> 27;
+    const double u = (double)((s * 2685821657736338717ULL) >> 11) * 0x1.0p-53;
+    gsl_vector_set(x, i, (2 * u - 1) / (2.0 * c->f.harmonics));
+  }
+}
+
+static int minimise(excite_ctx *c, gsl_vector *x, double *fbest)
+{
+  gsl_multimin_function fn = {merit, x->size, c};
+  gsl_multimin_fminimizer *mz = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2, x->size);
+  gsl_vector *step = gsl_vector_alloc(x->size);
+  if (!mz || !step) {
+    if (mz) gsl_multimin_fminimizer_free(mz);
+    gsl_vector_free(step);
+    return PRRU_ENOMEM;
+  }
+  gsl_vector_set_all(step, 0.1);
+  gsl_multimin_fminimizer_set(mz, &fn, x, step);
+  int st = PRRU_OK;
+  while (c->evals < c->o->max_evals) {
+    if (c->stop && *c->stop) {
+      st = PRRU_EINTERRUPTED;
+      break;
+    }
+    if (gsl_multimin_fminimizer_iterate(mz) != GSL_SUCCESS) break;
+    if (gsl_multimin_fminimizer_size(mz) < 1e-6) break;
+  }
+  gsl_vector_memcpy(x, mz->x);
+  *fbest = mz->fval;
+  gsl_multimin_fminimizer_free(mz);
+  gsl_vector_free(step);
+  return st;
+}
+
+int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_options *o,
+                volatile sig_atomic_t *stop, prru_fourier *f, prru_excite_result *r, char *msg,
+                int msglen)
+{
+  memset(r, 0, sizeof *r);
+  prru_gsl_init();
+  int st = check_options(m, b, o, f, msg, msglen);
+  if (st != PRRU_OK) return st;
+  excite_ctx c;
+  memset(&c, 0, sizeof c);
+  c.m = m, c.b = b, c.o = o, c.f = *f, c.stop = stop;
+  for (int k = 0; k < 3; k++) c.bound[k] = amplitude_bound(m, o, k);
+  const size_t nx = 6 * (size_t)f->harmonics, p = (size_t)b->nbase;
+  c.d = malloc(sizeof *c.d);
+  c.W = gsl_matrix_alloc(3 * (size_t)o->samples, p);
+  c.V = gsl_matrix_alloc(p, p);
+  c.sv = gsl_vector_alloc(p);
+  c.work = gsl_vector_alloc(p);
+  gsl_vector *x = gsl_vector_alloc(nx);
+  st = c.d && c.W && c.V && c.sv && c.work && x ? PRRU_OK : PRRU_ENOMEM;
+  if (st == PRRU_OK) {
+    prru_check_regular(m, c.d, f->centre, NULL);
+    c.mode = pose_mode(c.d);
+    start_point(&c, x, o->seed);
+    r->cond_start = merit(x, &c);
+    double best;
+    st = minimise(&c, x, &best);
+    unpack(&c, x);
+    r->cond = merit(x, &c);
+    r->evals = c.evals;
+    *f = c.f;
+    if (st == PRRU_OK && r->cond >= 1e6) {
+      snprintf(msg, (size_t)msglen, "no feasible excitation found (every trial left the workspace, "
+               "met a singularity or exceeded a force limit); lower the amplitudes or raise the limits");
+      st = PRRU_ENOCONV;
+    }
+  }
+  if (st == PRRU_OK) {
+    double tb = 0;
+    int cs = prru_excite_check(m, f, o, o->check_samples, r->fd_peak, &r->rcond_worst, &tb);
+    /* Between the optimisation samples a limit can be crossed: shrink the
+     * motion about the centre until the dense check passes. */
+    for (int shrink = 0; cs != PRRU_OK && cs != PRRU_ENOMEM && shrink < 30; shrink++) {
+      for (int k = 0; k < 3; k++)
+        for (int l = 0; l < f->harmonics; l++) f->a[k][l] *= 0.95, f->b[k][l] *= 0.95;
+      cs = prru_excite_check(m, f, o, o->check_samples, r->fd_peak, &r->rcond_worst, &tb);
+      r->shrunk = shrink + 1;
+    }
+    if (cs == PRRU_OK && r->shrunk) {
+      gsl_vector *y = gsl_vector_alloc(nx);
+      if (y) {
+        pack(&c, f, y);
+        r->cond = merit(y, &c);
+        gsl_vector_free(y);
+      }
+    }
+    if (cs != PRRU_OK) {
+      snprintf(msg, (size_t)msglen, "the optimised excitation fails the dense check at t = %.6g s (%s); "
+               "use more samples", tb, cs == PRRU_EINPUT ? "force limit exceeded" : prru_strerror(cs));
+      st = PRRU_ENOCONV;
+    }
+  }
+  free(c.d);
+  gsl_matrix_free(c.W), gsl_matrix_free(c.V), gsl_vector_free(c.sv), gsl_vector_free(c.work);
+  gsl_vector_free(x);
+  return st;
+}

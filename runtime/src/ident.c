@@ -1,0 +1,375 @@
+/* Standard and base parameters, and the least-squares identification
+ * (prru_ident.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multifit.h>
+#include <gsl/gsl_permutation.h>
+
+#include "internal.h"
+#include "prru_ident.h"
+
+void prru_ident_standard(const prru_mechanism *me, double pi[PRRU_NREG])
+{
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    double *p = pi + PRRU_NBODYPAR * b;
+    const double m = me->mass[b], *c = me->com[b], *I = me->inertia[b];
+    const double s = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    p[0] = m;
+    for (int k = 0; k < 3; k++) p[1 + k] = m * c[k];
+    /* Parallel axes: I_O = I_c + m (|c|^2 E - c c^T). */
+    for (int k = 0; k < 3; k++) p[4 + k] = I[4 * k] + m * (s - c[k] * c[k]);
+    p[7] = I[1] - m * c[0] * c[1];
+    p[8] = I[2] - m * c[0] * c[2];
+    p[9] = I[5] - m * c[1] * c[2];
+  }
+  double *dr = pi + PRRU_NBODYPAR * PRRU_NBODY;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    dr[i] = me->armature[i];
+    dr[PRRU_NACT + i] = me->damping[i];
+    dr[2 * PRRU_NACT + i] = me->coulomb[i];
+  }
+}
+
+int prru_ident_body(const double pib[PRRU_NBODYPAR], double *mass, double com[3], double inertia[6])
+{
+  for (int k = 0; k < PRRU_NBODYPAR; k++)
+    if (!isfinite(pib[k])) return PRRU_EINPUT;
+  const double m = pib[0];
+  if (!(m > 0)) return PRRU_EINPUT;
+  for (int k = 0; k < 3; k++) com[k] = pib[1 + k] / m;
+  const double s = com[0] * com[0] + com[1] * com[1] + com[2] * com[2];
+  for (int k = 0; k < 3; k++) inertia[k] = pib[4 + k] - m * (s - com[k] * com[k]);
+  inertia[3] = pib[7] + m * com[0] * com[1];
+  inertia[4] = pib[8] + m * com[0] * com[2];
+  inertia[5] = pib[9] + m * com[1] * com[2];
+  *mass = m;
+  return PRRU_OK;
+}
+
+/* xorshift64* in [0, 1): reproducible on every platform, unlike rand(). */
+static double uniform(unsigned long long *s)
+{
+  *s ^= *s >> 12;
+  *s ^= *s << 25;
+  *s ^= *s >> 27;
+  return (double)((*s * 2685821657736338717ULL) >> 11) * 0x1.0p-53;
+}
+
+static double det3(const double *a)
+{
+  return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+         a[2] * (a[3] * a[7] - a[4] * a[6]);
+}
+
+/* The assembly mode at (0, 0, q3): det J_d's sign (three actuators; 1 for
+ * four, whose J_d has no determinant and no second mode in reach). */
+static int mode_sign(const double Jd[PRRU_NACT * 3])
+{
+#if PRRU_NACT == 3
+  return det3(Jd) > 0 ? 1 : -1;
+#else
+  (void)det3;
+  (void)Jd;
+  return 1;
+#endif
+}
+
+int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
+                            double q[3], double qd[3], double qdd[3])
+{
+  const double L = prru_length_scale(m->mech);
+  const double home[3] = {0.0, 0.0, 0.0};
+  if (prru_check_regular(m, d, home, NULL) != PRRU_OK) return PRRU_ENOCONV;
+  const int mode = mode_sign(d->Jd);
+  for (int tries = 0; tries < 1000; tries++) {
+    double rc;
+    q[0] = 0.3 * (2 * uniform(s) - 1);
+    q[1] = 0.3 * (2 * uniform(s) - 1);
+    q[2] = 0.2 * L * (2 * uniform(s) - 1);
+    if (prru_check_regular(m, d, q, &rc) != PRRU_OK || rc < 1e-3 || mode_sign(d->Jd) != mode)
+      continue;
+    for (int k = 0; k < 3; k++) {
+      const double scale = k == 2 ? L : 1.0;
+      qd[k] = scale * (2 * uniform(s) - 1);
+      qdd[k] = 4 * scale * (2 * uniform(s) - 1);
+    }
+    return PRRU_OK;
+  }
+  return PRRU_ENOCONV;
+}
+
+/* Y stacked over the states (rows 3 per state). */
+static int stack_states(const prru_model *m, double vs, int nstates, unsigned long seed,
+                        gsl_matrix *W)
+{
+  prru_data *d = malloc(sizeof *d);
+  if (!d) return PRRU_ENOMEM;
+  unsigned long long s = 0x9E3779B97F4A7C15ULL ^ (unsigned long long)seed;
+  if (!s) s = 1;
+  int st = PRRU_OK;
+  for (int i = 0; i < nstates && st == PRRU_OK; i++) {
+    double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG];
+    st = prru_ident_random_state(m, d, &s, q, qd, qdd);
+    if (st != PRRU_OK) break;
+    prru_regressor(q, qd, qdd, &vs, Y);
+    for (int r = 0; r < 3; r++)
+      for (int j = 0; j < PRRU_NREG; j++) gsl_matrix_set(W, 3 * (size_t)i + r, j, Y[r * PRRU_NREG + j]);
+  }
+  free(d);
+  return st;
+}
+
+/* Pivoted QR of W's non-zero columns scaled to unit norm; fills b. */
+static int reduce(gsl_matrix *W, prru_base *b)
+{
+  double norm[PRRU_NREG], big = 0;
+  int nz[PRRU_NREG], n = 0;
+  for (int j = 0; j < PRRU_NREG; j++) {
+    gsl_vector_view c = gsl_matrix_column(W, j);
+    norm[j] = gsl_blas_dnrm2(&c.vector);
+    if (norm[j] > big) big = norm[j];
+  }
+  for (int j = 0; j < PRRU_NREG; j++) {
+    /* A column of rounding-level size is one the dynamics does not contain
+     * (its entries cancel exactly in exact arithmetic). */
+    b->role[j] = norm[j] > 1e-13 * big ? PRRU_PAR_COMBINED : PRRU_PAR_NONE;
+    if (b->role[j] == PRRU_PAR_COMBINED) nz[n++] = j;
+  }
+  gsl_matrix *A = gsl_matrix_alloc(W->size1, (size_t)n);
+  gsl_vector *tau = gsl_vector_alloc((size_t)(n < (int)W->size1 ? n : (int)W->size1));
+  gsl_vector *work = gsl_vector_alloc((size_t)n);
+  gsl_permutation *p = gsl_permutation_alloc((size_t)n);
+  int sign;
+  if (!A || !tau || !work || !p) {
+    gsl_matrix_free(A), gsl_vector_free(tau), gsl_vector_free(work), gsl_permutation_free(p);
+    return PRRU_ENOMEM;
+  }
+  for (size_t i = 0; i < W->size1; i++)
+    for (int k = 0; k < n; k++) gsl_matrix_set(A, i, (size_t)k, gsl_matrix_get(W, i, nz[k]) / norm[nz[k]]);
+  gsl_linalg_QRPT_decomp(A, tau, p, &sign, work);
+  const double r00 = fabs(gsl_matrix_get(A, 0, 0));
+  int r = 0;
+  while (r < n && r < (int)W->size1 && fabs(gsl_matrix_get(A, (size_t)r, (size_t)r)) > PRRU_BASE_RTOL * r00) r++;
+  b->nbase = r;
+  b->last_kept = r > 0 ? fabs(gsl_matrix_get(A, (size_t)r - 1, (size_t)r - 1)) / r00 : 0;
+  b->first_dropped = r < n && r < (int)W->size1 ? fabs(gsl_matrix_get(A, (size_t)r, (size_t)r)) / r00 : 0;
+  memset(b->B, 0, sizeof b->B);
+  for (int i = 0; i < r; i++) {
+    const int ci = nz[gsl_permutation_get(p, (size_t)i)];
+    b->col[i] = ci;
+    b->role[ci] = PRRU_PAR_BASE;
+    b->B[i * PRRU_NREG + ci] = 1.0;
+  }
+  /* K = R11^-1 R12 in scaled columns, solved column by column. */
+  gsl_matrix_view R11 = gsl_matrix_submatrix(A, 0, 0, (size_t)r, (size_t)r);
+  gsl_vector *x = gsl_vector_alloc((size_t)(r > 0 ? r : 1));
+  for (int k = r; k < n && x && r > 0; k++) {
+    const int cj = nz[gsl_permutation_get(p, (size_t)k)];
+    for (int i = 0; i < r; i++) gsl_vector_set(x, (size_t)i, gsl_matrix_get(A, (size_t)i, (size_t)k));
+    gsl_blas_dtrsv(CblasUpper, CblasNoTrans, CblasNonUnit, &R11.matrix, x);
+    for (int i = 0; i < r; i++)
+      b->B[i * PRRU_NREG + cj] = gsl_vector_get(x, (size_t)i) * norm[cj] / norm[b->col[i]];
+  }
+  int st = x ? PRRU_OK : PRRU_ENOMEM;
+  int k = 0;
+  for (int j = 0; j < PRRU_NREG; j++)
+    if (b->role[j] != PRRU_PAR_BASE) b->col[r + k++] = j;
+  gsl_vector_free(x);
+  gsl_matrix_free(A), gsl_vector_free(tau), gsl_vector_free(work), gsl_permutation_free(p);
+  return st;
+}
+
+int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed, prru_base *b)
+{
+  if (!(vs > 0) || !isfinite(vs)) return PRRU_EINPUT;
+  if (nstates <= 0) nstates = PRRU_BASE_STATES;
+  if (3 * nstates < PRRU_NREG) nstates = PRRU_NREG;
+  prru_gsl_init();
+  gsl_matrix *W = gsl_matrix_alloc(3 * (size_t)nstates, PRRU_NREG);
+  if (!W) return PRRU_ENOMEM;
+  b->vs = vs;
+  b->nstates = nstates;
+  b->seed = seed;
+  int st = stack_states(m, vs, nstates, seed, W);
+  if (st == PRRU_OK) st = reduce(W, b);
+  gsl_matrix_free(W);
+  return st;
+}
+
+void prru_base_params(const prru_base *b, const double pi[PRRU_NREG], double beta[PRRU_NREG])
+{
+  for (int i = 0; i < b->nbase; i++) {
+    double s = 0;
+    for (int j = 0; j < PRRU_NREG; j++) s += b->B[i * PRRU_NREG + j] * pi[j];
+    beta[i] = s;
+  }
+}
+
+void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *Yb)
+{
+  for (int r = 0; r < rows; r++)
+    for (int i = 0; i < b->nbase; i++) Yb[r * b->nbase + i] = Y[r * PRRU_NREG + b->col[i]];
+}
+
+void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
+                           const double pi0[PRRU_NREG], double pi[PRRU_NREG])
+{
+  memcpy(pi, pi0, sizeof(double) * PRRU_NREG);
+  /* Row i of B has 1 at col[i] and otherwise entries only at non-base
+   * parameters, which keep pi0's values. */
+  for (int i = 0; i < b->nbase; i++) {
+    double s = beta[i];
+    for (int j = 0; j < PRRU_NREG; j++)
+      if (j != b->col[i]) s -= b->B[i * PRRU_NREG + j] * pi0[j];
+    pi[b->col[i]] = s;
+  }
+}
+
+int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
+                    const double qd[3], const double qdd[3], const double fd[PRRU_NACT],
+                    double *A, double y[PRRU_NACT])
+{
+  for (int k = 0; k < 3; k++)
+    if (!isfinite(qd[k]) || !isfinite(qdd[k])) return PRRU_EINPUT;
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(fd[i])) return PRRU_EINPUT;
+  int st = prru_check_regular(m, d, q, NULL);
+  if (st != PRRU_OK) return st;
+  double Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG], tau[3];
+  prru_regressor(q, qd, qdd, &b->vs, Y);
+  prru_base_regressor(b, Y, 3, Yb);
+  for (int k = 0; k < 3; k++) {
+    tau[k] = 0;
+    for (int i = 0; i < PRRU_NACT; i++) tau[k] += d->Jd[i * 3 + k] * fd[i];
+  }
+  /* J_d^+T: (J_d^+)^T[i][k] = Jdpinv[k * NACT + i]. */
+  for (int i = 0; i < PRRU_NACT; i++) {
+    y[i] = 0;
+    for (int k = 0; k < 3; k++) y[i] += d->Jdpinv[k * PRRU_NACT + i] * tau[k];
+    for (int j = 0; j < b->nbase; j++) {
+      double s = 0;
+      for (int k = 0; k < 3; k++) s += d->Jdpinv[k * PRRU_NACT + i] * Yb[k * b->nbase + j];
+      A[i * b->nbase + j] = s;
+    }
+  }
+  return PRRU_OK;
+}
+
+/* X and y of every sample; *bad the failing sample. */
+static int fill_rows(const prru_model *m, const prru_base *b, int n, const double *q,
+                     const double *qd, const double *qdd, const double *fd, gsl_matrix *X,
+                     gsl_vector *y, int *bad)
+{
+  prru_data *d = malloc(sizeof *d);
+  double *A = malloc(sizeof(double) * PRRU_NACT * (size_t)b->nbase);
+  int st = d && A ? PRRU_OK : PRRU_ENOMEM;
+  for (int s = 0; s < n && st == PRRU_OK; s++) {
+    double ys[PRRU_NACT];
+    st = prru_ident_rows(m, d, b, q + 3 * s, qd + 3 * s, qdd + 3 * s, fd + PRRU_NACT * s, A, ys);
+    if (st != PRRU_OK) {
+      if (bad) *bad = s;
+      break;
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      const size_t row = (size_t)s * PRRU_NACT + (size_t)i;
+      gsl_vector_set(y, row, ys[i]);
+      for (int j = 0; j < b->nbase; j++) gsl_matrix_set(X, row, (size_t)j, A[i * b->nbase + j]);
+    }
+  }
+  free(A);
+  free(d);
+  return st;
+}
+
+/* (X^T X)^-1 through a Cholesky factor of the column-scaled normal matrix,
+ * and the 2-norm condition number of the column-scaled X (its SVD). */
+static int unit_covariance(const gsl_matrix *X, gsl_matrix *C, double *cond)
+{
+  const size_t p = X->size2;
+  gsl_vector *sc = gsl_vector_alloc(p);
+  gsl_matrix *Xs = gsl_matrix_alloc(X->size1, p);
+  gsl_matrix *V = gsl_matrix_alloc(p, p);
+  gsl_vector *sv = gsl_vector_alloc(p), *work = gsl_vector_alloc(p);
+  int st = sc && Xs && V && sv && work ? PRRU_OK : PRRU_ENOMEM;
+  if (st == PRRU_OK) {
+    gsl_matrix_memcpy(Xs, X);
+    for (size_t j = 0; j < p; j++) {
+      gsl_vector_view c = gsl_matrix_column(Xs, j);
+      double nrm = gsl_blas_dnrm2(&c.vector);
+      if (!(nrm > 0)) nrm = 1;
+      gsl_vector_set(sc, j, nrm);
+      gsl_vector_scale(&c.vector, 1.0 / nrm);
+    }
+    gsl_blas_dsyrk(CblasLower, CblasTrans, 1.0, Xs, 0.0, C);
+    if (gsl_linalg_cholesky_decomp1(C) != GSL_SUCCESS || gsl_linalg_cholesky_invert(C) != GSL_SUCCESS)
+      st = PRRU_ESINGULAR;
+    if (gsl_linalg_SV_decomp(Xs, V, sv, work) != GSL_SUCCESS) st = PRRU_ESINGULAR;
+    const double smin = gsl_vector_get(sv, p - 1);
+    *cond = smin > 0 ? gsl_vector_get(sv, 0) / smin : INFINITY;
+    for (size_t i = 0; i < p && st == PRRU_OK; i++)
+      for (size_t j = 0; j < p; j++)
+        gsl_matrix_set(C, i, j, gsl_matrix_get(C, i, j) / (gsl_vector_get(sc, i) * gsl_vector_get(sc, j)));
+  }
+  gsl_vector_free(sc), gsl_matrix_free(Xs), gsl_matrix_free(V), gsl_vector_free(sv), gsl_vector_free(work);
+  return st;
+}
+
+static int solve(const gsl_matrix *X, const gsl_vector *y, int n, const prru_base *b,
+                 prru_ident_result *r)
+{
+  const size_t p = (size_t)b->nbase;
+  gsl_vector *c = gsl_vector_alloc(p), *res = gsl_vector_alloc(X->size1);
+  gsl_matrix *cov = gsl_matrix_alloc(p, p), *C = gsl_matrix_alloc(p, p);
+  gsl_multifit_linear_workspace *w = gsl_multifit_linear_alloc(X->size1, p);
+  int st = c && res && cov && C && w ? PRRU_OK : PRRU_ENOMEM;
+  if (st == PRRU_OK) st = unit_covariance(X, C, &r->cond);
+  if (st == PRRU_OK && r->cond > 1e12) st = PRRU_ESINGULAR;
+  double chisq = 0;
+  if (st == PRRU_OK) {
+    if (gsl_multifit_linear(X, y, c, cov, &chisq, w) != GSL_SUCCESS) st = PRRU_ESINGULAR;
+  }
+  if (st == PRRU_OK) {
+    gsl_multifit_linear_residuals(X, y, c, res);
+    r->dof = 3 * n - b->nbase;
+    const double s2 = chisq / r->dof;
+    r->sigma = sqrt(s2);
+    for (size_t i = 0; i < p; i++) {
+      r->beta[i] = gsl_vector_get(c, i);
+      r->se[i] = sqrt(s2 * gsl_matrix_get(C, i, i));
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      double s = 0;
+      for (int k = 0; k < n; k++) {
+        const double e = gsl_vector_get(res, (size_t)k * PRRU_NACT + (size_t)i);
+        s += e * e;
+      }
+      r->rms[i] = sqrt(s / n);
+    }
+  }
+  gsl_vector_free(c), gsl_vector_free(res), gsl_matrix_free(cov), gsl_matrix_free(C);
+  if (w) gsl_multifit_linear_free(w);
+  return st;
+}
+
+int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
+                  const double *qdd, const double *fd, prru_ident_result *r, int *bad)
+{
+  memset(r, 0, sizeof *r);
+  prru_gsl_init();
+  if (bad) *bad = -1;
+  if (n <= 0 || 3 * n <= b->nbase || b->nbase <= 0) return PRRU_EINPUT;
+  r->nsamples = n;
+  r->nrows = n * PRRU_NACT;
+  gsl_matrix *X = gsl_matrix_alloc((size_t)r->nrows, (size_t)b->nbase);
+  gsl_vector *y = gsl_vector_alloc((size_t)r->nrows);
+  int st = X && y ? PRRU_OK : PRRU_ENOMEM;
+  if (st == PRRU_OK) st = fill_rows(m, b, n, q, qd, qdd, fd, X, y, bad);
+  if (st == PRRU_OK) st = solve(X, y, n, b, r);
+  gsl_matrix_free(X);
+  gsl_vector_free(y);
+  return st;
+}

@@ -1,0 +1,336 @@
+/* Regressor, base parameters and identification (prru_regressor.h,
+ * prru_ident.h) of whatever model the build uses:
+ *  - Y pi = M qdd + h - G - passive to 1e-12 at 500 random states, pi the
+ *    model's standard parameters, against the constant dynamics kernels;
+ *  - the same at 40 random parameter sets (masses, centres of mass, full
+ *    inertia tensors, drives, all perturbed) against the runtime-parameter
+ *    kernels given the same numbers: linearity in m, m c and I_O holds for
+ *    every parameter, not only the model's zeros;
+ *  - the runtime's conversion (prru_ident_standard) = the generator's exact
+ *    one (prru_regressor_model), and prru_ident_body inverts it;
+ *  - base parameters: Y pi = Y_base (B pi) to 1e-12 for random pi at states
+ *    not used to find B; the number of base parameters is the same with
+ *    twice the states and another seed; prru_base_to_standard gives B pi =
+ *    beta;
+ *  - identification from inverse-dynamics data along an excitation:
+ *    noise-free, beta to 1e-9 relative; with Gaussian noise of known sigma
+ *    on fd, every base parameter within 4 standard errors, the mean
+ *    squared normalised error near 1 and the residual sigma near the
+ *    noise's; an unreachable sample is named. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "prru.h"
+#include "prru_ident.h"
+#include "prru_kernels.h"
+#include "prru_param_kernels.h"
+#include "prru_regressor.h"
+#include "testutil.h"
+
+#define NSTATE 500
+#define NDESIGN 40
+#define NB PRRU_NBODY
+#define NA PRRU_NACT
+
+static prru_model model;
+static prru_data data;
+static unsigned long long state_seed = 12345;
+
+static void random_state(double q[3], double qd[3], double qdd[3])
+{
+  int st = prru_ident_random_state(&model, &data, &state_seed, q, qd, qdd);
+  if (st != PRRU_OK) {
+    fprintf(stderr, "no random state\n");
+    exit(1);
+  }
+}
+
+static double vs_of(void)
+{
+  return prru_mech.coulomb_velocity > 0 ? prru_mech.coulomb_velocity : 1.0;
+}
+
+static void y_times(const double *Y, const double *pi, double out[3])
+{
+  for (int r = 0; r < 3; r++) {
+    out[r] = 0;
+    for (int j = 0; j < PRRU_NREG; j++) out[r] += Y[r * PRRU_NREG + j] * pi[j];
+  }
+}
+
+static void check_model_params(void)
+{
+  double pi[PRRU_NREG];
+  prru_ident_standard(&prru_mech, pi);
+  TU_CLOSE(pi, prru_regressor_model, PRRU_NREG, 4e-16, "runtime standard parameters = generator's");
+  double worst = 0;
+  for (int b = 0; b < NB; b++) {
+    double m, c[3], I[6];
+    int st = prru_ident_body(pi + PRRU_NBODYPAR * b, &m, c, I);
+    const double Im[6] = {prru_mech.inertia[b][0], prru_mech.inertia[b][4], prru_mech.inertia[b][8],
+                          prru_mech.inertia[b][1], prru_mech.inertia[b][2], prru_mech.inertia[b][5]};
+    TU_TRUE(st == PRRU_OK, "prru_ident_body accepts the model's bodies");
+    double e = fabs(m - prru_mech.mass[b]) / prru_mech.mass[b];
+    for (int k = 0; k < 3; k++) e = fmax(e, fabs(c[k] - prru_mech.com[b][k]) / 1.0);
+    for (int k = 0; k < 6; k++) e = fmax(e, fabs(I[k] - Im[k]) / fabs(Im[0] + Im[1] + Im[2]));
+    worst = fmax(worst, e);
+  }
+  tu_check(worst < 1e-13, "prru_ident_body inverts prru_ident_standard", worst, 1e-13);
+  double bad[PRRU_NBODYPAR] = {0}, m, c[3], I[6];
+  TU_TRUE(prru_ident_body(bad, &m, c, I) == PRRU_EINPUT, "a body of mass 0 is refused");
+}
+
+static void check_model_dynamics(void)
+{
+  double pi[PRRU_NREG], worst = 0, vs = vs_of();
+  prru_ident_standard(&prru_mech, pi);
+  for (int s = 0; s < NSTATE; s++) {
+    double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG], M[9], h[3], G[3], Qp[3], tau[3], yp[3];
+    random_state(q, qd, qdd);
+    prru_regressor(q, qd, qdd, &vs, Y);
+    prru_dynamics(q, qd, M, h, G);
+    prru_passive(q, qd, Qp);
+    for (int i = 0; i < 3; i++)
+      tau[i] = M[3 * i] * qdd[0] + M[3 * i + 1] * qdd[1] + M[3 * i + 2] * qdd[2] + h[i] - G[i] - Qp[i];
+    y_times(Y, pi, yp);
+    worst = fmax(worst, tu_relerr(yp, tau, 3, 1e-300));
+  }
+  printf("Y pi vs M qdd + h - G - passive, model's parameters, %d states: %.2e\n", NSTATE, worst);
+  tu_check(worst <= 1e-12, "Y pi = dynamics at the model's parameters", worst, 1e-12);
+}
+
+/* A random parameter set: every inertial and drive number perturbed, in
+ * the descriptor (for prru_ident_standard) and in prru_params alike. */
+static void random_design(prru_mechanism *me, prru_params *p)
+{
+  *me = prru_mech;
+  *p = prru_params_model;
+  for (int b = 0; b < NB; b++) {
+    p->mass[b] = me->mass[b] = prru_mech.mass[b] * tu_uniform(0.5, 1.5);
+    for (int k = 0; k < 3; k++) p->com[b][k] = me->com[b][k] = tu_uniform(-0.03, 0.03);
+    const double base = prru_mech.inertia[b][0] + prru_mech.inertia[b][4] + prru_mech.inertia[b][8];
+    double t[6];
+    for (int k = 0; k < 3; k++) t[k] = base * tu_uniform(0.2, 0.5);
+    for (int k = 3; k < 6; k++) t[k] = base * tu_uniform(-0.05, 0.05);
+    const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    for (int k = 0; k < 6; k++) {
+      p->inertia[b][k] = t[k];
+      me->inertia[b][3 * at[k][0] + at[k][1]] = me->inertia[b][3 * at[k][1] + at[k][0]] = t[k];
+    }
+  }
+  for (int i = 0; i < NA; i++) {
+    p->armature[i] = me->armature[i] = tu_uniform(0, 0.5);
+    p->damping[i] = me->damping[i] = tu_uniform(0, 30);
+    p->coulomb[i] = me->coulomb[i] = tu_uniform(0, 5);
+  }
+  p->coulomb_velocity = me->coulomb_velocity = tu_uniform(0.002, 0.05);
+}
+
+static void check_random_designs(void)
+{
+  double worst = 0;
+  for (int k = 0; k < NDESIGN; k++) {
+    prru_mechanism me;
+    prru_params p;
+    double pi[PRRU_NREG];
+    random_design(&me, &p);
+    prru_ident_standard(&me, pi);
+    for (int s = 0; s < 20; s++) {
+      double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG], M[9], h[3], G[3], Qp[3], tau[3], yp[3];
+      random_state(q, qd, qdd);
+      prru_regressor(q, qd, qdd, &p.coulomb_velocity, Y);
+      prru_param_dynamics(&p, q, qd, M, h, G);
+      prru_param_passive(&p, q, qd, Qp);
+      for (int i = 0; i < 3; i++)
+        tau[i] = M[3 * i] * qdd[0] + M[3 * i + 1] * qdd[1] + M[3 * i + 2] * qdd[2] + h[i] - G[i] - Qp[i];
+      y_times(Y, pi, yp);
+      worst = fmax(worst, tu_relerr(yp, tau, 3, 1e-300));
+    }
+  }
+  printf("Y pi vs runtime-parameter dynamics, %d random parameter sets x 20 states: %.2e\n", NDESIGN, worst);
+  tu_check(worst <= 1e-12, "Y pi = dynamics for random parameters", worst, 1e-12);
+  double q[3] = {NAN, 0, 0}, qd[3] = {0}, qdd[3] = {0}, Y[3 * PRRU_NREG], vs = 1;
+  prru_regressor(q, qd, qdd, &vs, Y);
+  int all_nan = 1;
+  for (int j = 0; j < 3 * PRRU_NREG; j++) all_nan &= isnan(Y[j]);
+  TU_TRUE(all_nan, "regressor: NaN q gives NaN everywhere");
+}
+
+static void check_base(prru_base *b)
+{
+  const double vs = vs_of();
+  TU_TRUE(prru_base_compute(&model, vs, 0, 1, b) == PRRU_OK, "base parameters computed");
+  prru_base *b2 = malloc(sizeof *b2);
+  TU_TRUE(b2 && prru_base_compute(&model, vs, 2 * PRRU_BASE_STATES, 7, b2) == PRRU_OK,
+          "base parameters with twice the states");
+  printf("base parameters: %d of %d (pivot gap %.1e kept / %.1e dropped); %d with %d states, seed 7\n",
+         b->nbase, PRRU_NREG, b->last_kept, b->first_dropped, b2->nbase, b2->nstates);
+  TU_TRUE(b2->nbase == b->nbase, "the number of base parameters does not change with more states");
+  tu_check(b->first_dropped < 1e-12 && b->last_kept > 1e-6, "a clear gap at the rank cut",
+           b->first_dropped, 1e-12);
+  free(b2);
+  double worst = 0, worst_std = 0;
+  for (int k = 0; k < 20; k++) {
+    double pi[PRRU_NREG], beta[PRRU_NREG], pi2[PRRU_NREG], beta2[PRRU_NREG];
+    for (int j = 0; j < PRRU_NREG; j++) pi[j] = tu_uniform(-1, 1);
+    prru_base_params(b, pi, beta);
+    for (int s = 0; s < 10; s++) {
+      double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG], yp[3], yb[3];
+      random_state(q, qd, qdd);
+      prru_regressor(q, qd, qdd, &vs, Y);
+      prru_base_regressor(b, Y, 3, Yb);
+      y_times(Y, pi, yp);
+      for (int r = 0; r < 3; r++) {
+        yb[r] = 0;
+        for (int i = 0; i < b->nbase; i++) yb[r] += Yb[r * b->nbase + i] * beta[i];
+      }
+      worst = fmax(worst, tu_relerr(yb, yp, 3, 1e-300));
+    }
+    double pi0[PRRU_NREG];
+    for (int j = 0; j < PRRU_NREG; j++) pi0[j] = tu_uniform(-1, 1);
+    prru_base_to_standard(b, beta, pi0, pi2);
+    prru_base_params(b, pi2, beta2);
+    worst_std = fmax(worst_std, tu_relerr(beta2, beta, b->nbase, 1e-300));
+  }
+  printf("Y pi vs Y_base beta, random pi at fresh states: %.2e; B(base_to_standard(beta)) vs beta: %.2e\n",
+         worst, worst_std);
+  tu_check(worst <= 1e-12, "Y pi = Y_base B pi", worst, 1e-12);
+  tu_check(worst_std <= 1e-12, "B pi' = beta for pi' = prru_base_to_standard(beta)", worst_std, 1e-12);
+}
+
+static double gauss(void)
+{
+  double u = tu_uniform(1e-300, 1), v = tu_uniform(0, 1);
+  return sqrt(-2 * log(u)) * cos(2 * 3.14159265358979323846 * v);
+}
+
+/* n samples of an excitation, fd by inverse dynamics (+ noise sigma). */
+static int make_data(int n, double sigma, double *q, double *qd, double *qdd, double *fd)
+{
+  prru_fourier f;
+  memset(&f, 0, sizeof f);
+  f.period = 4;
+  f.harmonics = 4;
+  const double L = prru_mech.l1[0];
+  for (int l = 0; l < 4; l++) {
+    f.a[0][l] = 0.05 / (l + 1), f.b[0][l] = 0.03 * (l % 2 ? 1 : -1) / (l + 1);
+    f.a[1][l] = -0.04 / (l + 1), f.b[1][l] = 0.05 / (l + 1.5);
+    f.a[2][l] = 0.04 * L / (l + 1), f.b[2][l] = -0.03 * L / (l + 1);
+  }
+  prru_loads ld;
+  memset(&ld, 0, sizeof ld);
+  for (int s = 0; s < n; s++) {
+    prru_fourier_eval(&f, f.period * s / n, q + 3 * s, qd + 3 * s, qdd + 3 * s);
+    if (prru_inverse_dynamics(&model, &data, q + 3 * s, qd + 3 * s, qdd + 3 * s, &ld, fd + NA * s))
+      return 1;
+    for (int i = 0; i < NA; i++) fd[NA * s + i] += sigma * gauss();
+  }
+  return 0;
+}
+
+static void check_identify(const prru_base *b)
+{
+  enum { N = 2000 };
+  double *q = malloc(sizeof(double) * 3 * N), *qd = malloc(sizeof(double) * 3 * N);
+  double *qdd = malloc(sizeof(double) * 3 * N), *fd = malloc(sizeof(double) * NA * N);
+  prru_ident_result *r = malloc(sizeof *r);
+  double pi[PRRU_NREG], beta[PRRU_NREG];
+  prru_ident_standard(&prru_mech, pi);
+  prru_base_params(b, pi, beta);
+  if (!TU_TRUE(q && qd && qdd && fd && r && !make_data(N, 0, q, qd, qdd, fd), "excitation data")) return;
+  int bad = -2;
+  int st = prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad);
+  TU_TRUE(st == PRRU_OK, "noise-free identification runs");
+  /* Relative to |beta_i|, or for a parameter near 0 (exact zeros come
+   * out of B as rounding-level values) to u_i = rms(y) / rms(X_i), the
+   * value at which it alone would give forces of the data's size. */
+  double *A = malloc(sizeof(double) * NA * PRRU_NREG), colsq[PRRU_NREG] = {0}, ysq = 0, y[NA];
+  for (int s = 0; s < N && A; s++) {
+    prru_ident_rows(&model, &data, b, q + 3 * s, qd + 3 * s, qdd + 3 * s, fd + NA * s, A, y);
+    for (int i = 0; i < NA; i++) {
+      ysq += y[i] * y[i];
+      for (int j = 0; j < b->nbase; j++) colsq[j] += A[i * b->nbase + j] * A[i * b->nbase + j];
+    }
+  }
+  free(A);
+  double e = 0;
+  for (int i = 0; i < b->nbase; i++)
+    e = fmax(e, fabs(r->beta[i] - beta[i]) / fmax(fabs(beta[i]), sqrt(ysq / colsq[i])));
+  printf("noise-free: %d samples, cond %.3g, worst relative error of a base parameter %.2e, "
+         "sigma %.2e N\n", N, r->cond, e, r->sigma);
+  tu_check(e <= 1e-9, "noise-free identification recovers beta", e, 1e-9);
+
+  const double sigma = 0.5;
+  make_data(N, sigma, q, qd, qdd, fd);
+  st = prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad);
+  TU_TRUE(st == PRRU_OK, "noisy identification runs");
+  double worst = 0, chi = 0;
+  for (int i = 0; i < b->nbase; i++) {
+    const double z = (r->beta[i] - beta[i]) / r->se[i];
+    worst = fmax(worst, fabs(z));
+    chi += z * z;
+  }
+  chi /= b->nbase;
+  printf("noise sigma %.2f N: estimated %.4f N, worst |error| / se %.2f, mean (error / se)^2 %.3f\n", sigma,
+         r->sigma, worst, chi);
+  tu_check(worst <= 4, "every base parameter within 4 standard errors", worst, 4);
+  tu_check(chi > 0.5 && chi < 1.6, "mean squared normalised error near 1", chi, 1);
+  tu_check(fabs(r->sigma / sigma - 1) < 0.05, "residual sigma = noise sigma (5 %)", r->sigma / sigma, 1);
+
+  q[3 * 17] = 2.5; /* q1 far outside the workspace */
+  st = prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad);
+  TU_TRUE(st != PRRU_OK && bad == 17, "an unreachable sample is refused and named");
+  TU_TRUE(prru_identify(&model, b, 3, q, qd, qdd, fd, r, &bad) == PRRU_EINPUT, "too few samples refused");
+  free(q), free(qd), free(qdd), free(fd), free(r);
+}
+
+static void check_excite(const prru_base *b)
+{
+  prru_excite_options o;
+  prru_excite_options_default(&o);
+  o.max_evals = 400;
+  o.samples = 60;
+  o.check_samples = 600;
+  prru_fourier f;
+  memset(&f, 0, sizeof f);
+  f.period = 5, f.harmonics = 3;
+  prru_excite_result r;
+  char msg[256];
+  int st = prru_excite(&model, b, &o, NULL, &f, &r, msg, sizeof msg);
+  if (!TU_TRUE(st == PRRU_OK, "prru_excite finds a trajectory")) {
+    fprintf(stderr, "%s\n", msg);
+    return;
+  }
+  printf("excitation: cond %.4g from %.4g in %d evaluations, worst rcond %.3g\n", r.cond, r.cond_start, r.evals,
+         r.rcond_worst);
+  TU_TRUE(r.cond <= r.cond_start, "the optimiser does not make the condition worse");
+  double peak[NA], rw, tb;
+  TU_TRUE(prru_excite_check(&model, &f, &o, 5000, peak, &rw, &tb) == PRRU_OK && rw >= o.rcond_min,
+          "the trajectory passes a denser check");
+  prru_fourier f2;
+  memset(&f2, 0, sizeof f2);
+  f2.period = 5, f2.harmonics = 3;
+  prru_excite_result r2;
+  prru_excite(&model, b, &o, NULL, &f2, &r2, msg, sizeof msg);
+  TU_TRUE(memcmp(&f, &f2, sizeof f) == 0, "deterministic");
+  f2.centre[0] = 3.0;
+  TU_TRUE(prru_excite(&model, b, &o, NULL, &f2, &r2, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "centre") != NULL,
+          "an unreachable centre is refused by name");
+}
+
+int main(void)
+{
+  prru_model_default(&model);
+  check_model_params();
+  check_model_dynamics();
+  check_random_designs();
+  prru_base *b = malloc(sizeof *b);
+  if (!b) return 1;
+  check_base(b);
+  check_identify(b);
+  check_excite(b);
+  free(b);
+  return tu_finish("test_ident");
+}
