@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "prru.h"
+#include "prru_traj.h"
 
 static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
@@ -195,6 +196,8 @@ int prru_cmd_fk(int argc, char **argv)
 /* %s: the output's columns. */
 static const char id_help[] =
     "usage: prru id --traj FILE.csv [--out FILE.csv|-] [--preload T] [--null-vector]\n"
+    "               [--differentiate] [--window M] [--degree P] [--derivatives]\n"
+    "               [--rates] [--reactions]\n"
     "Inverse dynamics along a trajectory: FILE has a header row and columns\n"
     "t, q1..q3, qd1..qd3, qdd1..qdd3 (any order, other columns ignored) and\n"
     "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); lines starting\n"
@@ -203,6 +206,22 @@ static const char id_help[] =
     "--out -); --out FILE keeps its old contents until the first row is ready\n"
     "(it is built as FILE.partial-XXXXXX and renamed). The output is a load\n"
     "table for `prru simulate --loads` (actuator forces only).\n"
+    "Without the columns qd1..3 and qdd1..3 (or with --differentiate) the\n"
+    "velocities and accelerations come from q(t) alone: at each row, the\n"
+    "least-squares polynomial of degree P (--degree, default 4) through the\n"
+    "2M + 1 rows around it (--window M, default 4; the 2M + 1 first or last\n"
+    "rows near the ends; times may be uneven). It is exact for polynomials of\n"
+    "degree P. For a smooth q the error of qdd is at most TRUNC times the\n"
+    "largest (P+1)-th derivative of q, and white noise of size s on q becomes\n"
+    "noise of size GAIN s on qdd; a comment line of the output gives both\n"
+    "(the worst over the rows, which is at the ends). At 1 ms rows with the\n"
+    "defaults, TRUNC = 2.7e-7 s^3 (2.2e-9 s^3 away from the ends) and\n"
+    "GAIN = 2.2e6 s^-2 (4.4e5 s^-2): a wider window or a lower degree averages\n"
+    "noise away, a narrower one follows fast motion better.\n"
+    "--derivatives adds the columns qd1..3, qdd1..3 used; --rates the slider\n"
+    "velocities %s (m/s) and actuator powers %s = fd dd (W);\n"
+    "--reactions the joint reactions (columns as in 'prru simulate'). With any\n"
+    "of them the output is no longer a load table.\n"
     "%s"
     "A row where the pose is unreachable or J_d singular stops with exit 1,\n"
     "SIGINT/SIGTERM/SIGHUP with exit 130/143/129; the rows before it are kept.\n"
@@ -226,26 +245,106 @@ static const char id_help_3[] =
     "model with redundant actuators (e.g. models/4prru.json) and are usage\n"
     "errors here.\n";
 
+/* qd, qdd from q(t) (prru_traj.h) for every row of t: arrays of 3 per
+ * row, malloc'ed in *qd (qd then qdd); the comment line for the output in
+ * note. 0, or 2 after a message naming the file and row. */
+static int id_differentiate(const char *traj, const prru_table *t, const int col[4],
+                            const prru_diff_options *o, double **qd, char *note, size_t notelen)
+{
+  const size_t n = (size_t)t->nrows;
+  double *buf = malloc((n ? n : 1) * 16 * sizeof *buf);
+  if (!buf) {
+    prru_cli_error("id", "out of memory");
+    return 1;
+  }
+  double *tt = buf, *q = buf + n, *trunc = buf + 4 * n, *gain = buf + 7 * n, *res = buf + 10 * n;
+  for (size_t i = 0; i < n; i++) {
+    const double *row = t->data + i * (size_t)t->ncols;
+    tt[i] = row[col[0]];
+    for (int c = 0; c < 3; c++) q[3 * i + c] = row[col[1 + c]];
+  }
+  char msg[300];
+  if (prru_diff_signal(tt, t->nrows, q, 3, o, NULL, res, res + 3 * n, trunc, gain, msg,
+                       sizeof msg) != PRRU_OK) {
+    prru_cli_error("id", "--traj %s: cannot differentiate q(t): %s", traj, msg);
+    free(buf);
+    return 2;
+  }
+  double w[4] = {0, 0, 0, 0};
+  for (size_t i = 0; i < n; i++) {
+    w[0] = fmax(w[0], trunc[3 * i + 1]);
+    w[1] = fmax(w[1], trunc[3 * i + 2]);
+    w[2] = fmax(w[2], gain[3 * i + 1]);
+    w[3] = fmax(w[3], gain[3 * i + 2]);
+  }
+  snprintf(note, notelen, "# qd, qdd from q(t): least-squares polynomials of degree %d over %d rows; "
+           "error bound factors TRUNC qd %.3g s^%d, qdd %.3g s^%d (times the largest derivative "
+           "%d of q); noise gains GAIN qd %.3g s^-1, qdd %.3g s^-2\n", o->degree,
+           2 * o->half_width + 1, w[0], o->degree, w[1], o->degree - 1, o->degree + 1, w[2], w[3]);
+  memmove(buf, res, 6 * n * sizeof *buf);
+  *qd = buf;
+  return 0;
+}
+
+/* --window and --degree into o. 0 or 2. */
+static int id_diff_options(const char *wins, const char *degs, prru_diff_options *o)
+{
+  prru_diff_options_default(o);
+  double v;
+  if (wins) {
+    if (prru_cli_number("id", "window", wins, &v)) return 2;
+    if (!(v >= 1 && v <= PRRU_DIFF_MAX_HALF && v == floor(v))) {
+      prru_cli_error("id", "--window '%s': must be a whole number from 1 to %d (rows on each side)",
+                     wins, PRRU_DIFF_MAX_HALF);
+      return 2;
+    }
+    o->half_width = (int)v;
+  }
+  if (degs) {
+    if (prru_cli_number("id", "degree", degs, &v)) return 2;
+    if (!(v >= 2 && v <= PRRU_DIFF_MAX_DEGREE && v == floor(v))) {
+      prru_cli_error("id", "--degree '%s': must be a whole number from 2 to %d", degs,
+                     PRRU_DIFF_MAX_DEGREE);
+      return 2;
+    }
+    o->degree = (int)v;
+  }
+  if (o->degree > 2 * o->half_width) {
+    prru_cli_error("id", "--degree %d needs --window %d or more (a polynomial of degree P needs "
+                   "P + 1 rows; the window has 2M + 1)", o->degree, (o->degree + 1) / 2);
+    return 2;
+  }
+  return 0;
+}
+
 int prru_cmd_id(int argc, char **argv)
 {
-  const char *traj = NULL, *out = NULL, *pre = NULL;
-  int help = 0, null_vector = 0;
+  const char *traj = NULL, *out = NULL, *pre = NULL, *wins = NULL, *degs = NULL;
+  int help = 0, null_vector = 0, force_diff = 0, derivs = 0, rates = 0, reactions = 0;
   prru_cli_option opts[] = {{"traj", 1, &traj, NULL},
                             {"out", 1, &out, NULL},
                             {"preload", 1, &pre, NULL},
                             {"null-vector", 0, NULL, &null_vector},
+                            {"differentiate", 0, NULL, &force_diff},
+                            {"window", 1, &wins, NULL},
+                            {"degree", 1, &degs, NULL},
+                            {"derivatives", 0, NULL, &derivs},
+                            {"rates", 0, NULL, &rates},
+                            {"reactions", 0, NULL, &reactions},
                             {"help", 0, NULL, &help}};
-  if (prru_cli_parse("id", argc, argv, opts, 5)) return 2;
-  char fd_names[256], n_names[256];
+  if (prru_cli_parse("id", argc, argv, opts, 11)) return 2;
+  char fd_names[256], n_names[256], dd_names[256], pow_names[256];
   prru_cli_names(fd_names, sizeof fd_names, "fd", PRRU_NACT, ",");
   prru_cli_names(n_names, sizeof n_names, "n", PRRU_NACT, ",");
+  prru_cli_names(dd_names, sizeof dd_names, "dd", PRRU_NACT, ",");
+  prru_cli_names(pow_names, sizeof pow_names, "pow", PRRU_NACT, ",");
   if (help) {
     char extra[sizeof id_help_redundant + 300];
     if (PRRU_NPRELOAD > 0)
       snprintf(extra, sizeof extra, id_help_redundant, PRRU_NACT, n_names);
     else
       snprintf(extra, sizeof extra, "%s", id_help_3);
-    printf(id_help, fd_names, extra);
+    printf(id_help, fd_names, dd_names, pow_names, extra);
     return 0;
   }
   if (!traj) {
@@ -270,18 +369,45 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_error("id", "--traj %s", msg);
     return 2;
   }
-  int col[16];
-  for (int k = 0; k < 10; k++)
-    if ((col[k] = prru_table_column(&t, need[k])) < 0) {
-      prru_cli_error("id", "--traj %s: missing column '%s' (need t, q1..3, qd1..3, qdd1..3)", traj, need[k]);
+  int col[16], nrates = 0;
+  for (int k = 0; k < 10; k++) {
+    col[k] = prru_table_column(&t, need[k]);
+    nrates += k >= 4 && col[k] >= 0;
+    if (k < 4 && col[k] < 0) {
+      prru_cli_error("id", "--traj %s: missing column '%s' (need t, q1..3, and qd1..3, qdd1..3 "
+                     "unless they are to be computed from q)", traj, need[k]);
       prru_table_free(&t);
       return 2;
     }
+  }
+  /* Velocities and accelerations from q(t) when the file has none. */
+  const int diff = force_diff || nrates == 0;
+  if (!diff && nrates < 6) {
+    prru_cli_error("id", "--traj %s: has %d of the 6 columns qd1..3, qdd1..3: give all of them, "
+                   "or none (or --differentiate) to compute them from q(t)", traj, nrates);
+    prru_table_free(&t);
+    return 2;
+  }
+  if (!diff && (wins || degs)) {
+    prru_cli_error("id", "--%s applies when qd, qdd are computed from q(t): %s has them (add "
+                   "--differentiate to recompute them)", wins ? "window" : "degree", traj);
+    prru_table_free(&t);
+    return 2;
+  }
   for (int k = 0; k < 6; k++) col[10 + k] = prru_table_column(&t, opt[k]);
+  prru_diff_options dopt;
+  double *rates_q = NULL;
+  char note[600] = "";
+  if (diff && (id_diff_options(wins, degs, &dopt) ||
+               (st = id_differentiate(traj, &t, col, &dopt, &rates_q, note, sizeof note)) != 0)) {
+    prru_table_free(&t);
+    return st == 1 ? 1 : 2;
+  }
   prru_cli_catch_signals();
   prru_cli_out o;
   if (prru_cli_out_open(&o, "id", out)) {
     prru_table_free(&t);
+    free(rates_q);
     return 1;
   }
   const char *name = o.name;
@@ -297,7 +423,16 @@ int prru_cmd_id(int argc, char **argv)
                             "vector with J_d^T n = 0 (fd . n = %.17g)\n", preload, preload);
     prru_cli_out_line(&o);
   }
-  prru_cli_out_printf(&o, "t,%s%s%s\n", fd_names, null_vector ? "," : "", null_vector ? n_names : "");
+  if (diff) {
+    prru_cli_out_printf(&o, "%s", note);
+    prru_cli_out_line(&o);
+  }
+  prru_cli_out_printf(&o, "t,%s%s%s", fd_names, null_vector ? "," : "", null_vector ? n_names : "");
+  if (derivs) prru_cli_out_printf(&o, ",qd1,qd2,qd3,qdd1,qdd2,qdd3");
+  if (rates) prru_cli_out_printf(&o, ",%s,%s", dd_names, pow_names);
+  for (int k = 0; reactions && k < PRRU_NLAMBDA; k++)
+    prru_cli_out_printf(&o, ",%s", prru_mech.lambda_labels[k]);
+  prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
   char why[700] = "";
   for (int i = 0; st == PRRU_OK && !o.err && i < t.nrows; i++) {
@@ -309,6 +444,10 @@ int prru_cmd_id(int argc, char **argv)
     const double *row = t.data + (size_t)i * (size_t)t.ncols;
     double v[16], fd[PRRU_NACT];
     for (int k = 0; k < 16; k++) v[k] = col[k] < 0 ? 0.0 : row[col[k]];
+    if (diff) {
+      memcpy(v + 4, rates_q + 3 * i, 3 * sizeof v[0]);
+      memcpy(v + 7, rates_q + 3 * ((size_t)t.nrows + (size_t)i), 3 * sizeof v[0]);
+    }
     prru_loads l;
     memset(&l, 0, sizeof l);
     memcpy(l.fp, v + 10, sizeof l.fp);
@@ -316,6 +455,15 @@ int prru_cmd_id(int argc, char **argv)
     double n[PRRU_NACT];
     st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
+    double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
+    if (st == PRRU_OK && rates) {
+      prru_actuator_rates(v + 1, v + 4, dd, ddb);
+      for (int k = 0; k < PRRU_NACT; k++) pw[k] = fd[k] * dd[k];
+    }
+    if (st == PRRU_OK && reactions) {
+      memcpy(l.fd, fd, sizeof l.fd);
+      st = prru_reactions(&m, d, v + 1, v + 4, &l, lambda);
+    }
     if (st != PRRU_OK) {
       snprintf(why, sizeof why, "%s: data row %d (t = %g): %s", traj, i + 1, v[0], prru_strerror(st));
       break;
@@ -323,12 +471,19 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_out_printf(&o, "%.17g", v[0]);
     prru_cli_out_numbers(&o, fd, PRRU_NACT);
     if (null_vector) prru_cli_out_numbers(&o, n, PRRU_NACT);
+    if (derivs) prru_cli_out_numbers(&o, v + 4, 6);
+    if (rates) {
+      prru_cli_out_numbers(&o, dd, PRRU_NACT);
+      prru_cli_out_numbers(&o, pw, PRRU_NACT);
+    }
+    if (reactions) prru_cli_out_numbers(&o, lambda, PRRU_NLAMBDA);
     prru_cli_out_printf(&o, "\n");
     prru_cli_out_row(&o);
   }
   long rows = o.rows;
   int io = o.err != 0;
   free(d);
+  free(rates_q);
   prru_table_free(&t);
   /* The rows before a stop are kept; nothing (and the old file) when the
    * first row already failed or the output could not be written. */

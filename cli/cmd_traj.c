@@ -119,8 +119,8 @@ static const char *pose_problem(int st)
 /* ---- prru traj ---- */
 
 static const char traj_help[] =
-    "usage: prru traj [--quintic] --waypoints 'q1,q2,q3;q1,q2,q3;...' --durations T1,T2,...\n"
-    "                 [--dt S] [--out FILE.csv|-]\n"
+    "usage: prru traj [--quintic] --waypoints 'q1,q2,q3;q1,q2,q3;...'\n"
+    "                 --durations T1,T2,... [--dt S] [--out FILE.csv|-]\n"
     "A point-to-point trajectory: from each waypoint to the next in the given\n"
     "time, along the straight line in q with the quintic time law\n"
     "s = 10 u^3 - 15 u^4 + 6 u^5 (u the fraction of the segment's time), which\n"
@@ -149,7 +149,8 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
   }
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
   const long n = (long)ceil((t1 - t0) / dt - 1e-9);
-  int st = PRRU_OK;
+  int st = PRRU_OK, sign = 0;
+  double t_prev = t0;
   for (long k = 0; k <= n && !o->err; k++) {
     double t = k == n ? t1 : t0 + (double)k * dt, q[3], qd[3], qdd[3], dd[PRRU_NACT],
            ddb[PRRU_NACT], rc;
@@ -160,14 +161,25 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     }
     prru_quintic_eval(tr, t, q, qd, qdd);
     st = prru_traj_pose_ok(&m, d, q, &rc);
-    if (st != PRRU_OK) {
+    int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0;
+    if (st != PRRU_OK || s * sign < 0) {
       int seg = 0;
       while (seg + 2 < tr->n && tr->t[seg + 1] <= t) seg++;
-      snprintf(why, whylen, "sample %ld (t = %.9g s, segment %d: waypoint %d to %d): q = (%.9g, "
-               "%.9g, %.9g) is %s", k + 1, t, seg + 1, seg + 1, seg + 2, q[0], q[1], q[2],
-               pose_problem(st));
+      if (st == PRRU_OK) {
+        st = PRRU_ESINGULAR;
+        snprintf(why, whylen, "sample %ld (t = %.9g s, segment %d: waypoint %d to %d): the path "
+                 "crosses a singularity (J_d singular) after t = %.9g s: det J_d changes sign "
+                 "at q = (%.9g, %.9g, %.9g)", k + 1, t, seg + 1, seg + 1, seg + 2, t_prev, q[0],
+                 q[1], q[2]);
+      } else {
+        snprintf(why, whylen, "sample %ld (t = %.9g s, segment %d: waypoint %d to %d): q = (%.9g, "
+                 "%.9g, %.9g) is %s", k + 1, t, seg + 1, seg + 1, seg + 2, q[0], q[1], q[2],
+                 pose_problem(st));
+      }
       break;
     }
+    if (s) sign = s;
+    t_prev = t;
     prru_actuator_rates(q, qd, dd, ddb);
     prru_cli_out_printf(o, "%.17g", t);
     prru_cli_out_numbers(o, q, 3);
@@ -280,7 +292,9 @@ static const char track_help[] =
     "the stroke at every row time (else exit 2, nothing written); a plant\n"
     "that leaves its stroke stops the run (exit 1, rows kept).\n"
     "Output: the model line, a line with the settings, then\n"
-    "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s\n"
+    "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,\n"
+    "  %s,%s,\n"
+    "  %s,%s\n"
     "(qr the reference, fdc the controller's forces before clipping, sat 1 where\n"
     "clipped, d the slider heights) to --out or stdout; a JSON summary (RMS and\n"
     "largest error per coordinate, largest force and saturated fraction of the\n"
@@ -400,12 +414,21 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
   if (!d) return 1;
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
   const long n = (long)ceil((t1 - t0) / step - 1e-9);
-  int rc = 0;
+  int rc = 0, sign = 0;
   *ff_peak = 0;
   for (long k = 0; k <= n && !rc; k++) {
     double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
     prru_quintic_eval(tr, t, q, qd, qdd);
     int st = prru_traj_pose_ok(&m, d, q, &rcond);
+    int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0;
+    if (s * sign < 0) {
+      prru_cli_error("track", "reference at sample %ld (t = %.9g s): the path crosses a "
+                     "singularity (det J_d changes sign) before q = (%.9g, %.9g, %.9g); nothing "
+                     "written", k + 1, t, q[0], q[1], q[2]);
+      rc = 2;
+      break;
+    }
+    if (s) sign = s;
     if (st != PRRU_OK) {
       prru_cli_error("track", "reference at sample %ld (t = %.9g s): q = (%.9g, %.9g, %.9g) is %s; "
                      "nothing written", k + 1, t, q[0], q[1], q[2], pose_problem(st));

@@ -1,0 +1,264 @@
+#!/usr/bin/env bash
+# prru traj, prru track and prru id from q(t), for any model: the quintic
+# trajectory's rows against its defining properties and against prru ik;
+# paths out of the workspace or across a singularity stopped at the first
+# bad sample with the rows before it kept and no NaN; id from q(t) alone
+# within the error bound it states, and its slider velocities, powers and
+# reactions against prru ik and prru eval; track: exact model to 1e-9,
+# mismatch error falling with the bandwidth, saturation reported and never
+# exceeded, seeded noise reproducible, the CSV reference equal to the
+# waypoints, and every kind of bad input refused with nothing written.
+# Needs $PRRU, $PRRU_MODEL, $PRRU_SOURCE_DIR (cli_lib.sh).
+. "$(dirname "$0")/cli_lib.sh"
+
+WP='0,0,0;0.1,-0.08,0.02;0,0,0'
+# A CSV's data (no '#' lines) as python rows: cols(FILE) -> header, rows.
+PYCSV='
+import csv, math, sys
+def cols(p):
+    r = list(csv.reader(l for l in open(p) if not l.startswith("#")))
+    return r[0], [[float(x) for x in row] for row in r[1:]]
+'
+
+# ---- help ----
+for c in traj track; do
+  "$PRRU" $c --help >"$tmp/help_$c.txt" && ok || bad "$c --help failed"
+done
+{ grep -n -i -E "gsl|odeiv|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" "$tmp"/help_*.txt
+  grep -n -E "PRRU_|DBL_" "$tmp"/help_*.txt; } >"$tmp/jargon.txt"
+[ -s "$tmp/jargon.txt" ] && bad "help with internal names: $(head -c 300 "$tmp/jargon.txt")" || ok
+awk 'length > 80 { print FILENAME ": " $0; bad = 1 } END { exit bad }' "$tmp"/help_*.txt >"$tmp/long.txt" \
+  && ok || bad "help lines over 80 columns: $(head -c 300 "$tmp/long.txt")"
+grep -qF "$(act_names d),$(act_names dd)" "$tmp/help_traj.txt" && grep -qF "$(act_names sat)" "$tmp/help_track.txt" \
+  && ok || bad "help texts do not list the model's $nact actuators"
+"$PRRU" id --help >"$tmp/help_id.txt"
+grep -qF "$(act_names pow)" "$tmp/help_id.txt" && grep -q -- "--window M" "$tmp/help_id.txt" && ok \
+  || bad "id --help does not describe differentiation and powers"
+
+# ---- prru traj ----
+"$PRRU" traj --quintic --waypoints "$WP" --durations 1,1 --out "$tmp/t.csv" 2>"$tmp/err" \
+  && ok || bad "traj failed: $(cat "$tmp/err")"
+head -1 "$tmp/t.csv" | grep -qxF "$csv_comment" && ok || bad "traj: no model line"
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1])
+ix = {n: i for i, n in enumerate(h)}
+assert h[:10] == 't q1 q2 q3 qd1 qd2 qd3 qdd1 qdd2 qdd3'.split(), h
+assert len(r) == 2001 and r[-1][0] == 2.0, (len(r), r[-1][0])
+wp = [[0, 0, 0], [0.1, -0.08, 0.02], [0, 0, 0]]
+for k, row in ((0, r[0]), (1, r[1000]), (2, r[2000])):
+    assert max(abs(row[1 + c] - wp[k][c]) for c in range(3)) < 1e-15, ('waypoint', k, row[:4])
+    assert max(abs(v) for v in row[4:10]) < 1e-13, ('not at rest', k, row[4:10])
+# Peak speed 1.875 dq / T at mid-segment (t = 0.5 is a sample).
+mid = r[500]
+for c in range(3):
+    assert abs(mid[4 + c] - 1.875 * wp[1][c]) < 1e-14, ('peak speed', c, mid[4 + c])
+    assert max(abs(row[4 + c]) for row in r) <= 1.875 * abs(wp[1][c]) + 1e-15
+assert all(math.isfinite(v) for row in r for v in row)
+" "$tmp/t.csv" && ok || bad "traj rows do not have the quintic's properties"
+# d and dd = J_d qd against prru ik at a moving sample.
+row=$(grep -v '^#' "$tmp/t.csv" | sed -n '301p')
+q=$(echo "$row" | cut -d, -f2-4)
+"$PRRU" ik --q "$q" >"$tmp/ik.json"
+python3 -c "
+import json, sys
+ik = json.load(open(sys.argv[1])); row = [float(x) for x in sys.argv[2].split(',')]; n = int(sys.argv[3])
+qd = row[4:7]; d = row[10:10 + n]; dd = row[10 + n:10 + 2 * n]
+assert max(abs(a - b) for a, b in zip(d, ik['d'])) <= 1e-15 * max(1, max(map(abs, d))), (d, ik['d'])
+jq = [sum(J[j] * qd[j] for j in range(3)) for J in ik['Jd']]
+assert max(abs(a - b) for a, b in zip(dd, jq)) <= 1e-14 * max(1e-3, max(map(abs, jq))), (dd, jq)
+" "$tmp/ik.json" "$row" "$nact" && ok || bad "traj d, dd disagree with prru ik's d and J_d qd"
+
+# Out of the workspace: a tilt no model reaches; the rows before it kept.
+"$PRRU" traj --waypoints '0,0,0;1.5,0,0' --durations 1 --out "$tmp/u.csv" 2>"$tmp/err"
+st=$?
+[ $st -eq 1 ] && grep -q "sample [0-9]* (t = .*outside the workspace" "$tmp/err" && ok \
+  || bad "traj out of the workspace: exit $st, $(cat "$tmp/err")"
+python3 -c "$PYCSV
+import re
+h, r = cols(sys.argv[1])
+k = int(re.search(r'sample (\d+)', open(sys.argv[2]).read()).group(1))
+assert len(r) == k - 1 and len(r) > 100, (len(r), k)
+assert all(math.isfinite(v) for row in r for v in row)
+" "$tmp/u.csv" "$tmp/err" && ok || bad "traj: rows before the bad sample not kept as they were, or NaN written"
+grep -qi nan "$tmp/u.csv" && bad "NaN in the kept rows" || ok
+
+# Across a singularity: find a regular pose with the other sign of det J_d
+# (3 actuators) on a line from home, if the model has one there.
+if [ "$nact" -eq 3 ]; then
+  detpy='
+import json, sys
+d = json.load(sys.stdin); J = d["Jd"]
+det = J[0][0]*(J[1][1]*J[2][2]-J[1][2]*J[2][1]) - J[0][1]*(J[1][0]*J[2][2]-J[1][2]*J[2][0]) + J[0][2]*(J[1][0]*J[2][1]-J[1][1]*J[2][0])
+print(("+" if det > 0 else "-") if not d["singular"] else "0")'
+  home=$("$PRRU" ik --q 0,0,0 | python3 -c "$detpy")
+  far=$(for q1 in 0.3 0.4 0.5 0.6; do
+    s=$("$PRRU" ik --q "$q1,-pi/4,0" 2>/dev/null | python3 -c "$detpy" 2>/dev/null)
+    if [ -n "$s" ] && [ "$s" != 0 ] && [ "$s" != "$home" ]; then echo "$q1"; fi
+  done | head -1)
+  if [ -n "$far" ]; then
+    "$PRRU" traj --waypoints "0,0,0;$far,-pi/4,0" --durations 1 --out "$tmp/s.csv" 2>"$tmp/err"
+    st=$?
+    [ $st -eq 1 ] && grep -q "crosses a singularity" "$tmp/err" && ! grep -qi nan "$tmp/s.csv" && ok \
+      || bad "traj across the singularity to q1 = $far: exit $st, $(cat "$tmp/err")"
+    expect 2 "crosses a singularity" -- track --waypoints "0,0,0;$far,-pi/4,0" --durations 1 --out "$tmp/s2.csv"
+    [ -e "$tmp/s2.csv" ] && bad "track wrote a file for a singular reference" || ok
+  else
+    echo "note: no pose of opposite det J_d sign found near q2 = -pi/4; crossing check skipped"
+  fi
+fi
+
+# Bad options: exit 2, nothing written.
+expect 2 "need 2 (one per segment)" -- traj --waypoints "$WP" --durations 1 --out "$tmp/b.csv"
+expect 2 "duration 2" -- traj --waypoints "$WP" --durations 1,-1 --out "$tmp/b.csv"
+expect 2 "waypoint 2" -- traj --waypoints '0,0,0;0.1,x,0' --durations 1 --out "$tmp/b.csv"
+expect 2 "at least 2" -- traj --waypoints '0,0,0' --durations 1 --out "$tmp/b.csv"
+expect 2 "--dt" -- traj --waypoints "$WP" --durations 1,1 --dt 0 --out "$tmp/b.csv"
+expect 2 "--waypoints is required" -- traj --durations 1
+[ -e "$tmp/b.csv" ] && bad "a refused traj wrote its file" || ok
+
+# ---- prru id from q(t) alone ----
+# q = A sin(w t + p) per coordinate, 1 ms rows over 2 s, exact qd, qdd.
+python3 -c "
+import math, sys
+A = (0.06, 0.05, 0.012); W = (4.0, 3.1, 5.3); P = (0.2, 1.0, -0.4)
+with open(sys.argv[1], 'w') as f, open(sys.argv[2], 'w') as g:
+    f.write('t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3\n'); g.write('t,q1,q2,q3\n')
+    for i in range(2001):
+        t = i * 1e-3
+        q = [A[c] * math.sin(W[c] * t + P[c]) for c in range(3)]
+        qd = [A[c] * W[c] * math.cos(W[c] * t + P[c]) for c in range(3)]
+        qdd = [-W[c] ** 2 * q[c] for c in range(3)]
+        f.write(','.join('%.17g' % v for v in [t] + q + qd + qdd) + '\n')
+        g.write(','.join('%.17g' % v for v in [t] + q) + '\n')
+print(max(A[c] * W[c] ** 5 for c in range(3)))
+" "$tmp/exact.csv" "$tmp/qonly.csv" >"$tmp/d5max"
+"$PRRU" id --traj "$tmp/exact.csv" --derivatives --rates --out "$tmp/id_exact.csv" 2>"$tmp/err" && ok || bad "id exact: $(cat "$tmp/err")"
+"$PRRU" id --traj "$tmp/qonly.csv" --derivatives --rates --out "$tmp/id_q.csv" 2>"$tmp/err" && ok || bad "id q(t): $(cat "$tmp/err")"
+grep -q "^# qd, qdd from q(t): least-squares polynomials of degree 4 over 9 rows" "$tmp/id_q.csv" && ok \
+  || bad "id q(t): no comment line on the differentiation"
+python3 -c "$PYCSV
+import re
+he, e = cols(sys.argv[1]); hq, q = cols(sys.argv[2])
+note = [l for l in open(sys.argv[2]) if l.startswith('# qd, qdd')][0]
+tq, tqdd = [float(x) for x in re.search(r'TRUNC qd (\S+) s\^\d+, qdd (\S+) s\^', note).groups()]
+gq, gqdd = [float(x) for x in re.search(r'GAIN qd (\S+) s\^-1, qdd (\S+) s\^-2', note).groups()]
+d5 = float(open(sys.argv[3]).read())
+assert he == hq and len(e) == len(q) == 2001
+ix = {n: i for i, n in enumerate(he)}
+# The stated bound, plus the rounding of q's 17 digits through the noise gain.
+bq, bqdd = tq * d5 + gq * 1e-16, tqdd * d5 + gqdd * 1e-16
+wq = max(abs(a[ix['qd%d' % c]] - b[ix['qd%d' % c]]) for a, b in zip(e, q) for c in (1, 2, 3))
+wqdd = max(abs(a[ix['qdd%d' % c]] - b[ix['qdd%d' % c]]) for a, b in zip(e, q) for c in (1, 2, 3))
+assert wq <= bq and wqdd <= bqdd, ('beyond the stated bound', wq, bq, wqdd, bqdd)
+assert wqdd >= 0.01 * bqdd, ('stated bound loose by 100x', wqdd, bqdd)
+fd = ['fd%d' % i for i in range(1, 20) if 'fd%d' % i in ix]
+sc = max(abs(a[ix[n]]) for a in e for n in fd)
+wf = max(abs(a[ix[n]] - b[ix[n]]) for a, b in zip(e, q) for n in fd)
+print('id from q(t): qd %.3g (bound %.3g), qdd %.3g (bound %.3g), fd %.3g N of %.3g N' % (wq, bq, wqdd, bqdd, wf, sc))
+assert wf <= 1e-4 * sc, ('forces', wf, sc)
+assert all(math.isfinite(v) for row in q for v in row)
+" "$tmp/id_exact.csv" "$tmp/id_q.csv" "$tmp/d5max" && ok || bad "id from q(t) outside its stated bound"
+# Powers are fd dd; dd = J_d qd against prru ik at one row.
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1]); n = int(sys.argv[2]); ix = {c: i for i, c in enumerate(h)}
+for row in r:
+    for i in range(1, n + 1):
+        assert row[ix['pow%d' % i]] == row[ix['fd%d' % i]] * row[ix['dd%d' % i]]
+" "$tmp/id_exact.csv" "$nact" && ok || bad "id: power is not fd dd"
+# Reactions at one row against prru eval with the same q, qd and forces.
+"$PRRU" id --traj "$tmp/exact.csv" --reactions --out "$tmp/id_r.csv" 2>"$tmp/err" && ok || bad "id --reactions: $(cat "$tmp/err")"
+row=$(grep -v '^#' "$tmp/exact.csv" | sed -n '778p')
+fdrow=$(grep -v '^#' "$tmp/id_r.csv" | sed -n '778p' | cut -d, -f2-$((nact + 1)))
+"$PRRU" eval --q "$(echo "$row" | cut -d, -f2-4)" --qd "$(echo "$row" | cut -d, -f5-7)" --fd "$fdrow" >"$tmp/ev.json"
+python3 -c "$PYCSV
+import json
+h, r = cols(sys.argv[1]); ev = json.load(open(sys.argv[2])); row = r[776]
+lam = row[1 + int(sys.argv[3]):]
+assert len(lam) == len(ev['lambda'])
+sc = max(abs(x) for x in ev['lambda'])
+assert max(abs(a - b) for a, b in zip(lam, ev['lambda'])) <= 1e-12 * sc
+" "$tmp/id_r.csv" "$tmp/ev.json" "$nact" && ok || bad "id --reactions disagree with prru eval"
+# Refusals.
+cut -d, -f1-5 "$tmp/exact.csv" >"$tmp/partial.csv"
+expect 2 "has 1 of the 6 columns" -- id --traj "$tmp/partial.csv"
+expect 2 "--window applies when" -- id --traj "$tmp/exact.csv" --window 3
+expect 2 "--degree '9'" -- id --traj "$tmp/qonly.csv" --degree 9
+expect 2 "--degree 6 needs --window 3" -- id --traj "$tmp/qonly.csv" --degree 6 --window 2
+head -6 "$tmp/qonly.csv" >"$tmp/short.csv"
+expect 2 "needs at least 9" -- id --traj "$tmp/short.csv"
+{ head -3 "$tmp/qonly.csv"; sed -n 3p "$tmp/qonly.csv"; sed -n '4,40p' "$tmp/qonly.csv"; } >"$tmp/rep.csv"
+expect 2 "row 3: time" -- id --traj "$tmp/rep.csv"
+"$PRRU" id --traj "$tmp/exact.csv" --differentiate --out "$tmp/id_d.csv" 2>/dev/null \
+  && grep -q "^# qd, qdd from q(t)" "$tmp/id_d.csv" && ok || bad "id --differentiate ignored"
+
+# ---- prru track ----
+trk() { "$PRRU" track "$@" --out "$tmp/tr.csv" --summary "$tmp/sum.json" 2>"$tmp/err"; }
+trk --waypoints "$WP" --durations 1,1 && ok || bad "track: $(cat "$tmp/err")"
+jcheck "$tmp/sum.json" "d['model'] == model and d['samples'] == 2001 and max(d['max_error']) <= 1e-9 and d['status'] == 'complete' and d['any_saturated_fraction'] == 0" \
+  "track, exact model: not on the reference to 1e-9"
+head -1 "$tmp/tr.csv" | grep -qxF "$csv_comment" && ok || bad "track: no model line"
+# The CSV reference (prru traj's rows, quintic interpolation) is the same reference.
+"$PRRU" track --ref "$tmp/t.csv" --mismatch mass=1.1 --out "$tmp/tr_ref.csv" --summary "$tmp/s_ref.json" 2>"$tmp/err" || bad "track --ref: $(cat "$tmp/err")"
+"$PRRU" track --waypoints "$WP" --durations 1,1 --mismatch mass=1.1 --out "$tmp/tr_wp.csv" --summary "$tmp/s_wp.json" 2>"$tmp/err" || bad "track mismatch: $(cat "$tmp/err")"
+python3 -c "
+import json, sys
+a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))
+assert max(abs(x - y) for x, y in zip(a['max_error'], b['max_error'])) <= 1e-12, (a['max_error'], b['max_error'])
+" "$tmp/s_ref.json" "$tmp/s_wp.json" && ok || bad "track --ref of traj's CSV differs from --waypoints"
+# Mismatch: the error falls with the bandwidth (about as 1/W^2).
+for w in 10 40; do
+  "$PRRU" track --waypoints "$WP" --durations 1,1 --mismatch mass=1.1 --bandwidth $w --out "$tmp/m$w.csv" \
+    --summary "$tmp/m$w.json" 2>"$tmp/err" || bad "track --bandwidth $w: $(cat "$tmp/err")"
+done
+python3 -c "
+import json, sys
+a = max(json.load(open(sys.argv[1]))['max_error']); b = max(json.load(open(sys.argv[2]))['max_error'])
+print('track mass x 1.1: max error %.3g (W = 10), %.3g (W = 40)' % (a, b))
+assert 1e-6 < a < 0.05 and a / b > 9, (a, b)
+" "$tmp/m10.json" "$tmp/m40.json" && ok || bad "track: mismatch error does not fall with the gains"
+# Saturation: a limit below the feed-forward peak.
+# (At 0.9 of it the platform sinks under gravity until the controller
+# meets a singularity: a run that stops, rows kept.)
+lim=$(json "$tmp/s_wp.json" "0.97 * d['feedforward_peak']")
+trk --waypoints "$WP" --durations 1,1 --fmax "$lim" || bad "track --fmax: $(cat "$tmp/err")"
+jcheck "$tmp/sum.json" "d['any_saturated_fraction'] > 0 and max(d['max_fd']) <= $lim" "track: saturation not reported"
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1]); n = int(sys.argv[2]); lim = float(sys.argv[3]); ix = {c: i for i, c in enumerate(h)}
+for row in r:
+    for i in range(1, n + 1):
+        sat = abs(row[ix['fdc%d' % i]]) > lim
+        assert row[ix['sat%d' % i]] == sat and abs(row[ix['fd%d' % i]]) <= lim
+        assert row[ix['fd%d' % i]] == (row[ix['fdc%d' % i]] if not sat else (lim if row[ix['fdc%d' % i]] > 0 else -lim))
+" "$tmp/tr.csv" "$nact" "$lim" && ok || bad "track: saturation flags or clipping wrong in the CSV"
+# Seeded noise with a sampled controller: same seed, same bytes.
+for s in 1 1b 2; do
+  "$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --noise 1e-5,1e-3 --seed "${s%b}" \
+    --out "$tmp/n$s.csv" --summary "$tmp/n$s.json" 2>"$tmp/err" || bad "track --noise: $(cat "$tmp/err")"
+done
+cmp -s "$tmp/n1.csv" "$tmp/n1b.csv" && ! cmp -s "$tmp/n1.csv" "$tmp/n2.csv" && ok || bad "track noise not reproducible per seed"
+jcheck "$tmp/n1.json" "d['control'] == 'zero-order hold' and d['samples'] == 1001 and 1e-7 < max(d['max_error']) < 1e-3" \
+  "track --period: wrong sampling or error"
+# Bad input: exit 2, nothing written.
+rm -f "$tmp/x.csv"
+expect 2 "outside the workspace" -- track --waypoints '0,0,0;1.5,0,0' --durations 1 --out "$tmp/x.csv"
+dmax=$(grep -v '^#' "$tmp/t.csv" | sed -n 2p | cut -d, -f11)
+expect 2 "outside its --stroke" -- track --waypoints "$WP" --durations 1,1 --stroke -10,"$dmax" --out "$tmp/x.csv"
+expect 2 "needs --period > 0" -- track --waypoints "$WP" --durations 1,1 --noise 1e-5,0 --out "$tmp/x.csv"
+expect 2 "unknown key 'masses'" -- track --waypoints "$WP" --durations 1,1 --mismatch masses=2 --out "$tmp/x.csv"
+expect 2 "is not a number > 0" -- track --waypoints "$WP" --durations 1,1 --mismatch mass=0 --out "$tmp/x.csv"
+expect 2 "--fmax: limit" -- track --waypoints "$WP" --durations 1,1 --fmax 0 --out "$tmp/x.csv"
+expect 2 "is empty" -- track --waypoints "$WP" --durations 1,1 --stroke 1,0 --out "$tmp/x.csv"
+expect 2 "--plot needs --out" -- track --waypoints "$WP" --durations 1,1 --plot "$tmp/x.png"
+expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations 1,1
+expect 2 "missing column 'qd1'" -- track --ref "$tmp/qonly.csv" --out "$tmp/x.csv"
+expect 2 "--bandwidth excludes" -- track --waypoints "$WP" --durations 1,1 --bandwidth 5 --kp 1,1,1
+[ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# The figure, where gnuplot is installed.
+if command -v gnuplot >/dev/null; then
+  "$PRRU" track --waypoints "$WP" --durations 1,1 --fmax "$lim" --out "$tmp/p.csv" --plot "$tmp/p.png" \
+    >/dev/null 2>"$tmp/err" && [ "$(head -c 4 "$tmp/p.png" | tail -c 3)" = PNG ] && ok \
+    || bad "track --plot: $(cat "$tmp/err")"
+fi
+
+echo "test_cli_traj: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
