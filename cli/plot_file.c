@@ -61,6 +61,9 @@ static int read_head(FILE *f, csv_comments *c, char **header, long *line_no)
     if (strncmp(*header, sim_header, sizeof sim_header - 1) == 0) return CSV_SIMULATION;
     return CSV_UNKNOWN;
   }
+  /* No header line: getline's buffer holds nothing meaningful. */
+  free(*header);
+  *header = NULL;
   return CSV_UNKNOWN;
 }
 
@@ -283,10 +286,12 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
   long line_no = 0;
   int kind = read_head(f, &com, &header, &line_no);
   if (kind == CSV_UNKNOWN) {
-    prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate (header t,q1,q2,q3,qd1,qd2,qd3,d1,...) "
-                   "or prru map (header %s)%s%.60s%s", in, line_no, map_header,
-                   header && *header ? ": the header is '" : "", header ? header : "",
-                   header && *header ? "'" : ": no header line");
+    if (header)
+      prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate (header t,q1,q2,q3,qd1,qd2,qd3,d1,...) "
+                     "or prru map (header %s): the header is '%.60s'", in, line_no, map_header, header);
+    else
+      prru_cli_error(cmd, "%s: no header line (%s): not a CSV of prru simulate or prru map", in,
+                     line_no ? "only comments" : "empty");
     free(header);
     fclose(f);
     return 2;

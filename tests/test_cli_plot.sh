@@ -71,7 +71,8 @@ bad_file() { # NAME CONTENT NEEDLE
   expect 2 "$3" -- plot "$tmp/$1.csv"
   [ ! -e "$tmp/$1.png" ] && ok || bad "plot of the bad $1.csv left $1.png"
 }
-bad_file empty "" "no header line"
+bad_file empty "" "empty.csv: no header line (empty)"
+bad_file comments "# prru\n# more\n" "comments.csv: no header line (only comments)"
 bad_file other "# x\na,b\n1,2\n" "$tmp/other.csv:2: not a CSV of prru simulate"
 bad_file maprow "q1,q2,q3,w_R,status\n0,0,0,1.5,ok\n0,1,0,x,ok\n" "$tmp/maprow.csv:3: expected q1,q2,q3,w_R,status"
 bad_file mapnan "q1,q2,q3,w_R,status\n0,0,0,NaN,ok\n" "$tmp/mapnan.csv:2:"
