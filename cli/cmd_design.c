@@ -1,4 +1,4 @@
-/* prru optimize, prru sensitivity (with shards) and prru merge:
+/* prru optimize, prru sensitivity, prru merge and the shards of prru map:
  * design optimisation of w_R over a workspace rectangle with the
  * runtime-parameter kernels (runtime/include/prru_design.h). */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, isatty, open_memstream */
@@ -163,7 +163,48 @@ static void map_row(prru_cli_out *o, double q1, double q2, double q3, double w, 
   if (st == PRRU_OK)
     prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, q3, w);
   else
-    prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, q3, prru_dme_status_name(st));
+    prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, q3,
+                        prru_cli_map_status_name(st == PRRU_DESIGN_OTHER_MODE ? PRRU_CLI_MAP_OTHER_MODE : st));
+}
+
+/* ---- Map shards ---- */
+
+int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads, int k, int n,
+                       const char *out)
+{
+  long r0, r1;
+  shard_range(g->n1, k, n, &r0, &r1);
+  prru_cli_catch_signals();
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "map", out)) return 1;
+  double *w = NULL;
+  unsigned char *st = NULL;
+  /* More shards than rows leaves some empty: they still write their
+   * header, so that every task of a job array succeeds alike. */
+  int rc = r0 < r1 ? prru_cli_map_run_rows("map", m, g, (int)r0, (int)r1, nthreads, NULL, &w, &st) : PRRU_OK;
+  if (rc == PRRU_OK) {
+    prru_cli_out_comment(&o);
+    prru_cli_out_printf(&o, "# shard %d/%d map q1=%.17g:%.17g:%d q2=%.17g:%.17g:%d q3=%.17g rcond_min=%.17g\n",
+                        k, n, g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3, m->jd_rcond_min);
+    prru_cli_out_line(&o);
+    prru_cli_out_printf(&o, "q1,q2,q3,w_R,status\n");
+    prru_cli_out_line(&o);
+    rc = prru_cli_map_write_rows(&o, g, w, st, (int)r0, (int)r1, prru_cli_signal_count);
+  }
+  free(w);
+  free(st);
+  /* A shard is merged whole or not at all: an interrupted one is dropped. */
+  if (prru_cli_out_close(&o, rc == PRRU_OK && !o.err)) return 1;
+  if (rc == PRRU_EINTERRUPTED) {
+    prru_cli_error("map", "interrupted (%s): %s is not changed", prru_cli_signal_name(), out);
+    return prru_cli_exit_interrupted();
+  }
+  if (rc != PRRU_OK) return 1;
+  /* The summary needs every shard: 'prru merge' prints it. */
+  FILE *f = strcmp(out, "-") == 0 ? stderr : stdout;
+  fprintf(f, "model: %s\nshard %d/%d: q1 rows %ld to %ld of %d written to %s (no summary: see prru merge)\n",
+          prru_cli_model_id(), k, n, r0 + 1, r1, g->n1, out);
+  return 0;
 }
 
 /* ---- Sensitivity rows (shared by sensitivity and merge) ---- */
@@ -440,7 +481,8 @@ int prru_cmd_sensitivity(int argc, char **argv)
 
 static const char merge_help[] =
     "usage: prru merge --in SHARD1,SHARD2,... --out FILE [--plot FILE.png]\n"
-    "Joins the shard files of one 'prru sensitivity --shard K/N' sweep (all N of them, in any order; file names without\n"
+    "Joins the shard files of one 'prru map --shard K/N' or 'prru sensitivity\n"
+    "--shard K/N' sweep (all N of them, in any order; file names without\n"
     "commas) into FILE, byte for byte what one run without --shard writes, and\n"
     "prints what that run prints. Every shard must come from this model and\n"
     "program version with the same settings (checked), each K from 1 to N\n"
@@ -505,6 +547,76 @@ static int read_shard(const char *path, const char *model_line, shard_file *s)
   s->header = l3;
   s->rows = l4;
   return 0;
+}
+
+/* Map rows back to w_R and statuses (exactly: they were written with 17
+ * digits); 0 or 2. */
+static int parse_map_rows(const char *path, char *rows, const prru_map_grid *g, long first, long count,
+                          double *w, unsigned char *st)
+{
+  long k = 0;
+  for (char *line = rows, *next; *line; line = next) {
+    next = next_line(line);
+    if (!next) next = line + strlen(line);
+    double q[3], v;
+    char stat[32];
+    if (k >= count || sscanf(line, "%lf,%lf,%lf,%lf,%31s", &q[0], &q[1], &q[2], &v, stat) != 5) {
+      prru_cli_error("merge", "%s: row %ld is not a map row of this shard", path, k + 1);
+      return 2;
+    }
+    long idx = first + k;
+    int i = (int)(idx / g->n2), j = (int)(idx % g->n2), s = -1;
+    const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_CLI_MAP_OTHER_MODE};
+    for (int c = 0; c < 4; c++)
+      if (strcmp(stat, prru_cli_map_status_name(codes[c])) == 0) s = codes[c];
+    if (s < 0 || q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
+        q[1] != prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j) || q[2] != g->q3) {
+      prru_cli_error("merge", "%s: row %ld does not belong to this grid", path, k + 1);
+      return 2;
+    }
+    w[idx] = s == PRRU_OK ? v : NAN;
+    st[idx] = (unsigned char)s;
+    k++;
+  }
+  if (k != count) {
+    prru_cli_error("merge", "%s: %ld rows, the shard has %ld (incomplete file)", path, k, count);
+    return 2;
+  }
+  return 0;
+}
+
+static int merge_map(shard_file *sh, char **paths, int n, const char *out)
+{
+  prru_map_grid g = {0, 0, 0, 0, 0.0, 0, 0};
+  double rcond;
+  if (sscanf(sh[0].kind_line, "map q1=%lf:%lf:%d q2=%lf:%lf:%d q3=%lf rcond_min=%lf", &g.q1_lo, &g.q1_hi,
+             &g.n1, &g.q2_lo, &g.q2_hi, &g.n2, &g.q3, &rcond) != 8 ||
+      prru_map_check(&g) != PRRU_OK || (double)g.n1 * g.n2 > 5e7) {
+    prru_cli_error("merge", "%s: malformed map settings line", paths[0]);
+    return 2;
+  }
+  long npts = (long)g.n1 * g.n2;
+  double *w = malloc((size_t)npts * sizeof *w);
+  unsigned char *st = malloc((size_t)npts);
+  int rc = w && st ? 0 : 1;
+  for (int i = 0; i < n && !rc; i++) {
+    long r0, r1;
+    shard_range(g.n1, sh[i].k, n, &r0, &r1);
+    rc = parse_map_rows(paths[i], sh[i].rows, &g, r0 * g.n2, (r1 - r0) * g.n2, w, st);
+  }
+  prru_cli_map_summary sum;
+  if (!rc && prru_cli_map_summarize(&g, w, st, &sum) != PRRU_OK) rc = 1;
+  prru_cli_out o;
+  if (!rc && prru_cli_out_open(&o, "merge", out)) rc = 1;
+  if (!rc) {
+    int ws = prru_cli_map_write_csv(&o, &g, w, st, g.n1, prru_cli_signal_count);
+    if (prru_cli_out_close(&o, ws == PRRU_OK && !o.err)) rc = 1;
+    else if (ws != PRRU_OK) rc = prru_cli_exit_for(ws);
+  }
+  if (!rc) prru_cli_map_print_summary(strcmp(out, "-") == 0 ? stderr : stdout, &sum, rcond);
+  free(w);
+  free(st);
+  return rc;
 }
 
 static int parse_sens_rows(const char *path, char *rows, sens_row *out, long max, long *count)
@@ -632,7 +744,14 @@ int prru_cmd_merge(int argc, char **argv)
       paths[j - 1] = p;
     }
   if (!rc) {
-    if (strncmp(sh[0].kind_line, "sensitivity ", 12) == 0) {
+    if (strncmp(sh[0].kind_line, "map ", 4) == 0) {
+      if (plot) {
+        prru_cli_error("merge", "--plot: only for sensitivity shards (plot a map with 'prru plot')");
+        rc = 2;
+      } else {
+        rc = merge_map(sh, paths, n, out);
+      }
+    } else if (strncmp(sh[0].kind_line, "sensitivity ", 12) == 0) {
       rc = merge_sensitivity(sh, paths, n, out, plot);
     } else {
       prru_cli_error("merge", "%s: unknown kind of shard", paths[0]);
@@ -671,13 +790,13 @@ static const char opt_help[] =
     "B a body (P L1 U1 S1 ...) or L, U, S (that body of every limb); armature,\n"
     "armature_i. Tied parameters move by the same amount. --set: the start design\n"
     "is the model's numbers with these changes.\n"
-    "Optimiser: GSL's Nelder-Mead simplex (nmsimplex2) on a sine transform of\n"
-    "each variable onto its bounds, restarted from the best point while that\n"
-    "helps, at most N iterations in all (default 600); deterministic: the same\n"
-    "command gives the same bits. Progress on stderr (--progress, or a terminal).\n"
+    "Optimiser: the Nelder-Mead simplex method on a sine transform of each\n"
+    "variable onto its bounds, restarted from the best point while that helps,\n"
+    "at most N iterations in all (default 600); deterministic: the same command\n"
+    "gives the same bits. Progress on stderr (--progress, or a terminal).\n"
     "Writes MODEL.json, the optimised design as a format-2 model file (name NAME,\n"
-    "default the model's name + _opt) for 'python3 gen/prru_gen.py' or a build\n"
-    "with -DPRRU_MODEL=MODEL.json, and DIR/ with report.txt (before and after:\n"
+    "default the model's name + _opt), ready to build the tool and the dynamics\n"
+    "code from ('make test MODEL=MODEL.json'), and DIR/ with report.txt (before and after:\n"
     "global index, mean ln w_R, max w_R, singular fraction, slider range; every\n"
     "variable before, after and its bounds; iterations), before_map.csv and\n"
     "after_map.csv (as 'prru map' writes them) and optimize_maps.png (both w_R\n"

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "design_cli.h"
 #include "mapgrid.h"
 #include "progress.h"
 #include "prru.h"
@@ -12,6 +13,7 @@
 static const char map_help[] =
     "usage: prru map --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"
     "                --out FILE.csv|- [--rcond-min R] [--threads N] [--progress]\n"
+    "                [--shard K/N]\n"
     "w_R (see 'prru dme --help') at every grid point q1 = START..STOP (COUNT\n"
     "equally spaced values, rad, COUNT >= 2, START < STOP; START and STOP may be\n"
     "multiples of pi: -pi/6:pi/6:201), q2 likewise, q3 = Z (m, default 0).\n"
@@ -38,17 +40,24 @@ static const char map_help[] =
     "SIGTERM or SIGHUP (exit 130, 143, 129) stop the computation; the complete\n"
     "q1 rows computed so far are then written (a second signal stops that too,\n"
     "at a row boundary) and no summary is printed. A write error exits 1 with\n"
-    "the reason and leaves FILE unchanged.\n";
+    "the reason and leaves FILE unchanged.\n"
+    "--shard K/N: only the K-th of N contiguous blocks of q1 rows (a cluster job\n"
+    "array runs one block per task), with a second comment line naming the\n"
+    "shard and the settings and no summary; 'prru merge' joins the N files into\n"
+    "exactly the file one run writes and prints its summary. An interrupted\n"
+    "shard keeps nothing.\n";
 
 int prru_cmd_map(int argc, char **argv)
 {
   const char *q1s = NULL, *q2s = NULL, *q3s = NULL, *out = NULL, *rcs = NULL, *ths = NULL;
+  const char *shs = NULL;
   int help = 0, progress = 0;
   prru_cli_option opts[] = {{"q1", 1, &q1s, NULL},        {"q2", 1, &q2s, NULL},
                             {"q3", 1, &q3s, NULL},        {"out", 1, &out, NULL},
                             {"rcond-min", 1, &rcs, NULL}, {"threads", 1, &ths, NULL},
-                            {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
-  if (prru_cli_parse("map", argc, argv, opts, 8)) return 2;
+                            {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help},
+                            {"shard", 1, &shs, NULL}};
+  if (prru_cli_parse("map", argc, argv, opts, 9)) return 2;
   if (help) {
     printf(map_help, PRRU_NACT > 3 ? " (not tested with more actuators than\ncoordinates: J_d is not square)" : "",
            PRRU_NACT > 3 ? "+" : "-1", PRRU_CLI_MAP_RCOND_MIN, 1.0 / PRRU_CLI_MAP_RCOND_MIN);
@@ -81,6 +90,11 @@ int prru_cmd_map(int argc, char **argv)
   prru_model_default(&m);
   m.jd_rcond_min = PRRU_CLI_MAP_RCOND_MIN;
   if (prru_cli_parse_rcond("map", rcs, &m)) return 2;
+  if (shs) {
+    int k, n;
+    if (prru_cli_parse_shard("map", shs, &k, &n)) return 2;
+    return prru_cli_map_shard(&m, &g, nthreads, k, n, out);
+  }
   /* With the CSV on stdout the summary goes to stderr. */
   FILE *summary = strcmp(out, "-") == 0 ? stderr : stdout;
   long npts = (long)g.n1 * g.n2;

@@ -80,20 +80,14 @@ int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st)
   return (int)(k / g->n2);
 }
 
-/* The map's CSV (comment, header, the first nrows q1 rows) into o;
- * PRRU_OK, PRRU_EIO (o->err) or PRRU_EINTERRUPTED when a signal arrives
- * (one more than the signal_count it started with) before the last row. */
-int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double *w,
-                         const unsigned char *st, int nrows, int signal_count)
+int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const double *w,
+                            const unsigned char *st, int r0, int r1, int signal_count)
 {
-  prru_cli_out_comment(o);
-  prru_cli_out_printf(o, "q1,q2,q3,w_R,status\n");
-  prru_cli_out_line(o);
-  for (int i = 0; i < nrows; i++) {
+  for (int i = r0; i < r1; i++) {
     double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
     for (int j = 0; j < g->n2; j++) {
       if (prru_cli_signal_count != signal_count) return PRRU_EINTERRUPTED;
-      long k = (long)i * g->n2 + j;
+      long k = (long)(i - r0) * g->n2 + j;
       double q2 = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
       if (st[k] == PRRU_OK)
         prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, g->q3, w[k]);
@@ -103,6 +97,18 @@ int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double
     }
   }
   return prru_cli_out_flush(o) ? PRRU_EIO : PRRU_OK;
+}
+
+/* The map's CSV (comment, header, the first nrows q1 rows) into o;
+ * PRRU_OK, PRRU_EIO (o->err) or PRRU_EINTERRUPTED when a signal arrives
+ * (one more than the signal_count it started with) before the last row. */
+int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double *w,
+                         const unsigned char *st, int nrows, int signal_count)
+{
+  prru_cli_out_comment(o);
+  prru_cli_out_printf(o, "q1,q2,q3,w_R,status\n");
+  prru_cli_out_line(o);
+  return prru_cli_map_write_rows(o, g, w, st, 0, nrows, signal_count);
 }
 
 const char *prru_cli_map_status_name(int status)
@@ -139,17 +145,18 @@ static int jd_det_sign(const double q[3])
   return det > 0 ? 1 : det < 0 ? -1 : 0;
 }
 
-/* Marks the ok poses whose det J_d sign is not the home pose's; returns
- * how many, or -1 when the test does not apply. */
-static long mark_other_mode(const prru_map_grid *g, double *w, unsigned char *st)
+/* Marks the ok poses of rows r0 .. r1 - 1 (w[0], st[0]: row r0's first
+ * point) whose det J_d sign is not the home pose's; returns how many, or
+ * -1 when the test does not apply. */
+static long mark_other_mode(const prru_map_grid *g, int r0, int r1, double *w, unsigned char *st)
 {
   const int home = jd_det_sign((const double[3]){0.0, 0.0, g->q3});
   if (home == 0) return -1;
   long n = 0;
-  for (int i = 0; i < g->n1; i++) {
+  for (int i = r0; i < r1; i++) {
     double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3};
     for (int j = 0; j < g->n2; j++) {
-      long k = (long)i * g->n2 + j;
+      long k = (long)(i - r0) * g->n2 + j;
       if (st[k] != PRRU_OK) continue;
       q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
       if (jd_det_sign(q) != home) {
@@ -162,29 +169,28 @@ static long mark_other_mode(const prru_map_grid *g, double *w, unsigned char *st
   return n;
 }
 
-/* The summary with the other assembly mode counted as not ok. */
-static int summarize(const prru_map_grid *g, const double *w, const unsigned char *st, long n_other,
-                     prru_cli_map_summary *sum)
+int prru_cli_map_summarize(const prru_map_grid *g, const double *w, const unsigned char *st,
+                           prru_cli_map_summary *sum)
 {
   size_t n = (size_t)g->n1 * (size_t)g->n2;
   unsigned char *tmp = malloc(n);
   if (!tmp) return PRRU_ENOMEM;
-  for (size_t k = 0; k < n; k++) tmp[k] = st[k] == PRRU_CLI_MAP_OTHER_MODE ? PRRU_ESINGULAR : st[k];
+  long n_other = 0;
+  for (size_t k = 0; k < n; k++) {
+    n_other += st[k] == PRRU_CLI_MAP_OTHER_MODE;
+    tmp[k] = st[k] == PRRU_CLI_MAP_OTHER_MODE ? PRRU_ESINGULAR : st[k];
+  }
   prru_map_summarize(g, w, tmp, &sum->s);
   free(tmp);
-  sum->n_other_mode = n_other > 0 ? n_other : 0;
-  sum->modes_checked = n_other >= 0;
+  sum->n_other_mode = n_other;
+  sum->modes_checked = jd_det_sign((const double[3]){0.0, 0.0, g->q3}) != 0;
   return PRRU_OK;
 }
 
-/* Allocates and evaluates a map (statuses PRRU_CLI_MAP_NOT_DONE where it did not
- * get to): PRRU_OK, PRRU_EINTERRUPTED (a signal: the rows done so far are
- * in w and st) or another status after a message. */
-int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
-                   prru_cli_progress *progress, double **w, unsigned char **st,
-                   prru_cli_map_summary *sum)
+int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
+                          int nthreads, prru_cli_progress *progress, double **w, unsigned char **st)
 {
-  size_t n = (size_t)g->n1 * (size_t)g->n2;
+  size_t n = (size_t)(r1 - r0) * (size_t)g->n2;
   *w = malloc(n * sizeof **w);
   *st = malloc(n);
   if (!*w || !*st) {
@@ -200,11 +206,8 @@ int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *
     o.ctx = progress;
   }
   o.interrupt = &prru_cli_interrupted;
-  int rc = prru_map_eval(m, g, &o, *w, *st, NULL);
-  if (rc == PRRU_OK || rc == PRRU_EINTERRUPTED) {
-    long n_other = mark_other_mode(g, *w, *st);
-    if (rc == PRRU_OK) rc = summarize(g, *w, *st, n_other, sum);
-  }
+  int rc = prru_map_eval_rows(m, g, r0, r1, &o, *w, *st);
+  if (rc == PRRU_OK || rc == PRRU_EINTERRUPTED) mark_other_mode(g, r0, r1, *w, *st);
   if (rc != PRRU_OK) {
     if (progress) prru_cli_progress_end(progress);
     if (rc != PRRU_EINTERRUPTED) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
@@ -212,3 +215,17 @@ int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *
   return rc;
 }
 
+/* Allocates and evaluates a map (statuses PRRU_CLI_MAP_NOT_DONE where it did not
+ * get to): PRRU_OK, PRRU_EINTERRUPTED (a signal: the rows done so far are
+ * in w and st) or another status after a message. */
+int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
+                   prru_cli_progress *progress, double **w, unsigned char **st,
+                   prru_cli_map_summary *sum)
+{
+  int rc = prru_cli_map_run_rows(cmd, m, g, 0, g->n1, nthreads, progress, w, st);
+  if (rc == PRRU_OK) {
+    rc = prru_cli_map_summarize(g, *w, *st, sum);
+    if (rc != PRRU_OK) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
+  }
+  return rc;
+}

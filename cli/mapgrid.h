@@ -60,6 +60,18 @@ int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m);
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
                      prru_cli_progress *progress, double **w, unsigned char **st,
                      prru_cli_map_summary *sum);
+/* Only the q1 rows r0 .. r1 - 1 (a shard: `prru map --shard K/N`): *w and
+ * *st hold (r1 - r0) n2 points from row r0's first, the values
+ * prru_cli_map_run gives them (the other assembly mode marked); no
+ * summary. Statuses as prru_cli_map_run. */
+int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
+                          int nthreads, prru_cli_progress *progress, double **w, unsigned char **st);
+/* The summary of a whole grid's w and statuses (PRRU_CLI_MAP_OTHER_MODE
+ * counted as singular and on its own): what prru_cli_map_run reports;
+ * `prru merge` computes it from the joined shards. PRRU_OK or
+ * PRRU_ENOMEM. */
+int prru_cli_map_summarize(const prru_map_grid *g, const double *w, const unsigned char *st,
+                           prru_cli_map_summary *sum);
 /* The number of complete q1 rows of an interrupted map (prru_map_eval
  * hands rows out in order and finishes every row it started). */
 int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
@@ -69,6 +81,10 @@ int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
  * from signal_count) before the last row. */
 int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double *w,
                            const unsigned char *st, int nrows, int signal_count);
+/* The data rows r0 .. r1 - 1 (w[0], st[0]: row r0's first point) into o,
+ * as prru_cli_map_write_csv writes them. */
+int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const double *w,
+                            const unsigned char *st, int r0, int r1, int signal_count);
 /* The summary `prru map` prints: model, point counts, global index,
  * singular fraction, mean ln w_R, range (key: value lines). */
 void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *s, double rcond_min);

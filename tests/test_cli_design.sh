@@ -16,6 +16,12 @@ nothing_written() {
   if [ -z "$(ls -A "$1")" ]; then ok; else bad "$2: left $(ls -A "$1" | tr '\n' ' ')"; fi
 }
 
+# Help speaks of the robot and the numbers, not of the code inside.
+for c in optimize sensitivity merge; do "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"; done
+{ grep -n -i -E "gsl|odeiv|hybridsj|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" "$tmp"/help_*.txt
+  grep -n -E "PRRU_|DBL_" "$tmp"/help_*.txt; } >"$tmp/jargon.txt"
+[ -s "$tmp/jargon.txt" ] && bad "help texts with internal names: $(head -c 300 "$tmp/jargon.txt")" || ok
+
 # ---- optimize: a short run ----
 opt() { "$PRRU" optimize --vars l2,b12 --range 5 --q1 "$Q1" --q2 "$Q2" --max-iter 40 "$@"; }
 mkdir "$tmp/o1" "$tmp/o2"
@@ -143,6 +149,31 @@ expect 2 "cannot open" -- merge --in "$tmp/s/nosuch.csv" --out "$tmp/s/x.csv"
 sed '1s/model /model other/' "$tmp/s/p1.csv" >"$tmp/s/other.csv"
 expect 2 "not a shard of this model" -- merge --in "$tmp/s/other.csv,$tmp/s/p2.csv,$tmp/s/p3.csv,$tmp/s/p4.csv,$tmp/s/p5.csv" --out "$tmp/s/x.csv"
 [ -e "$tmp/s/x.csv" ] && bad "a refused merge wrote its file" || ok
+
+# ---- map shards: merged, exactly one run (a rectangle with every status) ----
+mkdir "$tmp/m"
+M=(--q1 -1.2:1.2:23 --q2 -1.3:0.9:17)
+"$PRRU" map "${M[@]}" --out "$tmp/m/one.csv" >"$tmp/m/one.out" || bad "map failed"
+for n in 1 4 23 30; do
+  list=""
+  for ((k = n; k >= 1; k--)); do
+    "$PRRU" map "${M[@]}" --shard $k/$n --threads 1 --out "$tmp/m/s$k.csv" >/dev/null || bad "map shard $k/$n failed"
+    list="$list${list:+,}$tmp/m/s$k.csv"
+  done
+  "$PRRU" merge --in "$list" --out "$tmp/m/merged.csv" >"$tmp/m/merged.out" || bad "map merge of $n failed"
+  cmp -s "$tmp/m/one.csv" "$tmp/m/merged.csv" && ok || bad "map: $n shards merged differ from one run"
+  cmp -s "$tmp/m/one.out" "$tmp/m/merged.out" && ok || bad "map: merge of $n prints differently from one run"
+  rm -f "$tmp/m"/s*.csv
+done
+expect 2 "--shard '3/2'" -- map "${M[@]}" --shard 3/2 --out "$tmp/m/x.csv"
+"$PRRU" map "${M[@]}" --shard 1/2 --out "$tmp/m/a.csv" >/dev/null
+"$PRRU" map "${M[@]}" --shard 2/2 --rcond-min 1e-3 --out "$tmp/m/b.csv" >/dev/null
+expect 2 "another sweep or settings" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+"$PRRU" map "${M[@]}" --shard 2/2 --out "$tmp/m/b.csv" >/dev/null
+expect 2 "only for sensitivity" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv" --plot "$tmp/m/x.png"
+sed -E '5s/,[a-z_]+$/,bogus/' "$tmp/m/a.csv" >"$tmp/m/c.csv"
+expect 2 "does not belong to this grid" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+[ -e "$tmp/m/x.csv" ] && bad "a refused map merge wrote its file" || ok
 
 echo "test_cli_design: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

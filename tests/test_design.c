@@ -60,7 +60,7 @@ static void objective_equals_map(void)
     int i = (int)(k / fig7.n2), j = (int)(k % fig7.n2);
     if (st[k] == PRRU_OK && det_sign_at(prru_map_axis(fig7.q1_lo, fig7.q1_hi, fig7.n1, i),
                                         prru_map_axis(fig7.q2_lo, fig7.q2_hi, fig7.n2, j), fig7.q3) != home_sign) {
-      st[k] = PRRU_ESINGULAR;
+      st[k] = PRRU_DESIGN_OTHER_MODE;
       w[k] = NAN;
       n_other++;
     }

@@ -120,11 +120,15 @@ void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g
 /* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
 int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
 
+/* The status of a regular grid point in the other assembly mode;
+ * prru_map_summarize counts it as singular. */
+#define PRRU_DESIGN_OTHER_MODE 0xFE
+
 /* Per-grid-point workspace, allocated once per problem. */
 typedef struct {
   long n;
   double *w_R;           /* n, NaN where status != PRRU_OK */
-  unsigned char *status; /* n, a prru_status per point */
+  unsigned char *status; /* n, a prru_status per point or PRRU_DESIGN_OTHER_MODE */
 } prru_design_data;
 
 /* PRRU_OK or PRRU_ENOMEM. */

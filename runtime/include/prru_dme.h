@@ -183,6 +183,15 @@ int prru_map_check(const prru_map_grid *g);
 int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
                   double *w_R, unsigned char *status, prru_map_summary *sum);
 
+/* Only the q1 rows row_begin .. row_end - 1 of the grid (a shard of a map
+ * split across processes): w_R[k] and status[k] for k = (i - row_begin) n2
+ * + j, the same values prru_map_eval gives those points. No summary (it
+ * needs the whole grid: prru_map_summarize on the joined rows). PRRU_OK,
+ * PRRU_EINPUT (bad grid, options or rows), PRRU_ENOMEM,
+ * PRRU_EINTERRUPTED. prru_map_eval is this for every row. */
+int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begin, int row_end,
+                       const prru_map_options *o, double *w_R, unsigned char *status);
+
 /* The summary of an already computed map (used by prru_map_eval). */
 void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
                         prru_map_summary *sum);

@@ -392,9 +392,7 @@ static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_N
   return e;
 }
 
-/* point_w's status for a point in the other assembly mode (stored and
- * summarized as PRRU_ESINGULAR). */
-#define OTHER_MODE 0xFE
+#define OTHER_MODE PRRU_DESIGN_OTHER_MODE
 
 /* The sign of det J_d (three actuators; 0 when it is 0 or not finite, and
  * always with more actuators, where J_d has no determinant). */
@@ -485,10 +483,7 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
       long k = (long)i * g->n2 + j;
       q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
       int st = point_w(pr, p, L, home, q, d, &dd->w_R[k], &v);
-      if (st == OTHER_MODE) {
-        ev->n_other_mode++;
-        st = PRRU_ESINGULAR;
-      }
+      if (st == OTHER_MODE) ev->n_other_mode++;
       dd->status[k] = (unsigned char)st;
       viol += v;
       if (st == PRRU_EUNREACHABLE) continue;
@@ -696,7 +691,6 @@ static double objective_unchecked(const prru_design_problem *pr, const prru_para
       long k = (long)i * g->n2 + j;
       qq[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
       int st = point_w(pr, q, L, home, qq, d, &dd->w_R[k], &viol);
-      if (st == OTHER_MODE) st = PRRU_ESINGULAR;
       if (compare && (st == PRRU_OK) != (dd->status[k] == PRRU_OK)) *changed = 1;
       dd->status[k] = (unsigned char)st;
     }

@@ -43,7 +43,8 @@ typedef struct {
   unsigned char *st;
   const prru_map_options *o;
   pthread_mutex_t lock;
-  int next_row, stop;
+  int next_row, row_end, stop; /* rows next_row .. row_end - 1 are left */
+  int row_begin;               /* w[0], st[0] belong to this row's first point */
   long done;
 } map_job;
 
@@ -59,7 +60,7 @@ static int take_row(map_job *j, long finished_points)
   pthread_mutex_lock(&j->lock);
   j->done += finished_points;
   if (j->o->interrupt && *j->o->interrupt) j->stop = 1;
-  int row = (j->stop || j->next_row >= j->g->n1) ? -1 : j->next_row++;
+  int row = (j->stop || j->next_row >= j->row_end) ? -1 : j->next_row++;
   pthread_mutex_unlock(&j->lock);
   return row;
 }
@@ -67,7 +68,7 @@ static int take_row(map_job *j, long finished_points)
 /* The caller's progress report; a non-zero answer stops the map. */
 static void report_progress(map_job *j)
 {
-  const long total = (long)j->g->n1 * j->g->n2;
+  const long total = (long)(j->row_end - j->row_begin) * j->g->n2;
   pthread_mutex_lock(&j->lock);
   long done = j->done;
   pthread_mutex_unlock(&j->lock);
@@ -92,7 +93,7 @@ static void *map_worker_run(void *arg)
     for (int c = 0; c < g->n2; c++) {
       q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c);
       int s = prru_dme_eval(j->m, w->data, q, &dme);
-      long k = (long)row * g->n2 + c;
+      long k = (long)(row - j->row_begin) * g->n2 + c;
       j->w[k] = dme.w_R;
       if (j->st) j->st[k] = (unsigned char)s;
     }
@@ -109,12 +110,14 @@ static void *map_worker_run(void *arg)
   return NULL;
 }
 
-int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
-                  double *w_R, unsigned char *status, prru_map_summary *sum)
+int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begin, int row_end,
+                       const prru_map_options *o, double *w_R, unsigned char *status)
 {
   if (prru_map_check(g) != PRRU_OK || o->nthreads < 1 || o->nthreads > 256) return PRRU_EINPUT;
-  int nt = o->nthreads > g->n1 ? g->n1 : o->nthreads;
-  map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, 0, 0, 0};
+  if (row_begin < 0 || row_end > g->n1 || row_begin >= row_end) return PRRU_EINPUT;
+  const int nrows = row_end - row_begin;
+  int nt = o->nthreads > nrows ? nrows : o->nthreads;
+  map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, row_begin, row_end, 0, row_begin, 0};
   map_worker *workers = calloc((size_t)nt, sizeof *workers);
   pthread_t *tid = calloc((size_t)nt, sizeof *tid);
   int rc = PRRU_OK, started = 0;
@@ -142,6 +145,14 @@ int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_op
   free(tid);
   pthread_mutex_destroy(&job.lock);
   if (rc == PRRU_OK && o->progress) o->progress(job.done, job.done, o->ctx);
+  return rc;
+}
+
+int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
+                  double *w_R, unsigned char *status, prru_map_summary *sum)
+{
+  if (prru_map_check(g) != PRRU_OK) return PRRU_EINPUT;
+  int rc = prru_map_eval_rows(m, g, 0, g->n1, o, w_R, status);
   if (rc == PRRU_OK && sum) {
     if (status) {
       prru_map_summarize(g, w_R, status, sum);
