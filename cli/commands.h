@@ -25,6 +25,8 @@ int prru_cmd_simulate(int argc, char **argv);
 int prru_cmd_ik(int argc, char **argv);
 int prru_cmd_fk(int argc, char **argv);
 int prru_cmd_id(int argc, char **argv);
+int prru_cmd_excite(int argc, char **argv);
+int prru_cmd_identify(int argc, char **argv);
 int prru_cmd_paper(int argc, char **argv);
 int prru_cmd_dme(int argc, char **argv);
 int prru_cmd_map(int argc, char **argv);

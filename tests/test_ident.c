@@ -265,17 +265,32 @@ static void check_identify(const prru_base *b)
   make_data(N, sigma, q, qd, qdd, fd);
   st = prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad);
   TU_TRUE(st == PRRU_OK, "noisy identification runs");
-  double worst = 0, chi = 0;
+  /* Each error alone against its standard error, and all together: the
+   * errors are correlated (strongly, along the regressor's weakest
+   * direction), so the joint statistic is |X (beta^ - beta)|^2 / s^2,
+   * chi-squared with nbase degrees of freedom: mean 1 per parameter,
+   * standard deviation sqrt(2 / nbase). */
+  double worst = 0, chi = 0, dbeta[PRRU_NREG];
   for (int i = 0; i < b->nbase; i++) {
-    const double z = (r->beta[i] - beta[i]) / r->se[i];
-    worst = fmax(worst, fabs(z));
-    chi += z * z;
+    dbeta[i] = r->beta[i] - beta[i];
+    worst = fmax(worst, fabs(dbeta[i] / r->se[i]));
   }
-  chi /= b->nbase;
-  printf("noise sigma %.2f N: estimated %.4f N, worst |error| / se %.2f, mean (error / se)^2 %.3f\n", sigma,
-         r->sigma, worst, chi);
+  A = malloc(sizeof(double) * NA * PRRU_NREG);
+  for (int s = 0; s < N && A; s++) {
+    prru_ident_rows(&model, &data, b, q + 3 * s, qd + 3 * s, qdd + 3 * s, fd + NA * s, A, y);
+    for (int i = 0; i < NA; i++) {
+      double v = 0;
+      for (int j = 0; j < b->nbase; j++) v += A[i * b->nbase + j] * dbeta[j];
+      chi += v * v;
+    }
+  }
+  free(A);
+  chi /= r->sigma * r->sigma * b->nbase;
+  const double sd = sqrt(2.0 / b->nbase);
+  printf("noise sigma %.2f N: estimated %.4f N, worst |error| / se %.2f, |X error|^2 / (s^2 nbase) %.3f "
+         "(expected 1 +- %.2f)\n", sigma, r->sigma, worst, chi, sd);
   tu_check(worst <= 4, "every base parameter within 4 standard errors", worst, 4);
-  tu_check(chi > 0.5 && chi < 1.6, "mean squared normalised error near 1", chi, 1);
+  tu_check(fabs(chi - 1) < 4 * sd, "joint error chi-squared as the noise predicts (4 sd)", chi, 1);
   tu_check(fabs(r->sigma / sigma - 1) < 0.05, "residual sigma = noise sigma (5 %)", r->sigma / sigma, 1);
 
   q[3 * 17] = 2.5; /* q1 far outside the workspace */

@@ -99,6 +99,10 @@ typedef struct {
   int nsamples, nrows, dof;   /* dof = 3 nsamples - nbase */
   double beta[PRRU_NREG];     /* the estimate, nbase values */
   double se[PRRU_NREG];       /* standard errors */
+  /* Resolution: rms(y) / rms(X_i), the value at which parameter i alone
+   * would give forces of the data's RMS size; an estimate within 1e-9 of
+   * it of a bound is at the bound to rounding. */
+  double scale[PRRU_NREG];
   double sigma;               /* residual standard deviation s (N) */
   double rms[PRRU_NACT];      /* residual RMS per row of a sample (N) */
   double cond;                /* 2-norm condition number of the column-scaled X */

@@ -122,6 +122,9 @@ int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_exc
   return st;
 }
 
+#define MERIT_RANK 50.0
+#define MERIT_INFEASIBLE 100.0
+
 typedef struct {
   const prru_model *m;
   const prru_base *b;
@@ -164,8 +167,9 @@ static void pack(excite_ctx *c, const prru_fourier *f, gsl_vector *x)
     }
 }
 
-/* 2-norm condition number of the column-scaled stacked base regressor at
- * the optimisation samples, or a penalty above 1e6 growing with how far
+/* log10 of the 2-norm condition number of the column-scaled stacked base
+ * regressor at the optimisation samples (below 17), MERIT_RANK when it is
+ * rank deficient, or a penalty above MERIT_INFEASIBLE growing with how far
  * the trajectory leaves the feasible set. */
 static double merit(const gsl_vector *x, void *ctx)
 {
@@ -186,16 +190,16 @@ static double merit(const gsl_vector *x, void *ctx)
     for (int r = 0; r < 3; r++)
       for (int j = 0; j < p; j++) gsl_matrix_set(c->W, 3 * (size_t)s + (size_t)r, (size_t)j, Yb[r * p + j]);
   }
-  if (excess > 0) return 1e6 * (1 + excess);
+  if (excess > 0) return MERIT_INFEASIBLE * (1 + excess);
   for (int j = 0; j < p; j++) {
     gsl_vector_view col = gsl_matrix_column(c->W, (size_t)j);
     double nrm = gsl_blas_dnrm2(&col.vector);
-    if (!(nrm > 0)) return 1e6;
+    if (!(nrm > 0)) return MERIT_RANK;
     gsl_vector_scale(&col.vector, 1.0 / nrm);
   }
   gsl_linalg_SV_decomp(c->W, c->V, c->sv, c->work);
   const double smin = gsl_vector_get(c->sv, (size_t)p - 1);
-  return smin > 0 ? fmin(gsl_vector_get(c->sv, 0) / smin, 1e6) : 1e6;
+  return smin > 0 ? fmin(log10(gsl_vector_get(c->sv, 0) / smin), MERIT_RANK) : MERIT_RANK;
 }
 
 static int check_options(const prru_model *m, const prru_base *b, const prru_excite_options *o,
@@ -303,14 +307,15 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
     prru_check_regular(m, c.d, f->centre, NULL);
     c.mode = pose_mode(c.d);
     start_point(&c, x, o->seed);
-    r->cond_start = merit(x, &c);
+    r->cond_start = pow(10, merit(x, &c));
     double best;
     st = minimise(&c, x, &best);
     unpack(&c, x);
-    r->cond = merit(x, &c);
+    const double best_merit = merit(x, &c);
+    r->cond = pow(10, best_merit);
     r->evals = c.evals;
     *f = c.f;
-    if (st == PRRU_OK && r->cond >= 1e6) {
+    if (st == PRRU_OK && best_merit >= MERIT_RANK) {
       snprintf(msg, (size_t)msglen, "no feasible excitation found (every trial left the workspace, "
                "met a singularity or exceeded a force limit); lower the amplitudes or raise the limits");
       st = PRRU_ENOCONV;
@@ -331,7 +336,7 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
       gsl_vector *y = gsl_vector_alloc(nx);
       if (y) {
         pack(&c, f, y);
-        r->cond = merit(y, &c);
+        r->cond = pow(10, merit(y, &c));
         gsl_vector_free(y);
       }
     }

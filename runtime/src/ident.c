@@ -285,8 +285,10 @@ static int fill_rows(const prru_model *m, const prru_base *b, int n, const doubl
   return st;
 }
 
-/* (X^T X)^-1 through a Cholesky factor of the column-scaled normal matrix,
- * and the 2-norm condition number of the column-scaled X (its SVD). */
+/* (X^T X)^-1 and the 2-norm condition number of the column-scaled X, both
+ * from the SVD Xs = U S V^T of X D (D scaling the columns to unit norm):
+ * (X^T X)^-1 = D V S^-2 V^T D. Never the normal equations, whose
+ * condition number is the square of X's (1e15 for a poor excitation). */
 static int unit_covariance(const gsl_matrix *X, gsl_matrix *C, double *cond)
 {
   const size_t p = X->size2;
@@ -304,15 +306,19 @@ static int unit_covariance(const gsl_matrix *X, gsl_matrix *C, double *cond)
       gsl_vector_set(sc, j, nrm);
       gsl_vector_scale(&c.vector, 1.0 / nrm);
     }
-    gsl_blas_dsyrk(CblasLower, CblasTrans, 1.0, Xs, 0.0, C);
-    if (gsl_linalg_cholesky_decomp1(C) != GSL_SUCCESS || gsl_linalg_cholesky_invert(C) != GSL_SUCCESS)
-      st = PRRU_ESINGULAR;
     if (gsl_linalg_SV_decomp(Xs, V, sv, work) != GSL_SUCCESS) st = PRRU_ESINGULAR;
     const double smin = gsl_vector_get(sv, p - 1);
     *cond = smin > 0 ? gsl_vector_get(sv, 0) / smin : INFINITY;
+    if (!(smin > 0)) st = PRRU_ESINGULAR;
     for (size_t i = 0; i < p && st == PRRU_OK; i++)
-      for (size_t j = 0; j < p; j++)
-        gsl_matrix_set(C, i, j, gsl_matrix_get(C, i, j) / (gsl_vector_get(sc, i) * gsl_vector_get(sc, j)));
+      for (size_t j = 0; j < p; j++) {
+        double s = 0;
+        for (size_t k = 0; k < p; k++) {
+          const double sk = gsl_vector_get(sv, k);
+          s += gsl_matrix_get(V, i, k) * gsl_matrix_get(V, j, k) / (sk * sk);
+        }
+        gsl_matrix_set(C, i, j, s / (gsl_vector_get(sc, i) * gsl_vector_get(sc, j)));
+      }
   }
   gsl_vector_free(sc), gsl_matrix_free(Xs), gsl_matrix_free(V), gsl_vector_free(sv), gsl_vector_free(work);
   return st;
@@ -340,6 +346,13 @@ static int solve(const gsl_matrix *X, const gsl_vector *y, int n, const prru_bas
     for (size_t i = 0; i < p; i++) {
       r->beta[i] = gsl_vector_get(c, i);
       r->se[i] = sqrt(s2 * gsl_matrix_get(C, i, i));
+    }
+    gsl_vector_const_view yv = gsl_vector_const_subvector(y, 0, y->size);
+    const double yn = gsl_blas_dnrm2(&yv.vector);
+    for (size_t i = 0; i < p; i++) {
+      gsl_vector_const_view col = gsl_matrix_const_column(X, i);
+      const double xn = gsl_blas_dnrm2(&col.vector);
+      r->scale[i] = xn > 0 ? yn / xn : INFINITY;
     }
     for (int i = 0; i < PRRU_NACT; i++) {
       double s = 0;

@@ -1,0 +1,696 @@
+/* prru excite and prru identify: excitation trajectories and least-squares
+ * identification of the base inertial parameters (prru_ident.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "commands.h"
+#include "prru_ident.h"
+#include "prru_param_kernels.h"
+#include "prru_traj.h"
+
+/* The Coulomb smoothing velocity the regressor uses: --coulomb-velocity,
+ * else the model's, else 1 mm/s. */
+static int coulomb_velocity(const char *cmd, const char *text, double *vs)
+{
+  *vs = prru_mech.coulomb_velocity > 0 ? prru_mech.coulomb_velocity : 1e-3;
+  if (!text) return 0;
+  if (prru_cli_number(cmd, "coulomb-velocity", text, vs)) return 2;
+  if (!(*vs > 0)) {
+    prru_cli_error(cmd, "--coulomb-velocity: %s must be positive (m/s)", text);
+    return 2;
+  }
+  return 0;
+}
+
+static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_base **b)
+{
+  *b = malloc(sizeof **b);
+  int st = *b ? prru_base_compute(m, vs, 0, 1, *b) : PRRU_ENOMEM;
+  if (st != PRRU_OK) prru_cli_error(cmd, "base parameters: %s", prru_strerror(st));
+  return st == PRRU_OK ? 0 : 1;
+}
+
+/* ------------------------------------------------------------ excite --- */
+
+static const char excite_help[] =
+    "usage: prru excite [--out FILE.csv|-] [--period T] [--harmonics L] [--periods N]\n"
+    "                   [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3]\n"
+    "                   [--fd-max F | F1,...] [--rcond-min R] [--evals N] [--samples N]\n"
+    "                   [--seed S] [--coulomb-velocity VS]\n"
+    "An excitation trajectory for identification: each coordinate a Fourier\n"
+    "series q_k(t) = c_k + sum_l (a_kl sin(l w t) + b_kl cos(l w t)), w = 2 pi / T\n"
+    "(default T = 10 s, L = 5 harmonics, centre c = 0), whose coefficients are\n"
+    "chosen (Nelder-Mead, deterministic for a --seed, default 1; --evals\n"
+    "evaluations, default 3000) for the smallest condition number of the base\n"
+    "regressor (columns scaled to unit norm) stacked over --samples points per\n"
+    "period (default 100), subject to: every point reachable, J_d regular\n"
+    "(rcond >= --rcond-min, default 1e-2, prru ik's Jd_rcond) in the centre's\n"
+    "assembly mode, |q_k - c_k| <= A_k (default 0.25 rad, 0.25 rad, 0.1 L with L\n"
+    "the mean upper-link length), and the actuator forces of this model's\n"
+    "inverse dynamics (no platform loads) within --fd-max (N, one value for all\n"
+    "or one per actuator, default 500). The result is then checked at 2000\n"
+    "points per period, and shrunk about the centre until it passes.\n"
+    "Writes the model line, comment lines with the coefficients and the\n"
+    "condition number, then t,q1..q3,qd1..qd3,qdd1..qdd3,%s,%s at --dt (default\n"
+    "0.01 s) over --periods periods (default 1; the last row at N T), to\n"
+    "--out (default stdout): a trajectory for `prru id --traj` and, with\n"
+    "measured forces in the fd columns, data for `prru identify`. A summary goes\n"
+    "to stderr. Exit 2 for bad options or an unreachable or singular centre, 1\n"
+    "when no feasible trajectory is found (nothing written).\n";
+
+typedef struct {
+  const char *out, *period, *harm, *periods, *dt, *centre, *amp, *fdmax, *rcond, *evals, *samples,
+      *seed, *vs;
+  int help;
+} excite_args;
+
+static int parse_count(const char *cmd, const char *name, const char *text, int lo, int hi, int *out)
+{
+  double v;
+  if (prru_cli_number(cmd, name, text, &v)) return 2;
+  if (v != floor(v) || v < lo || v > hi) {
+    prru_cli_error(cmd, "--%s: %s must be a whole number in %d..%d", name, text, lo, hi);
+    return 2;
+  }
+  *out = (int)v;
+  return 0;
+}
+
+static int parse_positive(const char *cmd, const char *name, const char *text, double *out)
+{
+  if (prru_cli_number(cmd, name, text, out)) return 2;
+  if (!(*out > 0)) {
+    prru_cli_error(cmd, "--%s: %s must be positive", name, text);
+    return 2;
+  }
+  return 0;
+}
+
+static int parse_fd_max(const char *text, double fd_max[PRRU_NACT])
+{
+  double one;
+  if (!strchr(text, ',')) {
+    if (parse_positive("excite", "fd-max", text, &one)) return 2;
+    for (int i = 0; i < PRRU_NACT; i++) fd_max[i] = one;
+    return 0;
+  }
+  if (prru_cli_numbers("excite", "fd-max", text, fd_max, PRRU_NACT)) return 2;
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(fd_max[i] > 0)) {
+      prru_cli_error("excite", "--fd-max: the limit of actuator %d must be positive", i + 1);
+      return 2;
+    }
+  return 0;
+}
+
+static int excite_options(const excite_args *a, prru_excite_options *o, prru_fourier *f, int *periods,
+                          double *dt)
+{
+  const char *c = "excite";
+  prru_excite_options_default(o);
+  memset(f, 0, sizeof *f);
+  f->period = 10, f->harmonics = 5, *periods = 1, *dt = 0.01;
+  int seed = 1;
+  if (a->period && parse_positive(c, "period", a->period, &f->period)) return 2;
+  if (a->harm && parse_count(c, "harmonics", a->harm, 1, PRRU_EXCITE_MAX_HARMONICS, &f->harmonics)) return 2;
+  if (a->periods && parse_count(c, "periods", a->periods, 1, 1000, periods)) return 2;
+  if (a->dt && parse_positive(c, "dt", a->dt, dt)) return 2;
+  if (a->centre && prru_cli_numbers(c, "centre", a->centre, f->centre, 3)) return 2;
+  if (a->amp) {
+    if (prru_cli_numbers(c, "amplitude", a->amp, o->amplitude_max, 3)) return 2;
+    for (int k = 0; k < 3; k++)
+      if (!(o->amplitude_max[k] > 0)) {
+        prru_cli_error(c, "--amplitude: the bound of q%d must be positive", k + 1);
+        return 2;
+      }
+  }
+  if (a->fdmax && parse_fd_max(a->fdmax, o->fd_max)) return 2;
+  if (a->rcond && prru_cli_number(c, "rcond-min", a->rcond, &o->rcond_min)) return 2;
+  if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
+    prru_cli_error(c, "--rcond-min: %s must lie between 0 and 1", a->rcond);
+    return 2;
+  }
+  if (a->evals && parse_count(c, "evals", a->evals, 1, 10000000, &o->max_evals)) return 2;
+  if (a->samples && parse_count(c, "samples", a->samples, 1, 100000, &o->samples)) return 2;
+  if (a->seed && parse_count(c, "seed", a->seed, 0, 2000000000, &seed)) return 2;
+  o->seed = (unsigned long)seed;
+  if (o->check_samples < o->samples) o->check_samples = 20 * o->samples;
+  if (*dt > f->period * *periods) {
+    prru_cli_error(c, "--dt: %s is longer than the run (%g s)", a->dt, f->period * *periods);
+    return 2;
+  }
+  return 0;
+}
+
+static void excite_comments(prru_cli_out *o, const prru_fourier *f, const prru_excite_result *r,
+                            const prru_base *b)
+{
+  prru_cli_out_printf(o, "# excitation: period %.17g s, %d harmonics, centre %.17g %.17g %.17g; "
+                      "condition number %.6g (start %.6g) of the base regressor (%d base parameters)\n",
+                      f->period, f->harmonics, f->centre[0], f->centre[1], f->centre[2], r->cond,
+                      r->cond_start, b->nbase);
+  prru_cli_out_line(o);
+  for (int k = 0; k < 3; k++) {
+    prru_cli_out_printf(o, "# q%d: a", k + 1);
+    for (int l = 0; l < f->harmonics; l++) prru_cli_out_printf(o, " %.17g", f->a[k][l]);
+    prru_cli_out_printf(o, "; b");
+    for (int l = 0; l < f->harmonics; l++) prru_cli_out_printf(o, " %.17g", f->b[k][l]);
+    prru_cli_out_printf(o, "\n");
+    prru_cli_out_line(o);
+  }
+}
+
+/* The rows; a failing inverse dynamics (never after the check) stops. */
+static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier *f, int periods, double dt)
+{
+  prru_data *d = malloc(sizeof *d);
+  if (!d) return PRRU_ENOMEM;
+  char dn[256], fn[256];
+  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_out_printf(o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n", dn, fn);
+  prru_cli_out_line(o);
+  const double t_end = f->period * periods;
+  const long n = (long)floor(t_end / dt * (1 + 1e-12));
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  int st = PRRU_OK;
+  for (long i = 0; i <= n && st == PRRU_OK && !o->err; i++) {
+    if (prru_cli_interrupted) {
+      st = PRRU_EINTERRUPTED;
+      break;
+    }
+    const double t = i * dt;
+    double q[3], qd[3], qdd[3], fd[PRRU_NACT];
+    prru_fourier_eval(f, t, q, qd, qdd);
+    st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
+    if (st != PRRU_OK) break;
+    prru_cli_out_printf(o, "%.17g", t);
+    prru_cli_out_numbers(o, q, 3);
+    prru_cli_out_numbers(o, qd, 3);
+    prru_cli_out_numbers(o, qdd, 3);
+    prru_cli_out_numbers(o, d->d, PRRU_NACT);
+    prru_cli_out_numbers(o, fd, PRRU_NACT);
+    prru_cli_out_printf(o, "\n");
+    prru_cli_out_row(o);
+  }
+  free(d);
+  return st;
+}
+
+int prru_cmd_excite(int argc, char **argv)
+{
+  excite_args a;
+  memset(&a, 0, sizeof a);
+  prru_cli_option opts[] = {
+      {"out", 1, &a.out, NULL},         {"period", 1, &a.period, NULL},   {"harmonics", 1, &a.harm, NULL},
+      {"periods", 1, &a.periods, NULL}, {"dt", 1, &a.dt, NULL},           {"centre", 1, &a.centre, NULL},
+      {"amplitude", 1, &a.amp, NULL},   {"fd-max", 1, &a.fdmax, NULL},    {"rcond-min", 1, &a.rcond, NULL},
+      {"evals", 1, &a.evals, NULL},     {"samples", 1, &a.samples, NULL}, {"seed", 1, &a.seed, NULL},
+      {"coulomb-velocity", 1, &a.vs, NULL}, {"help", 0, NULL, &a.help}};
+  if (prru_cli_parse("excite", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  if (a.help) {
+    char dn[256], fn[256];
+    printf(excite_help, prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","),
+           prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","));
+    return 0;
+  }
+  prru_excite_options o;
+  prru_fourier f;
+  int periods;
+  double dt, vs;
+  if (excite_options(&a, &o, &f, &periods, &dt) || coulomb_velocity("excite", a.vs, &vs)) return 2;
+  prru_model m;
+  prru_model_default(&m);
+  prru_base *b;
+  if (base_or_fail("excite", &m, vs, &b)) {
+    free(b);
+    return 1;
+  }
+  prru_cli_catch_signals();
+  prru_excite_result r;
+  char msg[512];
+  int st = prru_excite(&m, b, &o, &prru_cli_interrupted, &f, &r, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    free(b);
+    if (st == PRRU_EINTERRUPTED) {
+      prru_cli_error("excite", "interrupted (%s); nothing written", prru_cli_signal_name());
+      return prru_cli_exit_interrupted();
+    }
+    prru_cli_error("excite", "%s; nothing written", msg);
+    return st == PRRU_EINPUT ? 2 : 1;
+  }
+  prru_cli_out out;
+  if (prru_cli_out_open(&out, "excite", a.out)) {
+    free(b);
+    return 1;
+  }
+  prru_cli_out_comment(&out);
+  excite_comments(&out, &f, &r, b);
+  st = excite_rows(&out, &m, &f, periods, dt);
+  int io = out.err != 0;
+  if (prru_cli_out_close(&out, !io && st == PRRU_OK)) {
+    free(b);
+    return 1;
+  }
+  if (st != PRRU_OK) {
+    free(b);
+    prru_cli_error("excite", "%s; nothing written", prru_strerror(st));
+    return st == PRRU_EINTERRUPTED ? prru_cli_exit_interrupted() : 1;
+  }
+  fprintf(stderr, "excite: %d base parameters; condition number %.6g (start %.6g, %d evaluations%s); "
+                  "worst J_d rcond %.4g; peak |fd|",
+          b->nbase, r.cond, r.cond_start, r.evals, r.shrunk ? ", shrunk to pass the dense check" : "",
+          r.rcond_worst);
+  for (int i = 0; i < PRRU_NACT; i++) fprintf(stderr, " %.4g", r.fd_peak[i]);
+  fprintf(stderr, " N\n");
+  free(b);
+  return 0;
+}
+
+/* ---------------------------------------------------------- identify --- */
+
+static const char identify_help[] =
+    "usage: prru identify --data FILE.csv --out MODEL.json [--report FILE.csv|-]\n"
+    "                     [--name NAME] [--coulomb-velocity VS] [--window M] [--degree P]\n"
+    "Least-squares identification of the base inertial parameters from measured\n"
+    "motion and actuator forces. FILE (header row, '#' lines skipped, columns in\n"
+    "any order) has t (s, increasing), the forces %s (N) and the pose as\n"
+    "q1,q2,q3 or as the slider positions %s (m, turned into q by forward\n"
+    "kinematics from the previous row's pose). Velocities and accelerations are\n"
+    "the columns qd1..qd3 and qdd1..qdd3 when present (prru excite writes the\n"
+    "exact ones), else derivatives of q by a local polynomial fit (Savitzky-Golay,\n"
+    "2M+1 samples, degree P; default M = 4, P = 4). The platform must carry no\n"
+    "load. Each sample gives J_d^T fd = Y(q, qd, qdd) pi, pi the standard\n"
+    "parameters (per body m, m c, inertia about the body-frame origin; per\n"
+    "actuator armature, damping, Coulomb force for the smoothing velocity VS,\n"
+    "default the model's); only the base parameters, fixed combinations of them,\n"
+    "can be identified (docs/model.md, identification). They are fitted to the\n"
+    "actuator forces (GSL least squares) with standard errors from the residual\n"
+    "variance.\n"
+    "--out: a format-2 model file named NAME (default: this model's name + _id):\n"
+    "this model's geometry and gravity, and its inertial and drive parameters\n"
+    "(the prior) changed only where the data say: each base parameter's own\n"
+    "standard parameter takes the value that makes the combination equal the\n"
+    "estimate; parameters that no motion reveals keep the prior's values.\n"
+    "--report (default stdout): comment lines with the fit (samples, residual\n"
+    "sigma, condition number, parameters kept from the prior), then\n"
+    "index,parameter,estimate,se,prior,combination per base parameter (prior:\n"
+    "the combination at this model's numbers). Model files hold no magnitude\n"
+    "below 1e-9 but 0: smaller values are written as 0.\n"
+    "Exit 2 for bad options or a malformed FILE, 1 when a row is unreachable or\n"
+    "singular (named), the data do not excite every base parameter, or the\n"
+    "result is not physical (a mass <= 0, an inertia not positive definite, a\n"
+    "negative drive coefficient beyond 3 standard errors; the report is written,\n"
+    "the model file is not). Nothing is half-written.\n";
+
+typedef struct {
+  int n;
+  double *t, *q, *qd, *qdd, *fd;
+} ident_data;
+
+static void data_free(ident_data *D)
+{
+  free(D->t), free(D->q), free(D->qd), free(D->qdd), free(D->fd);
+}
+
+/* The table's columns into D; 0, or 2 after a message. */
+static int data_columns(const char *path, const prru_table *t, int *cq, int *cd, int *cv, int *ca, int *cf)
+{
+  char name[32];
+  int have_q = 1, have_d = 1, have_v = 1, have_a = 1;
+  for (int k = 0; k < 3; k++) {
+    snprintf(name, sizeof name, "q%d", k + 1);
+    have_q &= (cq[k] = prru_table_column(t, name)) >= 0;
+    snprintf(name, sizeof name, "qd%d", k + 1);
+    have_v &= (cv[k] = prru_table_column(t, name)) >= 0;
+    snprintf(name, sizeof name, "qdd%d", k + 1);
+    have_a &= (ca[k] = prru_table_column(t, name)) >= 0;
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    snprintf(name, sizeof name, "d%d", i + 1);
+    have_d &= (cd[i] = prru_table_column(t, name)) >= 0;
+    snprintf(name, sizeof name, "fd%d", i + 1);
+    if ((cf[i] = prru_table_column(t, name)) < 0) {
+      prru_cli_error("identify", "--data %s: missing column '%s' (the measured actuator forces)", path, name);
+      return 2;
+    }
+  }
+  if (prru_table_column(t, "t") < 0) {
+    prru_cli_error("identify", "--data %s: missing column 't'", path);
+    return 2;
+  }
+  if (!have_q && !have_d) {
+    prru_cli_error("identify", "--data %s: no pose: need the columns q1,q2,q3 or d1..d%d", path, PRRU_NACT);
+    return 2;
+  }
+  if (!have_q) cq[0] = -1;
+  if (!(have_v && have_a)) cv[0] = -1;
+  return 0;
+}
+
+/* q of every row by forward kinematics from the slider columns. */
+static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, ident_data *D)
+{
+  prru_model m;
+  prru_model_default(&m);
+  prru_data *d = malloc(sizeof *d);
+  double seed[3] = {0, 0, 0};
+  int rc = d ? 0 : 1;
+  for (int i = 0; i < t->nrows && !rc; i++) {
+    const double *row = t->data + (size_t)i * (size_t)t->ncols;
+    double act[PRRU_NACT], res;
+    for (int k = 0; k < PRRU_NACT; k++) act[k] = row[cd[k]];
+    int st = prru_forward_kinematics_lsq(&m, d, act, seed, D->q + 3 * i, &res);
+    if (st != PRRU_OK || !(res <= 1e-9 * (1 + fabs(act[0])))) {
+      prru_cli_error("identify", "%s: data row %d: no pose for the sliders (%s)", path, i + 1,
+                     st != PRRU_OK ? prru_strerror(st) : "inconsistent slider positions");
+      rc = 1;
+    }
+    memcpy(seed, D->q + 3 * i, sizeof seed);
+  }
+  free(d);
+  return rc;
+}
+
+static int read_data(const char *path, const prru_diff_options *dopt, ident_data *D)
+{
+  char msg[700];
+  prru_table t;
+  memset(D, 0, sizeof *D);
+  if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error("identify", "--data %s", msg);
+    return 2;
+  }
+  int cq[3], cd[PRRU_NACT], cv[3], ca[3], cf[PRRU_NACT];
+  int rc = data_columns(path, &t, cq, cd, cv, ca, cf);
+  const int ct = prru_table_column(&t, "t");
+  const size_t n = (size_t)t.nrows;
+  D->n = t.nrows;
+  if (!rc) {
+    D->t = malloc(sizeof(double) * (n + 1));
+    D->q = malloc(sizeof(double) * 3 * (n + 1));
+    D->qd = malloc(sizeof(double) * 3 * (n + 1));
+    D->qdd = malloc(sizeof(double) * 3 * (n + 1));
+    D->fd = malloc(sizeof(double) * PRRU_NACT * (n + 1));
+    if (!D->t || !D->q || !D->qd || !D->qdd || !D->fd) {
+      prru_cli_error("identify", "out of memory for %d rows", t.nrows);
+      rc = 1;
+    }
+  }
+  for (size_t i = 0; i < n && !rc; i++) {
+    const double *row = t.data + i * (size_t)t.ncols;
+    D->t[i] = row[ct];
+    for (int k = 0; k < 3; k++) {
+      if (cq[0] >= 0) D->q[3 * i + k] = row[cq[k]];
+      if (cv[0] >= 0) D->qd[3 * i + k] = row[cv[k]], D->qdd[3 * i + k] = row[ca[k]];
+    }
+    for (int k = 0; k < PRRU_NACT; k++) D->fd[PRRU_NACT * i + k] = row[cf[k]];
+    if (i > 0 && !(D->t[i] > D->t[i - 1])) {
+      prru_cli_error("identify", "%s: data row %zu: t = %g is not after the previous row's", path, i + 1, D->t[i]);
+      rc = 2;
+    }
+  }
+  if (!rc && cq[0] < 0) rc = poses_from_sliders(path, &t, cd, D);
+  if (!rc && cv[0] < 0 &&
+      prru_diff_signal(D->t, D->n, D->q, 3, dopt, NULL, D->qd, D->qdd, NULL, NULL, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error("identify", "%s: differentiating q: %s", path, msg);
+    rc = 2;
+  }
+  prru_table_free(&t);
+  return rc;
+}
+
+/* "U1.Ixx + 0.25 L1.m - ...": base parameter i as a combination. */
+static void combination(const prru_base *b, int i, char *buf, size_t len)
+{
+  size_t k = (size_t)snprintf(buf, len, "%s", prru_regressor_names[b->col[i]]);
+  for (int j = 0; j < PRRU_NREG && k < len; j++) {
+    const double c = b->B[i * PRRU_NREG + j];
+    if (j == b->col[i] || fabs(c) < 1e-12) continue;
+    k += (size_t)snprintf(buf + k, len - k, " %c %.10g %s", c < 0 ? '-' : '+', fabs(c), prru_regressor_names[j]);
+  }
+}
+
+static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_result *r, const double *prior)
+{
+  prru_cli_out_comment(o);
+  prru_cli_out_printf(o, "# identify: %d samples, %d rows, %d base parameters of %d, %d degrees of freedom; "
+                      "residual sigma %.6g N; condition number %.6g; Coulomb smoothing velocity %.6g m/s\n",
+                      r->nsamples, r->nrows, b->nbase, PRRU_NREG, r->dof, r->sigma, r->cond, b->vs);
+  prru_cli_out_line(o);
+  prru_cli_out_printf(o, "# residual RMS per actuator (N):");
+  for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, " %.6g", r->rms[i]);
+  prru_cli_out_printf(o, "\n# no effect on any actuator force (kept from the prior):");
+  prru_cli_out_line(o);
+  for (int j = 0; j < PRRU_NREG; j++)
+    if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
+  prru_cli_out_printf(o, "\n# only in combinations (kept from the prior):");
+  for (int j = 0; j < PRRU_NREG; j++)
+    if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
+  prru_cli_out_printf(o, "\nindex,parameter,estimate,se,prior,combination\n");
+  prru_cli_out_line(o);
+  for (int i = 0; i < b->nbase; i++) {
+    char comb[4096];
+    combination(b, i, comb, sizeof comb);
+    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%s\n", i + 1, prru_regressor_names[b->col[i]], r->beta[i],
+                        r->se[i], prior[i], comb);
+    prru_cli_out_row(o);
+  }
+}
+
+/* The identified standard parameters as model numbers in p; 0, or 1 with
+ * why naming the first non-physical body or drive. */
+static int to_params(const prru_base *b, const prru_ident_result *r, const double *pi, prru_params *p,
+                     char *why, size_t len)
+{
+  *p = prru_params_model;
+  for (int k = 0; k < PRRU_NBODY; k++) {
+    double m, c[3], I[6];
+    if (prru_ident_body(pi + PRRU_NBODYPAR * k, &m, c, I) != PRRU_OK) {
+      snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_mech.body_names[k], pi[PRRU_NBODYPAR * k]);
+      return 1;
+    }
+    const double m2 = I[0] * I[1] - I[3] * I[3];
+    const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
+                      I[4] * (I[3] * I[5] - I[1] * I[4]);
+    if (!(I[0] > 0 && m2 > 0 && m3 > 0)) {
+      snprintf(why, len, "body %s: the identified inertia about the centre of mass is not positive definite",
+               prru_mech.body_names[k]);
+      return 1;
+    }
+    p->mass[k] = m;
+    memcpy(p->com[k], c, sizeof c);
+    memcpy(p->inertia[k], I, sizeof I);
+  }
+  double *dr[3] = {p->armature, p->damping, p->coulomb};
+  static const char *const dn[3] = {"armature", "damping", "coulomb"};
+  for (int g = 0; g < 3; g++)
+    for (int i = 0; i < PRRU_NACT; i++) {
+      const int j = PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i;
+      double v = pi[j], se = 0, res = 0;
+      for (int k = 0; k < b->nbase; k++)
+        if (b->col[k] == j) se = r->se[k], res = r->scale[k];
+      /* Within 3 standard errors (or rounding) of 0: a drive without this
+       * term. */
+      if (v < 0 && v >= -3 * se - 1e-9 * res) v = 0;
+      if (v < 0) {
+        snprintf(why, len, "%s%d = %.6g is negative (standard error %.3g)", dn[g], i + 1, pi[j], se);
+        return 1;
+      }
+      dr[g][i] = v;
+    }
+  p->coulomb_velocity = b->vs;
+  return 0;
+}
+
+/* Model files hold no magnitude below 1e-9 but 0 (the loader refuses
+ * them as typing errors): smaller identified values are written as 0. */
+static double model_number(double v)
+{
+  return fabs(v) < 1e-9 ? 0.0 : v;
+}
+
+static void json_list(prru_cli_out *o, const double *v, int n)
+{
+  prru_cli_out_printf(o, "[");
+  for (int i = 0; i < n; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", model_number(v[i]));
+  prru_cli_out_printf(o, "]");
+}
+
+static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *data)
+{
+  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n", name);
+  prru_cli_out_printf(o, "  \"description\": \"Identified by prru identify from ");
+  for (const char *s = data; *s; s++)
+    prru_cli_out_printf(o, "%c", *s == '"' || *s == '\\' || (unsigned char)*s < 32 ? '_' : *s);
+  prru_cli_out_printf(o, " (prior: model %s)\",\n  \"gravity\": ", prru_mech.name);
+  json_list(o, p->gravity, 3);
+  prru_cli_out_printf(o, ",\n  \"geometry\": {\n    \"b\": ");
+  json_list(o, p->b, PRRU_NLIMB);
+  prru_cli_out_printf(o, ",\n    \"l1\": ");
+  json_list(o, p->l1, PRRU_NLIMB);
+  prru_cli_out_printf(o, ",\n    \"l2\": ");
+  json_list(o, p->l2, PRRU_NLIMB);
+  prru_cli_out_printf(o, ",\n    \"a\": ");
+  json_list(o, p->a, 2);
+  prru_cli_out_printf(o, "\n  },\n  \"bodies\": {\n");
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": ", prru_mech.body_names[b],
+                        model_number(p->mass[b]));
+    json_list(o, p->com[b], 3);
+    prru_cli_out_printf(o, ",\n      \"inertia\": ");
+    json_list(o, p->inertia[b], 6);
+    prru_cli_out_printf(o, "}%s\n", b + 1 < PRRU_NBODY ? "," : "");
+  }
+  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n    \"armature\": ");
+  json_list(o, p->armature, PRRU_NACT);
+  prru_cli_out_printf(o, ",\n    \"damping\": ");
+  json_list(o, p->damping, PRRU_NACT);
+  prru_cli_out_printf(o, ",\n    \"coulomb\": ");
+  json_list(o, p->coulomb, PRRU_NACT);
+  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g\n  }\n}\n", p->coulomb_velocity);
+  prru_cli_out_line(o);
+}
+
+static int valid_name(const char *s)
+{
+  size_t n = strlen(s);
+  if (n < 1 || n > 16 || s[0] < 'a' || s[0] > 'z') return 0;
+  for (size_t i = 0; i < n; i++)
+    if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') || s[i] == '_')) return 0;
+  return 1;
+}
+
+typedef struct {
+  const char *data, *out, *report, *name, *vs, *window, *degree;
+  int help;
+} identify_args;
+
+static int identify_options(identify_args *a, char *name, size_t len, prru_diff_options *dopt, double *vs)
+{
+  if (!a->data || !a->out) {
+    prru_cli_error("identify", "--data and --out are required (see 'prru identify --help')");
+    return 2;
+  }
+  if (a->report && strcmp(a->report, "-") != 0 && strcmp(a->report, a->out) == 0) {
+    prru_cli_error("identify", "--report and --out are the same file %s", a->out);
+    return 2;
+  }
+  snprintf(name, len, "%.13s_id", prru_mech.name);
+  if (a->name) {
+    if (!valid_name(a->name)) {
+      prru_cli_error("identify", "--name: '%s' must be a lower-case C identifier of at most 16 characters",
+                     a->name);
+      return 2;
+    }
+    snprintf(name, len, "%s", a->name);
+  }
+  prru_diff_options_default(dopt);
+  if (a->window && parse_count("identify", "window", a->window, 1, PRRU_DIFF_MAX_HALF, &dopt->half_width))
+    return 2;
+  if (a->degree && parse_count("identify", "degree", a->degree, 2, PRRU_DIFF_MAX_DEGREE, &dopt->degree)) return 2;
+  if (dopt->degree > 2 * dopt->half_width) {
+    prru_cli_error("identify", "--degree %d needs --window of at least %d", dopt->degree, (dopt->degree + 1) / 2);
+    return 2;
+  }
+  return coulomb_velocity("identify", a->vs, vs);
+}
+
+/* Fit and outputs once the data are read; the exit status. */
+static int identify_run(const identify_args *a, const char *name, const ident_data *D, prru_base *b)
+{
+  prru_model m;
+  prru_model_default(&m);
+  prru_ident_result *r = malloc(sizeof *r);
+  double *pi0 = malloc(sizeof(double) * PRRU_NREG * 3), *pi = pi0 + PRRU_NREG, *prior = pi + PRRU_NREG;
+  if (!r || !pi0) {
+    free(r), free(pi0);
+    prru_cli_error("identify", "out of memory");
+    return 1;
+  }
+  int bad = -1, rc = 0;
+  int st = prru_identify(&m, b, D->n, D->q, D->qd, D->qdd, D->fd, r, &bad);
+  if (st != PRRU_OK) {
+    if (bad >= 0)
+      prru_cli_error("identify", "%s: data row %d (t = %g): %s; nothing written", a->data, bad + 1, D->t[bad],
+                     prru_strerror(st));
+    else if (st == PRRU_EINPUT)
+      prru_cli_error("identify", "%s: %d samples give %d independent rows, fewer than the %d base parameters "
+                     "need; nothing written", a->data, D->n, 3 * D->n, b->nbase + 1);
+    else
+      prru_cli_error("identify", "%s: the motion does not excite every base parameter (condition number %.3g "
+                     "of the column-scaled regressor); use an excitation from prru excite; nothing written",
+                     a->data, r->cond);
+    free(r), free(pi0);
+    return 1;
+  }
+  prru_ident_standard(&prru_mech, pi0);
+  prru_base_params(b, pi0, prior);
+  prru_base_to_standard(b, r->beta, pi0, pi);
+  prru_params p;
+  char why[300];
+  const int unphysical = to_params(b, r, pi, &p, why, sizeof why);
+  prru_cli_out ro;
+  if (prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
+  if (!rc) {
+    write_report(&ro, b, r, prior);
+    if (prru_cli_out_close(&ro, !ro.err)) rc = 1;
+  }
+  if (!rc && unphysical) {
+    prru_cli_error("identify", "the identified parameters are not physical: %s; %s not written (see the "
+                   "report; more or better excitation data, or a check of the force signs)", why, a->out);
+    rc = 1;
+  }
+  prru_cli_out mo;
+  if (!rc && prru_cli_out_open(&mo, "identify", a->out)) rc = 1;
+  if (!rc) {
+    write_model(&mo, &p, name, a->data);
+    if (prru_cli_out_close(&mo, !mo.err)) rc = 1;
+  }
+  if (!rc)
+    fprintf(stderr, "identify: %d base parameters from %d samples, residual sigma %.6g N, condition number "
+                    "%.6g; model %s written to %s\n", b->nbase, D->n, r->sigma, r->cond, name, a->out);
+  free(r), free(pi0);
+  return rc;
+}
+
+int prru_cmd_identify(int argc, char **argv)
+{
+  identify_args a;
+  memset(&a, 0, sizeof a);
+  prru_cli_option opts[] = {{"data", 1, &a.data, NULL},     {"out", 1, &a.out, NULL},
+                            {"report", 1, &a.report, NULL}, {"name", 1, &a.name, NULL},
+                            {"coulomb-velocity", 1, &a.vs, NULL}, {"window", 1, &a.window, NULL},
+                            {"degree", 1, &a.degree, NULL}, {"help", 0, NULL, &a.help}};
+  if (prru_cli_parse("identify", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  if (a.help) {
+    char dn[256], fn[256];
+    printf(identify_help, prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","),
+           prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","));
+    return 0;
+  }
+  char name[32];
+  prru_diff_options dopt;
+  double vs;
+  int rc = identify_options(&a, name, sizeof name, &dopt, &vs);
+  if (rc) return rc;
+  ident_data D;
+  rc = read_data(a.data, &dopt, &D);
+  if (rc) {
+    data_free(&D);
+    return rc;
+  }
+  prru_model m;
+  prru_model_default(&m);
+  prru_base *b = NULL;
+  if (base_or_fail("identify", &m, vs, &b))
+    rc = 1;
+  else
+    rc = identify_run(&a, name, &D, b);
+  free(b);
+  data_free(&D);
+  return rc;
+}
