@@ -111,6 +111,20 @@ rm "$tmp/bad/m.json"
 expect 1 "cannot open" -- optimize --vars l2 --q1 "$Q1" --q2 "$Q2" --out "$tmp/nodir/m.json" --report "$tmp/bad/rep"
 nothing_written "$tmp/bad" "optimize into a missing directory"
 
+# A signal stops the run: exit 128 + signal, nothing written, no staging
+# directory left. (TERM: a background job of a script ignores INT.)
+mkdir "$tmp/int"
+"$PRRU" optimize --vars b12,l2 --q1 -0.3:0.3:201 --q2 -0.3:0.3:201 --max-iter 1000000 \
+  --out "$tmp/int/m.json" --report "$tmp/int/rep" >/dev/null 2>"$tmp/int.err" &
+pid=$!
+sleep 1
+kill -TERM $pid
+wait $pid
+rc=$?
+[ $rc -eq 143 ] && grep -q "interrupted (SIGTERM): nothing written" "$tmp/int.err" && ok \
+  || bad "optimize stopped by SIGTERM: exit $rc, $(head -c 300 "$tmp/int.err")"
+nothing_written "$tmp/int" "optimize stopped by a signal"
+
 # ---- sensitivity: shards merge into one run, byte for byte ----
 S=(--q1 "$Q1" --q2 "$Q2")
 mkdir "$tmp/s"
