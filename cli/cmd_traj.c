@@ -289,7 +289,8 @@ static const char track_help[] =
     "Limits: --fmax, one force limit (N) for every actuator or one each;\n"
     "--stroke, the slider range (m), for all sliders or per slider. The\n"
     "reference must stay inside the workspace, away from singularities and in\n"
-    "the stroke at every row time (else exit 2, nothing written); a plant\n"
+    "the stroke, checked at every row and at least every millisecond (else\n"
+    "exit 2, nothing written); a plant\n"
     "that leaves its stroke stops the run (exit 1, rows kept).\n"
     "Output: the model line, a line with the settings, then\n"
     "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,\n"
@@ -730,7 +731,9 @@ int prru_cmd_track(int argc, char **argv)
     prru_quintic_free(&tr);
     return 2;
   }
-  if ((rc = check_reference(&tr, &o, step, &ff_peak)) != 0) {
+  /* The reference is checked every millisecond at least, also between
+   * coarse rows. */
+  if ((rc = check_reference(&tr, &o, fmin(step, 1e-3), &ff_peak)) != 0) {
     prru_quintic_free(&tr);
     return rc;
   }

@@ -68,10 +68,11 @@ jq = [sum(J[j] * qd[j] for j in range(3)) for J in ik['Jd']]
 assert max(abs(a - b) for a, b in zip(dd, jq)) <= 1e-14 * max(1e-3, max(map(abs, jq))), (dd, jq)
 " "$tmp/ik.json" "$row" "$nact" && ok || bad "traj d, dd disagree with prru ik's d and J_d qd"
 
-# Out of the workspace: a tilt no model reaches; the rows before it kept.
+# Towards a tilt no model reaches: the path leaves the workspace (or, on
+# some models, first crosses a singularity); the rows before it kept.
 "$PRRU" traj --waypoints '0,0,0;1.5,0,0' --durations 1 --out "$tmp/u.csv" 2>"$tmp/err"
 st=$?
-[ $st -eq 1 ] && grep -q "sample [0-9]* (t = .*outside the workspace" "$tmp/err" && ok \
+[ $st -eq 1 ] && grep -q -E "sample [0-9]+ \(t = .*(outside the workspace|crosses a singularity)" "$tmp/err" && ok \
   || bad "traj out of the workspace: exit $st, $(cat "$tmp/err")"
 python3 -c "$PYCSV
 import re
@@ -81,6 +82,11 @@ assert len(r) == k - 1 and len(r) > 100, (len(r), k)
 assert all(math.isfinite(v) for row in r for v in row)
 " "$tmp/u.csv" "$tmp/err" && ok || bad "traj: rows before the bad sample not kept as they were, or NaN written"
 grep -qi nan "$tmp/u.csv" && bad "NaN in the kept rows" || ok
+# Sampled coarsely, the unreachable pose itself is the first bad sample.
+"$PRRU" traj --waypoints '0,0,0;0.02,0,0;1.5,0,0' --durations 1,1 --dt 1 --out "$tmp/u1.csv" 2>"$tmp/err"
+st=$?
+[ $st -eq 1 ] && grep -qF "sample 3 (t = 2 s, segment 2: waypoint 2 to 3): q = (1.5, 0, 0) is outside the workspace" "$tmp/err" \
+  && [ "$(grep -vc '^#' "$tmp/u1.csv")" -eq 3 ] && ok || bad "traj to an unreachable waypoint: exit $st, $(cat "$tmp/err")"
 
 # Across a singularity: find a regular pose with the other sign of det J_d
 # (3 actuators) on a line from home, if the model has one there.
@@ -240,7 +246,10 @@ jcheck "$tmp/n1.json" "d['control'] == 'zero-order hold' and d['samples'] == 100
   "track --period: wrong sampling or error"
 # Bad input: exit 2, nothing written.
 rm -f "$tmp/x.csv"
-expect 2 "outside the workspace" -- track --waypoints '0,0,0;1.5,0,0' --durations 1 --out "$tmp/x.csv"
+"$PRRU" track --waypoints '0,0,0;0.02,0,0;1.5,0,0' --durations 1,1 --dt 1 --out "$tmp/x.csv" 2>"$tmp/err"
+st=$?
+[ $st -eq 2 ] && grep -q -E "reference at sample [0-9]+ \(t = .*(outside the workspace|crosses a singularity).*nothing written" "$tmp/err" \
+  && ok || bad "track with an unreachable reference: exit $st, $(cat "$tmp/err")"
 dmax=$(grep -v '^#' "$tmp/t.csv" | sed -n 2p | cut -d, -f11)
 expect 2 "outside its --stroke" -- track --waypoints "$WP" --durations 1,1 --stroke -10,"$dmax" --out "$tmp/x.csv"
 expect 2 "needs --period > 0" -- track --waypoints "$WP" --durations 1,1 --noise 1e-5,0 --out "$tmp/x.csv"
