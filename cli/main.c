@@ -44,8 +44,8 @@ static void usage(FILE *f)
           PRRU_NLIMB, PRRU_NACT > 3 ? " (redundantly actuated)" : "", PRRU_NACT, prru_mech.name,
           prru_mech.model_file);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-    fprintf(f, "  %-11s %s\n", commands[i].name, commands[i].help);
-  fprintf(f, "  %-11s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
+    fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
+  fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
   fprintf(f, "\nexit status: 0 success, 1 failure (state unreachable or singular, no\n"
              "convergence, I/O error: the reason on stderr), 2 usage error or bad input\n"
              "file, 130/143/129 stopped by SIGINT/SIGTERM/SIGHUP (simulate, id, map,\n"

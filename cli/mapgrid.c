@@ -11,6 +11,7 @@
 #include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
+#include "prru_traj.h" /* prru_jd_det_sign */
 
 int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m)
 {
@@ -137,12 +138,9 @@ void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *c, double r
  * (unreachable) or not defined (more actuators than coordinates). */
 static int jd_det_sign(const double q[3])
 {
-  if (PRRU_NACT != 3) return 0;
   double d[PRRU_NACT], J[PRRU_NACT * 3];
   prru_ik_jd(q, d, J);
-  double det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) +
-               J[2] * (J[3] * J[7] - J[4] * J[6]);
-  return det > 0 ? 1 : det < 0 ? -1 : 0;
+  return prru_jd_det_sign(J);
 }
 
 /* Marks the ok poses of rows r0 .. r1 - 1 (w[0], st[0]: row r0's first

@@ -12,6 +12,7 @@
 
 #include "internal.h"
 #include "prru_design.h"
+#include "prru_traj.h" /* prru_jd_det_sign: the assembly mode */
 
 /* ---- Names ---- */
 
@@ -394,16 +395,6 @@ static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_N
 
 #define OTHER_MODE PRRU_DESIGN_OTHER_MODE
 
-/* The sign of det J_d (three actuators; 0 when it is 0 or not finite, and
- * always with more actuators, where J_d has no determinant). */
-static int det_sign(const double Jd[PRRU_NACT * 3])
-{
-  if (PRRU_NACT != 3) return 0;
-  double det = Jd[0] * (Jd[4] * Jd[8] - Jd[5] * Jd[7]) - Jd[1] * (Jd[3] * Jd[8] - Jd[5] * Jd[6]) +
-               Jd[2] * (Jd[3] * Jd[7] - Jd[4] * Jd[6]);
-  return det > 0 ? 1 : det < 0 ? -1 : 0;
-}
-
 /* The assembly mode of the design at home, (0, 0, q3): det J_d's sign, or
  * 0 when it cannot be told (then no point is in "the other" mode). */
 static int home_mode(const prru_params *p, double q3)
@@ -413,7 +404,7 @@ static int home_mode(const prru_params *p, double q3)
   prru_param_ik_jd(p, q, d, Jd);
   for (int i = 0; i < PRRU_NACT; i++)
     if (!isfinite(d[i])) return 0;
-  return det_sign(Jd);
+  return prru_jd_det_sign(Jd);
 }
 
 /* w_R at one grid point exactly as `prru map` gets it with the model's
@@ -439,7 +430,7 @@ static int point_w(const prru_design_problem *pr, const prru_params *p, double L
       return PRRU_EUNREACHABLE;
     }
   int st = prru_jd_regular(Jd, L, r, Jdpinv, &rc);
-  if (home != 0 && det_sign(Jd) != home) {
+  if (home != 0 && prru_jd_det_sign(Jd) != home) {
     *viol = cap + log1p(rc / r);
     return st == PRRU_OK ? OTHER_MODE : st;
   }
