@@ -23,6 +23,8 @@
  *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      432 arithmetic (76 add, 62 sub, 288 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   joint_reactions    775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
 #define PRRU_KERNELS_H
@@ -60,6 +62,8 @@
 #define PRRU_ARITH_ACTUATOR_RATES 148 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 12 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 58 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 432 /* arithmetic operations */
+#define PRRU_ARITH_JOINT_REACTIONS 775 /* arithmetic operations */
 #define PRRU_OPS_IK "30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JD "63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_IK_JD "74 arithmetic (8 add, 11 sub, 52 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -78,6 +82,8 @@
 #define PRRU_OPS_ACTUATOR_RATES "148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "432 arithmetic (76 add, 62 sub, 288 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JOINT_REACTIONS "775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
 extern "C" {
@@ -136,6 +142,12 @@ void prru_passive(const double q[3], const double qd[3], double Qp[3]);
 
 /* Q (60x57) mapping the joint reaction coordinates lambda to body wrenches about each centre, so that Phi H qdd + K = Fbar + Q lambda. */
 void prru_reaction_basis(const double q[3], double Q[3420]);
+
+/* d, J_d (as prru_ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. */
+void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double tau[3]);
+
+/* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. */
+void prru_joint_reactions(const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);
 
 #ifdef __cplusplus
 }

@@ -2,6 +2,7 @@
 
 from . import sym
 from .cgen import Kernel
+from .reactions import Reactions, null_direction
 
 Q = ("q", ["q1", "q2", "q3"])
 QD = ("qd", ["qd1", "qd2", "qd3"])
@@ -80,8 +81,50 @@ def kernels(deriv):
                                                     deriv.mech.joints)),
          [Q], [("Q", deriv.reaction_basis())]),
     ]
+    spec.append(_inverse_terms(deriv, d, jd, m, fp, mp))
+    spec += _reaction_kernels(deriv, fd, fp, mp)
     return [Kernel(name, doc, ins, outs, guards)
             for name, doc, ins, outs in spec]
+
+
+def _inverse_terms(deriv, d, jd, m, fp, mp):
+    """ik_jd and the generalized force of the drives in one kernel: inverse
+    dynamics needs both, and they share the inverse kinematics."""
+    qdd = _vec("qdd")
+    b = deriv.eom_rhs([sym.ZERO] * len(d), fp, mp)
+    tau = [sym.add(*([sym.mul(m[3 * i + j], qdd[j]) for j in range(3)]
+                     + [-b[i]])) for i in range(3)]
+    return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h - G "
+            "- J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the "
+            "drives supply: J_d^T fd = tau.",
+            [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)],
+            [("d", d), ("Jd", jd), ("tau", tau)])
+
+
+def _reaction_kernels(deriv, fd, fp, mp):
+    """joint_reactions (and, with a redundant reaction direction,
+    reaction_nullspace): the closed form of reactions.py."""
+    nact = len(fd)
+    qdd = _vec("qdd")
+    lam, z = Reactions(deriv, qdd, fd, fp, mp).solve()
+    outs = [("lambda", lam)]
+    doc = ("The joint reaction coordinates lambda (%d, docs/model.md section "
+           "7) at the accelerations qdd (which must solve the equations of "
+           "motion: M qdd = b of prru_eom), in closed form limb by limb"
+           % len(lam))
+    if z is None:
+        doc += "."
+    else:
+        doc += (": the solution of least norm, lambda . z = 0, and z, the "
+                "unit null direction of Q (C3's force along e2 positive).")
+        outs.append(("z", z))
+    ins = [Q, QD, _arg("qdd", 3), _arg("fd", nact), _arg("fp", 3),
+           _arg("mp", 3)]
+    spec = [("joint_reactions", doc, ins, outs)]
+    if z is not None:
+        spec.append(("reaction_nullspace", "z of joint_reactions at q alone.",
+                     [Q], [("z", null_direction(deriv))]))
+    return spec
 
 
 def lambda_labels(mech):
