@@ -294,11 +294,15 @@ static const char identify_help[] =
     "this model's geometry and gravity, and its inertial and drive parameters\n"
     "(the prior) changed only where the data say: each base parameter's own\n"
     "standard parameter takes the value that makes the combination equal the\n"
-    "estimate; parameters that no motion reveals keep the prior's values.\n"
+    "estimate; parameters that no motion reveals keep the prior's values. When\n"
+    "that makes a body non-physical, the base parameters whose estimates lie\n"
+    "within 3 standard errors of the prior's (the data do not contradict it)\n"
+    "keep the prior's values (listed in the report).\n"
     "--report (default stdout): comment lines with the fit (samples, residual\n"
     "sigma, condition number, parameters kept from the prior), then\n"
-    "index,parameter,estimate,se,prior,combination per base parameter (prior:\n"
-    "the combination at this model's numbers). Model files hold no magnitude\n"
+    "index,parameter,estimate,se,prior,resolution,combination per base\n"
+    "parameter (prior: the combination at this model's numbers; resolution:\n"
+    "the value at which it alone would give forces of the data's RMS size). Model files hold no magnitude\n"
     "below 1e-9 but 0: smaller values are written as 0.\n"
     "Exit 2 for bad options or a malformed FILE, 1 when a row is unreachable or\n"
     "singular (named), the data do not excite every base parameter, or the\n"
@@ -434,7 +438,8 @@ static void combination(const prru_base *b, int i, char *buf, size_t len)
   }
 }
 
-static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_result *r, const double *prior)
+static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_result *r, const double *prior,
+                         const int *kept)
 {
   prru_cli_out_comment(o);
   prru_cli_out_printf(o, "# identify: %d samples, %d rows, %d base parameters of %d, %d degrees of freedom; "
@@ -450,15 +455,46 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   prru_cli_out_printf(o, "\n# only in combinations (kept from the prior):");
   for (int j = 0; j < PRRU_NREG; j++)
     if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
-  prru_cli_out_printf(o, "\nindex,parameter,estimate,se,prior,combination\n");
+  int nkept = 0;
+  for (int i = 0; i < b->nbase; i++) nkept += kept[i];
+  if (nkept) {
+    prru_cli_out_printf(o, "\n# within 3 se of the prior, written as the prior's value so that every body is "
+                        "physical:");
+    for (int i = 0; i < b->nbase; i++)
+      if (kept[i]) prru_cli_out_printf(o, " %d", i + 1);
+  }
+  prru_cli_out_printf(o, "\nindex,parameter,estimate,se,prior,resolution,combination\n");
   prru_cli_out_line(o);
   for (int i = 0; i < b->nbase; i++) {
     char comb[4096];
     combination(b, i, comb, sizeof comb);
-    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%s\n", i + 1, prru_regressor_names[b->col[i]], r->beta[i],
-                        r->se[i], prior[i], comb);
+    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%s\n", i + 1, prru_regressor_names[b->col[i]],
+                        r->beta[i], r->se[i], prior[i], r->scale[i], comb);
     prru_cli_out_row(o);
   }
+}
+
+static int to_params(const prru_base *b, const prru_ident_result *r, const double *pi, prru_params *p,
+                     char *why, size_t len);
+
+/* The model file's numbers: the estimates put into the prior
+ * (prru_base_to_standard); when that makes a body or drive non-physical,
+ * once more with every base parameter that lies within 3 standard errors
+ * of the prior's value (no significant evidence against the prior) at the
+ * prior's value, kept[i] = 1 for those. 0, or 1 with why. */
+static int model_params(const prru_base *b, const prru_ident_result *r, const double *pi0, const double *prior,
+                        double *pi, int *kept, prru_params *p, char *why, size_t len)
+{
+  double beta[PRRU_NREG];
+  memset(kept, 0, sizeof(int) * PRRU_NREG);
+  prru_base_to_standard(b, r->beta, pi0, pi);
+  if (!to_params(b, r, pi, p, why, len)) return 0;
+  for (int i = 0; i < b->nbase; i++) {
+    kept[i] = fabs(r->beta[i] - prior[i]) <= 3 * r->se[i];
+    beta[i] = kept[i] ? prior[i] : r->beta[i];
+  }
+  prru_base_to_standard(b, beta, pi0, pi);
+  return to_params(b, r, pi, p, why, len);
 }
 
 /* The identified standard parameters as model numbers in p; 0, or 1 with
@@ -629,14 +665,14 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   }
   prru_ident_standard(&prru_mech, pi0);
   prru_base_params(b, pi0, prior);
-  prru_base_to_standard(b, r->beta, pi0, pi);
   prru_params p;
   char why[300];
-  const int unphysical = to_params(b, r, pi, &p, why, sizeof why);
+  int kept[PRRU_NREG];
+  const int unphysical = model_params(b, r, pi0, prior, pi, kept, &p, why, sizeof why);
   prru_cli_out ro;
   if (prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
   if (!rc) {
-    write_report(&ro, b, r, prior);
+    write_report(&ro, b, r, prior, kept);
     if (prru_cli_out_close(&ro, !ro.err)) rc = 1;
   }
   if (!rc && unphysical) {

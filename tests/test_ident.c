@@ -206,6 +206,11 @@ static double gauss(void)
 }
 
 /* n samples of an excitation, fd by inverse dynamics (+ noise sigma). */
+/* n samples of an excitation with fd from the dynamics of *truth (the
+ * runtime-parameter kernels; the model's own numbers when NULL), plus
+ * Gaussian noise sigma. */
+static const prru_params *truth;
+
 static int make_data(int n, double sigma, double *q, double *qd, double *qdd, double *fd)
 {
   prru_fourier f;
@@ -218,13 +223,19 @@ static int make_data(int n, double sigma, double *q, double *qd, double *qdd, do
     f.a[1][l] = -0.04 / (l + 1), f.b[1][l] = 0.05 / (l + 1.5);
     f.a[2][l] = 0.04 * L / (l + 1), f.b[2][l] = -0.03 * L / (l + 1);
   }
-  prru_loads ld;
-  memset(&ld, 0, sizeof ld);
+  const prru_params *p = truth ? truth : &prru_params_model;
   for (int s = 0; s < n; s++) {
-    prru_fourier_eval(&f, f.period * s / n, q + 3 * s, qd + 3 * s, qdd + 3 * s);
-    if (prru_inverse_dynamics(&model, &data, q + 3 * s, qd + 3 * s, qdd + 3 * s, &ld, fd + NA * s))
-      return 1;
-    for (int i = 0; i < NA; i++) fd[NA * s + i] += sigma * gauss();
+    double *x = q + 3 * s, *v = qd + 3 * s, *a = qdd + 3 * s, M[9], h[3], G[3], Qp[3], tau[3];
+    prru_fourier_eval(&f, f.period * s / n, x, v, a);
+    if (prru_check_regular(&model, &data, x, NULL) != PRRU_OK) return 1;
+    prru_param_dynamics(p, x, v, M, h, G);
+    prru_param_passive(p, x, v, Qp);
+    for (int i = 0; i < 3; i++) tau[i] = M[3 * i] * a[0] + M[3 * i + 1] * a[1] + M[3 * i + 2] * a[2] + h[i] - G[i] - Qp[i];
+    /* J_d^T fd = tau, fd = J_d^+T tau. */
+    for (int i = 0; i < NA; i++) {
+      fd[NA * s + i] = sigma * gauss();
+      for (int k = 0; k < 3; k++) fd[NA * s + i] += data.Jdpinv[k * NA + i] * tau[k];
+    }
   }
   return 0;
 }
@@ -236,7 +247,19 @@ static void check_identify(const prru_base *b)
   double *qdd = malloc(sizeof(double) * 3 * N), *fd = malloc(sizeof(double) * NA * N);
   prru_ident_result *r = malloc(sizeof *r);
   double pi[PRRU_NREG], beta[PRRU_NREG];
-  prru_ident_standard(&prru_mech, pi);
+  prru_mechanism me = prru_mech;
+  if (truth) {
+    memcpy(me.mass, truth->mass, sizeof me.mass);
+    memcpy(me.com, truth->com, sizeof me.com);
+    const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+    for (int k = 0; k < NB; k++)
+      for (int e = 0; e < 6; e++)
+        me.inertia[k][3 * at[e][0] + at[e][1]] = me.inertia[k][3 * at[e][1] + at[e][0]] = truth->inertia[k][e];
+    memcpy(me.armature, truth->armature, sizeof me.armature);
+    memcpy(me.damping, truth->damping, sizeof me.damping);
+    memcpy(me.coulomb, truth->coulomb, sizeof me.coulomb);
+  }
+  prru_ident_standard(&me, pi);
   prru_base_params(b, pi, beta);
   if (!TU_TRUE(q && qd && qdd && fd && r && !make_data(N, 0, q, qd, qdd, fd), "excitation data")) return;
   int bad = -2;
@@ -345,6 +368,17 @@ int main(void)
   if (!b) return 1;
   check_base(b);
   check_identify(b);
+  /* A truth other than the model (the prior): every inertial and drive
+   * number perturbed, Coulomb smoothing as in the base parameters. */
+  prru_mechanism me;
+  prru_params p;
+  tu_rng_state = 99;
+  random_design(&me, &p);
+  p.coulomb_velocity = b->vs;
+  truth = &p;
+  printf("-- data from a perturbed model, the built one as the prior:\n");
+  check_identify(b);
+  truth = NULL;
   check_excite(b);
   free(b);
   return tu_finish("test_ident");

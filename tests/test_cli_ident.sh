@@ -1,0 +1,179 @@
+#!/usr/bin/env bash
+# prru excite and prru identify on the model the binary was built from:
+#  - excite: exit 0, the model line, its columns, no NaN, the bounds it was
+#    given (amplitudes, force limits), byte-identical on a second run, and
+#    its fd columns are what `prru id --traj` computes for its q, qd, qdd;
+#  - identify on excite's own (noise-free) data: every base parameter equals
+#    the model's combination to 1e-9 (relative, or of its resolution), the
+#    written model file is accepted by the generator;
+#  - with Gaussian noise (sigma 0.5 N, seeded) on the forces: every base
+#    parameter within 4 of its reported standard errors of the truth, the
+#    residual sigma within 5 % of 0.5 N;
+#  - from t, the sliders d and fd alone (forward kinematics and
+#    Savitzky-Golay derivatives at 2 ms): within 1e-5;
+#  - bad input: messages naming the option, file and row, exit 2 or 1, and
+#    no model file written (an old one kept).
+# shellcheck source=tests/cli_lib.sh
+. "$(dirname "$0")/cli_lib.sh"
+
+fds=$(act_names fd)
+ds=$(act_names d)
+
+# ---- excite ----
+"$PRRU" excite --evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02 --fd-max "$(nlist 400)" \
+  --out "$tmp/ex.csv" 2>"$tmp/ex.err" && ok || bad "excite: $(cat "$tmp/ex.err")"
+[ "$(head -n 1 "$tmp/ex.csv")" = "$csv_comment" ] && ok || bad "excite: model line: $(head -n 1 "$tmp/ex.csv")"
+grep -qx "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,$ds,$fds" "$tmp/ex.csv" && ok || bad "excite: header"
+grep -qi nan "$tmp/ex.csv" && bad "excite: NaN written" || ok
+grep -q "condition number" "$tmp/ex.err" && ok || bad "excite: no summary on stderr"
+python3 - "$tmp/ex.csv" "$nact" <<'PY' && ok || bad "excite: bounds or row count"
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith('#'))]
+head, data = rows[0], [[float(x) for x in r] for r in rows[1:]]
+col = {n: i for i, n in enumerate(head)}
+n = int(sys.argv[2])
+assert len(data) == 801, len(data)                  # 8 s at 0.01 s, both ends
+assert abs(data[-1][0] - 8.0) < 1e-12
+for r in data:
+    assert abs(r[col['q1']]) <= 0.2 + 1e-12 and abs(r[col['q2']]) <= 0.2 + 1e-12
+    assert abs(r[col['q3']]) <= 0.02 + 1e-12
+    assert all(abs(r[col['fd%d' % (i + 1)]]) <= 400 for i in range(n))
+# periodic: the last row is the first
+assert all(abs(a - b) <= 1e-9 * (1 + abs(b)) for a, b in zip(data[0][1:10], data[-1][1:10]))
+PY
+"$PRRU" excite --evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02 --fd-max "$(nlist 400)" \
+  --out "$tmp/ex2.csv" 2>/dev/null
+cmp -s "$tmp/ex.csv" "$tmp/ex2.csv" && ok || bad "excite is not deterministic"
+"$PRRU" id --traj "$tmp/ex.csv" --out "$tmp/id.csv" 2>"$tmp/id.err" && ok || bad "id on excite's output: $(cat "$tmp/id.err")"
+python3 - "$tmp/ex.csv" "$tmp/id.csv" "$nact" <<'PY' && ok || bad "excite's fd differ from prru id's"
+import csv, sys
+def table(p):
+    rows = list(csv.reader(l for l in open(p) if not l.startswith('#')))
+    return rows[0], [[float(x) for x in r] for r in rows[1:]]
+ha, a = table(sys.argv[1]); hb, b = table(sys.argv[2])
+n = int(sys.argv[3])
+scale = max(abs(r[ha.index('fd1')]) for r in a)
+err = max(abs(ra[ha.index('fd%d' % (i + 1))] - rb[hb.index('fd%d' % (i + 1))])
+          for ra, rb in zip(a, b) for i in range(n))
+assert len(a) == len(b) and err <= 1e-12 * scale, err
+PY
+
+# ---- identify, noise-free ----
+"$PRRU" identify --data "$tmp/ex.csv" --out "$tmp/id.json" --report "$tmp/rep.csv" 2>"$tmp/idf.err" \
+  && ok || bad "identify: $(cat "$tmp/idf.err")"
+[ "$(head -n 1 "$tmp/rep.csv")" = "$csv_comment" ] && ok || bad "identify: report model line"
+# check_report FILE TOL SIGMAS: |estimate - prior| <= TOL max(|prior|,
+# resolution) + SIGMAS se for every base parameter.
+check_report() {
+  python3 - "$1" "$2" "$3" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
+tol, k = float(sys.argv[2]), float(sys.argv[3])
+assert len(rows) > 10
+worst = 0
+for r in rows:
+    e, p, se, res = (float(r[x]) for x in ('estimate', 'prior', 'se', 'resolution'))
+    bound = tol * max(abs(p), res) + k * se
+    worst = max(worst, abs(e - p) / bound)
+print(worst)
+sys.exit(0 if worst <= 1 else 1)
+PY
+}
+w=$(check_report "$tmp/rep.csv" 1e-9 0) && ok || bad "noise-free identification: worst error / bound $w"
+python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/id.json" --out "$tmp/gen" --quiet 2>"$tmp/gen.err" \
+  && ok || bad "the identified model file is refused by the generator: $(cat "$tmp/gen.err")"
+python3 - "$tmp/id.json" "$PRRU_MODEL" <<'PY' && ok || bad "identified masses differ from the model's"
+import json, sys
+a = json.load(open(sys.argv[1])); m = json.load(open(sys.argv[2]))
+for name, body in m["bodies"].items():
+    assert abs(a["bodies"][name]["mass"] - body["mass"]) <= 1e-9 * body["mass"], name
+PY
+
+# ---- identify with noise ----
+# 4 periods of data: enough samples for the noise to average.
+"$PRRU" excite --evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02 --fd-max "$(nlist 400)" \
+  --periods 4 --out "$tmp/ex4.csv" 2>/dev/null
+python3 - "$tmp/ex4.csv" "$tmp/noisy.csv" "$nact" <<'PY'
+import random, sys
+rnd = random.Random(20171)
+out, head = [], None
+for l in open(sys.argv[1]).read().splitlines():
+    if l.startswith('#'):
+        out.append(l); continue
+    if head is None:
+        head = l.split(','); out.append(l); continue
+    v = l.split(',')
+    for i in range(int(sys.argv[3])):
+        k = head.index('fd%d' % (i + 1))
+        v[k] = repr(float(v[k]) + rnd.gauss(0, 0.5))
+    out.append(','.join(v))
+open(sys.argv[2], 'w').write('\n'.join(out) + '\n')
+PY
+"$PRRU" identify --data "$tmp/noisy.csv" --out "$tmp/idn.json" --report "$tmp/repn.csv" 2>"$tmp/idn.err" \
+  && ok || bad "noisy identify: $(cat "$tmp/idn.err")"
+w=$(check_report "$tmp/repn.csv" 0 4) && ok || bad "noisy identification: worst |error| / (4 se) $w"
+sigma=$(sed -n 's/.*residual sigma \([0-9.e+-]*\) N.*/\1/p' "$tmp/repn.csv")
+python3 -c "import sys; sys.exit(0 if abs(float(sys.argv[1]) / 0.5 - 1) < 0.05 else 1)" "$sigma" \
+  && ok || bad "residual sigma $sigma, noise 0.5 N"
+
+# ---- identify from the sliders alone ----
+"$PRRU" excite --evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02 --fd-max "$(nlist 400)" \
+  --dt 0.002 --out "$tmp/exf.csv" 2>/dev/null
+python3 - "$tmp/exf.csv" "$tmp/d.csv" "$nact" <<'PY'
+import sys
+n = int(sys.argv[3])
+keep = ['t'] + ['d%d' % (i + 1) for i in range(n)] + ['fd%d' % (i + 1) for i in range(n)]
+out, idx = [], None
+for l in open(sys.argv[1]).read().splitlines():
+    if l.startswith('#'):
+        out.append(l); continue
+    v = l.split(',')
+    if idx is None:
+        idx = [v.index(k) for k in keep]
+    out.append(','.join(v[i] for i in idx))
+open(sys.argv[2], 'w').write('\n'.join(out) + '\n')
+PY
+"$PRRU" identify --data "$tmp/d.csv" --out "$tmp/idd.json" --report "$tmp/repd.csv" 2>"$tmp/idd.err" \
+  && ok || bad "identify from d: $(cat "$tmp/idd.err")"
+w=$(check_report "$tmp/repd.csv" 1e-5 0) && ok || bad "identification from d and fd: worst error / bound $w"
+
+# ---- bad input ----
+echo old >"$tmp/keep.json"
+expect 2 "--data and --out are required" -- identify --data "$tmp/ex.csv"
+cut -d, -f1-13 "$tmp/ex.csv" >"$tmp/nofd.csv"
+expect 2 "missing column 'fd1'" -- identify --data "$tmp/nofd.csv" --out "$tmp/keep.json"
+awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$2=2.5} {print}' "$tmp/ex.csv" >"$tmp/far.csv"
+expect 1 "data row 3" -- identify --data "$tmp/far.csv" --out "$tmp/keep.json"
+grep -q "not reachable" "$tmp/err" && ok || bad "unreachable row: reason missing: $(cat "$tmp/err")"
+awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$1=0} {print}' "$tmp/ex.csv" >"$tmp/time.csv"
+expect 2 "is not after the previous row's" -- identify --data "$tmp/time.csv" --out "$tmp/keep.json"
+head -n 12 "$tmp/ex.csv" >"$tmp/short.csv"
+expect 1 "fewer than the" -- identify --data "$tmp/short.csv" --out "$tmp/keep.json"
+python3 - "$tmp/ex.csv" "$tmp/flip.csv" <<'PY'
+import sys
+out, head = [], None
+for l in open(sys.argv[1]).read().splitlines():
+    if l.startswith('#'):
+        out.append(l); continue
+    if head is None:
+        head = l.split(','); out.append(l); continue
+    v = l.split(',')
+    for k, name in enumerate(head):
+        if name.startswith('fd'):
+            v[k] = repr(-float(v[k]))
+    out.append(','.join(v))
+open(sys.argv[2], 'w').write('\n'.join(out) + '\n')
+PY
+expect 1 "not physical" -- identify --data "$tmp/flip.csv" --out "$tmp/keep.json" --report "$tmp/flip_rep.csv"
+[ "$(cat "$tmp/keep.json")" = old ] && ok || bad "a refused identification changed the model file"
+expect 2 "--name" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --name Bad-Name
+expect 2 "--coulomb-velocity" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --coulomb-velocity 0
+expect 2 "centre" -- excite --centre 3,0,0 --out "$tmp/c.csv"
+expect 2 "--harmonics" -- excite --harmonics 0 --out "$tmp/c.csv"
+expect 2 "--period" -- excite --period -1 --out "$tmp/c.csv"
+expect 2 "--fd-max" -- excite --fd-max 0 --out "$tmp/c.csv"
+expect 1 "no feasible excitation" -- excite --fd-max 1 --evals 50 --out "$tmp/c.csv"
+[ ! -e "$tmp/c.csv" ] && ok || bad "a refused excite wrote its output"
+[ ! -e "$tmp/x.json" ] && ok || bad "a refused identify wrote its output"
+
+finish test_cli_ident
