@@ -22,7 +22,9 @@ static const char map_help[] =
     "unreachable, or other_mode: a regular pose of the other assembly mode, where\n"
     "det J_d has the opposite sign to the home pose's (q1 = q2 = 0 at this q3),\n"
     "cut off from it by the singular locus, so the robot cannot get there\n"
-    "without passing a singularity%s. w_R is NaN unless the status is ok.\n"
+    "without passing a singularity.\n"
+    "%s"
+    "w_R is NaN unless the status is ok.\n"
     "Prints the model (name, file, sha256) and the global index: the mean of\n"
     "w_R - 1 over the ok points, with the share of the grid that is not ok (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
@@ -59,7 +61,8 @@ int prru_cmd_map(int argc, char **argv)
                             {"shard", 1, &shs, NULL}};
   if (prru_cli_parse("map", argc, argv, opts, 9)) return 2;
   if (help) {
-    printf(map_help, PRRU_NACT > 3 ? " (not tested with more actuators than\ncoordinates: J_d is not square)" : "",
+    printf(map_help, PRRU_NACT > 3 ? "(The test needs a square J_d: with more actuators than coordinates no\n"
+                                   "point is other_mode.)\n" : "",
            PRRU_NACT > 3 ? "+" : "-1", PRRU_CLI_MAP_RCOND_MIN, 1.0 / PRRU_CLI_MAP_RCOND_MIN);
     return 0;
   }
