@@ -85,11 +85,14 @@ typedef struct {
   double Jdpinv[3 * PRRU_NACT];
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
+  /* Q, K, A, P: no call writes them since the reactions are computed in
+   * closed form; kept so that the layout the Python binding mirrors
+   * (python/prru/_lib.py) stays as it is, until both drop them. */
   double Q[PRRU_NH * PRRU_NLAMBDA]; /* reaction basis */
   double K[PRRU_NH];              /* wrench bias */
   double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
   double P[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* its factor, arrowhead order */
-  double r[PRRU_NLAMBDA];
+  double r[PRRU_NLAMBDA];         /* the last prru_reactions' lambda */
   /* The unit null vector z of Q at the last prru_reactions (see
    * prru_reaction_null); all 0 when PRRU_NREACTION_NULL = 0. */
   double lambda_null[PRRU_NLAMBDA];
@@ -166,14 +169,18 @@ int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const doubl
 int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
                        double n[PRRU_NACT]);
 /* The joint reaction coordinates (eq. 31, PRRU_NLAMBDA of them) at the
- * state's qdd, which it solves for first and leaves in d->qdd. The sliders
- * receive the actuator forces net of the drives' armature, damping and
- * friction (model format 2).
+ * state's qdd, which it solves for first and leaves in d->qdd; lambda is
+ * also left in d->r. The sliders receive the actuator forces net of the
+ * drives' armature, damping and friction (model format 2). Computed by the
+ * generated closed form prru_joint_reactions (no linear solve; d->Q, d->K,
+ * d->A and d->P are not written).
  * With PRRU_NREACTION_NULL = 1 (the 4-PRRU) Q^T Phi^-1 Q is singular: every
  * lambda + s z (z: prru_reaction_null) satisfies the equations of motion
  * equally well, and the reactions reported are the solution of least
  * Euclidean norm, lambda . z = 0 (coordinates in N and N m as they stand).
- * z is left in d->lambda_null. Three limbs: the plain SPD solve. */
+ * z is left in d->lambda_null. PRRU_ESINGULAR where the joints cannot
+ * carry the loads at all (a constraint singularity, which shows at rest
+ * too), PRRU_EINPUT where velocities or loads overflow the arithmetic. */
 int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                    const prru_loads *l, double lambda[PRRU_NLAMBDA]);
 /* z: the unit vector spanning null(Q) at q (Q z = 0, |z| = 1), the one
