@@ -1199,6 +1199,11 @@ int prru_cmd_optimize(int argc, char **argv)
   snprintf(report_dir, sizeof report_dir, "%s", report);
   for (size_t l = strlen(report_dir); l > 1 && report_dir[l - 1] == '/'; l--) report_dir[l - 1] = '\0';
   report = report_dir;
+  struct stat rs;
+  if (stat(report, &rs) == 0 && !S_ISDIR(rs.st_mode)) {
+    prru_cli_error(cmd, "--report %s: exists and is not a directory", report);
+    return 2;
+  }
   /* Both outputs are checked before the optimisation runs. */
   prru_cli_catch_signals();
   prru_cli_out jo;

@@ -102,6 +102,9 @@ expect 1 "no feasible design found" -- optimize --vars l2 --range 0.1 --max-iter
   --q2 -1.5:1.5:9 --out "$tmp/bad/m.json" --report "$tmp/bad/rep"
 # A stroke no slider can keep is infeasible too.
 expect 1 "no feasible design found" -- optimize --vars l2 --range 0.1 --max-iter 5 --stroke 50:51 "${B[@]}"
+echo x >"$tmp/bad/file"
+expect 2 "exists and is not a directory" -- optimize --vars l2 --q1 "$Q1" --q2 "$Q2" --out "$tmp/bad/m.json" --report "$tmp/bad/file"
+rm "$tmp/bad/file"
 nothing_written "$tmp/bad" "optimize refusals"
 # An existing model file stays as it was when the run fails.
 echo keep >"$tmp/bad/m.json"
