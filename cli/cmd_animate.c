@@ -16,6 +16,7 @@
 
 static const char animate_help[] =
     "usage: prru animate FILE.csv [--out FILE.gif|-] [--frames N] [--fps F]\n"
+    "                    [--segments FILE.dat]\n"
     "An animated GIF of a run written by prru simulate (or prru paper's\n"
     "paper_sim.csv): the mechanism drawn in 3-D at N instants equally spaced\n"
     "over the run (default 50, at most the number of rows, 2 to 1000), shown\n"
@@ -25,8 +26,11 @@ static const char animate_help[] =
     "The poses are this build's model's; a FILE whose first line names another\n"
     "model (a different sha256) is refused. Writes FILE.gif beside FILE.csv\n"
     "unless --out says where (--out -: stdout); the GIF is replaced only when\n"
-    "the new one is complete. Needs gnuplot. Exit 2 on a bad file or option,\n"
-    "1 when gnuplot is missing or fails or a row's pose is out of reach.\n";
+    "the new one is complete. --segments also writes what is drawn: one line\n"
+    "per segment, x y z dx dy dz body (m, in {S}; body 1 rail, 2 slider, 3\n"
+    "upper link, 4 lower link, 5 platform), frames separated by two blank\n"
+    "lines. Needs gnuplot. Exit 2 on a bad file or option, 1 when gnuplot is\n"
+    "missing or fails or a row's pose is out of reach.\n";
 
 /* Body colours: gnuplot line types set in the script. */
 enum { COL_RAIL = 1, COL_SLIDER, COL_UPPER, COL_LOWER, COL_PLATFORM };
@@ -49,7 +53,7 @@ static void limb_points(const double p[3 * PRRU_NBODY], int i, double A[3], doub
  * between rows would be drawn as a mesh by splot). */
 static void seg(FILE *f, const double a[3], const double b[3], int col)
 {
-  fprintf(f, "%.6g %.6g %.6g %.6g %.6g %.6g %d\n", a[0], a[1], a[2], b[0] - a[0], b[1] - a[1],
+  fprintf(f, "%.12g %.12g %.12g %.12g %.12g %.12g %d\n", a[0], a[1], a[2], b[0] - a[0], b[1] - a[1],
           b[2] - a[2], col);
 }
 
@@ -193,6 +197,8 @@ static int write_frames(const char *cmd, const prru_table *t, const char *dir, l
     free(rows);
     return 1;
   }
+  fputs("# x y z dx dy dz body: segments from (x, y, z) (m, base frame); body 1 rail, 2 slider,\n"
+        "# 3 upper link, 4 lower link, 5 platform; one block per frame\n", f);
   for (long i = 0; i < nframes; i++) {
     const double *r = t->data + (size_t)rows[i] * (size_t)t->ncols;
     const double q[3] = {r[cq[0]], r[cq[1]], r[cq[2]]};
@@ -214,13 +220,14 @@ static int write_frames(const char *cmd, const prru_table *t, const char *dir, l
 
 int prru_cmd_animate(int argc, char **argv)
 {
-  const char *file, *out = NULL, *frames_s = NULL, *fps_s = NULL;
+  const char *file, *out = NULL, *frames_s = NULL, *fps_s = NULL, *segments = NULL;
   int help = 0;
   prru_cli_option opts[] = {{"out", 1, &out, NULL},
                             {"frames", 1, &frames_s, NULL},
                             {"fps", 1, &fps_s, NULL},
+                            {"segments", 1, &segments, NULL},
                             {"help", 0, NULL, &help}};
-  if (prru_cli_parse_file("animate", argc, argv, opts, 4, &file)) return 2;
+  if (prru_cli_parse_file("animate", argc, argv, opts, 5, &file)) return 2;
   if (help) {
     fputs(animate_help, stdout);
     return 0;
@@ -237,8 +244,10 @@ int prru_cmd_animate(int argc, char **argv)
     prru_plot_default_out(file, ".gif", def, sizeof def);
     out = def;
   }
-  if (strcmp(out, file) == 0) {
-    prru_cli_error("animate", "--out %s: that is the input file", out);
+  if (strcmp(out, file) == 0 || (segments && (strcmp(segments, file) == 0 || strcmp(segments, out) == 0))) {
+    prru_cli_error("animate", "--%s %s: that is %s", strcmp(out, file) == 0 ? "out" : "segments",
+                   strcmp(out, file) == 0 ? out : segments,
+                   strcmp(out, file) == 0 || strcmp(segments, file) == 0 ? "the input file" : "--out");
     return 2;
   }
   if (check_model(file)) return 2;
@@ -278,6 +287,10 @@ int prru_cmd_animate(int argc, char **argv)
   if (rc == 0) {
     snprintf(path, sizeof path, "%s/anim.gif", dir);
     rc = prru_plot_deliver("animate", path, out);
+  }
+  if (rc == 0 && segments) {
+    snprintf(path, sizeof path, "%s/frames.dat", dir);
+    rc = prru_plot_deliver("animate", path, segments);
   }
   free(script);
   static const char *const scratch[] = {"frames.dat", "anim.gp", "anim.gif"};

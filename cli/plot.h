@@ -88,8 +88,9 @@ char *prru_plot_animation_script(const char *dat, const char *gif, const char *t
 /* A new scratch directory $TMPDIR/prru-plot-XXXXXX (or /tmp) into dir;
  * 0, or 1 after a message. */
 int prru_plot_scratch(const char *cmd, char *dir, size_t len);
-/* Copies the picture file png to out ("-": stdout) through the CLI's
- * output file (never half-written); 0 or 1 after a message. */
+/* Copies the file png (a picture, or data made for gnuplot) to out ("-":
+ * stdout) through the CLI's output file (never half-written); 0 or 1
+ * after a message. */
 int prru_plot_deliver(const char *cmd, const char *png, const char *out);
 /* The default output name: FILE.csv -> FILE<ext>, other names + ext. */
 void prru_plot_default_out(const char *in, const char *ext, char *out, size_t len);

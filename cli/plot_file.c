@@ -230,7 +230,7 @@ int prru_plot_deliver(const char *cmd, const char *png, const char *out)
 {
   FILE *f = fopen(png, "rb");
   if (!f) {
-    prru_cli_error(cmd, "gnuplot wrote no picture (%s): %s", png, strerror(errno));
+    prru_cli_error(cmd, "%s (made by gnuplot or for it): %s", png, strerror(errno));
     return 1;
   }
   prru_cli_out o;

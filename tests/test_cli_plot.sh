@@ -105,6 +105,42 @@ PATH=/nonexistent "$PRRU" plot "$tmp/run.csv" --out "$tmp/ng.png" 2>"$tmp/err"
 # More frames than rows: one per row (21 rows).
 "$PRRU" animate "$tmp/run.csv" --out "$tmp/all.gif" --frames 500 && [ "$(gif_frames "$tmp/all.gif" | cut -d' ' -f1)" = 21 ] \
   && ok || bad "animate --frames 500 of 21 rows: $(gif_frames "$tmp/all.gif")"
+# What is drawn is the mechanism: per limb (as many as actuators) a
+# vertical rail where the model file puts it, the slider on it, the upper
+# link from the slider of the model's length l1, the lower link from there
+# of length l2, the platform's arm to it of length a (limbs 1, 2) or 0.
+"$PRRU" animate "$tmp/run.csv" --frames 5 --out "$tmp/seg.gif" --segments "$tmp/seg.dat" || bad "animate --segments"
+r=$(python3 - "$tmp/seg.dat" "$PRRU_MODEL" "$nact" <<'PY'
+import json, math, sys
+g = json.load(open(sys.argv[2]))['geometry']; n = int(sys.argv[3])
+per = lambda v, k: v[k] if isinstance(v, list) else v
+if 'b' in g: b = g['b']
+else: b = [g['b12'], g['b12'], g['b3']]
+a = [per(g['a'], k) if k < 2 else 0.0 for k in range(n)]
+rail = [(0, -b[0]), (0, b[1]), (b[2], 0), (-b[3] if n > 3 else 0, 0)][:n]
+frames, errs = [], []
+for line in open(sys.argv[1]):
+    if line.startswith('# frame'): frames.append([])
+    elif line.strip() and not line.startswith('#'): frames[-1].append([float(x) for x in line.split()])
+if len(frames) != 5: errs.append('%d frames' % len(frames))
+close = lambda u, v: abs(u - v) <= 1e-9 * (1 + abs(v))
+length = lambda r: math.sqrt(r[3] ** 2 + r[4] ** 2 + r[5] ** 2)
+for f in frames:
+    for k in range(n):
+        rl, sl, up, lo, arm = f[5 * k:5 * k + 5]
+        if [r[6] for r in (rl, sl, up, lo, arm)] != [1, 2, 3, 4, 5]: errs.append('limb %d: bodies %s' % (k, [r[6] for r in (rl, sl, up, lo, arm)]))
+        if not (close(rl[0], rail[k][0]) and close(rl[1], rail[k][1]) and rl[3] == rl[4] == 0): errs.append('limb %d: rail %s' % (k, rl[:3]))
+        if not (close(sl[0], rl[0]) and close(sl[1], rl[1]) and close(sl[2] + sl[5] / 2, up[2])): errs.append('limb %d: slider off its rail or the link' % k)
+        if not close(length(up), per(g['l1'], k)): errs.append('limb %d: upper link %.12g' % (k, length(up)))
+        if not all(close(lo[c], up[c] + up[c + 3]) for c in range(3)): errs.append('limb %d: links not joined' % k)
+        if not close(length(lo), per(g['l2'], k)): errs.append('limb %d: lower link %.12g' % (k, length(lo)))
+        if not (all(close(arm[c] + arm[c + 3], lo[c] + lo[c + 3]) for c in range(3)) and abs(length(arm) - a[k]) <= 1e-9): errs.append('limb %d: arm %.12g' % (k, length(arm)))
+    if len(f) != 5 * n + 5: errs.append('%d segments' % len(f))
+print('; '.join(errs[:3]) if errs else 'ok')
+PY
+)
+[ "$r" = ok ] && ok || bad "animate draws something else than the model's mechanism: $r"
+expect 2 "--segments $tmp/run.csv: that is the input file" -- animate "$tmp/run.csv" --segments "$tmp/run.csv"
 expect 2 "--frames '1': must be an integer from 2 to 1000" -- animate "$tmp/run.csv" --frames 1
 expect 2 "--fps '0'" -- animate "$tmp/run.csv" --fps 0
 expect 2 "no column 't': not a CSV of prru simulate" -- animate "$tmp/other.csv"
