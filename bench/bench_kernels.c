@@ -11,7 +11,7 @@
 
 /* What the generated side of the runtime's paths executes (runtime/src/core.c,
  * reactions.c): the generated kernels named, plus the listed numerics. */
-#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom: " PRRU_OPS_EOM "; + unrolled 3x3 Cholesky"
+#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom: " PRRU_OPS_EOM "; + 3x3 adjugate solve"
 #if PRRU_NACT == 3
 #define PRRU_BENCH_OPS_JD_INVERSE "3x3 adjugate solve"
 #define PRRU_BENCH_OPS_JD_ALGEBRA "3x3 algebra"
@@ -19,13 +19,11 @@
 #define PRRU_BENCH_OPS_JD_INVERSE "J_d^+ by Householder QR of the 4x3 J_d"
 #define PRRU_BENCH_OPS_JD_ALGEBRA "J_d^+ by Householder QR, 4x4 and 3x4 algebra"
 #endif
-#define PRRU_BENCH_OPS_INVERSE_DYNAMICS "ik_jd + eom (" \
-  PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) \
-  " arithmetic) + " PRRU_BENCH_OPS_JD_INVERSE
-#define PRRU_BENCH_OPS_REACTIONS "forward_dynamics + poses + reaction_basis + wrench_bias (" \
-  PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_POSES) " + " \
-  PRRU_OPS_ARITH_STR(PRRU_ARITH_REACTION_BASIS) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_WRENCH_BIAS) \
-  " arithmetic) + per-body Q^T Phi^-1 Q + arrowhead block Cholesky (GSL)"
+#define PRRU_BENCH_OPS_INVERSE_DYNAMICS "inverse_terms (ik_jd and M qdd - b fused, " \
+  PRRU_OPS_ARITH_STR(PRRU_ARITH_INVERSE_TERMS) " arithmetic) + " PRRU_BENCH_OPS_JD_INVERSE
+#define PRRU_BENCH_OPS_REACTIONS "forward_dynamics + joint_reactions (" \
+  PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_JOINT_REACTIONS) \
+  " arithmetic): closed form, no solve"
 #define PRRU_BENCH_OPS_W_R "ik_jd + mass + platform_jacobian (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_MASS) " + " \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_PLATFORM_JACOBIAN) " arithmetic) + " PRRU_BENCH_OPS_JD_ALGEBRA \

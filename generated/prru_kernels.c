@@ -23,7 +23,8 @@
  *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      432 arithmetic (76 add, 62 sub, 288 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          468 arithmetic (68 add, 73 sub, 318 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      471 arithmetic (75 add, 71 sub, 315 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #include <math.h>
@@ -5128,7 +5129,167 @@ void prru_reaction_basis(const double q[3], double Q[3420])
   Q[3419] = 0.0;
 }
 
-void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double tau[3])
+void prru_eom_solve(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3])
+{
+  const double q1 = q[0];
+  const double q2 = q[1];
+  const double q3 = q[2];
+  const double qd1 = qd[0];
+  const double qd2 = qd[1];
+  const double fd1 = fd[0];
+  const double fd2 = fd[1];
+  const double fd3 = fd[2];
+  const double fp3 = fp[2];
+  const double mp1 = mp[0];
+  const double mp2 = mp[1];
+  const double mp3 = mp[2];
+  const double t0 = cos(q1);
+  const double t1 = cos(q2);
+  const double t2 = t0 * t1;
+  const double t3 = t0 * t0;
+  const double t4 = t1 * t1;
+  const double t5 = sin(q2);
+  const double t6 = t5 * t5;
+  const double t7 = t3 * t4 + t6;
+  const double t8 = sqrt(t7);
+  const double t9 = 1.0 / t8;
+  const double t10 = t2 * t9 - 1.4;
+  /* Unreachable or non-finite q: every output is NaN. */
+  if (!(fabs((1.3333333333333333 - t0) * 1.173913043478261) <= 1.0 &&
+        fabs(t10 * 0.9782608695652174) <= 1.0 &&
+        fabs(q1) <= 1.7976931348623157e308 &&
+        fabs(q2) <= 1.7976931348623157e308 &&
+        fabs(q3) <= 1.7976931348623157e308)) {
+    for (int i = 0; i < 9; i++) M[i] = (double)NAN;
+    for (int i = 0; i < 3; i++) b[i] = (double)NAN;
+    for (int i = 0; i < 3; i++) qdd[i] = (double)NAN;
+    for (int i = 0; i < 3; i++) minors[i] = (double)NAN;
+    return;
+  }
+  const double t11 = sin(q1);
+  const double t12 = t11 * t11;
+  const double t13 = t1 * t11;
+  const double t14 = t9 * t9;
+  const double t15 = t9 * t14;
+  const double t16 = t9 * t13 - t3 * t11 * (t1 * t4) * t15;
+  const double t17 = t16 * t16;
+  const double t18 = 1.0 / t7;
+  const double t19 = t18 * t18;
+  const double t20 = t0 - 1.3333333333333333;
+  const double t21 = t20 * t20;
+  const double t22 = (0.7256515775034293 - t21) * 1.3780718336483933;
+  const double t23 = sqrt(t22);
+  const double t24 = 1.0 / t23;
+  const double t25 = t11 * t20 * t24;
+  const double t26 = t25 * 0.5869565217391305;
+  const double t27 = t0 - t26;
+  const double t28 = t0 + t26;
+  const double t29 = t0 * t11;
+  const double t30 = t15 * (t5 * (t4 * t29));
+  const double t31 = t10 * t10;
+  const double t32 = (1.0449382716049382 - t31) * 0.9569943289224953;
+  const double t33 = sqrt(t32);
+  const double t34 = 1.0 / t33;
+  const double t35 = t10 * t34;
+  const double t36 = t16 * t35;
+  const double t37 = t30 - t36 * 0.4891304347826087;
+  const double t38 = 1.0 / t32;
+  const double t39 = 1.173913043478261 * t25;
+  const double t40 = t0 - t39;
+  const double t41 = t0 + t39;
+  const double t42 = t30 - 0.9782608695652174 * t36;
+  const double t43 = t42 * t42 * 25.154296875 + ((t40 * t40 + t41 * t41) * 36.2221875 + (t17 * t38 * 1.9438947306238186 + (t37 * t37 * 20.724609375 + (t12 * (1.0 / t22) * 5.5984168241965975 + ((t27 * t27 + t28 * t28) * 29.8434375 + (t19 * (t6 * (t4 * t12)) * 0.78125 + (t6 * (t3 * t12 * (t4 * t4)) * (t18 * t19) * 2.53125 + (t17 * 7.71240234375 + (t12 * 14.92171875 + (t6 + t4 * 0.75))))))))));
+  const double t44 = 11.485 + t43;
+  const double t45 = t44 * 0.0032;
+  const double t46 = t9 * (t0 * t5) + t15 * (t5 * (t4 * (t0 * t12)));
+  const double t47 = t1 * t9;
+  const double t48 = t15 * (t6 * (t1 * t12));
+  const double t49 = t47 - t48;
+  const double t50 = t35 * t46;
+  const double t51 = t49 - 0.4891304347826087 * t50;
+  const double t52 = t49 - 0.9782608695652174 * t50;
+  const double t53 = t42 * t52 * 3.2615384615384615 + (t46 * (t16 * t38) * 0.2520478890989288 + (t37 * t51 * 2.687179487179487 + (t19 * (t5 * (t1 * t29)) * 0.10129787907565685 + (t16 * t46 + t30 * t49 * 0.3282051282051282))));
+  const double t54 = t53 * 0.0246796875;
+  const double t55 = t25 * 1.9642992168512017;
+  const double t56 = t36 * 0.6820483391844451;
+  const double t57 = (t56 + (t55 - t30)) * 0.7245;
+  const double t58 = t46 * t46;
+  const double t59 = 3.2615384615384615 * (t52 * t52) + (0.2520478890989288 * (t38 * t58) + (2.687179487179487 * (t51 * t51) + (0.10129787907565685 * (t3 * t19) + (t58 + 0.3282051282051282 * (t49 * t49)))));
+  const double t60 = 0.11345362456473568 + t59;
+  const double t61 = t50 * 0.6820483391844451;
+  const double t62 = 0.7245 * (t61 + (t48 - t47));
+  const double t63 = qd1 * qd2;
+  const double t64 = qd1 * qd1;
+  const double t65 = t0 * t64;
+  const double t66 = t1 * t65;
+  const double t67 = t1 * (t11 * qd1);
+  const double t68 = t4 * (t11 * (t0 * qd1)) - t5 * (t1 * (t12 * qd2));
+  const double t69 = t11 * t63;
+  const double t70 = t5 * t69;
+  const double t71 = qd2 * qd2;
+  const double t72 = t1 * (t0 * t71);
+  const double t73 = t0 * qd2;
+  const double t74 = t5 * t73;
+  const double t75 = t2 * t15;
+  const double t76 = t12 * t64;
+  const double t77 = t12 * t71;
+  const double t78 = t6 * t77 + (t4 * (t3 * t64) - t4 * t76 - t4 * t77) - t5 * (t1 * (t11 * (t0 * t63))) * 4.0;
+  const double t79 = t9 * (t14 * t14);
+  const double t80 = t68 * t68;
+  const double t81 = (t68 * (t15 * t74) + (t15 * t67 * t68 - t9 * t70)) * 2.0 + (t9 * t66 + t9 * t72 - t75 * t78) - t2 * t79 * t80 * 3.0;
+  const double t82 = t1 * qd2;
+  const double t83 = t80 * (t5 * t79) * 1.5 + (t68 * (t15 * t82) - (t9 * (t5 * t71) - t78 * (t5 * t15)) * 0.5);
+  const double t84 = t67 + t74;
+  const double t85 = t68 * (t19 * (t4 * t73 + t5 * t84)) - 0.5 * (t18 * (2.0 * (t5 * t72) + (t4 * t69 - t82 * t84 - t5 * (t66 + t72 - t70 * 2.0))));
+  const double t86 = t11 * t64;
+  const double t87 = t24 * (t24 * t24);
+  const double t88 = t21 * t76 * t87;
+  const double t89 = t24 * (t20 * t65) - t24 * t76;
+  const double t90 = 0.5869565217391305 * t89;
+  const double t91 = t88 * 0.8088682501849265;
+  const double t92 = t9 * t67 + t9 * t74 - t68 * t75;
+  const double t93 = t92 * t92;
+  const double t94 = t34 * (t34 * t34);
+  const double t95 = t93 * (t31 * t94);
+  const double t96 = t35 * t81 - t34 * t93;
+  const double t97 = t95 * 0.23404752609517548 + (t83 - t96 * 0.24456521739130435);
+  const double t98 = t93 * (t10 * t94) - 1.0449382716049382 * (t34 * t81);
+  const double t99 = 1.173913043478261 * t89;
+  const double t100 = t88 * 1.617736500369853;
+  const double t101 = t95 * 0.46809505219035097 + (t83 - 0.4891304347826087 * t96);
+  const double t102 = t30 - t55 - t56;
+  const double t103 = mp1 * 0.14069951578261644 + ((t40 * (t86 + t99 - t100) + t41 * (t100 + (t86 - t99))) * 0.016308621573878853 + (t16 * t34 * t98 * 0.0008375768935282882 + ((t27 * (t86 + t90 - t91) + t28 * (t91 + (t86 - t90))) * 0.013436663057724087 + (t102 - t5 * (t1 * t63) * 0.00022511922525218629 - t11 * t65 * 0.006718331528862044 - t16 * t81 * 0.0034724200809162914 - t30 * t83 * 0.002279332155678386 - t18 * (t5 * t13) * t85 * 0.0007034975789130822) - t11 * t24 * (t24 * t65 - 1.3780718336483933 * (t87 * (t20 * t76))) * 0.0025206225162038866 - t37 * t97 * 0.018662032024616786)) - t42 * t101 * 0.02265086329705396) - (t40 * fd1 - t41 * fd2) * 0.037988869261306436 - t42 * fd3 * 0.031657391051088696;
+  const double t104 = t49 - t61;
+  const double t105 = 0.14069951578261644 * (t0 * mp2 + t11 * mp3) + (0.0008375768935282882 * (t98 * (t34 * t46)) + (t5 * (t1 * t64) * 0.00011255961262609314 + t104 - 0.0034724200809162914 * (t46 * t81) - 0.002279332155678386 * (t49 * t83) - 0.0007034975789130822 * (t85 * (t0 * t18)) - 0.018662032024616786 * (t51 * t97)) - 0.02265086329705396 * (t52 * t101) - 0.031657391051088696 * (t52 * fd3));
+  const double t106 = (fp3 + (fd3 + (fd1 + fd2))) * 0.6901311249137336 + (t95 * 0.3263581963252602 + (t88 * 1.353472711800119 + (t83 - t89 * 0.9821496084256008) - t96 * 0.34102416959222254)) - 83.88260869565218;
+  const double t107 = 0.11345362456473568 + (t59 - t104 * t104 * 1.7165869911632623);
+  const double t108 = t53 - 1.7165869911632623 * (t102 * t104);
+  const double t109 = t53 * t104 - t60 * t102;
+  const double t110 = t102 * t109 * 13.239009533898304 + (t44 * t107 - 7.71240234375 * (t53 * t108));
+  const double t111 = 1.0 / t110;
+  const double t112 = t53 * t102 - t44 * t104 * 0.12966128521684078;
+  const double t113 = t44 * t60 - 7.71240234375 * (t53 * t53);
+  M[0] = t45;
+  M[1] = t54;
+  M[2] = t57;
+  M[3] = t54;
+  M[4] = 0.0246796875 * t60;
+  M[5] = t62;
+  M[6] = t57;
+  M[7] = t62;
+  M[8] = 12.39;
+  b[0] = t103 * 7.107345;
+  b[1] = 7.107345 * t105;
+  b[2] = t106 * 1.449;
+  qdd[0] = t111 * (t103 * t107 - t105 * t108 - t106 * t109 * 0.011921422277509978) * 2221.0453125;
+  qdd[1] = -(2221.0453125 * (t111 * (0.011921422277509978 * (t106 * t112) + (t103 * t108 - t105 * (11.485 + (t43 - 13.239009533898304 * (t102 * t102))) * 0.12966128521684078))));
+  qdd[2] = -(t111 * (t103 * t109 + t105 * t112 - t106 * t113 * 0.0009004769010087451) * 129.87468352754237);
+  minors[0] = t45;
+  minors[1] = t113 * 7.8975e-05;
+  minors[2] = t110 * 0.00097850025;
+}
+
+void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3])
 {
   const double q1 = q[0];
   const double q2 = q[1];
@@ -5161,7 +5322,8 @@ void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[
         fabs(q3) <= 1.7976931348623157e308)) {
     for (int i = 0; i < 3; i++) d[i] = (double)NAN;
     for (int i = 0; i < 9; i++) Jd[i] = (double)NAN;
-    for (int i = 0; i < 3; i++) tau[i] = (double)NAN;
+    for (int i = 0; i < 9; i++) Jdinv[i] = (double)NAN;
+    for (int i = 0; i < 3; i++) fd[i] = (double)NAN;
     return;
   }
   const double t11 = sin(q1);
@@ -5194,69 +5356,76 @@ void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[
   const double t38 = t9 * (t0 * t5) + t27 * (t5 * (t4 * (t0 * t36)));
   const double t39 = t30 * t38;
   const double t40 = 0.9782608695652174 * t39;
-  const double t41 = t37 - t35;
-  const double t42 = qd1 * qd2;
-  const double t43 = qd1 * qd1;
-  const double t44 = t0 * t43;
-  const double t45 = t1 * t44;
-  const double t46 = t1 * (t11 * qd1);
-  const double t47 = t4 * (t11 * (t0 * qd1)) - t5 * (t1 * (t36 * qd2));
-  const double t48 = t11 * t42;
-  const double t49 = t5 * t48;
-  const double t50 = qd2 * qd2;
-  const double t51 = t1 * (t0 * t50);
-  const double t52 = t0 * qd2;
-  const double t53 = t5 * t52;
-  const double t54 = t2 * t27;
-  const double t55 = t36 * t43;
-  const double t56 = t36 * t50;
-  const double t57 = t6 * t56 + (t4 * (t3 * t43) - t4 * t55 - t4 * t56) - t5 * (t1 * (t11 * (t0 * t42))) * 4.0;
-  const double t58 = t9 * (t26 * t26);
-  const double t59 = t47 * t47;
-  const double t60 = (t47 * (t27 * t53) + (t27 * t46 * t47 - t9 * t49)) * 2.0 + (t9 * t45 + t9 * t51 - t54 * t57) - t2 * t58 * t59 * 3.0;
-  const double t61 = t1 * qd2;
-  const double t62 = t47 * (t27 * t61);
-  const double t63 = t9 * (t5 * t50) - t57 * (t5 * t27);
-  const double t64 = t59 * (t5 * t58) * 1.5;
-  const double t65 = t64 + (t62 - t63 * 0.5);
-  const double t66 = 1.0 / t7;
-  const double t67 = t66 * t66;
-  const double t68 = t46 + t53;
-  const double t69 = t47 * (t67 * (t4 * t52 + t5 * t68)) - 0.5 * (t66 * (2.0 * (t5 * t51) + (t4 * t48 - t61 * t68 - t5 * (t45 + t51 - t49 * 2.0))));
-  const double t70 = t22 * 0.5869565217391305;
-  const double t71 = t0 - t70;
-  const double t72 = t11 * t43;
-  const double t73 = t21 * (t21 * t21);
-  const double t74 = t13 * t55 * t73;
-  const double t75 = t21 * (t12 * t44) - t21 * t55;
-  const double t76 = 0.5869565217391305 * t75;
-  const double t77 = t74 * 0.8088682501849265;
-  const double t78 = t0 + t70;
-  const double t79 = t28 - t33 * 0.4891304347826087;
-  const double t80 = t9 * t46 + t9 * t53 - t47 * t54;
-  const double t81 = t80 * t80;
-  const double t82 = t29 * (t29 * t29);
-  const double t83 = t81 * (t18 * t82);
-  const double t84 = t30 * t60 - t29 * t81;
-  const double t85 = t83 * 0.23404752609517548 + (t65 - t84 * 0.24456521739130435);
-  const double t86 = t81 * (t10 * t82) - 1.0449382716049382 * (t29 * t60);
-  const double t87 = t0 - t23;
-  const double t88 = 1.173913043478261 * t75;
-  const double t89 = t74 * 1.617736500369853;
-  const double t90 = t28 - t34;
-  const double t91 = t83 * 0.46809505219035097 + (t65 - 0.4891304347826087 * t84);
-  const double t92 = t32 * t32;
-  const double t93 = 1.0 / t19;
-  const double t94 = t35 - t37;
-  const double t95 = t94 - t39 * 0.4891304347826087;
-  const double t96 = t94 - t40;
-  const double t97 = t90 * t96 * 3.2615384615384615 + (t38 * (t32 * t93) * 0.2520478890989288 + (t79 * t95 * 2.687179487179487 + (t67 * (t5 * (t1 * t25)) * 0.10129787907565685 + (t32 * t38 + t28 * t94 * 0.3282051282051282))));
-  const double t98 = t22 * 1.9642992168512017;
-  const double t99 = t33 * 0.6820483391844451;
-  const double t100 = t28 - t98 - t99;
-  const double t101 = t38 * t38;
-  const double t102 = t39 * 0.6820483391844451;
-  const double t103 = t94 - t102;
+  const double t41 = t35 - t37;
+  const double t42 = t41 - t40;
+  const double t43 = t24 * t42;
+  const double t44 = t0 - t23;
+  const double t45 = t42 * t44;
+  const double t46 = 1.0 / (t43 + t45);
+  const double t47 = t42 * t46 * 3.7037037037037037;
+  const double t48 = t28 * 0.8333333333333334;
+  const double t49 = t33 * 0.8152173913043478;
+  const double t50 = t23 + (t0 + t48) - t49;
+  const double t51 = t49 + (t0 - t48 - t23);
+  const double t52 = qd1 * qd2;
+  const double t53 = qd1 * qd1;
+  const double t54 = t0 * t53;
+  const double t55 = t1 * t54;
+  const double t56 = t1 * (t11 * qd1);
+  const double t57 = t4 * (t11 * (t0 * qd1)) - t5 * (t1 * (t36 * qd2));
+  const double t58 = t11 * t52;
+  const double t59 = t5 * t58;
+  const double t60 = qd2 * qd2;
+  const double t61 = t1 * (t0 * t60);
+  const double t62 = t0 * qd2;
+  const double t63 = t5 * t62;
+  const double t64 = t2 * t27;
+  const double t65 = t36 * t53;
+  const double t66 = t36 * t60;
+  const double t67 = t6 * t66 + (t4 * (t3 * t53) - t4 * t65 - t4 * t66) - t5 * (t1 * (t11 * (t0 * t52))) * 4.0;
+  const double t68 = t9 * (t26 * t26);
+  const double t69 = t57 * t57;
+  const double t70 = (t57 * (t27 * t63) + (t27 * t56 * t57 - t9 * t59)) * 2.0 + (t9 * t55 + t9 * t61 - t64 * t67) - t2 * t68 * t69 * 3.0;
+  const double t71 = t1 * qd2;
+  const double t72 = t57 * (t27 * t71);
+  const double t73 = t9 * (t5 * t60) - t67 * (t5 * t27);
+  const double t74 = t69 * (t5 * t68) * 1.5;
+  const double t75 = t74 + (t72 - t73 * 0.5);
+  const double t76 = 1.0 / t7;
+  const double t77 = t76 * t76;
+  const double t78 = t56 + t63;
+  const double t79 = t57 * (t77 * (t4 * t62 + t5 * t78)) - 0.5 * (t76 * (2.0 * (t5 * t61) + (t4 * t58 - t71 * t78 - t5 * (t55 + t61 - t59 * 2.0))));
+  const double t80 = t22 * 0.5869565217391305;
+  const double t81 = t0 - t80;
+  const double t82 = t11 * t53;
+  const double t83 = t21 * (t21 * t21);
+  const double t84 = t13 * t65 * t83;
+  const double t85 = t21 * (t12 * t54) - t21 * t65;
+  const double t86 = 0.5869565217391305 * t85;
+  const double t87 = t84 * 0.8088682501849265;
+  const double t88 = t0 + t80;
+  const double t89 = t28 - t33 * 0.4891304347826087;
+  const double t90 = t9 * t56 + t9 * t63 - t57 * t64;
+  const double t91 = t90 * t90;
+  const double t92 = t29 * (t29 * t29);
+  const double t93 = t91 * (t18 * t92);
+  const double t94 = t30 * t70 - t29 * t91;
+  const double t95 = t93 * 0.23404752609517548 + (t75 - t94 * 0.24456521739130435);
+  const double t96 = t91 * (t10 * t92) - 1.0449382716049382 * (t29 * t70);
+  const double t97 = 1.173913043478261 * t85;
+  const double t98 = t84 * 1.617736500369853;
+  const double t99 = t28 - t34;
+  const double t100 = t93 * 0.46809505219035097 + (t75 - 0.4891304347826087 * t94);
+  const double t101 = t32 * t32;
+  const double t102 = 1.0 / t19;
+  const double t103 = t41 - t39 * 0.4891304347826087;
+  const double t104 = t42 * t99 * 3.2615384615384615 + (t38 * (t32 * t102) * 0.2520478890989288 + (t89 * t103 * 2.687179487179487 + (t77 * (t5 * (t1 * t25)) * 0.10129787907565685 + (t32 * t38 + t28 * t41 * 0.3282051282051282))));
+  const double t105 = t28 - t22 * 1.9642992168512017 - t33 * 0.6820483391844451;
+  const double t106 = t42 * (t105 * qdd3 * 0.1019367991845056 + (mp1 * 0.14069951578261644 + ((t44 * (t82 + t97 - t98) + t24 * (t98 + (t82 - t97))) * 0.016308621573878853 + (t29 * t32 * t96 * 0.0008375768935282882 + ((t81 * (t82 + t86 - t87) + t88 * (t87 + (t82 - t86))) * 0.013436663057724087 + (t105 - t5 * (t1 * t52) * 0.00022511922525218629 - t11 * t54 * 0.006718331528862044 - (t32 * t70 + t104 * qdd2) * 0.0034724200809162914 - t28 * t75 * 0.002279332155678386 - t5 * t31 * t76 * t79 * 0.0007034975789130822) - t11 * t21 * (t21 * t54 - 1.3780718336483933 * (t83 * (t12 * t65))) * 0.0025206225162038866 - t89 * t95 * 0.018662032024616786)) - t99 * t100 * 0.02265086329705396) - (11.485 + (t99 * t99 * 25.154296875 + ((t44 * t44 + t24 * t24) * 36.2221875 + (t101 * t102 * 1.9438947306238186 + (t89 * t89 * 20.724609375 + (t36 * (1.0 / t14) * 5.5984168241965975 + ((t81 * t81 + t88 * t88) * 29.8434375 + (t77 * (t6 * (t4 * t36)) * 0.78125 + (t6 * (t3 * t36 * (t4 * t4)) * (t76 * t77) * 2.53125 + (t101 * 7.71240234375 + (t36 * 14.92171875 + (t6 + t4 * 0.75)))))))))))) * qdd1 * 0.00045023845050437257));
+  const double t107 = t38 * t38;
+  const double t108 = t41 - t39 * 0.6820483391844451;
+  const double t109 = 0.1019367991845056 * (qdd3 * t108) + (0.14069951578261644 * (t0 * mp2 + t11 * mp3) + (0.0008375768935282882 * (t96 * (t29 * t38)) + (t108 + t5 * (t1 * t53) * 0.00011255961262609314 - 0.0034724200809162914 * (qdd2 * (0.11345362456473568 + (3.2615384615384615 * (t42 * t42) + (0.2520478890989288 * (t102 * t107) + (2.687179487179487 * (t103 * t103) + (0.10129787907565685 * (t3 * t77) + (t107 + 0.3282051282051282 * (t41 * t41))))))) + (t38 * t70 + qdd1 * t104)) - 0.002279332155678386 * (t41 * t75) - 0.0007034975789130822 * (t79 * (t0 * t76)) - 0.018662032024616786 * (t95 * t103)) - 0.02265086329705396 * (t42 * t100)));
+  const double t110 = fp3 * 0.6901311249137336 + (t93 * 0.3263581963252602 + (t84 * 1.353472711800119 + (t74 + (t72 - 0.5 * (t73 - qdd1 * t105 - qdd2 * t108)) - t85 * 0.9821496084256008) - t94 * 0.34102416959222254)) - qdd3 * 8.55072463768116 - 83.88260869565218;
   d[0] = t17 + (q3 - t16);
   d[1] = t17 + (q3 + t16);
   d[2] = 0.23 * t20 + (q3 - t5 * t9 * 0.225);
@@ -5267,11 +5436,20 @@ void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[
   Jd[4] = 0.0;
   Jd[5] = 1.0;
   Jd[6] = 0.225 * (t34 - t28);
-  Jd[7] = 0.225 * (t40 + t41);
+  Jd[7] = 0.225 * (t40 + (t37 - t35));
   Jd[8] = 1.0;
-  tau[0] = ((11.485 + (t90 * t90 * 25.154296875 + ((t87 * t87 + t24 * t24) * 36.2221875 + (t92 * t93 * 1.9438947306238186 + (t79 * t79 * 20.724609375 + (t36 * (1.0 / t14) * 5.5984168241965975 + ((t71 * t71 + t78 * t78) * 29.8434375 + (t67 * (t6 * (t4 * t36)) * 0.78125 + (t6 * (t3 * t36 * (t4 * t4)) * (t66 * t67) * 2.53125 + (t92 * 7.71240234375 + (t36 * 14.92171875 + (t6 + t4 * 0.75)))))))))))) * qdd1 * 0.00045023845050437257 + (t90 * t91 * 0.02265086329705396 + (t79 * t85 * 0.018662032024616786 + (t11 * t21 * (t21 * t44 - 1.3780718336483933 * (t73 * (t12 * t55))) * 0.0025206225162038866 + (t5 * t31 * t66 * t69 * 0.0007034975789130822 + (t28 * t65 * 0.002279332155678386 + ((t32 * t60 + t97 * qdd2) * 0.0034724200809162914 + (t11 * t44 * 0.006718331528862044 + (t5 * (t1 * t42) * 0.00022511922525218629 + (t99 + (t98 - t28)))))) - (t71 * (t72 + t76 - t77) + t78 * (t77 + (t72 - t76))) * 0.013436663057724087)) - t29 * t32 * t86 * 0.0008375768935282882 - (t87 * (t72 + t88 - t89) + t24 * (t89 + (t72 - t88))) * 0.016308621573878853) - mp1 * 0.14069951578261644) - t100 * qdd3 * 0.1019367991845056) * 7.107345;
-  tau[1] = 7.107345 * (0.02265086329705396 * (t91 * t96) + (0.018662032024616786 * (t85 * t95) + (0.0007034975789130822 * (t69 * (t0 * t66)) + (0.002279332155678386 * (t65 * t94) + (0.0034724200809162914 * (qdd2 * (0.11345362456473568 + (3.2615384615384615 * (t96 * t96) + (0.2520478890989288 * (t93 * t101) + (2.687179487179487 * (t95 * t95) + (0.10129787907565685 * (t3 * t67) + (t101 + 0.3282051282051282 * (t94 * t94))))))) + (t38 * t60 + qdd1 * t97)) + (t41 + t102 - t5 * (t1 * t43) * 0.00011255961262609314)))) - 0.0008375768935282882 * (t86 * (t29 * t38))) - 0.14069951578261644 * (t0 * mp2 + t11 * mp3) - 0.1019367991845056 * (qdd3 * t103));
-  tau[2] = (83.88260869565218 + (qdd3 * 8.55072463768116 + (t84 * 0.34102416959222254 + (t75 * 0.9821496084256008 + (0.5 * (t63 - qdd1 * t100 - qdd2 * t103) - t62 - t64) - t74 * 1.353472711800119) - t83 * 0.3263581963252602 - fp3 * 0.6901311249137336))) * 1.449;
+  Jdinv[0] = -t47;
+  Jdinv[1] = t47;
+  Jdinv[2] = 0.0;
+  Jdinv[3] = t46 * t50 * 4.444444444444445;
+  Jdinv[4] = 4.444444444444445 * (t46 * t51);
+  Jdinv[5] = -(t0 * t46 * 8.88888888888889);
+  Jdinv[6] = t43 * t46;
+  Jdinv[7] = t45 * t46;
+  Jdinv[8] = 0.0;
+  fd[0] = t46 * (t106 - t50 * t109 * 1.2 - t43 * t110 * 0.05504587155963303) * 26.3235;
+  fd[1] = -(26.3235 * (t46 * (0.05504587155963303 * (t45 * t110) + (t106 + 1.2 * (t51 * t109)))));
+  fd[2] = t46 * (t0 * t109) * 63.1764;
 }
 
 void prru_joint_reactions(const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57])

@@ -23,7 +23,8 @@
  *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      432 arithmetic (76 add, 62 sub, 288 mul, 6 div); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          468 arithmetic (68 add, 73 sub, 318 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      471 arithmetic (75 add, 71 sub, 315 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
@@ -62,7 +63,8 @@
 #define PRRU_ARITH_ACTUATOR_RATES 148 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 12 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 58 /* arithmetic operations */
-#define PRRU_ARITH_INVERSE_TERMS 432 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 468 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 471 /* arithmetic operations */
 #define PRRU_ARITH_JOINT_REACTIONS 775 /* arithmetic operations */
 #define PRRU_OPS_IK "30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JD "63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -82,7 +84,8 @@
 #define PRRU_OPS_ACTUATOR_RATES "148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INVERSE_TERMS "432 arithmetic (76 add, 62 sub, 288 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "468 arithmetic (68 add, 73 sub, 318 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "471 arithmetic (75 add, 71 sub, 315 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JOINT_REACTIONS "775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
@@ -143,8 +146,11 @@ void prru_passive(const double q[3], const double qd[3], double Qp[3]);
 /* Q (60x57) mapping the joint reaction coordinates lambda to body wrenches about each centre, so that Phi H qdd + K = Fbar + Q lambda. */
 void prru_reaction_basis(const double q[3], double Q[3420]);
 
-/* d, J_d (as prru_ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. */
-void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double tau[3]);
+/* eom's M and b, qdd = M^-1 b by the adjugate, and M's leading principal minors (M00, M00 M11 - M01^2, det M): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
+void prru_eom_solve(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
+
+/* d, J_d (as prru_ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. */
+void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3]);
 
 /* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. */
 void prru_joint_reactions(const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);

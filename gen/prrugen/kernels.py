@@ -81,24 +81,76 @@ def kernels(deriv):
                                                     deriv.mech.joints)),
          [Q], [("Q", deriv.reaction_basis())]),
     ]
+    spec.append(_eom_solve(deriv, m, fd, fp, mp))
     spec.append(_inverse_terms(deriv, d, jd, m, fp, mp))
     spec += _reaction_kernels(deriv, fd, fp, mp)
     return [Kernel(name, doc, ins, outs, guards)
             for name, doc, ins, outs in spec]
 
 
+def _eom_solve(deriv, m, fd, fp, mp):
+    """eom with M qdd = b solved by the adjugate in the same evaluation:
+    the cofactors are products of M's entries, independent of each other,
+    so only one division is serial, and the compiler interleaves them with
+    the rest of the kernel."""
+    b = deriv.eom_rhs(fd, fp, mp)
+    e = [[m[3 * i + j] for j in range(3)] for i in range(3)]
+    cof = [[sym.add(sym.mul(e[(j + 1) % 3][(i + 1) % 3],
+                            e[(j + 2) % 3][(i + 2) % 3]),
+                    -sym.mul(e[(j + 1) % 3][(i + 2) % 3],
+                             e[(j + 2) % 3][(i + 1) % 3]))
+            for j in range(3)] for i in range(3)]
+    # Symmetric M: the adjugate is symmetric; one expression for both.
+    for i in range(3):
+        for j in range(i):
+            cof[i][j] = cof[j][i]
+    det = sym.add(*[sym.mul(e[0][k], cof[k][0]) for k in range(3)])
+    inv_det = sym.power(det, -1)
+    qdd = [sym.mul(sym.add(*[sym.mul(cof[i][k], b[k]) for k in range(3)]),
+                   inv_det) for i in range(3)]
+    minors = [e[0][0], cof[2][2], det]
+    return ("eom_solve", "eom's M and b, qdd = M^-1 b by the adjugate, and "
+            "M's leading principal minors (M00, M00 M11 - M01^2, det M): M "
+            "is positive definite exactly when all three are positive "
+            "(Sylvester), and qdd is meaningful only then.",
+            [Q, QD, _arg("fd", len(fd)), _arg("fp", 3), _arg("mp", 3)],
+            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)])
+
+
 def _inverse_terms(deriv, d, jd, m, fp, mp):
-    """ik_jd and the generalized force of the drives in one kernel: inverse
-    dynamics needs both, and they share the inverse kinematics."""
+    """Inverse dynamics in one evaluation: ik_jd, and the generalized force
+    tau = M qdd - b that the drives supply (J_d^T fd = tau); with three
+    actuators also J_d^-1 by its adjugate and fd = J_d^-T tau, so the
+    runtime only judges J_d's conditioning. Four actuators need J_d^+,
+    which the runtime forms by a QR of J_d."""
     qdd = _vec("qdd")
     b = deriv.eom_rhs([sym.ZERO] * len(d), fp, mp)
     tau = [sym.add(*([sym.mul(m[3 * i + j], qdd[j]) for j in range(3)]
                      + [-b[i]])) for i in range(3)]
-    return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h - G "
-            "- J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the "
-            "drives supply: J_d^T fd = tau.",
-            [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)],
-            [("d", d), ("Jd", jd), ("tau", tau)])
+    ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
+    if len(d) != 3:
+        return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h "
+                "- G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized "
+                "force the drives supply: J_d^T fd = tau.", ins,
+                [("d", d), ("Jd", jd), ("tau", tau)])
+    e = [[jd[3 * i + j] for j in range(3)] for i in range(3)]
+    # cof[i][j]: the cofactor of e[i][j]; J_d^-1 = cof^T / det.
+    cof = [[sym.add(sym.mul(e[(i + 1) % 3][(j + 1) % 3],
+                            e[(i + 2) % 3][(j + 2) % 3]),
+                    -sym.mul(e[(i + 1) % 3][(j + 2) % 3],
+                             e[(i + 2) % 3][(j + 1) % 3]))
+            for j in range(3)] for i in range(3)]
+    inv_det = sym.power(sym.add(*[sym.mul(e[0][k], cof[0][k])
+                                  for k in range(3)]), -1)
+    inv = [sym.mul(cof[j][i], inv_det) for i in range(3) for j in range(3)]
+    # fd = J_d^-T tau: fd_i = sum_k (J_d^-1)_ki tau_k = sum_k cof_ik tau_k / det.
+    fd = [sym.mul(sym.add(*[sym.mul(cof[i][k], tau[k]) for k in range(3)]),
+                  inv_det) for i in range(3)]
+    return ("inverse_terms", "d, J_d (as prru_ik_jd), J_d^-1 (by the "
+            "adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T "
+            "tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: "
+            "the actuator forces of the motion.", ins,
+            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd)])
 
 
 def _reaction_kernels(deriv, fd, fp, mp):

@@ -138,7 +138,9 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
  * the workspace, PRRU_ESINGULAR at a singular J_d. */
 int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                                 const double seed[3], double q[3], double *residual);
-/* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h (Cholesky). */
+/* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved
+ * inside the generated prru_eom_solve by M's adjugate; PRRU_ESINGULAR
+ * unless M is positive definite (its leading principal minors positive). */
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3]);
 /* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored):

@@ -223,30 +223,6 @@ static int classify_failure(const prru_model *m, prru_data *d, const double q[3]
   return finite3(b) ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
 
-/* Solves M x = b in place by Cholesky, unrolled for 3x3: GSL's generic
- * gsl_linalg_cholesky_decomp1 + svx cost about 200 ns here, twice the whole
- * generated dynamics kernel, so the hot path does the same arithmetic
- * inline (the reference and the 57x57 reaction system use GSL's). */
-static int solve_spd3(const double M[9], double b[3])
-{
-  double l00 = M[0];
-  if (!(l00 > 0)) return PRRU_ESINGULAR;
-  l00 = sqrt(l00);
-  double l10 = M[3] / l00, l20 = M[6] / l00;
-  double l11 = M[4] - l10 * l10;
-  if (!(l11 > 0)) return PRRU_ESINGULAR;
-  l11 = sqrt(l11);
-  double l21 = (M[7] - l20 * l10) / l11;
-  double l22 = M[8] - l20 * l20 - l21 * l21;
-  if (!(l22 > 0)) return PRRU_ESINGULAR;
-  l22 = sqrt(l22);
-  double y0 = b[0] / l00, y1 = (b[1] - l10 * y0) / l11, y2 = (b[2] - l20 * y0 - l21 * y1) / l22;
-  b[2] = y2 / l22;
-  b[1] = (y1 - l21 * b[2]) / l11;
-  b[0] = (y0 - l10 * b[1] - l20 * b[2]) / l00;
-  return PRRU_OK;
-}
-
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3])
 {
@@ -254,39 +230,76 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * the loads are checked here; NaN/inf in q or qd, or q out of reach,
    * always shows in b. */
   if (!loads_finite(l)) return PRRU_EINPUT;
-  prru_eom(q, qd, l->fd, l->fp, l->mp, d->M, d->b);
+  /* M qdd = b solved inside the kernel by M's adjugate (one division, the
+   * cofactors scheduled with the rest of the kernel: a separate Cholesky
+   * chained three square roots and six divisions after it). Whether M is
+   * positive definite is Sylvester's criterion on the leading minors the
+   * kernel returns: otherwise qdd is not used. */
+  double minors[3];
+  prru_eom_solve(q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
   if (!finite3(d->b)) {
     if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
     return classify_failure(m, d, q);
   }
-  memcpy(d->qdd, d->b, sizeof d->b);
-  int st = solve_spd3(d->M, d->qdd);
-  if (st != PRRU_OK) return st;
+  if (!(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0)) return PRRU_ESINGULAR;
   if (!finite3(d->qdd)) return PRRU_EINPUT; /* b finite, M^-1 b overflowed */
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }
 
+#if PRRU_NACT == 3
+/* prru_jd_regular's test rc >= rcond_min, rc = 1 / (|Js|_1 |Js^-1|_1) with
+ * Js = J_d diag(1/L, 1/L, 1), from J_d and J_d^-1 (Js^-1 = diag(L, L, 1)
+ * J_d^-1) and without a division on the kernel's outputs: with
+ * p = L |Js|_1 |Js^-1|_1 = L / rc, the test is p rcond_min <= L. False
+ * where J_d^-1 is not finite (J_d singular). */
+static int regular_from_inverse(const double J[9], const double inv[9], double L,
+                                double rcond_min)
+{
+  double na = 0, ni = 0; /* na = L |Js|_1, ni = |Js^-1|_1 */
+  for (int j = 0; j < 3; j++) {
+    const double sa = fabs(J[j]) + fabs(J[3 + j]) + fabs(J[6 + j]);
+    const double si = L * (fabs(inv[j]) + fabs(inv[3 + j])) + fabs(inv[6 + j]);
+    na = fmax(na, j < 2 ? sa : L * sa);
+    if (!(si <= ni)) ni = si; /* NaN propagates */
+  }
+  const double p = na * ni;
+  return p > 0 && isfinite(p) && p * rcond_min <= L;
+}
+#endif
+
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[PRRU_NACT])
 {
-  static const double zero_fd[PRRU_NACT] = {0};
   if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))
     return PRRU_EINPUT;
-  int st = prru_check_regular(m, d, q, NULL);
+#if PRRU_NACT == 3
+  /* One kernel gives d, J_d, J_d^-1 and fd = J_d^-T (M qdd - b); here only
+   * prru_check_regular's test, on that J_d and J_d^-1. */
+  double f[3];
+  prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
+  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
+    return PRRU_ESINGULAR;
+  if (!finite_n(f, 3)) return PRRU_EINPUT;
+  memcpy(fd, f, sizeof f);
+  return PRRU_OK;
+#else
+  /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
+   * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
+  double tau[3];
+  prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, tau);
+  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  int st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
   if (st != PRRU_OK) return st;
-  /* J_d^T fd = M qdd - (G + J_T,P^T fp + J_R,P^T mp - h). */
-  prru_eom(q, qd, zero_fd, l->fp, l->mp, d->M, d->b);
-  double r[3];
   const double *inv = d->Jdpinv;
   enum { N = PRRU_NACT };
-  for (int i = 0; i < 3; i++)
-    r[i] = d->M[3 * i] * qdd[0] + d->M[3 * i + 1] * qdd[1] + d->M[3 * i + 2] * qdd[2] - d->b[i];
-  /* fd = J_d^+T r: row i of J_d^+T is column i of J_d^+ (3 x NACT); the
-   * solution of J_d^T fd = r of least norm (J_d^-T r for three). */
-  for (int i = 0; i < N; i++) fd[i] = inv[i] * r[0] + inv[N + i] * r[1] + inv[2 * N + i] * r[2];
+  /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
+   * solution of J_d^T fd = tau of least norm. */
+  for (int i = 0; i < N; i++) fd[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
   return finite_n(fd, N) ? PRRU_OK : PRRU_EINPUT;
+#endif
 }
 
 /* n from J_d (regular): n_i = (-1)^i det(J_d without row i), the
