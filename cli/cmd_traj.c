@@ -133,10 +133,12 @@ static const char traj_help[] =
     "(d the slider heights, dd their velocities) every dt (default 1 ms; the\n"
     "last row at the end). The file is a trajectory for 'prru id --traj' and\n"
     "'prru track --ref'. Every sample is checked: a pose outside the workspace\n"
-    "or at a singularity (J_d singular to the model's tolerance) stops with a\n"
-    "message naming the sample, its time, segment and pose, and exit 1; the rows\n"
-    "before it are kept. Bad options exit 2 with nothing written; --out FILE is\n"
-    "built as FILE.partial-XXXXXX and renamed.\n";
+    "or at a singularity (J_d singular to the model's tolerance), or, with three\n"
+    "actuators, a sign change of det J_d since the previous sample (the path\n"
+    "crossed a singularity in between), stops with a message naming the sample,\n"
+    "its time, segment and pose, and exit 1; the rows before it are kept, none\n"
+    "holds NaN. Bad options exit 2 with nothing written; --out FILE is built as\n"
+    "FILE.partial-XXXXXX and renamed.\n";
 
 static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *why, size_t whylen)
 {
@@ -288,10 +290,14 @@ static const char track_help[] =
     "--seed (default 1): the same seed gives the same run.\n"
     "Limits: --fmax, one force limit (N) for every actuator or one each;\n"
     "--stroke, the slider range (m), for all sliders or per slider. The\n"
-    "reference must stay inside the workspace, away from singularities and in\n"
-    "the stroke, checked at every row and at least every millisecond (else\n"
-    "exit 2, nothing written); a plant\n"
-    "that leaves its stroke stops the run (exit 1, rows kept).\n"
+    "reference must stay inside the workspace, away from singularities (and\n"
+    "not cross one: det J_d keeps its sign) and in the stroke, checked at\n"
+    "every row and at least every millisecond (else exit 2, nothing written).\n"
+    "A plant found outside its stroke at a row stops the run (exit 1, rows\n"
+    "kept), as does a controller meeting a singular pose.\n"
+    "--q0-offset E starts the plant at q_ref(0) - E (an initial error);\n"
+    "--atol, --rtol: the integrator's tolerances (default 1e-12, at least\n"
+    "2.2e-14).\n"
     "Output: the model line, a line with the settings, then\n"
     "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,\n"
     "  %s,%s,\n"
