@@ -1,7 +1,8 @@
 /* prru animate: an animated GIF of a simulated run, the mechanism's bodies
  * (rails, sliders, upper and lower links, platform) placed at every frame
  * by the generated pose kernel prru_poses, limb by limb as the mechanism
- * descriptor lists them. */
+ * descriptor lists them (the frame origins of docs/model.md section 4,
+ * not the centres of mass). */
 #define _POSIX_C_SOURCE 200809L /* getline */
 #include <errno.h>
 #include <math.h>
@@ -35,15 +36,27 @@ static const char animate_help[] =
 /* Body colours: gnuplot line types set in the script. */
 enum { COL_RAIL = 1, COL_SLIDER, COL_UPPER, COL_LOWER, COL_PLATFORM };
 
+/* The origin of body b's frame: prru_poses gives the centre of mass p_b =
+ * origin + R_b com_b (the two differ for a model with offset centres). */
+static void frame_origin(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_NBODY], int b,
+                         double o[3])
+{
+  const double *Rb = R + 9 * b, *cb = prru_mech.com[b];
+  for (int c = 0; c < 3; c++)
+    o[c] = p[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
+}
+
 /* The joint centres of limb i at the poses (R, p) of prru_poses: slider
  * A_i (the slider's frame origin), B_i and C_i from the link frames'
  * origins, which are the links' midpoints (docs/model.md section 4). */
-static void limb_points(const double p[3 * PRRU_NBODY], int i, double A[3], double B[3], double C[3])
+static void limb_points(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_NBODY], int i,
+                        double A[3], double B[3], double C[3])
 {
-  const double *s = p + 3 * prru_mech.slider[i], *u = p + 3 * prru_mech.upper[i],
-               *l = p + 3 * prru_mech.lower[i];
+  double u[3], l[3];
+  frame_origin(R, p, prru_mech.slider[i], A);
+  frame_origin(R, p, prru_mech.upper[i], u);
+  frame_origin(R, p, prru_mech.lower[i], l);
   for (int c = 0; c < 3; c++) {
-    A[c] = s[c];
     B[c] = 2.0 * u[c] - A[c];
     C[c] = 2.0 * l[c] - B[c];
   }
@@ -91,7 +104,9 @@ static int frame(FILE *out, const double q[3], extent *e)
   for (int k = 0; k < 3 * PRRU_NBODY; k++)
     if (!isfinite(p[k])) return -1;
   const int P = prru_mech.platform;
-  const double *RP = R + 9 * P, *O = p + 3 * P, h = plate_half();
+  const double *RP = R + 9 * P, h = plate_half();
+  double O[3];
+  frame_origin(R, p, P, O);
   double corner[4][3], normal[3];
   for (int k = 0; k < 4; k++) {
     double x = (k == 0 || k == 3) ? -h : h, y = k < 2 ? -h : h;
@@ -100,7 +115,7 @@ static int frame(FILE *out, const double q[3], extent *e)
   for (int c = 0; c < 3; c++) normal[c] = O[c] + RP[3 * c + 2] * h;
   for (int i = 0; i < PRRU_NLIMB; i++) {
     double A[3], B[3], C[3];
-    limb_points(p, i, A, B, C);
+    limb_points(R, p, i, A, B, C);
     if (!out) {
       grow(e, A);
       grow(e, B);
