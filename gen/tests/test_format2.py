@@ -285,7 +285,9 @@ class Determinism(unittest.TestCase):
         self.assertEqual(sorted(files), ["prru_kernels.c", "prru_kernels.h",
                                          "prru_mechanism.c", "prru_mechanism.h",
                                          "prru_param_kernels.c",
-                                         "prru_param_kernels.h"])
+                                         "prru_param_kernels.h",
+                                         "prru_regressor.c",
+                                         "prru_regressor.h"])
         self.assertIn('/* .name = */ "proto"', files["prru_mechanism.c"])
         own, _ = prru_gen.generate(PROTO)
         self.assertIn("void proto_dynamics(", own["proto_kernels.c"])

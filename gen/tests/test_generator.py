@@ -126,7 +126,9 @@ class CommandLine(unittest.TestCase):
                                            "prru_mechanism.c",
                                            "prru_mechanism.h",
                                            "prru_param_kernels.c",
-                                           "prru_param_kernels.h"])
+                                           "prru_param_kernels.h",
+                                           "prru_regressor.c",
+                                           "prru_regressor.h"])
 
     def test_help_and_summary(self):
         r = run_gen("--help")

@@ -70,7 +70,8 @@ class ConstantKernelsUnchanged(unittest.TestCase):
             alone, _ = render.render(m, deriv, prru_gen.TEMPLATES, "prru")
             files, _ = prru_gen.generate_model(m, prefix="prru")
             self.assertEqual(sorted(files), sorted(alone) + [
-                "prru_param_kernels.c", "prru_param_kernels.h"])
+                "prru_param_kernels.c", "prru_param_kernels.h",
+                "prru_regressor.c", "prru_regressor.h"])
             for name, text in alone.items():
                 self.assertEqual(files[name], text, "%s: %s" % (path, name))
 
