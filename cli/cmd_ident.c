@@ -36,9 +36,9 @@ static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_ba
 
 static const char excite_help[] =
     "usage: prru excite [--out FILE.csv|-] [--period T] [--harmonics L] [--periods N]\n"
-    "                   [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3]\n"
-    "                   [--fd-max F | F1,...] [--rcond-min R] [--evals N] [--samples N]\n"
-    "                   [--seed S] [--coulomb-velocity VS]\n"
+    "         [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3] [--fd-max F|F1,..]\n"
+    "         [--rcond-min R] [--evals N] [--samples N] [--seed S]\n"
+    "         [--coulomb-velocity VS]\n"
     "An excitation trajectory for identification: each coordinate a Fourier\n"
     "series q_k(t) = c_k + sum_l (a_kl sin(l w t) + b_kl cos(l w t)), w = 2 pi / T\n"
     "(default T = 10 s, L = 5 harmonics, centre c = 0), whose coefficients are\n"
@@ -50,11 +50,13 @@ static const char excite_help[] =
     "assembly mode, |q_k - c_k| <= A_k (default 0.25 rad, 0.25 rad, 0.1 L with L\n"
     "the mean upper-link length), and the actuator forces of this model's\n"
     "inverse dynamics (no platform loads) within --fd-max (N, one value for all\n"
-    "or one per actuator, default 500). The result is then checked at 2000\n"
-    "points per period, and shrunk about the centre until it passes.\n"
+    "or one per actuator, default 500). The result is then checked at 20 times\n"
+    "as many points, and shrunk about the centre until it passes.\n"
     "Writes the model line, comment lines with the coefficients and the\n"
-    "condition number, then t,q1..q3,qd1..qd3,qdd1..qdd3,%s,%s at --dt (default\n"
-    "0.01 s) over --periods periods (default 1; the last row at N T), to\n"
+    "condition number, then the columns\n"
+    "  t,q1..q3,qd1..qd3,qdd1..qdd3,%s,%s\n"
+    "at --dt (default 0.01 s) over --periods periods (default 1; the last row\n"
+    "at N T), to\n"
     "--out (default stdout): a trajectory for `prru id --traj` and, with\n"
     "measured forces in the fd columns, data for `prru identify`. A summary goes\n"
     "to stderr. Exit 2 for bad options or an unreachable or singular centre, 1\n"
@@ -136,7 +138,7 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
   if (a->samples && parse_count(c, "samples", a->samples, 1, 100000, &o->samples)) return 2;
   if (a->seed && parse_count(c, "seed", a->seed, 0, 2000000000, &seed)) return 2;
   o->seed = (unsigned long)seed;
-  if (o->check_samples < o->samples) o->check_samples = 20 * o->samples;
+  o->check_samples = 20 * o->samples;
   if (*dt > f->period * *periods) {
     prru_cli_error(c, "--dt: %s is longer than the run (%g s)", a->dt, f->period * *periods);
     return 2;
@@ -274,7 +276,7 @@ int prru_cmd_excite(int argc, char **argv)
 
 static const char identify_help[] =
     "usage: prru identify --data FILE.csv --out MODEL.json [--report FILE.csv|-]\n"
-    "                     [--name NAME] [--coulomb-velocity VS] [--window M] [--degree P]\n"
+    "         [--name NAME] [--coulomb-velocity VS] [--window M] [--degree P]\n"
     "Least-squares identification of the base inertial parameters from measured\n"
     "motion and actuator forces. FILE (header row, '#' lines skipped, columns in\n"
     "any order) has t (s, increasing), the forces %s (N) and the pose as\n"
@@ -302,8 +304,9 @@ static const char identify_help[] =
     "sigma, condition number, parameters kept from the prior), then\n"
     "index,parameter,estimate,se,prior,resolution,combination per base\n"
     "parameter (prior: the combination at this model's numbers; resolution:\n"
-    "the value at which it alone would give forces of the data's RMS size). Model files hold no magnitude\n"
-    "below 1e-9 but 0: smaller values are written as 0.\n"
+    "the value at which it alone would give forces of the data's RMS size).\n"
+    "Model files hold no magnitude below 1e-9 but 0: smaller values are\n"
+    "written as 0.\n"
     "Exit 2 for bad options or a malformed FILE, 1 when a row is unreachable or\n"
     "singular (named), the data do not excite every base parameter, or the\n"
     "result is not physical (a mass <= 0, an inertia not positive definite, a\n"
