@@ -116,6 +116,20 @@ static int parse_problem(const char *cmd, const problem_text *t, prru_design_pro
   return 0;
 }
 
+/* --threads N: 1 to 256 (the result is the same for any); 0 or 2. */
+static int parse_threads(const char *cmd, const char *text, int *n)
+{
+  if (!text) return 0;
+  char *end;
+  long v = strtol(text, &end, 10);
+  if (!*text || *end || v < 1 || v > 256) {
+    prru_cli_error(cmd, "--threads '%s': must be an integer from 1 to 256", text);
+    return 2;
+  }
+  *n = (int)v;
+  return 0;
+}
+
 /* The settings that define a result, one line: shards of one sweep must
  * agree on it. */
 static void problem_line(char *buf, size_t len, const prru_design_problem *pr, const char *extra)
@@ -301,6 +315,7 @@ static const char sens_help[] =
     "                        --out FILE.csv [--params NAME,...] [--step H]\n"
     "                        [--objective mean|max|log] [--rcond-min R]\n"
     "                        [--set NAME=VALUE,...] [--shard K/N] [--plot FILE.png]\n"
+    "                        [--threads N]\n"
     "The derivative of the global index (the objective: mean of w_R - 1 over the\n"
     "regular grid points, or max w_R, or mean ln w_R) with respect to every\n"
     "parameter of the design (the paper's influence of the kinematic and inertial\n"
@@ -321,7 +336,8 @@ static const char sens_help[] =
     "--plot: a bar chart of the 30 largest |scaled|.\n"
     "--shard K/N: only the K-th of N contiguous parts of the parameter list (a\n"
     "cluster job array runs one part per task); 'prru merge' joins the parts into\n"
-    "exactly the file one run writes.\n";
+    "exactly the file one run writes. --threads: per evaluation (default 2; the\n"
+    "numbers are the same for any).\n";
 
 typedef struct {
   int nparam;
@@ -378,14 +394,14 @@ int prru_cmd_sensitivity(int argc, char **argv)
 {
   const char *cmd = "sensitivity";
   problem_text t = {0};
-  const char *out = NULL, *params = NULL, *steps = NULL, *shards = NULL, *plot = NULL;
-  int help = 0;
+  const char *out = NULL, *params = NULL, *steps = NULL, *shards = NULL, *plot = NULL, *ths = NULL;
+  int help = 0, nthreads = 2;
   prru_cli_option opts[] = {
       {"q1", 1, &t.q1, NULL},         {"q2", 1, &t.q2, NULL},       {"q3", 1, &t.q3, NULL},
       {"rcond-min", 1, &t.rcond, NULL}, {"objective", 1, &t.objective, NULL},
       {"set", 1, &t.set, NULL},       {"out", 1, &out, NULL},       {"params", 1, &params, NULL},
       {"step", 1, &steps, NULL},      {"shard", 1, &shards, NULL},  {"plot", 1, &plot, NULL},
-      {"help", 0, NULL, &help}};
+      {"threads", 1, &ths, NULL},     {"help", 0, NULL, &help}};
   if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (help) {
     fputs(sens_help, stdout);
@@ -398,7 +414,7 @@ int prru_cmd_sensitivity(int argc, char **argv)
   }
   prru_design_problem pr;
   prru_params p;
-  if (parse_problem(cmd, &t, &pr, &p)) return 2;
+  if (parse_problem(cmd, &t, &pr, &p) || parse_threads(cmd, ths, &nthreads)) return 2;
   double h = 1e-4;
   if (steps && prru_cli_number(cmd, "step", steps, &h)) return 2;
   if (!(h > 0 && h < 0.5)) {
@@ -427,6 +443,7 @@ int prru_cmd_sensitivity(int argc, char **argv)
   prru_design_eval ev;
   sens_row *rows = calloc((size_t)pl.nparam, sizeof *rows);
   rc = rows && prru_design_data_alloc(&dd, &pr.grid) == PRRU_OK ? 0 : 1;
+  dd.nthreads = nthreads;
   if (rc) prru_cli_error(cmd, "out of memory");
   else rc = base_eval(cmd, &pr, &p, &dd, &ev);
   char extra[128], settings[1024];
@@ -767,11 +784,12 @@ int prru_cmd_merge(int argc, char **argv)
 /* ---- prru optimize ---- */
 
 static const char opt_help[] =
-    "usage: prru optimize --vars SPEC[,SPEC...] --q1 START:STOP:COUNT --q2 START:STOP:COUNT\n"
-    "                     [--q3 Z] --out MODEL.json --report DIR [--range PCT]\n"
-    "                     [--objective mean|max|log] [--rcond-min R] [--stroke LO:HI]\n"
-    "                     [--set NAME=VALUE,...] [--max-iter N] [--penalty W]\n"
-    "                     [--name NAME] [--progress]\n"
+    "usage: prru optimize --vars SPEC[,SPEC...] --q1 START:STOP:COUNT\n"
+    "                     --q2 START:STOP:COUNT [--q3 Z] --out MODEL.json\n"
+    "                     --report DIR [--range PCT] [--objective mean|max|log]\n"
+    "                     [--rcond-min R] [--stroke LO:HI] [--set NAME=VALUE,...]\n"
+    "                     [--max-iter N] [--penalty W] [--name NAME] [--threads N]\n"
+    "                     [--progress]\n"
     "Chooses the design variables within their bounds so that the rotational\n"
     "dynamic manipulability w_R comes as close to 1 (isotropy) as it can over the\n"
     "workspace rectangle (grid as in 'prru map'), the paper's purpose for w_R.\n"
@@ -779,7 +797,8 @@ static const char opt_help[] =
     "over the grid; max the largest w_R; log the mean of ln w_R.\n"
     "Constraints: every grid point reachable and regular (J_d's scaled\n"
     "1/(|J|_1 |J^-1|_1) >= R, default 4e-3, i.e. cond_1 <= 250, the test of\n"
-    "'prru map --rcond-min'), and with --stroke every slider height d_i within\n"
+    "'prru map --rcond-min'; a pose of the other assembly mode counts as\n"
+    "singular, as there), and with --stroke every slider height d_i within\n"
     "[LO, HI] (m) on the grid. They enter as a penalty W x violation (default W\n"
     "1000), continuous so that an infeasible start (singular points in the\n"
     "rectangle) can move into feasibility; the result is accepted only when it\n"
@@ -793,17 +812,19 @@ static const char opt_help[] =
     "Optimiser: the Nelder-Mead simplex method on a sine transform of each\n"
     "variable onto its bounds, restarted from the best point while that helps,\n"
     "at most N iterations in all (default 600); deterministic: the same command\n"
-    "gives the same bits. Progress on stderr (--progress, or a terminal).\n"
+    "gives the same bits, whatever --threads (per evaluation, default 2).\n"
+    "Progress on stderr (--progress, or a terminal).\n"
     "Writes MODEL.json, the optimised design as a format-2 model file (name NAME,\n"
     "default the model's name + _opt), ready to build the tool and the dynamics\n"
-    "code from ('make test MODEL=MODEL.json'), and DIR/ with report.txt (before and after:\n"
-    "global index, mean ln w_R, max w_R, singular fraction, slider range; every\n"
-    "variable before, after and its bounds; iterations), before_map.csv and\n"
-    "after_map.csv (as 'prru map' writes them) and optimize_maps.png (both w_R\n"
-    "maps side by side). Nothing is written unless a feasible design is found\n"
-    "(exit 1 otherwise); the files are built aside and renamed. Bad options, a\n"
-    "start design that is not a buildable robot, bounds with LO >= HI or not\n"
-    "around the start: exit 2. No regular grid point at the start: exit 1.\n";
+    "code from ('make test MODEL=MODEL.json'), and DIR/ with report.txt (before\n"
+    "and after: global index, mean ln w_R, max w_R, singular fraction, slider\n"
+    "range; every variable before, after and its bounds; iterations),\n"
+    "before_map.csv and after_map.csv (as 'prru map' writes them) and\n"
+    "optimize_maps.png (both w_R maps side by side). Nothing is written unless a\n"
+    "feasible design is found (exit 1 otherwise); the files are built aside and\n"
+    "renamed. Bad options, a start design that is not a buildable robot, bounds\n"
+    "with LO >= HI or not around the start, a --report that is a file: exit 2.\n"
+    "No regular grid point at the start: exit 1.\n";
 
 /* Bounds -+ pct % of the start value (of the variable's scale at 0). */
 static void default_bounds(const prru_params *p, prru_design_var *v, double pct)
@@ -1130,7 +1151,7 @@ int prru_cmd_optimize(int argc, char **argv)
   const char *cmd = "optimize";
   problem_text t = {0};
   const char *vars_s = NULL, *out = NULL, *report = NULL, *range = NULL, *iters = NULL, *pen = NULL,
-             *name_s = NULL;
+             *name_s = NULL, *ths = NULL;
   int help = 0, progress = 0;
   prru_cli_option opts[] = {
       {"vars", 1, &vars_s, NULL},      {"q1", 1, &t.q1, NULL},       {"q2", 1, &t.q2, NULL},
@@ -1138,7 +1159,7 @@ int prru_cmd_optimize(int argc, char **argv)
       {"range", 1, &range, NULL},      {"objective", 1, &t.objective, NULL},
       {"rcond-min", 1, &t.rcond, NULL}, {"stroke", 1, &t.stroke, NULL}, {"set", 1, &t.set, NULL},
       {"max-iter", 1, &iters, NULL},   {"penalty", 1, &pen, NULL},   {"name", 1, &name_s, NULL},
-      {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
+      {"threads", 1, &ths, NULL},      {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
   if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (help) {
     printf(opt_help);
@@ -1161,6 +1182,7 @@ int prru_cmd_optimize(int argc, char **argv)
   }
   prru_design_options o;
   prru_design_options_default(&o);
+  if (parse_threads(cmd, ths, &o.nthreads)) return 2;
   if (iters) {
     char *end;
     long v = strtol(iters, &end, 10);

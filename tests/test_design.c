@@ -96,6 +96,33 @@ static void objective_equals_map(void)
   prru_design_data_free(&dd);
 }
 
+/* The same bits with any number of threads (rows summed in order). */
+static void threads_same_bits(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &fig7);
+  pr.stroke = 1;
+  pr.stroke_lo = 0.1;
+  pr.stroke_hi = 0.3;
+  prru_design_data a, b;
+  prru_design_data_alloc(&a, &fig7);
+  prru_design_data_alloc(&b, &fig7);
+  prru_design_eval ea, eb;
+  a.nthreads = 1;
+  prru_design_evaluate(&pr, &prru_params_model, &a, &ea);
+  int same = 1;
+  for (int t = 2; t <= 5; t++) {
+    b.nthreads = t;
+    prru_design_evaluate(&pr, &prru_params_model, &b, &eb);
+    same = same && memcmp(&ea, &eb, sizeof ea) == 0 && memcmp(a.status, b.status, (size_t)a.n) == 0;
+    for (long k = 0; k < a.n; k++)
+      if (a.status[k] == PRRU_OK && a.w_R[k] != b.w_R[k]) same = 0;
+  }
+  TU_TRUE(same, "evaluation with 1 to 5 threads: the same bits");
+  prru_design_data_free(&a);
+  prru_design_data_free(&b);
+}
+
 static void stroke_limits(void)
 {
   prru_design_problem pr;
@@ -337,6 +364,7 @@ static void optimizer(void)
 int main(void)
 {
   objective_equals_map();
+  threads_same_bits();
   stroke_limits();
   sensitivity_two_steps();
   variables();

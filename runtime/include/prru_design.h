@@ -36,8 +36,10 @@
  * design variables.
  *
  * Threading: the calls write only into their prru_design_data and
- * outputs; use one prru_design_data per thread. prru_design_evaluate does
- * not allocate. */
+ * outputs; use one prru_design_data per thread. An evaluation splits the
+ * grid's rows over prru_design_data.nthreads threads and sums them in row
+ * order, so the result has the same bits for any number of threads.
+ * prru_design_evaluate allocates nothing (it starts the threads). */
 #ifndef PRRU_DESIGN_H
 #define PRRU_DESIGN_H
 
@@ -124,14 +126,18 @@ int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msgl
  * prru_map_summarize counts it as singular. */
 #define PRRU_DESIGN_OTHER_MODE 0xFE
 
+struct prru_design_row;
+
 /* Per-grid-point workspace, allocated once per problem. */
 typedef struct {
   long n;
+  int nthreads;          /* threads per evaluation (default 2; the result is the same for any) */
   double *w_R;           /* n, NaN where status != PRRU_OK */
   unsigned char *status; /* n, a prru_status per point or PRRU_DESIGN_OTHER_MODE */
+  struct prru_design_row *rows; /* per grid row sums (private) */
 } prru_design_data;
 
-/* PRRU_OK or PRRU_ENOMEM. */
+/* PRRU_OK or PRRU_ENOMEM; nthreads 2. */
 int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g);
 void prru_design_data_free(prru_design_data *dd);
 
@@ -172,6 +178,7 @@ typedef struct {
   int max_iter;          /* Nelder-Mead iterations over all restarts (default 600) */
   double tol;            /* simplex size at which a run stops (default 1e-5) */
   int restarts;          /* fresh simplices from the best point (default 2) */
+  int nthreads;          /* threads per evaluation (default 2; the same result for any) */
   prru_design_progress_fn progress; void *ctx;
 } prru_design_options;
 

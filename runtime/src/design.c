@@ -1,8 +1,10 @@
 /* Design variables, validity, the global-index objective over a grid with
  * the runtime-parameter kernels, Nelder-Mead optimisation and finite
  * difference sensitivity; definitions in prru_design.h. */
+#define _POSIX_C_SOURCE 200809L
 #include <float.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -366,12 +368,22 @@ int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msgl
   return PRRU_OK;
 }
 
+/* What one grid row adds to an evaluation; rows are summed in order, so
+ * the result does not depend on which thread did which row. */
+struct prru_design_row {
+  double viol, stroke, dmin, dmax;
+  long nreach, nother;
+  int changed;
+};
+
 int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g)
 {
   dd->n = (long)g->n1 * g->n2;
+  dd->nthreads = 2;
   dd->w_R = malloc((size_t)dd->n * sizeof *dd->w_R);
   dd->status = malloc((size_t)dd->n);
-  if (dd->w_R && dd->status) return PRRU_OK;
+  dd->rows = malloc((size_t)g->n1 * sizeof *dd->rows);
+  if (dd->w_R && dd->status && dd->rows) return PRRU_OK;
   prru_design_data_free(dd);
   return PRRU_ENOMEM;
 }
@@ -380,8 +392,10 @@ void prru_design_data_free(prru_design_data *dd)
 {
   free(dd->w_R);
   free(dd->status);
+  free(dd->rows);
   dd->w_R = NULL;
   dd->status = NULL;
+  dd->rows = NULL;
   dd->n = 0;
 }
 
@@ -407,6 +421,22 @@ static int home_mode(const prru_params *p, double q3)
   return prru_jd_det_sign(Jd);
 }
 
+/* The design's kernels at a block of grid points, from the batched
+ * dme_terms (bit for bit prru_param_ik_jd, _mass, _platform_jacobian):
+ * rows of GRID_BLOCK, point c's entry i at [i * n + c]. */
+#define GRID_BLOCK 64
+typedef struct {
+  int n;
+  double q[3 * GRID_BLOCK], d[PRRU_NACT * GRID_BLOCK], Jd[3 * PRRU_NACT * GRID_BLOCK],
+      M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK];
+} grid_block;
+
+/* Point c's count entries of one of the block's outputs. */
+static void block_gather(const grid_block *b, int c, int count, const double *rows, double *out)
+{
+  for (int i = 0; i < count; i++) out[i] = rows[i * b->n + c];
+}
+
 /* w_R at one grid point exactly as `prru map` gets it with the model's
  * kernels, here with the design's: unreachable, singular (rcond below the
  * tolerance), or regular but in the other assembly mode (det J_d's sign
@@ -416,14 +446,15 @@ static int home_mode(const prru_params *p, double q3)
  * s = +-rcond (sign: home's mode or not), r = rcond_min, C = ln(r / eps):
  *   s >= r: 0;  0 < s < r: min(C, ln(r / s));  s <= 0: C + ln(1 + |s| / r);
  * unreachable points get C (rcond falls to 0 at the reach boundary). */
-static int point_w(const prru_design_problem *pr, const prru_params *p, double L, int home,
-                   const double q[3], double d[PRRU_NACT], double *w, double *viol)
+static int point_w(const prru_design_problem *pr, const grid_block *b, int c, double L, int home,
+                   double d[PRRU_NACT], double *w, double *viol)
 {
   const double r = pr->rcond_min, cap = log(r / DBL_EPSILON);
   double Jd[PRRU_NACT * 3], Jdpinv[3 * PRRU_NACT], rc = 0.0;
   prru_dme dme;
   *w = NAN;
-  prru_param_ik_jd(p, q, d, Jd);
+  block_gather(b, c, PRRU_NACT, b->d, d);
+  block_gather(b, c, 3 * PRRU_NACT, b->Jd, Jd);
   for (int i = 0; i < PRRU_NACT; i++)
     if (!isfinite(d[i])) {
       *viol = cap;
@@ -436,13 +467,95 @@ static int point_w(const prru_design_problem *pr, const prru_params *p, double L
   }
   if (st == PRRU_OK) {
     double M[9], JP[18];
-    prru_param_mass(p, q, M);
-    prru_param_platform_jacobian(p, q, JP);
+    block_gather(b, c, 9, b->M, M);
+    block_gather(b, c, 18, b->JP, JP);
     st = prru_dme_from(M, Jdpinv, JP, &dme);
     *w = dme.w_R;
   }
   *viol = st == PRRU_OK ? 0.0 : rc > 0 && rc < r ? fmin(cap, log(r / rc)) : cap;
   return st;
+}
+
+/* One design over the grid: rows handed out under a mutex (a row is n2
+ * evaluations, the lock is negligible). compare: note in the row when a
+ * point's regularity differs from the status dd holds from before. */
+typedef struct {
+  const prru_design_problem *pr;
+  const prru_params *p;
+  prru_design_data *dd;
+  double L;
+  int home, compare, next_row;
+  pthread_mutex_t lock;
+} grid_job;
+
+static void grid_row(grid_job *j, int i)
+{
+  const prru_design_problem *pr = j->pr;
+  const prru_map_grid *g = &pr->grid;
+  struct prru_design_row *r = &j->dd->rows[i];
+  const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
+  double d[PRRU_NACT], v;
+  grid_block b; /* 22 KB of this thread's stack: no allocation */
+  memset(r, 0, sizeof *r);
+  r->dmin = INFINITY;
+  r->dmax = -INFINITY;
+  for (int c = 0; c < g->n2; c++) {
+    const int c0 = c - c % GRID_BLOCK;
+    if (c == c0) { /* the kernels for the next block of points */
+      b.n = g->n2 - c0 < GRID_BLOCK ? g->n2 - c0 : GRID_BLOCK;
+      for (int t = 0; t < b.n; t++) {
+        b.q[t] = q1;
+        b.q[b.n + t] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + t);
+        b.q[2 * b.n + t] = g->q3;
+      }
+      prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
+    }
+    long k = (long)i * g->n2 + c;
+    int st = point_w(pr, &b, c - c0, j->L, j->home, d, &j->dd->w_R[k], &v);
+    if (j->compare && (st == PRRU_OK) != (j->dd->status[k] == PRRU_OK)) r->changed = 1;
+    j->dd->status[k] = (unsigned char)st;
+    r->nother += st == OTHER_MODE;
+    r->viol += v;
+    if (st == PRRU_EUNREACHABLE) continue;
+    r->nreach++;
+    for (int a = 0; a < PRRU_NACT; a++) {
+      r->dmin = fmin(r->dmin, d[a]);
+      r->dmax = fmax(r->dmax, d[a]);
+    }
+    if (pr->stroke) r->stroke += stroke_excess(pr, d) / j->L;
+  }
+}
+
+static void *grid_worker(void *arg)
+{
+  grid_job *j = arg;
+  for (;;) {
+    pthread_mutex_lock(&j->lock);
+    int i = j->next_row < j->pr->grid.n1 ? j->next_row++ : -1;
+    pthread_mutex_unlock(&j->lock);
+    if (i < 0) return NULL;
+    grid_row(j, i);
+  }
+}
+
+/* Every row of the grid for p, with dd->nthreads threads (the caller one
+ * of them; fewer when threads cannot be started: slower, never wrong). */
+static void grid_eval(const prru_design_problem *pr, const prru_params *p, prru_design_data *dd,
+                      int compare)
+{
+  grid_job j = {pr, p, dd, prru_design_length_scale(p), home_mode(p, pr->grid.q3), compare, 0,
+                PTHREAD_MUTEX_INITIALIZER};
+  enum { MAX_THREADS = 64 };
+  pthread_t tid[MAX_THREADS];
+  int nt = dd->nthreads < 1 ? 1 : dd->nthreads > MAX_THREADS ? MAX_THREADS : dd->nthreads, started = 0;
+  if (nt > pr->grid.n1) nt = pr->grid.n1;
+  for (int t = 1; t < nt; t++) {
+    if (pthread_create(&tid[started], NULL, grid_worker, &j) != 0) break;
+    started++;
+  }
+  grid_worker(&j);
+  for (int t = 0; t < started; t++) pthread_join(tid[t], NULL);
+  pthread_mutex_destroy(&j.lock);
 }
 
 static double objective_of(const prru_design_problem *pr, const prru_map_summary *s)
@@ -464,27 +577,17 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
   if (prru_design_check(p, NULL, 0) != PRRU_OK) return PRRU_EINPUT;
   ev->valid = 1;
   const prru_map_grid *g = &pr->grid;
-  const double L = prru_design_length_scale(p);
-  const int home = home_mode(p, g->q3);
+  grid_eval(pr, p, dd, 0);
   double viol = 0, stroke = 0, dmin = INFINITY, dmax = -INFINITY;
   long nreach = 0;
   for (int i = 0; i < g->n1; i++) {
-    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3}, d[PRRU_NACT], v;
-    for (int j = 0; j < g->n2; j++) {
-      long k = (long)i * g->n2 + j;
-      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
-      int st = point_w(pr, p, L, home, q, d, &dd->w_R[k], &v);
-      if (st == OTHER_MODE) ev->n_other_mode++;
-      dd->status[k] = (unsigned char)st;
-      viol += v;
-      if (st == PRRU_EUNREACHABLE) continue;
-      nreach++;
-      for (int a = 0; a < PRRU_NACT; a++) {
-        dmin = fmin(dmin, d[a]);
-        dmax = fmax(dmax, d[a]);
-      }
-      if (pr->stroke) stroke += stroke_excess(pr, d) / L;
-    }
+    const struct prru_design_row *r = &dd->rows[i];
+    viol += r->viol;
+    stroke += r->stroke;
+    nreach += r->nreach;
+    ev->n_other_mode += r->nother;
+    dmin = fmin(dmin, r->dmin);
+    dmax = fmax(dmax, r->dmax);
   }
   prru_map_summarize(g, dd->w_R, dd->status, &ev->sum);
   ev->objective = objective_of(pr, &ev->sum);
@@ -507,6 +610,7 @@ void prru_design_options_default(prru_design_options *o)
   o->max_iter = 600;
   o->tol = 1e-5;
   o->restarts = 2;
+  o->nthreads = 2;
   o->progress = NULL;
   o->ctx = NULL;
 }
@@ -642,6 +746,7 @@ int prru_design_optimize(const prru_design_problem *pr, const prru_params *start
   prru_design_data dd;
   if (prru_design_data_alloc(&dd, &pr->grid) != PRRU_OK)
     return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory for the grid");
+  dd.nthreads = o->nthreads;
   opt_ctx c = {pr, start, vars, nvar, 0, &dd, *start, {0}, r};
   r->best = *start;
   prru_design_evaluate(pr, start, &dd, &r->start_eval);
@@ -674,18 +779,9 @@ static double objective_unchecked(const prru_design_problem *pr, const prru_para
                                   prru_design_data *dd, int compare, int *changed)
 {
   const prru_map_grid *g = &pr->grid;
-  const double L = prru_design_length_scale(q);
-  const int home = home_mode(q, g->q3);
-  for (int i = 0; i < g->n1; i++) {
-    double qq[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3}, d[PRRU_NACT], viol;
-    for (int j = 0; j < g->n2; j++) {
-      long k = (long)i * g->n2 + j;
-      qq[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
-      int st = point_w(pr, q, L, home, qq, d, &dd->w_R[k], &viol);
-      if (compare && (st == PRRU_OK) != (dd->status[k] == PRRU_OK)) *changed = 1;
-      dd->status[k] = (unsigned char)st;
-    }
-  }
+  grid_eval(pr, q, dd, compare);
+  for (int i = 0; i < g->n1; i++)
+    if (dd->rows[i].changed) *changed = 1;
   prru_map_summary sum;
   prru_map_summarize(g, dd->w_R, dd->status, &sum);
   return objective_of(pr, &sum);
