@@ -614,6 +614,10 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
     prru_cli_error("identify", "--data and --out are required (see 'prru identify --help')");
     return 2;
   }
+  if (strcmp(a->out, "-") == 0 && (!a->report || strcmp(a->report, "-") == 0)) {
+    prru_cli_error("identify", "--out - and the report would both go to stdout: give --report FILE");
+    return 2;
+  }
   if (a->report && strcmp(a->report, "-") != 0 && strcmp(a->report, a->out) == 0) {
     prru_cli_error("identify", "--report and --out are the same file %s", a->out);
     return 2;

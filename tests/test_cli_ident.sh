@@ -166,6 +166,7 @@ open(sys.argv[2], 'w').write('\n'.join(out) + '\n')
 PY
 expect 1 "not physical" -- identify --data "$tmp/flip.csv" --out "$tmp/keep.json" --report "$tmp/flip_rep.csv"
 [ "$(cat "$tmp/keep.json")" = old ] && ok || bad "a refused identification changed the model file"
+expect 2 "both go to stdout" -- identify --data "$tmp/ex.csv" --out -
 expect 2 "--name" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --name Bad-Name
 expect 2 "--coulomb-velocity" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --coulomb-velocity 0
 expect 2 "centre" -- excite --centre 3,0,0 --out "$tmp/c.csv"
