@@ -5745,3 +5745,657 @@ void prru_joint_reactions(const double q[3], const double qd[3], const double qd
   lambda[55] = ((t11 + 1.4) * (t52 * 0.23404752609517548 + (t74 + (t22 - 0.5 * (t73 - t63 - t65)) - t77 * 0.24456521739130435) - t182 - 21.8) * 0.2942497753818509 + (t71 * (t68 - t14 * 0.5111111111111111) * 0.14712488769092544 + (t75 * 0.14375561545372867 + (t72 * 0.07187780772686433 + (t201 + (t200 + (t84 * 0.028212907622259552 + (t202 - t38 * 0.02699959259691663) - t199)) - t182)) - t83 * 1.4465408805031446 - t91 * 1.882690730106645)) - t76 * (t71 - t197) * 0.21900269541778974 - 21.8) * 0.2253825;
   lambda[56] = t204;
 }
+
+/* Batched kernels. PRRU_BATCH_LOOP marks each loop over states whose
+ * iterations are independent; the build may define it as _Pragma("omp simd")
+ * (with -fopenmp-simd) to have the loops vectorised, and
+ * PRRU_BATCH_TARGETS as a function attribute (e.g. target_clones).
+ * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN and
+ * _COS are sin and cos declared as having vector variants (glibc's libmvec,
+ * which <math.h> declares only under -ffast-math; the kernels are never
+ * built with it), within a few units in the last place of the scalar sin
+ * and cos; the kinematic kernels call sin and cos themselves and so agree
+ * with the scalar kernels bit for bit. */
+#ifndef PRRU_BATCH_LOOP
+#define PRRU_BATCH_LOOP
+#endif
+#ifndef PRRU_BATCH_TARGETS
+#define PRRU_BATCH_TARGETS
+#endif
+#if defined(PRRU_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern double prru_batch_vsin(double) __asm__("sin");
+#pragma omp declare simd notinbranch
+extern double prru_batch_vcos(double) __asm__("cos");
+#define PRRU_BATCH_SIN prru_batch_vsin
+#define PRRU_BATCH_COS prru_batch_vcos
+#else
+#define PRRU_BATCH_SIN sin
+#define PRRU_BATCH_COS cos
+#endif
+
+PRRU_BATCH_TARGETS void prru_batch_ik_jd(int n, const double *q, double *d, double *Jd)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = w0[k] * w0[k];
+      const double t5 = w1[k] * w1[k];
+      const double t6 = w2[k] * w2[k];
+      const double t7 = sqrt(t4 * t5 + t6);
+      const double t8 = 1.0 / t7;
+      const double t9 = w0[k] * w1[k] * t8 - 1.4;
+      const double t10 = w0[k] - 1.3333333333333333;
+      const double t11 = sqrt((0.7256515775034293 - t10 * t10) * 1.3780718336483933);
+      const double t12 = w3[k] * 0.27;
+      const double t13 = t11 * 0.23;
+      const double t14 = sqrt((1.0449382716049382 - t9 * t9) * 0.9569943289224953);
+      const double t15 = 1.173913043478261 * (w3[k] * t10 * (1.0 / t11));
+      const double t16 = t8 * (t8 * t8);
+      const double t17 = t9 * (1.0 / t14);
+      const double t18 = w3[k] * w3[k];
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t9 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      d[i] = ok ? t13 + (q3 - t12) : (double)NAN;
+      d[s + i] = ok ? t13 + (q3 + t12) : (double)NAN;
+      d[2 * s + i] = ok ? 0.23 * t14 + (q3 - w2[k] * t8 * 0.225) : (double)NAN;
+      Jd[i] = ok ? 0.27 * (t15 - w0[k]) : (double)NAN;
+      Jd[s + i] = ok ? 0.0 : (double)NAN;
+      Jd[2 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[3 * s + i] = ok ? 0.27 * (w0[k] + t15) : (double)NAN;
+      Jd[4 * s + i] = ok ? 0.0 : (double)NAN;
+      Jd[5 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[6 * s + i] = ok ? 0.225 * (0.9782608695652174 * (t17 * (t8 * (w1[k] * w3[k]) - t16 * (t4 * w3[k] * (w1[k] * t5)))) - w2[k] * (t5 * (w0[k] * w3[k])) * t16) : (double)NAN;
+      Jd[7 * s + i] = ok ? 0.225 * (0.9782608695652174 * (t17 * (t8 * (w0[k] * w2[k]) + t16 * (w2[k] * (t5 * (w0[k] * t18))))) + (t16 * (t6 * (w1[k] * t18)) - w1[k] * t8)) : (double)NAN;
+      Jd[8 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_batch_mass(int n, const double *q, double *M)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = w0[k] * w0[k];
+      const double t5 = w1[k] * w1[k];
+      const double t6 = w2[k] * w2[k];
+      const double t7 = t4 * t5 + t6;
+      const double t8 = sqrt(t7);
+      const double t9 = 1.0 / t8;
+      const double t10 = w0[k] * w1[k] * t9 - 1.4;
+      const double t11 = w3[k] * w3[k];
+      const double t12 = t9 * (t9 * t9);
+      const double t13 = t9 * (w1[k] * w3[k]) - t4 * w3[k] * (w1[k] * t5) * t12;
+      const double t14 = t13 * t13;
+      const double t15 = 1.0 / t7;
+      const double t16 = t15 * t15;
+      const double t17 = w0[k] - 1.3333333333333333;
+      const double t18 = (0.7256515775034293 - t17 * t17) * 1.3780718336483933;
+      const double t19 = sqrt(t18);
+      const double t20 = w3[k] * t17 * (1.0 / t19);
+      const double t21 = t20 * 0.5869565217391305;
+      const double t22 = w0[k] - t21;
+      const double t23 = w0[k] + t21;
+      const double t24 = w0[k] * w3[k];
+      const double t25 = t12 * (w2[k] * (t5 * t24));
+      const double t26 = (1.0449382716049382 - t10 * t10) * 0.9569943289224953;
+      const double t27 = sqrt(t26);
+      const double t28 = t10 * (1.0 / t27);
+      const double t29 = t13 * t28;
+      const double t30 = t25 - t29 * 0.4891304347826087;
+      const double t31 = 1.0 / t26;
+      const double t32 = 1.173913043478261 * t20;
+      const double t33 = w0[k] - t32;
+      const double t34 = w0[k] + t32;
+      const double t35 = t25 - 0.9782608695652174 * t29;
+      const double t36 = t9 * (w0[k] * w2[k]) + t12 * (w2[k] * (t5 * (w0[k] * t11)));
+      const double t37 = w1[k] * t9;
+      const double t38 = t12 * (t6 * (w1[k] * t11));
+      const double t39 = t37 - t38;
+      const double t40 = t28 * t36;
+      const double t41 = t39 - 0.4891304347826087 * t40;
+      const double t42 = t39 - 0.9782608695652174 * t40;
+      const double t43 = (t35 * t42 * 3.2615384615384615 + (t36 * (t13 * t31) * 0.2520478890989288 + (t30 * t41 * 2.687179487179487 + (t16 * (w2[k] * (w1[k] * t24)) * 0.10129787907565685 + (t13 * t36 + t25 * t39 * 0.3282051282051282))))) * 0.0246796875;
+      const double t44 = (t29 * 0.6820483391844451 + (t20 * 1.9642992168512017 - t25)) * 0.7245;
+      const double t45 = t36 * t36;
+      const double t46 = 0.7245 * (t40 * 0.6820483391844451 + (t38 - t37));
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t10 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (11.485 + (t35 * t35 * 25.154296875 + ((t33 * t33 + t34 * t34) * 36.2221875 + (t14 * t31 * 1.9438947306238186 + (t30 * t30 * 20.724609375 + (t11 * (1.0 / t18) * 5.5984168241965975 + ((t22 * t22 + t23 * t23) * 29.8434375 + (t16 * (t6 * (t5 * t11)) * 0.78125 + (t6 * (t4 * t11 * (t5 * t5)) * (t15 * t16) * 2.53125 + (t14 * 7.71240234375 + (t11 * 14.92171875 + (t6 + t5 * 0.75)))))))))))) * 0.0032 : (double)NAN;
+      M[s + i] = ok ? t43 : (double)NAN;
+      M[2 * s + i] = ok ? t44 : (double)NAN;
+      M[3 * s + i] = ok ? t43 : (double)NAN;
+      M[4 * s + i] = ok ? 0.0246796875 * (0.11345362456473568 + (3.2615384615384615 * (t42 * t42) + (0.2520478890989288 * (t31 * t45) + (2.687179487179487 * (t41 * t41) + (0.10129787907565685 * (t4 * t16) + (t45 + 0.3282051282051282 * (t39 * t39))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t46 : (double)NAN;
+      M[6 * s + i] = ok ? t44 : (double)NAN;
+      M[7 * s + i] = ok ? t46 : (double)NAN;
+      M[8 * s + i] = ok ? 12.39 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_batch_platform_jacobian(int n, const double *q, double *JP)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = sqrt(w0[k] * w0[k] * (w1[k] * w1[k]) + w2[k] * w2[k]);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs((w0[k] * w1[k] * (1.0 / t4) - 1.4) * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      JP[i] = ok ? 1.0 : (double)NAN;
+      JP[s + i] = ok ? 0.0 : (double)NAN;
+      JP[2 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[3 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[4 * s + i] = ok ? w0[k] : (double)NAN;
+      JP[5 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[6 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[7 * s + i] = ok ? w3[k] : (double)NAN;
+      JP[8 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[9 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[10 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[11 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[12 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[13 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[14 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[15 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[16 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[17 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_batch_dynamics(int n, const double *q, const double *qd, double *M, double *h, double *G)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = PRRU_BATCH_COS(q1);
+      w1[k] = PRRU_BATCH_COS(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = PRRU_BATCH_SIN(q2);
+      w3[k] = PRRU_BATCH_SIN(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double qd1 = qd[i];
+      const double qd2 = qd[s + i];
+      const double t4 = w0[k] * w1[k];
+      const double t5 = w0[k] * w0[k];
+      const double t6 = w1[k] * w1[k];
+      const double t7 = w2[k] * w2[k];
+      const double t8 = t5 * t6 + t7;
+      const double t9 = sqrt(t8);
+      const double t10 = 1.0 / t9;
+      const double t11 = t4 * t10 - 1.4;
+      const double t12 = w3[k] * w3[k];
+      const double t13 = w1[k] * w3[k];
+      const double t14 = t10 * t10;
+      const double t15 = t10 * t14;
+      const double t16 = t10 * t13 - t5 * w3[k] * (w1[k] * t6) * t15;
+      const double t17 = t16 * t16;
+      const double t18 = 1.0 / t8;
+      const double t19 = t18 * t18;
+      const double t20 = w0[k] - 1.3333333333333333;
+      const double t21 = t20 * t20;
+      const double t22 = (0.7256515775034293 - t21) * 1.3780718336483933;
+      const double t23 = sqrt(t22);
+      const double t24 = 1.0 / t23;
+      const double t25 = w3[k] * t20 * t24;
+      const double t26 = t25 * 0.5869565217391305;
+      const double t27 = w0[k] - t26;
+      const double t28 = w0[k] + t26;
+      const double t29 = w0[k] * w3[k];
+      const double t30 = t15 * (w2[k] * (t6 * t29));
+      const double t31 = t11 * t11;
+      const double t32 = (1.0449382716049382 - t31) * 0.9569943289224953;
+      const double t33 = sqrt(t32);
+      const double t34 = 1.0 / t33;
+      const double t35 = t11 * t34;
+      const double t36 = t16 * t35;
+      const double t37 = t30 - t36 * 0.4891304347826087;
+      const double t38 = 1.0 / t32;
+      const double t39 = 1.173913043478261 * t25;
+      const double t40 = w0[k] - t39;
+      const double t41 = w0[k] + t39;
+      const double t42 = t30 - 0.9782608695652174 * t36;
+      const double t43 = t10 * (w0[k] * w2[k]) + t15 * (w2[k] * (t6 * (w0[k] * t12)));
+      const double t44 = w1[k] * t10;
+      const double t45 = t15 * (t7 * (w1[k] * t12));
+      const double t46 = t44 - t45;
+      const double t47 = t35 * t43;
+      const double t48 = t46 - 0.4891304347826087 * t47;
+      const double t49 = t46 - 0.9782608695652174 * t47;
+      const double t50 = (t42 * t49 * 3.2615384615384615 + (t43 * (t16 * t38) * 0.2520478890989288 + (t37 * t48 * 2.687179487179487 + (t19 * (w2[k] * (w1[k] * t29)) * 0.10129787907565685 + (t16 * t43 + t30 * t46 * 0.3282051282051282))))) * 0.0246796875;
+      const double t51 = t25 * 1.9642992168512017;
+      const double t52 = t36 * 0.6820483391844451;
+      const double t53 = (t52 + (t51 - t30)) * 0.7245;
+      const double t54 = t43 * t43;
+      const double t55 = t47 * 0.6820483391844451;
+      const double t56 = 0.7245 * (t55 + (t45 - t44));
+      const double t57 = qd1 * qd2;
+      const double t58 = qd1 * qd1;
+      const double t59 = w0[k] * t58;
+      const double t60 = w1[k] * t59;
+      const double t61 = w1[k] * (w3[k] * qd1);
+      const double t62 = t6 * (w3[k] * (w0[k] * qd1)) - w2[k] * (w1[k] * (t12 * qd2));
+      const double t63 = w3[k] * t57;
+      const double t64 = w2[k] * t63;
+      const double t65 = qd2 * qd2;
+      const double t66 = w1[k] * (w0[k] * t65);
+      const double t67 = w0[k] * qd2;
+      const double t68 = w2[k] * t67;
+      const double t69 = t4 * t15;
+      const double t70 = t12 * t58;
+      const double t71 = t12 * t65;
+      const double t72 = t7 * t71 + (t6 * (t5 * t58) - t6 * t70 - t6 * t71) - w2[k] * (w1[k] * (w3[k] * (w0[k] * t57))) * 4.0;
+      const double t73 = t10 * (t14 * t14);
+      const double t74 = t62 * t62;
+      const double t75 = (t62 * (t15 * t68) + (t15 * t61 * t62 - t10 * t64)) * 2.0 + (t10 * t60 + t10 * t66 - t69 * t72) - t4 * t73 * t74 * 3.0;
+      const double t76 = w1[k] * qd2;
+      const double t77 = t62 * (t15 * t76);
+      const double t78 = (t10 * (w2[k] * t65) - t72 * (w2[k] * t15)) * 0.5;
+      const double t79 = t74 * (w2[k] * t73) * 1.5;
+      const double t80 = t79 + (t77 - t78);
+      const double t81 = t61 + t68;
+      const double t82 = t62 * (t19 * (t6 * t67 + w2[k] * t81)) - 0.5 * (t18 * (2.0 * (w2[k] * t66) + (t6 * t63 - t76 * t81 - w2[k] * (t60 + t66 - t64 * 2.0))));
+      const double t83 = w3[k] * t58;
+      const double t84 = t24 * (t24 * t24);
+      const double t85 = t21 * t70 * t84;
+      const double t86 = t24 * (t20 * t59) - t24 * t70;
+      const double t87 = 0.5869565217391305 * t86;
+      const double t88 = t85 * 0.8088682501849265;
+      const double t89 = t10 * t61 + t10 * t68 - t62 * t69;
+      const double t90 = t89 * t89;
+      const double t91 = t34 * (t34 * t34);
+      const double t92 = t90 * (t31 * t91);
+      const double t93 = t35 * t75 - t34 * t90;
+      const double t94 = t92 * 0.23404752609517548 + (t80 - t93 * 0.24456521739130435);
+      const double t95 = t90 * (t11 * t91) - 1.0449382716049382 * (t34 * t75);
+      const double t96 = 1.173913043478261 * t86;
+      const double t97 = t85 * 1.617736500369853;
+      const double t98 = t92 * 0.46809505219035097 + (t80 - 0.4891304347826087 * t93);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t11 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (11.485 + (t42 * t42 * 25.154296875 + ((t40 * t40 + t41 * t41) * 36.2221875 + (t17 * t38 * 1.9438947306238186 + (t37 * t37 * 20.724609375 + (t12 * (1.0 / t22) * 5.5984168241965975 + ((t27 * t27 + t28 * t28) * 29.8434375 + (t19 * (t7 * (t6 * t12)) * 0.78125 + (t7 * (t5 * t12 * (t6 * t6)) * (t18 * t19) * 2.53125 + (t17 * 7.71240234375 + (t12 * 14.92171875 + (t7 + t6 * 0.75)))))))))))) * 0.0032 : (double)NAN;
+      M[s + i] = ok ? t50 : (double)NAN;
+      M[2 * s + i] = ok ? t53 : (double)NAN;
+      M[3 * s + i] = ok ? t50 : (double)NAN;
+      M[4 * s + i] = ok ? 0.0246796875 * (0.11345362456473568 + (3.2615384615384615 * (t49 * t49) + (0.2520478890989288 * (t38 * t54) + (2.687179487179487 * (t48 * t48) + (0.10129787907565685 * (t5 * t19) + (t54 + 0.3282051282051282 * (t46 * t46))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t56 : (double)NAN;
+      M[6 * s + i] = ok ? t53 : (double)NAN;
+      M[7 * s + i] = ok ? t56 : (double)NAN;
+      M[8 * s + i] = ok ? 12.39 : (double)NAN;
+      h[i] = ok ? (t42 * t98 * 100.6171875 + (t37 * t94 * 82.8984375 + (w3[k] * t24 * (t24 * t59 - 1.3780718336483933 * (t84 * (t20 * t70))) * 11.196833648393195 + (t18 * (w2[k] * t13) * t82 * 3.125 + (t30 * t80 * 10.125 + (t16 * t75 * 15.4248046875 + (w2[k] * (w1[k] * t57) + 29.8434375 * (w3[k] * t59)))) - (t27 * (t83 + t87 - t88) + t28 * (t88 + (t83 - t87))) * 59.686875)) - t16 * t34 * t95 * 3.720592466458632 - (t40 * (t83 + t96 - t97) + t41 * (t97 + (t83 - t96))) * 72.444375)) * 0.0016 : (double)NAN;
+      h[s + i] = ok ? (t49 * t98 * 201.234375 + (t48 * t94 * 165.796875 + (t82 * (w0[k] * t18) * 6.25 + (t46 * t80 * 20.25 + (t43 * t75 * 30.849609375 - w2[k] * (w1[k] * t58)))) - t95 * (t34 * t43) * 7.441184932917264)) * 0.0008 : (double)NAN;
+      h[2 * s + i] = ok ? (t93 * 0.34102416959222254 + (t86 * 0.9821496084256008 + (t78 - t77 - t79) - t85 * 1.353472711800119) - t92 * 0.3263581963252602) * 1.449 : (double)NAN;
+      G[i] = ok ? (t30 - t51 - t52) * 7.107345 : (double)NAN;
+      G[s + i] = ok ? 7.107345 * (t46 - t55) : (double)NAN;
+      G[2 * s + i] = ok ? -121.5459 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_batch_eom(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = PRRU_BATCH_COS(q1);
+      w1[k] = PRRU_BATCH_COS(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = PRRU_BATCH_SIN(q2);
+      w3[k] = PRRU_BATCH_SIN(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double qd1 = qd[i];
+      const double qd2 = qd[s + i];
+      const double fd1 = fd[i];
+      const double fd2 = fd[s + i];
+      const double fd3 = fd[2 * s + i];
+      const double fp3 = fp[2 * s + i];
+      const double mp1 = mp[i];
+      const double mp2 = mp[s + i];
+      const double mp3 = mp[2 * s + i];
+      const double t4 = w0[k] * w1[k];
+      const double t5 = w0[k] * w0[k];
+      const double t6 = w1[k] * w1[k];
+      const double t7 = w2[k] * w2[k];
+      const double t8 = t5 * t6 + t7;
+      const double t9 = sqrt(t8);
+      const double t10 = 1.0 / t9;
+      const double t11 = t4 * t10 - 1.4;
+      const double t12 = w3[k] * w3[k];
+      const double t13 = w1[k] * w3[k];
+      const double t14 = t10 * t10;
+      const double t15 = t10 * t14;
+      const double t16 = t10 * t13 - t5 * w3[k] * (w1[k] * t6) * t15;
+      const double t17 = t16 * t16;
+      const double t18 = 1.0 / t8;
+      const double t19 = t18 * t18;
+      const double t20 = w0[k] - 1.3333333333333333;
+      const double t21 = t20 * t20;
+      const double t22 = (0.7256515775034293 - t21) * 1.3780718336483933;
+      const double t23 = sqrt(t22);
+      const double t24 = 1.0 / t23;
+      const double t25 = w3[k] * t20 * t24;
+      const double t26 = t25 * 0.5869565217391305;
+      const double t27 = w0[k] - t26;
+      const double t28 = w0[k] + t26;
+      const double t29 = w0[k] * w3[k];
+      const double t30 = t15 * (w2[k] * (t6 * t29));
+      const double t31 = t11 * t11;
+      const double t32 = (1.0449382716049382 - t31) * 0.9569943289224953;
+      const double t33 = sqrt(t32);
+      const double t34 = 1.0 / t33;
+      const double t35 = t11 * t34;
+      const double t36 = t16 * t35;
+      const double t37 = t30 - t36 * 0.4891304347826087;
+      const double t38 = 1.0 / t32;
+      const double t39 = 1.173913043478261 * t25;
+      const double t40 = w0[k] - t39;
+      const double t41 = w0[k] + t39;
+      const double t42 = t30 - 0.9782608695652174 * t36;
+      const double t43 = t10 * (w0[k] * w2[k]) + t15 * (w2[k] * (t6 * (w0[k] * t12)));
+      const double t44 = w1[k] * t10;
+      const double t45 = t15 * (t7 * (w1[k] * t12));
+      const double t46 = t44 - t45;
+      const double t47 = t35 * t43;
+      const double t48 = t46 - 0.4891304347826087 * t47;
+      const double t49 = t46 - 0.9782608695652174 * t47;
+      const double t50 = (t42 * t49 * 3.2615384615384615 + (t43 * (t16 * t38) * 0.2520478890989288 + (t37 * t48 * 2.687179487179487 + (t19 * (w2[k] * (w1[k] * t29)) * 0.10129787907565685 + (t16 * t43 + t30 * t46 * 0.3282051282051282))))) * 0.0246796875;
+      const double t51 = t25 * 1.9642992168512017;
+      const double t52 = t36 * 0.6820483391844451;
+      const double t53 = (t52 + (t51 - t30)) * 0.7245;
+      const double t54 = t43 * t43;
+      const double t55 = t47 * 0.6820483391844451;
+      const double t56 = 0.7245 * (t55 + (t45 - t44));
+      const double t57 = qd1 * qd2;
+      const double t58 = qd1 * qd1;
+      const double t59 = w0[k] * t58;
+      const double t60 = w1[k] * t59;
+      const double t61 = w1[k] * (w3[k] * qd1);
+      const double t62 = t6 * (w3[k] * (w0[k] * qd1)) - w2[k] * (w1[k] * (t12 * qd2));
+      const double t63 = w3[k] * t57;
+      const double t64 = w2[k] * t63;
+      const double t65 = qd2 * qd2;
+      const double t66 = w1[k] * (w0[k] * t65);
+      const double t67 = w0[k] * qd2;
+      const double t68 = w2[k] * t67;
+      const double t69 = t4 * t15;
+      const double t70 = t12 * t58;
+      const double t71 = t12 * t65;
+      const double t72 = t7 * t71 + (t6 * (t5 * t58) - t6 * t70 - t6 * t71) - w2[k] * (w1[k] * (w3[k] * (w0[k] * t57))) * 4.0;
+      const double t73 = t10 * (t14 * t14);
+      const double t74 = t62 * t62;
+      const double t75 = (t62 * (t15 * t68) + (t15 * t61 * t62 - t10 * t64)) * 2.0 + (t10 * t60 + t10 * t66 - t69 * t72) - t4 * t73 * t74 * 3.0;
+      const double t76 = w1[k] * qd2;
+      const double t77 = t74 * (w2[k] * t73) * 1.5 + (t62 * (t15 * t76) - (t10 * (w2[k] * t65) - t72 * (w2[k] * t15)) * 0.5);
+      const double t78 = t61 + t68;
+      const double t79 = t62 * (t19 * (t6 * t67 + w2[k] * t78)) - 0.5 * (t18 * (2.0 * (w2[k] * t66) + (t6 * t63 - t76 * t78 - w2[k] * (t60 + t66 - t64 * 2.0))));
+      const double t80 = w3[k] * t58;
+      const double t81 = t24 * (t24 * t24);
+      const double t82 = t21 * t70 * t81;
+      const double t83 = t24 * (t20 * t59) - t24 * t70;
+      const double t84 = 0.5869565217391305 * t83;
+      const double t85 = t82 * 0.8088682501849265;
+      const double t86 = t10 * t61 + t10 * t68 - t62 * t69;
+      const double t87 = t86 * t86;
+      const double t88 = t34 * (t34 * t34);
+      const double t89 = t87 * (t31 * t88);
+      const double t90 = t35 * t75 - t34 * t87;
+      const double t91 = t89 * 0.23404752609517548 + (t77 - t90 * 0.24456521739130435);
+      const double t92 = t87 * (t11 * t88) - 1.0449382716049382 * (t34 * t75);
+      const double t93 = 1.173913043478261 * t83;
+      const double t94 = t82 * 1.617736500369853;
+      const double t95 = t89 * 0.46809505219035097 + (t77 - 0.4891304347826087 * t90);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t11 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (11.485 + (t42 * t42 * 25.154296875 + ((t40 * t40 + t41 * t41) * 36.2221875 + (t17 * t38 * 1.9438947306238186 + (t37 * t37 * 20.724609375 + (t12 * (1.0 / t22) * 5.5984168241965975 + ((t27 * t27 + t28 * t28) * 29.8434375 + (t19 * (t7 * (t6 * t12)) * 0.78125 + (t7 * (t5 * t12 * (t6 * t6)) * (t18 * t19) * 2.53125 + (t17 * 7.71240234375 + (t12 * 14.92171875 + (t7 + t6 * 0.75)))))))))))) * 0.0032 : (double)NAN;
+      M[s + i] = ok ? t50 : (double)NAN;
+      M[2 * s + i] = ok ? t53 : (double)NAN;
+      M[3 * s + i] = ok ? t50 : (double)NAN;
+      M[4 * s + i] = ok ? 0.0246796875 * (0.11345362456473568 + (3.2615384615384615 * (t49 * t49) + (0.2520478890989288 * (t38 * t54) + (2.687179487179487 * (t48 * t48) + (0.10129787907565685 * (t5 * t19) + (t54 + 0.3282051282051282 * (t46 * t46))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t56 : (double)NAN;
+      M[6 * s + i] = ok ? t53 : (double)NAN;
+      M[7 * s + i] = ok ? t56 : (double)NAN;
+      M[8 * s + i] = ok ? 12.39 : (double)NAN;
+      b[i] = ok ? (mp1 * 0.14069951578261644 + ((t40 * (t80 + t93 - t94) + t41 * (t94 + (t80 - t93))) * 0.016308621573878853 + (t16 * t34 * t92 * 0.0008375768935282882 + ((t27 * (t80 + t84 - t85) + t28 * (t85 + (t80 - t84))) * 0.013436663057724087 + (t30 - t51 - t52 - w2[k] * (w1[k] * t57) * 0.00022511922525218629 - w3[k] * t59 * 0.006718331528862044 - t16 * t75 * 0.0034724200809162914 - t30 * t77 * 0.002279332155678386 - t18 * (w2[k] * t13) * t79 * 0.0007034975789130822) - w3[k] * t24 * (t24 * t59 - 1.3780718336483933 * (t81 * (t20 * t70))) * 0.0025206225162038866 - t37 * t91 * 0.018662032024616786)) - t42 * t95 * 0.02265086329705396) - (t40 * fd1 - t41 * fd2) * 0.037988869261306436 - t42 * fd3 * 0.031657391051088696) * 7.107345 : (double)NAN;
+      b[s + i] = ok ? 7.107345 * (0.14069951578261644 * (w0[k] * mp2 + w3[k] * mp3) + (0.0008375768935282882 * (t92 * (t34 * t43)) + (w2[k] * (w1[k] * t58) * 0.00011255961262609314 + (t46 - t55) - 0.0034724200809162914 * (t43 * t75) - 0.002279332155678386 * (t46 * t77) - 0.0007034975789130822 * (t79 * (w0[k] * t18)) - 0.018662032024616786 * (t48 * t91)) - 0.02265086329705396 * (t49 * t95) - 0.031657391051088696 * (t49 * fd3))) : (double)NAN;
+      b[2 * s + i] = ok ? ((fp3 + (fd3 + (fd1 + fd2))) * 0.6901311249137336 + (t89 * 0.3263581963252602 + (t82 * 1.353472711800119 + (t77 - t83 * 0.9821496084256008) - t90 * 0.34102416959222254)) - 83.88260869565218) * 1.449 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_batch_dme_terms(int n, const double *q, double *d, double *Jd, double *M, double *JP)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = w0[k] * w0[k];
+      const double t5 = w1[k] * w1[k];
+      const double t6 = w2[k] * w2[k];
+      const double t7 = t4 * t5 + t6;
+      const double t8 = sqrt(t7);
+      const double t9 = 1.0 / t8;
+      const double t10 = w0[k] * w1[k] * t9 - 1.4;
+      const double t11 = w0[k] - 1.3333333333333333;
+      const double t12 = (0.7256515775034293 - t11 * t11) * 1.3780718336483933;
+      const double t13 = sqrt(t12);
+      const double t14 = w3[k] * 0.27;
+      const double t15 = t13 * 0.23;
+      const double t16 = (1.0449382716049382 - t10 * t10) * 0.9569943289224953;
+      const double t17 = sqrt(t16);
+      const double t18 = w3[k] * t11 * (1.0 / t13);
+      const double t19 = 1.173913043478261 * t18;
+      const double t20 = w0[k] + t19;
+      const double t21 = w0[k] * w3[k];
+      const double t22 = t9 * (t9 * t9);
+      const double t23 = w2[k] * (t5 * t21) * t22;
+      const double t24 = t10 * (1.0 / t17);
+      const double t25 = t9 * (w1[k] * w3[k]) - t22 * (t4 * w3[k] * (w1[k] * t5));
+      const double t26 = t24 * t25;
+      const double t27 = 0.9782608695652174 * t26;
+      const double t28 = w1[k] * t9;
+      const double t29 = w3[k] * w3[k];
+      const double t30 = t22 * (t6 * (w1[k] * t29));
+      const double t31 = t9 * (w0[k] * w2[k]) + t22 * (w2[k] * (t5 * (w0[k] * t29)));
+      const double t32 = t24 * t31;
+      const double t33 = 0.9782608695652174 * t32;
+      const double t34 = t30 - t28;
+      const double t35 = t25 * t25;
+      const double t36 = 1.0 / t7;
+      const double t37 = t36 * t36;
+      const double t38 = t18 * 0.5869565217391305;
+      const double t39 = w0[k] - t38;
+      const double t40 = w0[k] + t38;
+      const double t41 = t23 - t26 * 0.4891304347826087;
+      const double t42 = 1.0 / t16;
+      const double t43 = w0[k] - t19;
+      const double t44 = t23 - t27;
+      const double t45 = t28 - t30;
+      const double t46 = t45 - t32 * 0.4891304347826087;
+      const double t47 = t45 - t33;
+      const double t48 = (t44 * t47 * 3.2615384615384615 + (t31 * (t25 * t42) * 0.2520478890989288 + (t41 * t46 * 2.687179487179487 + (t37 * (w2[k] * (w1[k] * t21)) * 0.10129787907565685 + (t25 * t31 + t23 * t45 * 0.3282051282051282))))) * 0.0246796875;
+      const double t49 = (t26 * 0.6820483391844451 + (t18 * 1.9642992168512017 - t23)) * 0.7245;
+      const double t50 = t31 * t31;
+      const double t51 = 0.7245 * (t34 + t32 * 0.6820483391844451);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t10 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      d[i] = ok ? t15 + (q3 - t14) : (double)NAN;
+      d[s + i] = ok ? t15 + (q3 + t14) : (double)NAN;
+      d[2 * s + i] = ok ? 0.23 * t17 + (q3 - w2[k] * t9 * 0.225) : (double)NAN;
+      Jd[i] = ok ? 0.27 * (t19 - w0[k]) : (double)NAN;
+      Jd[s + i] = ok ? 0.0 : (double)NAN;
+      Jd[2 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[3 * s + i] = ok ? 0.27 * t20 : (double)NAN;
+      Jd[4 * s + i] = ok ? 0.0 : (double)NAN;
+      Jd[5 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[6 * s + i] = ok ? 0.225 * (t27 - t23) : (double)NAN;
+      Jd[7 * s + i] = ok ? 0.225 * (t33 + t34) : (double)NAN;
+      Jd[8 * s + i] = ok ? 1.0 : (double)NAN;
+      M[i] = ok ? (11.485 + (t44 * t44 * 25.154296875 + ((t43 * t43 + t20 * t20) * 36.2221875 + (t35 * t42 * 1.9438947306238186 + (t41 * t41 * 20.724609375 + (t29 * (1.0 / t12) * 5.5984168241965975 + ((t39 * t39 + t40 * t40) * 29.8434375 + (t37 * (t6 * (t5 * t29)) * 0.78125 + (t6 * (t4 * t29 * (t5 * t5)) * (t36 * t37) * 2.53125 + (t35 * 7.71240234375 + (t29 * 14.92171875 + (t6 + t5 * 0.75)))))))))))) * 0.0032 : (double)NAN;
+      M[s + i] = ok ? t48 : (double)NAN;
+      M[2 * s + i] = ok ? t49 : (double)NAN;
+      M[3 * s + i] = ok ? t48 : (double)NAN;
+      M[4 * s + i] = ok ? 0.0246796875 * (0.11345362456473568 + (3.2615384615384615 * (t47 * t47) + (0.2520478890989288 * (t42 * t50) + (2.687179487179487 * (t46 * t46) + (0.10129787907565685 * (t4 * t37) + (t50 + 0.3282051282051282 * (t45 * t45))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t51 : (double)NAN;
+      M[6 * s + i] = ok ? t49 : (double)NAN;
+      M[7 * s + i] = ok ? t51 : (double)NAN;
+      M[8 * s + i] = ok ? 12.39 : (double)NAN;
+      JP[i] = ok ? 1.0 : (double)NAN;
+      JP[s + i] = ok ? 0.0 : (double)NAN;
+      JP[2 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[3 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[4 * s + i] = ok ? w0[k] : (double)NAN;
+      JP[5 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[6 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[7 * s + i] = ok ? w3[k] : (double)NAN;
+      JP[8 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[9 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[10 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[11 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[12 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[13 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[14 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[15 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[16 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[17 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}

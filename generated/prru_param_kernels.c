@@ -2028,3 +2028,1401 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
   Qp[1] = t43 * (t35 * (t20 * (t12 * t17) + t33 * (t17 * (t16 * (t12 * t37)))) + (t20 * (p_l2_2 * t13) - t33 * (t18 * (t13 * (p_l2_2 * t37)))));
   Qp[2] = -t29 - t32 - t49 - t51 - t40 - t42;
 }
+
+/* Batched kernels. PRRU_BATCH_LOOP marks each loop over states whose
+ * iterations are independent; the build may define it as _Pragma("omp simd")
+ * (with -fopenmp-simd) to have the loops vectorised, and
+ * PRRU_BATCH_TARGETS as a function attribute (e.g. target_clones).
+ * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN and
+ * _COS are sin and cos declared as having vector variants (glibc's libmvec,
+ * which <math.h> declares only under -ffast-math; the kernels are never
+ * built with it), within a few units in the last place of the scalar sin
+ * and cos; the kinematic kernels call sin and cos themselves and so agree
+ * with the scalar kernels bit for bit. */
+#ifndef PRRU_BATCH_LOOP
+#define PRRU_BATCH_LOOP
+#endif
+#ifndef PRRU_BATCH_TARGETS
+#define PRRU_BATCH_TARGETS
+#endif
+#if defined(PRRU_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern double prru_batch_vsin(double) __asm__("sin");
+#pragma omp declare simd notinbranch
+extern double prru_batch_vcos(double) __asm__("cos");
+#define PRRU_BATCH_SIN prru_batch_vsin
+#define PRRU_BATCH_COS prru_batch_vcos
+#else
+#define PRRU_BATCH_SIN sin
+#define PRRU_BATCH_COS cos
+#endif
+
+PRRU_BATCH_TARGETS void prru_param_batch_ik_jd(const prru_params *p, int n, const double *q, double *d, double *Jd)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = 1.0 / p_l1_0;
+      const double t5 = p_a_0 * w0[k];
+      const double t6 = w0[k] * p_l2_0;
+      const double t7 = p_b_0 - t5 - t6;
+      const double t8 = t4 * t7;
+      const double t9 = 1.0 / p_l1_1;
+      const double t10 = w0[k] * p_a_1;
+      const double t11 = w0[k] * p_l2_1;
+      const double t12 = p_b_1 - t10 - t11;
+      const double t13 = t9 * t12;
+      const double t14 = 1.0 / p_l1_2;
+      const double t15 = w0[k] * p_l2_2;
+      const double t16 = w0[k] * w0[k];
+      const double t17 = w1[k] * w1[k];
+      const double t18 = w2[k] * w2[k];
+      const double t19 = sqrt(t16 * t17 + t18);
+      const double t20 = 1.0 / t19;
+      const double t21 = p_b_2 - t15 * w1[k] * t20;
+      const double t22 = t14 * t21;
+      const double t23 = p_a_0 * w3[k];
+      const double t24 = p_l2_0 * w3[k];
+      const double t25 = sqrt(1.0 - t4 * t4 * (t7 * t7));
+      const double t26 = p_a_1 * w3[k];
+      const double t27 = p_l2_1 * w3[k];
+      const double t28 = sqrt(1.0 - t9 * t9 * (t12 * t12));
+      const double t29 = sqrt(1.0 - t14 * t14 * (t21 * t21));
+      const double t30 = t20 * (t20 * t20);
+      const double t31 = t22 * (1.0 / t29);
+      const double t32 = w3[k] * w3[k];
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(t8), 1.0) &
+          islessequal(fabs(t13), 1.0) &
+          islessequal(fabs(-t22), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      d[i] = ok ? p_l1_0 * t25 + (q3 - t23 - t24) : (double)NAN;
+      d[s + i] = ok ? p_l1_1 * t28 + (t27 + (q3 + t26)) : (double)NAN;
+      d[2 * s + i] = ok ? p_l1_2 * t29 + (q3 - t20 * (p_l2_2 * w2[k])) : (double)NAN;
+      Jd[i] = ok ? -t5 - t6 - t8 * (1.0 / t25) * (t23 + t24) : (double)NAN;
+      Jd[s + i] = ok ? 0.0 : (double)NAN;
+      Jd[2 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[3 * s + i] = ok ? t10 + t11 - t13 * (1.0 / t28) * (t26 + t27) : (double)NAN;
+      Jd[4 * s + i] = ok ? 0.0 : (double)NAN;
+      Jd[5 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[6 * s + i] = ok ? t31 * (t30 * (w3[k] * (p_l2_2 * t16) * (w1[k] * t17)) - t20 * (w1[k] * (p_l2_2 * w3[k]))) - w2[k] * (t17 * (t15 * w3[k])) * t30 : (double)NAN;
+      Jd[7 * s + i] = ok ? t30 * (t18 * (w1[k] * (p_l2_2 * t32))) - t20 * (p_l2_2 * w1[k]) - t31 * (t20 * (t15 * w2[k]) + t30 * (w2[k] * (t17 * (t15 * t32)))) : (double)NAN;
+      Jd[8 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_param_batch_mass(const prru_params *p, int n, const double *q, double *M)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const double p_mass_0 = p->mass[0];
+  const double p_mass_1 = p->mass[1];
+  const double p_mass_2 = p->mass[2];
+  const double p_mass_3 = p->mass[3];
+  const double p_mass_4 = p->mass[4];
+  const double p_mass_5 = p->mass[5];
+  const double p_mass_6 = p->mass[6];
+  const double p_mass_7 = p->mass[7];
+  const double p_mass_8 = p->mass[8];
+  const double p_mass_9 = p->mass[9];
+  const double p_com_0_0 = p->com[0][0];
+  const double p_com_0_1 = p->com[0][1];
+  const double p_com_0_2 = p->com[0][2];
+  const double p_com_1_1 = p->com[1][1];
+  const double p_com_1_2 = p->com[1][2];
+  const double p_com_2_1 = p->com[2][1];
+  const double p_com_2_2 = p->com[2][2];
+  const double p_com_3_0 = p->com[3][0];
+  const double p_com_3_2 = p->com[3][2];
+  const double p_com_4_1 = p->com[4][1];
+  const double p_com_4_2 = p->com[4][2];
+  const double p_com_5_1 = p->com[5][1];
+  const double p_com_5_2 = p->com[5][2];
+  const double p_com_6_0 = p->com[6][0];
+  const double p_com_6_2 = p->com[6][2];
+  const double p_inertia_0_0 = p->inertia[0][0];
+  const double p_inertia_0_1 = p->inertia[0][1];
+  const double p_inertia_0_2 = p->inertia[0][2];
+  const double p_inertia_0_3 = p->inertia[0][3];
+  const double p_inertia_0_4 = p->inertia[0][4];
+  const double p_inertia_0_5 = p->inertia[0][5];
+  const double p_inertia_1_0 = p->inertia[1][0];
+  const double p_inertia_2_0 = p->inertia[2][0];
+  const double p_inertia_3_1 = p->inertia[3][1];
+  const double p_inertia_4_0 = p->inertia[4][0];
+  const double p_inertia_5_0 = p->inertia[5][0];
+  const double p_inertia_6_1 = p->inertia[6][1];
+  const double p_armature_0 = p->armature[0];
+  const double p_armature_1 = p->armature[1];
+  const double p_armature_2 = p->armature[2];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = 1.0 / p_l1_0;
+      const double t5 = p_a_0 * w0[k];
+      const double t6 = w0[k] * p_l2_0;
+      const double t7 = p_b_0 - t5 - t6;
+      const double t8 = t4 * t7;
+      const double t9 = 1.0 / p_l1_1;
+      const double t10 = w0[k] * p_a_1;
+      const double t11 = w0[k] * p_l2_1;
+      const double t12 = p_b_1 - t10 - t11;
+      const double t13 = t9 * t12;
+      const double t14 = 1.0 / p_l1_2;
+      const double t15 = w0[k] * p_l2_2;
+      const double t16 = w0[k] * w0[k];
+      const double t17 = w1[k] * w1[k];
+      const double t18 = w2[k] * w2[k];
+      const double t19 = t16 * t17 + t18;
+      const double t20 = sqrt(t19);
+      const double t21 = 1.0 / t20;
+      const double t22 = p_b_2 - t15 * w1[k] * t21;
+      const double t23 = t14 * t22;
+      const double t24 = w0[k] * p_com_0_2;
+      const double t25 = w0[k] * p_com_0_0;
+      const double t26 = p_com_0_1 * w3[k] + w1[k] * t24 - w2[k] * t25;
+      const double t27 = w3[k] * p_com_0_0;
+      const double t28 = w3[k] * p_com_0_2;
+      const double t29 = w2[k] * t27 + w0[k] * p_com_0_1 - w1[k] * t28;
+      const double t30 = p_a_0 * w3[k];
+      const double t31 = p_l2_0 * w3[k];
+      const double t32 = t31 * 0.5 + (t30 - w3[k] * p_com_1_1 - w0[k] * p_com_1_2);
+      const double t33 = t6 * 0.5 + (w3[k] * p_com_1_2 + (t5 - w0[k] * p_com_1_1));
+      const double t34 = p_a_1 * w3[k];
+      const double t35 = p_l2_1 * w3[k];
+      const double t36 = 0.5 * t35 + (w0[k] * p_com_2_2 + (t34 + w3[k] * p_com_2_1));
+      const double t37 = t11 * 0.5 + (t10 + w0[k] * p_com_2_1 - w3[k] * p_com_2_2);
+      const double t38 = w1[k] * t17;
+      const double t39 = t21 * (t21 * t21);
+      const double t40 = w0[k] * p_com_3_2;
+      const double t41 = w3[k] * (p_l2_2 * t16) * t38 * t39 - t21 * (w1[k] * (p_l2_2 * w3[k]));
+      const double t42 = (t39 * (w2[k] * (t17 * (w3[k] * t40))) + (t39 * (t38 * (w3[k] * (t16 * p_com_3_0))) - t21 * (w1[k] * (w3[k] * p_com_3_0)))) * 2.0 + t41;
+      const double t43 = t39 * (w2[k] * (t17 * (t15 * w3[k])));
+      const double t44 = w0[k] * p_com_3_0;
+      const double t45 = t43 - 2.0 * (t39 * (t38 * (w3[k] * (t16 * p_com_3_2))) - t21 * (w1[k] * (w3[k] * p_com_3_2)) - t39 * (w2[k] * (t17 * (w3[k] * t44))));
+      const double t46 = w3[k] * w3[k];
+      const double t47 = 1.0 / t19;
+      const double t48 = t47 * t47;
+      const double t49 = t4 * t4;
+      const double t50 = 1.0 - t49 * (t7 * t7);
+      const double t51 = sqrt(t50);
+      const double t52 = 1.0 / t51;
+      const double t53 = t30 + t31;
+      const double t54 = t8 * t52 * t53;
+      const double t55 = t5 + t6;
+      const double t56 = 0.5 * t54 + (t55 - t53 * (t4 * p_com_4_2) - t53 * (t52 * (t7 * (t49 * p_com_4_1))));
+      const double t57 = t53 + 2.0 * (t53 * (t4 * p_com_4_1) - t53 * (t52 * (t7 * (t49 * p_com_4_2))));
+      const double t58 = t9 * t9;
+      const double t59 = 1.0 - t58 * (t12 * t12);
+      const double t60 = sqrt(t59);
+      const double t61 = 1.0 / t60;
+      const double t62 = t34 + t35;
+      const double t63 = t13 * t61 * t62;
+      const double t64 = t10 + t11;
+      const double t65 = t62 * (t9 * p_com_5_2) + (t64 - t62 * (t61 * (t12 * (t58 * p_com_5_1)))) - 0.5 * t63;
+      const double t66 = t62 - 2.0 * (t62 * (t9 * p_com_5_1) + t62 * (t61 * (t12 * (t58 * p_com_5_2))));
+      const double t67 = t14 * t14;
+      const double t68 = 1.0 - t67 * (t22 * t22);
+      const double t69 = sqrt(t68);
+      const double t70 = 1.0 / t69;
+      const double t71 = t23 * t70;
+      const double t72 = t41 * t71;
+      const double t73 = t70 * (t22 * (t67 * p_com_6_0));
+      const double t74 = t14 * p_com_6_2;
+      const double t75 = t43 + t41 * t73 - t41 * t74 - 0.5 * t72;
+      const double t76 = t70 * (t22 * (t67 * p_com_6_2));
+      const double t77 = t14 * p_com_6_0;
+      const double t78 = t41 + 2.0 * (t41 * t76 + t41 * t77);
+      const double t79 = t67 * p_inertia_6_1 * (1.0 / t68);
+      const double t80 = t54 + t55;
+      const double t81 = t80 * t80;
+      const double t82 = t64 - t63;
+      const double t83 = t82 * t82;
+      const double t84 = t43 - t72;
+      const double t85 = t84 * t84;
+      const double t86 = w1[k] * t27 + w2[k] * t28;
+      const double t87 = p_mass_0 * t29;
+      const double t88 = w2[k] * t24 + w1[k] * t25;
+      const double t89 = t21 * (t15 * w2[k]) + t39 * (w2[k] * (t17 * (t15 * t46)));
+      const double t90 = 2.0 * (t39 * (t18 * (w1[k] * (p_com_3_2 * t46))) + (t21 * (w2[k] * t44) + t39 * (w2[k] * (t17 * (t44 * t46))) - t21 * (w1[k] * p_com_3_2))) + t89;
+      const double t91 = p_mass_3 * t45;
+      const double t92 = t21 * (p_l2_2 * w1[k]) - t39 * (t18 * (w1[k] * (p_l2_2 * t46)));
+      const double t93 = 2.0 * (t21 * (w1[k] * p_com_3_0) + (t21 * (w2[k] * t40) + t39 * (w2[k] * (t17 * (t40 * t46)))) - t39 * (t18 * (w1[k] * (p_com_3_0 * t46)))) + t92;
+      const double t94 = p_mass_6 * t75;
+      const double t95 = t71 * t89;
+      const double t96 = 0.5 * t95 + (t74 * t89 + (t92 - t73 * t89));
+      const double t97 = t89 + 2.0 * (t76 * t89 + t77 * t89);
+      const double t98 = p_mass_9 * t84;
+      const double t99 = t92 + t95;
+      const double t100 = t84 * p_armature_2;
+      const double t101 = t99 * t100 + (t98 * t99 + (t94 * t96 + (t48 * (w2[k] * (w1[k] * (w3[k] * (w0[k] * p_inertia_3_1)))) + (w2[k] * p_inertia_0_5 + (w1[k] * p_inertia_0_3 - p_mass_0 * t26 * t86 - t87 * t88))) - t89 * (t41 * t79))) - 0.25 * (p_mass_6 * t78 * t97 + (p_mass_3 * t42 * t90 - t91 * t93));
+      const double t102 = t82 * p_armature_1 + (p_mass_8 * t82 + (p_mass_5 * t65 + (p_mass_2 * t37 + (t87 - p_mass_1 * t33) - p_mass_4 * t56) - t94 - p_mass_7 * t80) - t98) - t80 * p_armature_0 - t100 - 0.5 * t91;
+      const double t103 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const double t104 = t99 * t99;
+      const double t105 = -(p_mass_0 * t88) - p_mass_6 * t96 - p_mass_9 * t99 - p_armature_2 * t99 - 0.5 * (p_mass_3 * t93);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(t8), 1.0) &
+          islessequal(fabs(t13), 1.0) &
+          islessequal(fabs(-t23), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (p_mass_6 * (t78 * t78) + (p_mass_5 * (t66 * t66) + (p_mass_4 * (t57 * t57) + (p_mass_3 * (t42 * t42) + p_mass_3 * (t45 * t45))))) * 0.25 + (w2[k] * (w1[k] * p_inertia_0_4) * 2.0 + (t85 * p_armature_2 + (t83 * p_armature_1 + (t81 * p_armature_0 + (p_mass_9 * t85 + (p_mass_8 * t83 + (p_mass_7 * t81 + (t79 * (t41 * t41) + (p_mass_6 * (t75 * t75) + (t58 * p_inertia_5_0 * (1.0 / t59) * (t62 * t62) + (p_mass_5 * (t65 * t65) + (t49 * p_inertia_4_0 * (1.0 / t50) * (t53 * t53) + (p_mass_4 * (t56 * t56) + (t18 * (t17 * (p_inertia_3_1 * t46)) * t48 + (p_mass_2 * (t37 * t37) + (p_mass_2 * (t36 * t36) + (p_mass_1 * (t33 * t33) + (p_mass_1 * (t32 * t32) + (t18 * p_inertia_0_2 + (t17 * p_inertia_0_0 + (p_mass_0 * (t29 * t29) + (p_mass_0 * (t26 * t26) + (p_inertia_1_0 + p_inertia_2_0))))))))))))))))))))))) : (double)NAN;
+      M[s + i] = ok ? t101 : (double)NAN;
+      M[2 * s + i] = ok ? t102 : (double)NAN;
+      M[3 * s + i] = ok ? t101 : (double)NAN;
+      M[4 * s + i] = ok ? 0.25 * (p_mass_6 * (t97 * t97) + (p_mass_3 * (t90 * t90) + p_mass_3 * (t93 * t93))) + (p_armature_2 * t104 + (p_mass_9 * t104 + (t79 * (t89 * t89) + (p_mass_6 * (t96 * t96) + (t48 * (t16 * p_inertia_3_1) + (p_mass_0 * (t88 * t88) + (p_mass_0 * (t86 * t86) + (p_inertia_0_1 + p_mass_0 * (t103 * t103))))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t105 : (double)NAN;
+      M[6 * s + i] = ok ? t102 : (double)NAN;
+      M[7 * s + i] = ok ? t105 : (double)NAN;
+      M[8 * s + i] = ok ? p_armature_2 + (p_armature_1 + (p_armature_0 + (p_mass_9 + (p_mass_8 + (p_mass_7 + (p_mass_6 + (p_mass_5 + (p_mass_4 + (p_mass_3 + (p_mass_2 + (p_mass_0 + p_mass_1))))))))))) : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_param_batch_platform_jacobian(const prru_params *p, int n, const double *q, double *JP)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = sqrt(w0[k] * w0[k] * (w1[k] * w1[k]) + w2[k] * w2[k]);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(1.0 / p_l1_0 * (p_b_0 - p_a_0 * w0[k] - w0[k] * p_l2_0)), 1.0) &
+          islessequal(fabs(1.0 / p_l1_1 * (p_b_1 - w0[k] * p_a_1 - w0[k] * p_l2_1)), 1.0) &
+          islessequal(fabs(-(1.0 / p_l1_2 * (p_b_2 - w0[k] * p_l2_2 * w1[k] * (1.0 / t4)))), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      JP[i] = ok ? 1.0 : (double)NAN;
+      JP[s + i] = ok ? 0.0 : (double)NAN;
+      JP[2 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[3 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[4 * s + i] = ok ? w0[k] : (double)NAN;
+      JP[5 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[6 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[7 * s + i] = ok ? w3[k] : (double)NAN;
+      JP[8 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[9 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[10 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[11 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[12 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[13 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[14 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[15 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[16 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[17 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_param_batch_dynamics(const prru_params *p, int n, const double *q, const double *qd, double *M, double *h, double *G)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const double p_gravity_0 = p->gravity[0];
+  const double p_gravity_1 = p->gravity[1];
+  const double p_gravity_2 = p->gravity[2];
+  const double p_mass_0 = p->mass[0];
+  const double p_mass_1 = p->mass[1];
+  const double p_mass_2 = p->mass[2];
+  const double p_mass_3 = p->mass[3];
+  const double p_mass_4 = p->mass[4];
+  const double p_mass_5 = p->mass[5];
+  const double p_mass_6 = p->mass[6];
+  const double p_mass_7 = p->mass[7];
+  const double p_mass_8 = p->mass[8];
+  const double p_mass_9 = p->mass[9];
+  const double p_com_0_0 = p->com[0][0];
+  const double p_com_0_1 = p->com[0][1];
+  const double p_com_0_2 = p->com[0][2];
+  const double p_com_1_1 = p->com[1][1];
+  const double p_com_1_2 = p->com[1][2];
+  const double p_com_2_1 = p->com[2][1];
+  const double p_com_2_2 = p->com[2][2];
+  const double p_com_3_0 = p->com[3][0];
+  const double p_com_3_2 = p->com[3][2];
+  const double p_com_4_1 = p->com[4][1];
+  const double p_com_4_2 = p->com[4][2];
+  const double p_com_5_1 = p->com[5][1];
+  const double p_com_5_2 = p->com[5][2];
+  const double p_com_6_0 = p->com[6][0];
+  const double p_com_6_2 = p->com[6][2];
+  const double p_inertia_0_0 = p->inertia[0][0];
+  const double p_inertia_0_1 = p->inertia[0][1];
+  const double p_inertia_0_2 = p->inertia[0][2];
+  const double p_inertia_0_3 = p->inertia[0][3];
+  const double p_inertia_0_4 = p->inertia[0][4];
+  const double p_inertia_0_5 = p->inertia[0][5];
+  const double p_inertia_1_0 = p->inertia[1][0];
+  const double p_inertia_2_0 = p->inertia[2][0];
+  const double p_inertia_3_1 = p->inertia[3][1];
+  const double p_inertia_4_0 = p->inertia[4][0];
+  const double p_inertia_5_0 = p->inertia[5][0];
+  const double p_inertia_6_1 = p->inertia[6][1];
+  const double p_armature_0 = p->armature[0];
+  const double p_armature_1 = p->armature[1];
+  const double p_armature_2 = p->armature[2];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = PRRU_BATCH_COS(q1);
+      w1[k] = PRRU_BATCH_COS(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = PRRU_BATCH_SIN(q2);
+      w3[k] = PRRU_BATCH_SIN(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double qd1 = qd[i];
+      const double qd2 = qd[s + i];
+      const double t4 = 1.0 / p_l1_0;
+      const double t5 = p_a_0 * w0[k];
+      const double t6 = w0[k] * p_l2_0;
+      const double t7 = p_b_0 - t5 - t6;
+      const double t8 = t4 * t7;
+      const double t9 = 1.0 / p_l1_1;
+      const double t10 = w0[k] * p_a_1;
+      const double t11 = w0[k] * p_l2_1;
+      const double t12 = p_b_1 - t10 - t11;
+      const double t13 = t9 * t12;
+      const double t14 = 1.0 / p_l1_2;
+      const double t15 = w0[k] * p_l2_2;
+      const double t16 = t15 * w1[k];
+      const double t17 = w0[k] * w0[k];
+      const double t18 = w1[k] * w1[k];
+      const double t19 = w2[k] * w2[k];
+      const double t20 = t17 * t18 + t19;
+      const double t21 = sqrt(t20);
+      const double t22 = 1.0 / t21;
+      const double t23 = p_b_2 - t16 * t22;
+      const double t24 = t14 * t23;
+      const double t25 = w0[k] * p_com_0_2;
+      const double t26 = w0[k] * p_com_0_0;
+      const double t27 = p_com_0_1 * w3[k] + w1[k] * t25 - w2[k] * t26;
+      const double t28 = w3[k] * p_com_0_0;
+      const double t29 = w3[k] * p_com_0_2;
+      const double t30 = w2[k] * t28 + w0[k] * p_com_0_1 - w1[k] * t29;
+      const double t31 = p_a_0 * w3[k];
+      const double t32 = p_l2_0 * w3[k];
+      const double t33 = t32 * 0.5 + (t31 - w3[k] * p_com_1_1 - w0[k] * p_com_1_2);
+      const double t34 = t6 * 0.5 + (w3[k] * p_com_1_2 + (t5 - w0[k] * p_com_1_1));
+      const double t35 = p_a_1 * w3[k];
+      const double t36 = p_l2_1 * w3[k];
+      const double t37 = 0.5 * t36 + (w0[k] * p_com_2_2 + (t35 + w3[k] * p_com_2_1));
+      const double t38 = t11 * 0.5 + (t10 + w0[k] * p_com_2_1 - w3[k] * p_com_2_2);
+      const double t39 = w1[k] * t18;
+      const double t40 = t22 * t22;
+      const double t41 = t22 * t40;
+      const double t42 = w0[k] * p_com_3_2;
+      const double t43 = w3[k] * (p_l2_2 * t17) * t39 * t41 - t22 * (w1[k] * (p_l2_2 * w3[k]));
+      const double t44 = (t41 * (w2[k] * (t18 * (w3[k] * t42))) + (t41 * (t39 * (w3[k] * (t17 * p_com_3_0))) - t22 * (w1[k] * (w3[k] * p_com_3_0)))) * 2.0 + t43;
+      const double t45 = t41 * (w2[k] * (t18 * (t15 * w3[k])));
+      const double t46 = w0[k] * p_com_3_0;
+      const double t47 = t45 - 2.0 * (t41 * (t39 * (w3[k] * (t17 * p_com_3_2))) - t22 * (w1[k] * (w3[k] * p_com_3_2)) - t41 * (w2[k] * (t18 * (w3[k] * t46))));
+      const double t48 = w3[k] * w3[k];
+      const double t49 = 1.0 / t20;
+      const double t50 = t49 * t49;
+      const double t51 = t4 * t4;
+      const double t52 = t7 * t7;
+      const double t53 = 1.0 - t51 * t52;
+      const double t54 = sqrt(t53);
+      const double t55 = 1.0 / t54;
+      const double t56 = t8 * t55;
+      const double t57 = t31 + t32;
+      const double t58 = t56 * t57;
+      const double t59 = t4 * p_com_4_2;
+      const double t60 = t51 * p_com_4_1;
+      const double t61 = t55 * (t7 * t60);
+      const double t62 = t5 + t6;
+      const double t63 = 0.5 * t58 + (t62 - t57 * t59 - t57 * t61);
+      const double t64 = t4 * p_com_4_1;
+      const double t65 = t51 * p_com_4_2;
+      const double t66 = t55 * (t7 * t65);
+      const double t67 = t57 + 2.0 * (t57 * t64 - t57 * t66);
+      const double t68 = t9 * t9;
+      const double t69 = t12 * t12;
+      const double t70 = 1.0 - t68 * t69;
+      const double t71 = sqrt(t70);
+      const double t72 = 1.0 / t71;
+      const double t73 = t13 * t72;
+      const double t74 = t35 + t36;
+      const double t75 = t73 * t74;
+      const double t76 = t68 * p_com_5_1;
+      const double t77 = t72 * (t12 * t76);
+      const double t78 = t9 * p_com_5_2;
+      const double t79 = t10 + t11;
+      const double t80 = t74 * t78 + (t79 - t74 * t77) - 0.5 * t75;
+      const double t81 = t9 * p_com_5_1;
+      const double t82 = t68 * p_com_5_2;
+      const double t83 = t72 * (t12 * t82);
+      const double t84 = t74 - 2.0 * (t74 * t81 + t74 * t83);
+      const double t85 = t14 * t14;
+      const double t86 = t23 * t23;
+      const double t87 = 1.0 - t85 * t86;
+      const double t88 = sqrt(t87);
+      const double t89 = 1.0 / t88;
+      const double t90 = t24 * t89;
+      const double t91 = t43 * t90;
+      const double t92 = t85 * p_com_6_0;
+      const double t93 = t89 * (t23 * t92);
+      const double t94 = t14 * p_com_6_2;
+      const double t95 = t45 + t43 * t93 - t43 * t94 - 0.5 * t91;
+      const double t96 = t85 * p_com_6_2;
+      const double t97 = t89 * (t23 * t96);
+      const double t98 = t14 * p_com_6_0;
+      const double t99 = t43 + 2.0 * (t43 * t97 + t43 * t98);
+      const double t100 = t85 * p_inertia_6_1 * (1.0 / t87);
+      const double t101 = t58 + t62;
+      const double t102 = t101 * t101;
+      const double t103 = t79 - t75;
+      const double t104 = t103 * t103;
+      const double t105 = t45 - t91;
+      const double t106 = t105 * t105;
+      const double t107 = p_mass_0 * t27;
+      const double t108 = w1[k] * t28 + w2[k] * t29;
+      const double t109 = p_mass_0 * t30;
+      const double t110 = w2[k] * t25 + w1[k] * t26;
+      const double t111 = p_mass_3 * t44;
+      const double t112 = t22 * (t15 * w2[k]) + t41 * (w2[k] * (t18 * (t15 * t48)));
+      const double t113 = 2.0 * (t41 * (t19 * (w1[k] * (p_com_3_2 * t48))) + (t22 * (w2[k] * t46) + t41 * (w2[k] * (t18 * (t46 * t48))) - t22 * (w1[k] * p_com_3_2))) + t112;
+      const double t114 = p_mass_3 * t47;
+      const double t115 = t22 * (p_l2_2 * w1[k]) - t41 * (t19 * (w1[k] * (p_l2_2 * t48)));
+      const double t116 = 2.0 * (t22 * (w1[k] * p_com_3_0) + (t22 * (w2[k] * t42) + t41 * (w2[k] * (t18 * (t42 * t48)))) - t41 * (t19 * (w1[k] * (p_com_3_0 * t48)))) + t115;
+      const double t117 = w0[k] * p_inertia_3_1;
+      const double t118 = p_mass_6 * t95;
+      const double t119 = t90 * t112;
+      const double t120 = 0.5 * t119 + (t94 * t112 + (t115 - t93 * t112));
+      const double t121 = p_mass_6 * t99;
+      const double t122 = t112 + 2.0 * (t97 * t112 + t98 * t112);
+      const double t123 = p_mass_9 * t105;
+      const double t124 = t115 + t119;
+      const double t125 = t105 * p_armature_2;
+      const double t126 = t124 * t125 + (t123 * t124 + (t118 * t120 + (t50 * (w2[k] * (w1[k] * (w3[k] * t117))) + (w2[k] * p_inertia_0_5 + (w1[k] * p_inertia_0_3 - t107 * t108 - t109 * t110))) - t112 * (t43 * t100))) - 0.25 * (t121 * t122 + (t111 * t113 - t114 * t116));
+      const double t127 = p_mass_1 * t34;
+      const double t128 = p_mass_2 * t38;
+      const double t129 = p_mass_4 * t63;
+      const double t130 = p_mass_5 * t80;
+      const double t131 = p_mass_7 * t101;
+      const double t132 = p_mass_8 * t103;
+      const double t133 = t103 * p_armature_1;
+      const double t134 = t101 * p_armature_0;
+      const double t135 = 0.5 * t114;
+      const double t136 = t132 + (t130 + (t128 + (t109 - t127) - t129) - t118 - t131) - t123;
+      const double t137 = t133 + t136 - t134 - t125 - t135;
+      const double t138 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const double t139 = t124 * t124;
+      const double t140 = p_mass_0 * t110;
+      const double t141 = p_mass_3 * t116;
+      const double t142 = p_mass_6 * t120;
+      const double t143 = p_mass_9 * t124;
+      const double t144 = p_armature_2 * t124;
+      const double t145 = 0.5 * t141;
+      const double t146 = -t140 - t142 - t143 - t144 - t145;
+      const double t147 = p_mass_9 + (p_mass_8 + (p_mass_7 + (p_mass_6 + (p_mass_5 + (p_mass_4 + (p_mass_3 + (p_mass_2 + (p_mass_0 + p_mass_1))))))));
+      const double t148 = p_com_0_0 * qd1 * qd2;
+      const double t149 = qd1 * qd1;
+      const double t150 = p_com_0_0 * t149;
+      const double t151 = qd2 * qd2;
+      const double t152 = p_com_0_0 * t151;
+      const double t153 = p_com_0_1 * t149;
+      const double t154 = p_com_0_2 * t149;
+      const double t155 = qd2 * (p_com_0_2 * qd1);
+      const double t156 = p_com_0_2 * t151;
+      const double t157 = w1[k] * (w0[k] * t148) + w2[k] * (w0[k] * t155) - 0.5 * (w0[k] * t153 + (w2[k] * (w3[k] * t150) + w2[k] * (w3[k] * t152)) - w1[k] * (w3[k] * t154) - w1[k] * (w3[k] * t156));
+      const double t158 = w1[k] * (w0[k] * t156) + (w3[k] * t153 + w1[k] * (w0[k] * t154)) - w2[k] * (w0[k] * t152) - w2[k] * (w0[k] * t150) - 2.0 * (w2[k] * (w3[k] * t155) + w1[k] * (w3[k] * t148));
+      const double t159 = p_inertia_0_4 * qd1;
+      const double t160 = qd2 * t159;
+      const double t161 = p_inertia_0_0 * qd1;
+      const double t162 = p_inertia_0_2 * qd1;
+      const double t163 = w2[k] * t162 + (w1[k] * t159 + p_inertia_0_5 * qd2);
+      const double t164 = w2[k] * qd1;
+      const double t165 = p_inertia_0_3 * qd1;
+      const double t166 = p_inertia_0_5 * qd1;
+      const double t167 = w2[k] * t166 + (w1[k] * t165 + p_inertia_0_1 * qd2);
+      const double t168 = w1[k] * qd1;
+      const double t169 = w2[k] * t159 + (w1[k] * t161 + p_inertia_0_3 * qd2);
+      const double t170 = p_mass_1 * t33;
+      const double t171 = p_a_0 * t149;
+      const double t172 = w0[k] * t171;
+      const double t173 = p_l2_0 * t149;
+      const double t174 = w0[k] * t173;
+      const double t175 = p_com_1_1 * t149;
+      const double t176 = p_com_1_2 * t149;
+      const double t177 = w3[k] * t171;
+      const double t178 = w3[k] * t173;
+      const double t179 = 0.5 * t178 + (t177 - w3[k] * t175 - w0[k] * t176);
+      const double t180 = p_mass_2 * t37;
+      const double t181 = p_a_1 * t149;
+      const double t182 = w0[k] * t181;
+      const double t183 = p_l2_1 * t149;
+      const double t184 = w0[k] * t183;
+      const double t185 = p_com_2_1 * t149;
+      const double t186 = p_com_2_2 * t149;
+      const double t187 = w3[k] * t181;
+      const double t188 = w3[k] * t183;
+      const double t189 = 0.5 * t188 + (w0[k] * t186 + (t187 + w3[k] * t185));
+      const double t190 = t16 * t41;
+      const double t191 = qd1 * qd2;
+      const double t192 = t48 * t151;
+      const double t193 = t19 * t192 + (t18 * (t17 * t149) - t18 * (t48 * t149) - t18 * t192) - w2[k] * (w1[k] * (w3[k] * (w0[k] * t191))) * 4.0;
+      const double t194 = p_l2_2 * qd1;
+      const double t195 = w1[k] * (w3[k] * t194);
+      const double t196 = t18 * (w3[k] * (w0[k] * qd1)) - w2[k] * (w1[k] * (t48 * qd2));
+      const double t197 = p_l2_2 * qd2;
+      const double t198 = w2[k] * (w0[k] * t197);
+      const double t199 = t22 * (t40 * t40);
+      const double t200 = t196 * t196;
+      const double t201 = p_l2_2 * t151;
+      const double t202 = w1[k] * t46;
+      const double t203 = p_com_3_0 * qd1;
+      const double t204 = p_com_3_0 * qd2;
+      const double t205 = p_com_3_0 * t151;
+      const double t206 = p_com_3_2 * qd2;
+      const double t207 = p_com_3_2 * t151;
+      const double t208 = w2[k] * p_com_3_2;
+      const double t209 = t41 * t195 * t196 + t196 * (t41 * t198) - t22 * (w2[k] * (w3[k] * (qd2 * t194)));
+      const double t210 = t16 * t199 * t200 * 3.0;
+      const double t211 = t190 * t193 - t22 * (w1[k] * (w0[k] * (p_l2_2 * t149))) - t22 * (w1[k] * (w0[k] * t201));
+      const double t212 = (t200 * (t199 * t202) + t200 * (t199 * t208)) * 6.0 + (t210 + (t211 - 2.0 * (t22 * (w2[k] * t207) + (t22 * (w1[k] * (w0[k] * t205)) + (t22 * (w1[k] * (w0[k] * (p_com_3_0 * t149))) + (t209 - t193 * (t41 * t202)))) - t193 * (t41 * t208))) - 4.0 * (t196 * (t41 * (w1[k] * (w3[k] * t203))) + t196 * (t41 * (w2[k] * (w0[k] * t204))) - t22 * (w2[k] * (w3[k] * (qd2 * t203))) - t196 * (t41 * (w1[k] * t206))));
+      const double t213 = t196 * (t41 * (w1[k] * t197));
+      const double t214 = p_l2_2 * w2[k];
+      const double t215 = w1[k] * t42;
+      const double t216 = p_com_3_2 * qd1;
+      const double t217 = w2[k] * p_com_3_0;
+      const double t218 = t22 * (w2[k] * t201) - t193 * (t41 * t214);
+      const double t219 = t200 * (t199 * t214) * 1.5;
+      const double t220 = 2.0 * (t196 * (t41 * (w1[k] * t204)) + (t196 * (t41 * (w1[k] * (w3[k] * t216))) + t196 * (t41 * (w2[k] * (w0[k] * t206))) - t22 * (w2[k] * (w3[k] * (qd2 * t216))))) + (t219 + (t193 * (t41 * t217) + (t22 * (w1[k] * (w0[k] * t207)) + (t22 * (w1[k] * (w0[k] * (p_com_3_2 * t149))) + (t213 - t193 * (t41 * t215))) - t22 * (w2[k] * t205)) - 0.5 * t218)) - 3.0 * (t200 * (t199 * t215) - t200 * (t199 * t217));
+      const double t221 = w0[k] * qd2;
+      const double t222 = w1[k] * (w3[k] * qd1) + w2[k] * t221;
+      const double t223 = w3[k] * t191;
+      const double t224 = w1[k] * (w0[k] * t151);
+      const double t225 = t196 * (t50 * (t18 * t221 + w2[k] * t222)) - 0.5 * (t49 * (2.0 * (w2[k] * t224) + (t18 * t223 - t222 * (w1[k] * qd2) - w2[k] * (t224 + w1[k] * (w0[k] * t149) - 2.0 * (w2[k] * t223)))));
+      const double t226 = p_mass_4 * t67;
+      const double t227 = t172 + t174;
+      const double t228 = w3[k] * (p_a_0 * qd1) + w3[k] * (p_l2_0 * qd1);
+      const double t229 = t228 * t228;
+      const double t230 = t51 * t51;
+      const double t231 = t55 * (t55 * t55);
+      const double t232 = t4 * t55;
+      const double t233 = t229 * t232;
+      const double t234 = t4 * t51;
+      const double t235 = t229 * (t231 * (t52 * t234));
+      const double t236 = t56 * t227;
+      const double t237 = t177 + t178;
+      const double t238 = t61 * t227 + (t229 * (t231 * (t52 * (p_com_4_1 * t230))) + (t229 * (t55 * t60) + (t59 * t227 + t237))) - 0.5 * (t236 + (t233 + t235));
+      const double t239 = p_mass_5 * t84;
+      const double t240 = t182 + t184;
+      const double t241 = w3[k] * (p_a_1 * qd1) + w3[k] * (p_l2_1 * qd1);
+      const double t242 = t241 * t241;
+      const double t243 = t68 * t68;
+      const double t244 = t72 * (t72 * t72);
+      const double t245 = t9 * t72;
+      const double t246 = t242 * t245;
+      const double t247 = t9 * t68;
+      const double t248 = t242 * (t244 * (t69 * t247));
+      const double t249 = t73 * t240;
+      const double t250 = t187 + t188;
+      const double t251 = 0.5 * (t249 + (t246 + t248)) + (t77 * t240 + (t242 * (t244 * (t69 * (p_com_5_1 * t243))) + (t242 * (t72 * t76) + t250)) - t78 * t240);
+      const double t252 = t210 + (t211 - 2.0 * t209);
+      const double t253 = t190 * t196 - t22 * t195 - t22 * t198;
+      const double t254 = t253 * t253;
+      const double t255 = t85 * t85;
+      const double t256 = t89 * (t89 * t89);
+      const double t257 = t210 + (t211 - 2.0 * (t254 * (t86 * (p_com_6_2 * t255) * t256) + (t89 * t96 * t254 + (t209 - t97 * t252)) - t98 * t252));
+      const double t258 = t90 * t252;
+      const double t259 = t14 * t89;
+      const double t260 = t254 * t259;
+      const double t261 = t14 * t85;
+      const double t262 = t254 * (t256 * (t86 * t261));
+      const double t263 = t219 + (t213 - 0.5 * (t94 * t252 + (t254 * (t256 * (t86 * (p_com_6_0 * t255))) + (t254 * (t89 * t92) + (t218 - t93 * t252))))) - 0.25 * (t258 - t260 - t262);
+      const double t264 = t89 * (t14 * p_inertia_6_1);
+      const double t265 = t254 * (t256 * (t23 * t261)) - t252 * t259;
+      const double t266 = t237 - t233 - t235 - t236;
+      const double t267 = t249 + (t248 + (t246 + t250));
+      const double t268 = t219 + (t213 - 0.5 * (t218 + t258 - t260 - t262));
+      const double t269 = p_mass_0 * t138;
+      const double t270 = p_mass_3 * t113;
+      const double t271 = p_mass_6 * t122;
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(t8), 1.0) &
+          islessequal(fabs(t13), 1.0) &
+          islessequal(fabs(-t24), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (p_mass_6 * (t99 * t99) + (p_mass_5 * (t84 * t84) + (p_mass_4 * (t67 * t67) + (p_mass_3 * (t44 * t44) + p_mass_3 * (t47 * t47))))) * 0.25 + (w2[k] * (w1[k] * p_inertia_0_4) * 2.0 + (t106 * p_armature_2 + (t104 * p_armature_1 + (t102 * p_armature_0 + (p_mass_9 * t106 + (p_mass_8 * t104 + (p_mass_7 * t102 + (t100 * (t43 * t43) + (p_mass_6 * (t95 * t95) + (t68 * p_inertia_5_0 * (1.0 / t70) * (t74 * t74) + (p_mass_5 * (t80 * t80) + (t51 * p_inertia_4_0 * (1.0 / t53) * (t57 * t57) + (p_mass_4 * (t63 * t63) + (t19 * (t18 * (p_inertia_3_1 * t48)) * t50 + (p_mass_2 * (t38 * t38) + (p_mass_2 * (t37 * t37) + (p_mass_1 * (t34 * t34) + (p_mass_1 * (t33 * t33) + (t19 * p_inertia_0_2 + (t18 * p_inertia_0_0 + (p_mass_0 * (t30 * t30) + (p_mass_0 * (t27 * t27) + (p_inertia_1_0 + p_inertia_2_0))))))))))))))))))))))) : (double)NAN;
+      M[s + i] = ok ? t126 : (double)NAN;
+      M[2 * s + i] = ok ? t137 : (double)NAN;
+      M[3 * s + i] = ok ? t126 : (double)NAN;
+      M[4 * s + i] = ok ? 0.25 * (p_mass_6 * (t122 * t122) + (p_mass_3 * (t113 * t113) + p_mass_3 * (t116 * t116))) + (p_armature_2 * t139 + (p_mass_9 * t139 + (t100 * (t112 * t112) + (p_mass_6 * (t120 * t120) + (t50 * (t17 * p_inertia_3_1) + (p_mass_0 * (t110 * t110) + (p_mass_0 * (t108 * t108) + (p_inertia_0_1 + p_mass_0 * (t138 * t138))))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t146 : (double)NAN;
+      M[6 * s + i] = ok ? t137 : (double)NAN;
+      M[7 * s + i] = ok ? t146 : (double)NAN;
+      M[8 * s + i] = ok ? p_armature_2 + (p_armature_1 + (p_armature_0 + t147)) : (double)NAN;
+      h[i] = ok ? 2.0 * (0.25 * (t114 * t220) + ((t121 * t257 + (t239 * (t240 - 2.0 * (t83 * t240 + (t242 * (t69 * (p_com_5_2 * t243) * t244) + (t81 * t240 + t72 * t82 * t242)))) + (t111 * t212 + t226 * (t227 + 2.0 * (t64 * t227 - t55 * t65 * t229 - t229 * (t52 * (p_com_4_2 * t230) * t231) - t66 * t227))))) * 0.125 + (t125 * t268 + (t123 * t268 + (t118 * t263 + (t49 * (w2[k] * (w1[k] * (w3[k] * p_inertia_3_1))) * t225 - t107 * t157))) - 0.5 * (t133 * t267 + (t134 * t266 + (t132 * t267 + (t131 * t266 + (t43 * t264 * t265 + (t130 * t251 + (t129 * t238 + (t128 * t189 + (t127 * t179 + (t109 * t158 - w1[k] * (qd2 * t163 + (w1[k] * t160 - w2[k] * (qd2 * t161)) - t164 * t167) - w2[k] * (t167 * t168 + (w1[k] * (qd2 * t162) - w2[k] * t160) - qd2 * t169) - t170 * (0.5 * t174 + (w3[k] * t176 + (t172 - w0[k] * t175)))) - t180 * (0.5 * t184 + (t182 + w0[k] * t185 - w3[k] * t186)))) - t57 * (t55 * (t4 * p_inertia_4_0)) * (t229 * (t231 * (t7 * t234)) + t227 * t232)) - t74 * (t72 * (t9 * p_inertia_5_0)) * (t242 * (t244 * (t12 * t247)) + t240 * t245)))))))))) : (double)NAN;
+      h[s + i] = ok ? 0.5 * (t141 * t220) + (2.0 * (t144 * t268 + (t143 * t268 + (t142 * t263 + (t157 * (p_mass_0 * t108) + t225 * (t49 * t117))))) + (t265 * (t112 * t264) + (t164 * t169 + (w1[k] * (qd2 * t166) + (t269 * (w1[k] * t152 + w2[k] * t156) + t140 * t158) - w2[k] * (qd2 * t165)) - t163 * t168)) - 0.25 * (t212 * t270 + t257 * t271)) : (double)NAN;
+      h[2 * s + i] = ok ? p_armature_0 * t266 + (p_mass_7 * t266 + (p_mass_4 * t238 + (p_mass_1 * t179 - p_mass_0 * t158 - p_mass_2 * t189 - p_mass_3 * t220) - p_mass_5 * t251) - p_mass_8 * t267) - p_armature_1 * t267 - 2.0 * (p_armature_2 * t268 + (p_mass_6 * t263 + p_mass_9 * t268)) : (double)NAN;
+      G[i] = ok ? 0.5 * (p_gravity_0 * (t111 + t121) - 2.0 * (p_gravity_1 * (t180 + (t107 - t170) - 0.5 * (t226 - t239)) - p_gravity_2 * (t136 - t135))) : (double)NAN;
+      G[s + i] = ok ? t108 * (p_mass_0 * p_gravity_1) - p_gravity_0 * (t269 + 0.5 * (t270 + t271)) - p_gravity_2 * (t145 + (t143 + (t140 + t142))) : (double)NAN;
+      G[2 * s + i] = ok ? t147 * p_gravity_2 : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_param_batch_eom(const prru_params *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const double p_gravity_0 = p->gravity[0];
+  const double p_gravity_1 = p->gravity[1];
+  const double p_gravity_2 = p->gravity[2];
+  const double p_mass_0 = p->mass[0];
+  const double p_mass_1 = p->mass[1];
+  const double p_mass_2 = p->mass[2];
+  const double p_mass_3 = p->mass[3];
+  const double p_mass_4 = p->mass[4];
+  const double p_mass_5 = p->mass[5];
+  const double p_mass_6 = p->mass[6];
+  const double p_mass_7 = p->mass[7];
+  const double p_mass_8 = p->mass[8];
+  const double p_mass_9 = p->mass[9];
+  const double p_com_0_0 = p->com[0][0];
+  const double p_com_0_1 = p->com[0][1];
+  const double p_com_0_2 = p->com[0][2];
+  const double p_com_1_1 = p->com[1][1];
+  const double p_com_1_2 = p->com[1][2];
+  const double p_com_2_1 = p->com[2][1];
+  const double p_com_2_2 = p->com[2][2];
+  const double p_com_3_0 = p->com[3][0];
+  const double p_com_3_2 = p->com[3][2];
+  const double p_com_4_1 = p->com[4][1];
+  const double p_com_4_2 = p->com[4][2];
+  const double p_com_5_1 = p->com[5][1];
+  const double p_com_5_2 = p->com[5][2];
+  const double p_com_6_0 = p->com[6][0];
+  const double p_com_6_2 = p->com[6][2];
+  const double p_inertia_0_0 = p->inertia[0][0];
+  const double p_inertia_0_1 = p->inertia[0][1];
+  const double p_inertia_0_2 = p->inertia[0][2];
+  const double p_inertia_0_3 = p->inertia[0][3];
+  const double p_inertia_0_4 = p->inertia[0][4];
+  const double p_inertia_0_5 = p->inertia[0][5];
+  const double p_inertia_1_0 = p->inertia[1][0];
+  const double p_inertia_2_0 = p->inertia[2][0];
+  const double p_inertia_3_1 = p->inertia[3][1];
+  const double p_inertia_4_0 = p->inertia[4][0];
+  const double p_inertia_5_0 = p->inertia[5][0];
+  const double p_inertia_6_1 = p->inertia[6][1];
+  const double p_armature_0 = p->armature[0];
+  const double p_armature_1 = p->armature[1];
+  const double p_armature_2 = p->armature[2];
+  const double p_damping_0 = p->damping[0];
+  const double p_damping_1 = p->damping[1];
+  const double p_damping_2 = p->damping[2];
+  const double p_coulomb_0 = p->coulomb[0];
+  const double p_coulomb_1 = p->coulomb[1];
+  const double p_coulomb_2 = p->coulomb[2];
+  const double p_coulomb_velocity = p->coulomb_velocity;
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = PRRU_BATCH_COS(q1);
+      w1[k] = PRRU_BATCH_COS(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = PRRU_BATCH_SIN(q2);
+      w3[k] = PRRU_BATCH_SIN(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double qd1 = qd[i];
+      const double qd2 = qd[s + i];
+      const double qd3 = qd[2 * s + i];
+      const double fd1 = fd[i];
+      const double fd2 = fd[s + i];
+      const double fd3 = fd[2 * s + i];
+      const double fp3 = fp[2 * s + i];
+      const double mp1 = mp[i];
+      const double mp2 = mp[s + i];
+      const double mp3 = mp[2 * s + i];
+      const double t4 = 1.0 / p_l1_0;
+      const double t5 = p_a_0 * w0[k];
+      const double t6 = w0[k] * p_l2_0;
+      const double t7 = p_b_0 - t5 - t6;
+      const double t8 = t4 * t7;
+      const double t9 = 1.0 / p_l1_1;
+      const double t10 = w0[k] * p_a_1;
+      const double t11 = w0[k] * p_l2_1;
+      const double t12 = p_b_1 - t10 - t11;
+      const double t13 = t9 * t12;
+      const double t14 = 1.0 / p_l1_2;
+      const double t15 = w0[k] * p_l2_2;
+      const double t16 = t15 * w1[k];
+      const double t17 = w0[k] * w0[k];
+      const double t18 = w1[k] * w1[k];
+      const double t19 = w2[k] * w2[k];
+      const double t20 = t17 * t18 + t19;
+      const double t21 = sqrt(t20);
+      const double t22 = 1.0 / t21;
+      const double t23 = p_b_2 - t16 * t22;
+      const double t24 = t14 * t23;
+      const double t25 = w0[k] * p_com_0_2;
+      const double t26 = w0[k] * p_com_0_0;
+      const double t27 = p_com_0_1 * w3[k] + w1[k] * t25 - w2[k] * t26;
+      const double t28 = w3[k] * p_com_0_0;
+      const double t29 = w3[k] * p_com_0_2;
+      const double t30 = w2[k] * t28 + w0[k] * p_com_0_1 - w1[k] * t29;
+      const double t31 = p_a_0 * w3[k];
+      const double t32 = p_l2_0 * w3[k];
+      const double t33 = t32 * 0.5 + (t31 - w3[k] * p_com_1_1 - w0[k] * p_com_1_2);
+      const double t34 = t6 * 0.5 + (w3[k] * p_com_1_2 + (t5 - w0[k] * p_com_1_1));
+      const double t35 = p_a_1 * w3[k];
+      const double t36 = p_l2_1 * w3[k];
+      const double t37 = 0.5 * t36 + (w0[k] * p_com_2_2 + (t35 + w3[k] * p_com_2_1));
+      const double t38 = t11 * 0.5 + (t10 + w0[k] * p_com_2_1 - w3[k] * p_com_2_2);
+      const double t39 = w1[k] * t18;
+      const double t40 = t22 * t22;
+      const double t41 = t22 * t40;
+      const double t42 = w0[k] * p_com_3_2;
+      const double t43 = w3[k] * (p_l2_2 * t17) * t39 * t41 - t22 * (w1[k] * (p_l2_2 * w3[k]));
+      const double t44 = (t41 * (w2[k] * (t18 * (w3[k] * t42))) + (t41 * (t39 * (w3[k] * (t17 * p_com_3_0))) - t22 * (w1[k] * (w3[k] * p_com_3_0)))) * 2.0 + t43;
+      const double t45 = t41 * (w2[k] * (t18 * (t15 * w3[k])));
+      const double t46 = w0[k] * p_com_3_0;
+      const double t47 = t45 - 2.0 * (t41 * (t39 * (w3[k] * (t17 * p_com_3_2))) - t22 * (w1[k] * (w3[k] * p_com_3_2)) - t41 * (w2[k] * (t18 * (w3[k] * t46))));
+      const double t48 = w3[k] * w3[k];
+      const double t49 = 1.0 / t20;
+      const double t50 = t49 * t49;
+      const double t51 = t4 * t4;
+      const double t52 = t7 * t7;
+      const double t53 = 1.0 - t51 * t52;
+      const double t54 = sqrt(t53);
+      const double t55 = 1.0 / t54;
+      const double t56 = t8 * t55;
+      const double t57 = t31 + t32;
+      const double t58 = t56 * t57;
+      const double t59 = t4 * p_com_4_2;
+      const double t60 = t51 * p_com_4_1;
+      const double t61 = t55 * (t7 * t60);
+      const double t62 = t5 + t6;
+      const double t63 = 0.5 * t58 + (t62 - t57 * t59 - t57 * t61);
+      const double t64 = t4 * p_com_4_1;
+      const double t65 = t51 * p_com_4_2;
+      const double t66 = t55 * (t7 * t65);
+      const double t67 = t57 + 2.0 * (t57 * t64 - t57 * t66);
+      const double t68 = t9 * t9;
+      const double t69 = t12 * t12;
+      const double t70 = 1.0 - t68 * t69;
+      const double t71 = sqrt(t70);
+      const double t72 = 1.0 / t71;
+      const double t73 = t13 * t72;
+      const double t74 = t35 + t36;
+      const double t75 = t73 * t74;
+      const double t76 = t68 * p_com_5_1;
+      const double t77 = t72 * (t12 * t76);
+      const double t78 = t9 * p_com_5_2;
+      const double t79 = t10 + t11;
+      const double t80 = t74 * t78 + (t79 - t74 * t77) - 0.5 * t75;
+      const double t81 = t9 * p_com_5_1;
+      const double t82 = t68 * p_com_5_2;
+      const double t83 = t72 * (t12 * t82);
+      const double t84 = t74 - 2.0 * (t74 * t81 + t74 * t83);
+      const double t85 = t14 * t14;
+      const double t86 = t23 * t23;
+      const double t87 = 1.0 - t85 * t86;
+      const double t88 = sqrt(t87);
+      const double t89 = 1.0 / t88;
+      const double t90 = t24 * t89;
+      const double t91 = t43 * t90;
+      const double t92 = t85 * p_com_6_0;
+      const double t93 = t89 * (t23 * t92);
+      const double t94 = t14 * p_com_6_2;
+      const double t95 = t45 + t43 * t93 - t43 * t94 - 0.5 * t91;
+      const double t96 = t85 * p_com_6_2;
+      const double t97 = t89 * (t23 * t96);
+      const double t98 = t14 * p_com_6_0;
+      const double t99 = t43 + 2.0 * (t43 * t97 + t43 * t98);
+      const double t100 = t85 * p_inertia_6_1 * (1.0 / t87);
+      const double t101 = t58 + t62;
+      const double t102 = t101 * t101;
+      const double t103 = t79 - t75;
+      const double t104 = t103 * t103;
+      const double t105 = t45 - t91;
+      const double t106 = t105 * t105;
+      const double t107 = p_mass_0 * t27;
+      const double t108 = w1[k] * t28 + w2[k] * t29;
+      const double t109 = p_mass_0 * t30;
+      const double t110 = w2[k] * t25 + w1[k] * t26;
+      const double t111 = p_mass_3 * t44;
+      const double t112 = t22 * (t15 * w2[k]) + t41 * (w2[k] * (t18 * (t15 * t48)));
+      const double t113 = 2.0 * (t41 * (t19 * (w1[k] * (p_com_3_2 * t48))) + (t22 * (w2[k] * t46) + t41 * (w2[k] * (t18 * (t46 * t48))) - t22 * (w1[k] * p_com_3_2))) + t112;
+      const double t114 = p_mass_3 * t47;
+      const double t115 = t22 * (p_l2_2 * w1[k]) - t41 * (t19 * (w1[k] * (p_l2_2 * t48)));
+      const double t116 = 2.0 * (t22 * (w1[k] * p_com_3_0) + (t22 * (w2[k] * t42) + t41 * (w2[k] * (t18 * (t42 * t48)))) - t41 * (t19 * (w1[k] * (p_com_3_0 * t48)))) + t115;
+      const double t117 = w0[k] * p_inertia_3_1;
+      const double t118 = p_mass_6 * t95;
+      const double t119 = t90 * t112;
+      const double t120 = 0.5 * t119 + (t94 * t112 + (t115 - t93 * t112));
+      const double t121 = p_mass_6 * t99;
+      const double t122 = t112 + 2.0 * (t97 * t112 + t98 * t112);
+      const double t123 = p_mass_9 * t105;
+      const double t124 = t115 + t119;
+      const double t125 = t105 * p_armature_2;
+      const double t126 = t124 * t125 + (t123 * t124 + (t118 * t120 + (t50 * (w2[k] * (w1[k] * (w3[k] * t117))) + (w2[k] * p_inertia_0_5 + (w1[k] * p_inertia_0_3 - t107 * t108 - t109 * t110))) - t112 * (t43 * t100))) - 0.25 * (t121 * t122 + (t111 * t113 - t114 * t116));
+      const double t127 = p_mass_1 * t34;
+      const double t128 = p_mass_2 * t38;
+      const double t129 = p_mass_4 * t63;
+      const double t130 = p_mass_5 * t80;
+      const double t131 = p_mass_7 * t101;
+      const double t132 = p_mass_8 * t103;
+      const double t133 = t103 * p_armature_1;
+      const double t134 = t101 * p_armature_0;
+      const double t135 = 0.5 * t114;
+      const double t136 = t132 + (t130 + (t128 + (t109 - t127) - t129) - t118 - t131) - t123;
+      const double t137 = t133 + t136 - t134 - t125 - t135;
+      const double t138 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const double t139 = t124 * t124;
+      const double t140 = p_mass_0 * t110;
+      const double t141 = p_mass_3 * t116;
+      const double t142 = p_mass_6 * t120;
+      const double t143 = p_mass_9 * t124;
+      const double t144 = p_armature_2 * t124;
+      const double t145 = 0.5 * t141;
+      const double t146 = -t140 - t142 - t143 - t144 - t145;
+      const double t147 = p_mass_9 + (p_mass_8 + (p_mass_7 + (p_mass_6 + (p_mass_5 + (p_mass_4 + (p_mass_3 + (p_mass_2 + (p_mass_0 + p_mass_1))))))));
+      const double t148 = p_com_0_0 * qd1 * qd2;
+      const double t149 = qd1 * qd1;
+      const double t150 = p_com_0_0 * t149;
+      const double t151 = qd2 * qd2;
+      const double t152 = p_com_0_0 * t151;
+      const double t153 = p_com_0_1 * t149;
+      const double t154 = p_com_0_2 * t149;
+      const double t155 = qd2 * (p_com_0_2 * qd1);
+      const double t156 = p_com_0_2 * t151;
+      const double t157 = w1[k] * (w0[k] * t148) + w2[k] * (w0[k] * t155) - 0.5 * (w0[k] * t153 + (w2[k] * (w3[k] * t150) + w2[k] * (w3[k] * t152)) - w1[k] * (w3[k] * t154) - w1[k] * (w3[k] * t156));
+      const double t158 = w1[k] * (w0[k] * t156) + (w3[k] * t153 + w1[k] * (w0[k] * t154)) - w2[k] * (w0[k] * t152) - w2[k] * (w0[k] * t150) - 2.0 * (w2[k] * (w3[k] * t155) + w1[k] * (w3[k] * t148));
+      const double t159 = p_inertia_0_4 * qd1;
+      const double t160 = qd2 * t159;
+      const double t161 = p_inertia_0_0 * qd1;
+      const double t162 = p_inertia_0_2 * qd1;
+      const double t163 = w2[k] * t162 + (w1[k] * t159 + p_inertia_0_5 * qd2);
+      const double t164 = w2[k] * qd1;
+      const double t165 = p_inertia_0_3 * qd1;
+      const double t166 = p_inertia_0_5 * qd1;
+      const double t167 = w2[k] * t166 + (w1[k] * t165 + p_inertia_0_1 * qd2);
+      const double t168 = w1[k] * qd1;
+      const double t169 = w2[k] * t159 + (w1[k] * t161 + p_inertia_0_3 * qd2);
+      const double t170 = p_mass_1 * t33;
+      const double t171 = p_a_0 * t149;
+      const double t172 = w0[k] * t171;
+      const double t173 = p_l2_0 * t149;
+      const double t174 = w0[k] * t173;
+      const double t175 = p_com_1_1 * t149;
+      const double t176 = p_com_1_2 * t149;
+      const double t177 = w3[k] * t171;
+      const double t178 = w3[k] * t173;
+      const double t179 = 0.5 * t178 + (t177 - w3[k] * t175 - w0[k] * t176);
+      const double t180 = p_mass_2 * t37;
+      const double t181 = p_a_1 * t149;
+      const double t182 = w0[k] * t181;
+      const double t183 = p_l2_1 * t149;
+      const double t184 = w0[k] * t183;
+      const double t185 = p_com_2_1 * t149;
+      const double t186 = p_com_2_2 * t149;
+      const double t187 = w3[k] * t181;
+      const double t188 = w3[k] * t183;
+      const double t189 = 0.5 * t188 + (w0[k] * t186 + (t187 + w3[k] * t185));
+      const double t190 = t16 * t41;
+      const double t191 = qd1 * qd2;
+      const double t192 = t48 * t151;
+      const double t193 = t19 * t192 + (t18 * (t17 * t149) - t18 * (t48 * t149) - t18 * t192) - w2[k] * (w1[k] * (w3[k] * (w0[k] * t191))) * 4.0;
+      const double t194 = p_l2_2 * qd1;
+      const double t195 = w1[k] * (w3[k] * t194);
+      const double t196 = t18 * (w3[k] * (w0[k] * qd1)) - w2[k] * (w1[k] * (t48 * qd2));
+      const double t197 = p_l2_2 * qd2;
+      const double t198 = w2[k] * (w0[k] * t197);
+      const double t199 = t22 * (t40 * t40);
+      const double t200 = t196 * t196;
+      const double t201 = p_l2_2 * t151;
+      const double t202 = w1[k] * t46;
+      const double t203 = p_com_3_0 * qd1;
+      const double t204 = p_com_3_0 * qd2;
+      const double t205 = p_com_3_0 * t151;
+      const double t206 = p_com_3_2 * qd2;
+      const double t207 = p_com_3_2 * t151;
+      const double t208 = w2[k] * p_com_3_2;
+      const double t209 = t41 * t195 * t196 + t196 * (t41 * t198) - t22 * (w2[k] * (w3[k] * (qd2 * t194)));
+      const double t210 = t16 * t199 * t200 * 3.0;
+      const double t211 = t190 * t193 - t22 * (w1[k] * (w0[k] * (p_l2_2 * t149))) - t22 * (w1[k] * (w0[k] * t201));
+      const double t212 = (t200 * (t199 * t202) + t200 * (t199 * t208)) * 6.0 + (t210 + (t211 - 2.0 * (t22 * (w2[k] * t207) + (t22 * (w1[k] * (w0[k] * t205)) + (t22 * (w1[k] * (w0[k] * (p_com_3_0 * t149))) + (t209 - t193 * (t41 * t202)))) - t193 * (t41 * t208))) - 4.0 * (t196 * (t41 * (w1[k] * (w3[k] * t203))) + t196 * (t41 * (w2[k] * (w0[k] * t204))) - t22 * (w2[k] * (w3[k] * (qd2 * t203))) - t196 * (t41 * (w1[k] * t206))));
+      const double t213 = w1[k] * t197;
+      const double t214 = t196 * (t41 * t213);
+      const double t215 = p_l2_2 * w2[k];
+      const double t216 = t41 * t215;
+      const double t217 = w1[k] * t42;
+      const double t218 = p_com_3_2 * qd1;
+      const double t219 = w2[k] * p_com_3_0;
+      const double t220 = t22 * (w2[k] * t201) - t193 * t216;
+      const double t221 = t200 * (t199 * t215) * 1.5;
+      const double t222 = 2.0 * (t196 * (t41 * (w1[k] * t204)) + (t196 * (t41 * (w1[k] * (w3[k] * t218))) + t196 * (t41 * (w2[k] * (w0[k] * t206))) - t22 * (w2[k] * (w3[k] * (qd2 * t218))))) + (t221 + (t193 * (t41 * t219) + (t22 * (w1[k] * (w0[k] * t207)) + (t22 * (w1[k] * (w0[k] * (p_com_3_2 * t149))) + (t214 - t193 * (t41 * t217))) - t22 * (w2[k] * t205)) - 0.5 * t220)) - 3.0 * (t200 * (t199 * t217) - t200 * (t199 * t219));
+      const double t223 = w0[k] * qd2;
+      const double t224 = w1[k] * (w3[k] * qd1) + w2[k] * t223;
+      const double t225 = w3[k] * t191;
+      const double t226 = w1[k] * (w0[k] * t151);
+      const double t227 = t196 * (t50 * (t18 * t223 + w2[k] * t224)) - 0.5 * (t49 * (2.0 * (w2[k] * t226) + (t18 * t225 - t224 * (w1[k] * qd2) - w2[k] * (t226 + w1[k] * (w0[k] * t149) - 2.0 * (w2[k] * t225)))));
+      const double t228 = p_mass_4 * t67;
+      const double t229 = t172 + t174;
+      const double t230 = p_a_0 * qd1;
+      const double t231 = p_l2_0 * qd1;
+      const double t232 = w3[k] * t230 + w3[k] * t231;
+      const double t233 = t232 * t232;
+      const double t234 = t51 * t51;
+      const double t235 = t55 * (t55 * t55);
+      const double t236 = t4 * t55;
+      const double t237 = t233 * t236;
+      const double t238 = t4 * t51;
+      const double t239 = t233 * (t235 * (t52 * t238));
+      const double t240 = t56 * t229;
+      const double t241 = t177 + t178;
+      const double t242 = t61 * t229 + (t233 * (t235 * (t52 * (p_com_4_1 * t234))) + (t233 * (t55 * t60) + (t59 * t229 + t241))) - 0.5 * (t240 + (t237 + t239));
+      const double t243 = p_mass_5 * t84;
+      const double t244 = t182 + t184;
+      const double t245 = p_a_1 * qd1;
+      const double t246 = p_l2_1 * qd1;
+      const double t247 = w3[k] * t245 + w3[k] * t246;
+      const double t248 = t247 * t247;
+      const double t249 = t68 * t68;
+      const double t250 = t72 * (t72 * t72);
+      const double t251 = t9 * t72;
+      const double t252 = t248 * t251;
+      const double t253 = t9 * t68;
+      const double t254 = t248 * (t250 * (t69 * t253));
+      const double t255 = t73 * t244;
+      const double t256 = t187 + t188;
+      const double t257 = 0.5 * (t255 + (t252 + t254)) + (t77 * t244 + (t248 * (t250 * (t69 * (p_com_5_1 * t249))) + (t248 * (t72 * t76) + t256)) - t78 * t244);
+      const double t258 = t210 + (t211 - 2.0 * t209);
+      const double t259 = t190 * t196 - t22 * t195 - t22 * t198;
+      const double t260 = t259 * t259;
+      const double t261 = t85 * t85;
+      const double t262 = t89 * (t89 * t89);
+      const double t263 = t210 + (t211 - 2.0 * (t260 * (t86 * (p_com_6_2 * t261) * t262) + (t89 * t96 * t260 + (t209 - t97 * t258)) - t98 * t258));
+      const double t264 = t90 * t258;
+      const double t265 = t14 * t89;
+      const double t266 = t260 * t265;
+      const double t267 = t14 * t85;
+      const double t268 = t260 * (t262 * (t86 * t267));
+      const double t269 = t221 + (t214 - 0.5 * (t94 * t258 + (t260 * (t262 * (t86 * (p_com_6_0 * t261))) + (t260 * (t89 * t92) + (t220 - t93 * t258))))) - 0.25 * (t264 - t266 - t268);
+      const double t270 = t89 * (t14 * p_inertia_6_1);
+      const double t271 = t260 * (t262 * (t23 * t267)) - t258 * t265;
+      const double t272 = t241 - t237 - t239 - t240;
+      const double t273 = t255 + (t254 + (t252 + t256));
+      const double t274 = t221 + (t214 - 0.5 * (t220 + t264 - t266 - t268));
+      const double t275 = qd3 - w0[k] * t230 - w0[k] * t231 - t56 * t232;
+      const double t276 = p_damping_0 * t275;
+      const double t277 = 1.0 / p_coulomb_velocity;
+      const double t278 = tanh(t275 * t277);
+      const double t279 = p_coulomb_0 * t278;
+      const double t280 = t90 * t259 + (qd3 - t22 * t213 - t196 * t216);
+      const double t281 = p_damping_2 * t280;
+      const double t282 = tanh(t277 * t280);
+      const double t283 = p_coulomb_2 * t282;
+      const double t284 = t281 + t283;
+      const double t285 = w0[k] * t246 + (qd3 + w0[k] * t245) - t73 * t247;
+      const double t286 = p_damping_1 * t285;
+      const double t287 = tanh(t277 * t285);
+      const double t288 = p_coulomb_1 * t287;
+      const double t289 = p_mass_0 * t138;
+      const double t290 = p_mass_3 * t113;
+      const double t291 = p_mass_6 * t122;
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(t8), 1.0) &
+          islessequal(fabs(t13), 1.0) &
+          islessequal(fabs(-t24), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? (p_mass_6 * (t99 * t99) + (p_mass_5 * (t84 * t84) + (p_mass_4 * (t67 * t67) + (p_mass_3 * (t44 * t44) + p_mass_3 * (t47 * t47))))) * 0.25 + (w2[k] * (w1[k] * p_inertia_0_4) * 2.0 + (t106 * p_armature_2 + (t104 * p_armature_1 + (t102 * p_armature_0 + (p_mass_9 * t106 + (p_mass_8 * t104 + (p_mass_7 * t102 + (t100 * (t43 * t43) + (p_mass_6 * (t95 * t95) + (t68 * p_inertia_5_0 * (1.0 / t70) * (t74 * t74) + (p_mass_5 * (t80 * t80) + (t51 * p_inertia_4_0 * (1.0 / t53) * (t57 * t57) + (p_mass_4 * (t63 * t63) + (t19 * (t18 * (p_inertia_3_1 * t48)) * t50 + (p_mass_2 * (t38 * t38) + (p_mass_2 * (t37 * t37) + (p_mass_1 * (t34 * t34) + (p_mass_1 * (t33 * t33) + (t19 * p_inertia_0_2 + (t18 * p_inertia_0_0 + (p_mass_0 * (t30 * t30) + (p_mass_0 * (t27 * t27) + (p_inertia_1_0 + p_inertia_2_0))))))))))))))))))))))) : (double)NAN;
+      M[s + i] = ok ? t126 : (double)NAN;
+      M[2 * s + i] = ok ? t137 : (double)NAN;
+      M[3 * s + i] = ok ? t126 : (double)NAN;
+      M[4 * s + i] = ok ? 0.25 * (p_mass_6 * (t122 * t122) + (p_mass_3 * (t113 * t113) + p_mass_3 * (t116 * t116))) + (p_armature_2 * t139 + (p_mass_9 * t139 + (t100 * (t112 * t112) + (p_mass_6 * (t120 * t120) + (t50 * (t17 * p_inertia_3_1) + (p_mass_0 * (t110 * t110) + (p_mass_0 * (t108 * t108) + (p_inertia_0_1 + p_mass_0 * (t138 * t138))))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t146 : (double)NAN;
+      M[6 * s + i] = ok ? t137 : (double)NAN;
+      M[7 * s + i] = ok ? t146 : (double)NAN;
+      M[8 * s + i] = ok ? p_armature_2 + (p_armature_1 + (p_armature_0 + t147)) : (double)NAN;
+      b[i] = ok ? 2.0 * (0.5 * (t105 * t284 + (t101 * (t276 + t279) + (t103 * fd2 + (mp1 + (p_gravity_2 * (t136 - t135) + (t133 * t273 + (t134 * t272 + (t132 * t273 + (t131 * t272 + (t43 * t270 * t271 + (t130 * t257 + (t129 * t242 + (t128 * t189 + (t127 * t179 + (t109 * t158 - w1[k] * (qd2 * t163 + (w1[k] * t160 - w2[k] * (qd2 * t161)) - t164 * t167) - w2[k] * (t167 * t168 + (w1[k] * (qd2 * t162) - w2[k] * t160) - qd2 * t169) - t170 * (0.5 * t174 + (w3[k] * t176 + (t172 - w0[k] * t175)))) - t180 * (0.5 * t184 + (t182 + w0[k] * t185 - w3[k] * t186)))) - t57 * (t55 * (t4 * p_inertia_4_0)) * (t233 * (t235 * (t7 * t238)) + t229 * t236)) - t74 * (t72 * (t9 * p_inertia_5_0)) * (t248 * (t250 * (t12 * t253)) + t244 * t251)))))) - p_gravity_1 * (t180 + (t107 - t170) - 0.5 * (t228 - t243))))) - t101 * fd1 - t105 * fd3)) - t103 * (t286 + t288)) + (t107 * t157 - t49 * (w2[k] * (w1[k] * (w3[k] * p_inertia_3_1))) * t227 - t118 * t269 - t123 * t274 - t125 * t274) - (t121 * t263 + (t243 * (t244 - 2.0 * (t83 * t244 + (t248 * (t69 * (p_com_5_2 * t249) * t250) + (t81 * t244 + t72 * t82 * t248)))) + (t111 * t212 + t228 * (t229 + 2.0 * (t64 * t229 - t55 * t65 * t233 - t233 * (t52 * (p_com_4_2 * t234) * t235) - t66 * t229))))) * 0.125 - 0.25 * (t114 * t222 - p_gravity_0 * (t111 + t121))) : (double)NAN;
+      b[s + i] = ok ? 0.25 * (t212 * t290 + t263 * t291) + (t124 * t284 + (w3[k] * mp3 + (w0[k] * mp2 + (t108 * (p_mass_0 * p_gravity_1) + (t163 * t168 + (w2[k] * (qd2 * t165) - t289 * (w1[k] * t152 + w2[k] * t156) - t140 * t158 - w1[k] * (qd2 * t166) - t164 * t169) - t271 * (t112 * t270) - p_gravity_0 * (t289 + 0.5 * (t290 + t291))) - p_gravity_2 * (t145 + (t143 + (t140 + t142))) - t124 * fd3))) - 2.0 * (t144 * t274 + (t143 * t274 + (t142 * t269 + (t157 * (p_mass_0 * t108) + t227 * (t49 * t117)))))) - 0.5 * (t141 * t222) : (double)NAN;
+      b[2 * s + i] = ok ? 2.0 * (p_armature_2 * t274 + (p_mass_6 * t269 + p_mass_9 * t274)) + (fp3 + (fd3 + (fd2 + (fd1 + (t147 * p_gravity_2 + (p_armature_1 * t273 + (p_mass_8 * t273 + (p_mass_5 * t257 + (p_mass_3 * t222 + (p_mass_2 * t189 + (p_mass_0 * t158 - p_mass_1 * t179)) - p_mass_4 * t242) - p_mass_7 * t272) - p_armature_0 * t272)))))) - t276 - t279 - t286 - t288 - t281 - t283) : (double)NAN;
+    }
+  }
+}
+
+PRRU_BATCH_TARGETS void prru_param_batch_dme_terms(const prru_params *p, int n, const double *q, double *d, double *Jd, double *M, double *JP)
+{
+  const double p_b_0 = p->b[0];
+  const double p_b_1 = p->b[1];
+  const double p_b_2 = p->b[2];
+  const double p_l1_0 = p->l1[0];
+  const double p_l1_1 = p->l1[1];
+  const double p_l1_2 = p->l1[2];
+  const double p_l2_0 = p->l2[0];
+  const double p_l2_1 = p->l2[1];
+  const double p_l2_2 = p->l2[2];
+  const double p_a_0 = p->a[0];
+  const double p_a_1 = p->a[1];
+  const double p_mass_0 = p->mass[0];
+  const double p_mass_1 = p->mass[1];
+  const double p_mass_2 = p->mass[2];
+  const double p_mass_3 = p->mass[3];
+  const double p_mass_4 = p->mass[4];
+  const double p_mass_5 = p->mass[5];
+  const double p_mass_6 = p->mass[6];
+  const double p_mass_7 = p->mass[7];
+  const double p_mass_8 = p->mass[8];
+  const double p_mass_9 = p->mass[9];
+  const double p_com_0_0 = p->com[0][0];
+  const double p_com_0_1 = p->com[0][1];
+  const double p_com_0_2 = p->com[0][2];
+  const double p_com_1_1 = p->com[1][1];
+  const double p_com_1_2 = p->com[1][2];
+  const double p_com_2_1 = p->com[2][1];
+  const double p_com_2_2 = p->com[2][2];
+  const double p_com_3_0 = p->com[3][0];
+  const double p_com_3_2 = p->com[3][2];
+  const double p_com_4_1 = p->com[4][1];
+  const double p_com_4_2 = p->com[4][2];
+  const double p_com_5_1 = p->com[5][1];
+  const double p_com_5_2 = p->com[5][2];
+  const double p_com_6_0 = p->com[6][0];
+  const double p_com_6_2 = p->com[6][2];
+  const double p_inertia_0_0 = p->inertia[0][0];
+  const double p_inertia_0_1 = p->inertia[0][1];
+  const double p_inertia_0_2 = p->inertia[0][2];
+  const double p_inertia_0_3 = p->inertia[0][3];
+  const double p_inertia_0_4 = p->inertia[0][4];
+  const double p_inertia_0_5 = p->inertia[0][5];
+  const double p_inertia_1_0 = p->inertia[1][0];
+  const double p_inertia_2_0 = p->inertia[2][0];
+  const double p_inertia_3_1 = p->inertia[3][1];
+  const double p_inertia_4_0 = p->inertia[4][0];
+  const double p_inertia_5_0 = p->inertia[5][0];
+  const double p_inertia_6_1 = p->inertia[6][1];
+  const double p_armature_0 = p->armature[0];
+  const double p_armature_1 = p->armature[1];
+  const double p_armature_2 = p->armature[2];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = cos(q1);
+      w1[k] = cos(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = sin(q2);
+      w3[k] = sin(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double t4 = 1.0 / p_l1_0;
+      const double t5 = p_a_0 * w0[k];
+      const double t6 = w0[k] * p_l2_0;
+      const double t7 = p_b_0 - t5 - t6;
+      const double t8 = t4 * t7;
+      const double t9 = 1.0 / p_l1_1;
+      const double t10 = w0[k] * p_a_1;
+      const double t11 = w0[k] * p_l2_1;
+      const double t12 = p_b_1 - t10 - t11;
+      const double t13 = t9 * t12;
+      const double t14 = 1.0 / p_l1_2;
+      const double t15 = w0[k] * p_l2_2;
+      const double t16 = w0[k] * w0[k];
+      const double t17 = w1[k] * w1[k];
+      const double t18 = w2[k] * w2[k];
+      const double t19 = t16 * t17 + t18;
+      const double t20 = sqrt(t19);
+      const double t21 = 1.0 / t20;
+      const double t22 = p_b_2 - t15 * w1[k] * t21;
+      const double t23 = t14 * t22;
+      const double t24 = p_a_0 * w3[k];
+      const double t25 = p_l2_0 * w3[k];
+      const double t26 = t4 * t4;
+      const double t27 = 1.0 - t26 * (t7 * t7);
+      const double t28 = sqrt(t27);
+      const double t29 = p_a_1 * w3[k];
+      const double t30 = p_l2_1 * w3[k];
+      const double t31 = t9 * t9;
+      const double t32 = 1.0 - t31 * (t12 * t12);
+      const double t33 = sqrt(t32);
+      const double t34 = t14 * t14;
+      const double t35 = 1.0 - t34 * (t22 * t22);
+      const double t36 = sqrt(t35);
+      const double t37 = 1.0 / t28;
+      const double t38 = t24 + t25;
+      const double t39 = t8 * t37 * t38;
+      const double t40 = 1.0 / t33;
+      const double t41 = t29 + t30;
+      const double t42 = t13 * t40 * t41;
+      const double t43 = t10 + t11;
+      const double t44 = t43 - t42;
+      const double t45 = t21 * (t21 * t21);
+      const double t46 = w2[k] * (t17 * (t15 * w3[k])) * t45;
+      const double t47 = 1.0 / t36;
+      const double t48 = t23 * t47;
+      const double t49 = w1[k] * t17;
+      const double t50 = t45 * (w3[k] * (p_l2_2 * t16) * t49) - t21 * (w1[k] * (p_l2_2 * w3[k]));
+      const double t51 = t48 * t50;
+      const double t52 = t21 * (p_l2_2 * w1[k]);
+      const double t53 = w3[k] * w3[k];
+      const double t54 = t45 * (t18 * (w1[k] * (p_l2_2 * t53)));
+      const double t55 = t21 * (t15 * w2[k]) + t45 * (w2[k] * (t17 * (t15 * t53)));
+      const double t56 = t48 * t55;
+      const double t57 = w0[k] * p_com_0_2;
+      const double t58 = w0[k] * p_com_0_0;
+      const double t59 = w3[k] * p_com_0_1 + w1[k] * t57 - w2[k] * t58;
+      const double t60 = w3[k] * p_com_0_0;
+      const double t61 = w3[k] * p_com_0_2;
+      const double t62 = w2[k] * t60 + w0[k] * p_com_0_1 - w1[k] * t61;
+      const double t63 = t25 * 0.5 + (t24 - w3[k] * p_com_1_1 - w0[k] * p_com_1_2);
+      const double t64 = t6 * 0.5 + (w3[k] * p_com_1_2 + (t5 - w0[k] * p_com_1_1));
+      const double t65 = t30 * 0.5 + (w0[k] * p_com_2_2 + (t29 + w3[k] * p_com_2_1));
+      const double t66 = t11 * 0.5 + (t10 + w0[k] * p_com_2_1 - w3[k] * p_com_2_2);
+      const double t67 = w0[k] * p_com_3_2;
+      const double t68 = t50 + (t45 * (w2[k] * (t17 * (w3[k] * t67))) + (t45 * (t49 * (w3[k] * (t16 * p_com_3_0))) - t21 * (w1[k] * (w3[k] * p_com_3_0)))) * 2.0;
+      const double t69 = w0[k] * p_com_3_0;
+      const double t70 = t46 - 2.0 * (t45 * (t49 * (w3[k] * (t16 * p_com_3_2))) - t21 * (w1[k] * (w3[k] * p_com_3_2)) - t45 * (w2[k] * (t17 * (w3[k] * t69))));
+      const double t71 = 1.0 / t19;
+      const double t72 = t71 * t71;
+      const double t73 = t5 + t6;
+      const double t74 = t39 * 0.5 + (t73 - t38 * (t4 * p_com_4_2) - t38 * (t37 * (t7 * (t26 * p_com_4_1))));
+      const double t75 = t38 + 2.0 * (t38 * (t4 * p_com_4_1) - t38 * (t37 * (t7 * (t26 * p_com_4_2))));
+      const double t76 = t41 * (t9 * p_com_5_2) + (t43 - t41 * (t40 * (t12 * (t31 * p_com_5_1)))) - t42 * 0.5;
+      const double t77 = t41 - 2.0 * (t41 * (t9 * p_com_5_1) + t41 * (t40 * (t12 * (t31 * p_com_5_2))));
+      const double t78 = t47 * (t22 * (t34 * p_com_6_0));
+      const double t79 = t14 * p_com_6_2;
+      const double t80 = t46 + t50 * t78 - t50 * t79 - t51 * 0.5;
+      const double t81 = t47 * (t22 * (t34 * p_com_6_2));
+      const double t82 = t14 * p_com_6_0;
+      const double t83 = t50 + 2.0 * (t50 * t81 + t50 * t82);
+      const double t84 = t34 * p_inertia_6_1 * (1.0 / t35);
+      const double t85 = t39 + t73;
+      const double t86 = t85 * t85;
+      const double t87 = t44 * t44;
+      const double t88 = t46 - t51;
+      const double t89 = t88 * t88;
+      const double t90 = w1[k] * t60 + w2[k] * t61;
+      const double t91 = p_mass_0 * t62;
+      const double t92 = w2[k] * t57 + w1[k] * t58;
+      const double t93 = t55 + 2.0 * (t45 * (t18 * (w1[k] * (t53 * p_com_3_2))) + (t21 * (w2[k] * t69) + t45 * (w2[k] * (t17 * (t53 * t69))) - t21 * (w1[k] * p_com_3_2)));
+      const double t94 = p_mass_3 * t70;
+      const double t95 = t52 - t54;
+      const double t96 = 2.0 * (t21 * (w1[k] * p_com_3_0) + (t21 * (w2[k] * t67) + t45 * (w2[k] * (t17 * (t53 * t67)))) - t45 * (t18 * (w1[k] * (t53 * p_com_3_0)))) + t95;
+      const double t97 = p_mass_6 * t80;
+      const double t98 = t56 * 0.5 + (t55 * t79 + (t95 - t55 * t78));
+      const double t99 = t55 + 2.0 * (t55 * t81 + t55 * t82);
+      const double t100 = p_mass_9 * t88;
+      const double t101 = t56 + t95;
+      const double t102 = t88 * p_armature_2;
+      const double t103 = t101 * t102 + (t100 * t101 + (t97 * t98 + (t72 * (w2[k] * (w1[k] * (w3[k] * (w0[k] * p_inertia_3_1)))) + (w2[k] * p_inertia_0_5 + (w1[k] * p_inertia_0_3 - p_mass_0 * t59 * t90 - t91 * t92))) - t55 * (t50 * t84))) - 0.25 * (p_mass_6 * t83 * t99 + (p_mass_3 * t68 * t93 - t94 * t96));
+      const double t104 = t44 * p_armature_1 + (t44 * p_mass_8 + (p_mass_5 * t76 + (p_mass_2 * t66 + (t91 - p_mass_1 * t64) - p_mass_4 * t74) - t97 - p_mass_7 * t85) - t100) - t85 * p_armature_0 - t102 - 0.5 * t94;
+      const double t105 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const double t106 = t101 * t101;
+      const double t107 = -(p_mass_0 * t92) - p_mass_6 * t98 - p_mass_9 * t101 - p_armature_2 * t101 - 0.5 * (p_mass_3 * t96);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs(t8), 1.0) &
+          islessequal(fabs(t13), 1.0) &
+          islessequal(fabs(-t23), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      d[i] = ok ? p_l1_0 * t28 + (q3 - t24 - t25) : (double)NAN;
+      d[s + i] = ok ? p_l1_1 * t33 + (t30 + (q3 + t29)) : (double)NAN;
+      d[2 * s + i] = ok ? p_l1_2 * t36 + (q3 - t21 * (p_l2_2 * w2[k])) : (double)NAN;
+      Jd[i] = ok ? -t5 - t6 - t39 : (double)NAN;
+      Jd[s + i] = ok ? 0.0 : (double)NAN;
+      Jd[2 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[3 * s + i] = ok ? t44 : (double)NAN;
+      Jd[4 * s + i] = ok ? 0.0 : (double)NAN;
+      Jd[5 * s + i] = ok ? 1.0 : (double)NAN;
+      Jd[6 * s + i] = ok ? t51 - t46 : (double)NAN;
+      Jd[7 * s + i] = ok ? t54 - t52 - t56 : (double)NAN;
+      Jd[8 * s + i] = ok ? 1.0 : (double)NAN;
+      M[i] = ok ? (p_mass_6 * (t83 * t83) + (p_mass_5 * (t77 * t77) + (p_mass_4 * (t75 * t75) + (p_mass_3 * (t68 * t68) + p_mass_3 * (t70 * t70))))) * 0.25 + (w2[k] * (w1[k] * p_inertia_0_4) * 2.0 + (t89 * p_armature_2 + (t87 * p_armature_1 + (t86 * p_armature_0 + (p_mass_9 * t89 + (p_mass_8 * t87 + (p_mass_7 * t86 + (t84 * (t50 * t50) + (p_mass_6 * (t80 * t80) + (t31 * p_inertia_5_0 * (1.0 / t32) * (t41 * t41) + (p_mass_5 * (t76 * t76) + (t26 * p_inertia_4_0 * (1.0 / t27) * (t38 * t38) + (p_mass_4 * (t74 * t74) + (t18 * (t17 * (t53 * p_inertia_3_1)) * t72 + (p_mass_2 * (t66 * t66) + (p_mass_2 * (t65 * t65) + (p_mass_1 * (t64 * t64) + (p_mass_1 * (t63 * t63) + (t18 * p_inertia_0_2 + (t17 * p_inertia_0_0 + (p_mass_0 * (t62 * t62) + (p_mass_0 * (t59 * t59) + (p_inertia_1_0 + p_inertia_2_0))))))))))))))))))))))) : (double)NAN;
+      M[s + i] = ok ? t103 : (double)NAN;
+      M[2 * s + i] = ok ? t104 : (double)NAN;
+      M[3 * s + i] = ok ? t103 : (double)NAN;
+      M[4 * s + i] = ok ? 0.25 * (p_mass_6 * (t99 * t99) + (p_mass_3 * (t93 * t93) + p_mass_3 * (t96 * t96))) + (p_armature_2 * t106 + (p_mass_9 * t106 + (t84 * (t55 * t55) + (p_mass_6 * (t98 * t98) + (t72 * (t16 * p_inertia_3_1) + (p_mass_0 * (t92 * t92) + (p_mass_0 * (t90 * t90) + (p_inertia_0_1 + p_mass_0 * (t105 * t105))))))))) : (double)NAN;
+      M[5 * s + i] = ok ? t107 : (double)NAN;
+      M[6 * s + i] = ok ? t104 : (double)NAN;
+      M[7 * s + i] = ok ? t107 : (double)NAN;
+      M[8 * s + i] = ok ? p_armature_2 + (p_armature_1 + (p_armature_0 + (p_mass_9 + (p_mass_8 + (p_mass_7 + (p_mass_6 + (p_mass_5 + (p_mass_4 + (p_mass_3 + (p_mass_2 + (p_mass_0 + p_mass_1))))))))))) : (double)NAN;
+      JP[i] = ok ? 1.0 : (double)NAN;
+      JP[s + i] = ok ? 0.0 : (double)NAN;
+      JP[2 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[3 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[4 * s + i] = ok ? w0[k] : (double)NAN;
+      JP[5 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[6 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[7 * s + i] = ok ? w3[k] : (double)NAN;
+      JP[8 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[9 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[10 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[11 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[12 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[13 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[14 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[15 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[16 * s + i] = ok ? 0.0 : (double)NAN;
+      JP[17 * s + i] = ok ? 1.0 : (double)NAN;
+    }
+  }
+}

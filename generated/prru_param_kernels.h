@@ -128,6 +128,35 @@ void prru_param_actuator_rates(const prru_params *p, const double q[3], const do
 /* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Parameters from *p. */
 void prru_param_passive(const prru_params *p, const double q[3], const double qd[3], double Qp[3]);
 
+/* Batched kernels, prru_param_batch_<name>(n, inputs..., outputs...): the
+ * kernel of the same name (or, for dme_terms, the named ones fused) for n
+ * states in one call. Every array holds one row of n per component:
+ * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
+ * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
+ * with the scalar kernels state by state: bit for bit for ik_jd, mass,
+ * platform_jacobian and dme_terms; for dynamics and eom bit for bit unless
+ * the build provides vector sin and cos (see the source), then within
+ * 1e-14 of each output's largest entry (h and b: 2e-14). Outputs must not
+ * overlap the inputs. */
+
+/* prru_ik and prru_jd fused. */
+void prru_param_batch_ik_jd(const prru_params *p, int n, const double *q, double *d, double *Jd);
+
+/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */
+void prru_param_batch_mass(const prru_params *p, int n, const double *q, double *M);
+
+/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). */
+void prru_param_batch_platform_jacobian(const prru_params *p, int n, const double *q, double *JP);
+
+/* M, h and G fused (one shared evaluation). */
+void prru_param_batch_dynamics(const prru_params *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
+
+/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
+void prru_param_batch_eom(const prru_params *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
+
+/* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
+void prru_param_batch_dme_terms(const prru_params *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
+
 #ifdef __cplusplus
 }
 #endif

@@ -4,7 +4,7 @@ import os
 import re
 from string import Template
 
-from . import cgen, params, regressor
+from . import batch, cgen, params, regressor
 from .kernels import kernels, lambda_labels
 from .model import c_double
 
@@ -171,6 +171,10 @@ def render_params(model, pmodel, deriv, templates_dir, prefix=None):
                          % (e.doc, e.signature) for e in emitted)
     bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
                           for e in emitted)
+    bdecls, bbodies = _batched(params.param_kernels(deriv, pmodel, prefix),
+                               prefix + "_param", prefix)
+    decls += "\n\n" + bdecls
+    bodies += "\n\n" + bbodies
     values = dict(banner=banner, prefix=prefix, PREFIX=upper,
                   macros="\n".join(macros), declarations=decls,
                   functions=bodies, initializer=_initializer(model))
@@ -210,6 +214,23 @@ def render_regressor(model, rmodel, deriv, templates_dir, prefix=None):
     return files, emitted
 
 
+def _batched(kernel_list, prefix, file_prefix):
+    """(declarations, definitions) of the batched variants of kernel_list's
+    kernels (batch.py), named <prefix>_batch_<name>, for the file whose
+    macros carry file_prefix."""
+    loop = "%s_BATCH_LOOP" % file_prefix.upper()
+    targets = "%s_BATCH_TARGETS" % file_prefix.upper()
+    vector_trig = "%s_BATCH_%%s" % file_prefix.upper()
+    emitted = [batch.emit_batch(k, prefix, loop, vector_trig)
+               for k in batch.batch_kernels(kernel_list)]
+    decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
+                        for e in emitted)
+    bodies = "\n\n".join("%s %s\n{\n%s\n}" % (targets, e.signature, e.body)
+                         for e in emitted)
+    return (batch.header_note(prefix) + "\n\n" + decls,
+            batch.prologue(file_prefix) + "\n\n" + bodies)
+
+
 def render(model, deriv, templates_dir, prefix=None):
     """{file name: text} for the kernels and mechanism descriptor of model,
     and the emitted kernels. prefix: the C prefix (default: model name)."""
@@ -237,6 +258,9 @@ def render(model, deriv, templates_dir, prefix=None):
                         for e in emitted)
     bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
                          for e in emitted)
+    bdecls, bbodies = _batched(kernels(deriv), prefix, prefix)
+    decls += "\n\n" + bdecls
+    bodies += "\n\n" + bbodies
     values = dict(banner=banner, head=head + " */", prefix=prefix,
                   PREFIX=upper, macros="\n".join(macros),
                   declarations=decls, functions=bodies,

@@ -7,6 +7,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 
+#include "internal.h"
 #include "prru_dme.h"
 
 void prru_map_options_default(prru_map_options *o)
@@ -48,11 +49,64 @@ typedef struct {
   long done;
 } map_job;
 
+/* Points per call of the batched kernel: its outputs (d, J_d, M, J_P; 34
+ * doubles a point with three actuators) stay in the first-level cache. */
+#define MAP_BLOCK 128
+
+/* A worker's batch: q and the batched kernel's outputs, rows of MAP_BLOCK. */
+typedef struct {
+  double q[3 * MAP_BLOCK], d[PRRU_NACT * MAP_BLOCK], Jd[3 * PRRU_NACT * MAP_BLOCK],
+      M[9 * MAP_BLOCK], JP[18 * MAP_BLOCK];
+} map_block;
+
 typedef struct {
   map_job *job;
-  prru_data *data;
+  map_block *block;
   int is_caller;
 } map_worker;
+
+/* Point c of the block as prru_dme_eval evaluates it: the kernels' part
+ * (prru_ik_jd, prru_mass, prru_platform_jacobian) from the batched
+ * dme_terms, the checks of prru_check_regular, then prru_dme_from. */
+static int block_point(const prru_model *m, const map_block *b, int n, int c, prru_dme *dme)
+{
+  double Jd[3 * PRRU_NACT], Jdpinv[3 * PRRU_NACT], M[9], JP[18];
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(b->d[i * n + c])) {
+      dme->w_R = NAN;
+      return PRRU_EUNREACHABLE;
+    }
+  for (int i = 0; i < 3 * PRRU_NACT; i++) Jd[i] = b->Jd[i * n + c];
+  double rcond = 0.0;
+  int st = prru_jd_regular(Jd, prru_length_scale(m->mech), m->jd_rcond_min, Jdpinv, &rcond);
+  if (st != PRRU_OK) {
+    dme->w_R = NAN;
+    return st;
+  }
+  for (int i = 0; i < 9; i++) M[i] = b->M[i * n + c];
+  for (int i = 0; i < 18; i++) JP[i] = b->JP[i * n + c];
+  return prru_dme_from(M, Jdpinv, JP, dme);
+}
+
+/* Row `row` of the grid, points c0 .. c0 + n - 1 (n <= MAP_BLOCK). */
+static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
+{
+  const prru_map_grid *g = j->g;
+  const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, row);
+  for (int c = 0; c < n; c++) {
+    b->q[c] = q1;
+    b->q[n + c] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + c);
+    b->q[2 * n + c] = g->q3;
+  }
+  prru_batch_dme_terms(n, b->q, b->d, b->Jd, b->M, b->JP);
+  for (int c = 0; c < n; c++) {
+    prru_dme dme;
+    int s = block_point(j->m, b, n, c, &dme);
+    long k = (long)(row - j->row_begin) * g->n2 + c0 + c;
+    j->w[k] = dme.w_R;
+    if (j->st) j->st[k] = (unsigned char)s;
+  }
+}
 
 /* The next row to do, or -1 when there is none or the map was stopped. */
 static int take_row(map_job *j, long finished_points)
@@ -86,17 +140,10 @@ static void *map_worker_run(void *arg)
   const prru_map_grid *g = j->g;
   const int reports = w->is_caller && j->o->progress;
   int reported = 0;
-  prru_dme dme;
   int row = take_row(j, 0);
   while (row >= 0) {
-    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, row), 0.0, g->q3};
-    for (int c = 0; c < g->n2; c++) {
-      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c);
-      int s = prru_dme_eval(j->m, w->data, q, &dme);
-      long k = (long)(row - j->row_begin) * g->n2 + c;
-      j->w[k] = dme.w_R;
-      if (j->st) j->st[k] = (unsigned char)s;
-    }
+    for (int c0 = 0; c0 < g->n2; c0 += MAP_BLOCK)
+      map_block_eval(j, w->block, row, c0, g->n2 - c0 < MAP_BLOCK ? g->n2 - c0 : MAP_BLOCK);
     row = take_row(j, g->n2);
     if (reports) {
       report_progress(j);
@@ -125,8 +172,8 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   for (int t = 0; t < nt && rc == PRRU_OK; t++) {
     workers[t].job = &job;
     workers[t].is_caller = t == 0;
-    workers[t].data = malloc(sizeof(prru_data));
-    if (!workers[t].data) rc = PRRU_ENOMEM;
+    workers[t].block = malloc(sizeof(map_block));
+    if (!workers[t].block) rc = PRRU_ENOMEM;
   }
   if (rc == PRRU_OK) {
     for (int t = 1; t < nt; t++) {
@@ -140,7 +187,7 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
     if (job.stop) rc = PRRU_EINTERRUPTED;
   }
   if (workers)
-    for (int t = 0; t < nt; t++) free(workers[t].data);
+    for (int t = 0; t < nt; t++) free(workers[t].block);
   free(workers);
   free(tid);
   pthread_mutex_destroy(&job.lock);

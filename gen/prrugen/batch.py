@@ -1,0 +1,262 @@
+"""Batched (structure-of-arrays) variants of kernels: n states per call.
+
+A batched kernel evaluates the same lowered graph as its scalar namesake
+(cgen), so each output is computed by the same operations in the same
+order and agrees bit for bit, but inside a loop over the states that a
+compiler can vectorise:
+
+* arrays hold one component per row of n: component i of state k is
+  x[i n + k] (q1 of every state, then q2, ...);
+* sin and cos of the inputs are taken in a first loop over a chunk of
+  BATCH_CHUNK states into local arrays, so the arithmetic loop has no
+  calls but sqrt, which vectorises as an instruction (vector sin/cos
+  take part where the build provides them, see the header);
+* the scalar kernel's early return for an unreachable q becomes a
+  per-state select, so the loop has no branch.
+
+Each loop carries PREFIX_BATCH_LOOP, empty unless the build defines it
+(e.g. as _Pragma("omp simd") with -fopenmp-simd): the generated code stays
+portable C99 that compiles to a plain scalar loop anywhere.
+"""
+
+from . import cgen
+from .cgen import ARITH, PREC, Graph, Node, _Names, _uses
+
+BATCH_CHUNK = 32
+
+# Which kernels get a batched variant (in header order), and the fused
+# ones that exist only batched: their outputs are those of the named scalar
+# kernels (all with the inputs q, hence the same guards).
+BATCH_KERNELS = ("ik_jd", "mass", "platform_jacobian", "dynamics", "eom")
+FUSED = (("dme_terms", "prru_ik_jd, prru_mass and prru_platform_jacobian "
+          "fused: what the manipulability maps need at each q.",
+          ("ik_jd", "mass", "platform_jacobian")),)
+
+
+# Kernels whose batched variants keep the scalar sin and cos, so that they
+# agree bit for bit (w_R, computed from their outputs, is ill-conditioned
+# near singular poses: a few ulp in J_d move it by 1e-12 there). The others
+# call the vector sin and cos where the build provides them.
+EXACT = ("ik_jd", "mass", "platform_jacobian", "dme_terms")
+
+
+def batch_kernels(kernel_list, names=BATCH_KERNELS, fused=FUSED):
+    """The kernels to emit batched, from the scalar kernel list."""
+    by_name = {k.name: k for k in kernel_list}
+    out = [by_name[n] for n in names if n in by_name]
+    for name, doc, parts in fused:
+        if not all(p in by_name for p in parts):
+            continue
+        first = by_name[parts[0]]
+        outputs, seen = [], set()
+        for p in parts:
+            for arr, exprs in by_name[p].outputs:
+                if arr not in seen:
+                    seen.add(arr)
+                    outputs.append((arr, exprs))
+        out.append(cgen.Kernel(name, doc, first.inputs, outputs,
+                               first.guards, first.params))
+    return out
+
+
+def _is_input_trig(n):
+    return n.op == "call" and n.args[0] in ("sin", "cos") and \
+        isinstance(n.args[1], Node) and n.args[1].op == "in"
+
+
+def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
+    """cgen.Emitted for the batched variant of kernel, named
+    <prefix>_batch_<name>. vector_trig % "sin" is the name of the sin the
+    vectorisable kernels call (kernels in EXACT call sin itself)."""
+    trig_name = (lambda fn: fn) if kernel.name in EXACT else \
+        (lambda fn: vector_trig % fn.upper())
+    params = kernel.params
+    names = _Names(params)
+    for arr, syms in kernel.inputs:
+        for i, s in enumerate(syms):
+            names[s] = "%s%d" % (arr, i + 1)
+    g = Graph(names)
+    guard_nodes = [g.lower(x) for x in kernel.guards]
+    finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
+        if guard_nodes else []
+    out_nodes = [(arr, [g.lower(x) for x in exprs])
+                 for arr, exprs in kernel.outputs]
+    roots = guard_nodes + finite_nodes + [n for _, ns in out_nodes for n in ns]
+    uses, live = _uses(roots)
+    counts = {}
+    for i in sorted(live):
+        n = g.nodes[i]
+        if n.op in ARITH:
+            counts[n.op] = counts.get(n.op, 0) + 1
+        elif n.op == "call":
+            key = "call:" + n.args[0]
+            counts[key] = counts.get(key, 0) + 1
+
+    def materialized(n):
+        return n.op not in ("num", "in") and \
+            (uses.get(n.index, 0) > 1 or n.op == "call")
+
+    temp = {}
+
+    def expr(n, parent_prec=0, right=False):
+        if n.op in ("in", "num"):
+            return n.args[0]
+        if n.index in temp:
+            return temp[n.index]
+        return inline(n, parent_prec, right)
+
+    def inline(n, parent_prec=0, right=False):
+        op = n.op
+        if op == "call":
+            return "%s(%s)" % (n.args[0],
+                               ", ".join(expr(a) for a in n.args[1:]))
+        if op == "neg":
+            s = "-" + expr(n.args[0], 3)
+        else:
+            sym_op = {"add": "+", "sub": "-", "mul": "*", "div": "/"}[op]
+            p = PREC[op]
+            s = "%s %s %s" % (expr(n.args[0], p), sym_op,
+                              expr(n.args[1], p, right=True))
+        p = PREC[op]
+        if p < parent_prec or (p == parent_prec and right):
+            return "(" + s + ")"
+        return s
+
+    used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
+    trig = [g.nodes[i] for i in sorted(live) if _is_input_trig(g.nodes[i])]
+    trig_inputs = sorted({n.args[1].args[0] for n in trig})
+    # Input name -> row index in its array.
+    row = {}
+    for arr, syms in kernel.inputs:
+        for i, _ in enumerate(syms):
+            row["%s%d" % (arr, i + 1)] = (arr, i)
+
+    def load(name, index):
+        arr, i = row[name]
+        at = index if i == 0 else "%d * s + %s" % (i, index) if i > 1 \
+            else "s + " + index
+        return "const double %s = %s[%s];" % (name, arr, at)
+
+    lines = []
+    if params is not None:
+        lines += ["const double %s = %s;" % (params.local(s), params.access(s))
+                  for s in params.order if params.local(s) in used_inputs]
+    lines.append("const long s = n;")
+    lines.append("for (long k0 = 0; k0 < s; k0 += %d) {" % BATCH_CHUNK)
+    lines.append("  const long m = s - k0 < %d ? s - k0 : %d;"
+                 % (BATCH_CHUNK, BATCH_CHUNK))
+    body = []
+    if trig:
+        body.append("double %s;" % ", ".join("w%d[%d]" % (j, BATCH_CHUNK)
+                                              for j in range(len(trig))))
+        # One loop per function: sin and cos of one argument in one loop
+        # would be merged into a sincos call, which has no vector variant.
+        for fn in ("cos", "sin"):
+            group = [(j, n) for j, n in enumerate(trig) if n.args[0] == fn]
+            if not group:
+                continue
+            body.append(loop_macro)
+            body.append("for (long k = 0; k < m; k++) {")
+            body += ["  " + load(name, "k0 + k") for name in trig_inputs
+                     if any(n.args[1].args[0] == name for _, n in group)]
+            for j, n in group:
+                body.append("  w%d[k] = %s(%s);" % (j, trig_name(fn),
+                                                   n.args[1].args[0]))
+                temp[n.index] = "w%d[k]" % j
+            body.append("}")
+    body.append(loop_macro)
+    body.append("for (long k = 0; k < m; k++) {")
+    inner = ["const long i = k0 + k;"]
+    inner += [load(name, "i") for arr, syms in kernel.inputs
+              for name in ("%s%d" % (arr, j + 1) for j in range(len(syms)))
+              if name in used_inputs]
+    for i in sorted(live):
+        n = g.nodes[i]
+        if i in temp or not materialized(n):
+            continue
+        name = "t%d" % len(temp)
+        inner.append("const double %s = %s;" % (name, inline(n)))
+        temp[i] = name
+    if guard_nodes:
+        conds = ["islessequal(fabs(%s), 1.0)" % expr(n)
+                 for n in guard_nodes]
+        conds += ["islessequal(fabs(%s), 1.7976931348623157e308)" % expr(n)
+                  for n in finite_nodes]
+        inner.append("/* Unreachable or non-finite q: NaN (a select, not a "
+                     "branch). */")
+        inner.append("const int ok = %s;" % " &\n    ".join(conds))
+    for arr, ns in out_nodes:
+        for j, n in enumerate(ns):
+            at = "i" if j == 0 else "s + i" if j == 1 else "%d * s + i" % j
+            value = expr(n)
+            if guard_nodes:
+                value = "ok ? %s : (double)NAN" % value
+            inner.append("%s[%s] = %s;" % (arr, at, value))
+    body += ["  " + l.replace("\n", "\n  ") for l in inner]
+    body.append("}")
+    lines += ["  " + l.replace("\n", "\n  ") for l in body]
+    lines.append("}")
+    args = []
+    if params is not None:
+        args.append("const %s *p" % params.ctype)
+    args.append("int n")
+    args += ["const double *%s" % arr for arr, _ in kernel.inputs]
+    args += ["double *%s" % arr for arr, _ in out_nodes]
+    unused = [arr for arr, syms in kernel.inputs
+              if not any(("%s%d" % (arr, i + 1)) in used_inputs
+                         for i in range(len(syms)))]
+    lines = ["(void)%s;" % a for a in unused] + lines
+    signature = "void %s_batch_%s(%s)" % (prefix, kernel.name, ", ".join(args))
+    text = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
+    return cgen.Emitted(kernel.name, signature, text, counts, kernel.doc)
+
+
+PROLOGUE = """/* Batched kernels. ${PREFIX}_BATCH_LOOP marks each loop over states whose
+ * iterations are independent; the build may define it as _Pragma("omp simd")
+ * (with -fopenmp-simd) to have the loops vectorised, and
+ * ${PREFIX}_BATCH_TARGETS as a function attribute (e.g. target_clones).
+ * With ${PREFIX}_BATCH_VECTOR_MATH defined (GCC), ${PREFIX}_BATCH_SIN and
+ * _COS are sin and cos declared as having vector variants (glibc's libmvec,
+ * which <math.h> declares only under -ffast-math; the kernels are never
+ * built with it), within a few units in the last place of the scalar sin
+ * and cos; the kinematic kernels call sin and cos themselves and so agree
+ * with the scalar kernels bit for bit. */
+#ifndef ${PREFIX}_BATCH_LOOP
+#define ${PREFIX}_BATCH_LOOP
+#endif
+#ifndef ${PREFIX}_BATCH_TARGETS
+#define ${PREFIX}_BATCH_TARGETS
+#endif
+#if defined(${PREFIX}_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern double ${prefix}_batch_vsin(double) __asm__("sin");
+#pragma omp declare simd notinbranch
+extern double ${prefix}_batch_vcos(double) __asm__("cos");
+#define ${PREFIX}_BATCH_SIN ${prefix}_batch_vsin
+#define ${PREFIX}_BATCH_COS ${prefix}_batch_vcos
+#else
+#define ${PREFIX}_BATCH_SIN sin
+#define ${PREFIX}_BATCH_COS cos
+#endif"""
+
+
+def prologue(prefix):
+    """Macros the batched kernels' definitions need (in the .c file)."""
+    return PROLOGUE.replace("${PREFIX}", prefix.upper()).replace(
+        "${prefix}", prefix)
+
+
+HEADER_NOTE = """/* Batched kernels, <prefix>_batch_<name>(n, inputs..., outputs...): the
+ * kernel of the same name (or, for dme_terms, the named ones fused) for n
+ * states in one call. Every array holds one row of n per component:
+ * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
+ * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
+ * with the scalar kernels state by state: bit for bit for ik_jd, mass,
+ * platform_jacobian and dme_terms; for dynamics and eom bit for bit unless
+ * the build provides vector sin and cos (see the source), then within
+ * 1e-14 of each output's largest entry (h and b: 2e-14). Outputs must not
+ * overlap the inputs. */"""
+
+
+def header_note(prefix):
+    return HEADER_NOTE.replace("<prefix>", prefix)
