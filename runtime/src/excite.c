@@ -138,9 +138,10 @@ typedef struct {
   volatile sig_atomic_t *stop;
 } excite_ctx;
 
-/* Coefficients from the optimiser's variables: x -> bound tanh-free
- * clipping keeps the sum of |a|, |b| of a coordinate within its bound, so
- * that |q_k - c_k| never exceeds it. */
+/* Coefficients from the optimiser's variables: a coordinate's variables
+ * times its amplitude bound, scaled down together when the sum of their
+ * magnitudes exceeds 1, so that |q_k - c_k| <= sum |a| + |b| never exceeds
+ * the bound whatever the simplex tries (no constraint to violate). */
 static void unpack(excite_ctx *c, const gsl_vector *x)
 {
   const int L = c->f.harmonics;
