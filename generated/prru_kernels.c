@@ -6277,6 +6277,179 @@ PRRU_BATCH_TARGETS void prru_batch_eom(int n, const double *q, const double *qd,
   }
 }
 
+PRRU_BATCH_TARGETS void prru_batch_eom_solve(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors)
+{
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    double w0[32], w1[32], w2[32], w3[32];
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w0[k] = PRRU_BATCH_COS(q1);
+      w1[k] = PRRU_BATCH_COS(q2);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const double q1 = q[k0 + k];
+      const double q2 = q[s + k0 + k];
+      w2[k] = PRRU_BATCH_SIN(q2);
+      w3[k] = PRRU_BATCH_SIN(q1);
+    }
+    PRRU_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const double q1 = q[i];
+      const double q2 = q[s + i];
+      const double q3 = q[2 * s + i];
+      const double qd1 = qd[i];
+      const double qd2 = qd[s + i];
+      const double fd1 = fd[i];
+      const double fd2 = fd[s + i];
+      const double fd3 = fd[2 * s + i];
+      const double fp3 = fp[2 * s + i];
+      const double mp1 = mp[i];
+      const double mp2 = mp[s + i];
+      const double mp3 = mp[2 * s + i];
+      const double t4 = w0[k] * w1[k];
+      const double t5 = w0[k] * w0[k];
+      const double t6 = w1[k] * w1[k];
+      const double t7 = w2[k] * w2[k];
+      const double t8 = t5 * t6 + t7;
+      const double t9 = sqrt(t8);
+      const double t10 = 1.0 / t9;
+      const double t11 = t4 * t10 - 1.4;
+      const double t12 = w3[k] * w3[k];
+      const double t13 = w1[k] * w3[k];
+      const double t14 = t10 * t10;
+      const double t15 = t10 * t14;
+      const double t16 = t10 * t13 - t5 * w3[k] * (w1[k] * t6) * t15;
+      const double t17 = t16 * t16;
+      const double t18 = 1.0 / t8;
+      const double t19 = t18 * t18;
+      const double t20 = w0[k] - 1.3333333333333333;
+      const double t21 = t20 * t20;
+      const double t22 = (0.7256515775034293 - t21) * 1.3780718336483933;
+      const double t23 = sqrt(t22);
+      const double t24 = 1.0 / t23;
+      const double t25 = w3[k] * t20 * t24;
+      const double t26 = t25 * 0.5869565217391305;
+      const double t27 = w0[k] - t26;
+      const double t28 = w0[k] + t26;
+      const double t29 = w0[k] * w3[k];
+      const double t30 = t15 * (w2[k] * (t6 * t29));
+      const double t31 = t11 * t11;
+      const double t32 = (1.0449382716049382 - t31) * 0.9569943289224953;
+      const double t33 = sqrt(t32);
+      const double t34 = 1.0 / t33;
+      const double t35 = t11 * t34;
+      const double t36 = t16 * t35;
+      const double t37 = t30 - t36 * 0.4891304347826087;
+      const double t38 = 1.0 / t32;
+      const double t39 = 1.173913043478261 * t25;
+      const double t40 = w0[k] - t39;
+      const double t41 = w0[k] + t39;
+      const double t42 = t30 - 0.9782608695652174 * t36;
+      const double t43 = t42 * t42 * 25.154296875 + ((t40 * t40 + t41 * t41) * 36.2221875 + (t17 * t38 * 1.9438947306238186 + (t37 * t37 * 20.724609375 + (t12 * (1.0 / t22) * 5.5984168241965975 + ((t27 * t27 + t28 * t28) * 29.8434375 + (t19 * (t7 * (t6 * t12)) * 0.78125 + (t7 * (t5 * t12 * (t6 * t6)) * (t18 * t19) * 2.53125 + (t17 * 7.71240234375 + (t12 * 14.92171875 + (t7 + t6 * 0.75))))))))));
+      const double t44 = 11.485 + t43;
+      const double t45 = t44 * 0.0032;
+      const double t46 = t10 * (w0[k] * w2[k]) + t15 * (w2[k] * (t6 * (w0[k] * t12)));
+      const double t47 = w1[k] * t10;
+      const double t48 = t15 * (t7 * (w1[k] * t12));
+      const double t49 = t47 - t48;
+      const double t50 = t35 * t46;
+      const double t51 = t49 - 0.4891304347826087 * t50;
+      const double t52 = t49 - 0.9782608695652174 * t50;
+      const double t53 = t42 * t52 * 3.2615384615384615 + (t46 * (t16 * t38) * 0.2520478890989288 + (t37 * t51 * 2.687179487179487 + (t19 * (w2[k] * (w1[k] * t29)) * 0.10129787907565685 + (t16 * t46 + t30 * t49 * 0.3282051282051282))));
+      const double t54 = t53 * 0.0246796875;
+      const double t55 = t25 * 1.9642992168512017;
+      const double t56 = t36 * 0.6820483391844451;
+      const double t57 = (t56 + (t55 - t30)) * 0.7245;
+      const double t58 = t46 * t46;
+      const double t59 = 3.2615384615384615 * (t52 * t52) + (0.2520478890989288 * (t38 * t58) + (2.687179487179487 * (t51 * t51) + (0.10129787907565685 * (t5 * t19) + (t58 + 0.3282051282051282 * (t49 * t49)))));
+      const double t60 = 0.11345362456473568 + t59;
+      const double t61 = t50 * 0.6820483391844451;
+      const double t62 = 0.7245 * (t61 + (t48 - t47));
+      const double t63 = qd1 * qd2;
+      const double t64 = qd1 * qd1;
+      const double t65 = w0[k] * t64;
+      const double t66 = w1[k] * t65;
+      const double t67 = w1[k] * (w3[k] * qd1);
+      const double t68 = t6 * (w3[k] * (w0[k] * qd1)) - w2[k] * (w1[k] * (t12 * qd2));
+      const double t69 = w3[k] * t63;
+      const double t70 = w2[k] * t69;
+      const double t71 = qd2 * qd2;
+      const double t72 = w1[k] * (w0[k] * t71);
+      const double t73 = w0[k] * qd2;
+      const double t74 = w2[k] * t73;
+      const double t75 = t4 * t15;
+      const double t76 = t12 * t64;
+      const double t77 = t12 * t71;
+      const double t78 = t7 * t77 + (t6 * (t5 * t64) - t6 * t76 - t6 * t77) - w2[k] * (w1[k] * (w3[k] * (w0[k] * t63))) * 4.0;
+      const double t79 = t10 * (t14 * t14);
+      const double t80 = t68 * t68;
+      const double t81 = (t68 * (t15 * t74) + (t15 * t67 * t68 - t10 * t70)) * 2.0 + (t10 * t66 + t10 * t72 - t75 * t78) - t4 * t79 * t80 * 3.0;
+      const double t82 = w1[k] * qd2;
+      const double t83 = t80 * (w2[k] * t79) * 1.5 + (t68 * (t15 * t82) - (t10 * (w2[k] * t71) - t78 * (w2[k] * t15)) * 0.5);
+      const double t84 = t67 + t74;
+      const double t85 = t68 * (t19 * (t6 * t73 + w2[k] * t84)) - 0.5 * (t18 * (2.0 * (w2[k] * t72) + (t6 * t69 - t82 * t84 - w2[k] * (t66 + t72 - t70 * 2.0))));
+      const double t86 = w3[k] * t64;
+      const double t87 = t24 * (t24 * t24);
+      const double t88 = t21 * t76 * t87;
+      const double t89 = t24 * (t20 * t65) - t24 * t76;
+      const double t90 = 0.5869565217391305 * t89;
+      const double t91 = t88 * 0.8088682501849265;
+      const double t92 = t10 * t67 + t10 * t74 - t68 * t75;
+      const double t93 = t92 * t92;
+      const double t94 = t34 * (t34 * t34);
+      const double t95 = t93 * (t31 * t94);
+      const double t96 = t35 * t81 - t34 * t93;
+      const double t97 = t95 * 0.23404752609517548 + (t83 - t96 * 0.24456521739130435);
+      const double t98 = t93 * (t11 * t94) - 1.0449382716049382 * (t34 * t81);
+      const double t99 = 1.173913043478261 * t89;
+      const double t100 = t88 * 1.617736500369853;
+      const double t101 = t95 * 0.46809505219035097 + (t83 - 0.4891304347826087 * t96);
+      const double t102 = t30 - t55 - t56;
+      const double t103 = mp1 * 0.14069951578261644 + ((t40 * (t86 + t99 - t100) + t41 * (t100 + (t86 - t99))) * 0.016308621573878853 + (t16 * t34 * t98 * 0.0008375768935282882 + ((t27 * (t86 + t90 - t91) + t28 * (t91 + (t86 - t90))) * 0.013436663057724087 + (t102 - w2[k] * (w1[k] * t63) * 0.00022511922525218629 - w3[k] * t65 * 0.006718331528862044 - t16 * t81 * 0.0034724200809162914 - t30 * t83 * 0.002279332155678386 - t18 * (w2[k] * t13) * t85 * 0.0007034975789130822) - w3[k] * t24 * (t24 * t65 - 1.3780718336483933 * (t87 * (t20 * t76))) * 0.0025206225162038866 - t37 * t97 * 0.018662032024616786)) - t42 * t101 * 0.02265086329705396) - (t40 * fd1 - t41 * fd2) * 0.037988869261306436 - t42 * fd3 * 0.031657391051088696;
+      const double t104 = t49 - t61;
+      const double t105 = 0.14069951578261644 * (w0[k] * mp2 + w3[k] * mp3) + (0.0008375768935282882 * (t98 * (t34 * t46)) + (w2[k] * (w1[k] * t64) * 0.00011255961262609314 + t104 - 0.0034724200809162914 * (t46 * t81) - 0.002279332155678386 * (t49 * t83) - 0.0007034975789130822 * (t85 * (w0[k] * t18)) - 0.018662032024616786 * (t51 * t97)) - 0.02265086329705396 * (t52 * t101) - 0.031657391051088696 * (t52 * fd3));
+      const double t106 = (fp3 + (fd3 + (fd1 + fd2))) * 0.6901311249137336 + (t95 * 0.3263581963252602 + (t88 * 1.353472711800119 + (t83 - t89 * 0.9821496084256008) - t96 * 0.34102416959222254)) - 83.88260869565218;
+      const double t107 = 0.11345362456473568 + (t59 - t104 * t104 * 1.7165869911632623);
+      const double t108 = t53 - 1.7165869911632623 * (t102 * t104);
+      const double t109 = t53 * t104 - t60 * t102;
+      const double t110 = t102 * t109 * 13.239009533898304 + (t44 * t107 - 7.71240234375 * (t53 * t108));
+      const double t111 = 1.0 / t110;
+      const double t112 = t53 * t102 - t44 * t104 * 0.12966128521684078;
+      const double t113 = t44 * t60 - 7.71240234375 * (t53 * t53);
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
+          islessequal(fabs(t11 * 0.9782608695652174), 1.0) &
+          islessequal(fabs(q1), 1.7976931348623157e308) &
+          islessequal(fabs(q2), 1.7976931348623157e308) &
+          islessequal(fabs(q3), 1.7976931348623157e308);
+      M[i] = ok ? t45 : (double)NAN;
+      M[s + i] = ok ? t54 : (double)NAN;
+      M[2 * s + i] = ok ? t57 : (double)NAN;
+      M[3 * s + i] = ok ? t54 : (double)NAN;
+      M[4 * s + i] = ok ? 0.0246796875 * t60 : (double)NAN;
+      M[5 * s + i] = ok ? t62 : (double)NAN;
+      M[6 * s + i] = ok ? t57 : (double)NAN;
+      M[7 * s + i] = ok ? t62 : (double)NAN;
+      M[8 * s + i] = ok ? 12.39 : (double)NAN;
+      b[i] = ok ? t103 * 7.107345 : (double)NAN;
+      b[s + i] = ok ? 7.107345 * t105 : (double)NAN;
+      b[2 * s + i] = ok ? t106 * 1.449 : (double)NAN;
+      qdd[i] = ok ? t111 * (t103 * t107 - t105 * t108 - t106 * t109 * 0.011921422277509978) * 2221.0453125 : (double)NAN;
+      qdd[s + i] = ok ? -(2221.0453125 * (t111 * (0.011921422277509978 * (t106 * t112) + (t103 * t108 - t105 * (11.485 + (t43 - 13.239009533898304 * (t102 * t102))) * 0.12966128521684078)))) : (double)NAN;
+      qdd[2 * s + i] = ok ? -(t111 * (t103 * t109 + t105 * t112 - t106 * t113 * 0.0009004769010087451) * 129.87468352754237) : (double)NAN;
+      minors[i] = ok ? t45 : (double)NAN;
+      minors[s + i] = ok ? t113 * 7.8975e-05 : (double)NAN;
+      minors[2 * s + i] = ok ? t110 * 0.00097850025 : (double)NAN;
+    }
+  }
+}
+
 PRRU_BATCH_TARGETS void prru_batch_dme_terms(int n, const double *q, double *d, double *Jd, double *M, double *JP)
 {
   const long s = n;

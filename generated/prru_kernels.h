@@ -161,9 +161,10 @@ void prru_joint_reactions(const double q[3], const double qd[3], const double qd
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics and eom bit for bit unless
+ * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
+ * forward-dynamics step's kernel) bit for bit unless
  * the build provides vector sin and cos (see the source), then within
- * 1e-14 of each output's largest entry (h and b: 2e-14). Outputs must not
+ * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
  * overlap the inputs. */
 
 /* prru_ik and prru_jd fused. */
@@ -180,6 +181,9 @@ void prru_batch_dynamics(int n, const double *q, const double *qd, double *M, do
 
 /* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
 void prru_batch_eom(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
+
+/* eom's M and b, qdd = M^-1 b by the adjugate, and M's leading principal minors (M00, M00 M11 - M01^2, det M): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
+void prru_batch_eom_solve(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void prru_batch_dme_terms(int n, const double *q, double *d, double *Jd, double *M, double *JP);

@@ -1,7 +1,7 @@
 /* Batched kernels (prru_batch_*, prru_param_batch_*) against their scalar
  * namesakes, state by state: ik_jd, mass, platform_jacobian and dme_terms
- * bit for bit, dynamics and eom within 1e-14 of the scalar
- * kernel's (h and b: 2e-14, see TOL_BIAS), relative to the largest entry of
+ * bit for bit, dynamics, eom and eom_solve within 1e-14 of the scalar
+ * kernel's (h, b, qdd: 2e-14, see TOL_BIAS), relative to the largest entry of
  * that output array at that state (the only difference the build allows is
  * the vector sin and cos, within a few ulp), at every state at least MARGIN from a singular
  * boundary (testref.h's ref_margin, as test_param_kernels: nearer, the
@@ -23,7 +23,7 @@
 
 #define NMAX 203
 #define TOL 1e-14
-/* h and b (dynamics, eom): sums of qd-quadratic terms that cancel, so the
+/* h, b and qdd (dynamics, eom, eom_solve): sums of qd-quadratic terms that cancel, so the
  * vector sin and cos's few ulp show up to 1.6e-14 of the largest entry in
  * the runtime-parameter kernels (measured over these states); the constant
  * kernels stay within TOL. */
@@ -86,7 +86,8 @@ static double compare(const char *kernel, const char *name, const double *batch,
 {
   /* The kinematic kernels keep the scalar sin and cos: bit for bit. */
   const int exact = strstr(kernel, "dynamics") == NULL && strstr(kernel, "eom") == NULL;
-  const double tol = exact ? 0.0 : strcmp(name, "h") == 0 || strcmp(name, "b") == 0 ? TOL_BIAS : TOL;
+  const int bias = strcmp(name, "h") == 0 || strcmp(name, "b") == 0 || strcmp(name, "qdd") == 0;
+  const double tol = exact ? 0.0 : bias ? TOL_BIAS : TOL;
   double worst = 0, x[64];
   for (int k = 0; k < n; k++) {
     const double *ref = scalar + k * dim;
@@ -109,7 +110,7 @@ static double compare(const char *kernel, const char *name, const double *batch,
 
 typedef struct {
   double d[NMAX][NA], Jd[NMAX][NA * 3], M[NMAX][9], h[NMAX][3], G[NMAX][3], b[NMAX][3],
-      JP[NMAX][18];
+      JP[NMAX][18], qdd[NMAX][3], minors[NMAX][3];
 } outs;
 
 static outs want, got_store;
@@ -177,6 +178,17 @@ static double run(const prru_params *p, const states *s, int n, int *nan_ok)
   else prru_batch_eom(n, q, qd, fd, fp, mp, got[2], got[6]);
   CMP("eom", "M", got[2], M, 9);
   CMP("eom", "b", got[6], b, 3);
+  /* eom_solve (constant kernels only): the forward-dynamics step */
+  if (!p) {
+    for (int i = 0; i < n; i++)
+      prru_eom_solve(s->q[i], s->qd[i], s->fd[i], s->fp[i], s->mp[i], want.M[i], want.b[i],
+                     want.qdd[i], want.minors[i]);
+    prru_batch_eom_solve(n, q, qd, fd, fp, mp, got[2], got[6], got[7], got[4]);
+    CMP("eom_solve", "M", got[2], M, 9);
+    CMP("eom_solve", "b", got[6], b, 3);
+    CMP("eom_solve", "qdd", got[7], qdd, 3);
+    CMP("eom_solve", "minors", got[4], minors, 3);
+  }
 #undef CMP
   (void)got_store;
   return worst;
@@ -199,7 +211,7 @@ int main(void)
   }
   TU_TRUE(nan_ok, "NaN exactly where the scalar kernels give NaN");
   TU_TRUE(nfar > NMAX / 10 && nreach < NMAX - 10, "both reachable and unreachable states drawn");
-  printf("batched vs scalar kernels: worst relative difference %.2e (bound %.0e, h and b %.0e); last batch: "
+  printf("batched vs scalar kernels: worst relative difference %.2e (bound %.0e, h, b, qdd %.0e); last batch: "
          "%d of %d states reachable, %d compared (margin >= %.2g)\n",
          worst, TOL, TOL_BIAS, nreach, NMAX, nfar, MARGIN);
   return tu_finish("test_batch");

@@ -27,7 +27,8 @@ BATCH_CHUNK = 32
 # Which kernels get a batched variant (in header order), and the fused
 # ones that exist only batched: their outputs are those of the named scalar
 # kernels (all with the inputs q, hence the same guards).
-BATCH_KERNELS = ("ik_jd", "mass", "platform_jacobian", "dynamics", "eom")
+BATCH_KERNELS = ("ik_jd", "mass", "platform_jacobian", "dynamics", "eom",
+                 "eom_solve")
 FUSED = (("dme_terms", "prru_ik_jd, prru_mass and prru_platform_jacobian "
           "fused: what the manipulability maps need at each q.",
           ("ik_jd", "mass", "platform_jacobian")),)
@@ -252,9 +253,10 @@ HEADER_NOTE = """/* Batched kernels, <prefix>_batch_<name>(n, inputs..., outputs
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics and eom bit for bit unless
+ * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
+ * forward-dynamics step's kernel) bit for bit unless
  * the build provides vector sin and cos (see the source), then within
- * 1e-14 of each output's largest entry (h and b: 2e-14). Outputs must not
+ * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
  * overlap the inputs. */"""
 
 
