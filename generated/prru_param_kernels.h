@@ -134,9 +134,10 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics and eom bit for bit unless
+ * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
+ * forward-dynamics step's kernel) bit for bit unless
  * the build provides vector sin and cos (see the source), then within
- * 1e-14 of each output's largest entry (h and b: 2e-14). Outputs must not
+ * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
  * overlap the inputs. */
 
 /* prru_ik and prru_jd fused. */
