@@ -262,6 +262,24 @@ expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations
 expect 2 "missing column 'qd1'" -- track --ref "$tmp/qonly.csv" --out "$tmp/x.csv"
 expect 2 "--bandwidth excludes" -- track --waypoints "$WP" --durations 1,1 --bandwidth 5 --kp 1,1,1
 [ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# SIGTERM during a long run (a background job ignores SIGINT): exit 143,
+# whole rows kept, the summary says why.
+"$PRRU" track --waypoints "$WP" --durations 200,200 --out "$tmp/sig.csv" --summary "$tmp/sig.json" 2>"$tmp/sig.err" &
+pid=$!
+for _ in $(seq 200); do
+  [ -n "$(find "$tmp" -name '*sig.csv.partial-*' -size +100k)" ] && break
+  sleep 0.05
+done
+kill -TERM $pid
+wait $pid
+st=$?
+[ $st -eq 143 ] && grep -q "interrupted.*SIGTERM" "$tmp/sig.err" && ok || bad "track SIGTERM: exit $st, $(cat "$tmp/sig.err")"
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1])
+assert 100 < len(r) < 400001 and all(len(x) == len(h) for x in r), len(r)
+assert all(math.isfinite(v) for row in r for v in row)
+" "$tmp/sig.csv" && jcheck "$tmp/sig.json" "'interrupted' in d['status'] and d['samples'] > 100" "track SIGTERM: rows or summary"
+
 # The figure, where gnuplot is installed.
 if command -v gnuplot >/dev/null; then
   "$PRRU" track --waypoints "$WP" --durations 1,1 --fmax "$lim" --out "$tmp/p.csv" --plot "$tmp/p.png" \
