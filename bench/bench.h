@@ -124,6 +124,27 @@ void bench_simulated_second(const prru_model *m, int reps, sim_result *res);
 void bench_map_throughput(const prru_model *m, int quick, map_result *res);
 #endif
 
+/* bench_modes.c: latency next to throughput, batched against scalar, and
+ * thread scaling only with a second core free. */
+typedef struct {
+  bench_stats latency_ns, throughput_ns, ratio; /* ratio: latency / throughput */
+} bench_mode_row;
+typedef struct {
+  bench_stats batched_ns, scalar_ns, speedup; /* per state; speedup: scalar / batched */
+} bench_batch_row;
+typedef struct {
+  bench_mode_row dynamics, forward, inverse;
+  bench_batch_row batch_dynamics, batch_eom_solve, batch_dme_terms, batch_w_r;
+  int ncpu, scaling_measured;
+  double idle_second_core; /* of the second most idle CPU, just before */
+  bench_stats scaling;     /* map: 1-thread time / 2-thread time */
+} bench_modes;
+extern bench_modes bench_modes_result;
+extern int bench_modes_done; /* bench_modes_result is filled: report it */
+void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m);
+void bench_modes_print_table(const bench_modes *m);
+void bench_modes_print_json(const bench_modes *m);
+
 /* bench_regen.c */
 int bench_time_regeneration(int reps, bench_stats *out);
 

@@ -150,6 +150,13 @@ int main(int argc, char **argv)
   if (!op.json) fprintf(stderr, "mapping...\n");
   bench_map_throughput(&c.m, op.quick, &map);
 #endif
+  if (!op.json) fprintf(stderr, "latency, throughput and batched kernels...\n");
+  bench_modes_run(&c, op.reps, op.quick, &bench_modes_result);
+  if (c.failures) {
+    fprintf(stderr, "prru_bench: %ld calls failed in the latency and batched runs\n", c.failures);
+    return 1;
+  }
+  bench_modes_done = 1;
   if (!op.json) fprintf(stderr, "regenerating...\n");
   bench_stats regen = {0, 0, 0};
   int regen_ok = bench_time_regeneration(op.quick ? 1 : 3, &regen) == 0;

@@ -1,0 +1,359 @@
+/* Latency next to throughput, the batched kernels against the scalar loop,
+ * and the thread-scaling figure only where a second core is really free.
+ *
+ * Latency: each call's input depends on the previous call's output
+ * (q + 0.0 * out: IEEE arithmetic may not drop the product, since out could
+ * be infinite or NaN, so the next call waits for the last one), as an
+ * integrator's steps do. Throughput: the same calls on independent states,
+ * so the core overlaps consecutive calls. Batched: one call of the
+ * prru_batch_* kernel for NB states against NB calls of the scalar kernel
+ * on the same states; w_R: prru_map_eval (one thread, batched kernels)
+ * against a loop of prru_dme_eval over the same grid. Every pair is timed
+ * interleaved and reported as the median [min-max] of the per-repetition
+ * ratios, so load that comes and goes hits both sides alike. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "bench.h"
+#include "prru_dme.h"
+
+#define NB 1024   /* states per batched call */
+#define MAP_N 64  /* w_R grid: MAP_N x MAP_N */
+
+bench_modes bench_modes_result;
+int bench_modes_done;
+
+/* ---- latency and throughput of one runtime path ---- */
+
+static double run_dynamics(bench_ctx *c, long n, int chained)
+{
+  double M[9], h[3], G[3], acc = 0.0, dep = 0.0;
+  double t0 = bench_now_ns();
+  for (long i = 0; i < n; i++) {
+    const bench_state *s = &c->st[i & (NSTATES - 1)];
+    double q[3] = {s->q[0] + dep, s->q[1], s->q[2]};
+    prru_dynamics(q, s->qd, M, h, G);
+    if (chained) dep = 0.0 * (M[0] + h[0] + G[2]);
+    acc += M[4] + h[1] + G[0];
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + acc + dep;
+  return t / (double)n;
+}
+
+static double run_forward(bench_ctx *c, long n, int chained)
+{
+  double qdd[3], acc = 0.0, dep = 0.0;
+  double t0 = bench_now_ns();
+  for (long i = 0; i < n; i++) {
+    const bench_state *s = &c->st[i & (NSTATES - 1)];
+    double q[3] = {s->q[0] + dep, s->q[1], s->q[2]};
+    c->failures += prru_forward_dynamics(&c->m, c->d, q, s->qd, &s->l, qdd) != PRRU_OK;
+    if (chained) dep = 0.0 * qdd[0];
+    acc += qdd[0] + qdd[1] + qdd[2];
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + acc + dep;
+  return t / (double)n;
+}
+
+static double run_inverse(bench_ctx *c, long n, int chained)
+{
+  double fd[PRRU_NACT], acc = 0.0, dep = 0.0;
+  double t0 = bench_now_ns();
+  for (long i = 0; i < n; i++) {
+    const bench_state *s = &c->st[i & (NSTATES - 1)];
+    double q[3] = {s->q[0] + dep, s->q[1], s->q[2]};
+    c->failures += prru_inverse_dynamics(&c->m, c->d, q, s->qd, s->qdd, &s->l, fd) != PRRU_OK;
+    if (chained) dep = 0.0 * fd[0];
+    for (int a = 0; a < PRRU_NACT; a++) acc += fd[a];
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + acc + dep;
+  return t / (double)n;
+}
+
+typedef double (*mode_fn)(bench_ctx *c, long n, int chained);
+
+static void time_modes(bench_ctx *c, mode_fn f, long n, int reps, bench_mode_row *r)
+{
+  double lat[MAXREPS], thr[MAXREPS], ratio[MAXREPS];
+  f(c, n, 0);
+  f(c, n, 1);
+  for (int i = 0; i < reps; i++) {
+    thr[i] = f(c, n, 0);
+    lat[i] = f(c, n, 1);
+    ratio[i] = lat[i] / thr[i];
+  }
+  r->throughput_ns = bench_stats_of(thr, reps);
+  r->latency_ns = bench_stats_of(lat, reps);
+  r->ratio = bench_stats_of(ratio, reps);
+}
+
+/* ---- batched kernels against the scalar loop ---- */
+
+typedef struct {
+  double q[3 * NB], qd[3 * NB], fd[PRRU_NACT * NB], fp[3 * NB], mp[3 * NB];
+  double out[48 * NB]; /* the largest output set: dme_terms, 4 NACT + 27 rows */
+} soa_states;
+
+static soa_states soa;
+
+static void fill_soa(const bench_ctx *c)
+{
+  for (int k = 0; k < NB; k++) {
+    const bench_state *s = &c->st[k & (NSTATES - 1)];
+    for (int i = 0; i < 3; i++) {
+      soa.q[i * NB + k] = s->q[i];
+      soa.qd[i * NB + k] = s->qd[i];
+      soa.fp[i * NB + k] = s->l.fp[i];
+      soa.mp[i * NB + k] = s->l.mp[i];
+    }
+    for (int i = 0; i < PRRU_NACT; i++) soa.fd[i * NB + k] = s->l.fd[i];
+  }
+}
+
+static double sum_out(int n)
+{
+  double acc = 0.0;
+  for (int i = 0; i < n; i++) acc += soa.out[i];
+  return acc;
+}
+
+/* kind: 0 dynamics, 1 eom_solve, 2 dme_terms; batched or the scalar loop.
+ * Returns ns per state. */
+static double run_batch(const bench_ctx *c, int kind, int batched)
+{
+  double *o = soa.out;
+  double t0 = bench_now_ns();
+  if (batched) {
+    if (kind == 0) prru_batch_dynamics(NB, soa.q, soa.qd, o, o + 9 * NB, o + 12 * NB);
+    if (kind == 1)
+      prru_batch_eom_solve(NB, soa.q, soa.qd, soa.fd, soa.fp, soa.mp, o, o + 9 * NB, o + 12 * NB,
+                           o + 15 * NB);
+    if (kind == 2) prru_batch_dme_terms(NB, soa.q, o, o + PRRU_NACT * NB, o + 4 * PRRU_NACT * NB,
+                                        o + (4 * PRRU_NACT + 9) * NB);
+  } else {
+    for (int k = 0; k < NB; k++) {
+      const bench_state *s = &c->st[k & (NSTATES - 1)];
+      double *x = o + 48 * (k & 31); /* AoS, reused: the loop's outputs stay in cache too */
+      if (kind == 0) prru_dynamics(s->q, s->qd, x, x + 9, x + 12);
+      if (kind == 1) prru_eom_solve(s->q, s->qd, s->l.fd, s->l.fp, s->l.mp, x, x + 9, x + 12, x + 15);
+      if (kind == 2) prru_ik_jd(s->q, x, x + PRRU_NACT), prru_mass(s->q, x + 4 * PRRU_NACT),
+                     prru_platform_jacobian(s->q, x + 4 * PRRU_NACT + 9);
+      bench_sink = bench_sink + x[0] + x[9];
+    }
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + sum_out(32);
+  return t / NB;
+}
+
+/* w_R over the MAP_N^2 grid of the fig. 7 rectangle: prru_map_eval with
+ * `threads` threads, or (threads 0) a loop of prru_dme_eval. ns per point. */
+static double run_map(bench_ctx *c, int threads, double *w, unsigned char *st)
+{
+  const prru_map_grid g = {-PRRU_BENCH_PI / 6, PRRU_BENCH_PI / 6, -PRRU_BENCH_PI / 4,
+                           PRRU_BENCH_PI / 4, 0.0, MAP_N, MAP_N};
+  double t0 = bench_now_ns(), acc = 0.0;
+  if (threads > 0) {
+    prru_map_options o;
+    prru_map_options_default(&o);
+    o.nthreads = threads;
+    c->failures += prru_map_eval(&c->m, &g, &o, w, st, NULL) != PRRU_OK;
+    for (int k = 0; k < MAP_N * MAP_N; k++) acc += st[k] == PRRU_OK ? w[k] : 0.0;
+  } else {
+    for (int i = 0; i < MAP_N; i++)
+      for (int j = 0; j < MAP_N; j++) {
+        double q[3] = {prru_map_axis(g.q1_lo, g.q1_hi, g.n1, i),
+                       prru_map_axis(g.q2_lo, g.q2_hi, g.n2, j), g.q3};
+        prru_dme r;
+        if (prru_dme_eval(&c->m, c->d, q, &r) == PRRU_OK) acc += r.w_R;
+      }
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + acc;
+  return t / (MAP_N * MAP_N);
+}
+
+static void time_batched(bench_ctx *c, int kind, int reps, bench_batch_row *r)
+{
+  double b[MAXREPS], s[MAXREPS], ratio[MAXREPS];
+  static double w[MAP_N * MAP_N];
+  static unsigned char st[MAP_N * MAP_N];
+  for (int i = -2; i < reps; i++) { /* two warm-up rounds */
+    double tb, ts;
+    if (kind < 3) {
+      ts = run_batch(c, kind, 0);
+      tb = run_batch(c, kind, 1);
+    } else {
+      ts = run_map(c, 0, w, st);
+      tb = run_map(c, 1, w, st);
+    }
+    if (i < 0) continue;
+    b[i] = tb;
+    s[i] = ts;
+    ratio[i] = ts / tb;
+  }
+  r->batched_ns = bench_stats_of(b, reps);
+  r->scalar_ns = bench_stats_of(s, reps);
+  r->speedup = bench_stats_of(ratio, reps);
+}
+
+/* ---- is a second core free? ---- */
+
+/* Fraction of the time every other CPU was idle over `seconds`, from
+ * /proc/stat (this process sleeps meanwhile, so its own CPU counts too):
+ * the smallest idle fraction of the two most idle CPUs. -1 if unknown. */
+static double second_core_idle(double seconds, int *ncpu)
+{
+  enum { MAXCPU = 256 };
+  static unsigned long long idle0[MAXCPU], total0[MAXCPU];
+  double frac[MAXCPU];
+  int n = 0;
+  for (int pass = 0; pass < 2; pass++) {
+    FILE *f = fopen("/proc/stat", "r");
+    if (!f) return -1;
+    char line[512];
+    int cpu = 0;
+    while (fgets(line, sizeof line, f) && cpu < MAXCPU) {
+      unsigned long long v[8] = {0};
+      if (strncmp(line, "cpu", 3) != 0 || line[3] == ' ') continue;
+      if (sscanf(line + 3, "%*d %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3],
+                 &v[4], &v[5], &v[6], &v[7]) < 4)
+        continue;
+      unsigned long long idle = v[3] + v[4], total = 0;
+      for (int i = 0; i < 8; i++) total += v[i];
+      if (pass == 0) {
+        idle0[cpu] = idle;
+        total0[cpu] = total;
+      } else {
+        frac[cpu] = total > total0[cpu] ? (double)(idle - idle0[cpu]) / (double)(total - total0[cpu])
+                                        : 0.0;
+      }
+      cpu++;
+    }
+    fclose(f);
+    n = cpu;
+    if (pass == 0) {
+      struct timespec ts = {(time_t)seconds, (long)((seconds - floor(seconds)) * 1e9)};
+      nanosleep(&ts, NULL);
+    }
+  }
+  *ncpu = n;
+  if (n < 2) return 0.0;
+  double best = -1, second = -1;
+  for (int i = 0; i < n; i++) {
+    if (frac[i] > best) {
+      second = best;
+      best = frac[i];
+    } else if (frac[i] > second) {
+      second = frac[i];
+    }
+  }
+  return second;
+}
+
+void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m)
+{
+  memset(m, 0, sizeof *m);
+  const long n = quick ? 4 * NSTATES : 256 * NSTATES;
+  time_modes(c, run_dynamics, n, reps, &m->dynamics);
+  time_modes(c, run_forward, n, reps, &m->forward);
+  time_modes(c, run_inverse, n, reps, &m->inverse);
+  fill_soa(c);
+  time_batched(c, 0, reps, &m->batch_dynamics);
+  time_batched(c, 1, reps, &m->batch_eom_solve);
+  time_batched(c, 2, reps, &m->batch_dme_terms);
+  time_batched(c, 3, reps, &m->batch_w_r);
+  /* Thread scaling only with a second core idle (>= 90 %) just before. */
+  m->idle_second_core = second_core_idle(quick ? 0.05 : 0.5, &m->ncpu);
+  m->scaling_measured = m->ncpu > 1 && m->idle_second_core >= 0.9;
+  if (m->scaling_measured) {
+    static double w[MAP_N * MAP_N];
+    static unsigned char st[MAP_N * MAP_N];
+    double r[MAXREPS];
+    for (int i = 0; i < reps; i++) r[i] = run_map(c, 1, w, st) / run_map(c, 2, w, st);
+    m->scaling = bench_stats_of(r, reps);
+  }
+}
+
+static void row(const char *name, const bench_mode_row *r)
+{
+  printf("  %-17s latency %7.1f ns  throughput %7.1f ns  latency/throughput %.2f [%.2f-%.2f]\n",
+         name, r->latency_ns.median, r->throughput_ns.median, r->ratio.median, r->ratio.min,
+         r->ratio.max);
+}
+
+static void batch_row(const char *name, const bench_batch_row *r)
+{
+  printf("  %-17s %7.1f ns/state batched, %7.1f scalar loop: %.2fx [%.2f-%.2f]\n", name,
+         r->batched_ns.median, r->scalar_ns.median, r->speedup.median, r->speedup.min,
+         r->speedup.max);
+}
+
+void bench_modes_print_table(const bench_modes *m)
+{
+  printf("latency (each call's input depends on the last output, as an integrator) and\n"
+         "throughput (independent states), per call, median of interleaved repetitions:\n");
+  row("dynamics", &m->dynamics);
+  row("forward_dynamics", &m->forward);
+  row("inverse_dynamics", &m->inverse);
+  printf("batched kernels (%d states a call, one thread) against the scalar loop:\n", NB);
+  batch_row("dynamics", &m->batch_dynamics);
+  batch_row("eom_solve", &m->batch_eom_solve);
+  batch_row("dme_terms", &m->batch_dme_terms);
+  batch_row("w_R (64x64 map)", &m->batch_w_r);
+  if (m->scaling_measured)
+    printf("thread scaling (map, 2 threads vs 1; a second core was %.0f %% idle): %.2fx "
+           "[%.2f-%.2f]\n\n",
+           100 * m->idle_second_core, m->scaling.median, m->scaling.min, m->scaling.max);
+  else
+    printf("thread scaling: not measured (%d CPUs; the second most idle was %.0f %% idle, "
+           "below 90 %%)\n\n",
+           m->ncpu, 100 * m->idle_second_core);
+}
+
+static void json_stats(const char *key, const bench_stats *s)
+{
+  printf("\"%s\": {\"median\": %.4g, \"min\": %.4g, \"max\": %.4g}", key, s->median, s->min, s->max);
+}
+
+static void json_mode(const char *name, const bench_mode_row *r, int last)
+{
+  printf("\"%s\": {\"latency_ns\": %.4g, \"throughput_ns\": %.4g, ", name, r->latency_ns.median,
+         r->throughput_ns.median);
+  json_stats("latency_over_throughput", &r->ratio);
+  printf("}%s", last ? "" : ", ");
+}
+
+static void json_batch(const char *name, const bench_batch_row *r, int last)
+{
+  printf("\"%s\": {\"batched_ns\": %.4g, \"scalar_ns\": %.4g, ", name, r->batched_ns.median,
+         r->scalar_ns.median);
+  json_stats("speedup", &r->speedup);
+  printf("}%s", last ? "" : ", ");
+}
+
+void bench_modes_print_json(const bench_modes *m)
+{
+  printf(", \"modes\": {");
+  json_mode("dynamics", &m->dynamics, 0);
+  json_mode("forward_dynamics", &m->forward, 0);
+  json_mode("inverse_dynamics", &m->inverse, 1);
+  printf("}, \"batched\": {\"states_per_call\": %d, ", NB);
+  json_batch("dynamics", &m->batch_dynamics, 0);
+  json_batch("eom_solve", &m->batch_eom_solve, 0);
+  json_batch("dme_terms", &m->batch_dme_terms, 0);
+  json_batch("w_r", &m->batch_w_r, 1);
+  printf("}, \"thread_scaling\": ");
+  if (m->scaling_measured) {
+    printf("{\"second_core_idle\": %.3f, ", m->idle_second_core);
+    json_stats("map_2_over_1_threads", &m->scaling);
+    printf("}");
+  } else {
+    printf("{\"second_core_idle\": %.3f, \"measured\": false}", m->idle_second_core);
+  }
+}
