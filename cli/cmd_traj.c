@@ -738,8 +738,10 @@ int prru_cmd_track(int argc, char **argv)
     return 2;
   }
   /* The reference is checked every millisecond at least, also between
-   * coarse rows. */
-  if ((rc = check_reference(&tr, &o, fmin(step, 1e-3), &ff_peak)) != 0) {
+   * coarse rows (up to 1e8 checks: a reference of more than 1e5 s is
+   * checked at its rows). */
+  double check_step = span / 1e-3 <= 1e8 ? fmin(step, 1e-3) : step;
+  if ((rc = check_reference(&tr, &o, check_step, &ff_peak)) != 0) {
     prru_quintic_free(&tr);
     return rc;
   }
