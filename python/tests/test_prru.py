@@ -37,6 +37,11 @@ try:
     import numpy
 except ImportError:
     numpy = None
+# Set by ctest to 1 when the build found NumPy for this interpreter: then the
+# NumPy tests must run, not be skipped.
+if numpy is None and os.environ.get("PRRU_EXPECT_NUMPY") == "1":
+    sys.exit("test_prru: NumPy was importable by %s when the build was configured and is "
+             "not now: reconfigure, or reinstall NumPy" % sys.executable)
 
 
 def cli(*args, ok=True):
