@@ -859,7 +859,24 @@ static void test_parsing(void)
               sc.opt.max_steps == 500 && sc.opt.rel_tol == 2.3e-14,
           "scenario max_steps and a tolerance at the floor parse");
   prru_scenario_free(&sc);
+  /* Angles and every other number as on the command line: multiples of pi
+   * are the same doubles as the arithmetic written out in C. */
+  const double pi = 3.14159265358979323846;
+  const char *with_pi = "q0 = 0, pi/6, -pi/4\nqd0 = -2*pi/3, 0.5pi, +pi\n"
+                        "harmonic = 50, 4pi\nt_end = pi/4\n";
+  int st_pi = prru_scenario_parse(&sc, with_pi, strlen(with_pi), "mem", NULL, msg, 300);
+  TU_TRUE(st_pi == PRRU_OK &&
+              sc.q0[0] == 0 && sc.q0[1] == pi / 6 && sc.q0[2] == -(pi / 4) &&
+              sc.qd0[0] == -(2 * pi / 3) && sc.qd0[1] == 0.5 * pi && sc.qd0[2] == pi &&
+              sc.loads.omega == 4 * pi && sc.opt.t_end == pi / 4,
+          "scenario values in multiples of pi parse as on the command line");
+  if (st_pi != PRRU_OK) fprintf(stderr, "  got: %s\n", msg);
+  prru_scenario_free(&sc);
   const struct { const char *text, *needle; } bad_sc[] = {
+      {"q0 = 0, pi/0, 0\n", "mem:1: q0: expected 3 comma-separated finite numbers (decimal, or multiples of pi"},
+      {"qd0 = 0, 0, pi/-2\n", "mem:1: qd0"},
+      {"q0 = 0, 2 pi, 0\n", "mem:1: q0"},
+      {"t_end = -pi\n", "mem:1: t_end"},
       {"q0 = 1,2\n", "mem:1: q0"},
       {"speed = 3\n", "unknown key 'speed'"},
       {"t_end = -1\n", "t_end"},

@@ -39,7 +39,9 @@ static char *trim(char *s)
   return s;
 }
 
-/* Applies one key; returns PRRU_OK or fills msg. */
+/* Applies one key; returns PRRU_OK or fills msg. Numbers are read as on
+ * the command line (prru_parse_value/s: decimal or [+-][K[*]]pi[/N]), so a
+ * scenario file and the flags it stands for accept the same values. */
 static int apply_key(prru_scenario *s, const char *key, const char *val, const char *where,
                      const char *base_dir, int *has_table, char *msg, int msglen)
 {
@@ -48,8 +50,8 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
       {"fp", s->loads.base.fp, 3}, {"mp", s->loads.base.mp, 3}};
   for (size_t i = 0; i < sizeof vec / sizeof vec[0]; i++)
     if (strcmp(key, vec[i].name) == 0) {
-      if (prru_parse_list(val, vec[i].dst, vec[i].n) != PRRU_OK)
-        return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected %d comma-separated finite numbers, got '%.60s'", where, key, vec[i].n, val);
+      if (prru_parse_values(val, vec[i].dst, vec[i].n) != PRRU_OK)
+        return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected %d comma-separated finite numbers (decimal, or multiples of pi such as -pi/6), got '%.60s'", where, key, vec[i].n, val);
       return PRRU_OK;
     }
   struct { const char *name; double *dst; int positive; } num[] = {
@@ -58,7 +60,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
   for (size_t i = 0; i < sizeof num / sizeof num[0]; i++)
     if (strcmp(key, num[i].name) == 0) {
       double v;
-      if (prru_parse_double(val, &v) != PRRU_OK || v < 0 || (num[i].positive && v == 0))
+      if (prru_parse_value(val, &v) != PRRU_OK || v < 0 || (num[i].positive && v == 0))
         return prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s: expected a %s number, got '%.60s'", where, key, num[i].positive ? "positive" : "non-negative", val);
       if ((num[i].dst == &s->opt.abs_tol || num[i].dst == &s->opt.rel_tol) && v > 0 &&
           v < PRRU_TOL_MIN)
@@ -68,7 +70,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
     }
   if (strcmp(key, "max_steps") == 0) {
     double v;
-    if (prru_parse_double(val, &v) != PRRU_OK || !(v >= 0 && v < (double)LONG_MAX && v == floor(v)))
+    if (prru_parse_value(val, &v) != PRRU_OK || !(v >= 0 && v < (double)LONG_MAX && v == floor(v)))
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: max_steps: expected a whole number of steps per output interval (0: default %ld), got '%.60s'", where, PRRU_MAX_STEPS_DEFAULT, val);
     s->opt.max_steps = (long)v;
     return PRRU_OK;
@@ -82,7 +84,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
     double v[2];
     if (*has_table)
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: harmonic: cannot be combined with a loads table", where);
-    if (prru_parse_list(val, v, 2) != PRRU_OK)
+    if (prru_parse_values(val, v, 2) != PRRU_OK)
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: harmonic: expected 'amplitude, angular frequency', got '%.60s'", where, val);
     s->loads.kind = PRRU_LOAD_HARMONIC;
     s->loads.amp = v[0];
