@@ -3,13 +3,13 @@
 # every finding fatal) and runs each for a bounded time from the committed
 # seed corpus, after replaying every committed regression input once.
 #
-#   fuzz/run.sh [harness...]      default: parse table schedule scenario
+#   fuzz/run.sh [harness...]      default: parse parse_pi table schedule scenario
 #   FUZZ_SECONDS   seconds per harness (default 30)
 #   FUZZ_BUILD     build/work directory (default: a fresh temporary one)
 #   FUZZ_JOBS      libFuzzer -fork workers (default 1; the CI box has 2 cores)
 #
-# Needs clang and its fuzzer runtime (Debian: clang, libclang-rt-14-dev) and
-# GSL. Exit status: 0 clean, 1 a harness found a crash (the reproducer is
+# Needs clang and its fuzzer runtime (Debian: clang and libclang-rt-N-dev for
+# clang N, which `make fuzz` installs) and GSL. Exit status: 0 clean, 1 a harness found a crash (the reproducer is
 # copied to fuzz/findings/<harness>/ and its path printed: reproduce with
 # fuzz/run.sh --repro <harness> <file>, then commit it to
 # fuzz/regressions/<harness>/ once fixed), 2 set-up error.
@@ -22,13 +22,25 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
 seconds=${FUZZ_SECONDS:-30}
 jobs=${FUZZ_JOBS:-1}
-all=(parse table schedule scenario)
+all=(parse parse_pi table schedule scenario)
 
 CC=${FUZZ_CC:-clang}
 if ! command -v "$CC" >/dev/null 2>&1; then
-  echo "fuzz/run.sh: $CC not found (Debian packages: clang libclang-rt-14-dev)" >&2
+  echo "fuzz/run.sh: $CC not found (Debian: clang, then libclang-rt-N-dev for clang N;" \
+    "'make fuzz' installs both)" >&2
   exit 2
 fi
+
+# The Debian package holding the fuzzer runtime of this clang, read from its
+# version line as cmake/debian_deps.sh does (clang-runtime), so the message
+# names the package that fits rather than one release's.
+runtime_package() {
+  local major
+  major=$("$CC" --version 2>/dev/null | sed -n 's/.*clang version \([0-9][0-9]*\)\..*/\1/p' | head -n 1)
+  if [ -z "$major" ]; then echo "the libclang-rt-N-dev matching '$CC --version'"
+  elif [ "$major" -ge 14 ]; then echo "libclang-rt-$major-dev"
+  else echo "libclang-common-$major-dev"; fi
+}
 
 work=${FUZZ_BUILD:-}
 if [ -z "$work" ]; then
@@ -36,6 +48,18 @@ if [ -z "$work" ]; then
   trap 'rm -rf "$work"' EXIT
 fi
 mkdir -p "$work" || exit 2
+
+# A missing runtime otherwise shows up as a link error inside the first
+# harness's build; say which package it is instead.
+printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n);\n%s\n' \
+  'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n) { (void)d; (void)n; return 0; }' \
+  >"$work/probe.c"
+if ! "$CC" -fsanitize=fuzzer,address,undefined "$work/probe.c" -o "$work/probe" >"$work/probe.log" 2>&1; then
+  sed -n 1,5p "$work/probe.log" >&2
+  echo "fuzz/run.sh: $CC cannot link a libFuzzer program: its runtime is missing" \
+    "(Debian package $(runtime_package); 'make fuzz' installs it)" >&2
+  exit 2
+fi
 
 # The runtime is compiled once into an object list shared by the harnesses;
 # the committed generated/ kernels are enough (no Python needed).
