@@ -145,6 +145,19 @@ void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m);
 void bench_modes_print_table(const bench_modes *m);
 void bench_modes_print_json(const bench_modes *m);
 
+/* bench_peer.c: prru_dynamics against its SymPy peer (bench/sympy_peer.py). */
+typedef struct {
+  int available;            /* built, agreeing and timed */
+  const char *reason;       /* why not, otherwise */
+  double derive_s, cse_s;   /* the peer's SymPy derivation and cse, when built */
+  double max_rel_diff;      /* against prru_dynamics at the bench states */
+  bench_stats ours_ns, peer_ns, ratio; /* ratio: peer / generated, per repetition */
+} bench_peer;
+extern bench_peer bench_peer_result;
+void bench_peer_run(const bench_ctx *c, int reps, int quick, bench_peer *r);
+void bench_peer_print_table(const bench_peer *r);
+void bench_peer_print_json(const bench_peer *r);
+
 /* bench_regen.c */
 int bench_time_regeneration(int reps, bench_stats *out);
 

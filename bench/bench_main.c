@@ -156,6 +156,8 @@ int main(int argc, char **argv)
     fprintf(stderr, "prru_bench: %ld calls failed in the latency and batched runs\n", c.failures);
     return 1;
   }
+  if (!op.json) fprintf(stderr, "dynamics against the SymPy peer...\n");
+  bench_peer_run(&c, op.reps, op.quick, &bench_peer_result);
   bench_modes_done = 1;
   if (!op.json) fprintf(stderr, "regenerating...\n");
   bench_stats regen = {0, 0, 0};

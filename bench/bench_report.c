@@ -113,7 +113,10 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
     printf(", \"regeneration_s\": %.4g", regen->median);
   else
     printf(", \"regeneration_s\": null");
-  if (bench_modes_done) bench_modes_print_json(&bench_modes_result);
+  if (bench_modes_done) {
+    bench_modes_print_json(&bench_modes_result);
+    bench_peer_print_json(&bench_peer_result);
+  }
   printf("}\n");
 }
 
@@ -184,7 +187,10 @@ void bench_print_table(const bench_options *op, const char *cpu, const sim_resul
   } else {
     printf("w_R map: not measured\n");
   }
-  if (bench_modes_done) bench_modes_print_table(&bench_modes_result);
+  if (bench_modes_done) {
+    bench_modes_print_table(&bench_modes_result);
+    bench_peer_print_table(&bench_peer_result);
+  }
   if (regen_ok)
     printf("regeneration of every kernel from %s: %.3f s [%.3f-%.3f] (target < 2 s)\n",
            PRRU_BENCH_MODEL, regen->median, regen->min, regen->max);
