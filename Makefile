@@ -14,14 +14,15 @@ FUZZ_SECONDS ?= 60
 #   demo (and build, bench, compare-designs): the build and the plots;
 #   test: + g++ and clang (tests/test_dropin.sh), pkg-config
 #         (tests/test_install.sh), MuJoCo (validation/), NumPy (the
-#         Python binding's array path, python/tests);
+#         Python binding's array path, python/tests), SymPy (the bench's
+#         peer of the dynamics kernel, bench/sympy_peer.py);
 #   test-asan: + valgrind (gcc's own sanitizers need nothing more);
 #   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
 DEPS_DEMO = cmake gcc make python3 libgsl-dev gnuplot-nox
-DEPS_TEST = $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev python3-numpy
+DEPS_TEST = $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev python3-numpy python3-sympy
 DEPS_ASAN = $(DEPS_TEST) valgrind
 DEPS_FUZZ = clang clang-runtime libgsl-dev
 DEPS_DRY_RUN ?=
