@@ -11,9 +11,10 @@
 
 /* What the generated side of the runtime's paths executes (runtime/src/core.c,
  * reactions.c): the generated kernels named, plus the listed numerics. */
-#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom: " PRRU_OPS_EOM "; + 3x3 adjugate solve"
+#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom_solve (eom and M's adjugate solve fused): " \
+  PRRU_OPS_EOM_SOLVE
 #if PRRU_NACT == 3
-#define PRRU_BENCH_OPS_JD_INVERSE "3x3 adjugate solve"
+#define PRRU_BENCH_OPS_JD_INVERSE "J_d^-1 and fd in the kernel; conditioning test"
 #define PRRU_BENCH_OPS_JD_ALGEBRA "3x3 algebra"
 #else /* the redundant 4-PRRU: J_d^+ (spec section 12) */
 #define PRRU_BENCH_OPS_JD_INVERSE "J_d^+ by Householder QR of the 4x3 J_d"
@@ -22,7 +23,7 @@
 #define PRRU_BENCH_OPS_INVERSE_DYNAMICS "inverse_terms (ik_jd and M qdd - b fused, " \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_INVERSE_TERMS) " arithmetic) + " PRRU_BENCH_OPS_JD_INVERSE
 #define PRRU_BENCH_OPS_REACTIONS "forward_dynamics + joint_reactions (" \
-  PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_JOINT_REACTIONS) \
+  PRRU_OPS_ARITH_STR(PRRU_ARITH_EOM_SOLVE) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_JOINT_REACTIONS) \
   " arithmetic): closed form, no solve"
 #define PRRU_BENCH_OPS_W_R "ik_jd + mass + platform_jacobian (" \
   PRRU_OPS_ARITH_STR(PRRU_ARITH_IK_JD) " + " PRRU_OPS_ARITH_STR(PRRU_ARITH_MASS) " + " \
