@@ -8,7 +8,11 @@
 #   (`make compare-designs` makes both: build/ and build-4prru/).
 # Both prru binaries map w_R over the paper's fig. 7 rectangle (q1 in
 # [-pi/6, pi/6], q2 in [-pi/4, pi/6], q3 = 0, 201 x 201) with the same
-# practical singularity tolerance, and report w_R at q = 0. Writes
+# practical singularity tolerance, and report w_R at q = 0. A grid point
+# counts as regular only when J_d is regular there and the pose is in the
+# home pose's assembly mode (prru map's status ok); singular, unreachable
+# and other-assembly-mode points are left out of the index, reported as one
+# share and drawn white. Writes
 # OUTDIR/{3prru,4prru}_map.csv and _summary.txt, compare_wR.png (the two
 # maps side by side on one colour scale) and summary.txt.
 set -euo pipefail
@@ -38,14 +42,15 @@ l3=$(field "$out/3prru_summary.txt" index_log) l4=$(field "$out/4prru_summary.tx
 {
   echo "Three vs four limbs: rotational dynamic manipulability w_R over the paper's"
   echo "fig. 7 rectangle (q1 in [-pi/6, pi/6], q2 in [-pi/4, pi/6], q3 = 0, 201 x 201),"
-  echo "J_d singular where rcond < $RCOND (cond_1 > 250, rotations in units of l1)."
+  echo "J_d singular where rcond < $RCOND (cond_1 > 250, rotations in units of l1);"
+  echo "other assembly mode: regular, but cut off from the home pose by the singular locus."
   head -1 "$out/3prru_summary.txt" | sed 's/^model:/3 limbs, model:/'
   head -1 "$out/4prru_summary.txt" | sed 's/^model:/4 limbs, model:/'
   printf '%-34s %14s %14s\n' "" "3 limbs" "4 limbs"
   printf '%-34s %14s %14s\n' "w_R at q = 0" "$w3" "$w4"
   printf '%-34s %14.6f %14.6f\n' "global index (mean of w_R - 1)" "$i3" "$i4"
   printf '%-34s %14.6f %14.6f\n' "mean of ln w_R" "$l3" "$l4"
-  printf '%-34s %13.3f%% %13.3f%%\n' "singular or unreachable" \
+  printf '%-34s %13.3f%% %13.3f%%\n' "singular, unreachable, other mode" \
     "$(python3 -c "print(100*$s3)")" "$(python3 -c "print(100*$s4)")"
 } >"$out/summary.txt"
 cat "$out/summary.txt"
@@ -55,7 +60,7 @@ if command -v gnuplot >/dev/null 2>&1; then
 set datafile separator ','
 set terminal pngcairo size 1400,620 enhanced font 'Sans,11'
 set output 'compare_wR.png'
-set multiplot layout 1,2 title "Rotational dynamic manipulability index w_R, q_3 = 0 (paper fig. 7 rectangle): 3 limbs vs 4 limbs\nwhite: J_d singular (cond_1 > 250) or unreachable; one colour scale"
+set multiplot layout 1,2 title "Rotational dynamic manipulability index w_R, q_3 = 0 (paper fig. 7 rectangle): 3 limbs vs 4 limbs\nwhite: J_d singular (cond_1 > 250), unreachable or the other assembly mode; one colour scale"
 set view map
 set xlabel 'q_1 (rad)'
 set ylabel 'q_2 (rad)'
