@@ -38,7 +38,7 @@ static const char excite_help[] =
     "usage: prru excite [--out FILE.csv|-] [--period T] [--harmonics L] [--periods N]\n"
     "         [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3] [--fd-max F|F1,..]\n"
     "         [--rcond-min R] [--evals N] [--samples N] [--seed S]\n"
-    "         [--coulomb-velocity VS]\n"
+    "         [--stroke LO,HI|LO1,HI1,..] [--coulomb-velocity VS]\n"
     "An excitation trajectory for identification: each coordinate a Fourier\n"
     "series q_k(t) = c_k + sum_l (a_kl sin(l w t) + b_kl cos(l w t)), w = 2 pi / T\n"
     "(default T = 10 s, L = 5 harmonics, centre c = 0), whose coefficients are\n"
@@ -50,7 +50,8 @@ static const char excite_help[] =
     "assembly mode, |q_k - c_k| <= A_k (default 0.25 rad, 0.25 rad, 0.1 L with L\n"
     "the mean upper-link length), and the actuator forces of this model's\n"
     "inverse dynamics (no platform loads) within --fd-max (N, one value for all\n"
-    "or one per actuator, default 500). The result is then checked at 20 times\n"
+    "or one per actuator, default 500), the sliders within --stroke (m, for all\n"
+    "or per slider; default none). The result is then checked at 20 times\n"
     "as many points, and shrunk about the centre until it passes.\n"
     "Writes the model line, comment lines with the coefficients and the\n"
     "condition number, then the columns\n"
@@ -64,7 +65,7 @@ static const char excite_help[] =
 
 typedef struct {
   const char *out, *period, *harm, *periods, *dt, *centre, *amp, *fdmax, *rcond, *evals, *samples,
-      *seed, *vs;
+      *seed, *vs, *stroke;
   int help;
 } excite_args;
 
@@ -107,6 +108,30 @@ static int parse_fd_max(const char *text, double fd_max[PRRU_NACT])
   return 0;
 }
 
+/* --stroke LO,HI (all sliders) or LO1,HI1,..: 0 or 2. */
+static int parse_stroke(const char *text, prru_excite_options *o)
+{
+  int n = 1;
+  for (const char *c = text; *c; c++) n += *c == ',';
+  double v[2 * PRRU_NACT];
+  if (n != 2 && n != 2 * PRRU_NACT) {
+    prru_cli_error("excite", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per slider), not %d",
+                   2 * PRRU_NACT, n);
+    return 2;
+  }
+  if (prru_cli_numbers("excite", "stroke", text, v, n)) return 2;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    o->d_min[i] = v[n == 2 ? 0 : 2 * i];
+    o->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
+    if (!(o->d_min[i] < o->d_max[i])) {
+      prru_cli_error("excite", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)", i + 1,
+                     o->d_min[i], o->d_max[i]);
+      return 2;
+    }
+  }
+  return 0;
+}
+
 static int excite_options(const excite_args *a, prru_excite_options *o, prru_fourier *f, int *periods,
                           double *dt)
 {
@@ -129,6 +154,7 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
       }
   }
   if (a->fdmax && parse_fd_max(a->fdmax, o->fd_max)) return 2;
+  if (a->stroke && parse_stroke(a->stroke, o)) return 2;
   if (a->rcond && prru_cli_number(c, "rcond-min", a->rcond, &o->rcond_min)) return 2;
   if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
     prru_cli_error(c, "--rcond-min: %s must lie between 0 and 1", a->rcond);
@@ -146,13 +172,24 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
   return 0;
 }
 
+/* The starting condition number, or why there is none. */
+static void start_text(const prru_excite_result *r, char *buf, size_t len)
+{
+  if (isfinite(r->cond_start))
+    snprintf(buf, len, "%.6g", r->cond_start);
+  else
+    snprintf(buf, len, "infeasible");
+}
+
 static void excite_comments(prru_cli_out *o, const prru_fourier *f, const prru_excite_result *r,
                             const prru_base *b)
 {
+  char start[64];
+  start_text(r, start, sizeof start);
   prru_cli_out_printf(o, "# excitation: period %.17g s, %d harmonics, centre %.17g %.17g %.17g; "
-                      "condition number %.6g (start %.6g) of the base regressor (%d base parameters)\n",
-                      f->period, f->harmonics, f->centre[0], f->centre[1], f->centre[2], r->cond,
-                      r->cond_start, b->nbase);
+                      "condition number %.6g (start %s) of the base regressor (%d base parameters)\n",
+                      f->period, f->harmonics, f->centre[0], f->centre[1], f->centre[2], r->cond, start,
+                      b->nbase);
   prru_cli_out_line(o);
   for (int k = 0; k < 3; k++) {
     prru_cli_out_printf(o, "# q%d: a", k + 1);
@@ -211,7 +248,7 @@ int prru_cmd_excite(int argc, char **argv)
       {"periods", 1, &a.periods, NULL}, {"dt", 1, &a.dt, NULL},           {"centre", 1, &a.centre, NULL},
       {"amplitude", 1, &a.amp, NULL},   {"fd-max", 1, &a.fdmax, NULL},    {"rcond-min", 1, &a.rcond, NULL},
       {"evals", 1, &a.evals, NULL},     {"samples", 1, &a.samples, NULL}, {"seed", 1, &a.seed, NULL},
-      {"coulomb-velocity", 1, &a.vs, NULL}, {"help", 0, NULL, &a.help}};
+      {"coulomb-velocity", 1, &a.vs, NULL}, {"stroke", 1, &a.stroke, NULL}, {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("excite", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (a.help) {
     char dn[256], fn[256];
@@ -262,10 +299,11 @@ int prru_cmd_excite(int argc, char **argv)
     prru_cli_error("excite", "%s; nothing written", prru_strerror(st));
     return st == PRRU_EINTERRUPTED ? prru_cli_exit_interrupted() : 1;
   }
-  fprintf(stderr, "excite: %d base parameters; condition number %.6g (start %.6g, %d evaluations%s); "
+  char start[64];
+  start_text(&r, start, sizeof start);
+  fprintf(stderr, "excite: %d base parameters; condition number %.6g (start %s, %d evaluations%s); "
                   "worst J_d rcond %.4g; peak |fd|",
-          b->nbase, r.cond, r.cond_start, r.evals, r.shrunk ? ", shrunk to pass the dense check" : "",
-          r.rcond_worst);
+          b->nbase, r.cond, start, r.evals, r.shrunk ? ", shrunk to pass the dense check" : "", r.rcond_worst);
   for (int i = 0; i < PRRU_NACT; i++) fprintf(stderr, " %.4g", r.fd_peak[i]);
   fprintf(stderr, " N\n");
   free(b);

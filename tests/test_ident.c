@@ -353,6 +353,24 @@ static void check_excite(const prru_base *b)
          r.rcond_worst);
   excitation = f;
   TU_TRUE(r.cond <= r.cond_start, "the optimiser does not make the condition worse");
+  /* Strokes: the sliders of the result stay within a band around home. */
+  prru_excite_options os = o;
+  double d0[NA], dmin = INFINITY, dmax = -INFINITY;
+  const double q0[3] = {0, 0, 0};
+  prru_actuators(&model, &data, q0, d0);
+  for (int i = 0; i < NA; i++) os.d_min[i] = d0[i] - 0.02, os.d_max[i] = d0[i] + 0.02;
+  prru_fourier fs;
+  memset(&fs, 0, sizeof fs);
+  fs.period = 5, fs.harmonics = 3;
+  st = prru_excite(&model, b, &os, NULL, &fs, &r, msg, sizeof msg);
+  for (int s = 0; st == PRRU_OK && s < 5000; s++) {
+    double q[3], dd[NA];
+    prru_fourier_eval(&fs, fs.period * s / 5000, q, NULL, NULL);
+    prru_actuators(&model, &data, q, dd);
+    for (int i = 0; i < NA; i++) dmin = fmin(dmin, dd[i] - d0[i]), dmax = fmax(dmax, dd[i] - d0[i]);
+  }
+  printf("excitation within +-20 mm strokes: sliders from %.4g to %.4g m about home\n", dmin, dmax);
+  TU_TRUE(st == PRRU_OK && dmin >= -0.02 && dmax <= 0.02, "excitation within the strokes");
   double peak[NA], rw, tb;
   TU_TRUE(prru_excite_check(&model, &f, &o, 5000, peak, &rw, &tb) == PRRU_OK && rw >= o.rcond_min,
           "the trajectory passes a denser check");

@@ -134,6 +134,7 @@ void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3
 
 typedef struct {
   double fd_max[PRRU_NACT];  /* |fd_i| limit (N), > 0 */
+  double d_min[PRRU_NACT], d_max[PRRU_NACT]; /* slider strokes (m), -inf/+inf by default */
   double rcond_min;          /* regularity along the path (prru_check_regular's rcond) */
   double amplitude_max[3];   /* |q_k - c_k| bound of the start and of each coordinate's sum of |a|, |b| */
   int samples;               /* points per period the objective stacks (>= nbase/3 + 1) */
@@ -142,13 +143,13 @@ typedef struct {
   unsigned long seed;
 } prru_excite_options;
 
-/* fd_max 500 N each, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
+/* fd_max 500 N each, no stroke limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, 2000 check samples, 3000 evaluations, seed 1. */
 void prru_excite_options_default(prru_excite_options *o);
 
 typedef struct {
   double cond;          /* condition number of the column-scaled stacked base regressor */
-  double cond_start;    /* the same for the starting coefficients */
+  double cond_start;    /* the same for the starting coefficients (inf: infeasible start) */
   double fd_peak[PRRU_NACT];
   double rcond_worst;
   int evals;
@@ -159,7 +160,7 @@ typedef struct {
  * smallest condition number of the stacked base regressor under the
  * model m (inverse dynamics with no platform loads), subject to every
  * checked point being reachable, regular (rcond >= rcond_min), in the
- * assembly mode of the centre and within the force limits. Deterministic
+ * assembly mode of the centre and within the force and stroke limits. Deterministic
  * (seeded start, GSL nmsimplex2). PRRU_EINPUT for bad options or centre
  * (msg says which), PRRU_ENOCONV when no feasible trajectory was found,
  * PRRU_EINTERRUPTED when *stop became non-zero. Allocates. */
@@ -169,7 +170,8 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
 
 /* The excitation's feasibility at n points per period: 0 and the peak
  * forces and worst rcond, or the first failing point's status
- * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, or PRRU_EINPUT for a force limit)
+ * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, or PRRU_EINPUT for a force or
+ * stroke limit)
  * with *t_bad its time. */
 int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
                       int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad);

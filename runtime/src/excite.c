@@ -16,7 +16,7 @@
 void prru_excite_options_default(prru_excite_options *o)
 {
   memset(o, 0, sizeof *o);
-  for (int i = 0; i < PRRU_NACT; i++) o->fd_max[i] = 500.0;
+  for (int i = 0; i < PRRU_NACT; i++) o->fd_max[i] = 500.0, o->d_min[i] = -HUGE_VAL, o->d_max[i] = HUGE_VAL;
   o->rcond_min = 1e-2;
   o->amplitude_max[0] = o->amplitude_max[1] = 0.25;
   o->amplitude_max[2] = -0.1; /* negative: that many length scales L */
@@ -86,6 +86,12 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
   if (st != PRRU_OK) {
     *excess = 10;
     return st;
+  }
+  /* Stroke violations relative to the stroke (d holds the sliders). */
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double range = o->d_max[i] - o->d_min[i];
+    if (d->d[i] < o->d_min[i]) *excess += (o->d_min[i] - d->d[i]) / range;
+    if (d->d[i] > o->d_max[i]) *excess += (d->d[i] - o->d_max[i]) / range;
   }
   st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
   if (st != PRRU_OK) {
@@ -219,6 +225,11 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
       snprintf(msg, (size_t)msglen, "force limit of actuator %d must be positive", i + 1);
       return PRRU_EINPUT;
     }
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(o->d_min[i] < o->d_max[i])) {
+      snprintf(msg, (size_t)msglen, "stroke of slider %d is empty", i + 1);
+      return PRRU_EINPUT;
+    }
   if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
     snprintf(msg, (size_t)msglen, "rcond_min must lie in (0, 1)");
     return PRRU_EINPUT;
@@ -241,6 +252,12 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
              st == PRRU_OK ? "too close to a singularity (rcond below the limit)" : prru_strerror(st));
     return PRRU_EINPUT;
   }
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (d.d[i] < o->d_min[i] || d.d[i] > o->d_max[i]) {
+      snprintf(msg, (size_t)msglen, "centre (%g, %g, %g) puts slider %d at %g m, outside its stroke", f->centre[0],
+               f->centre[1], f->centre[2], i + 1, d.d[i]);
+      return PRRU_EINPUT;
+    }
   return PRRU_OK;
 }
 
@@ -308,7 +325,8 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
     prru_check_regular(m, c.d, f->centre, NULL);
     c.mode = pose_mode(c.d);
     start_point(&c, x, o->seed);
-    r->cond_start = pow(10, merit(x, &c));
+    const double m0 = merit(x, &c);
+    r->cond_start = m0 < MERIT_RANK ? pow(10, m0) : INFINITY;
     double best;
     st = minimise(&c, x, &best);
     unpack(&c, x);
@@ -343,7 +361,7 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
     }
     if (cs != PRRU_OK) {
       snprintf(msg, (size_t)msglen, "the optimised excitation fails the dense check at t = %.6g s (%s); "
-               "use more samples", tb, cs == PRRU_EINPUT ? "force limit exceeded" : prru_strerror(cs));
+               "use more samples", tb, cs == PRRU_EINPUT ? "a force or stroke limit exceeded" : prru_strerror(cs));
       st = PRRU_ENOCONV;
     }
   }
