@@ -37,7 +37,8 @@ static int finite_lambda(const double v[NL])
 static void orient_null(double z[NL])
 {
   double big = 0;
-  for (int i = 0; i < NL; i++) big = fmax(big, fabs(z[i]));
+  for (int i = 0; i < NL; i++) /* not fmax: a libm call per element here */
+    if (fabs(z[i]) > big) big = fabs(z[i]);
   for (int i = 0; i < NL; i++)
     if (fabs(z[i]) >= 0.5 * big) {
       if (z[i] < 0)
