@@ -23,7 +23,8 @@ small integer powers printed as products (pow(x, 2) is slower) and sqrt,
 (static: bench/bench_peer.c includes the file).
 
 For a model with drives (armature) the file only defines PEER_UNAVAILABLE
-with the reason: the peer covers the rigid bodies only. The derivation takes tens of seconds, so the bench build
+with the reason: the peer covers the rigid bodies only. The derivation
+takes about 3 s (half a minute on a loaded machine), so the bench build
 caches FILE.c in the build tree (regenerated when the model or this script
 changes).
 """
