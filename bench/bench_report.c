@@ -180,6 +180,8 @@ void bench_print_table(const bench_options *op, const char *cpu, const sim_resul
     printf("  generated  %dx%d in %.3f s [%.3f-%.3f] with 2 threads (%.3g points/s), %.3f s with 1"
            "\n", map->n, map->n, map->gen2_s.median, map->gen2_s.min, map->gen2_s.max,
            pts / map->gen2_s.median, map->gen1_s.median);
+    if (bench_modes_done && !bench_modes_result.scaling_measured)
+      printf("  (the second core was not free: 2 threads against 1 is no scaling figure here)\n");
     printf("  reference  %dx%d in %.3f s, 1 thread (%.3g points/s); per-thread ratio %.1fx; "
            "max rel diff %.1e\n", map->n_ref, map->n_ref, map->ref_s.median,
            rpts / map->ref_s.median, (pts / map->gen1_s.median) / (rpts / map->ref_s.median),
