@@ -532,30 +532,9 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
     return 1;
   }
   if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
-  char *buf = NULL;
-  size_t len = 0;
-  FILE *g = open_memstream(&buf, &len);
-  if (!g) return 1;
-  prru_plot_model_var(g);
-  fputs("set datafile separator ','\n"
-        "set terminal pngcairo size 1000,800 enhanced font 'Sans,11'\n"
-        "set output 'track.png'\nf = ", g);
-  prru_plot_string(g, abs_csv);
-  fputs("\nset multiplot layout 2,1 title 'Computed-torque tracking, model '.model\n"
-        "set grid\nset key outside right\nset lmargin 12\nset offsets 0, 0, graph 0.05, graph 0.05\n"
-        "set ylabel 'error q_{ref} - q (rad, m)'\n"
-        "plot f using 't':'e1' with lines lw 2 title 'e_1', '' using 't':'e2' with lines lw 2 "
-        "title 'e_2', '' using 't':'e3' with lines lw 2 title 'e_3'\n"
-        "set xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\nplot ", g);
-  for (int i = 1; i <= PRRU_NACT; i++)
-    fprintf(g, "%s't':'fd%d' with lines lw 2 title 'f_{d%d}'", i == 1 ? "f using " : ", '' using ", i, i);
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (isfinite(o->f_max[i]))
-      fprintf(g, ", %.17g with lines dt 2 lc 'black' notitle, %.17g with lines dt 2 lc 'black' notitle",
-              o->f_max[i], -o->f_max[i]);
-  fputs("\nunset multiplot\n", g);
-  fclose(g);
+  char *buf = prru_plot_track_script(abs_csv, "track.png", NULL, PRRU_NACT, o->f_max);
   int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
+  if (!buf) prru_cli_error("track", "--plot: out of memory");
   free(buf);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {
     prru_cli_error("track", "--plot: gnuplot not found: install gnuplot-nox (e.g. with 'make deps')");

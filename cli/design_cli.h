@@ -19,14 +19,4 @@ int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads
 /* "K/N", 1 <= K <= N: 0, or 2 after a message naming cmd. */
 int prru_cli_parse_shard(const char *cmd, const char *text, int *k, int *n);
 
-/* Gnuplot scripts (cli/plot_design.c; malloc'ed, NULL when out of
- * memory), run with prru_plot_run. The sensitivity bar chart of dat (lines
- * "INDEX NAME SCALED") into png. */
-char *prru_plot_sensitivity_script(const char *dat, const char *png);
-/* before.dat and after.dat (lines "q1 q2 w_R", NaN where not regular,
- * blank line between q1 scans) side by side into optimize_maps.png. */
-char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, double index_before,
-                                double index_after, double sing_before, double sing_after,
-                                const char *name);
-
 #endif

@@ -4,6 +4,7 @@
 #define _POSIX_C_SOURCE 200809L /* fork, waitpid, nanosleep, open_memstream */
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,13 +19,15 @@
 #include "prru.h"
 
 /* s as a single-quoted gnuplot string; escape_enhanced: with the
- * enhanced-text specials escaped (titles and labels, not file names). */
+ * enhanced-text specials escaped (titles and labels, not file names). A
+ * quote is joined in as "'" ('a'."'".'b'): gnuplot 5.4 misreads the
+ * doubled quote '' next to another one or at the start of a string. */
 static void put_string(FILE *g, const char *s, int escape_enhanced)
 {
   fputc('\'', g);
   for (const char *c = s; *c; c++) {
     if (*c == '\'')
-      fputs("''", g);
+      fputs("'.\"'\".'", g);
     else if (escape_enhanced && strchr("_^{}@&~", *c))
       fprintf(g, "\\%c", *c);
     else if ((unsigned char)*c >= 0x20)
@@ -449,6 +452,114 @@ char *prru_plot_series_script(const char *csv, const char *png, const char *subt
   return close_script(g, &buf);
 }
 
+/* "plot f using 't':'<col>1' with lines lw 2 title '<pre>1<post>', ..." for
+ * the n columns col1..coln, without the line end. */
+static void put_series(FILE *g, const char *col, const char *pre, const char *post, int n)
+{
+  fputs("plot ", g);
+  for (int i = 1; i <= n; i++)
+    fprintf(g, "%s't':'%s%d' with lines lw 2 title '%s%d%s'", i == 1 ? "f using " : ", '' using ", col,
+            i, pre, i, post);
+}
+
+/* The CSV f (datafile separator ',') and the PNG of a figure of height px. */
+static void put_csv_figure(FILE *g, const char *csv, const char *png, int px)
+{
+  fprintf(g, "set datafile separator ','\n"
+             "set terminal pngcairo size 1000,%d enhanced font 'Sans,11'\nset output ", px);
+  prru_plot_string(g, png);
+  fputs("\nf = ", g);
+  prru_plot_string(g, csv);
+}
+
+/* sub = the subtitle, and the multiplot layout of panels rows under title. */
+static void put_panels(FILE *g, const char *subtitle, int panels, const char *title)
+{
+  fputs("\nsub = ", g);
+  prru_plot_label(g, subtitle);
+  fprintf(g, "\nset multiplot layout %d,1 title \"%s\\n\".sub\n", panels, title);
+}
+
+/* The panels q1 and q2 (rad), then q3 (m), then the slider heights d. */
+static void put_coordinate_panels(FILE *g, int nact)
+{
+  fputs("set grid\nset key outside right\n"
+        "set ylabel 'rotation (rad)'\n"
+        "plot f using 't':'q1' with lines lw 2 title 'q_1', '' using 't':'q2' with lines lw 2 title 'q_2'\n"
+        "set ylabel 'height (m)'\n"
+        "plot f using 't':'q3' with lines lw 2 title 'q_3'\n"
+        "set ylabel 'slider height (m)'\n", g);
+  put_series(g, "d", "d_", "", nact);
+  fputc('\n', g);
+}
+
+/* ---- prru track, and prru plot of the CSVs of track, traj, excite, id ---- */
+
+char *prru_plot_track_script(const char *csv, const char *png, const char *subtitle, int nact,
+                             const double *f_max)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  if (!subtitle) prru_plot_model_var(g);
+  put_csv_figure(g, csv, png, 800);
+  if (subtitle)
+    put_panels(g, subtitle, 2, "Computed-torque tracking");
+  else
+    fputs("\nset multiplot layout 2,1 title 'Computed-torque tracking, model '.model\n", g);
+  fputs("set grid\nset key outside right\nset lmargin 12\nset offsets 0, 0, graph 0.05, graph 0.05\n"
+        "set ylabel 'error q_{ref} - q (rad, m)'\n"
+        "plot f using 't':'e1' with lines lw 2 title 'e_1', '' using 't':'e2' with lines lw 2 "
+        "title 'e_2', '' using 't':'e3' with lines lw 2 title 'e_3'\n"
+        "set xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\n", g);
+  put_series(g, "fd", "f_{d", "}", nact);
+  /* The force limits, dashed, each as +limit and -limit. */
+  for (int i = 0; i < nact; i++)
+    if (isfinite(f_max[i]))
+      fprintf(g, ", %.17g with lines dt 2 lc 'black' notitle, %.17g with lines dt 2 lc 'black' notitle",
+              f_max[i], -f_max[i]);
+  fputs("\nunset multiplot\n", g);
+  return close_script(g, &buf);
+}
+
+char *prru_plot_motion_script(const char *csv, const char *png, const char *subtitle, int nact,
+                              int forces)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  put_csv_figure(g, csv, png, 120 + 220 * 4);
+  put_panels(g, subtitle, 4, forces ? "Excitation trajectory: coordinates, slider heights and actuator "
+                                      "forces over time" :
+                                      "Trajectory: coordinates, slider heights and velocities over time");
+  put_coordinate_panels(g, nact);
+  if (forces) {
+    fputs("set xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\n", g);
+    put_series(g, "fd", "f_{d", "}", nact);
+  } else {
+    fputs("set xlabel 'time t (s)'\nset ylabel 'slider velocity (m/s)'\n", g);
+    put_series(g, "dd", "v_{d", "}", nact);
+  }
+  fputs("\nunset multiplot\n", g);
+  return close_script(g, &buf);
+}
+
+char *prru_plot_forces_script(const char *csv, const char *png, const char *subtitle, int nact)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  put_csv_figure(g, csv, png, 600);
+  put_panels(g, subtitle, 1, "Inverse dynamics: actuator forces along the trajectory");
+  fputs("set grid\nset key outside right\nset xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\n", g);
+  put_series(g, "fd", "f_{d", "}", nact);
+  fputs("\nunset multiplot\n", g);
+  return close_script(g, &buf);
+}
+
 /* ---- prru animate ---- */
 
 char *prru_plot_animation_script(const char *dat, const char *gif, const char *title, long n,
@@ -490,5 +601,73 @@ char *prru_plot_animation_script(const char *dat, const char *gif, const char *t
              "lower links orange, platform green)\", model, T[i + 1])\n"
              "  splot f index i using 1:2:3:4:5:6:7 with vectors nohead lc variable lw 3 notitle\n"
              "}\n", n - 1);
+  return close_script(g, &buf);
+}
+
+/* ---- prru optimize and prru sensitivity ---- */
+
+char *prru_plot_sensitivity_script(const char *dat, const char *png)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return NULL;
+  prru_plot_model_var(g);
+  fputs("set terminal pngcairo size 1200,650 enhanced font 'Sans,11'\nset output ", g);
+  prru_plot_string(g, png);
+  fputs("\ndat = ", g);
+  prru_plot_string(g, dat);
+  fputs("\n"
+        "set title \"Sensitivity of the objective to the design parameters, model \".model.\"\\n"
+        "d(objective)/d(p) x scale of p (the parameter's magnitude; body inertia, length or slider mass where p may be 0), largest 30\\n"
+        "*: a grid point changed status between p - h and p + h (the difference includes a jump)\"\n"
+        "set style fill solid 0.8 border -1\n"
+        "set boxwidth 0.7\n"
+        "set xtics rotate by -60 noenhanced\n"
+        "set ylabel 'change of the objective per scale of p'\n"
+        "set grid ytics\n"
+        "set key off\n"
+        "set xzeroaxis lt -1\n"
+        "plot dat using 1:3:($3 < 0 ? 0x3b528b : 0xd95f02):xtic(2) with boxes lc rgb variable\n",
+        g);
+  return close_script(g, &buf);
+}
+
+char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, double index_before,
+                                double index_after, double sing_before, double sing_after,
+                                const char *name)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *g = open_memstream(&buf, &len);
+  if (!g) return NULL;
+  prru_plot_model_var(g);
+  fputs("opt = ", g);
+  prru_plot_label(g, name);
+  fprintf(g, "\nq1lo = %.17g\nq1hi = %.17g\nq2lo = %.17g\nq2hi = %.17g\nq3 = %.9g\n", grid->q1_lo,
+          grid->q1_hi, grid->q2_lo, grid->q2_hi, grid->q3);
+  fprintf(g, "cond = %.6g\nib = %.9g\nia = %.9g\nsb = %.6g\nsa = %.6g\n", 1.0 / rcond_min, index_before,
+          index_after, 100 * sing_before, 100 * sing_after);
+  fputs("set terminal pngcairo size 1400,640 enhanced font 'Sans,11'\n"
+        "set output 'optimize_maps.png'\n"
+        "set multiplot layout 1,2 title sprintf(\"Rotational dynamic manipulability w_R over the workspace, q_3 = %g m: \"."
+        "\"before and after prru optimize\\nwhite: J_d singular (cond_1 > %g), other assembly mode or unreachable; one colour scale, w_R > 5 drawn as 5\", q3, cond)\n"
+        "set xlabel 'q_1 (rad)'\n"
+        "set ylabel 'q_2 (rad)'\n"
+        "set cblabel 'w_R = {/Symbol s}_1/{/Symbol s}_2'\n"
+        "set logscale cb\n"
+        "set cbrange [1:5]\n"
+        "set cbtics (1, 1.2, 1.5, 2, 3, 5)\n"
+        "set palette rgbformulae 22,13,-31\n"
+        "set xrange [q1lo:q1hi]\n"
+        "set yrange [q2lo:q2hi]\n"
+        "set size ratio -1\n"
+        "unset key\n"
+        "set title sprintf(\"before: model %s\\nglobal index %.4f, %.2f %% singular\", model, ib, sb)\n"
+        "plot 'before.dat' using 1:2:($3 > 5 ? 5 : $3) with image\n"
+        "set title sprintf(\"after: %s\\nglobal index %.4f, %.2f %% singular\", opt, ia, sa)\n"
+        "plot 'after.dat' using 1:2:($3 > 5 ? 5 : $3) with image\n"
+        "unset multiplot\n",
+        g);
   return close_script(g, &buf);
 }

@@ -1,6 +1,8 @@
-/* Plotting for the `prru` tool: every gnuplot script and every gnuplot run
- * lives in cli/plot.c. Commands hand it data files (CSVs as the tool
- * writes them) and get PNGs back; they never write gnuplot themselves.
+/* Plotting for the `prru` tool, one module: every gnuplot script and every
+ * gnuplot run lives in cli/plot.c; cli/plot_file.c reads and checks the
+ * CSVs `prru plot` is given and hands the pictures over (scratch
+ * directories, output files). Commands hand it data files (CSVs as the
+ * tool writes them) and get PNGs back; they never write gnuplot themselves.
  *
  * All functions name the command (`cmd`) in their messages. A return of
  * 0 is success; PRRU_PLOT_NO_GNUPLOT means gnuplot is not installed (no
@@ -12,6 +14,8 @@
 
 #include <stddef.h>
 #include <stdio.h>
+
+#include "prru_dme.h" /* prru_map_grid */
 
 #define PRRU_PLOT_NO_GNUPLOT 3
 
@@ -26,12 +30,14 @@
 int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
                   const char *script_name, const char *script);
 
-/* The line `model = '<model name>'`: a gnuplot string for titles (quotes
- * doubled, enhanced-text specials escaped). */
+/* The line `model = '<model name>'`: a gnuplot string for titles (as
+ * prru_plot_label writes it). */
 void prru_plot_model_var(FILE *g);
 
-/* Text as a gnuplot single-quoted string literal, quotes doubled and
- * control characters dropped: prru_plot_string for file names,
+/* Text as a gnuplot string expression: single-quoted, a quote in the text
+ * joined in as "'" ('it'."'".'s'), control characters dropped; for where
+ * gnuplot takes an expression (assignments, set output).
+ * prru_plot_string for file names,
  * prru_plot_label for titles (enhanced-text specials _ ^ { } @ & ~
  * escaped so that they print as themselves). */
 void prru_plot_string(FILE *g, const char *s);
@@ -53,11 +59,11 @@ char *prru_plot_fig7_script(int nposes, double rcond_min);
 
 /* ---- prru plot and prru animate (cli/plot_file.c, cli/cmd_plot.c) ---- */
 
-/* A PNG of a CSV written by prru simulate or prru map (recognised by its
- * header; '#' lines go into the title) at out ("-": stdout; a file is
- * replaced only when the picture is complete). 0; 2 when the file cannot
- * be read or is not such a CSV (message with the line); 1 when gnuplot is
- * missing or fails. */
+/* A PNG of a CSV written by prru simulate, map, track, traj, excite or id
+ * (recognised by its header; '#' lines go into the title) at out ("-":
+ * stdout; a file is replaced only when the picture is complete). 0; 2
+ * when the file cannot be read or is not such a CSV (message with the
+ * line); 1 when gnuplot is missing or fails. */
 int prru_plot_csv(const char *cmd, const char *in, const char *out);
 
 /* A map CSV as prru_plot_map_script draws it. */
@@ -77,6 +83,22 @@ char *prru_plot_map_script(const char *dat, const char *png, const char *subtitl
 char *prru_plot_series_script(const char *csv, const char *png, const char *subtitle, int nact,
                               int energies);
 
+/* The tracking figure of a `prru track` CSV (absolute path csv) into png:
+ * the errors e1..e3, and the forces fd1..fd<nact> with dashed lines at
+ * +-f_max[i] where f_max[i] is finite (the limit of actuator i). Title:
+ * the model (compiled in) when subtitle is NULL, else subtitle (the CSV's
+ * comment lines). Malloc'ed, NULL: no memory. */
+char *prru_plot_track_script(const char *csv, const char *png, const char *subtitle, int nact,
+                             const double *f_max);
+/* Time series panels of a `prru traj` CSV (forces 0: q1, q2; q3; d; the
+ * slider velocities dd) or of a `prru excite` CSV (forces 1: the same with
+ * the actuator forces fd last). Malloc'ed, NULL: no memory. */
+char *prru_plot_motion_script(const char *csv, const char *png, const char *subtitle, int nact,
+                              int forces);
+/* The actuator forces fd1..fd<nact> of a `prru id` CSV over time.
+ * Malloc'ed, NULL: no memory. */
+char *prru_plot_forces_script(const char *csv, const char *png, const char *subtitle, int nact);
+
 /* The animated GIF gif of dat: n frames (data blocks), one segment per
  * row: x y z dx dy dz colour (1..5 = rail, slider, upper link, lower
  * link, platform); frame i at time times[i], fps frames per
@@ -84,6 +106,21 @@ char *prru_plot_series_script(const char *csv, const char *png, const char *subt
 char *prru_plot_animation_script(const char *dat, const char *gif, const char *title, long n,
                                  const double *times, long fps, const double lo[3],
                                  const double hi[3]);
+
+/* ---- prru optimize and prru sensitivity (cli/cmd_design.c) ---- */
+
+/* The sensitivity bar chart of dat (lines "INDEX NAME SCALED") into png.
+ * Malloc'ed, NULL: no memory. */
+char *prru_plot_sensitivity_script(const char *dat, const char *png);
+/* before.dat and after.dat (lines "q1 q2 w_R", NaN where not ok, blank
+ * line between q1 scans) side by side into optimize_maps.png; the
+ * fractions are of the grid points not ok (singular, unreachable or in
+ * the other assembly mode). Malloc'ed, NULL: no memory. */
+char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, double index_before,
+                                double index_after, double sing_before, double sing_after,
+                                const char *name);
+
+/* ---- pictures out of a scratch directory (cli/plot_file.c) ---- */
 
 /* A new scratch directory $TMPDIR/prru-plot-XXXXXX (or /tmp) into dir;
  * 0, or 1 after a message. */

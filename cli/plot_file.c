@@ -1,7 +1,8 @@
-/* prru plot: a PNG of a CSV that prru wrote. A simulation CSV (header
- * t,q1,q2,q3,qd1,qd2,qd3,d1,...) becomes time series panels, a map CSV
- * (q1,q2,q3,w_R,status) a w_R contour map; the '#' lines (the model the
- * file came from) go into the title. The file is checked before gnuplot
+/* prru plot: a PNG of a CSV that prru wrote. A map CSV
+ * (q1,q2,q3,w_R,status) becomes a w_R contour map, a track CSV the figure
+ * of `prru track --plot`, the CSVs of simulate, traj, excite and id time
+ * series panels; the kind is told by the header, and the '#' lines (the
+ * model the file came from) go into the title. The file is checked before gnuplot
  * sees it, so that a bad file is a message with its line, not a gnuplot
  * error. */
 #define _XOPEN_SOURCE 700 /* getline, mkdtemp, realpath */
@@ -18,10 +19,43 @@
 #include "prru.h"
 
 /* What a CSV holds, from its header. */
-enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP };
+enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP, CSV_TRACK, CSV_TRAJ, CSV_EXCITE, CSV_ID };
 
+/* The header of a map CSV, and the start of the others'. */
 static const char map_header[] = "q1,q2,q3,w_R,status";
 static const char sim_header[] = "t,q1,q2,q3,qd1,qd2,qd3,d1,";
+static const char track_header[] = "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,fd1,";
+static const char motion_header[] = "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,d1,"; /* traj, excite */
+static const char id_header[] = "t,fd1,";
+
+/* Whether the comma-separated header has the column name. */
+static int has_column(const char *header, const char *name)
+{
+  size_t n = strlen(name);
+  for (const char *c = header;; c++) {
+    if (strncmp(c, name, n) == 0 && (c[n] == ',' || c[n] == '\0')) return 1;
+    if (!(c = strchr(c, ','))) return 0;
+  }
+}
+
+static int starts_with(const char *s, const char *prefix)
+{
+  return strncmp(s, prefix, strlen(prefix)) == 0;
+}
+
+/* The kind of CSV a header line begins. traj and excite share their
+ * first columns: traj goes on with the slider velocities dd, excite with
+ * the actuator forces fd. */
+static int header_kind(const char *header)
+{
+  if (strcmp(header, map_header) == 0) return CSV_MAP;
+  if (starts_with(header, sim_header)) return CSV_SIMULATION;
+  if (starts_with(header, track_header)) return CSV_TRACK;
+  if (starts_with(header, motion_header) && has_column(header, "dd1")) return CSV_TRAJ;
+  if (starts_with(header, motion_header) && has_column(header, "fd1")) return CSV_EXCITE;
+  if (starts_with(header, id_header)) return CSV_ID;
+  return CSV_UNKNOWN;
+}
 
 /* The '#' lines of a file, joined for a title (at most 3, 400 bytes). */
 typedef struct {
@@ -57,9 +91,7 @@ static int read_head(FILE *f, csv_comments *c, char **header, long *line_no)
       add_comment(c, *header);
       continue;
     }
-    if (strcmp(*header, map_header) == 0) return CSV_MAP;
-    if (strncmp(*header, sim_header, sizeof sim_header - 1) == 0) return CSV_SIMULATION;
-    return CSV_UNKNOWN;
+    return header_kind(*header);
   }
   /* No header line: getline's buffer holds nothing meaningful. */
   free(*header);
@@ -184,31 +216,97 @@ static int convert_map(const char *cmd, const char *path, FILE *f, long line_no,
   return rc;
 }
 
-/* ---- simulation CSVs ---- */
+/* ---- time series CSVs (simulate, track, traj, excite, id) ---- */
 
-/* Checks a simulation CSV (every row as long as the header, finite
- * numbers) with the runtime's table reader; 0, or 2 after its message. */
-static int check_simulation(const char *cmd, const char *path, int *nact, int *energies)
+/* What each kind is called in messages, by the enum. */
+static const char *const kind_name[] = {"", "simulation", "map", "tracking", "trajectory",
+                                        "excitation", "inverse dynamics"};
+
+/* The number of columns <prefix>1, <prefix>2, ... of t. */
+static int count_columns(const prru_table *t, const char *prefix)
+{
+  char name[32];
+  int n = 0;
+  for (;;) {
+    snprintf(name, sizeof name, "%s%d", prefix, n + 1);
+    if (prru_table_column(t, name) < 0) return n;
+    n++;
+  }
+}
+
+/* 0 when t has the columns <prefix>1..<prefix>n, else 2 after a message. */
+static int need_columns(const char *cmd, const char *path, int kind, const prru_table *t,
+                        const char *prefix, int n)
+{
+  if (count_columns(t, prefix) >= n) return 0;
+  prru_cli_error(cmd, "%s: a %s CSV with %d sliders needs the columns %s1..%s%d", path,
+                 kind_name[kind], n, prefix, prefix, n);
+  return 2;
+}
+
+/* The force limit of each actuator as a track CSV shows it: |fd_i| at a
+ * row with sat_i = 1 (a clipped force is the limit itself); NaN for an
+ * actuator never clipped, whose limit the file does not hold. */
+static void track_limits(const prru_table *t, int nact, double *f_max)
+{
+  char name[32];
+  for (int i = 0; i < nact; i++) {
+    snprintf(name, sizeof name, "fd%d", i + 1);
+    int fd = prru_table_column(t, name);
+    snprintf(name, sizeof name, "sat%d", i + 1);
+    int sat = prru_table_column(t, name);
+    f_max[i] = NAN;
+    for (int r = 0; r < t->nrows && isnan(f_max[i]); r++) {
+      const double *row = t->data + (size_t)r * (size_t)t->ncols;
+      if (row[sat] == 1) f_max[i] = fabs(row[fd]);
+    }
+  }
+}
+
+/* Checks a time series CSV of the kind (every row as long as the header,
+ * finite numbers, the columns the figure draws) with the runtime's table
+ * reader and writes its script (the CSV by its absolute path abs) into
+ * *script; 0, 1 (no memory) or 2 after a message. */
+static int series_script(const char *cmd, const char *path, const char *abs, int kind,
+                         const char *subtitle, char **script)
 {
   prru_table t;
   char msg[600];
+  *script = NULL;
   if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
     prru_cli_error(cmd, "%s", msg);
     return 2;
   }
   int rc = 0;
   if (t.nrows < 2) {
-    prru_cli_error(cmd, "%s: a simulation CSV with fewer than 2 rows has nothing to plot", path);
+    prru_cli_error(cmd, "%s: a %s CSV with fewer than 2 rows has nothing to plot", path, kind_name[kind]);
     rc = 2;
   }
-  *nact = 0;
-  char name[16];
-  for (;;) {
-    snprintf(name, sizeof name, "d%d", *nact + 1);
-    if (prru_table_column(&t, name) < 0) break;
-    ++*nact;
+  int nact = count_columns(&t, kind == CSV_TRACK || kind == CSV_ID ? "fd" : "d");
+  double f_max[64];
+  if (rc == 0 && kind == CSV_TRACK && nact > (int)(sizeof f_max / sizeof f_max[0])) {
+    prru_cli_error(cmd, "%s: more than %d actuators", path, (int)(sizeof f_max / sizeof f_max[0]));
+    rc = 2;
   }
-  *energies = prru_table_column(&t, "T") >= 0 && prru_table_column(&t, "V") >= 0;
+  if (rc == 0 && kind == CSV_TRACK) rc = need_columns(cmd, path, kind, &t, "sat", nact);
+  if (rc == 0 && kind == CSV_TRAJ) rc = need_columns(cmd, path, kind, &t, "dd", nact);
+  if (rc == 0 && kind == CSV_EXCITE) rc = need_columns(cmd, path, kind, &t, "fd", nact);
+  if (rc == 0) {
+    if (kind == CSV_SIMULATION)
+      *script = prru_plot_series_script(abs, "plot.png", subtitle, nact,
+                                        prru_table_column(&t, "T") >= 0 && prru_table_column(&t, "V") >= 0);
+    else if (kind == CSV_TRACK) {
+      track_limits(&t, nact, f_max);
+      *script = prru_plot_track_script(abs, "plot.png", subtitle, nact, f_max);
+    } else if (kind == CSV_ID)
+      *script = prru_plot_forces_script(abs, "plot.png", subtitle, nact);
+    else
+      *script = prru_plot_motion_script(abs, "plot.png", subtitle, nact, kind == CSV_EXCITE);
+    if (!*script) {
+      prru_cli_error(cmd, "out of memory");
+      rc = 1;
+    }
+  }
   prru_table_free(&t);
   return rc;
 }
@@ -287,11 +385,12 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
   int kind = read_head(f, &com, &header, &line_no);
   if (kind == CSV_UNKNOWN) {
     if (header)
-      prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate (header t,q1,q2,q3,qd1,qd2,qd3,d1,...) "
-                     "or prru map (header %s): the header is '%.60s'", in, line_no, map_header, header);
+      prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate, map, track, traj, excite or id "
+                     "(their headers: see 'prru plot --help'): the header is '%.60s'", in, line_no,
+                     header);
     else
-      prru_cli_error(cmd, "%s: no header line (%s): not a CSV of prru simulate or prru map", in,
-                     line_no ? "only comments" : "empty");
+      prru_cli_error(cmd, "%s: no header line (%s): not a CSV of prru simulate, map, track, traj, "
+                     "excite or id", in, line_no ? "only comments" : "empty");
     free(header);
     fclose(f);
     return 2;
@@ -324,16 +423,11 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
     fclose(f);
   } else {
     fclose(f);
-    int nact, energies;
-    rc = check_simulation(cmd, in, &nact, &energies);
-    if (rc == 0 && !realpath(in, abs_in)) {
+    if (!realpath(in, abs_in)) {
       prru_cli_error(cmd, "%s: %s", in, strerror(errno));
       rc = 2;
     }
-    if (rc == 0) {
-      script = prru_plot_series_script(abs_in, "plot.png", com.text, nact, energies);
-      if (!script) rc = 1;
-    }
+    if (rc == 0) rc = series_script(cmd, in, abs_in, kind, com.text, &script);
   }
   if (rc == 0) rc = prru_plot_run(cmd, dir, dir, "plot.gp", script);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {
