@@ -384,9 +384,11 @@ static int base_eval(const char *cmd, const prru_design_problem *pr, const prru_
 {
   prru_design_evaluate(pr, p, dd, ev);
   if (ev->sum.n_ok > 0) return 0;
-  prru_cli_error(cmd, "no grid point of the workspace is regular (%ld singular, %ld unreachable "
-                      "of %ld): the objective is not defined there",
-                 ev->sum.n_singular, ev->sum.n_unreachable, ev->sum.n_points);
+  /* The runtime counts the other assembly mode among the singular points. */
+  prru_cli_error(cmd, "no grid point of the workspace is regular (%ld singular, %ld in the other "
+                      "assembly mode, %ld unreachable, of %ld): the objective is not defined there",
+                 ev->sum.n_singular - ev->n_other_mode, ev->n_other_mode, ev->sum.n_unreachable,
+                 ev->sum.n_points);
   return 1;
 }
 
@@ -817,8 +819,9 @@ static const char opt_help[] =
     "Writes MODEL.json, the optimised design as a format-2 model file (name NAME,\n"
     "default the model's name + _opt), ready to build the tool and the dynamics\n"
     "code from ('make test MODEL=MODEL.json'), and DIR/ with report.txt (before\n"
-    "and after: global index, mean ln w_R, max w_R, singular fraction, slider\n"
-    "range; every variable before, after and its bounds; iterations),\n"
+    "and after: global index, mean ln w_R, max w_R, the share of the grid that\n"
+    "is singular, unreachable or in the other assembly mode, slider range;\n"
+    "every variable before, after and its bounds; iterations),\n"
     "before_map.csv and after_map.csv (as 'prru map' writes them) and\n"
     "optimize_maps.png (both w_R maps side by side). Nothing is written unless a\n"
     "feasible design is found (exit 1 otherwise); the files are built aside and\n"
@@ -877,7 +880,7 @@ static int on_iteration(int iter, int evals, const prru_design_eval *best, doubl
   opt_progress *p = ctx;
   if (p->show)
     fprintf(stderr, "\roptimize: iteration %4d, %5d evaluations, merit %.10g, index %.8g, "
-                    "singular %.3g %%, simplex %.2g   ",
+                    "singular/unreachable/other mode %.3g %%, simplex %.2g   ",
             iter, evals, best->merit, best->sum.index, 100 * best->sum.singular_fraction, size);
   return prru_cli_interrupted != 0;
 }
@@ -967,9 +970,10 @@ static void report_eval_rows(FILE *f, const prru_design_eval *a, const prru_desi
   fprintf(f, "%-34s %22.12g %22.12g\n", "mean of ln w_R", a->sum.index_log, b->sum.index_log);
   fprintf(f, "%-34s %22.12g %22.12g\n", "min w_R", a->sum.w_min, b->sum.w_min);
   fprintf(f, "%-34s %22.12g %22.12g\n", "max w_R", a->sum.w_max, b->sum.w_max);
-  fprintf(f, "%-34s %21.6f%% %21.6f%%\n", "singular or unreachable", 100 * a->sum.singular_fraction,
-          100 * b->sum.singular_fraction);
-  fprintf(f, "%-34s %22ld %22ld\n", "singular / unreachable points", a->sum.n_singular + a->sum.n_unreachable,
+  /* sum.n_singular counts the other assembly mode too (n_other_mode). */
+  fprintf(f, "%-34s %21.6f%% %21.6f%%\n", "singular, unreachable, other mode",
+          100 * a->sum.singular_fraction, 100 * b->sum.singular_fraction);
+  fprintf(f, "%-34s %22ld %22ld\n", "  grid points", a->sum.n_singular + a->sum.n_unreachable,
           b->sum.n_singular + b->sum.n_unreachable);
   fprintf(f, "%-34s %22ld %22ld\n", "  of them in the other assembly mode", a->n_other_mode, b->n_other_mode);
   fprintf(f, "%-34s %10.6f..%-10.6f %10.6f..%-10.6f\n", "slider heights d (m)", a->d_min, a->d_max, b->d_min,
@@ -1257,9 +1261,10 @@ int prru_cmd_optimize(int argc, char **argv)
       prru_cli_error(cmd, "%s", msg);
       rc = st == PRRU_EINPUT ? 2 : 1;
     } else if (!r->best_eval.feasible) {
-      prru_cli_error(cmd, "no feasible design found: the best has %.4g %% of the grid singular or "
-                          "unreachable and a stroke violation of %.3g; nothing written (widen the bounds, "
-                          "shrink the rectangle or loosen --rcond-min / --stroke)",
+      prru_cli_error(cmd, "no feasible design found: the best has %.4g %% of the grid singular, "
+                          "unreachable or in the other assembly mode and a stroke violation of "
+                          "%.3g; nothing written (widen the bounds, shrink the rectangle or "
+                          "loosen --rcond-min / --stroke)",
                      100 * r->best_eval.sum.singular_fraction, r->best_eval.stroke_violation);
       rc = 1;
     }

@@ -1,4 +1,4 @@
-/* prru plot: a PNG of any simulation or map CSV prru wrote. */
+/* prru plot: a PNG of any CSV prru writes with time or a map in it. */
 #include <stdio.h>
 #include <string.h>
 
@@ -8,13 +8,23 @@
 
 static const char plot_help[] =
     "usage: prru plot FILE.csv [--out FILE.png|-]\n"
-    "Draws a CSV written by prru simulate (or prru paper's paper_sim.csv) or\n"
-    "prru map (or fig7_map.csv), recognised by its header:\n"
-    "  t,q1,q2,q3,qd1,...   time series panels: q1 and q2, q3, the slider\n"
-    "                       heights d, and the energies T, V, T + V;\n"
-    "  q1,q2,q3,w_R,status  the w_R contour map, colours clipped at 3 (the key\n"
-    "                       says so), singular or unreachable points red,\n"
-    "                       the other assembly mode grey.\n"
+    "Draws a CSV written by prru simulate (or prru paper's paper_sim.csv), map\n"
+    "(or fig7_map.csv), track, traj, excite or id, recognised by its header:\n"
+    "  t,q1,q2,q3,qd1,...      (simulate) time series panels: q1 and q2, q3,\n"
+    "                          the slider heights d, and the energies T, V,\n"
+    "                          T + V;\n"
+    "  q1,q2,q3,w_R,status     (map) the w_R contour map, colours clipped at 3\n"
+    "                          (the key says so), singular or unreachable\n"
+    "                          points red, the other assembly mode grey;\n"
+    "  t,qr1,qr2,qr3,q1,...    (track) the figure of 'prru track --plot': the\n"
+    "                          errors e, and the forces fd with each force limit\n"
+    "                          the run reached (a clipped force is the limit; a\n"
+    "                          limit never reached is not in the file);\n"
+    "  t,q1,..,qdd3,d1,..,dd1  (traj) q1 and q2, q3, d, and the slider\n"
+    "                          velocities dd;\n"
+    "  t,q1,..,qdd3,d1,..,fd1  (excite) q1 and q2, q3, d, and the actuator\n"
+    "                          forces fd;\n"
+    "  t,fd1,...               (id) the actuator forces fd.\n"
     "The file's '#' lines (the model it was computed with) go into the title.\n"
     "Writes FILE.png beside FILE.csv unless --out says where (--out -:\n"
     "stdout); the PNG is replaced only when the new one is complete. Needs\n"

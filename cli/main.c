@@ -22,7 +22,7 @@ static const struct {
     {"identify", prru_cmd_identify, "base inertial parameters from measured motion and forces (model)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
-    {"plot", prru_cmd_plot, "PNG of a simulation CSV (time series) or map CSV (w_R contours)"},
+    {"plot", prru_cmd_plot, "PNG of a CSV prru wrote: time series, tracking errors, w_R map"},
     {"animate", prru_cmd_animate, "animated GIF of the mechanism moving through a simulated run"},
     {"optimize", prru_cmd_optimize, "choose geometry/inertia so w_R is nearest 1 over a workspace"},
     {"sensitivity", prru_cmd_sensitivity, "d(global index)/d(parameter) for every parameter, CSV"},

@@ -663,9 +663,9 @@ char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, dou
         "set yrange [q2lo:q2hi]\n"
         "set size ratio -1\n"
         "unset key\n"
-        "set title sprintf(\"before: model %s\\nglobal index %.4f, %.2f %% singular\", model, ib, sb)\n"
+        "set title sprintf(\"before: model %s\\nglobal index %.4f, %.2f %% singular, unreachable or other mode\", model, ib, sb)\n"
         "plot 'before.dat' using 1:2:($3 > 5 ? 5 : $3) with image\n"
-        "set title sprintf(\"after: %s\\nglobal index %.4f, %.2f %% singular\", opt, ia, sa)\n"
+        "set title sprintf(\"after: %s\\nglobal index %.4f, %.2f %% singular, unreachable or other mode\", opt, ia, sa)\n"
         "plot 'after.dat' using 1:2:($3 > 5 ? 5 : $3) with image\n"
         "unset multiplot\n",
         g);

@@ -219,8 +219,8 @@ static int convert_map(const char *cmd, const char *path, FILE *f, long line_no,
 /* ---- time series CSVs (simulate, track, traj, excite, id) ---- */
 
 /* What each kind is called in messages, by the enum. */
-static const char *const kind_name[] = {"", "simulation", "map", "tracking", "trajectory",
-                                        "excitation", "inverse dynamics"};
+static const char *const kind_name[] = {"", "a simulation", "a map", "a tracking", "a trajectory",
+                                        "an excitation", "an inverse dynamics"};
 
 /* The number of columns <prefix>1, <prefix>2, ... of t. */
 static int count_columns(const prru_table *t, const char *prefix)
@@ -239,7 +239,7 @@ static int need_columns(const char *cmd, const char *path, int kind, const prru_
                         const char *prefix, int n)
 {
   if (count_columns(t, prefix) >= n) return 0;
-  prru_cli_error(cmd, "%s: a %s CSV with %d sliders needs the columns %s1..%s%d", path,
+  prru_cli_error(cmd, "%s: %s CSV with %d sliders needs the columns %s1..%s%d", path,
                  kind_name[kind], n, prefix, prefix, n);
   return 2;
 }
@@ -279,7 +279,7 @@ static int series_script(const char *cmd, const char *path, const char *abs, int
   }
   int rc = 0;
   if (t.nrows < 2) {
-    prru_cli_error(cmd, "%s: a %s CSV with fewer than 2 rows has nothing to plot", path, kind_name[kind]);
+    prru_cli_error(cmd, "%s: %s CSV with fewer than 2 rows has nothing to plot", path, kind_name[kind]);
     rc = 2;
   }
   int nact = count_columns(&t, kind == CSV_TRACK || kind == CSV_ID ? "fd" : "d");

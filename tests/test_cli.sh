@@ -40,7 +40,9 @@ tr '\n' ' ' <"$tmp/help_eval.txt" | grep -q "the $nl joint reaction" && tr '\n' 
   && ok || bad "help texts do not give the model's $nl reaction coordinates"
 grep -qi "spec" "$tmp"/help_*.txt && bad "help text talks of 'spec'" || ok
 # Help speaks of the robot and the numbers, not of the code inside.
-for c in plot animate; do "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"; done
+for c in plot animate traj track excite identify optimize sensitivity merge; do
+  "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"
+done
 { grep -n -i -E "gsl|odeiv|hybridsj|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" "$tmp"/help_*.txt "$tmp/h.txt"
   grep -n -E "PRRU_|DBL_" "$tmp"/help_*.txt "$tmp/h.txt"; } >"$tmp/jargon.txt"
 [ -s "$tmp/jargon.txt" ] && bad "help texts with internal names: $(head -c 300 "$tmp/jargon.txt")" || ok

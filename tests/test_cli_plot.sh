@@ -97,6 +97,52 @@ PATH=/nonexistent "$PRRU" plot "$tmp/run.csv" --out "$tmp/ng.png" 2>"$tmp/err"
 [ $? -eq 1 ] && grep -q "gnuplot not found: install gnuplot-nox" "$tmp/err" && [ ! -e "$tmp/ng.png" ] \
   && ok || bad "plot without gnuplot: $(head -c 200 "$tmp/err")"
 
+# ---- plot: the CSVs of track, traj, excite and id ----
+WP='0,0,-0.8;0.1,0.05,-0.78'
+"$PRRU" traj --waypoints "$WP" --durations 0.3 --dt 0.005 --out "$tmp/traj.csv" || bad "traj failed"
+"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax 40 --q0-offset 0.01,0,0 --out "$tmp/track.csv" \
+  --summary "$tmp/track.json" || bad "track failed"
+"$PRRU" id --traj "$tmp/traj.csv" --out "$tmp/id.csv" || bad "id failed"
+"$PRRU" excite --period 1 --harmonics 1 --evals 20 --samples 50 --dt 0.01 --out "$tmp/excite.csv" 2>/dev/null \
+  || bad "excite failed"
+# Each by its header, at its own size (track 2 panels, traj and excite 4,
+# id 1), with nothing said on stderr.
+for c in "track 1000 800" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
+  set -- $c
+  "$PRRU" plot "$tmp/$1.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/$1.png")" = "$2 $3" ] && [ ! -s "$tmp/err" ] \
+    && ok || bad "plot of a $1 CSV: $(png_size "$tmp/$1.png") $(head -c 300 "$tmp/err")"
+done
+# track --plot still makes its figure, the size of prru plot's.
+"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax 40 --q0-offset 0.01,0,0 --out "$tmp/track2.csv" \
+  --summary "$tmp/track2.json" --plot "$tmp/track2.png" 2>"$tmp/err" \
+  && [ "$(png_size "$tmp/track2.png")" = "1000 800" ] && cmp -s "$tmp/track.csv" "$tmp/track2.csv" \
+  && ok || bad "track --plot: $(png_size "$tmp/track2.png") $(head -c 300 "$tmp/err")"
+# Titles keep quotes whatever their neighbours: the track CSV's settings
+# line says mismatch '' (gnuplot misreads doubled quotes side by side).
+grep -q "mismatch ''" "$tmp/track.csv" && ok || bad "the track CSV no longer says mismatch '' (test input changed)"
+sed "1s/\$/ it's '''' quoted/" "$tmp/traj.csv" >"$tmp/quotes.csv"
+"$PRRU" plot "$tmp/quotes.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/quotes.png")" = "1000 1000" ] \
+  && ok || bad "plot of a CSV with quotes in its comments: $(head -c 300 "$tmp/err")"
+# Bad files of these kinds: exit 2 naming the file and the reason.
+h_track=$(grep -m1 '^t,' "$tmp/track.csv") h_traj=$(grep -m1 '^t,' "$tmp/traj.csv")
+h_id=$(grep -m1 '^t,' "$tmp/id.csv") h_excite=$(grep -m1 '^t,' "$tmp/excite.csv")
+row_traj=$(grep -m1 '^0,' "$tmp/traj.csv")
+bad_file trackone "$h_track\n$(grep -m1 '^0,' "$tmp/track.csv")\n" "a tracking CSV with fewer than 2 rows"
+# The track CSV without its sat columns: the limits cannot be told.
+awk -F, 'BEGIN { OFS = "," } /^#/ { print; next }
+  /^t,/ { for (i = 1; i <= NF; i++) drop[i] = $i ~ /^sat/ }
+  { s = ""; for (i = 1; i <= NF; i++) if (!drop[i]) s = s (s == "" ? "" : ",") $i; print s }' \
+  "$tmp/track.csv" >"$tmp/tracknosat.csv"
+expect 2 "tracknosat.csv: a tracking CSV with $nact sliders needs the columns sat1..sat$nact" -- plot "$tmp/tracknosat.csv"
+[ ! -e "$tmp/tracknosat.png" ] && ok || bad "plot of the bad tracknosat.csv left tracknosat.png"
+bad_file trajshort "$h_traj\n$row_traj\n1,0,0\n" "trajshort.csv:3"
+bad_file trajword "$h_traj\n$row_traj\n$(echo "$row_traj" | sed 's/^0,0,/0.1,x,/')\n" "trajword.csv:3"
+bad_file idone "$h_id\n$(grep -m1 '^0,' "$tmp/id.csv")\n" "an inverse dynamics CSV with fewer than 2 rows"
+bad_file exciteone "$h_excite\n$(grep -m1 '^0,' "$tmp/excite.csv")\n" "an excitation CSV with fewer than 2 rows"
+# traj's and excite's columns begin alike: the columns after d decide.
+bad_file motionother "$(echo "$h_traj" | sed 's/,dd[0-9]*//g'),x1\n" \
+  "not a CSV of prru simulate, map, track, traj, excite or id"
+
 # ---- animate: a GIF of the mechanism moving ----
 "$PRRU" animate "$tmp/run.csv" --frames 7 --fps 10 2>"$tmp/err" && [ "$(gif_frames "$tmp/run.gif")" = "7 differ" ] \
   && [ ! -s "$tmp/err" ] && ok || bad "animate --frames 7: $(gif_frames "$tmp/run.gif") $(head -c 300 "$tmp/err")"
