@@ -178,7 +178,7 @@ static void map_row(prru_cli_out *o, double q1, double q2, double q3, double w, 
     prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, q3, w);
   else
     prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, q3,
-                        prru_cli_map_status_name(st == PRRU_DESIGN_OTHER_MODE ? PRRU_CLI_MAP_OTHER_MODE : st));
+                        prru_dme_status_name(st));
 }
 
 /* ---- Map shards ---- */
@@ -585,9 +585,9 @@ static int parse_map_rows(const char *path, char *rows, const prru_map_grid *g, 
     }
     long idx = first + k;
     int i = (int)(idx / g->n2), j = (int)(idx % g->n2), s = -1;
-    const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_CLI_MAP_OTHER_MODE};
+    const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_DME_OTHER_MODE};
     for (int c = 0; c < 4; c++)
-      if (strcmp(stat, prru_cli_map_status_name(codes[c])) == 0) s = codes[c];
+      if (strcmp(stat, prru_dme_status_name(codes[c])) == 0) s = codes[c];
     if (s < 0 || q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
         q[1] != prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j) || q[2] != g->q3) {
       prru_cli_error("merge", "%s: row %ld does not belong to this grid", path, k + 1);
@@ -623,8 +623,8 @@ static int merge_map(shard_file *sh, char **paths, int n, const char *out)
     shard_range(g.n1, sh[i].k, n, &r0, &r1);
     rc = parse_map_rows(paths[i], sh[i].rows, &g, r0 * g.n2, (r1 - r0) * g.n2, w, st);
   }
-  prru_cli_map_summary sum;
-  if (!rc && prru_cli_map_summarize(&g, w, st, &sum) != PRRU_OK) rc = 1;
+  prru_map_summary sum;
+  if (!rc) prru_map_summarize(&g, w, st, &sum);
   prru_cli_out o;
   if (!rc && prru_cli_out_open(&o, "merge", out)) rc = 1;
   if (!rc) {

@@ -109,7 +109,7 @@ int prru_cmd_map(int argc, char **argv)
   if (prru_cli_out_open(&o, "map", out)) return 1;
   double *w = NULL;
   unsigned char *st = NULL;
-  prru_cli_map_summary sum;
+  prru_map_summary sum;
   int rc = prru_cli_map_run("map", &m, &g, nthreads, &bar, &w, &st, &sum);
   int nrows = rc == PRRU_OK ? g.n1 : rc == PRRU_EINTERRUPTED ? prru_cli_map_rows_done(&g, st) : 0;
   /* After a first signal the rows computed are still written; a later

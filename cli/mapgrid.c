@@ -11,7 +11,6 @@
 #include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
-#include "prru_traj.h" /* prru_jd_det_sign */
 
 int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m)
 {
@@ -93,7 +92,7 @@ int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const doubl
       if (st[k] == PRRU_OK)
         prru_cli_out_printf(o, "%.17g,%.17g,%.17g,%.17g,ok\n", q1, q2, g->q3, w[k]);
       else
-        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_cli_map_status_name(st[k]));
+        prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, g->q3, prru_dme_status_name(st[k]));
       if (prru_cli_out_row(o)) return PRRU_EIO;
     }
   }
@@ -112,18 +111,12 @@ int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double
   return prru_cli_map_write_rows(o, g, w, st, 0, nrows, signal_count);
 }
 
-const char *prru_cli_map_status_name(int status)
+void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
 {
-  return status == PRRU_CLI_MAP_OTHER_MODE ? "other_mode" : prru_dme_status_name(status);
-}
-
-void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *c, double rcond_min)
-{
-  const prru_map_summary *s = &c->s;
   fprintf(f, "model: %s\n", prru_cli_model_id());
   fprintf(f, "points: %ld (ok %ld, singular %ld, unreachable %ld, other assembly mode %ld; J_d "
              "singular below rcond %g)\n",
-          s->n_points, s->n_ok, s->n_singular - c->n_other_mode, s->n_unreachable, c->n_other_mode,
+          s->n_points, s->n_ok, s->n_singular - s->n_other_mode, s->n_unreachable, s->n_other_mode,
           rcond_min);
   fprintf(f, "global_index: %.10g (mean of w_R - 1 over the ok points)\n", s->index);
   fprintf(f, "singular_fraction: %.10g (share of the grid that is singular, unreachable or in the "
@@ -132,57 +125,6 @@ void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *c, double r
   if (s->n_ok)
     fprintf(f, "w_R range: %.10g at (q1, q2) = (%.6f, %.6f) to %.10g at (%.6f, %.6f)\n", s->w_min,
             s->w_min_q[0], s->w_min_q[1], s->w_max, s->w_max_q[0], s->w_max_q[1]);
-}
-
-/* The sign of det J_d at q: +1, -1, or 0 when it is zero, not finite
- * (unreachable) or not defined (more actuators than coordinates). */
-static int jd_det_sign(const double q[3])
-{
-  double d[PRRU_NACT], J[PRRU_NACT * 3];
-  prru_ik_jd(q, d, J);
-  return prru_jd_det_sign(J);
-}
-
-/* Marks the ok poses of rows r0 .. r1 - 1 (w[0], st[0]: row r0's first
- * point) whose det J_d sign is not the home pose's; returns how many, or
- * -1 when the test does not apply. */
-static long mark_other_mode(const prru_map_grid *g, int r0, int r1, double *w, unsigned char *st)
-{
-  const int home = jd_det_sign((const double[3]){0.0, 0.0, g->q3});
-  if (home == 0) return -1;
-  long n = 0;
-  for (int i = r0; i < r1; i++) {
-    double q[3] = {prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i), 0.0, g->q3};
-    for (int j = 0; j < g->n2; j++) {
-      long k = (long)(i - r0) * g->n2 + j;
-      if (st[k] != PRRU_OK) continue;
-      q[1] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j);
-      if (jd_det_sign(q) != home) {
-        st[k] = PRRU_CLI_MAP_OTHER_MODE;
-        w[k] = NAN;
-        n++;
-      }
-    }
-  }
-  return n;
-}
-
-int prru_cli_map_summarize(const prru_map_grid *g, const double *w, const unsigned char *st,
-                           prru_cli_map_summary *sum)
-{
-  size_t n = (size_t)g->n1 * (size_t)g->n2;
-  unsigned char *tmp = malloc(n);
-  if (!tmp) return PRRU_ENOMEM;
-  long n_other = 0;
-  for (size_t k = 0; k < n; k++) {
-    n_other += st[k] == PRRU_CLI_MAP_OTHER_MODE;
-    tmp[k] = st[k] == PRRU_CLI_MAP_OTHER_MODE ? PRRU_ESINGULAR : st[k];
-  }
-  prru_map_summarize(g, w, tmp, &sum->s);
-  free(tmp);
-  sum->n_other_mode = n_other;
-  sum->modes_checked = jd_det_sign((const double[3]){0.0, 0.0, g->q3}) != 0;
-  return PRRU_OK;
 }
 
 int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
@@ -205,7 +147,6 @@ int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_g
   }
   o.interrupt = &prru_cli_interrupted;
   int rc = prru_map_eval_rows(m, g, r0, r1, &o, *w, *st);
-  if (rc == PRRU_OK || rc == PRRU_EINTERRUPTED) mark_other_mode(g, r0, r1, *w, *st);
   if (rc != PRRU_OK) {
     if (progress) prru_cli_progress_end(progress);
     if (rc != PRRU_EINTERRUPTED) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
@@ -218,12 +159,9 @@ int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_g
  * in w and st) or another status after a message. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
                    prru_cli_progress *progress, double **w, unsigned char **st,
-                   prru_cli_map_summary *sum)
+                   prru_map_summary *sum)
 {
   int rc = prru_cli_map_run_rows(cmd, m, g, 0, g->n1, nthreads, progress, w, st);
-  if (rc == PRRU_OK) {
-    rc = prru_cli_map_summarize(g, *w, *st, sum);
-    if (rc != PRRU_OK) prru_cli_error(cmd, "map: %s", prru_strerror(rc));
-  }
+  if (rc == PRRU_OK) prru_map_summarize(g, *w, *st, sum);
   return rc;
 }

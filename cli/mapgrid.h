@@ -10,16 +10,9 @@
 #include "prru.h"
 #include "prru_dme.h"
 
-/* Grid statuses start as this: prru_map_eval writes a prru_status (small)
- * for every point it evaluated. */
+/* Grid statuses start as this: prru_map_eval writes a status (a
+ * prru_status or PRRU_DME_OTHER_MODE) for every point it evaluated. */
 #define PRRU_CLI_MAP_NOT_DONE 0xFF
-/* A regular pose of the other assembly mode: det J_d has the opposite sign
- * to the home pose's (q1 = q2 = 0 at the map's q3). det J_d changes sign
- * only through det J_d = 0, so such a pose is cut off from the home pose by
- * the singular locus: the robot assembled at home cannot reach it without
- * crossing a singularity. w_R is NaN there and it is not counted as ok.
- * Only for three actuators (a square J_d); with more, J_d has no sign. */
-#define PRRU_CLI_MAP_OTHER_MODE 0xFE
 
 /* The singularity tolerance of every w_R map the CLI computes (prru map's
  * default, prru paper's fig. 7): J_d counts as singular where cond_1 > 250
@@ -31,18 +24,6 @@
  * and the index converges. */
 #define PRRU_CLI_MAP_RCOND_MIN 4e-3
 
-/* A map's summary as the CLI reports it: the runtime's, with the poses of
- * the other assembly mode counted as not ok (in s.n_singular and
- * s.singular_fraction) and also on their own. */
-typedef struct {
-  prru_map_summary s;
-  long n_other_mode; /* of s.n_singular */
-  int modes_checked; /* 0: no sign test (redundant actuators, home pose not regular) */
-} prru_cli_map_summary;
-
-/* "ok", "singular", "unreachable", "other_mode" for a grid status. */
-const char *prru_cli_map_status_name(int status);
-
 /* --NAME "START:STOP:COUNT": finite START < STOP, an integer 2 <= COUNT <=
  * 1e6. 0, or 2 after a message naming cmd and the option. */
 int prru_cli_parse_range(const char *cmd, const char *name, const char *text, double *lo, double *hi,
@@ -53,25 +34,19 @@ int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m);
 
 /* Allocates *w and *st (statuses PRRU_CLI_MAP_NOT_DONE where the run did
  * not get to) and evaluates the map with nthreads threads, reporting to
- * progress (NULL: none), stopping at prru_cli_interrupted; then marks the
- * poses of the other assembly mode (PRRU_CLI_MAP_OTHER_MODE). PRRU_OK,
+ * progress (NULL: none), stopping at prru_cli_interrupted (the runtime
+ * marks the poses of the other assembly mode, PRRU_DME_OTHER_MODE). PRRU_OK,
  * PRRU_EINTERRUPTED (the rows done so far are in w and st) or another
  * status after a message. The caller frees *w and *st. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
                      prru_cli_progress *progress, double **w, unsigned char **st,
-                     prru_cli_map_summary *sum);
+                     prru_map_summary *sum);
 /* Only the q1 rows r0 .. r1 - 1 (a shard: `prru map --shard K/N`): *w and
  * *st hold (r1 - r0) n2 points from row r0's first, the values
- * prru_cli_map_run gives them (the other assembly mode marked); no
- * summary. Statuses as prru_cli_map_run. */
+ * prru_cli_map_run gives them; no summary (prru_map_summarize on the
+ * joined shards: `prru merge`). Statuses as prru_cli_map_run. */
 int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
                           int nthreads, prru_cli_progress *progress, double **w, unsigned char **st);
-/* The summary of a whole grid's w and statuses (PRRU_CLI_MAP_OTHER_MODE
- * counted as singular and on its own): what prru_cli_map_run reports;
- * `prru merge` computes it from the joined shards. PRRU_OK or
- * PRRU_ENOMEM. */
-int prru_cli_map_summarize(const prru_map_grid *g, const double *w, const unsigned char *st,
-                           prru_cli_map_summary *sum);
 /* The number of complete q1 rows of an interrupted map (prru_map_eval
  * hands rows out in order and finishes every row it started). */
 int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
@@ -87,6 +62,6 @@ int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const doubl
                             const unsigned char *st, int r0, int r1, int signal_count);
 /* The summary `prru map` prints: model, point counts, global index,
  * singular fraction, mean ln w_R, range (key: value lines). */
-void prru_cli_map_print_summary(FILE *f, const prru_cli_map_summary *s, double rcond_min);
+void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min);
 
 #endif

@@ -113,7 +113,7 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
   prru_map_grid g = {-FIG7_PI / 6, FIG7_PI / 6, -FIG7_PI / 4, FIG7_PI / 6, 0.0, 201, 201};
   double *w = NULL;
   unsigned char *st = NULL;
-  prru_cli_map_summary csum, csum_numeric;
+  prru_map_summary csum, csum_numeric;
   int rc = fig7_status(prru_cli_map_run("paper", &m, &g, 2, NULL, &w, &st, &csum));
   if (rc == 0) {
     /* The same grid at the numerical tolerance, for the summary only. */
@@ -125,7 +125,7 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
     free(w2);
     free(st2);
   }
-  const prru_map_summary *sum = &csum.s, *sum_numeric = &csum_numeric.s;
+  const prru_map_summary *sum = &csum, *sum_numeric = &csum_numeric;
   char path[4200];
   if (rc == 0) {
     char shown[4200];
@@ -171,7 +171,7 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
       if (st[k] != PRRU_OK)
         fprintf(f, "%.9g %.9g %d\n", prru_map_axis(g.q1_lo, g.q1_hi, g.n1, (int)(k / g.n2)),
                 prru_map_axis(g.q2_lo, g.q2_hi, g.n2, (int)(k % g.n2)),
-                st[k] == PRRU_CLI_MAP_OTHER_MODE);
+                st[k] == PRRU_DME_OTHER_MODE);
     /* gnuplot refuses a selection without points: one of each kind outside
      * the plotted range. */
     fputs("1e3 1e3 0\n1e3 1e3 1\n", f);
@@ -213,12 +213,12 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
       fprintf(s, "  global index (mean of w_R - 1 over the ok points) = %.10g\n", sum->index);
       fprintf(s, "  singular fraction = %.6g (%ld singular, %ld unreachable, %ld in the other assembly "
                  "mode of %ld points)\n",
-              sum->singular_fraction, sum->n_singular - csum.n_other_mode, sum->n_unreachable,
-              csum.n_other_mode, sum->n_points);
+              sum->singular_fraction, sum->n_singular - sum->n_other_mode, sum->n_unreachable,
+              sum->n_other_mode, sum->n_points);
       fprintf(s, "  mean ln w_R = %.10g; w_R from %.6g at (%.4f, %.4f) to %.6g at (%.4f, %.4f)\n",
               sum->index_log, sum->w_min, sum->w_min_q[0], sum->w_min_q[1], sum->w_max,
               sum->w_max_q[0], sum->w_max_q[1]);
-      if (csum.modes_checked)
+      if (prru_map_home_mode(&g) != 0)
         fputs("  other assembly mode: det J_d of the opposite sign to the home pose's, beyond the "
               "singular locus\n", s);
       fprintf(s, "with the numerical tolerance only (rcond < %g): global index = %.10g, not-ok "

@@ -428,7 +428,8 @@ static void test_singular(void)
   }
   TU_TRUE(strcmp(prru_dme_status_name(PRRU_OK), "ok") == 0 &&
               strcmp(prru_dme_status_name(PRRU_ESINGULAR), "singular") == 0 &&
-              strcmp(prru_dme_status_name(PRRU_EUNREACHABLE), "unreachable") == 0,
+              strcmp(prru_dme_status_name(PRRU_EUNREACHABLE), "unreachable") == 0 &&
+              strcmp(prru_dme_status_name(PRRU_DME_OTHER_MODE), "other_mode") == 0,
           "status names");
 }
 
@@ -476,9 +477,14 @@ static void test_map(void)
   TU_TRUE(memcmp(st[0], st[1], n) == 0 && memcmp(st[0], st[2], n) == 0, "and identical statuses");
   TU_TRUE(memcmp(&sum[0], &sum[1], sizeof sum[0]) == 0 && memcmp(&sum[0], &sum[2], sizeof sum[0]) == 0,
           "and identical summaries");
-  /* Every point as prru_dme_eval computes it alone; the summary recounted. */
+  /* Every point as prru_dme_eval computes it alone, a regular one whose
+   * det J_d (this file's det3) has not the home pose's sign being the
+   * other assembly mode; the summary recounted. */
+  double dh[PRRU_NACT], Jh[3 * PRRU_NACT];
+  prru_ik_jd((const double[3]){0.0, 0.0, g.q3}, dh, Jh);
+  const double home_det = PRRU_NACT == 3 ? det3(Jh) : 0.0;
   int same = 1;
-  long n_ok = 0, n_sing = 0, n_unr = 0;
+  long n_ok = 0, n_sing = 0, n_unr = 0, n_oth = 0;
   double acc = 0;
   for (int i = 0; i < g.n1; i++)
     for (int j = 0; j < g.n2; j++) {
@@ -489,6 +495,10 @@ static void test_map(void)
                      g.q3};
       prru_dme r;
       int s = prru_dme_eval(&m3, D, q, &r);
+      if (s == PRRU_OK && home_det != 0.0 && !(det3(D->Jd) * home_det > 0.0)) {
+        s = PRRU_DME_OTHER_MODE;
+        n_oth++;
+      }
       if (s != st[0][k] || (s == PRRU_OK ? fabs(r.w_R - w[0][k]) > 1e-13 * r.w_R : !isnan(w[0][k])))
         same = 0;
       if (s == PRRU_OK) {
@@ -503,8 +513,9 @@ static void test_map(void)
   TU_TRUE(same, "map points equal prru_dme_eval at the same q");
   TU_TRUE(n_ok > 0, "the grid has regular points");
   TU_TRUE(sum[0].n_ok == n_ok && sum[0].n_singular == n_sing && sum[0].n_unreachable == n_unr &&
-              sum[0].n_points == n,
+              sum[0].n_other_mode == n_oth && sum[0].n_points == n,
           "summary counts");
+  TU_TRUE(PRRU_NACT != 3 || n_oth > 0, "the grid reaches into the other assembly mode");
   tu_check(rel(sum[0].index, acc / n_ok) <= 1e-12, "global index = mean of w_R - 1",
            rel(sum[0].index, acc / n_ok), 1e-12);
   tu_check(fabs(sum[0].singular_fraction - (double)(n_sing + n_unr) / n) <= 1e-15,
@@ -512,6 +523,10 @@ static void test_map(void)
   /* Stopping from the progress callback, and bad grids. */
   prru_map_options o;
   prru_map_options_default(&o);
+  prru_map_summary sum_nost;
+  TU_TRUE(prru_map_eval(&m3, &g, &o, w[0], NULL, &sum_nost) == PRRU_OK &&
+              memcmp(&sum_nost, &sum[0], sizeof sum_nost) == 0,
+          "the same summary without statuses");
   prog stop = {0, 0, 0, 1};
   o.progress = on_progress;
   o.ctx = &stop;

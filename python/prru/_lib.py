@@ -67,6 +67,7 @@ class _MapGrid(ctypes.Structure):
 class _MapSummary(ctypes.Structure):
     _fields_ = [("n_points", ctypes.c_long), ("n_ok", ctypes.c_long),
                 ("n_singular", ctypes.c_long), ("n_unreachable", ctypes.c_long),
+                ("n_other_mode", ctypes.c_long),
                 ("index", ctypes.c_double), ("index_log", ctypes.c_double),
                 ("singular_fraction", ctypes.c_double),
                 ("w_min", ctypes.c_double), ("w_max", ctypes.c_double),
@@ -263,6 +264,7 @@ class Library:
         self._check_mechanism()
         self._check_scenario()
         self._check_data_and_dme()
+        self._check_map_summary()
 
     def _check_mechanism(self):
         me = self.mech
@@ -305,6 +307,27 @@ class Library:
         if not guard_intact(g):
             raise self._layout_error("sizeof(prru_scenario)")
         self.scenario_free(ctypes.byref(s))
+
+    def _check_map_summary(self):
+        """A 2 x 2 map's summary in a guarded mirror: its counts add up (a
+        field missing or moved reads a double as a count) and the library
+        writes nothing past the mirror."""
+        g = _MapGrid(-1e-3, 1e-3, -1e-3, 1e-3, 0.0, 2, 2)
+        o = _MapOptions()
+        self.map_options_default(ctypes.byref(o))
+        o.nthreads = 1
+        w, st = (ctypes.c_double * 4)(), (ctypes.c_ubyte * 4)()
+        gs = _guarded(_MapSummary, 4096)()
+        fill_guard(gs)
+        m = self.new_model()
+        if self.map_eval(ctypes.byref(m), ctypes.byref(g), ctypes.byref(o), w, st,
+                         ctypes.byref(gs.s)) != errors.OK:
+            return
+        s = gs.s
+        n_not_ok = s.n_singular + s.n_unreachable
+        if (s.n_points != 4 or s.n_ok + n_not_ok != 4 or not 0 <= s.n_other_mode <= s.n_singular
+                or s.singular_fraction != n_not_ok / 4 or not guard_intact(gs)):
+            raise self._layout_error("prru_map_summary")
 
     def _check_data_and_dme(self):
         """At q = 0 (every valid model assembles there; when J_d happens to

@@ -5,17 +5,23 @@ import ctypes
 
 from . import _convert, _interrupt, _lib, errors
 
+# PRRU_DME_OTHER_MODE (prru_dme.h): a regular pose of the other assembly mode.
+OTHER_MODE = 0xFE
 STATUS_NAMES = {errors.OK: "ok", errors.ESINGULAR: "singular",
-                errors.EUNREACHABLE: "unreachable", errors.EINPUT: "invalid"}
+                errors.EUNREACHABLE: "unreachable", OTHER_MODE: "other_mode",
+                errors.EINPUT: "invalid"}
 
 MapResult = collections.namedtuple("MapResult", "q1 q2 q3 w_R status summary")
 MapResult.__doc__ = """A w_R map: axes q1 (n1 values) and q2 (n2), the height q3;
 w_R[i][j] at (q1[i], q2[j]) (NaN where not ok; a NumPy array (n1, n2) for a
-model with numpy=True); status[i][j] "ok", "singular" or "unreachable";
-summary: a dict with n_points, n_ok, n_singular, n_unreachable, index (mean
-of w_R - 1 over the ok points, the paper's global index), index_log (mean
-of ln w_R), singular_fraction, w_min, w_max and their (q1, q2) w_min_q,
-w_max_q."""
+model with numpy=True); status[i][j] "ok", "singular", "unreachable" or
+"other_mode" (regular, but det J_d has the opposite sign to the home pose's
+(0, 0, q3): beyond the singular locus, out of reach of the robot assembled
+at home; three actuators only); summary: a dict with n_points, n_ok,
+n_singular (counting the other_mode points too), n_unreachable,
+n_other_mode, index (mean of w_R - 1 over the ok points, the paper's global
+index), index_log (mean of ln w_R), singular_fraction, w_min, w_max and
+their (q1, q2) w_min_q, w_max_q."""
 
 
 def _axis(name, value):
@@ -65,8 +71,8 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
     axis2 = [self.lib.map_axis(lo2, hi2, n2, j) for j in range(n2)]
     names = [STATUS_NAMES.get(v, "invalid") for v in st]
     summary = {k: getattr(s, k) for k in ("n_points", "n_ok", "n_singular", "n_unreachable",
-                                          "index", "index_log", "singular_fraction",
-                                          "w_min", "w_max")}
+                                          "n_other_mode", "index", "index_log",
+                                          "singular_fraction", "w_min", "w_max")}
     summary["w_min_q"], summary["w_max_q"] = tuple(s.w_min_q), tuple(s.w_max_q)
     out = self._out
     return MapResult(out.vec(axis1), out.vec(axis2), g.q3, out.mat(w, n1, n2),

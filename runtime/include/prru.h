@@ -112,6 +112,13 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
  * with a candidate design's own L, so both judge regularity alike. */
 int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
                     double Jdpinv[3 * PRRU_NACT], double *rcond);
+/* With three actuators, the sign (+1 or -1) of det J_d, 0 where it is 0;
+ * always 0 with more actuators (J_d has no determinant, and a path meets
+ * a rank deficiency of J_d only by exception). det J_d changes sign only
+ * through det J_d = 0, so two regular poses of opposite signs lie on
+ * either side of the singular locus: the assembly mode (prru_dme.h) and
+ * the crossing test of sampled paths (prru traj, prru track) rest on it. */
+int prru_jd_det_sign(const double Jd[PRRU_NACT * 3]);
 
 /* Actuator displacements (inverse kinematics). */
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT]);

@@ -122,9 +122,10 @@ void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g
 /* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
 int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
 
-/* The status of a regular grid point in the other assembly mode;
- * prru_map_summarize counts it as singular. */
-#define PRRU_DESIGN_OTHER_MODE 0xFE
+/* The status of a regular grid point in the other assembly mode: the
+ * map's (PRRU_DME_OTHER_MODE, classified by prru_mode_status);
+ * prru_map_summarize counts it as singular and in n_other_mode. */
+#define PRRU_DESIGN_OTHER_MODE PRRU_DME_OTHER_MODE
 
 struct prru_design_row;
 
@@ -145,7 +146,7 @@ typedef struct {
   int valid;                 /* prru_design_check passed (otherwise only merit is set) */
   prru_map_summary sum;      /* the map's summary of the grid */
   double objective;          /* the chosen measure; NaN when no point is regular */
-  long n_other_mode;          /* of sum.n_singular: regular, but in the other assembly mode */
+  long n_other_mode;          /* sum.n_other_mode (of sum.n_singular) */
   /* Regularity violation: the mean over the grid points of, with r =
    * rcond_min, C = ln(r / DBL_EPSILON) and s = rcond (home's mode) or
    * -rcond (the other): 0 for s >= r, min(C, ln(r / s)) for 0 < s < r,

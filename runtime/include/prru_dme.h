@@ -91,8 +91,31 @@ typedef struct {
   double Mt[PRRU_NACT * PRRU_NACT], JtR[3 * PRRU_NACT], JtT[3 * PRRU_NACT];
 } prru_dme;
 
-/* "ok", "singular", "unreachable" or "invalid" (PRRU_EINPUT). */
+/* A regular pose of the other assembly mode: det J_d has the opposite sign
+ * to the home pose's. det J_d changes sign only through det J_d = 0, so
+ * such a pose is cut off from home by the singular locus: the robot
+ * assembled at home cannot reach it without crossing a singularity. The
+ * status prru_map_eval gives it (w_R is NaN there, it is not ok); only
+ * with three actuators (a square J_d; with more, J_d has no sign). */
+#define PRRU_DME_OTHER_MODE 0xFE
+
+/* "ok", "singular", "unreachable", "other_mode" (PRRU_DME_OTHER_MODE) or
+ * "invalid" (PRRU_EINPUT and any other code). */
 const char *prru_dme_status_name(int status);
+
+/* The assembly mode of a pose from its slider positions d and J_d: the
+ * sign of det J_d (prru_jd_det_sign), or 0 when it cannot be told (a
+ * slider unreachable, det J_d = 0, more than three actuators); with home
+ * 0 no pose is in "the other" mode. */
+int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3]);
+/* 1 when home != 0 and det J_d's sign is not home (a pose beyond the
+ * singular locus, or on it), else 0. */
+int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home);
+/* A reachable pose's status from its regularity status (prru_jd_regular):
+ * PRRU_DME_OTHER_MODE when it is PRRU_OK but prru_jd_other_mode, else
+ * regular_status. The one classification of the map and the design
+ * optimiser. */
+int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home);
 
 /* Fills out at q (uses d->d, d->Jd, d->M as workspace) and returns
  * out->status. At a non-OK status every double of out except jd_rcond is
@@ -152,6 +175,7 @@ double prru_map_axis(double lo, double hi, int n, int i);
  * the result does not depend on threading. */
 typedef struct {
   long n_points, n_ok, n_singular, n_unreachable;
+  long n_other_mode; /* of n_singular: regular, but in the other assembly mode */
   double index;             /* mean of w_R - 1 over the OK points */
   double index_log;         /* mean of ln w_R over the OK points */
   double singular_fraction;
@@ -175,10 +199,17 @@ void prru_map_options_default(prru_map_options *o);
 /* PRRU_OK, or PRRU_EINPUT when the grid is invalid (see prru_map_grid). */
 int prru_map_check(const prru_map_grid *g);
 
+/* The model's assembly mode at the grid's home pose (0, 0, q3):
+ * prru_assembly_mode there, 0 when not told (no point of the map is then
+ * in the other mode). */
+int prru_map_home_mode(const prru_map_grid *g);
+
 /* Evaluates w_R at every grid point: index k = i n2 + j for (q1_i, q2_j)
- * (q1 outer). w_R[k] is NaN where status[k] != PRRU_OK. Allocates one
- * prru_data per thread (not per point). status may be NULL if not needed;
- * sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
+ * (q1 outer). status[k] is PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESINGULAR or
+ * PRRU_DME_OTHER_MODE (the regular poses whose assembly mode is not
+ * prru_map_home_mode's); w_R[k] is NaN where status[k] != PRRU_OK.
+ * Allocates one batch workspace per thread (not per point). status may be
+ * NULL if not needed; sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
  * PRRU_ENOMEM, or PRRU_EINTERRUPTED (outputs partly filled, sum not set). */
 int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
                   double *w_R, unsigned char *status, prru_map_summary *sum);
@@ -192,7 +223,8 @@ int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_op
 int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begin, int row_end,
                        const prru_map_options *o, double *w_R, unsigned char *status);
 
-/* The summary of an already computed map (used by prru_map_eval). */
+/* The summary of an already computed map (used by prru_map_eval):
+ * PRRU_DME_OTHER_MODE counts in n_singular and in n_other_mode. */
 void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
                         prru_map_summary *sum);
 

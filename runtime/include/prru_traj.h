@@ -106,13 +106,10 @@ void prru_quintic_free(prru_quintic *tr);
  * prru_check_regular's status (PRRU_OK, PRRU_EINPUT, PRRU_EUNREACHABLE,
  * PRRU_ESINGULAR), with *rcond as there. */
 int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], double *rcond);
-/* With three actuators, the sign (+1 or -1) of det J_d, 0 where it is 0;
- * always 0 with more actuators (J_d has no determinant, and a path meets
- * a rank deficiency of J_d only by exception). Samples of a path are
- * regular one by one even where the path crosses the singular set between
- * two of them; two regular samples with opposite signs show that crossing
- * whatever the sampling (prru traj and prru track refuse such a path). */
-int prru_jd_det_sign(const double Jd[PRRU_NACT * 3]);
+/* Samples of a path are regular one by one even where the path crosses
+ * the singular set between two of them; two regular samples with opposite
+ * signs of det J_d (prru_jd_det_sign, prru.h) show that crossing whatever
+ * the sampling (prru traj and prru track refuse such a path). */
 
 #ifdef __cplusplus
 }

@@ -188,6 +188,15 @@ int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
   return rc > 0 && rc >= rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
 
+int prru_jd_det_sign(const double Jd[PRRU_NACT * 3])
+{
+  if (PRRU_NACT != 3) return 0;
+  const double *a = Jd;
+  double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+               a[2] * (a[3] * a[7] - a[4] * a[6]);
+  return det > 0 ? 1 : det < 0 ? -1 : 0;
+}
+
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond)
 {
   if (rcond) *rcond = 0.0;

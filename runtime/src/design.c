@@ -14,7 +14,6 @@
 
 #include "internal.h"
 #include "prru_design.h"
-#include "prru_traj.h" /* prru_jd_det_sign: the assembly mode */
 
 /* ---- Names ---- */
 
@@ -372,7 +371,7 @@ int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msgl
  * the result does not depend on which thread did which row. */
 struct prru_design_row {
   double viol, stroke, dmin, dmax;
-  long nreach, nother;
+  long nreach;
   int changed;
 };
 
@@ -407,18 +406,15 @@ static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_N
   return e;
 }
 
-#define OTHER_MODE PRRU_DESIGN_OTHER_MODE
-
-/* The assembly mode of the design at home, (0, 0, q3): det J_d's sign, or
- * 0 when it cannot be told (then no point is in "the other" mode). */
+/* The assembly mode of the design at home, (0, 0, q3), as
+ * prru_map_home_mode tells the model's (0: no point is in "the other"
+ * mode). */
 static int home_mode(const prru_params *p, double q3)
 {
   const double q[3] = {0.0, 0.0, q3};
   double d[PRRU_NACT], Jd[PRRU_NACT * 3];
   prru_param_ik_jd(p, q, d, Jd);
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (!isfinite(d[i])) return 0;
-  return prru_jd_det_sign(Jd);
+  return prru_assembly_mode(d, Jd);
 }
 
 /* The design's kernels at a block of grid points, from the batched
@@ -460,10 +456,12 @@ static int point_w(const prru_design_problem *pr, const grid_block *b, int c, do
       *viol = cap;
       return PRRU_EUNREACHABLE;
     }
-  int st = prru_jd_regular(Jd, L, r, Jdpinv, &rc);
-  if (home != 0 && prru_jd_det_sign(Jd) != home) {
+  /* The status as the map classifies it; the penalty also for the other
+   * mode's singular points, so that it is continuous across the locus. */
+  int st = prru_mode_status(prru_jd_regular(Jd, L, r, Jdpinv, &rc), Jd, home);
+  if (prru_jd_other_mode(Jd, home)) {
     *viol = cap + log1p(rc / r);
-    return st == PRRU_OK ? OTHER_MODE : st;
+    return st;
   }
   if (st == PRRU_OK) {
     double M[9], JP[18];
@@ -514,7 +512,6 @@ static void grid_row(grid_job *j, int i)
     int st = point_w(pr, &b, c - c0, j->L, j->home, d, &j->dd->w_R[k], &v);
     if (j->compare && (st == PRRU_OK) != (j->dd->status[k] == PRRU_OK)) r->changed = 1;
     j->dd->status[k] = (unsigned char)st;
-    r->nother += st == OTHER_MODE;
     r->viol += v;
     if (st == PRRU_EUNREACHABLE) continue;
     r->nreach++;
@@ -585,11 +582,11 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
     viol += r->viol;
     stroke += r->stroke;
     nreach += r->nreach;
-    ev->n_other_mode += r->nother;
     dmin = fmin(dmin, r->dmin);
     dmax = fmax(dmax, r->dmax);
   }
   prru_map_summarize(g, dd->w_R, dd->status, &ev->sum);
+  ev->n_other_mode = ev->sum.n_other_mode;
   ev->objective = objective_of(pr, &ev->sum);
   ev->reg_violation = viol / (double)dd->n;
   ev->stroke_violation = nreach ? stroke / (double)nreach : 0.0;

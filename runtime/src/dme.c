@@ -11,8 +11,27 @@ const char *prru_dme_status_name(int status)
   case PRRU_OK: return "ok";
   case PRRU_ESINGULAR: return "singular";
   case PRRU_EUNREACHABLE: return "unreachable";
+  case PRRU_DME_OTHER_MODE: return "other_mode";
   default: return "invalid";
   }
+}
+
+int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3])
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!isfinite(d[i])) return 0;
+  return prru_jd_det_sign(Jd);
+}
+
+int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home)
+{
+  return home != 0 && prru_jd_det_sign(Jd) != home;
+}
+
+int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home)
+{
+  return regular_status == PRRU_OK && prru_jd_other_mode(Jd, home) ? PRRU_DME_OTHER_MODE
+                                                                   : regular_status;
 }
 
 /* N = PRRU_NACT: J_d^+ is 3 x N, Mt N x N, JtR and JtT 3 x N. Every sum

@@ -46,6 +46,7 @@ typedef struct {
   pthread_mutex_t lock;
   int next_row, row_end, stop; /* rows next_row .. row_end - 1 are left */
   int row_begin;               /* w[0], st[0] belong to this row's first point */
+  int home;                    /* prru_map_home_mode */
   long done;
 } map_job;
 
@@ -67,8 +68,9 @@ typedef struct {
 
 /* Point c of the block as prru_dme_eval evaluates it: the kernels' part
  * (prru_ik_jd, prru_mass, prru_platform_jacobian) from the batched
- * dme_terms, the checks of prru_check_regular, then prru_dme_from. */
-static int block_point(const prru_model *m, const map_block *b, int n, int c, prru_dme *dme)
+ * dme_terms, the checks of prru_check_regular and the assembly mode, then
+ * prru_dme_from. */
+static int block_point(const prru_model *m, const map_block *b, int n, int c, int home, prru_dme *dme)
 {
   double Jd[3 * PRRU_NACT], Jdpinv[3 * PRRU_NACT], M[9], JP[18];
   for (int i = 0; i < PRRU_NACT; i++)
@@ -79,6 +81,7 @@ static int block_point(const prru_model *m, const map_block *b, int n, int c, pr
   for (int i = 0; i < 3 * PRRU_NACT; i++) Jd[i] = b->Jd[i * n + c];
   double rcond = 0.0;
   int st = prru_jd_regular(Jd, prru_length_scale(m->mech), m->jd_rcond_min, Jdpinv, &rcond);
+  st = prru_mode_status(st, Jd, home);
   if (st != PRRU_OK) {
     dme->w_R = NAN;
     return st;
@@ -101,7 +104,7 @@ static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
   prru_batch_dme_terms(n, b->q, b->d, b->Jd, b->M, b->JP);
   for (int c = 0; c < n; c++) {
     prru_dme dme;
-    int s = block_point(j->m, b, n, c, &dme);
+    int s = block_point(j->m, b, n, c, j->home, &dme);
     long k = (long)(row - j->row_begin) * g->n2 + c0 + c;
     j->w[k] = dme.w_R;
     if (j->st) j->st[k] = (unsigned char)s;
@@ -164,7 +167,8 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   if (row_begin < 0 || row_end > g->n1 || row_begin >= row_end) return PRRU_EINPUT;
   const int nrows = row_end - row_begin;
   int nt = o->nthreads > nrows ? nrows : o->nthreads;
-  map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, row_begin, row_end, 0, row_begin, 0};
+  map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, row_begin, row_end, 0, row_begin,
+                 prru_map_home_mode(g), 0};
   map_worker *workers = calloc((size_t)nt, sizeof *workers);
   pthread_t *tid = calloc((size_t)nt, sizeof *tid);
   int rc = PRRU_OK, started = 0;
@@ -195,24 +199,24 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   return rc;
 }
 
+int prru_map_home_mode(const prru_map_grid *g)
+{
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3];
+  prru_ik_jd((const double[3]){0.0, 0.0, g->q3}, d, Jd);
+  return prru_assembly_mode(d, Jd);
+}
+
 int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
                   double *w_R, unsigned char *status, prru_map_summary *sum)
 {
   if (prru_map_check(g) != PRRU_OK) return PRRU_EINPUT;
-  int rc = prru_map_eval_rows(m, g, 0, g->n1, o, w_R, status);
-  if (rc == PRRU_OK && sum) {
-    if (status) {
-      prru_map_summarize(g, w_R, status, sum);
-    } else {
-      /* Without statuses, NaN stands for "not OK" (counted as singular). */
-      long n = (long)g->n1 * g->n2;
-      unsigned char *tmp = malloc((size_t)n);
-      if (!tmp) return PRRU_ENOMEM;
-      for (long k = 0; k < n; k++) tmp[k] = isnan(w_R[k]) ? PRRU_ESINGULAR : PRRU_OK;
-      prru_map_summarize(g, w_R, tmp, sum);
-      free(tmp);
-    }
-  }
+  /* The summary needs the statuses (NaN alone does not tell the kinds). */
+  unsigned char *st = status;
+  if (!st && sum) st = malloc((size_t)g->n1 * (size_t)g->n2);
+  if (!st && sum) return PRRU_ENOMEM;
+  int rc = prru_map_eval_rows(m, g, 0, g->n1, o, w_R, st);
+  if (rc == PRRU_OK && sum) prru_map_summarize(g, w_R, st, sum);
+  if (st != status) free(st);
   return rc;
 }
 
@@ -222,7 +226,7 @@ void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigne
   long n = (long)g->n1 * g->n2;
   double acc = 0.0, acc_log = 0.0;
   sum->n_points = n;
-  sum->n_ok = sum->n_singular = sum->n_unreachable = 0;
+  sum->n_ok = sum->n_singular = sum->n_unreachable = sum->n_other_mode = 0;
   sum->w_min = sum->w_max = NAN;
   sum->w_min_q[0] = sum->w_min_q[1] = sum->w_max_q[0] = sum->w_max_q[1] = NAN;
   for (long k = 0; k < n; k++) {
@@ -245,6 +249,7 @@ void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigne
     } else if (status[k] == PRRU_EUNREACHABLE) {
       sum->n_unreachable++;
     } else {
+      sum->n_other_mode += status[k] == PRRU_DME_OTHER_MODE;
       sum->n_singular++;
     }
   }

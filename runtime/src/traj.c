@@ -301,12 +301,3 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
 {
   return prru_check_regular(m, d, q, rcond);
 }
-
-int prru_jd_det_sign(const double Jd[PRRU_NACT * 3])
-{
-  if (PRRU_NACT != 3) return 0;
-  const double *a = Jd;
-  double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-               a[2] * (a[3] * a[7] - a[4] * a[6]);
-  return det > 0 ? 1 : det < 0 ? -1 : 0;
-}
