@@ -266,6 +266,27 @@ class TestAgainstCli(unittest.TestCase):
         self.assertEqual("%.10g" % r.summary["index"], "%.10g" % index)
         self.assertEqual(r.summary["n_points"], 20)
 
+    def test_map_other_mode(self):
+        # A grid reaching past the singular locus: the binding's statuses
+        # and counts are the CLI's, other_mode included (three actuators;
+        # with four J_d has no sign and no point is other_mode).
+        args = ("--q1", "-1:1:13", "--q2", "-1:1:11", "--q3", "0.05", "--rcond-min", "4e-3")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "map.csv")
+            text = cli("map", *args, "--out", path)
+            lines = [l for l in read(path).splitlines() if not l.startswith("#")]
+        statuses = [l.split(",")[4] for l in lines[1:]]
+        r = MODEL.map((-1, 1, 13), (-1, 1, 11), 0.05, jd_rcond_min=4e-3)
+        self.assertEqual([s for row in r.status for s in row], statuses)
+        s = r.summary
+        n_other = statuses.count("other_mode")
+        self.assertEqual(s["n_other_mode"], n_other)
+        self.assertEqual(n_other > 0, MODEL.nact == 3)
+        counts = re.search(r"ok (\d+), singular (\d+), unreachable (\d+), other assembly mode (\d+)",
+                           text).groups()
+        self.assertEqual([int(c) for c in counts],
+                         [s["n_ok"], s["n_singular"] - n_other, s["n_unreachable"], n_other])
+
 
 class TestRoundTrips(unittest.TestCase):
     def test_fk_of_ik(self):
