@@ -226,14 +226,7 @@ static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier 
     prru_fourier_eval(f, t, q, qd, qdd);
     st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
     if (st != PRRU_OK) break;
-    prru_cli_out_printf(o, "%.17g", t);
-    prru_cli_out_numbers(o, q, 3);
-    prru_cli_out_numbers(o, qd, 3);
-    prru_cli_out_numbers(o, qdd, 3);
-    prru_cli_out_numbers(o, d->d, PRRU_NACT);
-    prru_cli_out_numbers(o, fd, PRRU_NACT);
-    prru_cli_out_printf(o, "\n");
-    prru_cli_out_row(o);
+    prru_cli_out_motion_row(o, t, q, qd, qdd, d->d, fd);
   }
   free(d);
   return st;

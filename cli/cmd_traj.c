@@ -183,14 +183,7 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     if (s) sign = s;
     t_prev = t;
     prru_actuator_rates(q, qd, dd, ddb);
-    prru_cli_out_printf(o, "%.17g", t);
-    prru_cli_out_numbers(o, q, 3);
-    prru_cli_out_numbers(o, qd, 3);
-    prru_cli_out_numbers(o, qdd, 3);
-    prru_cli_out_numbers(o, d->d, PRRU_NACT);
-    prru_cli_out_numbers(o, dd, PRRU_NACT);
-    prru_cli_out_printf(o, "\n");
-    prru_cli_out_row(o);
+    prru_cli_out_motion_row(o, t, q, qd, qdd, d->d, dd);
   }
   free(d);
   return st;

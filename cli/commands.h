@@ -159,6 +159,11 @@ int prru_cli_out_line(prru_cli_out *o);
 /* Ends a data row (counted in rows); flushes at 64 kB or 0.2 s after the
  * last flush. 0 or -1 after a write error. */
 int prru_cli_out_row(prru_cli_out *o);
+/* A data row of a motion CSV (cli/util.c): t, q, qd, qdd (3 numbers
+ * each), d and v (PRRU_NACT each: the actuators' positions and a quantity
+ * per actuator, their forces or rates); prru_cli_out_row's result. */
+int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const double qd[3],
+                            const double qdd[3], const double d[PRRU_NACT], const double v[PRRU_NACT]);
 int prru_cli_out_flush(prru_cli_out *o);
 /* The model comment line, as prru_cli_csv_comment. */
 void prru_cli_out_comment(prru_cli_out *o);

@@ -278,3 +278,16 @@ void prru_cli_json_matrix(FILE *f, const double *v, int rows, int cols)
   }
   fputc(']', f);
 }
+
+int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const double qd[3],
+                            const double qdd[3], const double d[PRRU_NACT], const double v[PRRU_NACT])
+{
+  prru_cli_out_printf(o, "%.17g", t);
+  prru_cli_out_numbers(o, q, 3);
+  prru_cli_out_numbers(o, qd, 3);
+  prru_cli_out_numbers(o, qdd, 3);
+  prru_cli_out_numbers(o, d, PRRU_NACT);
+  prru_cli_out_numbers(o, v, PRRU_NACT);
+  prru_cli_out_printf(o, "\n");
+  return prru_cli_out_row(o);
+}
