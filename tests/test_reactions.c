@@ -22,15 +22,6 @@
 static prru_model model;
 static prru_data data;
 
-static void random_loads(prru_loads *l)
-{
-  for (int i = 0; i < NA; i++) l->fd[i] = tu_uniform(-80, 80);
-  for (int i = 0; i < 3; i++) {
-    l->fp[i] = tu_uniform(-40, 40);
-    l->mp[i] = tu_uniform(-4, 4);
-  }
-}
-
 #if PRRU_NREACTION_NULL == 1
 static double dot(const double *a, const double *b, int n)
 {
@@ -59,7 +50,7 @@ static void test_against_reference(void)
     prru_loads l;
     ts_random_state(&model, &data, q, qd);
     for (int i = 0; i < 3; i++) qd[i] *= 2.0;
-    random_loads(&l);
+    ts_random_loads(&l);
     if (prru_reactions(&model, &data, q, qd, &l, lam) != PRRU_OK ||
         prru_ref_reactions(&rp, w, q, qd, l.fd, l.fp, l.mp, ref) != 0) {
       ok = 0;
@@ -122,7 +113,7 @@ static void test_grid(void)
         if (prru_check_regular(&model, &data, q, NULL) != PRRU_OK) continue;
         regular++;
         prru_loads l;
-        random_loads(&l);
+        ts_random_loads(&l);
         if (prru_reactions(&model, &data, q, qd, &l, lam) != PRRU_OK) continue;
         if (prru_ref_reactions(&rp, w, q, qd, l.fd, l.fp, l.mp, ref) != 0) continue;
         solved++;

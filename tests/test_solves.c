@@ -23,15 +23,6 @@
 static prru_model model;
 static prru_data data;
 
-static void random_loads(prru_loads *l)
-{
-  for (int i = 0; i < NA; i++) l->fd[i] = tu_uniform(-80, 80);
-  for (int i = 0; i < 3; i++) {
-    l->fp[i] = tu_uniform(-40, 40);
-    l->mp[i] = tu_uniform(-4, 4);
-  }
-}
-
 /* x with A x = b for a 3x3 A, by GSL's LU with partial pivoting. */
 static void lu_solve3(const double A[9], const double b[3], double x[3])
 {
@@ -76,7 +67,7 @@ static void test_forward(void)
     prru_loads l;
     ts_random_state(&model, &data, q, qd);
     for (int i = 0; i < 3; i++) qd[i] *= 2.0;
-    random_loads(&l);
+    ts_random_loads(&l);
     ok &= prru_forward_dynamics(&model, &data, q, qd, &l, qdd) == PRRU_OK;
     prru_eom(q, qd, l.fd, l.fp, l.mp, M, b);
     lu_solve3(M, b, ref);
@@ -99,7 +90,7 @@ static void test_inverse(void)
     double q[3], qd[3], qdd[3], fd[NA], ref[NA], M[9], b[3], Jd[3 * NA], tau[3];
     prru_loads l;
     ts_random_state(&model, &data, q, qd);
-    random_loads(&l);
+    ts_random_loads(&l);
     for (int i = 0; i < 3; i++) qdd[i] = tu_uniform(-20, 20);
     ok &= prru_inverse_dynamics(&model, &data, q, qd, qdd, &l, fd) == PRRU_OK;
     double dd[NA], jd[3 * NA], jp[3 * NA];

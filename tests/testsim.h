@@ -23,6 +23,18 @@ static inline void ts_random_state(const prru_model *m, prru_data *d, double q[3
   for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
 }
 
+/* Random loads: actuator forces in [-80, 80] N, platform force in
+ * [-40, 40] N and moment in [-4, 4] N m per component (the rest of l as
+ * it was). */
+static inline void ts_random_loads(prru_loads *l)
+{
+  for (int i = 0; i < PRRU_NACT; i++) l->fd[i] = tu_uniform(-80, 80);
+  for (int i = 0; i < 3; i++) {
+    l->fp[i] = tu_uniform(-40, 40);
+    l->mp[i] = tu_uniform(-4, 4);
+  }
+}
+
 typedef struct {
   prru_sample first, last;
   long n;
