@@ -11,9 +11,9 @@
 #include <unistd.h>
 
 #include "commands.h"
-#include "design_cli.h"
 #include "mapgrid.h"
 #include "plot.h"
+#include "shard.h"
 #include "prru.h"
 #include "prru_design.h"
 #include "prru_dme.h"
@@ -147,30 +147,6 @@ static const char *objective_text(prru_objective o)
                                                                     : "mean of w_R - 1";
 }
 
-/* "K/N" with 1 <= K <= N <= 100000; 0 or 2. */
-int prru_cli_parse_shard(const char *cmd, const char *text, int *k, int *n)
-{
-  char *end;
-  long a = strtol(text, &end, 10);
-  if (end == text || *end != '/') goto bad;
-  const char *s = end + 1;
-  long b = strtol(s, &end, 10);
-  if (end == s || *end || a < 1 || b < 1 || a > b || b > 100000) goto bad;
-  *k = (int)a;
-  *n = (int)b;
-  return 0;
-bad:
-  prru_cli_error(cmd, "--shard '%s': expected K/N with 1 <= K <= N (e.g. 3/8: the third of 8)", text);
-  return 2;
-}
-
-/* Items [begin, end) of count for shard k of n: contiguous, in order. */
-static void shard_range(long count, int k, int n, long *begin, long *end)
-{
-  *begin = count * (k - 1) / n;
-  *end = count * k / n;
-}
-
 /* One map row as prru map writes it. */
 static void map_row(prru_cli_out *o, double q1, double q2, double q3, double w, int st)
 {
@@ -179,46 +155,6 @@ static void map_row(prru_cli_out *o, double q1, double q2, double q3, double w, 
   else
     prru_cli_out_printf(o, "%.17g,%.17g,%.17g,NaN,%s\n", q1, q2, q3,
                         prru_dme_status_name(st));
-}
-
-/* ---- Map shards ---- */
-
-int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads, int k, int n,
-                       const char *out)
-{
-  long r0, r1;
-  shard_range(g->n1, k, n, &r0, &r1);
-  prru_cli_catch_signals();
-  prru_cli_out o;
-  if (prru_cli_out_open(&o, "map", out)) return 1;
-  double *w = NULL;
-  unsigned char *st = NULL;
-  /* More shards than rows leaves some empty: they still write their
-   * header, so that every task of a job array succeeds alike. */
-  int rc = r0 < r1 ? prru_cli_map_run_rows("map", m, g, (int)r0, (int)r1, nthreads, NULL, &w, &st) : PRRU_OK;
-  if (rc == PRRU_OK) {
-    prru_cli_out_comment(&o);
-    prru_cli_out_printf(&o, "# shard %d/%d map q1=%.17g:%.17g:%d q2=%.17g:%.17g:%d q3=%.17g rcond_min=%.17g\n",
-                        k, n, g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3, m->jd_rcond_min);
-    prru_cli_out_line(&o);
-    prru_cli_out_printf(&o, "q1,q2,q3,w_R,status\n");
-    prru_cli_out_line(&o);
-    rc = prru_cli_map_write_rows(&o, g, w, st, (int)r0, (int)r1, prru_cli_signal_count);
-  }
-  free(w);
-  free(st);
-  /* A shard is merged whole or not at all: an interrupted one is dropped. */
-  if (prru_cli_out_close(&o, rc == PRRU_OK && !o.err)) return 1;
-  if (rc == PRRU_EINTERRUPTED) {
-    prru_cli_error("map", "interrupted (%s): %s is not changed", prru_cli_signal_name(), out);
-    return prru_cli_exit_interrupted();
-  }
-  if (rc != PRRU_OK) return 1;
-  /* The summary needs every shard: 'prru merge' prints it. */
-  FILE *f = strcmp(out, "-") == 0 ? stderr : stdout;
-  fprintf(f, "model: %s\nshard %d/%d: q1 rows %ld to %ld of %d written to %s (no summary: see prru merge)\n",
-          prru_cli_model_id(), k, n, r0 + 1, r1, g->n1, out);
-  return 0;
 }
 
 /* ---- Sensitivity rows (shared by sensitivity and merge) ---- */
@@ -452,7 +388,7 @@ int prru_cmd_sensitivity(int argc, char **argv)
   snprintf(extra, sizeof extra, "step=%.17g params=%d base=%.17g", h, pl.nparam, ev.objective);
   problem_line(settings, sizeof settings, &pr, extra);
   long b0 = 0, b1 = 0;
-  shard_range(pl.nparam, k, n, &b0, &b1);
+  prru_cli_shard_range(pl.nparam, k, n, &b0, &b1);
   for (long i = b0; i < b1 && !rc; i++) {
     if (prru_cli_interrupted) {
       rc = prru_cli_exit_interrupted();
@@ -620,7 +556,7 @@ static int merge_map(shard_file *sh, char **paths, int n, const char *out)
   int rc = w && st ? 0 : 1;
   for (int i = 0; i < n && !rc; i++) {
     long r0, r1;
-    shard_range(g.n1, sh[i].k, n, &r0, &r1);
+    prru_cli_shard_range(g.n1, sh[i].k, n, &r0, &r1);
     rc = parse_map_rows(paths[i], sh[i].rows, &g, r0 * g.n2, (r1 - r0) * g.n2, w, st);
   }
   prru_map_summary sum;
@@ -674,7 +610,7 @@ static int merge_sensitivity(shard_file *sh, char **paths, int n, const char *ou
   int rc = 0;
   for (int i = 0; i < n && !rc; i++) {
     long b0, b1, got = 0;
-    shard_range(np, sh[i].k, n, &b0, &b1);
+    prru_cli_shard_range(np, sh[i].k, n, &b0, &b1);
     rc = parse_sens_rows(paths[i], sh[i].rows, rows + b0, b1 - b0, &got);
     if (!rc && got != b1 - b0) {
       prru_cli_error("merge", "%s: %ld rows, the shard has %ld (incomplete file)", paths[i], got, b1 - b0);

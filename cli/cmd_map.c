@@ -4,11 +4,11 @@
 #include <string.h>
 
 #include "commands.h"
-#include "design_cli.h"
 #include "mapgrid.h"
 #include "progress.h"
 #include "prru.h"
 #include "prru_dme.h"
+#include "shard.h"
 
 static const char map_help[] =
     "usage: prru map --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"

@@ -34,6 +34,9 @@ int prru_cmd_plot(int argc, char **argv);
 int prru_cmd_animate(int argc, char **argv);
 int prru_cmd_traj(int argc, char **argv);
 int prru_cmd_track(int argc, char **argv);
+int prru_cmd_optimize(int argc, char **argv);
+int prru_cmd_sensitivity(int argc, char **argv);
+int prru_cmd_merge(int argc, char **argv);
 
 /* Shared helpers (cli/util.c). */
 /* `prru --version`: program version and the model's name, file, format,

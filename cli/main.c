@@ -3,7 +3,6 @@
 #include <string.h>
 
 #include "commands.h"
-#include "design_cli.h"
 #include "prru.h"
 
 static const struct {
