@@ -130,8 +130,6 @@ class Types:
         self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [
             ("d", _arr(d, nact)), ("Jd", _arr(d, nact * 3)), ("Jdpinv", _arr(d, 3 * nact)),
             ("M", _arr(d, 9)), ("b", _arr(d, 3)), ("qdd", _arr(d, 3)),
-            ("Q", _arr(d, nh * nlambda)), ("K", _arr(d, nh)),
-            ("A", _arr(d, nlambda * nlambda)), ("P", _arr(d, nlambda * nlambda)),
             ("r", _arr(d, nlambda)), ("lambda_null", _arr(d, nlambda))]})
         self.Schedule = type("prru_load_schedule", (ctypes.Structure,), {"_fields_": [
             ("kind", ctypes.c_int), ("base", self.Loads), ("amp", d), ("omega", d),

@@ -85,13 +85,6 @@ typedef struct {
   double Jdpinv[3 * PRRU_NACT];
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
-  /* Q, K, A, P: no call writes them since the reactions are computed in
-   * closed form; kept so that the layout the Python binding mirrors
-   * (python/prru/_lib.py) stays as it is, until both drop them. */
-  double Q[PRRU_NH * PRRU_NLAMBDA]; /* reaction basis */
-  double K[PRRU_NH];              /* wrench bias */
-  double A[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* Q^T Phi^-1 Q */
-  double P[PRRU_NLAMBDA * PRRU_NLAMBDA]; /* its factor, arrowhead order */
   double r[PRRU_NLAMBDA];         /* the last prru_reactions' lambda */
   /* The unit null vector z of Q at the last prru_reactions (see
    * prru_reaction_null); all 0 when PRRU_NREACTION_NULL = 0. */
@@ -181,8 +174,7 @@ int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
  * state's qdd, which it solves for first and leaves in d->qdd; lambda is
  * also left in d->r. The sliders receive the actuator forces net of the
  * drives' armature, damping and friction (model format 2). Computed by the
- * generated closed form prru_joint_reactions (no linear solve; d->Q, d->K,
- * d->A and d->P are not written).
+ * generated closed form prru_joint_reactions (no linear solve).
  * With PRRU_NREACTION_NULL = 1 (the 4-PRRU) Q^T Phi^-1 Q is singular: every
  * lambda + s z (z: prru_reaction_null) satisfies the equations of motion
  * equally well, and the reactions reported are the solution of least
