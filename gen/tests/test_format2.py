@@ -25,6 +25,7 @@ PAPER = os.path.join(ROOT, "models", "3prru_paper.json")
 PROTO = os.path.join(ROOT, "models", "prototype_example.json")
 
 import prru_gen  # noqa: E402  (gen/ is on the path: tests run from gen/)
+from tests.test_generator import OUTPUT_FILES  # noqa: E402
 
 
 def _load_json(path):
@@ -282,12 +283,7 @@ class Determinism(unittest.TestCase):
 
     def test_prefix_option(self):
         files, _ = prru_gen.generate(PROTO, prefix="prru")
-        self.assertEqual(sorted(files), ["prru_kernels.c", "prru_kernels.h",
-                                         "prru_mechanism.c", "prru_mechanism.h",
-                                         "prru_param_kernels.c",
-                                         "prru_param_kernels.h",
-                                         "prru_regressor.c",
-                                         "prru_regressor.h"])
+        self.assertEqual(sorted(files), OUTPUT_FILES)
         self.assertIn('/* .name = */ "proto"', files["prru_mechanism.c"])
         own, _ = prru_gen.generate(PROTO)
         self.assertIn("void proto_dynamics(", own["proto_kernels.c"])

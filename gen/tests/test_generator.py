@@ -16,6 +16,10 @@ GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROOT = os.path.dirname(GEN_DIR)
 MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
 ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
+# Every file one generation writes (prefix prru), in sorted order.
+OUTPUT_FILES = ["prru_kernels.c", "prru_kernels.h", "prru_mechanism.c",
+                "prru_mechanism.h", "prru_param_kernels.c",
+                "prru_param_kernels.h", "prru_regressor.c", "prru_regressor.h"]
 
 
 def read_dir(d):
@@ -122,13 +126,7 @@ class CommandLine(unittest.TestCase):
                 self.assertEqual(r.returncode, 0, r.stderr)
                 outs.append(read_dir(d))
         self.assertEqual(outs[0], outs[1])
-        self.assertEqual(sorted(outs[0]), ["prru_kernels.c", "prru_kernels.h",
-                                           "prru_mechanism.c",
-                                           "prru_mechanism.h",
-                                           "prru_param_kernels.c",
-                                           "prru_param_kernels.h",
-                                           "prru_regressor.c",
-                                           "prru_regressor.h"])
+        self.assertEqual(sorted(outs[0]), OUTPUT_FILES)
 
     def test_help_and_summary(self):
         r = run_gen("--help")

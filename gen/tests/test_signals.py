@@ -14,7 +14,7 @@ import unittest
 from unittest import mock
 
 from prrugen import output
-from tests.test_generator import ENTRY, MODEL as PAPER, read_dir as listing
+from tests.test_generator import ENTRY, MODEL as PAPER, OUTPUT_FILES, read_dir as listing
 
 
 class AtomicWrites(unittest.TestCase):
@@ -61,11 +61,6 @@ class AtomicWrites(unittest.TestCase):
         self.assertEqual(listing(self.dir), {"a.c": b"new a", "b.h": b"new b"})
 
 
-WHOLE_SET = ["prru_kernels.c", "prru_kernels.h", "prru_mechanism.c",
-             "prru_mechanism.h", "prru_param_kernels.c",
-             "prru_param_kernels.h"]
-
-
 class KilledGenerator(unittest.TestCase):
     def test_sigterm_at_any_time_leaves_old_or_new_and_no_temp_file(self):
         with tempfile.TemporaryDirectory() as d:
@@ -86,7 +81,7 @@ class KilledGenerator(unittest.TestCase):
                 self.assertFalse([n for n in files if n.startswith(".")],
                                  "temporary file left: %s" % sorted(files))
                 # Whatever the moment: the old set, or the whole new one.
-                whole = sorted(files) == WHOLE_SET and all(
+                whole = sorted(files) == OUTPUT_FILES and all(
                     v.startswith(b"/* GENERATED FILE") for v in files.values())
                 self.assertTrue(files == old or whole, sorted(files))
                 if proc.returncode == 128 + signal.SIGTERM:
