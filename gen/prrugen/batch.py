@@ -20,7 +20,7 @@ portable C99 that compiles to a plain scalar loop anywhere.
 """
 
 from . import cgen
-from .cgen import ARITH, PREC, Graph, Node, _Names, _uses
+from .cgen import PREC, Node
 
 BATCH_CHUNK = 32
 
@@ -72,26 +72,9 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     trig_name = (lambda fn: fn) if kernel.name in EXACT else \
         (lambda fn: vector_trig % fn.upper())
     params = kernel.params
-    names = _Names(params)
-    for arr, syms in kernel.inputs:
-        for i, s in enumerate(syms):
-            names[s] = "%s%d" % (arr, i + 1)
-    g = Graph(names)
-    guard_nodes = [g.lower(x) for x in kernel.guards]
-    finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
-        if guard_nodes else []
-    out_nodes = [(arr, [g.lower(x) for x in exprs])
-                 for arr, exprs in kernel.outputs]
-    roots = guard_nodes + finite_nodes + [n for _, ns in out_nodes for n in ns]
-    uses, live = _uses(roots)
-    counts = {}
-    for i in sorted(live):
-        n = g.nodes[i]
-        if n.op in ARITH:
-            counts[n.op] = counts.get(n.op, 0) + 1
-        elif n.op == "call":
-            key = "call:" + n.args[0]
-            counts[key] = counts.get(key, 0) + 1
+    low = cgen.Lowered(kernel)
+    names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
+    guard_nodes, finite_nodes, out_nodes = low.guard_nodes, low.finite_nodes, low.out_nodes
 
     def materialized(n):
         return n.op not in ("num", "in") and \

@@ -221,34 +221,45 @@ class Emitted:
         return text
 
 
+class Lowered:
+    """A kernel lowered to one graph: its guard, finiteness and output
+    nodes, how often each node is used, the live nodes and the operation
+    counts (what the scalar and the batched emitters share)."""
+
+    def __init__(self, kernel):
+        self.names = names = _Names(kernel.params)
+        for arr, syms in kernel.inputs:
+            for i, s in enumerate(syms):
+                names[s] = "%s%d" % (arr, i + 1)
+        self.graph = g = Graph(names)
+        self.guard_nodes = [g.lower(x) for x in kernel.guards]
+        # With guards, q itself must be finite too (q3 appears in no guard).
+        self.finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
+            if self.guard_nodes else []
+        self.out_nodes = [(arr, [g.lower(x) for x in exprs])
+                          for arr, exprs in kernel.outputs]
+        roots = self.guard_nodes + self.finite_nodes + \
+            [n for _, ns in self.out_nodes for n in ns]
+        self.uses, self.live = _uses(roots)
+        self.counts = counts = {}
+        for i in sorted(self.live):
+            n = g.nodes[i]
+            if n.op in ARITH:
+                counts[n.op] = counts.get(n.op, 0) + 1
+            elif n.op == "call":
+                key = "call:" + n.args[0]
+                counts[key] = counts.get(key, 0) + 1
+
+
 def emit(kernel, prefix):
     params = kernel.params
-    names = _Names(params)
-    for arr, syms in kernel.inputs:
-        for i, s in enumerate(syms):
-            names[s] = "%s%d" % (arr, i + 1)
-    g = Graph(names)
-    guard_nodes = [g.lower(x) for x in kernel.guards]
-    # With guards, q itself must be finite too (q3 appears in no guard).
-    finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
-        if guard_nodes else []
-    out_nodes = [(arr, [g.lower(x) for x in exprs])
-                 for arr, exprs in kernel.outputs]
-    roots = guard_nodes + finite_nodes + [n for _, ns in out_nodes for n in ns]
-    uses, live = _uses(roots)
+    low = Lowered(kernel)
+    names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
+    guard_nodes, finite_nodes, out_nodes = low.guard_nodes, low.finite_nodes, low.out_nodes
 
     def materialized(n):
         return n.op not in ("num", "in") and \
             (uses.get(n.index, 0) > 1 or n.op == "call")
-
-    counts = {}
-    for i in sorted(live):
-        n = g.nodes[i]
-        if n.op in ARITH:
-            counts[n.op] = counts.get(n.op, 0) + 1
-        elif n.op == "call":
-            key = "call:" + n.args[0]
-            counts[key] = counts.get(key, 0) + 1
 
     temp = {}
 
