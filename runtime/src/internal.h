@@ -27,4 +27,27 @@ double prru_length_scale(const prru_mechanism *me);
 /* Turns GSL's abort-on-error handler off, once per process: every runtime
  * call checks GSL's status codes itself. Thread-safe. */
 void prru_gsl_init(void);
+/* Poses per pass of prru_dme_batch's stages: its workspace (about 16 kB
+ * with three actuators) stays in the first-level cache. */
+#define PRRU_DME_BATCH_CHUNK 32
+typedef struct {
+  double inv[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], tmp[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+      JtR[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], JtT[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+      Mt[PRRU_NACT * PRRU_NACT][PRRU_DME_BATCH_CHUNK], c0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+      c1[PRRU_NACT][PRRU_DME_BATCH_CHUNK], g0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+      g1[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
+  double pre[PRRU_DME_BATCH_CHUNK], rcond[PRRU_DME_BATCH_CHUNK], other[PRRU_DME_BATCH_CHUNK],
+      ok[PRRU_DME_BATCH_CHUNK], w[PRRU_DME_BATCH_CHUNK];
+} prru_dme_batch_ws;
+/* w_R and the status of n poses from their kernel outputs in SoA layout
+ * (entry i of pose k at [i * n + k], as prru_batch_dme_terms gives d, J_d,
+ * M and [J_R,P; J_T,P]): at every pose bit for bit what prru_jd_regular
+ * (length scale L, tolerance rcond_min), prru_mode_status (home) and
+ * prru_dme_from give, w_R NaN where the status is not PRRU_OK (unreachable
+ * where a slider is not finite). rcond (prru_jd_regular's, 0 where
+ * unreachable) and other (prru_jd_other_mode at a reachable pose) may be
+ * NULL. No allocation: ws is scratch. */
+void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, const double *JP,
+                    double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
+                    unsigned char *status, double *rcond, unsigned char *other);
 #endif

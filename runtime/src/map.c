@@ -47,6 +47,7 @@ typedef struct {
   int next_row, row_end, stop; /* rows next_row .. row_end - 1 are left */
   int row_begin;               /* w[0], st[0] belong to this row's first point */
   int home;                    /* prru_map_home_mode */
+  double L;                    /* prru_length_scale */
   long done;
 } map_job;
 
@@ -54,10 +55,13 @@ typedef struct {
  * doubles a point with three actuators) stay in the first-level cache. */
 #define MAP_BLOCK 128
 
-/* A worker's batch: q and the batched kernel's outputs, rows of MAP_BLOCK. */
+/* A worker's batch: q and the batched kernel's outputs, rows of MAP_BLOCK;
+ * prru_dme_batch's scratch and the statuses when the caller wants none. */
 typedef struct {
   double q[3 * MAP_BLOCK], d[PRRU_NACT * MAP_BLOCK], Jd[3 * PRRU_NACT * MAP_BLOCK],
       M[9 * MAP_BLOCK], JP[18 * MAP_BLOCK];
+  unsigned char st[MAP_BLOCK];
+  prru_dme_batch_ws ws;
 } map_block;
 
 typedef struct {
@@ -66,32 +70,11 @@ typedef struct {
   int is_caller;
 } map_worker;
 
-/* Point c of the block as prru_dme_eval evaluates it: the kernels' part
- * (prru_ik_jd, prru_mass, prru_platform_jacobian) from the batched
- * dme_terms, the checks of prru_check_regular and the assembly mode, then
- * prru_dme_from. */
-static int block_point(const prru_model *m, const map_block *b, int n, int c, int home, prru_dme *dme)
-{
-  double Jd[3 * PRRU_NACT], Jdpinv[3 * PRRU_NACT], M[9], JP[18];
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (!isfinite(b->d[i * n + c])) {
-      dme->w_R = NAN;
-      return PRRU_EUNREACHABLE;
-    }
-  for (int i = 0; i < 3 * PRRU_NACT; i++) Jd[i] = b->Jd[i * n + c];
-  double rcond = 0.0;
-  int st = prru_jd_regular(Jd, prru_length_scale(m->mech), m->jd_rcond_min, Jdpinv, &rcond);
-  st = prru_mode_status(st, Jd, home);
-  if (st != PRRU_OK) {
-    dme->w_R = NAN;
-    return st;
-  }
-  for (int i = 0; i < 9; i++) M[i] = b->M[i * n + c];
-  for (int i = 0; i < 18; i++) JP[i] = b->JP[i * n + c];
-  return prru_dme_from(M, Jdpinv, JP, dme);
-}
-
-/* Row `row` of the grid, points c0 .. c0 + n - 1 (n <= MAP_BLOCK). */
+/* Row `row` of the grid, points c0 .. c0 + n - 1 (n <= MAP_BLOCK), each as
+ * prru_dme_eval evaluates it and classified by prru_mode_status: the
+ * kernels' part (prru_ik_jd, prru_mass, prru_platform_jacobian) from the
+ * batched dme_terms, the rest from prru_dme_batch, both bit for bit the
+ * scalar path. */
 static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
 {
   const prru_map_grid *g = j->g;
@@ -102,13 +85,9 @@ static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
     b->q[2 * n + c] = g->q3;
   }
   prru_batch_dme_terms(n, b->q, b->d, b->Jd, b->M, b->JP);
-  for (int c = 0; c < n; c++) {
-    prru_dme dme;
-    int s = block_point(j->m, b, n, c, j->home, &dme);
-    long k = (long)(row - j->row_begin) * g->n2 + c0 + c;
-    j->w[k] = dme.w_R;
-    if (j->st) j->st[k] = (unsigned char)s;
-  }
+  const long k = (long)(row - j->row_begin) * g->n2 + c0;
+  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, j->w + k,
+                 j->st ? j->st + k : b->st, NULL, NULL);
 }
 
 /* The next row to do, or -1 when there is none or the map was stopped. */
@@ -168,7 +147,7 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   const int nrows = row_end - row_begin;
   int nt = o->nthreads > nrows ? nrows : o->nthreads;
   map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, row_begin, row_end, 0, row_begin,
-                 prru_map_home_mode(g), 0};
+                 prru_map_home_mode(g), prru_length_scale(m->mech), 0};
   map_worker *workers = calloc((size_t)nt, sizeof *workers);
   pthread_t *tid = calloc((size_t)nt, sizeof *tid);
   int rc = PRRU_OK, started = 0;

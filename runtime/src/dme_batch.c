@@ -1,0 +1,327 @@
+/* w_R and the map's status over a block of poses, in structure-of-arrays
+ * layout, bit for bit what the scalar path gives pose by pose:
+ * prru_jd_regular (prru_rcond3's arithmetic with three actuators),
+ * prru_mode_status and prru_dme_from. Every IEEE operation is the scalar
+ * code's, in its order; its branches (pivots, early failures) are selects,
+ * so each stage is a loop over the poses that the build may vectorise
+ * (PRRU_BATCH_LOOP, PRRU_BATCH_TARGETS: the batched kernels' options,
+ * which never contract to FMA or reassociate). Lanes that fail early run
+ * on through the later stages on meaningless numbers (no traps: the
+ * results are discarded by the status). Only what w_R and the status need
+ * is computed: no directions, semi-axes or dir_T.
+ *
+ * Locals of a loop marked omp simd must not have their address taken
+ * (GCC turns them into per-lane arrays it does not vectorise), so the
+ * stages keep per-lane values in scalars or in the workspace's rows, and
+ * small loops over matrix entries are unrolled inside the loop over
+ * poses. */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "internal.h"
+#include "prru_dme.h"
+
+#ifndef PRRU_BATCH_LOOP
+#define PRRU_BATCH_LOOP
+#endif
+#ifndef PRRU_BATCH_TARGETS
+#define PRRU_BATCH_TARGETS
+#endif
+/* Complete unrolling of the loops over matrix entries before the
+ * vectoriser sees the loop over poses (GCC and Clang). */
+#if defined(__GNUC__)
+#define UNROLLED _Pragma("GCC unroll 16")
+#else
+#define UNROLLED
+#endif
+
+#define N PRRU_NACT
+#define CH PRRU_DME_BATCH_CHUNK
+
+/* isfinite as a comparison (vectorises everywhere; the same truth value). */
+#define FINITE(x) (fabs(x) <= DBL_MAX)
+
+/* Stage 1, three actuators: prru_jd_regular and prru_mode_status. Js =
+ * J_d diag(1/L, 1/L, 1); prru_rcond3's adjugate, determinant and 1-norms;
+ * J_d^-1 = diag(1/L, 1/L, 1) Js^-1 into ws->inv. pre[k] is the status
+ * before the DME (unreachable, singular, other mode, or OK to go on). */
+#if N == 3
+PRRU_BATCH_TARGETS static void regular3(int n, int o, int m, const double *d, const double *Jd, double L,
+                     double rcond_min, int home, prru_dme_batch_ws *ws)
+{
+  /* prru_jd_other_mode: det J_d's sign is not home's (+-1), i.e. not
+   * det J_d * home > 0 (exact: a product by +-1); never with home 0. The
+   * flags are selects of doubles: GCC vectorises no selects of booleans. */
+  const double hd = (double)home, other_code = home != 0 ? (double)PRRU_DME_OTHER_MODE : (double)PRRU_OK,
+               other_flag = home != 0 ? 1.0 : 0.0;
+  PRRU_BATCH_LOOP
+  for (int k = 0; k < m; k++) {
+    const long i = (long)o + k;
+    const double J0 = Jd[i], J1 = Jd[n + i], J2 = Jd[2L * n + i], J3 = Jd[3L * n + i],
+                 J4 = Jd[4L * n + i], J5 = Jd[5L * n + i], J6 = Jd[6L * n + i],
+                 J7 = Jd[7L * n + i], J8 = Jd[8L * n + i];
+    /* every slider finite: x * 0 is +-0 exactly when x is finite */
+    const int reach = d[i] * 0.0 + d[n + i] * 0.0 + d[2L * n + i] * 0.0 == 0.0;
+    const double a0 = J0 / L, a1 = J1 / L, a2 = J2, a3 = J3 / L, a4 = J4 / L, a5 = J5,
+                 a6 = J6 / L, a7 = J7 / L, a8 = J8;
+    const double c0 = a4 * a8 - a5 * a7, c1 = a2 * a7 - a1 * a8, c2 = a1 * a5 - a2 * a4;
+    const double c3 = a5 * a6 - a3 * a8, c4 = a0 * a8 - a2 * a6, c5 = a2 * a3 - a0 * a5;
+    const double c6 = a3 * a7 - a4 * a6, c7 = a1 * a6 - a0 * a7, c8 = a0 * a4 - a1 * a3;
+    const double det = a0 * c0 + a1 * c3 + a2 * c6;
+    double na = 0, ni = 0, s;
+    s = fabs(a0) + fabs(a3) + fabs(a6);
+    na = s > na ? s : na;
+    s = fabs(a1) + fabs(a4) + fabs(a7);
+    na = s > na ? s : na;
+    s = fabs(a2) + fabs(a5) + fabs(a8);
+    na = s > na ? s : na;
+    s = fabs(c0) + fabs(c3) + fabs(c6);
+    ni = s > ni ? s : ni;
+    s = fabs(c1) + fabs(c4) + fabs(c7);
+    ni = s > ni ? s : ni;
+    s = fabs(c2) + fabs(c5) + fabs(c8);
+    ni = s > ni ? s : ni;
+    ws->inv[0][k] = c0 / det / L;
+    ws->inv[1][k] = c1 / det / L;
+    ws->inv[2][k] = c2 / det / L;
+    ws->inv[3][k] = c3 / det / L;
+    ws->inv[4][k] = c4 / det / L;
+    ws->inv[5][k] = c5 / det / L;
+    ws->inv[6][k] = c6 / det;
+    ws->inv[7][k] = c7 / det;
+    ws->inv[8][k] = c8 / det;
+    double rc = fabs(det) / (na * ni);
+    rc = det != 0.0 ? rc : 0.0;
+    rc = FINITE(det) ? rc : 0.0;
+    /* prru_jd_det_sign, on the unscaled J_d */
+    const double dj = J0 * (J4 * J8 - J5 * J7) - J1 * (J3 * J8 - J5 * J6) + J2 * (J3 * J7 - J4 * J6);
+    double pre = dj * hd > 0 ? (double)PRRU_OK : other_code;
+    pre = rc > 0 ? pre : (double)PRRU_ESINGULAR; /* prru_jd_regular */
+    pre = rc >= rcond_min ? pre : (double)PRRU_ESINGULAR;
+    ws->pre[k] = reach ? pre : (double)PRRU_EUNREACHABLE;
+    ws->rcond[k] = reach ? rc : 0.0;
+    ws->other[k] = reach ? (dj * hd > 0 ? 0.0 : other_flag) : 0.0;
+  }
+}
+#else
+/* More actuators: J_d^+ by prru_jd_regular's Householder QR, pose by
+ * pose (its pivot-free but branching arithmetic is not batched). */
+static void regular_scalar(int n, int o, int m, const double *d, const double *Jd, double L,
+                           double rcond_min, int home, prru_dme_batch_ws *ws)
+{
+  for (int k = 0; k < m; k++) {
+    const long i = (long)o + k;
+    double J[3 * N], inv[3 * N] = {0}, rc = 0.0;
+    int reach = 1;
+    for (int r = 0; r < N; r++) reach = reach && isfinite(d[r * (long)n + i]);
+    for (int r = 0; r < 3 * N; r++) J[r] = Jd[r * (long)n + i];
+    int st = PRRU_EUNREACHABLE;
+    if (reach) st = prru_mode_status(prru_jd_regular(J, L, rcond_min, inv, &rc), J, home);
+    for (int r = 0; r < 3 * N; r++) ws->inv[r][k] = inv[r];
+    ws->rcond[k] = rc;
+    ws->other[k] = reach && prru_jd_other_mode(J, home) ? 1.0 : 0.0;
+    ws->pre[k] = (double)st;
+  }
+}
+#endif
+
+/* Mt = J^+T M J^+ (symmetrized), JtR = J_R,P J^+, JtT = J_T,P J^+: the
+ * three mul3n and the symmetric product of prru_dme_from. */
+PRRU_BATCH_TARGETS static void transformed(int n, int o, int m, const double *M, const double *JP,
+                        prru_dme_batch_ws *ws)
+{
+  PRRU_BATCH_LOOP
+  for (int k = 0; k < m; k++) {
+    const long x = (long)o + k;
+    UNROLLED
+    for (int i = 0; i < 3; i++) {
+      const double m0 = M[3 * i * (long)n + x], m1 = M[(3 * i + 1) * (long)n + x],
+                   m2 = M[(3 * i + 2) * (long)n + x];
+      const double r0 = JP[3 * i * (long)n + x], r1 = JP[(3 * i + 1) * (long)n + x],
+                   r2 = JP[(3 * i + 2) * (long)n + x];
+      const double t0 = JP[(9 + 3 * i) * (long)n + x], t1 = JP[(10 + 3 * i) * (long)n + x],
+                   t2 = JP[(11 + 3 * i) * (long)n + x];
+      UNROLLED
+      for (int j = 0; j < N; j++) {
+        const double v0 = ws->inv[j][k], v1 = ws->inv[N + j][k], v2 = ws->inv[2 * N + j][k];
+        ws->tmp[N * i + j][k] = m0 * v0 + m1 * v1 + m2 * v2;
+        ws->JtR[N * i + j][k] = r0 * v0 + r1 * v1 + r2 * v2;
+        ws->JtT[N * i + j][k] = t0 * v0 + t1 * v1 + t2 * v2;
+      }
+    }
+  }
+  PRRU_BATCH_LOOP
+  for (int k = 0; k < m; k++) {
+    UNROLLED
+    for (int i = 0; i < N; i++) {
+      UNROLLED
+      for (int j = i; j < N; j++) {
+        const double s = ws->inv[i][k] * ws->tmp[j][k] + ws->inv[N + i][k] * ws->tmp[N + j][k] +
+                         ws->inv[2 * N + i][k] * ws->tmp[2 * N + j][k];
+        const double s2 = ws->inv[j][k] * ws->tmp[i][k] + ws->inv[N + j][k] * ws->tmp[N + i][k] +
+                          ws->inv[2 * N + j][k] * ws->tmp[2 * N + i][k];
+        ws->Mt[N * i + j][k] = ws->Mt[N * j + i][k] = 0.5 * (s + s2);
+      }
+    }
+  }
+}
+
+/* prru_dme_from's basis (q0, q1) of range(J_R,P) and C = Q^T JtR (rows c0,
+ * c1): the column of largest squared norm (the first of equal ones), then
+ * the largest remainder of the others in column order. ok[k] is 0 where
+ * either norm is not positive. */
+PRRU_BATCH_TARGETS static void range_basis(int n, int o, int m, const double *JP, prru_dme_batch_ws *ws)
+{
+  PRRU_BATCH_LOOP
+  for (int k = 0; k < m; k++) {
+    const long x = (long)o + k;
+    /* column j of J_R,P is (a_j, b_j, c_j) */
+    const double a0 = JP[x], a1 = JP[n + x], a2 = JP[2L * n + x];
+    const double b0 = JP[3L * n + x], b1 = JP[4L * n + x], b2 = JP[5L * n + x];
+    const double c0 = JP[6L * n + x], c1 = JP[7L * n + x], c2 = JP[8L * n + x];
+    const double nn0 = a0 * a0 + b0 * b0 + c0 * c0, nn1 = a1 * a1 + b1 * b1 + c1 * c1,
+                 nn2 = a2 * a2 + b2 * b2 + c2 * c2;
+    const int t1 = nn1 > nn0;
+    const double nk1 = t1 ? nn1 : nn0, k01 = t1 ? 1.0 : 0.0;
+    const double ka1 = t1 ? a1 : a0, kb1 = t1 ? b1 : b0, kc1 = t1 ? c1 : c0;
+    const int t2 = nn2 > nk1;
+    const double nk = t2 ? nn2 : nk1, k0 = t2 ? 2.0 : k01; /* k0: the column's index */
+    const double ka = t2 ? a2 : ka1, kb = t2 ? b2 : kb1, kc = t2 ? c2 : kc1;
+    const double n0 = sqrt(nk);
+    const double q0a = ka / n0, q0b = kb / n0, q0c = kc / n0;
+    double best = -1, q1a = 0, q1b = 0, q1c = 0;
+#define REMAINDER(j, ca, cb, cc)                                                      \
+  do {                                                                              \
+    const double cq = (ca) * q0a + (cb) * q0b + (cc) * q0c;                         \
+    const double ra = (ca) - cq * q0a, rb = (cb) - cq * q0b, rc = (cc) - cq * q0c; \
+    const double nr = ra * ra + rb * rb + rc * rc;                                  \
+    const double cand = k0 != (j) ? nr : NAN; /* NaN > best is false */            \
+    q1a = cand > best ? ra : q1a;                                                   \
+    q1b = cand > best ? rb : q1b;                                                   \
+    q1c = cand > best ? rc : q1c;                                                   \
+    best = cand > best ? cand : best;                                               \
+  } while (0)
+    REMAINDER(0, a0, b0, c0);
+    REMAINDER(1, a1, b1, c1);
+    REMAINDER(2, a2, b2, c2);
+#undef REMAINDER
+    best = sqrt(best);
+    ws->ok[k] = n0 > 0 ? (best > 0 ? 1.0 : 0.0) : 0.0;
+    q1a /= best;
+    q1b /= best;
+    q1c /= best;
+    UNROLLED
+    for (int j = 0; j < N; j++) {
+      const double r0 = ws->JtR[j][k], r1 = ws->JtR[N + j][k], r2 = ws->JtR[2 * N + j][k];
+      ws->c0[j][k] = q0a * r0 + q0b * r1 + q0c * r2;
+      ws->c1[j][k] = q1a * r0 + q1b * r1 + q1c * r2;
+    }
+  }
+}
+
+/* The rest of prru_dme_from: S = C C^T, G = Mt C^T S^-1, the one-sided
+ * Jacobi rotation, the singular values sa >= sb, w_R = sa / sb; then
+ * sigma_T's squares f2, mf2, whose tests decide the status too. */
+PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
+{
+  PRRU_BATCH_LOOP
+  for (int k = 0; k < m; k++) {
+    double s00 = ws->c0[0][k] * ws->c0[0][k], s01 = ws->c0[0][k] * ws->c1[0][k],
+           s11 = ws->c1[0][k] * ws->c1[0][k];
+    UNROLLED
+    for (int j = 1; j < N; j++) {
+      s00 += ws->c0[j][k] * ws->c0[j][k];
+      s01 += ws->c0[j][k] * ws->c1[j][k];
+      s11 += ws->c1[j][k] * ws->c1[j][k];
+    }
+    const double det = s00 * s11 - s01 * s01;
+    const double i00 = s11 / det, i01 = -s01 / det, i11 = s00 / det;
+    UNROLLED
+    for (int i = 0; i < N; i++) {
+      double mc0 = ws->Mt[N * i][k] * ws->c0[0][k], mc1 = ws->Mt[N * i][k] * ws->c1[0][k];
+      UNROLLED
+      for (int j = 1; j < N; j++) {
+        mc0 += ws->Mt[N * i + j][k] * ws->c0[j][k];
+        mc1 += ws->Mt[N * i + j][k] * ws->c1[j][k];
+      }
+      ws->g0[i][k] = mc0 * i00 + mc1 * i01;
+      ws->g1[i][k] = mc0 * i01 + mc1 * i11;
+    }
+    double a = ws->g0[0][k] * ws->g0[0][k], b = ws->g1[0][k] * ws->g1[0][k],
+           g = ws->g0[0][k] * ws->g1[0][k];
+    UNROLLED
+    for (int i = 1; i < N; i++) {
+      a += ws->g0[i][k] * ws->g0[i][k];
+      b += ws->g1[i][k] * ws->g1[i][k];
+      g += ws->g0[i][k] * ws->g1[i][k];
+    }
+    const double tau = (b - a) / (2.0 * g);
+    const double t = (tau >= 0 ? 1.0 : -1.0) / (fabs(tau) + sqrt(1.0 + tau * tau));
+    const double ct = 1.0 / sqrt(1.0 + t * t);
+    const double cs = g != 0.0 ? ct : 1.0, sn = g != 0.0 ? t * ct : 0.0;
+    double h0 = cs * ws->g0[0][k] - sn * ws->g1[0][k], h1 = sn * ws->g0[0][k] + cs * ws->g1[0][k];
+    double hh0 = h0 * h0, hh1 = h1 * h1;
+    UNROLLED
+    for (int i = 1; i < N; i++) {
+      h0 = cs * ws->g0[i][k] - sn * ws->g1[i][k];
+      h1 = sn * ws->g0[i][k] + cs * ws->g1[i][k];
+      hh0 += h0 * h0;
+      hh1 += h1 * h1;
+    }
+    const double ra = sqrt(hh0), rb = sqrt(hh1);
+    const int swap = rb > ra;
+    const double sa = swap ? rb : ra, sb = swap ? ra : rb;
+    const double w = sa / sb;
+    /* sigma_T = sqrt(mf2) / f2: |JtT|_F^2 by columns, |Mt JtT^T|_F^2 */
+    double f2 = 0, mf2 = 0;
+    UNROLLED
+    for (int j = 0; j < N; j++) {
+      double cn = 0;
+      UNROLLED
+      for (int i = 0; i < 3; i++) cn += ws->JtT[N * i + j][k] * ws->JtT[N * i + j][k];
+      f2 += cn;
+    }
+    UNROLLED
+    for (int j = 0; j < 3; j++) {
+      UNROLLED
+      for (int i = 0; i < N; i++) {
+        double y = ws->Mt[N * i][k] * ws->JtT[N * j][k];
+        UNROLLED
+        for (int l = 1; l < N; l++) y += ws->Mt[N * i + l][k] * ws->JtT[N * j + l][k];
+        mf2 += y * y;
+      }
+    }
+    const double sigma_T = sqrt(mf2) / f2;
+    const int ok = (ws->ok[k] != 0.0) & (det > 0) & (sb > 0) & FINITE(sa) & (f2 > 0) & (mf2 > 0) &
+                   FINITE(w) & FINITE(sigma_T);
+    ws->ok[k] = ok ? 1.0 : 0.0;
+    ws->w[k] = w;
+  }
+}
+
+PRRU_BATCH_TARGETS
+void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, const double *JP,
+                    double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
+                    unsigned char *status, double *rcond, unsigned char *other)
+{
+  for (int o = 0; o < n; o += CH) {
+    const int m = n - o < CH ? n - o : CH;
+#if N == 3
+    regular3(n, o, m, d, Jd, L, rcond_min, home, ws);
+#else
+    regular_scalar(n, o, m, d, Jd, L, rcond_min, home, ws);
+#endif
+    transformed(n, o, m, M, JP, ws);
+    range_basis(n, o, m, JP, ws);
+    singular_values(m, ws);
+    for (int k = 0; k < m; k++) {
+      const int pre = (int)ws->pre[k];
+      const int st = pre != PRRU_OK ? pre : ws->ok[k] != 0.0 ? PRRU_OK : PRRU_ESINGULAR;
+      w_R[o + k] = st == PRRU_OK ? ws->w[k] : NAN;
+      status[o + k] = (unsigned char)st;
+      if (rcond) rcond[o + k] = ws->rcond[k];
+      if (other) other[o + k] = (unsigned char)(ws->other[k] != 0.0);
+    }
+  }
+}
