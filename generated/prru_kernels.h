@@ -5,27 +5,27 @@
  * Edit the model file or the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   ik                 30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3
- *   jd                 63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   ik_jd              74 arithmetic (8 add, 11 sub, 52 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   jacobians          98 arithmetic (6 add, 11 sub, 70 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   bias_terms         191 arithmetic (14 add, 32 sub, 135 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3
- *   mass               161 arithmetic (31 add, 15 sub, 109 mul, 6 div); calls: cos 2, sin 2, sqrt 3
- *   bias               287 arithmetic (35 add, 46 sub, 202 mul, 4 div); calls: cos 2, sin 2, sqrt 3
- *   gravity            61 arithmetic (2 add, 10 sub, 45 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   dynamics           386 arithmetic (62 add, 51 sub, 266 mul, 6 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   eom                409 arithmetic (63 add, 62 sub, 278 mul, 6 div); calls: cos 2, sin 2, sqrt 3
- *   platform_jacobian  12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 2, sqrt 1
- *   poses              60 arithmetic (11 add, 10 sub, 29 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
- *   inertia_world      86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   wrench_bias        212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   energy             137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3
- *   actuator_rates     148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   passive            12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1
- *   reaction_basis     58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          468 arithmetic (68 add, 73 sub, 318 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      471 arithmetic (75 add, 71 sub, 315 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   joint_reactions    775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   ik                 31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3
+ *   jd                 66 arithmetic (4 add, 9 sub, 50 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   ik_jd              77 arithmetic (8 add, 11 sub, 55 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   jacobians          100 arithmetic (6 add, 11 sub, 73 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   bias_terms         192 arithmetic (14 add, 32 sub, 137 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   mass               160 arithmetic (31 add, 15 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   bias               288 arithmetic (35 add, 46 sub, 204 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   gravity            64 arithmetic (2 add, 10 sub, 48 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   dynamics           384 arithmetic (62 add, 51 sub, 267 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom                407 arithmetic (63 add, 62 sub, 279 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   platform_jacobian  13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1
+ *   poses              61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
+ *   inertia_world      86 arithmetic (14 add, 7 sub, 61 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   wrench_bias        213 arithmetic (15 add, 35 sub, 153 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   energy             136 arithmetic (33 add, 12 sub, 88 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   actuator_rates     151 arithmetic (13 add, 24 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
+ *   reaction_basis     59 arithmetic (2 add, 5 sub, 34 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          466 arithmetic (68 add, 73 sub, 319 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      469 arithmetic (75 add, 71 sub, 316 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   joint_reactions    776 arithmetic (125 add, 195 sub, 444 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
 #define PRRU_KERNELS_H
@@ -45,48 +45,48 @@
 #define PRRU_NLAMBDA 57
 /* Body order of every array: P L1 L2 L3 U1 U2 U3 S1 S2 S3. The model's numbers and layout tables
    are in prru_mechanism.h. */
-#define PRRU_ARITH_IK 30 /* arithmetic operations */
-#define PRRU_ARITH_JD 63 /* arithmetic operations */
-#define PRRU_ARITH_IK_JD 74 /* arithmetic operations */
-#define PRRU_ARITH_JACOBIANS 98 /* arithmetic operations */
-#define PRRU_ARITH_BIAS_TERMS 191 /* arithmetic operations */
-#define PRRU_ARITH_MASS 161 /* arithmetic operations */
-#define PRRU_ARITH_BIAS 287 /* arithmetic operations */
-#define PRRU_ARITH_GRAVITY 61 /* arithmetic operations */
-#define PRRU_ARITH_DYNAMICS 386 /* arithmetic operations */
-#define PRRU_ARITH_EOM 409 /* arithmetic operations */
-#define PRRU_ARITH_PLATFORM_JACOBIAN 12 /* arithmetic operations */
-#define PRRU_ARITH_POSES 60 /* arithmetic operations */
+#define PRRU_ARITH_IK 31 /* arithmetic operations */
+#define PRRU_ARITH_JD 66 /* arithmetic operations */
+#define PRRU_ARITH_IK_JD 77 /* arithmetic operations */
+#define PRRU_ARITH_JACOBIANS 100 /* arithmetic operations */
+#define PRRU_ARITH_BIAS_TERMS 192 /* arithmetic operations */
+#define PRRU_ARITH_MASS 160 /* arithmetic operations */
+#define PRRU_ARITH_BIAS 288 /* arithmetic operations */
+#define PRRU_ARITH_GRAVITY 64 /* arithmetic operations */
+#define PRRU_ARITH_DYNAMICS 384 /* arithmetic operations */
+#define PRRU_ARITH_EOM 407 /* arithmetic operations */
+#define PRRU_ARITH_PLATFORM_JACOBIAN 13 /* arithmetic operations */
+#define PRRU_ARITH_POSES 61 /* arithmetic operations */
 #define PRRU_ARITH_INERTIA_WORLD 86 /* arithmetic operations */
-#define PRRU_ARITH_WRENCH_BIAS 212 /* arithmetic operations */
-#define PRRU_ARITH_ENERGY 137 /* arithmetic operations */
-#define PRRU_ARITH_ACTUATOR_RATES 148 /* arithmetic operations */
-#define PRRU_ARITH_PASSIVE 12 /* arithmetic operations */
-#define PRRU_ARITH_REACTION_BASIS 58 /* arithmetic operations */
-#define PRRU_ARITH_EOM_SOLVE 468 /* arithmetic operations */
-#define PRRU_ARITH_INVERSE_TERMS 471 /* arithmetic operations */
-#define PRRU_ARITH_JOINT_REACTIONS 775 /* arithmetic operations */
-#define PRRU_OPS_IK "30 arithmetic (5 add, 7 sub, 17 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JD "63 arithmetic (4 add, 9 sub, 47 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_IK_JD "74 arithmetic (8 add, 11 sub, 52 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JACOBIANS "98 arithmetic (6 add, 11 sub, 70 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS_TERMS "191 arithmetic (14 add, 32 sub, 135 mul, 4 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_MASS "161 arithmetic (31 add, 15 sub, 109 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS "287 arithmetic (35 add, 46 sub, 202 mul, 4 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_GRAVITY "61 arithmetic (2 add, 10 sub, 45 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_DYNAMICS "386 arithmetic (62 add, 51 sub, 266 mul, 6 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM "409 arithmetic (63 add, 62 sub, 278 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_PLATFORM_JACOBIAN "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_OPS_POSES "60 arithmetic (11 add, 10 sub, 29 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INERTIA_WORLD "86 arithmetic (14 add, 7 sub, 60 mul, 2 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_WRENCH_BIAS "212 arithmetic (15 add, 35 sub, 151 mul, 4 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ENERGY "137 arithmetic (33 add, 12 sub, 86 mul, 6 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ACTUATOR_RATES "148 arithmetic (13 add, 24 sub, 108 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_PASSIVE "12 arithmetic (1 add, 2 sub, 8 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
-#define PRRU_OPS_REACTION_BASIS "58 arithmetic (2 add, 5 sub, 33 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM_SOLVE "468 arithmetic (68 add, 73 sub, 318 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INVERSE_TERMS "471 arithmetic (75 add, 71 sub, 315 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JOINT_REACTIONS "775 arithmetic (125 add, 195 sub, 442 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_ARITH_WRENCH_BIAS 213 /* arithmetic operations */
+#define PRRU_ARITH_ENERGY 136 /* arithmetic operations */
+#define PRRU_ARITH_ACTUATOR_RATES 151 /* arithmetic operations */
+#define PRRU_ARITH_PASSIVE 13 /* arithmetic operations */
+#define PRRU_ARITH_REACTION_BASIS 59 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 466 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 469 /* arithmetic operations */
+#define PRRU_ARITH_JOINT_REACTIONS 776 /* arithmetic operations */
+#define PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JD "66 arithmetic (4 add, 9 sub, 50 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_IK_JD "77 arithmetic (8 add, 11 sub, 55 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JACOBIANS "100 arithmetic (6 add, 11 sub, 73 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS_TERMS "192 arithmetic (14 add, 32 sub, 137 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_MASS "160 arithmetic (31 add, 15 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS "288 arithmetic (35 add, 46 sub, 204 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_GRAVITY "64 arithmetic (2 add, 10 sub, 48 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_DYNAMICS "384 arithmetic (62 add, 51 sub, 267 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM "407 arithmetic (63 add, 62 sub, 279 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_PLATFORM_JACOBIAN "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
+#define PRRU_OPS_POSES "61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INERTIA_WORLD "86 arithmetic (14 add, 7 sub, 61 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_WRENCH_BIAS "213 arithmetic (15 add, 35 sub, 153 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ENERGY "136 arithmetic (33 add, 12 sub, 88 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ACTUATOR_RATES "151 arithmetic (13 add, 24 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_PASSIVE "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
+#define PRRU_OPS_REACTION_BASIS "59 arithmetic (2 add, 5 sub, 34 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "466 arithmetic (68 add, 73 sub, 319 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "469 arithmetic (75 add, 71 sub, 316 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JOINT_REACTIONS "776 arithmetic (125 add, 195 sub, 444 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
 extern "C" {

@@ -5,18 +5,18 @@
  * Edit the model file or the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   ik                 54 arithmetic (6 add, 11 sub, 32 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   jd                 90 arithmetic (5 add, 15 sub, 61 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   ik_jd              103 arithmetic (10 add, 18 sub, 66 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   mass               476 arithmetic (100 add, 51 sub, 312 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   bias               946 arithmetic (152 add, 114 sub, 671 mul, 8 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   gravity            340 arithmetic (58 add, 47 sub, 227 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   dynamics           1155 arithmetic (220 add, 139 sub, 783 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   eom                1218 arithmetic (235 add, 160 sub, 809 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   platform_jacobian  25 arithmetic (1 add, 5 sub, 14 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1
- *   energy             568 arithmetic (133 add, 67 sub, 355 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   actuator_rates     214 arithmetic (13 add, 36 sub, 156 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   passive            164 arithmetic (17 add, 27 sub, 110 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   ik                 55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   jd                 94 arithmetic (5 add, 15 sub, 65 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   ik_jd              107 arithmetic (10 add, 18 sub, 70 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   mass               475 arithmetic (100 add, 51 sub, 315 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   bias               948 arithmetic (152 add, 114 sub, 674 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   gravity            344 arithmetic (58 add, 47 sub, 231 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   dynamics           1154 arithmetic (220 add, 139 sub, 786 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   eom                1217 arithmetic (235 add, 160 sub, 812 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   platform_jacobian  26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1
+ *   energy             567 arithmetic (133 add, 67 sub, 358 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   actuator_rates     218 arithmetic (13 add, 36 sub, 160 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   passive            168 arithmetic (17 add, 27 sub, 114 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_PARAM_KERNELS_H
 #define PRRU_PARAM_KERNELS_H
@@ -41,30 +41,30 @@
  * allocation, re-entrant; depends only on <math.h>. */
 #include "prru_kernels.h"
 
-#define PRRU_PARAM_ARITH_IK 54 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_JD 90 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_IK_JD 103 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_MASS 476 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_BIAS 946 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_GRAVITY 340 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_DYNAMICS 1155 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_EOM 1218 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_PLATFORM_JACOBIAN 25 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ENERGY 568 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ACTUATOR_RATES 214 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_PASSIVE 164 /* arithmetic operations */
-#define PRRU_PARAM_OPS_IK "54 arithmetic (6 add, 11 sub, 32 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_JD "90 arithmetic (5 add, 15 sub, 61 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_IK_JD "103 arithmetic (10 add, 18 sub, 66 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_MASS "476 arithmetic (100 add, 51 sub, 312 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_BIAS "946 arithmetic (152 add, 114 sub, 671 mul, 8 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_GRAVITY "340 arithmetic (58 add, 47 sub, 227 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_DYNAMICS "1155 arithmetic (220 add, 139 sub, 783 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_EOM "1218 arithmetic (235 add, 160 sub, 809 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_PARAM_OPS_PLATFORM_JACOBIAN "25 arithmetic (1 add, 5 sub, 14 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_PARAM_OPS_ENERGY "568 arithmetic (133 add, 67 sub, 355 mul, 11 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_ACTUATOR_RATES "214 arithmetic (13 add, 36 sub, 156 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_PASSIVE "164 arithmetic (17 add, 27 sub, 110 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_PARAM_ARITH_IK 55 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_JD 94 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_IK_JD 107 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_MASS 475 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_BIAS 948 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_GRAVITY 344 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_DYNAMICS 1154 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_EOM 1217 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_PLATFORM_JACOBIAN 26 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_ENERGY 567 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_ACTUATOR_RATES 218 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_PASSIVE 168 /* arithmetic operations */
+#define PRRU_PARAM_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_JD "94 arithmetic (5 add, 15 sub, 65 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_IK_JD "107 arithmetic (10 add, 18 sub, 70 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_MASS "475 arithmetic (100 add, 51 sub, 315 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_BIAS "948 arithmetic (152 add, 114 sub, 674 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_GRAVITY "344 arithmetic (58 add, 47 sub, 231 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_DYNAMICS "1154 arithmetic (220 add, 139 sub, 786 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_EOM "1217 arithmetic (235 add, 160 sub, 812 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_PARAM_OPS_PLATFORM_JACOBIAN "26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
+#define PRRU_PARAM_OPS_ENERGY "567 arithmetic (133 add, 67 sub, 358 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_ACTUATOR_RATES "218 arithmetic (13 add, 36 sub, 160 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_PASSIVE "168 arithmetic (17 add, 27 sub, 114 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 
 #ifdef __cplusplus
 extern "C" {

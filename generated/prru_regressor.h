@@ -5,7 +5,7 @@
  * Edit the model file or the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   regressor          873 arithmetic (132 add, 172 sub, 548 mul, 7 div, 14 neg); calls: cos 2, sin 2, sqrt 3, tanh 3
+ *   regressor          873 arithmetic (132 add, 172 sub, 549 mul, 6 div, 14 neg); calls: cos 2, sin 2, sqrt 3, tanh 3
  */
 #ifndef PRRU_REGRESSOR_H
 #define PRRU_REGRESSOR_H
@@ -33,7 +33,7 @@
 
 #define PRRU_NREG 109 /* standard parameters, columns of Y */
 #define PRRU_ARITH_REGRESSOR 873 /* arithmetic operations */
-#define PRRU_OPS_REGRESSOR "873 arithmetic (132 add, 172 sub, 548 mul, 7 div, 14 neg); calls: cos 2, sin 2, sqrt 3, tanh 3"
+#define PRRU_OPS_REGRESSOR "873 arithmetic (132 add, 172 sub, 549 mul, 6 div, 14 neg); calls: cos 2, sin 2, sqrt 3, tanh 3"
 
 #ifdef __cplusplus
 extern "C" {

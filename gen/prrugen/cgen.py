@@ -123,17 +123,23 @@ class Graph:
         return acc
 
     def power(self, base, e):
-        if e.denominator == 1:
-            root = base
-        elif e.denominator == 2:
-            root = self.node("call", "sqrt", base)
-        else:
-            return self.node("call", "pow", base, self.num(e))
+        """base^e from one reciprocal 1/base and one sqrt(base) per base.
+
+        x^(-1/2) is sqrt(x) * (1/x), not 1/sqrt(x): the square root and the
+        division start together instead of one after the other, and 1/x is
+        the one division that x^-1, x^-3/2, ... share."""
         p = e.numerator
-        if p < 0:
-            root = self.node("div", self.num(1), root)
-            p = -p
-        return self._ipow(root, p)
+        if e.denominator == 1:
+            return self._ipow(base, p) if p > 0 else \
+                self._ipow(self.node("div", self.num(1), base), -p)
+        if e.denominator != 2:
+            return self.node("call", "pow", base, self.num(e))
+        root = self.node("call", "sqrt", base)
+        if p > 0:   # x^(p/2) = x^((p-1)/2) sqrt(x)
+            return root if p == 1 else \
+                self.node("mul", self._ipow(base, (p - 1) // 2), root)
+        recip = self.node("div", self.num(1), base)
+        return self.node("mul", root, self._ipow(recip, (1 - p) // 2))
 
     def _ipow(self, base, p):
         if p == 1:
@@ -323,9 +329,27 @@ def emit(kernel, prefix):
         lines += ["  " + f for f in fills]
         lines.append("  return;")
         lines.append("}")
-    emit_temps(live)
+    # Each temporary right before its first use and each output stored as
+    # soon as it is complete: GCC does not schedule before register
+    # allocation on x86-64, so the order printed is the order run, and
+    # computing every temporary first kept hundreds of them live at once.
+    def emit_needed(n):
+        for a in n.args:
+            if not isinstance(a, Node) or a.op in ("num", "in") or a.index in temp:
+                continue
+            emit_needed(a)
+            if materialized(a):
+                name = "t%d" % len(temp)
+                lines.append("const double %s = %s;" % (name, inline(a)))
+                temp[a.index] = name
+
     for arr, ns in out_nodes:
         for i, n in enumerate(ns):
+            if n.op not in ("num", "in") and n.index not in temp:
+                emit_needed(n)
+                if materialized(n):
+                    temp[n.index] = "t%d" % len(temp)
+                    lines.append("const double %s = %s;" % (temp[n.index], inline(n)))
             lines.append("%s[%d] = %s;" % (arr, i, expr(n)))
     for arr, syms in kernel.inputs:
         if not any(("%s%d" % (arr, i + 1)) in used_inputs
