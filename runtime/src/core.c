@@ -269,7 +269,8 @@ static int regular_from_inverse(const double J[9], const double inv[9], double L
   for (int j = 0; j < 3; j++) {
     const double sa = fabs(J[j]) + fabs(J[3 + j]) + fabs(J[6 + j]);
     const double si = L * (fabs(inv[j]) + fabs(inv[3 + j])) + fabs(inv[6 + j]);
-    na = fmax(na, j < 2 ? sa : L * sa);
+    const double ca = j < 2 ? sa : L * sa;
+    if (ca > na) na = ca; /* fmax's result (NaN ignored), without its libm call */
     if (!(si <= ni)) ni = si; /* NaN propagates */
   }
   const double p = na * ni;
