@@ -117,7 +117,9 @@ nothing_written "$tmp/bad" "optimize into a missing directory"
 # A signal stops the run: exit 128 + signal, nothing written, no staging
 # directory left. (TERM: a background job of a script ignores INT.)
 mkdir "$tmp/int"
-"$PRRU" optimize --vars b12,l2 --q1 -0.3:0.3:201 --q2 -0.3:0.3:201 --max-iter 1000000 \
+# The grid is large enough (2.25 M points an evaluation) that no machine
+# converges within the second before the signal; at 201 x 201 a fast one did.
+"$PRRU" optimize --vars b12,l2 --q1 -0.3:0.3:1501 --q2 -0.3:0.3:1501 --max-iter 1000000 \
   --out "$tmp/int/m.json" --report "$tmp/int/rep" >/dev/null 2>"$tmp/int.err" &
 pid=$!
 sleep 1
