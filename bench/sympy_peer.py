@@ -20,7 +20,8 @@ small integer powers printed as products (pow(x, 2) is slower) and sqrt,
   static void peer_dynamics(const double q[3], const double qd[3],
                             double M[9], double h[3], double G[3]);
 
-(static: bench/bench_peer.c includes the file).
+(static and, with GCC, noinline: bench/bench_peer.c includes the file but
+calls it as it calls prru_dynamics, which lives in another translation unit).
 
 For a model with drives (armature) the file only defines PEER_UNAVAILABLE
 with the reason: the peer covers the rigid bodies only. The derivation
@@ -144,7 +145,10 @@ def c_source(outputs):
                                optimizations="basic")
     cse_s = time.perf_counter() - start
     pr = ProductPowers()
+    # noinline: called from the timing loop as prru_dynamics is (another
+    # translation unit), never optimised into it.
     lines = ["#include <math.h>", "",
+             "#if defined(__GNUC__)", "__attribute__((noinline))", "#endif",
              "static void peer_dynamics(const double q[3], const double qd[3], "
              "double M[9], double h[3], double G[3])", "{"]
     for i in range(3):
