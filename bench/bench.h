@@ -158,6 +158,24 @@ void bench_peer_run(const bench_ctx *c, int reps, int quick, bench_peer *r);
 void bench_peer_print_table(const bench_peer *r);
 void bench_peer_print_json(const bench_peer *r);
 
+/* bench_bound.c: each kernel against a scalar lower bound (its multiplies
+ * two a cycle at the reported clock plus its sin, cos and sqrt alone). */
+#define BENCH_MAX_BOUND 16
+typedef struct {
+  const char *name;
+  int muls;
+  double bound_ns, measured_ns;
+} bench_bound_row;
+typedef struct {
+  double clock_ghz, calls_ns; /* calls_ns: sin, cos of q1 and q2 and nsqrt sqrt */
+  int nsqrt, n;
+  bench_bound_row row[BENCH_MAX_BOUND];
+} bench_bound;
+extern bench_bound bench_bound_result;
+void bench_bound_run(const bench_ctx *c, int reps, int quick, bench_bound *b);
+void bench_bound_print_table(const bench_bound *b);
+void bench_bound_print_json(const bench_bound *b);
+
 /* bench_regen.c */
 int bench_time_regeneration(int reps, bench_stats *out);
 

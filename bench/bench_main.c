@@ -158,6 +158,7 @@ int main(int argc, char **argv)
   }
   if (!op.json) fprintf(stderr, "dynamics against the SymPy peer...\n");
   bench_peer_run(&c, op.reps, op.quick, &bench_peer_result);
+  bench_bound_run(&c, op.reps, op.quick, &bench_bound_result);
   bench_modes_done = 1;
   if (!op.json) fprintf(stderr, "regenerating...\n");
   bench_stats regen = {0, 0, 0};

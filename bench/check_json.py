@@ -105,6 +105,19 @@ def main():
         fail("simulated second: scenario %r" % sim.get("scenario"))
     if not sim.get("max_abs_diff_q", 1.0) <= 1e-7:
         fail("simulated second: final q differs by %r" % sim.get("max_abs_diff_q"))
+    bound = doc.get("bound")
+    if not isinstance(bound, dict) or not positive(bound.get("calls_ns")):
+        fail("'bound' missing: %r" % (bound,))
+    if positive(bound.get("clock_ghz")):
+        rows = bound.get("kernels", {})
+        if not {"dynamics", "forward_dynamics", "inverse_dynamics"} <= set(rows):
+            fail("bound: rows %s" % sorted(rows))
+        for name, r in rows.items():
+            # the bound is the multiplies at the clock plus the calls
+            want = r["muls"] / 2.0 / bound["clock_ghz"] + bound["calls_ns"]
+            if not (isinstance(r["muls"], int) and r["muls"] > 0 and
+                    positive(r["measured_ns"]) and r["bound_ns"] >= want * (1 - 2e-3)):
+                fail("bound %r: %r" % (name, r))
     if not positive(doc.get("regeneration_s")):
         fail("regeneration_s missing")
     print("bench_smoke: JSON complete, %d kernels" % len(names))
