@@ -224,7 +224,9 @@ static const char id_help[] =
     "--reactions the joint reactions (columns as in 'prru simulate'). With any\n"
     "of them the output is no longer a load table.\n"
     "%s"
-    "A row where the pose is unreachable or J_d singular stops with exit 1,\n"
+    "A row where the pose is unreachable or J_d singular, or where det J_d has\n"
+    "changed sign since the row before (the motion crossed a singular pose in\n"
+    "between), stops with exit 1,\n"
     "SIGINT/SIGTERM/SIGHUP with exit 130/143/129; the rows before it are kept.\n"
     "A write error exits 1 with the reason; an unreadable or malformed FILE\n"
     "exits 2.\n";
@@ -436,6 +438,8 @@ int prru_cmd_id(int argc, char **argv)
   prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
   char why[700] = "";
+  int sign = 0; /* det J_d's sign at the rows so far (0 with four actuators) */
+  double t_prev = 0;
   for (int i = 0; st == PRRU_OK && !o.err && i < t.nrows; i++) {
     if (prru_cli_interrupted) {
       st = PRRU_EINTERRUPTED;
@@ -455,6 +459,7 @@ int prru_cmd_id(int argc, char **argv)
     memcpy(l.mp, v + 13, sizeof l.mp);
     double n[PRRU_NACT];
     st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
+    const int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0; /* J_d of this row */
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
     double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
     if (st == PRRU_OK && rates) {
@@ -469,6 +474,18 @@ int prru_cmd_id(int argc, char **argv)
       snprintf(why, sizeof why, "%s: data row %d (t = %g): %s", traj, i + 1, v[0], prru_strerror(st));
       break;
     }
+    /* Each row is regular on its own, but the motion between two rows
+     * passed a singular pose when det J_d changed sign (as in 'prru traj'):
+     * what it would take is not these forces. */
+    if (s * sign < 0) {
+      st = PRRU_ESINGULAR;
+      snprintf(why, sizeof why, "%s: data row %d (t = %g): the motion crosses a singularity "
+               "(J_d singular) after the row before (t = %g): det J_d changes sign at q = (%.9g, "
+               "%.9g, %.9g)", traj, i + 1, v[0], t_prev, v[1], v[2], v[3]);
+      break;
+    }
+    if (s) sign = s;
+    t_prev = v[0];
     prru_cli_out_printf(&o, "%.17g", v[0]);
     prru_cli_out_numbers(&o, fd, PRRU_NACT);
     if (null_vector) prru_cli_out_numbers(&o, n, PRRU_NACT);

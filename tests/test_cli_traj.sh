@@ -108,6 +108,15 @@ print(("+" if det > 0 else "-") if not d["singular"] else "0")'
       || bad "traj across the singularity to q1 = $far: exit $st, $(cat "$tmp/err")"
     expect 2 "crosses a singularity" -- track --waypoints "0,0,0;$far,-pi/4,0" --durations 1 --out "$tmp/s2.csv"
     [ -e "$tmp/s2.csv" ] && bad "track wrote a file for a singular reference" || ok
+    # prru id on rows that are each regular but of opposite det J_d signs:
+    # stops at the second row, the first kept.
+    printf 't,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3\n0,0,0,0,0,0,0,0,0,0\n1,%s,%s,0,0,0,0,0,0,0\n' \
+      "$far" "$(python3 -c 'import math; print(repr(-math.pi/4))')" >"$tmp/jump.csv"
+    "$PRRU" id --traj "$tmp/jump.csv" --out "$tmp/jump_fd.csv" 2>"$tmp/err"
+    st=$?
+    [ $st -eq 1 ] && grep -q "data row 2 (t = 1): the motion crosses a singularity" "$tmp/err" \
+      && [ "$(grep -vc '^#' "$tmp/jump_fd.csv")" -eq 2 ] && ok \
+      || bad "id across the singularity: exit $st, $(cat "$tmp/err")"
   else
     echo "note: no pose of opposite det J_d sign found near q2 = -pi/4; crossing check skipped"
   fi
