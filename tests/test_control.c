@@ -250,6 +250,55 @@ static void stroke(void)
   printf("stroke: %s (%ld samples)\n", msg, s.samples);
 }
 
+/* A slider that leaves its stroke only between two samples: continuous
+ * control (the plant follows the reference), samples 0.3 s apart (the waypoints, where the sliders
+ * turn, lie between them), the
+ * stroke 1e-7 m inside slider 1's highest or lowest point on the
+ * reference, whichever lies between samples with every sample inside. The
+ * run stops at an integration step between the samples, near that point. */
+static void stroke_between_samples(void)
+{
+  prru_track_options o;
+  prru_track_options_default(&o);
+  o.control_period = 0.0;
+  const double dt = 0.3;
+  o.dt_out = dt;
+  const double t1 = prru_quintic_t_end(&ref);
+  double q[3], d[PRRU_NACT], hi = -INFINITY, lo = INFINITY, t_hi = 0, t_lo = 0;
+  double hi_samples = -INFINITY, lo_samples = INFINITY;
+  for (long k = 0; k * 1e-5 <= t1; k++) { /* 10 us apart */
+    double t = k * 1e-5;
+    prru_quintic_eval(&ref, t, q, NULL, NULL);
+    prru_ik(q, d);
+    if (d[0] > hi) hi = d[0], t_hi = t;
+    if (d[0] < lo) lo = d[0], t_lo = t;
+    if (k % 30000 == 0 || k * 1e-5 + 1e-5 > t1) { /* the samples, the last at t1 */
+      hi_samples = fmax(hi_samples, d[0]);
+      lo_samples = fmin(lo_samples, d[0]);
+    }
+  }
+  double t_x = -1;
+  if (fmod(t_hi, dt) > 0.01 && fmod(t_hi, dt) < dt - 0.01 && hi_samples < hi - 1e-7) {
+    o.d_max[0] = hi - 1e-7;
+    t_x = t_hi;
+  } else if (fmod(t_lo, dt) > 0.01 && fmod(t_lo, dt) < dt - 0.01 && lo_samples > lo + 1e-7) {
+    o.d_min[0] = lo + 1e-7;
+    t_x = t_lo;
+  }
+  TU_TRUE(t_x > 0, "slider 1 has an extreme between samples on this reference");
+  if (!(t_x > 0)) return;
+  prru_track_summary s;
+  char msg[512];
+  int st = prru_track(&model, &ref, &o, &s, msg, sizeof msg);
+  const char *p = strstr(msg, "t = ");
+  double t_stop = p ? atof(p + 4) : -1;
+  printf("stroke between samples: extreme at t = %.6f s; %s (%ld samples)\n", t_x, msg,
+         s.samples);
+  TU_TRUE(st == PRRU_EUNREACHABLE && strstr(msg, "between samples") && strstr(msg, "slider 1") &&
+              fabs(t_stop - t_x) < 0.01 && s.samples == (long)floor(t_stop / dt) + 1,
+          "a stroke left between two samples stops the run there, samples before it kept");
+}
+
 static void refusals(void)
 {
   prru_track_options o;
@@ -298,6 +347,7 @@ int main(void)
   noise_deterministic();
   saturation();
   stroke();
+  stroke_between_samples();
   refusals();
   prru_quintic_free(&ref);
   return tu_finish("test_control");

@@ -195,14 +195,6 @@ static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
   return finite_all(s->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
 
-/* The first slider outside its stroke, or -1. */
-static int stroke_violation(const prru_track_options *o, const double d[PRRU_NACT])
-{
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (d[i] < o->d_min[i] || d[i] > o->d_max[i]) return i;
-  return -1;
-}
-
 static void summary_add(prru_track_summary *sum, const prru_track_sample *s)
 {
   sum->samples++;
@@ -232,13 +224,53 @@ static double tick_time(const prru_quintic *ref, double step, long k, long ntick
   return k == nticks ? prru_quintic_t_end(ref) : prru_quintic_t_begin(ref) + (double)k * step;
 }
 
+/* The first slider outside its stroke, or -1. */
+static int stroke_violation(const prru_track_options *o, const double d[PRRU_NACT])
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (d[i] < o->d_min[i] || d[i] > o->d_max[i]) return i;
+  return -1;
+}
+
+/* The plant from *t to t1 as gsl_odeiv2_driver_apply runs it (the same
+ * evolve calls, step-count and step-size rules), with the sliders checked
+ * against their stroke after every accepted step: between two ticks a
+ * slider can leave its stroke and come back. GSL_SUCCESS, the evolve's or
+ * the driver's error, or GSL_EDOM with *bad the slider out of its stroke
+ * (*t, y the state there). */
+static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, double *t,
+                         double t1, double y[6], int *bad)
+{
+  drv->n = 0;
+  while (t1 - *t > 0.0) {
+    int gs = gsl_odeiv2_evolve_apply(drv->e, drv->c, drv->s, drv->sys, t, t1, &drv->h, y);
+    if (gs != GSL_SUCCESS) return gs;
+    if (drv->nmax > 0 && drv->n > drv->nmax) return GSL_EMAXITER;
+    if (fabs(drv->h) > drv->hmax) drv->h = drv->hmax;
+    if (fabs(drv->h) < drv->hmin) return GSL_ENOPROG;
+    drv->n++;
+    double d[PRRU_NACT];
+    prru_param_ik(&o->plant, y, d); /* the plant's sliders, as at the ticks */
+    if ((*bad = stroke_violation(o, d)) >= 0) return GSL_EDOM;
+  }
+  return GSL_SUCCESS;
+}
+
 static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk, double y[6],
                       char *msg, int msglen)
 {
   c->status = PRRU_OK;
   gsl_odeiv2_driver_reset(drv);
-  int gs = gsl_odeiv2_driver_apply(drv, t, tk, y);
+  int bad = -1, gs = track_advance(drv, c->o, t, tk, y, &bad);
   if (gs == GSL_SUCCESS) return PRRU_OK;
+  if (gs == GSL_EDOM && bad >= 0) {
+    double d[PRRU_NACT];
+    prru_param_ik(&c->o->plant, y, d);
+    return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
+                     "stopped at t = %.9g s (between samples): slider %d at d = %.9g m "
+                     "left its stroke [%g, %g]", *t, bad + 1, d[bad], c->o->d_min[bad],
+                     c->o->d_max[bad]);
+  }
   int st = gs == GSL_EBADFUNC && c->status != PRRU_OK ? c->status : PRRU_ENOCONV;
   if (st == PRRU_EINTERRUPTED)
     return prru_fail(msg, msglen, st, "interrupted at t = %.9g s", *t);
