@@ -413,8 +413,6 @@ int prru_cmd_id(int argc, char **argv)
     free(rates_q);
     return 1;
   }
-  const char *name = o.name;
-  int in_place = o.tmp_path == NULL;
   prru_model m;
   prru_model_default(&m);
   prru_data *d = malloc(sizeof *d);
@@ -498,20 +496,8 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_out_printf(&o, "\n");
     prru_cli_out_row(&o);
   }
-  long rows = o.rows;
-  int io = o.err != 0;
   free(d);
   free(rates_q);
   prru_table_free(&t);
-  /* The rows before a stop are kept; nothing (and the old file) when the
-   * first row already failed or the output could not be written. */
-  if (prru_cli_out_close(&o, !io && (rows > 0 || st == PRRU_OK))) return 1;
-  if (st != PRRU_OK) {
-    if (rows > 0)
-      prru_cli_error("id", "%s; %ld rows written to %s", why, rows, name);
-    else
-      prru_cli_error("id", "%s; nothing written%s%s%s", why, in_place ? "" : ", ",
-                     in_place ? "" : name, in_place ? "" : " is not changed");
-  }
-  return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
+  return prru_cli_out_finish(&o, st, why);
 }

@@ -228,8 +228,6 @@ int prru_cmd_traj(int argc, char **argv)
     prru_quintic_free(&tr);
     return 1;
   }
-  const char *name = o.name;
-  int in_place = o.tmp_path == NULL;
   prru_cli_out_comment(&o);
   prru_cli_out_printf(&o, "# quintic point-to-point: %d waypoints, %.17g s\n", tr.n, span);
   prru_cli_out_line(&o);
@@ -238,17 +236,7 @@ int prru_cmd_traj(int argc, char **argv)
   char why[600] = "";
   int st = traj_rows(&o, &tr, dt, why, sizeof why);
   prru_quintic_free(&tr);
-  long rows = o.rows;
-  int io = o.err != 0;
-  if (prru_cli_out_close(&o, !io && (rows > 0 || st == PRRU_OK))) return 1;
-  if (st != PRRU_OK) {
-    if (rows > 0)
-      prru_cli_error("traj", "%s; the %ld rows before it written to %s", why, rows, name);
-    else
-      prru_cli_error("traj", "%s; nothing written%s%s%s", why, in_place ? "" : ", ",
-                     in_place ? "" : name, in_place ? "" : " is not changed");
-  }
-  return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
+  return prru_cli_out_finish(&o, st, why);
 }
 
 /* ---- prru track ---- */

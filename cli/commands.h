@@ -175,6 +175,11 @@ void prru_cli_out_comment(prru_cli_out *o);
  * its old contents). 0, or 1 after "prru CMD: FILE: write error: REASON"
  * when a write, sync, close or rename failed (the partial file removed). */
 int prru_cli_out_close(prru_cli_out *o, int keep);
+/* Closes o after a run that ended with status st, why saying why when it
+ * is not PRRU_OK: the rows are kept when there are some or the run
+ * succeeded, and a stop is reported with what was kept (the rows before
+ * it, or nothing and the old file unchanged). The command's exit status. */
+int prru_cli_out_finish(prru_cli_out *o, int st, const char *why);
 
 /* CSV of simulation samples: the model comment line, then the header
  * t,q1..3,qd1..3,d1..dNACT, the PRRU_NLAMBDA reactions (named by

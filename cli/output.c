@@ -247,6 +247,21 @@ int prru_cli_out_close(prru_cli_out *o, int keep)
   return rc;
 }
 
+int prru_cli_out_finish(prru_cli_out *o, int st, const char *why)
+{
+  const char *name = o->name;
+  const long rows = o->rows;
+  const int in_place = o->tmp_path == NULL;
+  if (prru_cli_out_close(o, !o->err && (rows > 0 || st == PRRU_OK))) return 1;
+  if (st == PRRU_OK) return 0;
+  if (rows > 0)
+    prru_cli_error(o->cmd, "%s; the %ld rows before it written to %s", why, rows, name);
+  else
+    prru_cli_error(o->cmd, "%s; nothing written%s%s%s", why, in_place ? "" : ", ",
+                   in_place ? "" : name, in_place ? "" : " is not changed");
+  return prru_cli_exit_for(st);
+}
+
 const char *prru_cli_out_error(const prru_cli_out *o)
 {
   return o->err ? strerror(o->err) : "no error";

@@ -20,7 +20,7 @@ portable C99 that compiles to a plain scalar loop anywhere.
 """
 
 from . import cgen
-from .cgen import PREC, Node
+from .cgen import Node
 
 BATCH_CHUNK = 32
 
@@ -90,21 +90,7 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
         return inline(n, parent_prec, right)
 
     def inline(n, parent_prec=0, right=False):
-        op = n.op
-        if op == "call":
-            return "%s(%s)" % (n.args[0],
-                               ", ".join(expr(a) for a in n.args[1:]))
-        if op == "neg":
-            s = "-" + expr(n.args[0], 3)
-        else:
-            sym_op = {"add": "+", "sub": "-", "mul": "*", "div": "/"}[op]
-            p = PREC[op]
-            s = "%s %s %s" % (expr(n.args[0], p), sym_op,
-                              expr(n.args[1], p, right=True))
-        p = PREC[op]
-        if p < parent_prec or (p == parent_prec and right):
-            return "(" + s + ")"
-        return s
+        return cgen.print_op(n, expr, parent_prec, right)
 
     used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
     trig = [g.nodes[i] for i in sorted(live) if _is_input_trig(g.nodes[i])]

@@ -150,6 +150,28 @@ class Graph:
         return self.node("mul", self._ipow(base, p - 1), base)
 
 
+def print_op(n, expr, parent_prec=0, right=False):
+    """C text of operation node n, its operands printed by
+    expr(node, precedence, right) (a temporary's name, an input, or the
+    operand inline)."""
+    op = n.op
+    if op == "call":
+        return "%s(%s)" % (n.args[0], ", ".join(expr(a) for a in n.args[1:]))
+    if op == "neg":
+        s = "-" + expr(n.args[0], 3)
+    else:
+        sym_op = {"add": "+", "sub": "-", "mul": "*", "div": "/"}[op]
+        p = PREC[op]
+        s = "%s %s %s" % (expr(n.args[0], p), sym_op,
+                          expr(n.args[1], p, right=True))
+    p = PREC[op]
+    # Left-associative printing: a right operand of equal precedence
+    # needs parentheses (a - (b + c)), a left one does not.
+    if p < parent_prec or (p == parent_prec and right):
+        return "(" + s + ")"
+    return s
+
+
 class Kernel:
     """One C function: inputs (C array, symbol names), outputs (C array, exprs)."""
 
@@ -279,22 +301,7 @@ def emit(kernel, prefix):
         return inline(n, parent_prec, right)
 
     def inline(n, parent_prec=0, right=False):
-        op = n.op
-        if op == "call":
-            return "%s(%s)" % (n.args[0], ", ".join(expr(a) for a in n.args[1:]))
-        if op == "neg":
-            s = "-" + expr(n.args[0], 3)
-        else:
-            sym_op = {"add": "+", "sub": "-", "mul": "*", "div": "/"}[op]
-            p = PREC[op]
-            s = "%s %s %s" % (expr(n.args[0], p), sym_op,
-                              expr(n.args[1], p, right=True))
-        p = PREC[op]
-        # Left-associative printing: a right operand of equal precedence
-        # needs parentheses (a - (b + c)), a left one does not.
-        if p < parent_prec or (p == parent_prec and right):
-            return "(" + s + ")"
-        return s
+        return print_op(n, expr, parent_prec, right)
 
     # Inputs of the guard first, then the guard, then everything else.
     guard_live = _uses(guard_nodes)[1] if guard_nodes else set()
