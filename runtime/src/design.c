@@ -419,59 +419,35 @@ static int home_mode(const prru_params *p, double q3)
 
 /* The design's kernels at a block of grid points, from the batched
  * dme_terms (bit for bit prru_param_ik_jd, _mass, _platform_jacobian):
- * rows of GRID_BLOCK, point c's entry i at [i * n + c]. */
+ * rows of GRID_BLOCK, point c's entry i at [i * n + c]; then w_R, the
+ * status, rcond and the mode of every point from prru_dme_batch (bit for
+ * bit prru_jd_regular, prru_mode_status and prru_dme_from). */
 #define GRID_BLOCK 64
 typedef struct {
   int n;
   double q[3 * GRID_BLOCK], d[PRRU_NACT * GRID_BLOCK], Jd[3 * PRRU_NACT * GRID_BLOCK],
-      M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK];
+      M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK], rc[GRID_BLOCK];
+  unsigned char st[GRID_BLOCK], other[GRID_BLOCK];
+  prru_dme_batch_ws ws;
 } grid_block;
 
-/* Point c's count entries of one of the block's outputs. */
-static void block_gather(const grid_block *b, int c, int count, const double *rows, double *out)
-{
-  for (int i = 0; i < count; i++) out[i] = rows[i * b->n + c];
-}
-
-/* w_R at one grid point exactly as `prru map` gets it with the model's
- * kernels, here with the design's: unreachable, singular (rcond below the
- * tolerance), or regular but in the other assembly mode (det J_d's sign
- * not home's: cut off from home by the singular locus; counted as
- * singular, like the map does) are not ok. *viol, the point's share of the
- * regularity violation, is continuous in the signed conditioning
- * s = +-rcond (sign: home's mode or not), r = rcond_min, C = ln(r / eps):
+/* Point c's share of the regularity violation, for the status the map
+ * gives it: unreachable, singular (rcond below the tolerance), or regular
+ * but in the other assembly mode (det J_d's sign not home's: cut off from
+ * home by the singular locus; counted as singular, like the map does) are
+ * not ok. The penalty is continuous in the signed conditioning s = +-rcond
+ * (sign: home's mode or not), r = rcond_min, C = ln(r / eps):
  *   s >= r: 0;  0 < s < r: min(C, ln(r / s));  s <= 0: C + ln(1 + |s| / r);
- * unreachable points get C (rcond falls to 0 at the reach boundary). */
-static int point_w(const prru_design_problem *pr, const grid_block *b, int c, double L, int home,
-                   double d[PRRU_NACT], double *w, double *viol)
+ * unreachable points get C (rcond falls to 0 at the reach boundary); the
+ * other mode's singular points are penalised too, so that it is continuous
+ * across the locus. */
+static double point_violation(const prru_design_problem *pr, const grid_block *b, int c)
 {
-  const double r = pr->rcond_min, cap = log(r / DBL_EPSILON);
-  double Jd[PRRU_NACT * 3], Jdpinv[3 * PRRU_NACT], rc = 0.0;
-  prru_dme dme;
-  *w = NAN;
-  block_gather(b, c, PRRU_NACT, b->d, d);
-  block_gather(b, c, 3 * PRRU_NACT, b->Jd, Jd);
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (!isfinite(d[i])) {
-      *viol = cap;
-      return PRRU_EUNREACHABLE;
-    }
-  /* The status as the map classifies it; the penalty also for the other
-   * mode's singular points, so that it is continuous across the locus. */
-  int st = prru_mode_status(prru_jd_regular(Jd, L, r, Jdpinv, &rc), Jd, home);
-  if (prru_jd_other_mode(Jd, home)) {
-    *viol = cap + log1p(rc / r);
-    return st;
-  }
-  if (st == PRRU_OK) {
-    double M[9], JP[18];
-    block_gather(b, c, 9, b->M, M);
-    block_gather(b, c, 18, b->JP, JP);
-    st = prru_dme_from(M, Jdpinv, JP, &dme);
-    *w = dme.w_R;
-  }
-  *viol = st == PRRU_OK ? 0.0 : rc > 0 && rc < r ? fmin(cap, log(r / rc)) : cap;
-  return st;
+  const double r = pr->rcond_min, cap = log(r / DBL_EPSILON), rc = b->rc[c];
+  const int st = b->st[c];
+  if (st == PRRU_EUNREACHABLE) return cap;
+  if (b->other[c]) return cap + log1p(rc / r);
+  return st == PRRU_OK ? 0.0 : rc > 0 && rc < r ? fmin(cap, log(r / rc)) : cap;
 }
 
 /* One design over the grid: rows handed out under a mutex (a row is n2
@@ -492,34 +468,37 @@ static void grid_row(grid_job *j, int i)
   const prru_map_grid *g = &pr->grid;
   struct prru_design_row *r = &j->dd->rows[i];
   const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
-  double d[PRRU_NACT], v;
-  grid_block b; /* 22 KB of this thread's stack: no allocation */
+  grid_block b; /* about 40 KB of this thread's stack: no allocation */
   memset(r, 0, sizeof *r);
   r->dmin = INFINITY;
   r->dmax = -INFINITY;
-  for (int c = 0; c < g->n2; c++) {
-    const int c0 = c - c % GRID_BLOCK;
-    if (c == c0) { /* the kernels for the next block of points */
-      b.n = g->n2 - c0 < GRID_BLOCK ? g->n2 - c0 : GRID_BLOCK;
-      for (int t = 0; t < b.n; t++) {
-        b.q[t] = q1;
-        b.q[b.n + t] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + t);
-        b.q[2 * b.n + t] = g->q3;
+  for (int c0 = 0; c0 < g->n2; c0 += GRID_BLOCK) {
+    b.n = g->n2 - c0 < GRID_BLOCK ? g->n2 - c0 : GRID_BLOCK;
+    for (int t = 0; t < b.n; t++) {
+      b.q[t] = q1;
+      b.q[b.n + t] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + t);
+      b.q[2 * b.n + t] = g->q3;
+    }
+    const long k0 = (long)i * g->n2 + c0;
+    prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
+    prru_dme_batch(b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
+                   &j->dd->w_R[k0], b.st, b.rc, b.other);
+    for (int c = 0; c < b.n; c++) {
+      const long k = k0 + c;
+      const int st = b.st[c];
+      if (j->compare && (st == PRRU_OK) != (j->dd->status[k] == PRRU_OK)) r->changed = 1;
+      j->dd->status[k] = (unsigned char)st;
+      r->viol += point_violation(pr, &b, c);
+      if (st == PRRU_EUNREACHABLE) continue;
+      r->nreach++;
+      double d[PRRU_NACT];
+      for (int a = 0; a < PRRU_NACT; a++) {
+        d[a] = b.d[a * b.n + c];
+        r->dmin = fmin(r->dmin, d[a]);
+        r->dmax = fmax(r->dmax, d[a]);
       }
-      prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
+      if (pr->stroke) r->stroke += stroke_excess(pr, d) / j->L;
     }
-    long k = (long)i * g->n2 + c;
-    int st = point_w(pr, &b, c - c0, j->L, j->home, d, &j->dd->w_R[k], &v);
-    if (j->compare && (st == PRRU_OK) != (j->dd->status[k] == PRRU_OK)) r->changed = 1;
-    j->dd->status[k] = (unsigned char)st;
-    r->viol += v;
-    if (st == PRRU_EUNREACHABLE) continue;
-    r->nreach++;
-    for (int a = 0; a < PRRU_NACT; a++) {
-      r->dmin = fmin(r->dmin, d[a]);
-      r->dmax = fmax(r->dmax, d[a]);
-    }
-    if (pr->stroke) r->stroke += stroke_excess(pr, d) / j->L;
   }
 }
 
