@@ -10,7 +10,10 @@
  * on the same states; w_R: prru_map_eval (one thread, batched kernels)
  * against a loop of prru_dme_eval over the same grid. Every pair is timed
  * interleaved and reported as the median [min-max] of the per-repetition
- * ratios, so load that comes and goes hits both sides alike. */
+ * ratios, so load that comes and goes hits both sides alike. Thread
+ * scaling: prru_map_eval on one and on two threads over a SCALE_N^2 grid,
+ * large enough (about 20 ms a map on one thread) that starting the threads
+ * and handing out rows cost nothing next to the work. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -21,6 +24,7 @@
 
 #define NB 1024   /* states per batched call */
 #define MAP_N 64  /* w_R grid: MAP_N x MAP_N */
+#define SCALE_N 512 /* thread-scaling grid: SCALE_N x SCALE_N */
 
 bench_modes bench_modes_result;
 int bench_modes_done;
@@ -151,22 +155,22 @@ static double run_batch(const bench_ctx *c, int kind, int batched)
   return t / NB;
 }
 
-/* w_R over the MAP_N^2 grid of the fig. 7 rectangle: prru_map_eval with
+/* w_R over the n x n grid of the fig. 7 rectangle: prru_map_eval with
  * `threads` threads, or (threads 0) a loop of prru_dme_eval. ns per point. */
-static double run_map(bench_ctx *c, int threads, double *w, unsigned char *st)
+static double run_map_n(bench_ctx *c, int n, int threads, double *w, unsigned char *st)
 {
   const prru_map_grid g = {-PRRU_BENCH_PI / 6, PRRU_BENCH_PI / 6, -PRRU_BENCH_PI / 4,
-                           PRRU_BENCH_PI / 4, 0.0, MAP_N, MAP_N};
+                           PRRU_BENCH_PI / 4, 0.0, n, n};
   double t0 = bench_now_ns(), acc = 0.0;
   if (threads > 0) {
     prru_map_options o;
     prru_map_options_default(&o);
     o.nthreads = threads;
     c->failures += prru_map_eval(&c->m, &g, &o, w, st, NULL) != PRRU_OK;
-    for (int k = 0; k < MAP_N * MAP_N; k++) acc += st[k] == PRRU_OK ? w[k] : 0.0;
+    for (long k = 0; k < (long)n * n; k++) acc += st[k] == PRRU_OK ? w[k] : 0.0;
   } else {
-    for (int i = 0; i < MAP_N; i++)
-      for (int j = 0; j < MAP_N; j++) {
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) {
         double q[3] = {prru_map_axis(g.q1_lo, g.q1_hi, g.n1, i),
                        prru_map_axis(g.q2_lo, g.q2_hi, g.n2, j), g.q3};
         prru_dme r;
@@ -175,7 +179,12 @@ static double run_map(bench_ctx *c, int threads, double *w, unsigned char *st)
   }
   double t = bench_now_ns() - t0;
   bench_sink = bench_sink + acc;
-  return t / (MAP_N * MAP_N);
+  return t / ((double)n * n);
+}
+
+static double run_map(bench_ctx *c, int threads, double *w, unsigned char *st)
+{
+  return run_map_n(c, MAP_N, threads, w, st);
 }
 
 static void time_batched(bench_ctx *c, int kind, int reps, bench_batch_row *r)
@@ -272,10 +281,12 @@ void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m)
   m->idle_second_core = second_core_idle(quick ? 0.05 : 0.5, &m->ncpu);
   m->scaling_measured = m->ncpu > 1 && m->idle_second_core >= 0.9;
   if (m->scaling_measured) {
-    static double w[MAP_N * MAP_N];
-    static unsigned char st[MAP_N * MAP_N];
+    static double w[SCALE_N * SCALE_N];
+    static unsigned char st[SCALE_N * SCALE_N];
     double r[MAXREPS];
-    for (int i = 0; i < reps; i++) r[i] = run_map(c, 1, w, st) / run_map(c, 2, w, st);
+    run_map_n(c, SCALE_N, 2, w, st); /* warm-up: the pages of w and st */
+    for (int i = 0; i < reps; i++)
+      r[i] = run_map_n(c, SCALE_N, 1, w, st) / run_map_n(c, SCALE_N, 2, w, st);
     m->scaling = bench_stats_of(r, reps);
   }
 }
@@ -307,9 +318,10 @@ void bench_modes_print_table(const bench_modes *m)
   batch_row("dme_terms", &m->batch_dme_terms);
   batch_row("w_R (64x64 map)", &m->batch_w_r);
   if (m->scaling_measured)
-    printf("thread scaling (map, 2 threads vs 1; a second core was %.0f %% idle): %.2fx "
-           "[%.2f-%.2f]\n\n",
-           100 * m->idle_second_core, m->scaling.median, m->scaling.min, m->scaling.max);
+    printf("thread scaling (%dx%d map, 2 threads vs 1; a second core was %.0f %% idle): "
+           "%.2fx [%.2f-%.2f]\n\n",
+           SCALE_N, SCALE_N, 100 * m->idle_second_core, m->scaling.median, m->scaling.min,
+           m->scaling.max);
   else
     printf("thread scaling: not measured (%d CPUs; the second most idle was %.0f %% idle, "
            "below 90 %%)\n\n",
@@ -350,7 +362,8 @@ void bench_modes_print_json(const bench_modes *m)
   json_batch("w_r", &m->batch_w_r, 1);
   printf("}, \"thread_scaling\": ");
   if (m->scaling_measured) {
-    printf("{\"second_core_idle\": %.3f, ", m->idle_second_core);
+    printf("{\"second_core_idle\": %.3f, \"map_points\": %d, ", m->idle_second_core,
+           SCALE_N * SCALE_N);
     json_stats("map_2_over_1_threads", &m->scaling);
     printf("}");
   } else {
