@@ -105,23 +105,105 @@ PRRU_BATCH_TARGETS static void regular3(int n, int o, int m, const double *d, co
   }
 }
 #else
-/* More actuators: J_d^+ by prru_jd_regular's Householder QR, pose by
- * pose (its pivot-free but branching arithmetic is not batched). */
-static void regular_scalar(int n, int o, int m, const double *d, const double *Jd, double L,
-                           double rcond_min, int home, prru_dme_batch_ws *ws)
+/* Stage 1, more actuators: prru_jd_regular with rcond_pinv's arithmetic
+ * (core.c): J_d^+ = diag(1/L, 1/L, 1) Js^+ from the Householder QR of Js,
+ * its early returns as a flag. With more than three actuators J_d has no
+ * determinant sign: prru_jd_other_mode is home != 0 (and home, from
+ * prru_assembly_mode, is 0). */
+PRRU_BATCH_TARGETS static void regular_qr(int n, int o, int m, const double *d, const double *Jd,
+                                          double L, double rcond_min, int home,
+                                          prru_dme_batch_ws *ws)
 {
+  const double other_code = home != 0 ? (double)PRRU_DME_OTHER_MODE : (double)PRRU_OK,
+               other_flag = home != 0 ? 1.0 : 0.0;
+  PRRU_BATCH_LOOP
   for (int k = 0; k < m; k++) {
-    const long i = (long)o + k;
-    double J[3 * N], inv[3 * N] = {0}, rc = 0.0;
-    int reach = 1;
-    for (int r = 0; r < N; r++) reach = reach && isfinite(d[r * (long)n + i]);
-    for (int r = 0; r < 3 * N; r++) J[r] = Jd[r * (long)n + i];
-    int st = PRRU_EUNREACHABLE;
-    if (reach) st = prru_mode_status(prru_jd_regular(J, L, rcond_min, inv, &rc), J, home);
-    for (int r = 0; r < 3 * N; r++) ws->inv[r][k] = inv[r];
-    ws->rcond[k] = rc;
-    ws->other[k] = reach && prru_jd_other_mode(J, home) ? 1.0 : 0.0;
-    ws->pre[k] = (double)st;
+    const long x = (long)o + k;
+    /* every slider and every entry of Js finite: x * 0 is +-0 exactly
+     * when x is finite */
+    double dz = 0.0, jz = 0.0;
+    UNROLLED
+    for (int i = 0; i < N; i++) {
+      dz += d[i * (long)n + x] * 0.0;
+      ws->W[3 * i][k] = Jd[3 * i * (long)n + x] / L;
+      ws->W[3 * i + 1][k] = Jd[(3 * i + 1) * (long)n + x] / L;
+      ws->W[3 * i + 2][k] = Jd[(3 * i + 2) * (long)n + x];
+      jz += ws->W[3 * i][k] * 0.0 + ws->W[3 * i + 1][k] * 0.0 + ws->W[3 * i + 2][k] * 0.0;
+    }
+    const int reach = dz == 0.0;
+    double ok = jz == 0.0 ? 1.0 : 0.0, na = 0;
+    UNROLLED
+    for (int j = 0; j < 3; j++) {
+      double s = 0;
+      UNROLLED
+      for (int i = 0; i < N; i++) s += fabs(ws->W[3 * i + j][k]);
+      na = s > na ? s : na;
+    }
+    UNROLLED
+    for (int c = 0; c < 3; c++) { /* H_c: W[c.., c] -> (alpha, 0, ...) */
+      double sc = 0, nx = 0, vv = 0;
+      UNROLLED
+      for (int i = c; i < N; i++) {
+        const double a = fabs(ws->W[3 * i + c][k]);
+        sc = a > sc ? a : sc; /* fmax: sc is never NaN */
+      }
+      ok = sc > 0 ? ok : 0.0;
+      UNROLLED
+      for (int i = 0; i < N; i++) ws->V[N * c + i][k] = i < c ? 0.0 : ws->W[3 * i + c][k] / sc;
+      UNROLLED
+      for (int i = c; i < N; i++) nx += ws->V[N * c + i][k] * ws->V[N * c + i][k];
+      nx = sqrt(nx);
+      const double alpha = ws->V[N * c + c][k] > 0 ? -nx : nx;
+      ws->V[N * c + c][k] -= alpha;
+      UNROLLED
+      for (int i = c; i < N; i++) vv += ws->V[N * c + i][k] * ws->V[N * c + i][k];
+      ws->beta[c][k] = 2.0 / vv;
+      UNROLLED
+      for (int j = c; j < 3; j++) {
+        double s = 0;
+        UNROLLED
+        for (int i = c; i < N; i++) s += ws->V[N * c + i][k] * ws->W[3 * i + j][k];
+        s *= ws->beta[c][k];
+        UNROLLED
+        for (int i = c; i < N; i++) ws->W[3 * i + j][k] -= s * ws->V[N * c + i][k];
+      }
+      ws->W[3 * c + c][k] = alpha * sc;
+    }
+    /* X = R^-1 (rows 0..2 of Q^T), column by column, into ws->inv */
+    double nxm = 0;
+    UNROLLED
+    for (int col = 0; col < N; col++) {
+      UNROLLED
+      for (int i = 0; i < N; i++) ws->e[i][k] = i == col ? 1.0 : 0.0;
+      UNROLLED
+      for (int c = 0; c < 3; c++) {
+        double s = 0;
+        UNROLLED
+        for (int i = c; i < N; i++) s += ws->V[N * c + i][k] * ws->e[i][k];
+        s *= ws->beta[c][k];
+        UNROLLED
+        for (int i = c; i < N; i++) ws->e[i][k] -= s * ws->V[N * c + i][k];
+      }
+      UNROLLED
+      for (int i = 2; i >= 0; i--) {
+        double s = ws->e[i][k];
+        UNROLLED
+        for (int j = i + 1; j < 3; j++) s -= ws->W[3 * i + j][k] * ws->inv[N * j + col][k];
+        ws->inv[N * i + col][k] = s / ws->W[3 * i + i][k];
+      }
+      const double s = fabs(ws->inv[col][k]) + fabs(ws->inv[N + col][k]) + fabs(ws->inv[2 * N + col][k]);
+      nxm = s <= nxm ? nxm : s; /* NaN propagates */
+    }
+    ok = FINITE(nxm) ? ok : 0.0;
+    ok = nxm > 0 ? ok : 0.0;
+    const double rc = ok != 0.0 ? 1.0 / (na * nxm) : 0.0;
+    UNROLLED
+    for (int j = 0; j < 2 * N; j++) ws->inv[j][k] /= L;
+    double pre = rc > 0 ? other_code : (double)PRRU_ESINGULAR;
+    pre = rc >= rcond_min ? pre : (double)PRRU_ESINGULAR;
+    ws->pre[k] = reach ? pre : (double)PRRU_EUNREACHABLE;
+    ws->rcond[k] = reach ? rc : 0.0;
+    ws->other[k] = reach ? other_flag : 0.0;
   }
 }
 #endif
@@ -310,7 +392,7 @@ void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, c
 #if N == 3
     regular3(n, o, m, d, Jd, L, rcond_min, home, ws);
 #else
-    regular_scalar(n, o, m, d, Jd, L, rcond_min, home, ws);
+    regular_qr(n, o, m, d, Jd, L, rcond_min, home, ws);
 #endif
     transformed(n, o, m, M, JP, ws);
     range_basis(n, o, m, JP, ws);

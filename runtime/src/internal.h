@@ -38,6 +38,10 @@ typedef struct {
       g1[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
   double pre[PRRU_DME_BATCH_CHUNK], rcond[PRRU_DME_BATCH_CHUNK], other[PRRU_DME_BATCH_CHUNK],
       ok[PRRU_DME_BATCH_CHUNK], w[PRRU_DME_BATCH_CHUNK];
+#if PRRU_NACT > 3 /* the Householder QR of J_d */
+  double W[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], V[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+      beta[3][PRRU_DME_BATCH_CHUNK], e[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
+#endif
 } prru_dme_batch_ws;
 /* w_R and the status of n poses from their kernel outputs in SoA layout
  * (entry i of pose k at [i * n + k], as prru_batch_dme_terms gives d, J_d,
