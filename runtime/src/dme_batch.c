@@ -1,7 +1,8 @@
 /* w_R and the map's status over a block of poses, in structure-of-arrays
  * layout, bit for bit what the scalar path gives pose by pose:
- * prru_jd_regular (prru_rcond3's arithmetic with three actuators),
- * prru_mode_status and prru_dme_from. Every IEEE operation is the scalar
+ * prru_jd_regular (prru_rcond3's arithmetic with three actuators, the
+ * Householder QR of rcond_pinv with more), prru_mode_status and
+ * prru_dme_from. Every IEEE operation is the scalar
  * code's, in its order; its branches (pivots, early failures) are selects,
  * so each stage is a loop over the poses that the build may vectorise
  * (PRRU_BATCH_LOOP, PRRU_BATCH_TARGETS: the batched kernels' options,
