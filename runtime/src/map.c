@@ -1,7 +1,9 @@
 /* w_R over a (q1, q2) grid with POSIX threads. Rows (fixed q1) are handed
  * out one at a time under a mutex: a row is n2 evaluations, so the lock is
- * negligible, and rows near the singular corners (cheaper: they stop at
- * the rcond test) do not unbalance a static split. */
+ * negligible, and a thread that is descheduled for a while (the machine
+ * shared) does not leave its static share of rows to the end. Each row is
+ * evaluated in blocks of points by the batched kernels and prru_dme_batch,
+ * which cost the same at every point. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <pthread.h>
