@@ -125,9 +125,11 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
 /* The one computation of the DME behind prru_dme_eval, from its
  * ingredients at a pose already found regular: M (3x3), J_d^+ (3 x N, as
  * prru_jd_regular leaves it) and the platform Jacobian [J_R,P; J_T,P]
- * (6x3, row-major, as prru_platform_jacobian). The design optimiser
- * (prru_design.h) calls it with a candidate design's matrices, so w_R has
- * one definition. Returns out->status (PRRU_ESINGULAR when a result is not
+ * (6x3, row-major, as prru_platform_jacobian). prru_map_eval and the
+ * design optimiser (prru_design.h) evaluate blocks of points with a
+ * batched copy of it that gives the same bits at every point (its
+ * operations in the same order, its branches as selects), so w_R has one
+ * definition. Returns out->status (PRRU_ESINGULAR when a result is not
  * finite); out->jd_rcond is left as it is. */
 int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
                   prru_dme *out);
