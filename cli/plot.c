@@ -24,9 +24,16 @@
  * doubled quote '' next to another one or at the start of a string. */
 static void put_string(FILE *g, const char *s, int escape_enhanced)
 {
+  /* Labels break at the first space after LABEL_WIDTH characters (a title
+   * made of a file's comment lines would run off a 1000-pixel image). */
+  enum { LABEL_WIDTH = 110 };
+  int col = 0;
   fputc('\'', g);
-  for (const char *c = s; *c; c++) {
-    if (*c == '\'')
+  for (const char *c = s; *c; c++, col++) {
+    if (escape_enhanced && *c == ' ' && col >= LABEL_WIDTH) {
+      fputs("'.\"\\n\".'", g);
+      col = -1;
+    } else if (*c == '\'')
       fputs("'.\"'\".'", g);
     else if (escape_enhanced && strchr("_^{}@&~", *c))
       fprintf(g, "\\%c", *c);

@@ -123,6 +123,22 @@ grep -q "mismatch ''" "$tmp/track.csv" && ok || bad "the track CSV no longer say
 sed "1s/\$/ it's '''' quoted/" "$tmp/traj.csv" >"$tmp/quotes.csv"
 "$PRRU" plot "$tmp/quotes.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/quotes.png")" = "1000 1000" ] \
   && ok || bad "plot of a CSV with quotes in its comments: $(head -c 300 "$tmp/err")"
+# A title made of long comment lines breaks into lines of about 110
+# characters instead of running off the image: the script gnuplot gets
+# (caught by a gnuplot on PATH that keeps a copy) has its subtitle in parts.
+mkdir -p "$tmp/fakebin"
+real_gnuplot=$(command -v gnuplot)
+printf '#!/bin/sh\ncp "$1" "%s/script.gp"\nexec "%s" "$@"\n' "$tmp" "$real_gnuplot" >"$tmp/fakebin/gnuplot"
+chmod +x "$tmp/fakebin/gnuplot"
+long=$(printf 'word%.0s ' $(seq 1 60))
+sed "1s/\$/ $long/" "$tmp/traj.csv" >"$tmp/long.csv"
+PATH="$tmp/fakebin:$PATH" "$PRRU" plot "$tmp/long.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/long.png")" = "1000 1000" ] \
+  && python3 - "$tmp/script.gp" <<'PY' && ok || bad "long title: $(head -c 300 "$tmp/err")"
+import re, sys
+sub = [l for l in open(sys.argv[1]) if l.startswith("sub = ")][0]
+parts = sub[len("sub = "):].strip().split("'.\"\\n\".'")
+assert len(parts) >= 3 and max(len(p) for p in parts) <= 130, [len(p) for p in parts]
+PY
 # Bad files of these kinds: exit 2 naming the file and the reason.
 h_track=$(grep -m1 '^t,' "$tmp/track.csv") h_traj=$(grep -m1 '^t,' "$tmp/traj.csv")
 h_id=$(grep -m1 '^t,' "$tmp/id.csv") h_excite=$(grep -m1 '^t,' "$tmp/excite.csv")
