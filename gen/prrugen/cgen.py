@@ -337,26 +337,33 @@ def emit(kernel, prefix):
         lines.append("  return;")
         lines.append("}")
     # Each temporary right before its first use and each output stored as
-    # soon as it is complete: GCC does not schedule before register
-    # allocation on x86-64, so the order printed is the order run, and
-    # computing every temporary first kept hundreds of them live at once.
-    def emit_needed(n):
-        for a in n.args:
-            if not isinstance(a, Node) or a.op in ("num", "in") or a.index in temp:
+    # soon as it is complete, rather than every temporary first and the
+    # outputs last: GCC does not reorder straight-line code before register
+    # allocation on x86-64, so the order printed is the order run.
+    def pending(n):
+        return isinstance(n, Node) and n.op not in ("num", "in") and \
+            n.index not in temp
+
+    def emit_needed(root):
+        """root's temporaries in operand order, each after its operands
+        (iterative, like _uses: the sums of long kernels nest deeply)."""
+        stack, seen = [(root, False)], set()
+        while stack:
+            n, done = stack.pop()
+            if done:
+                if materialized(n) and n.index not in temp:
+                    temp[n.index] = "t%d" % len(temp)
+                    lines.append("const double %s = %s;" % (temp[n.index], inline(n)))
                 continue
-            emit_needed(a)
-            if materialized(a):
-                name = "t%d" % len(temp)
-                lines.append("const double %s = %s;" % (name, inline(a)))
-                temp[a.index] = name
+            if not pending(n) or n.index in seen:
+                continue
+            seen.add(n.index)
+            stack.append((n, True))
+            stack.extend((a, False) for a in reversed(n.args) if pending(a))
 
     for arr, ns in out_nodes:
         for i, n in enumerate(ns):
-            if n.op not in ("num", "in") and n.index not in temp:
-                emit_needed(n)
-                if materialized(n):
-                    temp[n.index] = "t%d" % len(temp)
-                    lines.append("const double %s = %s;" % (temp[n.index], inline(n)))
+            emit_needed(n)
             lines.append("%s[%d] = %s;" % (arr, i, expr(n)))
     for arr, syms in kernel.inputs:
         if not any(("%s%d" % (arr, i + 1)) in used_inputs
