@@ -52,6 +52,23 @@ wait_file() {
   done
   return 1
 }
+# catch_stage GLOB SECONDS: runs the background prru ($pid) in slices of
+# about a millisecond (SIGCONT, sleep, SIGSTOP) until GLOB exists, and
+# leaves it stopped there (return 0; 1 when GLOB never appeared or prru
+# ended). A stage that lasts a few milliseconds (the paper's simulation
+# file) falls between two polls of a free-running process; not between
+# two slices.
+catch_stage() {
+  local glob=$1 i f
+  for ((i = 0; i < $2 * 500; i++)); do
+    kill -STOP "$pid" 2>/dev/null || return 1
+    for f in $glob; do [ -e "$f" ] && return 0; done
+    kill -CONT "$pid"
+    sleep 0.001
+  done
+  kill -CONT "$pid" 2>/dev/null
+  return 1
+}
 # start CMD...: runs prru in the background (pid in $pid) with its own
 # default SIGINT (job control on: without it bash ignores SIGINT in
 # background commands, and prru keeps signals it finds ignored), stderr in
@@ -196,8 +213,9 @@ for stage_file in "paper_sim.csv.partial-*" "fig_q.png"; do
   echo "old summary" >"$pd/summary.txt"
   echo "old png" >"$pd/fig_q.png"
   start paper --out "$pd"
-  wait_file "$pd/paper.partial-*/$stage_file" 60 || bad "paper: $stage_file never appeared"
+  catch_stage "$pd/paper.partial-*/$stage_file" 60 || bad "paper: $stage_file never appeared"
   kill -INT "$pid"
+  kill -CONT "$pid"
   finish_bg
   [ $rc -eq 130 ] && grep -q "is not changed" "$tmp/bg.err" && ok || bad "paper stopped at $stage_file: exit $rc: $(tail -c 300 "$tmp/bg.err")"
   [ "$(ls -A "$pd" | tr '\n' ' ')" = "fig_q.png summary.txt " ] && [ "$(cat "$pd/summary.txt")" = "old summary" ] \
@@ -205,8 +223,9 @@ for stage_file in "paper_sim.csv.partial-*" "fig_q.png"; do
 done
 # A new directory that a stopped run created is removed again.
 start paper --out "$tmp/pnew"
-wait_file "$tmp/pnew/paper.partial-*/paper_sim.csv.partial-*" 60
+catch_stage "$tmp/pnew/paper.partial-*/paper_sim.csv.partial-*" 60 || bad "paper: the simulation file never appeared"
 kill -TERM "$pid"
+kill -CONT "$pid"
 finish_bg
 [ $rc -eq 143 ] && [ ! -e "$tmp/pnew" ] && ok || bad "paper stopped in a new directory: exit $rc, left $(ls -A "$tmp/pnew" 2>&1)"
 
