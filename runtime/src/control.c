@@ -234,8 +234,8 @@ static int stroke_violation(const prru_track_options *o, const double d[PRRU_NAC
 
 /* The plant from *t to t1 as gsl_odeiv2_driver_apply runs it (the same
  * evolve calls, step-count and step-size rules), with the sliders checked
- * against their stroke after every accepted step: between two ticks a
- * slider can leave its stroke and come back. GSL_SUCCESS, the evolve's or
+ * against their stroke after every accepted step before t1: between two
+ * ticks a slider can leave its stroke and come back. GSL_SUCCESS, the evolve's or
  * the driver's error, or GSL_EDOM with *bad the slider out of its stroke
  * (*t, y the state there). */
 static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, double *t,
@@ -249,6 +249,7 @@ static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, do
     if (fabs(drv->h) > drv->hmax) drv->h = drv->hmax;
     if (fabs(drv->h) < drv->hmin) return GSL_ENOPROG;
     drv->n++;
+    if (*t >= t1) break; /* the tick itself: track_run checks its sample */
     double d[PRRU_NACT];
     prru_param_ik(&o->plant, y, d); /* the plant's sliders, as at the ticks */
     if ((*bad = stroke_violation(o, d)) >= 0) return GSL_EDOM;
