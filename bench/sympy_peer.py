@@ -56,8 +56,15 @@ def to_sympy(e, memo):
     op, a = e.op, e.args
     if op == "const":
         r = sympy.Rational(a[0].numerator, a[0].denominator)
+    elif op == "sym" and sym.definition(e) is not None:
+        # An atom of the generator (an intermediate angle): its value.
+        r = to_sympy(sym.definition(e).value, memo)
     elif op == "sym":
         r = {"q1": Q[0], "q2": Q[1], "q3": Q[2]}[a[0]]
+    elif op in ("sin", "cos") and sym.definition(a[0]) is not None:
+        # As the poses had it before atoms: sin(atan2(y, x)) = y / hypot.
+        f = sym.sin if op == "sin" else sym.cos
+        r = to_sympy(f(sym.definition(a[0]).value), memo)
     elif op == "add":
         c, terms = a
         r = sympy.Add(sympy.Rational(c.numerator, c.denominator),

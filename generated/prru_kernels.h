@@ -6,26 +6,26 @@
  *
  * Operation counts per kernel:
  *   ik                 31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3
- *   jd                 66 arithmetic (4 add, 9 sub, 50 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   ik_jd              77 arithmetic (8 add, 11 sub, 55 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   jacobians          100 arithmetic (6 add, 11 sub, 73 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   bias_terms         192 arithmetic (14 add, 32 sub, 137 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
- *   mass               160 arithmetic (31 add, 15 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   bias               288 arithmetic (35 add, 46 sub, 204 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   gravity            64 arithmetic (2 add, 10 sub, 48 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   dynamics           384 arithmetic (62 add, 51 sub, 267 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   eom                407 arithmetic (63 add, 62 sub, 279 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   jd                 50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   ik_jd              60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   jacobians          82 arithmetic (3 add, 11 sub, 57 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3
+ *   bias_terms         150 arithmetic (10 add, 23 sub, 108 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   mass               94 arithmetic (17 add, 11 sub, 62 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   bias               198 arithmetic (27 add, 30 sub, 138 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   gravity            42 arithmetic (1 add, 7 sub, 30 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   dynamics           251 arithmetic (41 add, 32 sub, 172 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom                273 arithmetic (48 add, 38 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   platform_jacobian  13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1
  *   poses              61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
- *   inertia_world      86 arithmetic (14 add, 7 sub, 61 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   wrench_bias        213 arithmetic (15 add, 35 sub, 153 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3
- *   energy             136 arithmetic (33 add, 12 sub, 88 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   actuator_rates     151 arithmetic (13 add, 24 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   inertia_world      87 arithmetic (14 add, 7 sub, 62 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   wrench_bias        173 arithmetic (11 add, 26 sub, 127 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   energy             119 arithmetic (30 add, 10 sub, 76 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   actuator_rates     124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
- *   reaction_basis     59 arithmetic (2 add, 5 sub, 34 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          466 arithmetic (68 add, 73 sub, 319 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      469 arithmetic (75 add, 71 sub, 316 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   joint_reactions    776 arithmetic (125 add, 195 sub, 444 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   reaction_basis     56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          347 arithmetic (64 add, 46 sub, 231 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      336 arithmetic (60 add, 47 sub, 222 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   joint_reactions    692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
 #define PRRU_KERNELS_H
@@ -46,47 +46,47 @@
 /* Body order of every array: P L1 L2 L3 U1 U2 U3 S1 S2 S3. The model's numbers and layout tables
    are in prru_mechanism.h. */
 #define PRRU_ARITH_IK 31 /* arithmetic operations */
-#define PRRU_ARITH_JD 66 /* arithmetic operations */
-#define PRRU_ARITH_IK_JD 77 /* arithmetic operations */
-#define PRRU_ARITH_JACOBIANS 100 /* arithmetic operations */
-#define PRRU_ARITH_BIAS_TERMS 192 /* arithmetic operations */
-#define PRRU_ARITH_MASS 160 /* arithmetic operations */
-#define PRRU_ARITH_BIAS 288 /* arithmetic operations */
-#define PRRU_ARITH_GRAVITY 64 /* arithmetic operations */
-#define PRRU_ARITH_DYNAMICS 384 /* arithmetic operations */
-#define PRRU_ARITH_EOM 407 /* arithmetic operations */
+#define PRRU_ARITH_JD 50 /* arithmetic operations */
+#define PRRU_ARITH_IK_JD 60 /* arithmetic operations */
+#define PRRU_ARITH_JACOBIANS 82 /* arithmetic operations */
+#define PRRU_ARITH_BIAS_TERMS 150 /* arithmetic operations */
+#define PRRU_ARITH_MASS 94 /* arithmetic operations */
+#define PRRU_ARITH_BIAS 198 /* arithmetic operations */
+#define PRRU_ARITH_GRAVITY 42 /* arithmetic operations */
+#define PRRU_ARITH_DYNAMICS 251 /* arithmetic operations */
+#define PRRU_ARITH_EOM 273 /* arithmetic operations */
 #define PRRU_ARITH_PLATFORM_JACOBIAN 13 /* arithmetic operations */
 #define PRRU_ARITH_POSES 61 /* arithmetic operations */
-#define PRRU_ARITH_INERTIA_WORLD 86 /* arithmetic operations */
-#define PRRU_ARITH_WRENCH_BIAS 213 /* arithmetic operations */
-#define PRRU_ARITH_ENERGY 136 /* arithmetic operations */
-#define PRRU_ARITH_ACTUATOR_RATES 151 /* arithmetic operations */
+#define PRRU_ARITH_INERTIA_WORLD 87 /* arithmetic operations */
+#define PRRU_ARITH_WRENCH_BIAS 173 /* arithmetic operations */
+#define PRRU_ARITH_ENERGY 119 /* arithmetic operations */
+#define PRRU_ARITH_ACTUATOR_RATES 124 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 13 /* arithmetic operations */
-#define PRRU_ARITH_REACTION_BASIS 59 /* arithmetic operations */
-#define PRRU_ARITH_EOM_SOLVE 466 /* arithmetic operations */
-#define PRRU_ARITH_INVERSE_TERMS 469 /* arithmetic operations */
-#define PRRU_ARITH_JOINT_REACTIONS 776 /* arithmetic operations */
+#define PRRU_ARITH_REACTION_BASIS 56 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 347 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 336 /* arithmetic operations */
+#define PRRU_ARITH_JOINT_REACTIONS 692 /* arithmetic operations */
 #define PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JD "66 arithmetic (4 add, 9 sub, 50 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_IK_JD "77 arithmetic (8 add, 11 sub, 55 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JACOBIANS "100 arithmetic (6 add, 11 sub, 73 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS_TERMS "192 arithmetic (14 add, 32 sub, 137 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_MASS "160 arithmetic (31 add, 15 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS "288 arithmetic (35 add, 46 sub, 204 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_GRAVITY "64 arithmetic (2 add, 10 sub, 48 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_DYNAMICS "384 arithmetic (62 add, 51 sub, 267 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM "407 arithmetic (63 add, 62 sub, 279 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JD "50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_IK_JD "60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JACOBIANS "82 arithmetic (3 add, 11 sub, 57 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS_TERMS "150 arithmetic (10 add, 23 sub, 108 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_MASS "94 arithmetic (17 add, 11 sub, 62 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS "198 arithmetic (27 add, 30 sub, 138 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_GRAVITY "42 arithmetic (1 add, 7 sub, 30 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_DYNAMICS "251 arithmetic (41 add, 32 sub, 172 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM "273 arithmetic (48 add, 38 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PLATFORM_JACOBIAN "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
 #define PRRU_OPS_POSES "61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INERTIA_WORLD "86 arithmetic (14 add, 7 sub, 61 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_WRENCH_BIAS "213 arithmetic (15 add, 35 sub, 153 mul, 3 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ENERGY "136 arithmetic (33 add, 12 sub, 88 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ACTUATOR_RATES "151 arithmetic (13 add, 24 sub, 111 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INERTIA_WORLD "87 arithmetic (14 add, 7 sub, 62 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_WRENCH_BIAS "173 arithmetic (11 add, 26 sub, 127 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ENERGY "119 arithmetic (30 add, 10 sub, 76 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ACTUATOR_RATES "124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
-#define PRRU_OPS_REACTION_BASIS "59 arithmetic (2 add, 5 sub, 34 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM_SOLVE "466 arithmetic (68 add, 73 sub, 319 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INVERSE_TERMS "469 arithmetic (75 add, 71 sub, 316 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JOINT_REACTIONS "776 arithmetic (125 add, 195 sub, 444 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_REACTION_BASIS "56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "347 arithmetic (64 add, 46 sub, 231 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "336 arithmetic (60 add, 47 sub, 222 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JOINT_REACTIONS "692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
 extern "C" {

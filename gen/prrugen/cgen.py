@@ -63,6 +63,9 @@ class Graph:
             v = e.args[0]
             return self.num(v) if v >= 0 else self.node("neg", self.num(-v))
         if op == "sym":
+            d = sym.definition(e)
+            if d is not None:
+                return self.lower(d.value)
             return self.node("in", self.names[e.args[0]])
         if op == "add":
             return self._sum(e)
@@ -79,8 +82,12 @@ class Graph:
             if abs(coef) != 1:
                 n = self.node("mul", self.num(abs(coef)), n)
             return self.node("neg", n) if coef < 0 else n
-        fn = {"atan2": "atan2"}.get(op, op)
-        return self.node("call", fn, *[self.lower(a) for a in e.args])
+        if op in ("sin", "cos") and sym.definition(e.args[0]) is not None:
+            # sin and cos of an atom angle from its value's closed form
+            # (sin(atan2(y, x)) = y / hypot(x, y), sin(acos x) = ...).
+            f = sym.sin if op == "sin" else sym.cos
+            return self.lower(f(sym.definition(e.args[0]).value))
+        return self.node("call", op, *[self.lower(a) for a in e.args])
 
     def _sum(self, e, negate=False):
         c, terms = e.args

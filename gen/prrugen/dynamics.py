@@ -13,6 +13,14 @@ and R^T (I delta + w x I w) = D delta_b + w_b x D w_b because
 d/dt (R^T w) = R^T w'. The world-frame quantities (H, delta, mu, K, I_b)
 are derived too, for the kernels that return them.
 
+M, h and G are formed in the coordinates theta = (q, atoms) and then
+projected, M = A^T Mt A, h = A^T ht, G = A^T Gt with A = d theta / d q:
+an atom (limb 3's angle gamma, a function of q1 and q2) then enters only
+through the few entries of A instead of into every product of Jacobians,
+so the bodies of limb 3 sum once, not once per entry of M. The theta
+Jacobians hold the atoms fixed (sym.diff explicit); mu is the same either
+way, d/dt (J_theta A) qd with the atom's rate bias in d/dt (A) qd.
+
 Drives (model format 2) enter through the actuator coordinates d(q): an
 armature k_i adds the kinetic energy k_i dd_i^2 / 2, so M += J_d^T K J_d
 and h += J_d^T K (Jd' qd); damping and Coulomb friction are generalized
@@ -28,7 +36,7 @@ from .linalg import vec, vadd, vscale, dot, cross, matvec, matmul, \
 class BodyTerms:
     """Derived velocity-level quantities of one body."""
 
-    def __init__(self, body, q, qd, dt):
+    def __init__(self, body, q, qd, dt, theta, theta_d):
         self.body = body
         rates = [dt(angle) for _, angle in body.chain]
         n = len(body.chain)
@@ -49,6 +57,9 @@ class BodyTerms:
         self.jr_w = jacobian(omega_w, qd)
         self.jr_b = jacobian(omega_b, qd)
         self.jt = jacobian(body.centre, q)
+        # In theta = (q, atoms), the atoms held fixed.
+        self.jr_theta = explicit_jacobian(omega_b, theta_d)
+        self.jt_theta = explicit_jacobian(body.centre, theta)
         self.delta_w = [dt(x) for x in omega_w]
         self.delta_b = [dt(x) for x in omega_b]
         velocity = [dt(x) for x in body.centre]
@@ -63,26 +74,32 @@ class BodyTerms:
                     cross(self.omega_b, d_w))
 
 
+def explicit_jacobian(f, xs):
+    """[d f_i / d x_j] with every atom not in xs held fixed."""
+    return [[sym.diff(fi, x, explicit=True) for x in xs] for fi in f]
+
+
 def _quad(a, d, b):
-    """a^T d b for 3x3 a, b and a constant symmetric d (its zero entries
+    """a^T d b for 3 x n a, b and a constant symmetric d (its zero entries
     contribute no terms, so a diagonal d gives the diagonal formula)."""
     return [[sym.add(*[sym.mul(d[k][l], a[k][i], b[l][j])
                        for k in range(3) for l in range(3)
                        if not sym.is_const(d[k][l], 0)])
-             for j in range(3)] for i in range(3)]
+             for j in range(len(b[0]))] for i in range(len(a[0]))]
 
 
 def _atb(a, v):
-    """a^T v (a has len(v) rows and 3 columns)."""
-    return [dot([a[k][i] for k in range(len(v))], v) for i in range(3)]
+    """a^T v (a has len(v) rows)."""
+    return [dot([a[k][i] for k in range(len(v))], v)
+            for i in range(len(a[0]))]
 
 
 def _quad_n(a, d, b):
-    """a^T d b for n x 3 a, b and a constant n x n diagonal d."""
+    """a^T d b for n x m a, b and a constant n x n diagonal d."""
     n = len(d)
     return [[sym.add(*[sym.mul(d[k][k], a[k][i], b[k][j]) for k in range(n)
                        if d[k][k]])
-             for j in range(3)] for i in range(3)]
+             for j in range(len(b[0]))] for i in range(len(a[0]))]
 
 
 class Derivation:
@@ -95,45 +112,55 @@ class Derivation:
         self.coulomb_velocity = model.coulomb_velocity
         q, qd = mech.q, mech.qd
         dt = sym.TimeDerivative(q, qd)
-        self.terms = [BodyTerms(b, q, qd, dt) for b in mech.bodies]
+        self.theta = list(q) + list(mech.atoms)
+        self.theta_d = list(qd) + [dt(a) for a in mech.atoms]
+        # A = d theta / d q: the identity over the atoms' partials.
+        self.a_rows = [[sym.diff(a, x) for x in q] for a in mech.atoms]
+        self.terms = [BodyTerms(b, q, qd, dt, self.theta, self.theta_d)
+                      for b in mech.bodies]
         self._jd = jacobian(mech.actuators, q)
+        self._jd_theta = explicit_jacobian(mech.actuators, self.theta)
         self.actuator_rates = [dt(x) for x in mech.actuators]
         self.actuator_bias = [dt(x) for x in self.actuator_rates]
 
-    def _armature_mass(self):
-        k = [[self.armature[i] if i == j else 0 for j in range(len(
-            self.armature))] for i in range(len(self.armature))]
-        return _quad_n(self._jd, k, self._jd)
+    def _project(self, v):
+        """A^T v for v over theta: a generalized force in q."""
+        return [sym.add(v[i], *[sym.mul(row[i], v[3 + a]) for a, row in
+                                enumerate(self.a_rows)]) for i in range(3)]
 
-    def mass(self):
+    def _sum(self, parts):
+        return [sym.add(*[p[i] for p in parts]) for i in
+                range(len(self.theta))]
+
+    def _mass_theta(self):
+        n = len(self.theta)
         parts = []
         for t in self.terms:
             m = t.body.mass
-            parts.append(_quad(t.jt, diag([m, m, m]), t.jt))
-            parts.append(_quad(t.jr_b, t.inertia, t.jr_b))
+            parts.append(_quad(t.jt_theta, diag([m, m, m]), t.jt_theta))
+            parts.append(_quad(t.jr_theta, t.inertia, t.jr_theta))
         if any(self.armature):
-            parts.append(self._armature_mass())
-        m = [sym.add(*[p[i][j] for p in parts]) for i in range(3)
-             for j in range(3)]
-        # Exact symmetry: take the upper triangle's expressions for both.
-        for i in range(3):
-            for j in range(i):
-                m[3 * i + j] = m[3 * j + i]
-        return m
+            k = [[self.armature[i] if i == j else 0 for j in range(len(
+                self.armature))] for i in range(len(self.armature))]
+            parts.append(_quad_n(self._jd_theta, k, self._jd_theta))
+        return [[sym.add(*[p[i][j] for p in parts]) for j in range(n)]
+                for i in range(n)]
 
-    def bias(self):
+    def _bias_theta(self):
         parts = []
         for t in self.terms:
-            parts.append(_atb(t.jt, vscale(t.body.mass, t.mu)))
-            parts.append(_atb(t.jr_b, t.gyro_b()))
+            parts.append(_atb(t.jt_theta, vscale(t.body.mass, t.mu)))
+            parts.append(_atb(t.jr_theta, t.gyro_b()))
         if any(self.armature):
-            parts.append(_atb(self._jd, [sym.mul(k, a) for k, a in zip(
+            parts.append(_atb(self._jd_theta, [sym.mul(k, a) for k, a in zip(
                 self.armature, self.actuator_bias)]))
-        return [sym.add(*[p[i] for p in parts]) for i in range(3)]
+        return self._sum(parts)
 
-    def passive(self):
-        """J_d^T (-c dd - f tanh(dd / v_s)): damping and Coulomb friction of
-        the drives as generalized forces (zero without drives)."""
+    def _gravity_theta(self):
+        v = self.potential()
+        return [-sym.diff(v, x, explicit=True) for x in self.theta]
+
+    def _passive_theta(self):
         forces = []
         for c, f, dd in zip(self.damping, self.coulomb, self.actuator_rates):
             terms = [sym.mul(-c, dd)]
@@ -141,7 +168,29 @@ class Derivation:
                 terms.append(sym.mul(-f, sym.tanh(sym.mul(
                     1 / self.coulomb_velocity, dd))))
             forces.append(sym.add(*terms))
-        return _atb(self._jd, forces)
+        return _atb(self._jd_theta, forces)
+
+    def mass(self):
+        mt = self._mass_theta()
+        n = len(self.theta)
+        # A^T Mt A: columns first, then rows.
+        cols = [self._project([mt[i][j] for i in range(n)]) for j in range(n)]
+        rows = [self._project([cols[j][i] for j in range(n)])
+                for i in range(3)]
+        m = [rows[i][j] for i in range(3) for j in range(3)]
+        # Exact symmetry: take the upper triangle's expressions for both.
+        for i in range(3):
+            for j in range(i):
+                m[3 * i + j] = m[3 * j + i]
+        return m
+
+    def bias(self):
+        return self._project(self._bias_theta())
+
+    def passive(self):
+        """J_d^T (-c dd - f tanh(dd / v_s)): damping and Coulomb friction of
+        the drives as generalized forces (zero without drives)."""
+        return self._project(self._passive_theta())
 
     def potential(self):
         gx, gy, gz = self.gravity
@@ -154,8 +203,7 @@ class Derivation:
             for k, g in enumerate(self.gravity) if g != 0])
 
     def gravity_force(self):
-        v = self.potential()
-        return [-sym.diff(v, x) for x in self.mech.q]
+        return self._project(self._gravity_theta())
 
     def kinetic(self):
         total = []
@@ -211,15 +259,29 @@ class Derivation:
         return jacobian(self.terms[0].body.origin, self.mech.q)
 
     def eom_rhs(self, fd, fp, mp):
-        """b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h."""
+        """b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h,
+        summed over theta and projected once."""
+        return self._project(self._rhs_theta(fd, fp, mp))
+
+    def drive_force(self, qdd, fp, mp):
+        """tau = M qdd - b (b without drive forces): the generalized force
+        the drives supply, A^T (Mt (A qdd) - bt), so M is never formed."""
+        mt = self._mass_theta()
+        acc = list(qdd) + [dot(row, qdd) for row in self.a_rows]
+        bt = self._rhs_theta([sym.ZERO] * len(self.mech.actuators), fp, mp)
+        return self._project([sym.add(dot(row, acc), -x)
+                              for row, x in zip(mt, bt)])
+
+    def _rhs_theta(self, fd, fp, mp):
         t = self.terms[0]
-        g, h = self.gravity_force(), self.bias()
-        ad, am = _atb(self._jd, fd), _atb(t.jr_w, mp)
-        af = _atb(self.tool_jacobian(), fp)
-        parts = [g, ad, af, am, [-x for x in h]]
+        jr = explicit_jacobian(t.omega_w, self.theta_d)
+        jt = explicit_jacobian(t.body.origin, self.theta)
+        parts = [self._gravity_theta(), _atb(self._jd_theta, fd),
+                 _atb(jt, fp), _atb(jr, mp),
+                 [-x for x in self._bias_theta()]]
         if any(self.damping) or any(self.coulomb):
-            parts.append(self.passive())
-        return [sym.add(*[p[i] for p in parts]) for i in range(3)]
+            parts.append(self._passive_theta())
+        return self._sum(parts)
 
     def reaction_basis(self):
         """Q (60 x 57): lambda -> wrenches about each body's centre."""

@@ -82,7 +82,7 @@ def kernels(deriv):
          [Q], [("Q", deriv.reaction_basis())]),
     ]
     spec.append(_eom_solve(deriv, m, fd, fp, mp))
-    spec.append(_inverse_terms(deriv, d, jd, m, fp, mp))
+    spec.append(_inverse_terms(deriv, d, jd, fp, mp))
     spec += _reaction_kernels(deriv, fd, fp, mp)
     return [Kernel(name, doc, ins, outs, guards)
             for name, doc, ins, outs in spec]
@@ -117,16 +117,14 @@ def _eom_solve(deriv, m, fd, fp, mp):
             [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)])
 
 
-def _inverse_terms(deriv, d, jd, m, fp, mp):
+def _inverse_terms(deriv, d, jd, fp, mp):
     """Inverse dynamics in one evaluation: ik_jd, and the generalized force
     tau = M qdd - b that the drives supply (J_d^T fd = tau); with three
     actuators also J_d^-1 by its adjugate and fd = J_d^-T tau, so the
     runtime only judges J_d's conditioning. Four actuators need J_d^+,
     which the runtime forms by a QR of J_d."""
     qdd = _vec("qdd")
-    b = deriv.eom_rhs([sym.ZERO] * len(d), fp, mp)
-    tau = [sym.add(*([sym.mul(m[3 * i + j], qdd[j]) for j in range(3)]
-                     + [-b[i]])) for i in range(3)]
+    tau = deriv.drive_force(qdd, fp, mp)
     ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
     if len(d) != 3:
         return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h "

@@ -53,8 +53,10 @@ class Joint:
 
 
 class Mechanism:
-    def __init__(self, q, qd, bodies, joints, actuators, guards, limbs):
+    def __init__(self, q, qd, bodies, joints, actuators, guards, limbs,
+                 atoms):
         self.q, self.qd = q, qd
+        self.atoms = atoms            # defined angle symbols (see atom())
         self.limbs = limbs            # per limb: joint centres, d, slider
         self.bodies = bodies
         self.joints = joints
@@ -80,12 +82,36 @@ def _limb12(s, g, platform_rot, p_platform):
                 slider=([], a_joint))
 
 
-def _limb34(s, g, p_platform):
+def atom(name, value, q, qd):
+    """value(q) as a defined symbol (an atom, see sym.define) whose partial
+    derivatives d value / d q_j, rate value' = J qd and rate bias J' qd are
+    atoms too: the poses, and whatever is differentiated from them, stay
+    polynomials in the atom's sin and cos and these few symbols."""
+    dt = sym.TimeDerivative(q, qd)
+    partials = {x: sym.define("%s_%s" % (name, x.args[0]), sym.diff(value, x))
+                for x in q if not sym.is_const(sym.diff(value, x), 0)}
+    bias = sym.define(name + "_bias", sym.add(*[
+        sym.mul(dt(p), v) for x, v in zip(q, qd) for y, p in partials.items()
+        if y is x]))
+    rate = sym.define(name + "_rate", sym.add(*[
+        sym.mul(p, v) for x, v in zip(q, qd) for y, p in partials.items()
+        if y is x]), rate=bias)
+    return sym.define(name, value, partials, rate)
+
+
+def _gamma(q, qd):
+    """The lower links of limbs 3 and 4 turn about e2 by gamma: their axis
+    x3 = Ry(gamma) e1 is the direction in the plane y = 0 normal to the
+    platform's R_P e3 = (sin q2, -sin q1 cos q2, cos q1 cos q2)."""
+    q1, q2 = q[0], q[1]
+    return atom("gamma", sym.atan2(sym.sin(q2), sym.cos(q1) * sym.cos(q2)),
+                q, qd)
+
+
+def _limb34(s, g, p_platform, gamma):
     """Limb 3 (s = +1) and its mirror, the redundant limb 4 (s = -1, spec
     section 12): in the plane y = 0, hinges along e2, U joint centre O',
     rail at x = s b, lower link along s x3."""
-    q1, q2 = sym.sym("q1"), sym.sym("q2")
-    gamma = sym.atan2(sym.sin(q2), sym.cos(q1) * sym.cos(q2))
     x3 = matvec(rot(Y, gamma), unit(X))
     outward = x3 if s > 0 else [-x for x in x3]
     b_joint = vadd(p_platform, vscale(s * g.l2, x3))
@@ -109,11 +135,12 @@ def build(model):
     platform_chain = [(X, q[0]), (Y, q[1])]
     p_platform = vec(0, 0, q[2])
     platform_rot = matmul(rot(X, q[0]), rot(Y, q[1]))
+    gamma = _gamma(q, qd)
     limbs = [_limb12(-1, g[0], platform_rot, p_platform),
              _limb12(+1, g[1], platform_rot, p_platform),
-             _limb34(+1, g[2], p_platform)]
+             _limb34(+1, g[2], p_platform, gamma)]
     if len(g) == 4:
-        limbs.append(_limb34(-1, g[3], p_platform))
+        limbs.append(_limb34(-1, g[3], p_platform, gamma))
 
     parts = [(platform_chain, p_platform)]
     parts += [limb["lower"] for limb in limbs]
@@ -130,7 +157,7 @@ def build(model):
         if limb["guard"] not in guards:
             guards.append(limb["guard"])
     return Mechanism(q, qd, bodies, joints, [l["d"] for l in limbs], guards,
-                     limbs)
+                     limbs, [gamma])
 
 
 def _tensor(entries):

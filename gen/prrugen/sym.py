@@ -14,6 +14,14 @@ Node kinds (Expr.op):
   sin cos tan tanh asin acos   args = (x,)
   atan2  args = (y, x)
 
+A symbol may be defined (define()): it stands for an expression of other
+symbols, its value, and may carry its own partial derivatives and time
+derivative, themselves defined symbols. The mechanism's intermediate
+angles are such atoms, so that derivatives go through them by the chain
+rule (d sin(g) = cos(g) dg, dg a symbol) instead of through their closed
+forms, whose derivatives grow with every differentiation; the lowering to
+C and evaluate() substitute the values.
+
 Simplifications applied at construction, because they are what makes the
 mechanism's expressions small: 0/1 elimination, constant folding, like terms
 and powers, a sin^2 + a cos^2 = a, and sin/cos of inverse trig functions
@@ -29,11 +37,12 @@ _counter = [0]
 
 
 class Expr:
-    __slots__ = ("op", "args", "id", "_free")
+    __slots__ = ("op", "args", "id", "_free", "_def")
 
     def __init__(self, op, args, ident):
         self.op, self.args, self.id = op, args, ident
         self._free = None
+        self._def = None              # a defined symbol's Definition
 
     def __hash__(self):
         return self.id
@@ -82,6 +91,35 @@ def sym(name):
 
 ZERO = const(0)
 ONE = const(1)
+
+class Definition:
+    __slots__ = ("value", "partials", "rate")
+
+    def __init__(self, value, partials, rate):
+        self.value = value            # the expression the symbol stands for
+        self.partials = partials      # {symbol id: d value / d symbol}
+        self.rate = rate              # d value / dt along q' = qd, or None
+
+
+def define(name, value, partials=None, rate=None):
+    """The symbol `name` standing for `value`. partials {symbol: Expr} and
+    rate give derivatives that differentiation then uses instead of
+    differentiating the value; they must equal the value's own."""
+    s = sym(name)
+    value = as_expr(value)
+    if s._def is not None and s._def.value is not value:
+        raise ValueError("symbol %s is already defined otherwise" % name)
+    if s._free is not None and s._def is None:
+        raise ValueError("symbol %s is used before its definition" % name)
+    s._def = Definition(value, {k.id: as_expr(v) for k, v in
+                                (partials or {}).items()},
+                        None if rate is None else as_expr(rate))
+    return s
+
+
+def definition(e):
+    """The Definition of a defined symbol, else None."""
+    return e._def
 
 
 def reset():
@@ -160,18 +198,16 @@ def _is_scaled_sum(x):
         and x.args[1][0][0].op == "add"
 
 
-def _trig_square(t, fn):
-    """If monomial t has a factor fn(u)^2, return (u, rest factors)."""
+def _trig_squares(t, fn):
+    """Every factor fn(u)^2 of monomial t, as [(u, rest factors)]."""
     if t.op == "mul" and t.args[0] == 1:
         factors = t.args[1]
     elif t.op == "mul":
-        return None
+        return []
     else:
         factors = ((t, Fraction(1)),)
-    for i, (b, e) in enumerate(factors):
-        if b.op == fn and e == 2:
-            return b.args[0], factors[:i] + factors[i + 1:]
-    return None
+    return [(b.args[0], factors[:i] + factors[i + 1:])
+            for i, (b, e) in enumerate(factors) if b.op == fn and e == 2]
 
 
 def _pythagoras(terms, c):
@@ -181,9 +217,8 @@ def _pythagoras(terms, c):
     trig = []
     for pos, (k, t) in enumerate(terms):
         for fn in ("sin", "cos"):
-            found = _trig_square(t, fn)
-            if found:
-                trig.append((pos, fn, found[0], found[1]))
+            for u, rest in _trig_squares(t, fn):
+                trig.append((pos, fn, u, rest))
     if not trig:
         return None
     index = {(fn, u.id, _key_part(rest)): pos for pos, fn, u, rest in trig}
@@ -410,7 +445,7 @@ def free_symbols(e):
             continue
         stack.pop()
         if n.op == "sym":
-            n._free = frozenset((n.id,))
+            n._free = frozenset((n.id,)).union(*[c._free for c in children(n)])
         else:
             n._free = frozenset().union(*[c._free for c in children(n)])
     return e._free
@@ -421,7 +456,9 @@ def children(e):
         return [t for _, t in e.args[1]]
     if e.op == "mul":
         return [b for b, _ in e.args[1]]
-    if e.op in ("const", "sym"):
+    if e.op == "sym":
+        return [e._def.value] if e._def is not None else []
+    if e.op == "const":
         return []
     return list(e.args)
 
@@ -429,25 +466,34 @@ def children(e):
 _diff_cache = {}
 
 
-def diff(e, s):
-    """d e / d s for a symbol s."""
+def diff(e, s, explicit=False):
+    """d e / d s for a symbol s; explicit: the partial derivative that
+    holds every defined symbol (atom) other than s fixed."""
     e = as_expr(e)
     if s.id not in free_symbols(e):
         return ZERO
-    key = (e.id, s.id)
+    key = (e.id, s.id, explicit)
     hit = _diff_cache.get(key)
     if hit is not None:
         return hit
     op = e.op
     if op == "sym":
-        r = ONE
+        d = e._def
+        if e is s:
+            r = ONE
+        elif explicit:
+            r = ZERO
+        elif s.id in d.partials:
+            r = d.partials[s.id]
+        else:
+            r = diff(d.value, s)
     elif op == "add":
-        r = add(*[mul(k, diff(t, s)) for k, t in e.args[1]])
+        r = add(*[mul(k, diff(t, s, explicit)) for k, t in e.args[1]])
     elif op == "mul":
         coef, factors = e.args
         terms = []
         for i, (b, ex) in enumerate(factors):
-            db = diff(b, s)
+            db = diff(b, s, explicit)
             if is_const(db, 0):
                 continue
             rest = [_make_mul(Fraction(1), ((bb, ee),))
@@ -456,7 +502,7 @@ def diff(e, s):
         r = add(*terms)
     else:
         x = e.args[0]
-        dx = diff(x, s) if op != "atan2" else None
+        dx = diff(x, s, explicit) if op != "atan2" else None
         if op == "sin":
             r = cos(x) * dx
         elif op == "cos":
@@ -471,7 +517,8 @@ def diff(e, s):
             r = -dx * power(1 - x * x, Fraction(-1, 2))
         elif op == "atan2":
             y, xx = e.args
-            r = (xx * diff(y, s) - y * diff(xx, s)) / (xx * xx + y * y)
+            r = (xx * diff(y, s, explicit) - y * diff(xx, s, explicit)) \
+                / (xx * xx + y * y)
         else:
             raise ValueError("cannot differentiate %s" % op)
     _diff_cache[key] = r
@@ -505,7 +552,11 @@ class TimeDerivative:
             return hit
         op = e.op
         if op == "sym":
-            r = self.rate[e.id]
+            d = e._def
+            if d is None:
+                r = self.rate[e.id]
+            else:
+                r = d.rate if d.rate is not None else self(d.value)
         elif op == "add":
             r = add(*[mul(k, self(t)) for k, t in e.args[1]])
         elif op == "mul":
@@ -587,7 +638,9 @@ def evaluate(exprs, env):
         if op == "const":
             v = float(n.args[0])
         elif op == "sym":
-            v = float(env[n.args[0]])
+            d = n._def
+            v = float(env[n.args[0]]) if d is None or n.args[0] in env \
+                else ev(d.value)
         elif op == "add":
             v = float(n.args[0]) + math.fsum(float(k) * ev(t)
                                              for k, t in n.args[1])

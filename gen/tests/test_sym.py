@@ -48,6 +48,12 @@ class Canonical(unittest.TestCase):
         self.assertIs(e, 3 * Y + Z)
         self.assertIs(sym.sin(X) ** 2 + sym.cos(X) ** 2, sym.ONE)
 
+    def test_pythagoras_finds_the_pair_among_other_trig_squares(self):
+        # sin(y)^2 sits beside the pair: the rule must look past it.
+        s2 = sym.sin(Y) ** 2
+        e = s2 * sym.sin(X) ** 2 * Z + s2 * sym.cos(X) ** 2 * Z
+        self.assertIs(e, s2 * Z)
+
     def test_inverse_trig_rewrites_keep_values(self):
         u = X * Fraction(1, 2)
         cases = [sym.sin(sym.acos(u)), sym.cos(sym.acos(u)),
@@ -105,6 +111,69 @@ class Differentiation(unittest.TestCase):
         env = {"x": 0.3, "y": -0.7, "xd": 1.5, "yd": 0.25}
         expect = math.cos(0.3) * 0.49 * 1.5 + math.sin(0.3) * 2 * -0.7 * 0.25
         self.assertAlmostEqual(value(d, env), expect, places=15)
+
+
+class Atoms(unittest.TestCase):
+    """Defined symbols: g = atan2(y, x * z) with its partials, rate and
+    rate bias as atoms, as mechanism.atom() builds them."""
+
+    def setUp(self):
+        self.x, self.y, self.z = sym.sym("x"), sym.sym("y"), sym.sym("z")
+        self.q = [self.x, self.y]
+        self.qd = [sym.sym("xd"), sym.sym("yd")]
+        self.value = sym.atan2(self.y, self.x * self.z)
+        dt = sym.TimeDerivative(self.q, self.qd)
+        gx = sym.define("g_x", sym.diff(self.value, self.x))
+        gy = sym.define("g_y", sym.diff(self.value, self.y))
+        bias = sym.define("g_bias", dt(gx) * self.qd[0] + dt(gy) * self.qd[1])
+        rate = sym.define("g_rate", gx * self.qd[0] + gy * self.qd[1],
+                          rate=bias)
+        self.g = sym.define("g", self.value, {self.x: gx, self.y: gy}, rate)
+        self.env = {"x": 0.4, "y": -0.3, "z": 1.7, "xd": 0.8, "yd": -1.1}
+
+    def test_values_and_free_symbols_come_from_the_definition(self):
+        e = sym.sin(self.g) * self.z
+        self.assertAlmostEqual(value(e, self.env), math.sin(math.atan2(
+            -0.3, 0.4 * 1.7)) * 1.7, places=15)
+        names = {sym.to_str(sym.sym(n)) for n in ("g", "x", "y", "z")}
+        got = {sym.to_str(n) for n in sym.topological([e]) if n.op == "sym"}
+        self.assertLessEqual(names, got)
+
+    def test_derivatives_through_the_atom_equal_those_of_its_value(self):
+        plain = sym.cos(self.value) * self.x ** 2
+        atom = sym.cos(self.g) * self.x ** 2
+        dt = sym.TimeDerivative(self.q, self.qd)
+        for a, b in [(sym.diff(atom, self.x), sym.diff(plain, self.x)),
+                     (sym.diff(atom, self.z), sym.diff(plain, self.z)),
+                     (dt(atom), dt(plain)), (dt(dt(atom)), dt(dt(plain)))]:
+            self.assertAlmostEqual(value(a, self.env), value(b, self.env),
+                                   places=13)
+        # The chain rule stops at the atom: d sin(g) = cos(g) g_x, short.
+        self.assertIs(sym.diff(sym.sin(self.g), self.x),
+                      sym.cos(self.g) * sym.sym("g_x"))
+        self.assertIs(dt(self.g), sym.sym("g_rate"))
+        self.assertIs(dt(sym.sym("g_rate")), sym.sym("g_bias"))
+
+    def test_explicit_partials_hold_the_atom_fixed(self):
+        e = sym.sin(self.g) * self.x + self.y
+        self.assertIs(sym.diff(e, self.x, explicit=True), sym.sin(self.g))
+        self.assertIs(sym.diff(e, self.g, explicit=True), sym.cos(self.g) * self.x)
+
+    def test_lowering_substitutes_the_values(self):
+        exprs = [sym.sin(self.g) * sym.sym("g_rate"), sym.sym("g_bias"),
+                 sym.cos(self.g) ** 2]
+        want = sym.evaluate(exprs, self.env)
+        got = evaluate_lowered(exprs, self.env)
+        for w, g in zip(want, got):
+            self.assertAlmostEqual(w, g, places=13)
+
+    def test_redefinition_and_definition_after_use_are_refused(self):
+        with self.assertRaises(ValueError):
+            sym.define("g", self.x)
+        s = sym.sym("late")
+        sym.diff(s * self.x, self.x)     # used: its free symbols are known
+        with self.assertRaises(ValueError):
+            sym.define("late", self.x)
 
 
 class Lowering(unittest.TestCase):
