@@ -23,8 +23,8 @@
  *   actuator_rates     124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          347 arithmetic (64 add, 46 sub, 231 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      336 arithmetic (60 add, 47 sub, 222 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          318 arithmetic (52 add, 48 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      325 arithmetic (55 add, 49 sub, 212 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
@@ -63,8 +63,8 @@
 #define PRRU_ARITH_ACTUATOR_RATES 124 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 13 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 56 /* arithmetic operations */
-#define PRRU_ARITH_EOM_SOLVE 347 /* arithmetic operations */
-#define PRRU_ARITH_INVERSE_TERMS 336 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 318 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 325 /* arithmetic operations */
 #define PRRU_ARITH_JOINT_REACTIONS 692 /* arithmetic operations */
 #define PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JD "50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -84,8 +84,8 @@
 #define PRRU_OPS_ACTUATOR_RATES "124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM_SOLVE "347 arithmetic (64 add, 46 sub, 231 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INVERSE_TERMS "336 arithmetic (60 add, 47 sub, 222 mul, 4 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "318 arithmetic (52 add, 48 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "325 arithmetic (55 add, 49 sub, 212 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JOINT_REACTIONS "692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus

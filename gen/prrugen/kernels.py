@@ -88,13 +88,23 @@ def kernels(deriv):
             for name, doc, ins, outs in spec]
 
 
+def _atom(name, x):
+    """x as a defined symbol (constants stay constants, to fold)."""
+    return x if x.op == "const" else sym.define("_" + name, x)
+
+
 def _eom_solve(deriv, m, fd, fp, mp):
     """eom with M qdd = b solved by the adjugate in the same evaluation:
     the cofactors are products of M's entries, independent of each other,
     so only one division is serial, and the compiler interleaves them with
     the rest of the kernel."""
     b = deriv.eom_rhs(fd, fp, mp)
-    e = [[m[3 * i + j] for j in range(3)] for i in range(3)]
+    # The solve works on M's and b's values as atoms, so that it is the
+    # plain adjugate arithmetic on them instead of being folded into their
+    # expressions (the sums' scale factors would multiply through it).
+    ma = [_atom("M%d" % k, x) for k, x in enumerate(m)]
+    ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
+    e = [[ma[3 * i + j] for j in range(3)] for i in range(3)]
     cof = [[sym.add(sym.mul(e[(j + 1) % 3][(i + 1) % 3],
                             e[(j + 2) % 3][(i + 2) % 3]),
                     -sym.mul(e[(j + 1) % 3][(i + 2) % 3],
@@ -106,7 +116,7 @@ def _eom_solve(deriv, m, fd, fp, mp):
             cof[i][j] = cof[j][i]
     det = sym.add(*[sym.mul(e[0][k], cof[k][0]) for k in range(3)])
     inv_det = sym.power(det, -1)
-    qdd = [sym.mul(sym.add(*[sym.mul(cof[i][k], b[k]) for k in range(3)]),
+    qdd = [sym.mul(sym.add(*[sym.mul(cof[i][k], ba[k]) for k in range(3)]),
                    inv_det) for i in range(3)]
     minors = [e[0][0], cof[2][2], det]
     return ("eom_solve", "eom's M and b, qdd = M^-1 b by the adjugate, and "
@@ -131,7 +141,11 @@ def _inverse_terms(deriv, d, jd, fp, mp):
                 "- G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized "
                 "force the drives supply: J_d^T fd = tau.", ins,
                 [("d", d), ("Jd", jd), ("tau", tau)])
-    e = [[jd[3 * i + j] for j in range(3)] for i in range(3)]
+    # As in eom_solve, the inverse and the solve work on J_d's and tau's
+    # values as atoms.
+    ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
+    tau = [_atom("tau%d" % k, x) for k, x in enumerate(tau)]
+    e = [[ja[3 * i + j] for j in range(3)] for i in range(3)]
     # cof[i][j]: the cofactor of e[i][j]; J_d^-1 = cof^T / det.
     cof = [[sym.add(sym.mul(e[(i + 1) % 3][(j + 1) % 3],
                             e[(i + 2) % 3][(j + 2) % 3]),
