@@ -108,6 +108,8 @@ def main():
     bound = doc.get("bound")
     if not isinstance(bound, dict) or not positive(bound.get("calls_ns")):
         fail("'bound' missing: %r" % (bound,))
+    if not isinstance(bound.get("clock_measured"), bool):
+        fail("bound: clock_measured %r" % bound.get("clock_measured"))
     if positive(bound.get("clock_ghz")):
         rows = bound.get("kernels", {})
         if not {"dynamics", "forward_dynamics", "inverse_dynamics"} <= set(rows):
