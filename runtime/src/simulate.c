@@ -162,6 +162,13 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
 }
 
+static int finite_state(const double y[6])
+{
+  for (int i = 0; i < 6; i++)
+    if (!isfinite(y[i])) return 0;
+  return 1;
+}
+
 static void progress(double t, double t_end)
 {
   int w = 40, n = (int)(w * t / t_end + 0.5);
@@ -274,6 +281,16 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
       }
     }
     int ss = make_sample(m, d, ls, o->reactions, tk, y, s);
+    if (ss == PRRU_EINPUT && finite_state(y)) {
+      /* A finite, regular state whose dynamics, reactions or energy
+       * overflow: the velocities or loads are too large, not q. */
+      st = ss;
+      prru_fail(msg, msglen, st,
+                "stopped at t = %.9g s: the dynamics overflow (velocities or loads too large: "
+                "qd = (%.9g, %.9g, %.9g))",
+                tk, y[3], y[4], y[5]);
+      break;
+    }
     if (ss != PRRU_OK) {
       st = ss;
       prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)", tk,
