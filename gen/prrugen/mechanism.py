@@ -90,12 +90,11 @@ def atom(name, value, q, qd):
     dt = sym.TimeDerivative(q, qd)
     partials = {x: sym.define("%s_%s" % (name, x.args[0]), sym.diff(value, x))
                 for x in q if not sym.is_const(sym.diff(value, x), 0)}
-    bias = sym.define(name + "_bias", sym.add(*[
-        sym.mul(dt(p), v) for x, v in zip(q, qd) for y, p in partials.items()
-        if y is x]))
-    rate = sym.define(name + "_rate", sym.add(*[
-        sym.mul(p, v) for x, v in zip(q, qd) for y, p in partials.items()
-        if y is x]), rate=bias)
+    used = [(partials[x], v) for x, v in zip(q, qd) if x in partials]
+    bias = sym.define(name + "_bias",
+                      sym.add(*[sym.mul(dt(p), v) for p, v in used]))
+    rate = sym.define(name + "_rate", sym.add(*[sym.mul(p, v) for p, v in used]),
+                      rate=bias)
     return sym.define(name, value, partials, rate)
 
 

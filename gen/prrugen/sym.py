@@ -92,13 +92,15 @@ def sym(name):
 ZERO = const(0)
 ONE = const(1)
 
+
 class Definition:
     __slots__ = ("value", "partials", "rate")
 
     def __init__(self, value, partials, rate):
         self.value = value            # the expression the symbol stands for
         self.partials = partials      # {symbol id: d value / d symbol}
-        self.rate = rate              # d value / dt along q' = qd, or None
+        self.rate = rate              # d value / dt along the mechanism's
+                                      # q' = qd, or None
 
 
 def define(name, value, partials=None, rate=None):
