@@ -8,24 +8,24 @@
  *   ik                 31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3
  *   jd                 50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   ik_jd              60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   jacobians          82 arithmetic (3 add, 11 sub, 57 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3
- *   bias_terms         150 arithmetic (10 add, 23 sub, 108 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   jacobians          86 arithmetic (3 add, 11 sub, 61 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3
+ *   bias_terms         153 arithmetic (13 add, 20 sub, 111 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
  *   mass               94 arithmetic (17 add, 11 sub, 62 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   bias               198 arithmetic (27 add, 30 sub, 138 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   gravity            42 arithmetic (1 add, 7 sub, 30 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   dynamics           251 arithmetic (41 add, 32 sub, 172 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   eom                273 arithmetic (48 add, 38 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   dynamics           252 arithmetic (41 add, 32 sub, 173 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom                274 arithmetic (48 add, 39 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   platform_jacobian  13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1
- *   poses              61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
- *   inertia_world      87 arithmetic (14 add, 7 sub, 62 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3
- *   wrench_bias        173 arithmetic (11 add, 26 sub, 127 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
+ *   poses              60 arithmetic (11 add, 9 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3
+ *   inertia_world      88 arithmetic (14 add, 7 sub, 63 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3
+ *   wrench_bias        174 arithmetic (16 add, 21 sub, 128 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3
  *   energy             119 arithmetic (30 add, 10 sub, 76 mul, 3 div); calls: cos 2, sin 2, sqrt 3
- *   actuator_rates     124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
+ *   actuator_rates     124 arithmetic (12 add, 17 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          318 arithmetic (52 add, 48 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_terms      325 arithmetic (55 add, 49 sub, 212 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
- *   joint_reactions    692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_terms      328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
+ *   joint_reactions    686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PRRU_KERNELS_H
 #define PRRU_KERNELS_H
@@ -48,45 +48,45 @@
 #define PRRU_ARITH_IK 31 /* arithmetic operations */
 #define PRRU_ARITH_JD 50 /* arithmetic operations */
 #define PRRU_ARITH_IK_JD 60 /* arithmetic operations */
-#define PRRU_ARITH_JACOBIANS 82 /* arithmetic operations */
-#define PRRU_ARITH_BIAS_TERMS 150 /* arithmetic operations */
+#define PRRU_ARITH_JACOBIANS 86 /* arithmetic operations */
+#define PRRU_ARITH_BIAS_TERMS 153 /* arithmetic operations */
 #define PRRU_ARITH_MASS 94 /* arithmetic operations */
 #define PRRU_ARITH_BIAS 198 /* arithmetic operations */
 #define PRRU_ARITH_GRAVITY 42 /* arithmetic operations */
-#define PRRU_ARITH_DYNAMICS 251 /* arithmetic operations */
-#define PRRU_ARITH_EOM 273 /* arithmetic operations */
+#define PRRU_ARITH_DYNAMICS 252 /* arithmetic operations */
+#define PRRU_ARITH_EOM 274 /* arithmetic operations */
 #define PRRU_ARITH_PLATFORM_JACOBIAN 13 /* arithmetic operations */
-#define PRRU_ARITH_POSES 61 /* arithmetic operations */
-#define PRRU_ARITH_INERTIA_WORLD 87 /* arithmetic operations */
-#define PRRU_ARITH_WRENCH_BIAS 173 /* arithmetic operations */
+#define PRRU_ARITH_POSES 60 /* arithmetic operations */
+#define PRRU_ARITH_INERTIA_WORLD 88 /* arithmetic operations */
+#define PRRU_ARITH_WRENCH_BIAS 174 /* arithmetic operations */
 #define PRRU_ARITH_ENERGY 119 /* arithmetic operations */
 #define PRRU_ARITH_ACTUATOR_RATES 124 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 13 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 56 /* arithmetic operations */
-#define PRRU_ARITH_EOM_SOLVE 318 /* arithmetic operations */
-#define PRRU_ARITH_INVERSE_TERMS 325 /* arithmetic operations */
-#define PRRU_ARITH_JOINT_REACTIONS 692 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 319 /* arithmetic operations */
+#define PRRU_ARITH_INVERSE_TERMS 328 /* arithmetic operations */
+#define PRRU_ARITH_JOINT_REACTIONS 686 /* arithmetic operations */
 #define PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JD "50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_IK_JD "60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JACOBIANS "82 arithmetic (3 add, 11 sub, 57 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_BIAS_TERMS "150 arithmetic (10 add, 23 sub, 108 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JACOBIANS "86 arithmetic (3 add, 11 sub, 61 mul, 3 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_BIAS_TERMS "153 arithmetic (13 add, 20 sub, 111 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_MASS "94 arithmetic (17 add, 11 sub, 62 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_BIAS "198 arithmetic (27 add, 30 sub, 138 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_GRAVITY "42 arithmetic (1 add, 7 sub, 30 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_DYNAMICS "251 arithmetic (41 add, 32 sub, 172 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM "273 arithmetic (48 add, 38 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_DYNAMICS "252 arithmetic (41 add, 32 sub, 173 mul, 3 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM "274 arithmetic (48 add, 39 sub, 183 mul, 3 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PLATFORM_JACOBIAN "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_OPS_POSES "61 arithmetic (11 add, 10 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INERTIA_WORLD "87 arithmetic (14 add, 7 sub, 62 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_WRENCH_BIAS "173 arithmetic (11 add, 26 sub, 127 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_POSES "60 arithmetic (11 add, 9 sub, 30 mul, 1 div, 9 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INERTIA_WORLD "88 arithmetic (14 add, 7 sub, 63 mul, 1 div, 3 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_WRENCH_BIAS "174 arithmetic (16 add, 21 sub, 128 mul, 3 div, 6 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_ENERGY "119 arithmetic (30 add, 10 sub, 76 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_ACTUATOR_RATES "124 arithmetic (11 add, 18 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_ACTUATOR_RATES "124 arithmetic (12 add, 17 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM_SOLVE "318 arithmetic (52 add, 48 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_INVERSE_TERMS "325 arithmetic (55 add, 49 sub, 212 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_JOINT_REACTIONS "692 arithmetic (122 add, 170 sub, 388 mul, 5 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_INVERSE_TERMS "328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_JOINT_REACTIONS "686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
 
 #ifdef __cplusplus
 extern "C" {

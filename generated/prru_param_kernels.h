@@ -6,17 +6,17 @@
  *
  * Operation counts per kernel:
  *   ik                 55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   jd                 81 arithmetic (4 add, 13 sub, 53 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   ik_jd              93 arithmetic (9 add, 16 sub, 57 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   mass               340 arithmetic (82 add, 33 sub, 216 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   bias               721 arithmetic (132 add, 78 sub, 503 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   gravity            246 arithmetic (46 add, 36 sub, 156 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   dynamics           888 arithmetic (189 add, 94 sub, 596 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   eom                947 arithmetic (210 add, 105 sub, 622 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   jd                 83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
+ *   ik_jd              95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
+ *   mass               343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   bias               730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   gravity            249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   dynamics           905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   eom                968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   platform_jacobian  26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1
- *   energy             521 arithmetic (127 add, 61 sub, 324 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   actuator_rates     193 arithmetic (11 add, 30 sub, 143 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   passive            128 arithmetic (16 add, 21 sub, 81 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   energy             524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   actuator_rates     198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
+ *   passive            134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_PARAM_KERNELS_H
 #define PRRU_PARAM_KERNELS_H
@@ -42,29 +42,29 @@
 #include "prru_kernels.h"
 
 #define PRRU_PARAM_ARITH_IK 55 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_JD 81 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_IK_JD 93 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_MASS 340 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_BIAS 721 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_GRAVITY 246 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_DYNAMICS 888 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_EOM 947 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_JD 83 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_IK_JD 95 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_MASS 343 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_BIAS 730 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_GRAVITY 249 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_DYNAMICS 905 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_EOM 968 /* arithmetic operations */
 #define PRRU_PARAM_ARITH_PLATFORM_JACOBIAN 26 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ENERGY 521 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ACTUATOR_RATES 193 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_PASSIVE 128 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_ENERGY 524 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_ACTUATOR_RATES 198 /* arithmetic operations */
+#define PRRU_PARAM_ARITH_PASSIVE 134 /* arithmetic operations */
 #define PRRU_PARAM_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_JD "81 arithmetic (4 add, 13 sub, 53 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_IK_JD "93 arithmetic (9 add, 16 sub, 57 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_MASS "340 arithmetic (82 add, 33 sub, 216 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_BIAS "721 arithmetic (132 add, 78 sub, 503 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_GRAVITY "246 arithmetic (46 add, 36 sub, 156 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_DYNAMICS "888 arithmetic (189 add, 94 sub, 596 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_EOM "947 arithmetic (210 add, 105 sub, 622 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_PARAM_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_MASS "343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_BIAS "730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_GRAVITY "249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_DYNAMICS "905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_EOM "968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_PARAM_OPS_PLATFORM_JACOBIAN "26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_PARAM_OPS_ENERGY "521 arithmetic (127 add, 61 sub, 324 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_ACTUATOR_RATES "193 arithmetic (11 add, 30 sub, 143 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_PASSIVE "128 arithmetic (16 add, 21 sub, 81 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_PARAM_OPS_ENERGY "524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_ACTUATOR_RATES "198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_PARAM_OPS_PASSIVE "134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 
 #ifdef __cplusplus
 extern "C" {

@@ -9,6 +9,7 @@ printed inline. Rational powers become products, one sqrt, and one shared
 reciprocal per denominator, so the only divisions are 1/x.
 """
 
+import heapq
 from fractions import Fraction
 
 from . import sym
@@ -16,6 +17,12 @@ from .model import c_double
 
 ARITH = ("add", "sub", "mul", "div", "neg")
 PREC = {"add": 1, "sub": 1, "mul": 2, "div": 2, "neg": 3}
+
+
+# Latencies (cycles, about those of current x86-64 cores) by which the
+# lowering associates sums and products: only their relative sizes matter.
+_LATENCY = {"add": 3, "sub": 3, "mul": 3, "div": 13, "neg": 1}
+_CALL_LATENCY = {"sqrt": 20, "sin": 40, "cos": 40}
 
 
 class Node:
@@ -30,6 +37,7 @@ class Graph:
 
     def __init__(self, names):
         self.nodes = []
+        self.ready = []             # per node: its latency from the inputs
         self._table = {}
         self._lowered = {}
         self.names = names          # symbol name -> C local name
@@ -44,6 +52,11 @@ class Graph:
             n = Node(op, args, len(self.nodes))
             self.nodes.append(n)
             self._table[key] = n
+            start = max([self.ready[a.index] for a in args
+                         if isinstance(a, Node)], default=0)
+            self.ready.append(0 if op in ("in", "num") else start + (
+                _CALL_LATENCY.get(args[0], 20) if op == "call"
+                else _LATENCY[op]))
         return n
 
     def num(self, value):
@@ -78,9 +91,7 @@ class Graph:
                 n = self._sum(base, negate=True)
                 return n if coef == -1 else \
                     self.node("mul", self.num(-coef), n)
-            n = self._product(factors)
-            if abs(coef) != 1:
-                n = self.node("mul", self.num(abs(coef)), n)
+            n = self._product(factors, abs(coef) if abs(coef) != 1 else None)
             return self.node("neg", n) if coef < 0 else n
         if op in ("sin", "cos") and sym.definition(e.args[0]) is not None:
             # sin and cos of an atom angle from its value's closed form
@@ -110,24 +121,44 @@ class Graph:
         return self._fold(signed)
 
     def _fold(self, signed):
-        """Left-to-right sum of (positive?, node), leading with a + term."""
-        first = next((i for i, (pos, _) in enumerate(signed) if pos), None)
-        if first is None:
-            acc = self.node("neg", signed[0][1])
-            rest = signed[1:]
-        else:
-            acc = signed[first][1]
-            rest = signed[:first] + signed[first + 1:]
-        for pos, n in rest:
-            acc = self.node("add" if pos else "sub", acc, n)
-        return acc
+        """The sum of (positive?, node), the two operands ready first added
+        first and each partial sum queued at its own ready time (Huffman on
+        the latencies from the inputs, Graph.ready): the operand ready last
+        waits for one addition only. Negative only if every term is."""
+        heap = [(self.ready[n.index], k, pos, n)
+                for k, (pos, n) in enumerate(signed)]
+        heapq.heapify(heap)
+        k = len(heap)
+        while len(heap) > 1:
+            _, _, pa, a = heapq.heappop(heap)
+            _, _, pb, b = heapq.heappop(heap)
+            if pa == pb:
+                pos, n = pa, self.node("add", a, b)
+            elif pa:
+                pos, n = True, self.node("sub", a, b)
+            else:
+                pos, n = True, self.node("sub", b, a)
+            heapq.heappush(heap, (self.ready[n.index], k, pos, n))
+            k += 1
+        _, _, pos, n = heap[0]
+        return n if pos else self.node("neg", n)
 
-    def _product(self, factors):
-        acc = None
-        for b, e in factors:
-            n = self.power(self.lower(b), e)
-            acc = n if acc is None else self.node("mul", acc, n)
-        return acc
+    def _product(self, factors, coef=None):
+        """The product of the factors (and a constant), associated as _fold
+        associates sums."""
+        nodes = [self.power(self.lower(b), e) for b, e in factors]
+        if coef is not None:
+            nodes.append(self.num(coef))
+        heap = [(self.ready[n.index], k, n) for k, n in enumerate(nodes)]
+        heapq.heapify(heap)
+        k = len(heap)
+        while len(heap) > 1:
+            _, _, a = heapq.heappop(heap)
+            _, _, b = heapq.heappop(heap)
+            n = self.node("mul", a, b)
+            heapq.heappush(heap, (self.ready[n.index], k, n))
+            k += 1
+        return heap[0][2]
 
     def power(self, base, e):
         """base^e from one reciprocal 1/base and one sqrt(base) per base.

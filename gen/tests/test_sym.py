@@ -177,6 +177,25 @@ class Atoms(unittest.TestCase):
 
 
 class Lowering(unittest.TestCase):
+    def test_sums_and_products_take_the_late_operand_last(self):
+        # sqrt(w + 1) is ready long after p and r: it joins last, so one
+        # operation follows it, not two. It is built before p and r, so
+        # term and factor order (creation order) would put it first.
+        from prrugen import cgen
+        late = sym.sqrt(sym.sym("w_late") + 1)
+        p, r = sym.sym("p_early"), sym.sym("r_early")
+        g = cgen.Graph({n: n for n in ("w_late", "p_early", "r_early")})
+        for e, op in ((late * p * r, "mul"), (late + p + r, "add")):
+            n = g.lower(e)
+            self.assertEqual(n.op, op)
+            a, b = n.args
+            root = g.lower(late)
+            self.assertIn(root, (a, b))
+            other = b if a is root else a
+            self.assertEqual(other.op, op)
+            self.assertEqual(g.ready[n.index], g.ready[root.index] + 3)
+
+
     def test_cse_and_lowering_preserve_values(self):
         exprs = [e for e in Differentiation.EXPRS]
         exprs += [sym.diff(e, X) for e in Differentiation.EXPRS]
