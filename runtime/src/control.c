@@ -84,12 +84,6 @@ int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_opt
   return PRRU_OK;
 }
 
-static int finite_all(const double *v, int n)
-{
-  for (int i = 0; i < n; i++)
-    if (!isfinite(v[i])) return 0;
-  return 1;
-}
 
 static int track_options_check(const prru_track_options *o, char *msg, int msglen)
 {
@@ -119,7 +113,7 @@ static int track_options_check(const prru_track_options *o, char *msg, int msgle
     return prru_fail(msg, msglen, PRRU_EINPUT,
                      "sensor noise needs a sampled controller (control period > 0): a "
                      "continuous controller inside the integrator cannot read noisy samples");
-  if (!finite_all(o->q0_offset, 3))
+  if (!prru_finite_n(o->q0_offset, 3))
     return prru_fail(msg, msglen, PRRU_EINPUT, "initial offset must be finite");
   if (!(o->abs_tol >= PRRU_TOL_MIN) || !(o->rel_tol >= PRRU_TOL_MIN) || !isfinite(o->abs_tol) ||
       !isfinite(o->rel_tol))
@@ -192,7 +186,7 @@ static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
   if (st != PRRU_OK) return st;
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
   prru_param_ik(&o->plant, y, s->d);
-  return finite_all(s->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
+  return prru_finite_n(s->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
 
 static void summary_add(prru_track_summary *sum, const prru_track_sample *s)

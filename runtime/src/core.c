@@ -37,17 +37,7 @@ static void gsl_handler_off(void) { gsl_set_error_handler_off(); }
 
 void prru_gsl_init(void) { pthread_once(&gsl_once, gsl_handler_off); }
 
-static int finite3(const double v[3])
-{
-  return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
-
-static int finite_n(const double *v, int n)
-{
-  for (int i = 0; i < n; i++)
-    if (!isfinite(v[i])) return 0;
-  return 1;
-}
+static int finite3(const double v[3]) { return prru_finite_n(v, 3); }
 
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
 {
@@ -55,7 +45,7 @@ int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik(q, d->d);
   /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
-  return finite_n(d->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
+  return prru_finite_n(d->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
 
 double prru_rcond3(const double a[9], double inv[9])
@@ -105,7 +95,7 @@ static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
   double W[N][3], V[3][N], beta[3];
   for (int i = 0; i < N; i++)
     for (int j = 0; j < 3; j++) W[i][j] = A[3 * i + j];
-  if (!finite_n(A, 3 * N)) return 0.0;
+  if (!prru_finite_n(A, 3 * N)) return 0.0;
   double na = 0;
   for (int j = 0; j < 3; j++) {
     double s = 0;
@@ -202,7 +192,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   if (rcond) *rcond = 0.0;
   if (!finite3(q)) return PRRU_EINPUT;
   prru_ik_jd(q, d->d, d->Jd);
-  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
 
@@ -215,7 +205,7 @@ int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double 
 
 static int loads_finite(const prru_loads *l)
 {
-  return finite_n(l->fd, PRRU_NACT) && finite3(l->fp) && finite3(l->mp);
+  return prru_finite_n(l->fd, PRRU_NACT) && finite3(l->fp) && finite3(l->mp);
 }
 
 /* Why prru_eom produced non-finite output from finite inputs: q out of
@@ -289,10 +279,10 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * prru_check_regular's test, on that J_d and J_d^-1. */
   double f[3];
   prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
-  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
     return PRRU_ESINGULAR;
-  if (!finite_n(f, 3)) return PRRU_EINPUT;
+  if (!prru_finite_n(f, 3)) return PRRU_EINPUT;
   memcpy(fd, f, sizeof f);
   return PRRU_OK;
 #else
@@ -300,7 +290,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
   double tau[3];
   prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, tau);
-  if (!finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   int st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
   if (st != PRRU_OK) return st;
   const double *inv = d->Jdpinv;
@@ -308,7 +298,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
    * solution of J_d^T fd = tau of least norm. */
   for (int i = 0; i < N; i++) fd[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
-  return finite_n(fd, N) ? PRRU_OK : PRRU_EINPUT;
+  return prru_finite_n(fd, N) ? PRRU_OK : PRRU_EINPUT;
 #endif
 }
 
@@ -383,7 +373,7 @@ int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const doubl
     st = null_from_jd(m, d->Jd, n);
     if (st != PRRU_OK) return st;
     for (int i = 0; i < PRRU_NACT; i++) f[i] += preload * n[i];
-    if (!finite_n(f, PRRU_NACT)) return PRRU_EINPUT;
+    if (!prru_finite_n(f, PRRU_NACT)) return PRRU_EINPUT;
   }
   memcpy(fd, f, sizeof f);
   return PRRU_OK;

@@ -1,12 +1,21 @@
 /* Helpers shared inside the runtime, not part of its API. */
 #ifndef PRRU_INTERNAL_H
 #define PRRU_INTERNAL_H
+#include <math.h>
 #include <stddef.h>
 
 #include "prru.h"
 
 /* C99 has no M_PI. */
 #define PRRU_PI 3.14159265358979323846
+
+/* Whether v[0..n) are all finite. */
+static inline int prru_finite_n(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
 
 /* Formats msg (if non-NULL) and returns status. */
 int prru_fail(char *msg, int msglen, int status, const char *fmt, ...)

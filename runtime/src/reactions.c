@@ -23,12 +23,6 @@
 #error "the reactions handle at most one redundant reaction direction"
 #endif
 
-static int finite_lambda(const double v[NL])
-{
-  for (int i = 0; i < NL; i++)
-    if (!isfinite(v[i])) return 0;
-  return 1;
-}
 
 #if PRRU_NREACTION_NULL == 1
 /* Sign of z: the first coordinate in lambda order of at least half the
@@ -72,9 +66,9 @@ static int classify_failure(prru_data *d, const double q[3])
   static const double zero[3] = {0, 0, 0}, zero_fd[PRRU_NACT] = {0};
   double lam[NL];
   closed_form(d, q, zero, zero, zero_fd, zero, zero, lam);
-  int rest_ok = finite_lambda(lam);
+  int rest_ok = prru_finite_n(lam, NL);
 #if PRRU_NREACTION_NULL == 1
-  rest_ok = rest_ok && finite_lambda(d->lambda_null);
+  rest_ok = rest_ok && prru_finite_n(d->lambda_null, NL);
 #endif
   return rest_ok ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
@@ -89,7 +83,7 @@ int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
   int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
   prru_reaction_nullspace(q, d->lambda_null);
-  if (!finite_lambda(d->lambda_null)) return PRRU_ESINGULAR;
+  if (!prru_finite_n(d->lambda_null, NL)) return PRRU_ESINGULAR;
   orient_null(d->lambda_null);
   memcpy(z, d->lambda_null, sizeof d->lambda_null);
   return PRRU_OK;
@@ -103,9 +97,9 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
   int st = prru_forward_dynamics(m, d, q, qd, l, qdd);
   if (st != PRRU_OK) return st;
   closed_form(d, q, qd, qdd, l->fd, l->fp, l->mp, d->r);
-  int ok = finite_lambda(d->r);
+  int ok = prru_finite_n(d->r, NL);
 #if PRRU_NREACTION_NULL == 1
-  ok = ok && finite_lambda(d->lambda_null);
+  ok = ok && prru_finite_n(d->lambda_null, NL);
 #endif
   if (!ok) {
     st = classify_failure(d, q);

@@ -162,13 +162,6 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
 }
 
-static int finite_state(const double y[6])
-{
-  for (int i = 0; i < 6; i++)
-    if (!isfinite(y[i])) return 0;
-  return 1;
-}
-
 static void progress(double t, double t_end)
 {
   int w = 40, n = (int)(w * t / t_end + 0.5);
@@ -281,7 +274,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
       }
     }
     int ss = make_sample(m, d, ls, o->reactions, tk, y, s);
-    if (ss == PRRU_EINPUT && finite_state(y)) {
+    if (ss == PRRU_EINPUT && prru_finite_n(y, 6)) {
       /* A finite, regular state whose dynamics, reactions or energy
        * overflow: the velocities or loads are too large, not q. */
       st = ss;

@@ -181,10 +181,6 @@ static int quintic_alloc(prru_quintic *tr, int n, char *msg, int msglen)
   return PRRU_OK;
 }
 
-static int finite_row(const double *v)
-{
-  return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
 
 int prru_quintic_samples(prru_quintic *tr, int n, const double *t, const double *q,
                          const double *qd, const double *qdd, char *msg, int msglen)
@@ -192,8 +188,8 @@ int prru_quintic_samples(prru_quintic *tr, int n, const double *t, const double 
   int st = quintic_alloc(tr, n, msg, msglen);
   if (st != PRRU_OK) return st;
   for (int i = 0; i < n; i++) {
-    if (!isfinite(t[i]) || !finite_row(q + 3 * i) || !finite_row(qd + 3 * i) ||
-        !finite_row(qdd + 3 * i)) {
+    if (!isfinite(t[i]) || !prru_finite_n(q + 3 * i, 3) || !prru_finite_n(qd + 3 * i, 3) ||
+        !prru_finite_n(qdd + 3 * i, 3)) {
       prru_quintic_free(tr);
       return prru_fail(msg, msglen, PRRU_EINPUT, "point %d: not finite", i + 1);
     }
@@ -231,7 +227,7 @@ int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const doubl
   int st = PRRU_OK;
   t[0] = t0;
   for (int i = 0; i < n && st == PRRU_OK; i++) {
-    if (!finite_row(q + 3 * i))
+    if (!prru_finite_n(q + 3 * i, 3))
       st = prru_fail(msg, msglen, PRRU_EINPUT, "waypoint %d is not finite", i + 1);
     else if (i > 0 && !(durations[i - 1] > 0.0 && isfinite(durations[i - 1])))
       st = prru_fail(msg, msglen, PRRU_EINPUT,
