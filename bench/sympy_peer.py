@@ -61,10 +61,9 @@ def to_sympy(e, memo):
         r = to_sympy(sym.definition(e).value, memo)
     elif op == "sym":
         r = {"q1": Q[0], "q2": Q[1], "q3": Q[2]}[a[0]]
-    elif op in ("sin", "cos") and sym.definition(a[0]) is not None:
+    elif sym.atom_trig(e) is not None:
         # As the poses had it before atoms: sin(atan2(y, x)) = y / hypot.
-        f = sym.sin if op == "sin" else sym.cos
-        r = to_sympy(f(sym.definition(a[0]).value), memo)
+        r = to_sympy(sym.atom_trig(e), memo)
     elif op == "add":
         c, terms = a
         r = sympy.Add(sympy.Rational(c.numerator, c.denominator),

@@ -93,11 +93,9 @@ class Graph:
                     self.node("mul", self.num(-coef), n)
             n = self._product(factors, abs(coef) if abs(coef) != 1 else None)
             return self.node("neg", n) if coef < 0 else n
-        if op in ("sin", "cos") and sym.definition(e.args[0]) is not None:
-            # sin and cos of an atom angle from its value's closed form
-            # (sin(atan2(y, x)) = y / hypot(x, y), sin(acos x) = ...).
-            f = sym.sin if op == "sin" else sym.cos
-            return self.lower(f(sym.definition(e.args[0]).value))
+        closed = sym.atom_trig(e)
+        if closed is not None:
+            return self.lower(closed)
         return self.node("call", op, *[self.lower(a) for a in e.args])
 
     def _sum(self, e, negate=False):

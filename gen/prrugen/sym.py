@@ -124,6 +124,14 @@ def definition(e):
     return e._def
 
 
+def atom_trig(e):
+    """sin or cos of a defined symbol as that of its value, in closed form
+    (sin(atan2(y, x)) = y / hypot(x, y), ...); None for anything else."""
+    if e.op in ("sin", "cos") and e.args[0]._def is not None:
+        return (sin if e.op == "sin" else cos)(e.args[0]._def.value)
+    return None
+
+
 def reset():
     """Forget every expression built since import. Term order follows
     creation order, so a generator run starts from here: the output of one
