@@ -87,6 +87,18 @@
 #define PRRU_OPS_EOM_SOLVE "319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_INVERSE_TERMS "328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JOINT_REACTIONS "686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
+/* Whether the inputs of prru_eom_solve that may not show in its b and qdd are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, fd, fp, mp) \
+  (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
+/* Whether the inputs of prru_inverse_terms that may not show in its d and fd are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp) \
+  (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
 
 #ifdef __cplusplus
 extern "C" {

@@ -190,6 +190,62 @@ static void test_bad_input(void)
   TU_TRUE(strcmp(prru_strerror(PRRU_ESINGULAR), prru_strerror(PRRU_EUNREACHABLE)) != 0, "distinct messages");
 }
 
+/* Every input component of forward and inverse dynamics, made NaN, +inf
+ * or -inf at a regular state and at a singular one (J_d below a raised
+ * tolerance), must give PRRU_EINPUT, and the outputs stay untouched: the
+ * runtime tests most inputs only through the kernels' outputs
+ * (PRRU_UNSEEN_FINITE_*), so this holds only if the generator's analysis
+ * of which inputs reach them is right. */
+static void test_every_bad_input(void)
+{
+  static const double bad[3] = {NAN, INFINITY, -INFINITY};
+  enum { NIN = 12 + PRRU_NACT + 3 };
+  prru_model strict = model;
+  strict.jd_rcond_min = 0.5;
+  int fails = 0, n = 0;
+  for (int s = 0; s < 2; s++) {
+    const prru_model *m = s ? &strict : &model;
+    double q[3], qd[3], qdd[3];
+    prru_loads l;
+    random_state(q, qd);
+    random_loads(&l);
+    for (int i = 0; i < 3; i++) qdd[i] = tu_uniform(-2, 2);
+    double out[PRRU_NACT], fd0[PRRU_NACT];
+    TU_TRUE(prru_forward_dynamics(m, &data, q, qd, &l, out) == PRRU_OK, "FD at the base state");
+    TU_TRUE(prru_inverse_dynamics(m, &data, q, qd, qdd, &l, fd0) == (s ? PRRU_ESINGULAR : PRRU_OK),
+            "ID at the base state");
+    for (int k = 0; k < NIN; k++) {
+      /* input k: q, qd, qdd, fd, fp, mp in that order */
+      double *v = k < 3 ? &q[k] : k < 6 ? &qd[k - 3] : k < 9 ? &qdd[k - 6]
+                  : k < 9 + PRRU_NACT ? &l.fd[k - 9] : k < 12 + PRRU_NACT ? &l.fp[k - 9 - PRRU_NACT]
+                  : &l.mp[k - 12 - PRRU_NACT];
+      const double saved = *v;
+      for (int b = 0; b < 3; b++) {
+        *v = bad[b];
+        double o[PRRU_NACT] = {7, 7, 7};
+        int ok = 1;
+        if (k < 6 || k >= 9) { /* forward dynamics has no qdd */
+          ok &= prru_forward_dynamics(m, &data, q, qd, &l, o) == PRRU_EINPUT;
+          n++;
+        }
+        if (k < 9 || k >= 9 + PRRU_NACT) { /* inverse dynamics has no fd */
+          ok &= prru_inverse_dynamics(m, &data, q, qd, qdd, &l, o) == PRRU_EINPUT;
+          n++;
+        }
+        ok &= o[0] == 7 && o[1] == 7 && o[2] == 7;
+        if (!ok) {
+          fails++;
+          printf("  input %d = %g (%s state): not PRRU_EINPUT, or output written\n", k, bad[b],
+                 s ? "singular" : "regular");
+        }
+      }
+      *v = saved;
+    }
+  }
+  printf("forward and inverse dynamics: %d calls with one non-finite input, %d wrong\n", n, fails);
+  TU_TRUE(fails == 0, "every non-finite input is PRRU_EINPUT");
+}
+
 /* ---- reactions ---- */
 /* Joint j's lambda coordinates. */
 static const double *joint_lambda(const double *lam, int j)
@@ -903,6 +959,7 @@ int main(void)
   test_inverse_of_forward();
   test_fk();
   test_bad_input();
+  test_every_bad_input();
   test_reactions();
   test_energy();
   test_steppers();

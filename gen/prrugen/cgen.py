@@ -211,12 +211,16 @@ def print_op(n, expr, parent_prec=0, right=False):
 class Kernel:
     """One C function: inputs (C array, symbol names), outputs (C array, exprs)."""
 
-    def __init__(self, name, doc, inputs, outputs, guards=(), params=None):
+    def __init__(self, name, doc, inputs, outputs, guards=(), params=None,
+                 witnesses=()):
         self.name, self.doc = name, doc
         self.inputs = inputs          # [(array name, [symbol names])]
         self.outputs = outputs        # [(array name, [Expr])]
         self.guards = list(guards)    # Exprs required to lie in [-1, 1]
         self.params = params          # ParamsArg, or None
+        # Output arrays whose finiteness the runtime tests after a call:
+        # unseen_inputs() names the inputs those tests do not cover.
+        self.witnesses = tuple(witnesses)
 
 
 class ParamsArg:
@@ -262,6 +266,54 @@ def _uses(roots):
                 uses[a.index] = uses.get(a.index, 0) + 1
                 stack.append(a)
     return uses, seen
+
+
+# Calls f with f(x) NaN or infinite whenever x is (sin(inf) is NaN,
+# sqrt(inf) is inf); tanh(inf) = 1, atan2(inf, 1) = pi/2 and pow are not.
+_STRICT_CALLS = ("sqrt", "sin", "cos", "tan", "asin", "acos")
+
+
+def _strict(graph):
+    """Per node of graph: the inputs (C local names) such that a NaN or an
+    infinity in any of them makes the node NaN or infinite, whatever the
+    other inputs are. IEEE arithmetic propagates both through +, -, * and a
+    numerator (inf - inf, inf * 0 and inf / inf are NaN); a denominator does
+    not (1 / inf = 0)."""
+    strict = []
+    for n in graph.nodes:                 # operands precede their users
+        op = n.op
+        if op == "in":
+            s = frozenset((n.args[0],))
+        elif op in ("add", "sub", "mul", "neg"):
+            s = frozenset().union(*[strict[a.index] for a in n.args])
+        elif op == "div":
+            s = strict[n.args[0].index]
+        elif op == "call" and n.args[0] in _STRICT_CALLS:
+            s = strict[n.args[1].index]
+        else:
+            s = frozenset()
+        strict.append(s)
+    return strict
+
+
+def unseen_inputs(kernel):
+    """{input array: [indices]} of the inputs whose NaN or infinity can
+    leave every output in kernel.witnesses finite: a caller that tests
+    those outputs' finiteness must test these inputs itself, and no
+    other. With guards, a non-finite q makes every output NaN."""
+    low = Lowered(kernel)
+    missing = set(kernel.witnesses) - {arr for arr, _ in low.out_nodes}
+    if missing:
+        raise ValueError("%s: no output %s" % (kernel.name, ", ".join(sorted(missing))))
+    strict = _strict(low.graph)
+    seen = set()
+    for arr, ns in low.out_nodes:
+        if arr in kernel.witnesses:
+            for n in ns:
+                seen |= strict[n.index]
+    seen |= {n.args[0] for n in low.finite_nodes}
+    return {arr: [i for i in range(len(syms)) if low.names[syms[i]] not in seen]
+            for arr, syms in kernel.inputs}
 
 
 class Emitted:

@@ -84,8 +84,10 @@ def kernels(deriv):
     spec.append(_eom_solve(deriv, m, fd, fp, mp))
     spec.append(_inverse_terms(deriv, d, jd, fp, mp))
     spec += _reaction_kernels(deriv, fd, fp, mp)
-    return [Kernel(name, doc, ins, outs, guards)
-            for name, doc, ins, outs in spec]
+    # eom_solve and inverse_terms also name the outputs whose finiteness
+    # the runtime tests after each call (Kernel.witnesses).
+    return [Kernel(k[0], k[1], k[2], k[3], guards, witnesses=k[4] if len(k) > 4 else ())
+            for k in spec]
 
 
 def _atom(name, x):
@@ -124,7 +126,7 @@ def _eom_solve(deriv, m, fd, fp, mp):
             "is positive definite exactly when all three are positive "
             "(Sylvester), and qdd is meaningful only then.",
             [Q, QD, _arg("fd", len(fd)), _arg("fp", 3), _arg("mp", 3)],
-            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)])
+            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)], ("b", "qdd"))
 
 
 def _inverse_terms(deriv, d, jd, fp, mp):
@@ -140,7 +142,7 @@ def _inverse_terms(deriv, d, jd, fp, mp):
         return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h "
                 "- G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized "
                 "force the drives supply: J_d^T fd = tau.", ins,
-                [("d", d), ("Jd", jd), ("tau", tau)])
+                [("d", d), ("Jd", jd), ("tau", tau)], ("d", "tau"))
     # As in eom_solve, the inverse and the solve work on J_d's and tau's
     # values as atoms.
     ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
@@ -162,7 +164,7 @@ def _inverse_terms(deriv, d, jd, fp, mp):
             "adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T "
             "tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: "
             "the actuator forces of the motion.", ins,
-            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd)])
+            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd)], ("d", "fd"))
 
 
 def _reaction_kernels(deriv, fd, fp, mp):

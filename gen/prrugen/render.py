@@ -231,6 +231,31 @@ def _batched(kernel_list, prefix, file_prefix):
             batch.prologue(file_prefix) + "\n\n" + bodies)
 
 
+def _unseen_macros(kernel_list, upper, prefix):
+    """PREFIX_UNSEEN_FINITE_KERNEL(inputs...): whether the inputs that the
+    kernel's witness outputs may not show (cgen.unseen_inputs) are finite,
+    for the kernels with witnesses. A macro, so that it costs only its
+    tests and the header needs no <math.h>."""
+    out = []
+    for k in kernel_list:
+        if not k.witnesses:
+            continue
+        unseen = cgen.unseen_inputs(k)
+        tests = ["isfinite((%s)[%d])" % (arr, i) for arr, _ in k.inputs
+                 for i in unseen[arr]]
+        out.append("/* Whether the inputs of %s_%s that may not show in its "
+                   "%s are finite:\n   a NaN or an infinity in any other input "
+                   "makes one of those outputs NaN or\n   infinite (the "
+                   "inputs tested here do not reach them, or reach them only "
+                   "through\n   tanh, atan2 or a denominator), so testing "
+                   "the outputs tests those inputs (isfinite: <math.h>). */"
+                   % (prefix, k.name, " and ".join(k.witnesses)))
+        out.append("#define %s_UNSEEN_FINITE_%s(%s) \\\n  (%s)"
+                   % (upper, k.name.upper(), ", ".join(arr for arr, _ in k.inputs),
+                      " && ".join(tests) if tests else "1"))
+    return out
+
+
 def render(model, deriv, templates_dir, prefix=None):
     """{file name: text} for the kernels and mechanism descriptor of model,
     and the emitted kernels. prefix: the C prefix (default: model name)."""
@@ -254,11 +279,13 @@ def render(model, deriv, templates_dir, prefix=None):
                % (upper, e.name.upper(), e.arithmetic) for e in emitted]
     macros += ['#define %s_OPS_%s "%s"' % (upper, e.name.upper(), e.summary())
                for e in emitted]
+    kernel_list = kernels(deriv)
+    macros += _unseen_macros(kernel_list, upper, prefix)
     decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
                         for e in emitted)
     bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
                          for e in emitted)
-    bdecls, bbodies = _batched(kernels(deriv), prefix, prefix)
+    bdecls, bbodies = _batched(kernel_list, prefix, prefix)
     decls += "\n\n" + bdecls
     bodies += "\n\n" + bbodies
     values = dict(banner=banner, head=head + " */", prefix=prefix,

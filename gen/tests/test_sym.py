@@ -196,6 +196,25 @@ class Lowering(unittest.TestCase):
             self.assertEqual(g.ready[n.index], g.ready[root.index] + 3)
 
 
+    def test_unseen_inputs(self):
+        # A NaN or an infinity reaches an output through +, -, * and a
+        # numerator, and sin, cos, sqrt; not through tanh or a denominator
+        # (tanh(inf) = 1, 1 / inf = 0), nor from an output that is no
+        # witness.
+        from prrugen import cgen
+        u, v, w = sym.sym("u"), sym.sym("v"), sym.sym("w")
+        outs = [("o", [X * sym.sin(Y) + sym.tanh(Z) * u / v]), ("p", [w])]
+        ins = [("a", ["x", "y", "z"]), ("b", ["u", "v", "w"])]
+        k = cgen.Kernel("k", "", ins, outs, witnesses=("o",))
+        self.assertEqual(cgen.unseen_inputs(k), {"a": [2], "b": [1, 2]})
+        k = cgen.Kernel("k", "", ins, outs, witnesses=("o", "p"))
+        self.assertEqual(cgen.unseen_inputs(k), {"a": [2], "b": [1]})
+        # With guards, a non-finite first input array makes every output NaN.
+        k = cgen.Kernel("k", "", ins, outs, guards=[X / 2], witnesses=("p",))
+        self.assertEqual(cgen.unseen_inputs(k), {"a": [], "b": [0, 1]})
+        with self.assertRaises(ValueError):
+            cgen.unseen_inputs(cgen.Kernel("k", "", ins, outs, witnesses=("q",)))
+
     def test_cse_and_lowering_preserve_values(self):
         exprs = [e for e in Differentiation.EXPRS]
         exprs += [sym.diff(e, X) for e in Differentiation.EXPRS]

@@ -222,13 +222,20 @@ static int classify_failure(const prru_model *m, prru_data *d, const double q[3]
   return finite3(b) ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
 
+/* Why prru_eom_solve's outputs failed the test of prru_forward_dynamics. */
+PRRU_COLD static int forward_failure(const prru_model *m, prru_data *d, const double q[3],
+                                     const double qd[3], const prru_loads *l,
+                                     const double minors[3])
+{
+  if (!finite3(q) || !finite3(qd) || !loads_finite(l)) return PRRU_EINPUT;
+  if (!finite3(d->b)) return classify_failure(m, d, q);
+  if (!(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0)) return PRRU_ESINGULAR;
+  return PRRU_EINPUT; /* b finite, M^-1 b overflowed */
+}
+
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3])
 {
-  /* A load component that does no work at this pose never reaches b, so
-   * the loads are checked here; NaN/inf in q or qd, or q out of reach,
-   * always shows in b. */
-  if (!loads_finite(l)) return PRRU_EINPUT;
   /* M qdd = b solved inside the kernel by M's adjugate (one division, the
    * cofactors scheduled with the rest of the kernel: a separate Cholesky
    * chained three square roots and six divisions after it). Whether M is
@@ -236,12 +243,15 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * kernel returns: otherwise qdd is not used. */
   double minors[3];
   prru_eom_solve(q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
-  if (!finite3(d->b)) {
-    if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
-    return classify_failure(m, d, q);
-  }
-  if (!(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0)) return PRRU_ESINGULAR;
-  if (!finite3(d->qdd)) return PRRU_EINPUT; /* b finite, M^-1 b overflowed */
+  /* Testing every input first cost as much as a tenth of the step, so the
+   * inputs are tested through the outputs: the generator proves that a NaN
+   * or an infinity in any input but the few PRRU_UNSEEN_FINITE_EOM_SOLVE
+   * tests makes b or qdd non-finite (with q unreachable, everything is
+   * NaN). Only on failure are all of them examined, to name the cause: the
+   * statuses are those of testing every input first. */
+  if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
+      !finite3(d->qdd) || !PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, l->fd, l->fp, l->mp))
+    return forward_failure(m, d, q, qd, l, minors);
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }
@@ -268,38 +278,51 @@ static int regular_from_inverse(const double J[9], const double inv[9], double L
 }
 #endif
 
+/* PRRU_EINPUT where an input is not finite, else st: the status of testing
+ * every input first. */
+PRRU_COLD static int inverse_failure(int st, const double q[3], const double qd[3],
+                                     const double qdd[3], const prru_loads *l)
+{
+  if (!(finite3(q) && finite3(qd) && finite3(qdd) && finite3(l->fp) && finite3(l->mp)))
+    return PRRU_EINPUT;
+  return st;
+}
+
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[PRRU_NACT])
 {
-  if (!finite3(q) || !finite3(qd) || !finite3(qdd) || !finite3(l->fp) || !finite3(l->mp))
-    return PRRU_EINPUT;
+  int st;
 #if PRRU_NACT == 3
   /* One kernel gives d, J_d, J_d^-1 and fd = J_d^-T (M qdd - b); here only
    * prru_check_regular's test, on that J_d and J_d^-1. */
   double f[3];
   prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
-  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
-  if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
-    return PRRU_ESINGULAR;
-  if (!prru_finite_n(f, 3)) return PRRU_EINPUT;
-  memcpy(fd, f, sizeof f);
-  return PRRU_OK;
+  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  else if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
+    st = PRRU_ESINGULAR;
+  else st = prru_finite_n(f, 3) ? PRRU_OK : PRRU_EINPUT;
 #else
   /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
    * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
-  double tau[3];
+  double tau[3], f[PRRU_NACT];
   prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, tau);
-  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
-  int st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
-  if (st != PRRU_OK) return st;
-  const double *inv = d->Jdpinv;
-  enum { N = PRRU_NACT };
-  /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
-   * solution of J_d^T fd = tau of least norm. */
-  for (int i = 0; i < N; i++) fd[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
-  return prru_finite_n(fd, N) ? PRRU_OK : PRRU_EINPUT;
+  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
+  if (st == PRRU_OK) {
+    const double *inv = d->Jdpinv;
+    enum { N = PRRU_NACT };
+    /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
+     * solution of J_d^T fd = tau of least norm; non-finite where tau is. */
+    for (int i = 0; i < N; i++) f[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
+    st = prru_finite_n(f, N) ? PRRU_OK : PRRU_EINPUT;
+  }
 #endif
+  /* Inputs tested through the outputs, as in prru_forward_dynamics. */
+  if (st != PRRU_OK || !PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, l->fp, l->mp))
+    return inverse_failure(st, q, qd, qdd, l);
+  memcpy(fd, f, sizeof f);
+  return PRRU_OK;
 }
 
 /* n from J_d (regular): n_i = (-1)^i det(J_d without row i), the

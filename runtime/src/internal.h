@@ -17,6 +17,14 @@ static inline int prru_finite_n(const double *v, int n)
   return 1;
 }
 
+/* Failure paths: kept out of line, so that the fast path they branch
+ * from saves no registers for them. */
+#if defined(__GNUC__)
+#define PRRU_COLD __attribute__((cold, noinline))
+#else
+#define PRRU_COLD
+#endif
+
 /* Formats msg (if non-NULL) and returns status. */
 int prru_fail(char *msg, int msglen, int status, const char *fmt, ...)
 #if defined(__GNUC__)
