@@ -11,7 +11,7 @@
 
 /* What the generated side of the runtime's paths executes (runtime/src/core.c,
  * reactions.c): the generated kernels named, plus the listed numerics. */
-#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom_solve (eom and M's adjugate solve fused): " \
+#define PRRU_BENCH_OPS_FORWARD_DYNAMICS "eom_solve (eom and the solve of M qdd = b fused): " \
   PRRU_OPS_EOM_SOLVE
 #if PRRU_NACT == 3
 #define PRRU_BENCH_OPS_JD_INVERSE "J_d^-1 and fd in the kernel; conditioning test"

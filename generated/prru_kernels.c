@@ -23,7 +23,7 @@
  *   actuator_rates     124 arithmetic (12 add, 17 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          305 arithmetic (48 add, 49 sub, 203 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   inverse_terms      328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3
  */
@@ -5169,19 +5169,23 @@ void prru_eom_solve(const double q[3], const double qd[3], const double fd[3], c
   b[1] = t76;
   const double t77 = 0.7245 * (t72 * 0.6527163926505204 + (t54 * 2.706945423600238 + ((fd1 + fd2 + (fd3 + fp3)) * 1.3802622498274673 - 167.76521739130436 - t70) + (t69 - t51 * 1.9642992168512017)) - 0.6820483391844451 * t73);
   b[2] = t77;
-  const double t78 = t42 * t46 - t44 * t45;
-  const double t79 = t45 - t46 * t46 * 0.08071025020177562;
-  const double t80 = t42 - 0.08071025020177562 * (t44 * t46);
-  const double t81 = t44 * t78 + 12.39 * (t40 * t79 - t42 * t80);
-  const double t82 = 1.0 / t81;
-  qdd[0] = t82 * (t77 * t78 + 12.39 * (t75 * t79 - t76 * t80));
-  const double t83 = t42 * t44 - t40 * t46;
-  qdd[1] = t82 * (t77 * t83 - 12.39 * (t75 * t80 - t76 * (t40 - 0.08071025020177562 * (t44 * t44))));
-  const double t84 = t40 * t45 - t42 * t42;
-  qdd[2] = t82 * (t77 * t84 + (t75 * t78 + t76 * t83));
-  minors[0] = t40;
-  minors[1] = t84;
-  minors[2] = t81;
+  const double t78 = t44 * 0.08071025020177562;
+  const double t79 = t40 - t44 * t78;
+  const double t80 = t46 * 0.08071025020177562;
+  const double t81 = t45 - t46 * t80;
+  const double t82 = t42 - t46 * t78;
+  const double t83 = t79 * t81 - t82 * t82;
+  const double t84 = 1.0 / t83;
+  const double t85 = t75 - t77 * t78;
+  const double t86 = t76 - t77 * t80;
+  const double t87 = t84 * (t81 * t85 - t82 * t86);
+  qdd[0] = t87;
+  const double t88 = t84 * (t79 * t86 - t82 * t85);
+  qdd[1] = t88;
+  qdd[2] = t77 * 0.08071025020177562 - t78 * t87 - t80 * t88;
+  minors[0] = 12.39;
+  minors[1] = 12.39 * t79;
+  minors[2] = 12.39 * t83;
 }
 
 void prru_inverse_terms(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3])
@@ -6179,13 +6183,17 @@ PRRU_BATCH_TARGETS void prru_batch_eom_solve(int n, const double *q, const doubl
       const double t75 = (mp1 * 0.07162835202274309 - w2[k] * (w1[k] * (qd1 * qd2)) * 0.00011460536323638894 - w3[k] * t48 * 0.003420217994909971 - t19 - (t18 * t48 - 1.3780718336483933 * (t51 * (t13 * t50))) * (w3[k] * t18) * 0.001283217187371524 - (t24 * fd1 - t25 * fd2) * 0.019339655046140634 + ((t21 * (t54 + (t49 - t55)) + t22 * (t49 + t55 - t54)) * 0.006840435989819942 + (t24 * (t56 + (t49 - t57)) + t25 * (t49 + t57 - t56)) * 0.008302513911308174) - t27 * t74 * 0.00017907088005685772) * 13.960952217391304;
       const double t76 = (w2[k] * (w1[k] * t47) + (w0[k] * mp2 + w3[k] * mp3) * 1250.0 - t41 * t74 * 3.125) * 0.0008;
       const double t77 = 0.7245 * (t72 * 0.6527163926505204 + (t52 * 2.706945423600238 + ((fd1 + fd2 + (fd3 + fp3)) * 1.3802622498274673 - 167.76521739130436 - t68) + (t67 - t53 * 1.9642992168512017)) - 0.6820483391844451 * t73);
-      const double t78 = t42 * t46 - t44 * t45;
-      const double t79 = t45 - t46 * t46 * 0.08071025020177562;
-      const double t80 = t42 - 0.08071025020177562 * (t44 * t46);
-      const double t81 = t44 * t78 + 12.39 * (t40 * t79 - t42 * t80);
-      const double t82 = 1.0 / t81;
-      const double t83 = t42 * t44 - t40 * t46;
-      const double t84 = t40 * t45 - t42 * t42;
+      const double t78 = t44 * 0.08071025020177562;
+      const double t79 = t40 - t44 * t78;
+      const double t80 = t46 * 0.08071025020177562;
+      const double t81 = t45 - t46 * t80;
+      const double t82 = t42 - t46 * t78;
+      const double t83 = t79 * t81 - t82 * t82;
+      const double t84 = 1.0 / t83;
+      const double t85 = t75 - t77 * t78;
+      const double t86 = t76 - t77 * t80;
+      const double t87 = t84 * (t81 * t85 - t82 * t86);
+      const double t88 = t84 * (t79 * t86 - t82 * t85);
       /* Unreachable or non-finite q: NaN (a select, not a branch). */
       const int ok = islessequal(fabs((1.3333333333333333 - w0[k]) * 1.173913043478261), 1.0) &
           islessequal(fabs(t11 * 0.9782608695652174), 1.0) &
@@ -6204,12 +6212,12 @@ PRRU_BATCH_TARGETS void prru_batch_eom_solve(int n, const double *q, const doubl
       b[i] = ok ? t75 : (double)NAN;
       b[s + i] = ok ? t76 : (double)NAN;
       b[2 * s + i] = ok ? t77 : (double)NAN;
-      qdd[i] = ok ? t82 * (t77 * t78 + 12.39 * (t75 * t79 - t76 * t80)) : (double)NAN;
-      qdd[s + i] = ok ? t82 * (t77 * t83 - 12.39 * (t75 * t80 - t76 * (t40 - 0.08071025020177562 * (t44 * t44)))) : (double)NAN;
-      qdd[2 * s + i] = ok ? t82 * (t77 * t84 + (t75 * t78 + t76 * t83)) : (double)NAN;
-      minors[i] = ok ? t40 : (double)NAN;
-      minors[s + i] = ok ? t84 : (double)NAN;
-      minors[2 * s + i] = ok ? t81 : (double)NAN;
+      qdd[i] = ok ? t87 : (double)NAN;
+      qdd[s + i] = ok ? t88 : (double)NAN;
+      qdd[2 * s + i] = ok ? t77 * 0.08071025020177562 - t78 * t87 - t80 * t88 : (double)NAN;
+      minors[i] = ok ? 12.39 : (double)NAN;
+      minors[s + i] = ok ? 12.39 * t79 : (double)NAN;
+      minors[2 * s + i] = ok ? 12.39 * t83 : (double)NAN;
     }
   }
 }

@@ -23,7 +23,7 @@
  *   actuator_rates     124 arithmetic (12 add, 17 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3
  *   passive            13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1
  *   reaction_basis     56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve          319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
+ *   eom_solve          305 arithmetic (48 add, 49 sub, 203 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   inverse_terms      328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3
  */
@@ -63,7 +63,7 @@
 #define PRRU_ARITH_ACTUATOR_RATES 124 /* arithmetic operations */
 #define PRRU_ARITH_PASSIVE 13 /* arithmetic operations */
 #define PRRU_ARITH_REACTION_BASIS 56 /* arithmetic operations */
-#define PRRU_ARITH_EOM_SOLVE 319 /* arithmetic operations */
+#define PRRU_ARITH_EOM_SOLVE 305 /* arithmetic operations */
 #define PRRU_ARITH_INVERSE_TERMS 328 /* arithmetic operations */
 #define PRRU_ARITH_JOINT_REACTIONS 686 /* arithmetic operations */
 #define PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
@@ -84,7 +84,7 @@
 #define PRRU_OPS_ACTUATOR_RATES "124 arithmetic (12 add, 17 sub, 92 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_PASSIVE "13 arithmetic (1 add, 2 sub, 9 mul, 1 div); calls: cos 2, sin 1, sqrt 1"
 #define PRRU_OPS_REACTION_BASIS "56 arithmetic (2 add, 5 sub, 31 mul, 1 div, 17 neg); calls: cos 2, sin 2, sqrt 3"
-#define PRRU_OPS_EOM_SOLVE "319 arithmetic (52 add, 49 sub, 213 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
+#define PRRU_OPS_EOM_SOLVE "305 arithmetic (48 add, 49 sub, 203 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_INVERSE_TERMS "328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
 #define PRRU_OPS_JOINT_REACTIONS "686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
 /* Whether the inputs of prru_eom_solve that may not show in its b and qdd are finite:
@@ -158,7 +158,7 @@ void prru_passive(const double q[3], const double qd[3], double Qp[3]);
 /* Q (60x57) mapping the joint reaction coordinates lambda to body wrenches about each centre, so that Phi H qdd + K = Fbar + Q lambda. */
 void prru_reaction_basis(const double q[3], double Q[3420]);
 
-/* eom's M and b, qdd = M^-1 b by the adjugate, and M's leading principal minors (M00, M00 M11 - M01^2, det M): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
+/* eom's M and b, qdd = M^-1 b (M_22, a constant, eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
 void prru_eom_solve(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
 
 /* d, J_d (as prru_ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. */
@@ -194,7 +194,7 @@ void prru_batch_dynamics(int n, const double *q, const double *qd, double *M, do
 /* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
 void prru_batch_eom(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
 
-/* eom's M and b, qdd = M^-1 b by the adjugate, and M's leading principal minors (M00, M00 M11 - M01^2, det M): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
+/* eom's M and b, qdd = M^-1 b (M_22, a constant, eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
 void prru_batch_eom_solve(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */

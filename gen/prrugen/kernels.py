@@ -96,17 +96,61 @@ def _atom(name, x):
 
 
 def _eom_solve(deriv, m, fd, fp, mp):
-    """eom with M qdd = b solved by the adjugate in the same evaluation:
-    the cofactors are products of M's entries, independent of each other,
-    so only one division is serial, and the compiler interleaves them with
-    the rest of the kernel."""
+    """eom with M qdd = b solved in the same evaluation, by eliminating a
+    constant diagonal entry of M first where there is one (_pivot_solve),
+    else by the adjugate (_adjugate_solve)."""
     b = deriv.eom_rhs(fd, fp, mp)
     # The solve works on M's and b's values as atoms, so that it is the
-    # plain adjugate arithmetic on them instead of being folded into their
+    # plain arithmetic on them instead of being folded into their
     # expressions (the sums' scale factors would multiply through it).
     ma = [_atom("M%d" % k, x) for k, x in enumerate(m)]
     ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
     e = [[ma[3 * i + j] for j in range(3)] for i in range(3)]
+    pivots = [k for k in range(3) if e[k][k].op == "const"]
+    if pivots:
+        qdd, minors, how_sets = _pivot_solve(e, ba, pivots[-1])
+    else:
+        qdd, minors, how_sets = _adjugate_solve(e, ba)
+    return ("eom_solve", "eom's M and b, qdd = M^-1 b (%s), and three "
+            "principal minors of M on nested index sets (%s): M is positive "
+            "definite exactly when all three are positive (Sylvester), and "
+            "qdd is meaningful only then." % how_sets,
+            [Q, QD, _arg("fd", len(fd)), _arg("fp", 3), _arg("mp", 3)],
+            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)], ("b", "qdd"))
+
+
+def _pivot_solve(e, b, k):
+    """M x = b with M_kk a constant: x_k eliminated first (a Cholesky step
+    with no square root and no division, 1/M_kk being a constant), then
+    the 2x2 Schur complement S by its adjugate. About 18 multiplies and one
+    division against the adjugate's 27; the minors are M_kk, M_kk S_ii and
+    det M = M_kk det S."""
+    i, j = [n for n in range(3) if n != k]
+    r = sym.power(e[k][k], -1)
+    ui = _atom("u%d" % i, sym.mul(e[i][k], r))
+    uj = _atom("u%d" % j, sym.mul(e[j][k], r))
+    sii = e[i][i] - ui * e[i][k]
+    sij = e[i][j] - ui * e[j][k]
+    sjj = e[j][j] - uj * e[j][k]
+    ci = b[i] - ui * b[k]
+    cj = b[j] - uj * b[k]
+    det = sii * sjj - sij * sij
+    inv = sym.power(det, -1)
+    x = [None] * 3
+    x[i] = _atom("x%d" % i, (sjj * ci - sij * cj) * inv)
+    x[j] = _atom("x%d" % j, (sii * cj - sij * ci) * inv)
+    # b_k / M_kk as an atom: otherwise the sum is normalised to
+    # (b_k - M_kk (u_i x_i + u_j x_j)) / M_kk, a multiply more.
+    x[k] = _atom("y%d" % k, b[k] * r) - ui * x[i] - uj * x[j]
+    minors = [e[k][k], e[k][k] * sii, e[k][k] * det]
+    return x, minors, ("M_%d%d, a constant, eliminated first, then the 2x2 "
+                       "Schur complement S by its adjugate" % (k, k),
+                       "{%d}, {%d, %d}, {0, 1, 2}" % (k, k, i))
+
+
+def _adjugate_solve(e, b):
+    """M x = b by M's adjugate: the cofactors are products of M's entries,
+    independent of each other, so only one division is serial."""
     cof = [[sym.add(sym.mul(e[(j + 1) % 3][(i + 1) % 3],
                             e[(j + 2) % 3][(i + 2) % 3]),
                     -sym.mul(e[(j + 1) % 3][(i + 2) % 3],
@@ -118,15 +162,9 @@ def _eom_solve(deriv, m, fd, fp, mp):
             cof[i][j] = cof[j][i]
     det = sym.add(*[sym.mul(e[0][k], cof[k][0]) for k in range(3)])
     inv_det = sym.power(det, -1)
-    qdd = [sym.mul(sym.add(*[sym.mul(cof[i][k], ba[k]) for k in range(3)]),
-                   inv_det) for i in range(3)]
-    minors = [e[0][0], cof[2][2], det]
-    return ("eom_solve", "eom's M and b, qdd = M^-1 b by the adjugate, and "
-            "M's leading principal minors (M00, M00 M11 - M01^2, det M): M "
-            "is positive definite exactly when all three are positive "
-            "(Sylvester), and qdd is meaningful only then.",
-            [Q, QD, _arg("fd", len(fd)), _arg("fp", 3), _arg("mp", 3)],
-            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)], ("b", "qdd"))
+    x = [sym.mul(sym.add(*[sym.mul(cof[i][k], b[k]) for k in range(3)]),
+                 inv_det) for i in range(3)]
+    return x, [e[0][0], cof[2][2], det], ("M's adjugate", "{0}, {0, 1}, {0, 1, 2}")
 
 
 def _inverse_terms(deriv, d, jd, fp, mp):

@@ -116,6 +116,48 @@ class Mechanism(unittest.TestCase):
         self.assertIs(self.deriv.mass()[8], sym.const(self.model.total_mass))
 
 
+class Solves(unittest.TestCase):
+    """eom_solve's two ways to solve M x = b, on random symmetric matrices."""
+
+    @staticmethod
+    def _det(a):
+        return (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))
+
+    def _check(self, solve, k, definite, rng):
+        sym.reset()  # the solves' atoms (_u0, _x1, ...) are defined anew
+        g = [[rng.uniform(-1, 1) for _ in range(3)] for _ in range(3)]
+        a = [[sum(g[i][n] * g[j][n] for n in range(3)) + (0.3 if i == j else 0)
+              for j in range(3)] for i in range(3)]
+        if not definite:
+            a[1][1] = -a[1][1]
+        names = [["m%d%d" % (min(i, j), max(i, j)) for j in range(3)] for i in range(3)]
+        e = [[sym.const(round(a[i][j], 6)) if (i, j) == (k, k) else sym.sym(names[i][j])
+              for j in range(3)] for i in range(3)]
+        if k is not None:
+            a[k][k] = round(a[k][k], 6)
+        env = {names[i][j]: a[i][j] for i in range(3) for j in range(3)}
+        b = [rng.uniform(-1, 1) for _ in range(3)]
+        env.update({"c%d" % i: b[i] for i in range(3)})
+        x, minors, _ = solve(e, [sym.sym("c%d" % i) for i in range(3)])
+        x, minors = sym.evaluate(x, env), sym.evaluate(minors, env)
+        for i in range(3):
+            self.assertAlmostEqual(sum(a[i][j] * x[j] for j in range(3)), b[i], delta=1e-12)
+        self.assertAlmostEqual(minors[2], self._det(a), delta=1e-12)
+        self.assertEqual(all(v > 0 for v in minors), definite)
+
+    def test_pivot_and_adjugate_solves(self):
+        from prrugen import kernels
+        rng = random.Random(7)
+        for _ in range(20):
+            for definite in (True, False):
+                self._check(kernels._adjugate_solve, None, definite, rng)
+                for k in range(3):
+                    self._check(lambda e, b, k=k: kernels._pivot_solve(e, b, k), k,
+                                definite, rng)
+
+
 class CommandLine(unittest.TestCase):
     def test_regeneration_is_byte_identical_under_any_hash_seed(self):
         outs = []

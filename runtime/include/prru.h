@@ -139,8 +139,10 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
 int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                                 const double seed[3], double q[3], double *residual);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved
- * inside the generated prru_eom_solve by M's adjugate; PRRU_ESINGULAR
- * unless M is positive definite (its leading principal minors positive). */
+ * inside the generated prru_eom_solve; PRRU_ESINGULAR unless M is positive
+ * definite (three nested principal minors positive). PRRU_EINPUT for a NaN
+ * or infinite input; d->M, d->b and d->qdd may then hold what the kernel
+ * made of it, qdd is untouched. */
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3]);
 /* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored):

@@ -236,19 +236,20 @@ PRRU_COLD static int forward_failure(const prru_model *m, prru_data *d, const do
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3])
 {
-  /* M qdd = b solved inside the kernel by M's adjugate (one division, the
-   * cofactors scheduled with the rest of the kernel: a separate Cholesky
+  /* M qdd = b solved inside the kernel (a constant diagonal entry of M
+   * eliminated first where the model has one, else M's adjugate; one
+   * division, scheduled with the rest of the kernel: a separate Cholesky
    * chained three square roots and six divisions after it). Whether M is
-   * positive definite is Sylvester's criterion on the leading minors the
-   * kernel returns: otherwise qdd is not used. */
+   * positive definite is Sylvester's criterion on the nested principal
+   * minors the kernel returns: otherwise qdd is not used. */
   double minors[3];
   prru_eom_solve(q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
-  /* Testing every input first cost as much as a tenth of the step, so the
-   * inputs are tested through the outputs: the generator proves that a NaN
-   * or an infinity in any input but the few PRRU_UNSEEN_FINITE_EOM_SOLVE
-   * tests makes b or qdd non-finite (with q unreachable, everything is
-   * NaN). Only on failure are all of them examined, to name the cause: the
-   * statuses are those of testing every input first. */
+  /* The inputs are tested through the outputs, not one by one before the
+   * call: the generator proves that a NaN or an infinity in any input but
+   * the few PRRU_UNSEEN_FINITE_EOM_SOLVE tests makes b or qdd non-finite
+   * (with q unreachable, everything is NaN). Only on failure are all of
+   * them examined, to name the cause: the statuses are those of testing
+   * every input first. */
   if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
       !finite3(d->qdd) || !PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, l->fd, l->fp, l->mp))
     return forward_failure(m, d, q, qd, l, minors);
