@@ -5599,12 +5599,12 @@ void prru_joint_reactions(const double q[3], const double qd[3], const double qd
  * iterations are independent; the build may define it as _Pragma("omp simd")
  * (with -fopenmp-simd) to have the loops vectorised, and
  * PRRU_BATCH_TARGETS as a function attribute (e.g. target_clones).
- * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN and
- * _COS are sin and cos declared as having vector variants (glibc's libmvec,
- * which <math.h> declares only under -ffast-math; the kernels are never
- * built with it), within a few units in the last place of the scalar sin
- * and cos; the kinematic kernels call sin and cos themselves and so agree
- * with the scalar kernels bit for bit. */
+ * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN,
+ * _COS and _TANH are sin, cos and tanh declared as having vector variants
+ * (glibc's libmvec, which <math.h> declares only under -ffast-math; the
+ * kernels are never built with it), within a few units in the last place
+ * of the scalar functions; the kinematic kernels call sin and cos
+ * themselves and so agree with the scalar kernels bit for bit. */
 #ifndef PRRU_BATCH_LOOP
 #define PRRU_BATCH_LOOP
 #endif
@@ -5616,11 +5616,18 @@ void prru_joint_reactions(const double q[3], const double qd[3], const double qd
 extern double prru_batch_vsin(double) __asm__("sin");
 #pragma omp declare simd notinbranch
 extern double prru_batch_vcos(double) __asm__("cos");
+/* const: tanh sets no errno (it cannot overflow) and reads no memory; a
+ * call GCC thinks may write memory stops the loop around it from being
+ * vectorised. */
+#pragma omp declare simd notinbranch
+extern double prru_batch_vtanh(double) __asm__("tanh") __attribute__((const));
 #define PRRU_BATCH_SIN prru_batch_vsin
 #define PRRU_BATCH_COS prru_batch_vcos
+#define PRRU_BATCH_TANH prru_batch_vtanh
 #else
 #define PRRU_BATCH_SIN sin
 #define PRRU_BATCH_COS cos
+#define PRRU_BATCH_TANH tanh
 #endif
 
 PRRU_BATCH_TARGETS void prru_batch_ik_jd(int n, const double *q, double *d, double *Jd)

@@ -175,7 +175,7 @@ void prru_joint_reactions(const double q[3], const double qd[3], const double qd
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
  * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
  * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin and cos (see the source), then within
+ * the build provides vector sin, cos and tanh (see the source), then within
  * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
  * overlap the inputs. */
 

@@ -1901,12 +1901,12 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
  * iterations are independent; the build may define it as _Pragma("omp simd")
  * (with -fopenmp-simd) to have the loops vectorised, and
  * PRRU_BATCH_TARGETS as a function attribute (e.g. target_clones).
- * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN and
- * _COS are sin and cos declared as having vector variants (glibc's libmvec,
- * which <math.h> declares only under -ffast-math; the kernels are never
- * built with it), within a few units in the last place of the scalar sin
- * and cos; the kinematic kernels call sin and cos themselves and so agree
- * with the scalar kernels bit for bit. */
+ * With PRRU_BATCH_VECTOR_MATH defined (GCC), PRRU_BATCH_SIN,
+ * _COS and _TANH are sin, cos and tanh declared as having vector variants
+ * (glibc's libmvec, which <math.h> declares only under -ffast-math; the
+ * kernels are never built with it), within a few units in the last place
+ * of the scalar functions; the kinematic kernels call sin and cos
+ * themselves and so agree with the scalar kernels bit for bit. */
 #ifndef PRRU_BATCH_LOOP
 #define PRRU_BATCH_LOOP
 #endif
@@ -1918,11 +1918,18 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
 extern double prru_batch_vsin(double) __asm__("sin");
 #pragma omp declare simd notinbranch
 extern double prru_batch_vcos(double) __asm__("cos");
+/* const: tanh sets no errno (it cannot overflow) and reads no memory; a
+ * call GCC thinks may write memory stops the loop around it from being
+ * vectorised. */
+#pragma omp declare simd notinbranch
+extern double prru_batch_vtanh(double) __asm__("tanh") __attribute__((const));
 #define PRRU_BATCH_SIN prru_batch_vsin
 #define PRRU_BATCH_COS prru_batch_vcos
+#define PRRU_BATCH_TANH prru_batch_vtanh
 #else
 #define PRRU_BATCH_SIN sin
 #define PRRU_BATCH_COS cos
+#define PRRU_BATCH_TANH tanh
 #endif
 
 PRRU_BATCH_TARGETS void prru_param_batch_ik_jd(const prru_params *p, int n, const double *q, double *d, double *Jd)
@@ -2911,11 +2918,11 @@ PRRU_BATCH_TARGETS void prru_param_batch_eom(const prru_params *p, int n, const 
       const double t210 = qd3 - w0[k] * t179 - w0[k] * t180 - t41 * (t7 * (t4 * t181));
       const double t211 = p_damping_0 * t210;
       const double t212 = 1.0 / p_coulomb_velocity;
-      const double t213 = tanh(t210 * t212);
+      const double t213 = PRRU_BATCH_TANH(t210 * t212);
       const double t214 = p_coulomb_0 * t213;
       const double t215 = w0[k] * t195 + (qd3 + w0[k] * t194) - t56 * (t11 * (t8 * t196));
       const double t216 = p_damping_1 * t215;
-      const double t217 = tanh(t212 * t215);
+      const double t217 = PRRU_BATCH_TANH(t212 * t215);
       const double t218 = p_coulomb_1 * t217;
       const double t219 = w0[k] * qd1;
       const double t220 = w3[k] * qd2;
@@ -2949,7 +2956,7 @@ PRRU_BATCH_TARGETS void prru_param_batch_eom(const prru_params *p, int n, const 
       const double t248 = t238 + t239 + (t242 + (t233 + t236));
       const double t249 = qd3 - t19 * (p_l2_2 * t224) - t85 * (t21 * (t72 * (t86 * t224)));
       const double t250 = p_damping_2 * t249;
-      const double t251 = tanh(t212 * t249);
+      const double t251 = PRRU_BATCH_TANH(t212 * t249);
       const double t252 = p_coulomb_2 * t251;
       const double t253 = (t123 * t248 + t124 * t248 + (t122 * t245 + ((t240 * (t21 * t241) + (t85 * t235 + t85 * t237)) * (t85 * (t72 * (t12 * (p_l2_2 * p_inertia_6_1)))) + (p_inertia_3_1 * t223 + t103 * fd3))) - t103 * (t250 + t252)) * 4.0 + (2.0 * (p_gravity_0 * (t230 + t247) + p_gravity_2 * (t121 + 2.0 * (t122 + t123))) + ((t229 + 2.0 * (t85 * (t21 * (t19 * (t96 * t225))) + t85 * (t102 * (t225 * (t80 * t246))) + (t240 * (t81 * (t102 * (t225 * (t244 * t246)))) + (t85 * (t21 * (t97 * t223)) + (t99 * t223 + t19 * (t98 * t225)))))) * t247 + ((2.0 * (t19 * t227 + t72 * t228 + (t75 * t223 - t74 * t223)) + t229) * t230 + t121 * t234)));
       /* Unreachable or non-finite q: NaN (a select, not a branch). */
@@ -2959,18 +2966,19 @@ PRRU_BATCH_TARGETS void prru_param_batch_eom(const prru_params *p, int n, const 
           islessequal(fabs(q1), 1.7976931348623157e308) &
           islessequal(fabs(q2), 1.7976931348623157e308) &
           islessequal(fabs(q3), 1.7976931348623157e308);
-      M[i] = ok ? t71 * t71 * t105 + (0.25 * (p_mass_4 * (t50 * t50) + p_mass_5 * (t65 * t65)) + (p_mass_5 * (t62 * t62) + (p_mass_7 * t67 + (t55 * (t57 * t57 * (t51 * p_inertia_5_0)) + (t40 * (t42 * t42 * (t36 * p_inertia_4_0)) + (p_mass_2 * (t35 * t35) + (p_mass_0 * (t24 * t24) + (t13 * p_inertia_0_0 + (p_inertia_1_0 + p_inertia_2_0) + (t14 * p_inertia_0_2 + w2[k] * (w1[k] * p_inertia_0_4) * 2.0))) + (p_mass_0 * (t27 * t27) + p_mass_1 * (t30 * t30) + (p_mass_1 * (t31 * t31) + p_mass_2 * (t34 * t34))))))) + (p_mass_8 * t69 + t67 * p_armature_0 + (p_mass_4 * (t47 * t47) + t69 * p_armature_1)))) : (double)NAN;
-      M[s + i] = ok ? t111 : (double)NAN;
-      M[2 * s + i] = ok ? t127 : (double)NAN;
-      M[3 * s + i] = ok ? t111 : (double)NAN;
-      M[4 * s + i] = ok ? t105 * (t110 * t110) + (p_inertia_0_1 + p_mass_0 * (t128 * t128) + (p_mass_0 * (t106 * t106) + p_mass_0 * (t108 * t108))) : (double)NAN;
-      M[5 * s + i] = ok ? t129 : (double)NAN;
-      M[6 * s + i] = ok ? t127 : (double)NAN;
-      M[7 * s + i] = ok ? t129 : (double)NAN;
-      M[8 * s + i] = ok ? p_armature_0 + p_armature_1 + (p_armature_2 + t130) + (t131 + t132 + (t133 + t134)) : (double)NAN;
-      b[i] = ok ? 2.0 * (t144 * t145 + 0.5 * (t66 * (t211 + t214) + (t68 * fd2 - (t199 * (t197 * (t11 * t202)) + t56 * t204) * (t56 * (t57 * (t8 * p_inertia_5_0))) + (t117 * t208 - t66 * fd1) + (t118 * t209 + t120 * t208 + (t119 * t209 + (mp1 - (t159 - w0[k] * t162 + (w3[k] * t163 + 0.5 * t161)) * t164 + (t113 * t167 - (t169 + w0[k] * t172 + (0.5 * t171 - w3[k] * t173)) * t174) + (t112 * t146 + t114 * t177 - (w1[k] * (qd2 * t151 + (w1[k] * t148 - w2[k] * (qd2 * t149)) - t154 * t155) + w2[k] * (t154 * t156 + (w1[k] * (qd2 * t150) - w2[k] * t148) - qd2 * t157))) - (t184 * (t182 * (t7 * t187)) + t41 * t189) * (t41 * (t42 * (t4 * p_inertia_4_0)))))) + (p_gravity_2 * (t126 + (t118 - t115)) + (t115 * t192 + t116 * t207)) - p_gravity_1 * (t174 + (t145 - t164) - 0.5 * (t185 - t200))) - t68 * (t216 + t218)) - (t71 * t253 + ((t178 + 2.0 * (t48 * t178 - t41 * (t49 * t182) - (t184 * (t37 * (t182 * (p_com_4_2 * t183))) + t41 * (t7 * (t49 * t178))))) * t185 + (t193 - 2.0 * (t63 * t193 + t56 * (t64 * t197) + (t199 * (t52 * (t197 * (p_com_5_2 * t198))) + t56 * (t11 * (t64 * t193))))) * t200)) * 0.125) : (double)NAN;
-      b[s + i] = ok ? w2[k] * (qd2 * t152) - w1[k] * (qd2 * t153) + (w0[k] * mp2 + w3[k] * mp3) - t128 * (p_mass_0 * p_gravity_0) - t108 * (p_mass_0 * p_gravity_2) + (t151 * t156 + t106 * (p_mass_0 * p_gravity_1) - ((w1[k] * t139 + w2[k] * t143) * (p_mass_0 * t128) + t155 * t157)) - t109 * t146 - 2.0 * (t107 * t144) - 0.25 * (t110 * t253) : (double)NAN;
-      b[2 * s + i] = ok ? p_mass_9 * t248 + (p_mass_5 * t207 + (p_mass_8 * t209 - p_armature_0 * t208 - (t216 + p_mass_7 * t208)) + (0.5 * (p_mass_3 * t234) + (p_armature_1 * t209 + (p_mass_0 * t146 + (p_mass_2 * t177 + (p_gravity_2 * (t132 + t133 + (t134 + (t130 + t131))) + (fd2 + fd1 + (fd3 + fp3)) - p_mass_1 * t167)) - t211) - p_mass_4 * t192)) - t214 - t218 - t250) + (p_mass_6 * t245 + p_armature_2 * t248) - t252 : (double)NAN;
+      const double okf = ok ? 1.0 : (double)NAN;
+      M[i] = (t71 * t71 * t105 + (0.25 * (p_mass_4 * (t50 * t50) + p_mass_5 * (t65 * t65)) + (p_mass_5 * (t62 * t62) + (p_mass_7 * t67 + (t55 * (t57 * t57 * (t51 * p_inertia_5_0)) + (t40 * (t42 * t42 * (t36 * p_inertia_4_0)) + (p_mass_2 * (t35 * t35) + (p_mass_0 * (t24 * t24) + (t13 * p_inertia_0_0 + (p_inertia_1_0 + p_inertia_2_0) + (t14 * p_inertia_0_2 + w2[k] * (w1[k] * p_inertia_0_4) * 2.0))) + (p_mass_0 * (t27 * t27) + p_mass_1 * (t30 * t30) + (p_mass_1 * (t31 * t31) + p_mass_2 * (t34 * t34))))))) + (p_mass_8 * t69 + t67 * p_armature_0 + (p_mass_4 * (t47 * t47) + t69 * p_armature_1))))) * okf;
+      M[s + i] = t111 * okf;
+      M[2 * s + i] = t127 * okf;
+      M[3 * s + i] = t111 * okf;
+      M[4 * s + i] = (t105 * (t110 * t110) + (p_inertia_0_1 + p_mass_0 * (t128 * t128) + (p_mass_0 * (t106 * t106) + p_mass_0 * (t108 * t108)))) * okf;
+      M[5 * s + i] = t129 * okf;
+      M[6 * s + i] = t127 * okf;
+      M[7 * s + i] = t129 * okf;
+      M[8 * s + i] = (p_armature_0 + p_armature_1 + (p_armature_2 + t130) + (t131 + t132 + (t133 + t134))) * okf;
+      b[i] = 2.0 * (t144 * t145 + 0.5 * (t66 * (t211 + t214) + (t68 * fd2 - (t199 * (t197 * (t11 * t202)) + t56 * t204) * (t56 * (t57 * (t8 * p_inertia_5_0))) + (t117 * t208 - t66 * fd1) + (t118 * t209 + t120 * t208 + (t119 * t209 + (mp1 - (t159 - w0[k] * t162 + (w3[k] * t163 + 0.5 * t161)) * t164 + (t113 * t167 - (t169 + w0[k] * t172 + (0.5 * t171 - w3[k] * t173)) * t174) + (t112 * t146 + t114 * t177 - (w1[k] * (qd2 * t151 + (w1[k] * t148 - w2[k] * (qd2 * t149)) - t154 * t155) + w2[k] * (t154 * t156 + (w1[k] * (qd2 * t150) - w2[k] * t148) - qd2 * t157))) - (t184 * (t182 * (t7 * t187)) + t41 * t189) * (t41 * (t42 * (t4 * p_inertia_4_0)))))) + (p_gravity_2 * (t126 + (t118 - t115)) + (t115 * t192 + t116 * t207)) - p_gravity_1 * (t174 + (t145 - t164) - 0.5 * (t185 - t200))) - t68 * (t216 + t218)) - (t71 * t253 + ((t178 + 2.0 * (t48 * t178 - t41 * (t49 * t182) - (t184 * (t37 * (t182 * (p_com_4_2 * t183))) + t41 * (t7 * (t49 * t178))))) * t185 + (t193 - 2.0 * (t63 * t193 + t56 * (t64 * t197) + (t199 * (t52 * (t197 * (p_com_5_2 * t198))) + t56 * (t11 * (t64 * t193))))) * t200)) * 0.125) * okf;
+      b[s + i] = (w2[k] * (qd2 * t152) - w1[k] * (qd2 * t153) + (w0[k] * mp2 + w3[k] * mp3) - t128 * (p_mass_0 * p_gravity_0) - t108 * (p_mass_0 * p_gravity_2) + (t151 * t156 + t106 * (p_mass_0 * p_gravity_1) - ((w1[k] * t139 + w2[k] * t143) * (p_mass_0 * t128) + t155 * t157)) - t109 * t146 - 2.0 * (t107 * t144) - 0.25 * (t110 * t253)) * okf;
+      b[2 * s + i] = (p_mass_9 * t248 + (p_mass_5 * t207 + (p_mass_8 * t209 - p_armature_0 * t208 - (t216 + p_mass_7 * t208)) + (0.5 * (p_mass_3 * t234) + (p_armature_1 * t209 + (p_mass_0 * t146 + (p_mass_2 * t177 + (p_gravity_2 * (t132 + t133 + (t134 + (t130 + t131))) + (fd2 + fd1 + (fd3 + fp3)) - p_mass_1 * t167)) - t211) - p_mass_4 * t192)) - t214 - t218 - t250) + (p_mass_6 * t245 + p_armature_2 * t248) - t252) * okf;
     }
   }
 }

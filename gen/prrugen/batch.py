@@ -12,7 +12,10 @@ compiler can vectorise:
   calls but sqrt, which vectorises as an instruction (vector sin/cos
   take part where the build provides them, see the header);
 * the scalar kernel's early return for an unreachable q becomes a
-  per-state select, so the loop has no branch.
+  per-state select, so the loop has no branch; where the loop calls a
+  function (tanh), each output is multiplied by 1 or NaN instead, because
+  GCC sinks the work a select guards into a branch, and a branch around
+  a call stops the loop from being vectorised.
 
 Each loop carries PREFIX_BATCH_LOOP, empty unless the build defines it
 (e.g. as _Pragma("omp simd") with -fopenmp-simd): the generated code stays
@@ -65,10 +68,16 @@ def _is_input_trig(n):
         isinstance(n.args[1], Node) and n.args[1].op == "in"
 
 
+# Calls with a vector variant declared in PROLOGUE (besides sin and cos of
+# the inputs, which get loops of their own).
+VECTOR_CALLS = ("tanh",)
+
+
 def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     """cgen.Emitted for the batched variant of kernel, named
-    <prefix>_batch_<name>. vector_trig % "sin" is the name of the sin the
-    vectorisable kernels call (kernels in EXACT call sin itself)."""
+    <prefix>_batch_<name>. vector_trig % "SIN" is the name of the sin the
+    vectorisable kernels call (kernels in EXACT call sin itself), likewise
+    for the VECTOR_CALLS."""
     trig_name = (lambda fn: fn) if kernel.name in EXACT else \
         (lambda fn: vector_trig % fn.upper())
     params = kernel.params
@@ -90,6 +99,8 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
         return inline(n, parent_prec, right)
 
     def inline(n, parent_prec=0, right=False):
+        if n.op == "call" and n.args[0] in VECTOR_CALLS:
+            return "%s(%s)" % (trig_name(n.args[0]), expr(n.args[1]))
         return cgen.print_op(n, expr, parent_prec, right)
 
     used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
@@ -155,11 +166,17 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
         inner.append("/* Unreachable or non-finite q: NaN (a select, not a "
                      "branch). */")
         inner.append("const int ok = %s;" % " &\n    ".join(conds))
+    calls = any(g.nodes[i].op == "call" and g.nodes[i].args[0] != "sqrt"
+                and not _is_input_trig(g.nodes[i]) for i in live)
+    if guard_nodes and calls:
+        inner.append("const double okf = ok ? 1.0 : (double)NAN;")
     for arr, ns in out_nodes:
         for j, n in enumerate(ns):
             at = "i" if j == 0 else "s + i" if j == 1 else "%d * s + i" % j
             value = expr(n)
-            if guard_nodes:
+            if guard_nodes and calls:
+                value = "%s * okf" % expr(n, cgen.PREC["mul"])
+            elif guard_nodes:
                 value = "ok ? %s : (double)NAN" % value
             inner.append("%s[%s] = %s;" % (arr, at, value))
     body += ["  " + l.replace("\n", "\n  ") for l in inner]
@@ -185,12 +202,12 @@ PROLOGUE = """/* Batched kernels. ${PREFIX}_BATCH_LOOP marks each loop over stat
  * iterations are independent; the build may define it as _Pragma("omp simd")
  * (with -fopenmp-simd) to have the loops vectorised, and
  * ${PREFIX}_BATCH_TARGETS as a function attribute (e.g. target_clones).
- * With ${PREFIX}_BATCH_VECTOR_MATH defined (GCC), ${PREFIX}_BATCH_SIN and
- * _COS are sin and cos declared as having vector variants (glibc's libmvec,
- * which <math.h> declares only under -ffast-math; the kernels are never
- * built with it), within a few units in the last place of the scalar sin
- * and cos; the kinematic kernels call sin and cos themselves and so agree
- * with the scalar kernels bit for bit. */
+ * With ${PREFIX}_BATCH_VECTOR_MATH defined (GCC), ${PREFIX}_BATCH_SIN,
+ * _COS and _TANH are sin, cos and tanh declared as having vector variants
+ * (glibc's libmvec, which <math.h> declares only under -ffast-math; the
+ * kernels are never built with it), within a few units in the last place
+ * of the scalar functions; the kinematic kernels call sin and cos
+ * themselves and so agree with the scalar kernels bit for bit. */
 #ifndef ${PREFIX}_BATCH_LOOP
 #define ${PREFIX}_BATCH_LOOP
 #endif
@@ -202,11 +219,18 @@ PROLOGUE = """/* Batched kernels. ${PREFIX}_BATCH_LOOP marks each loop over stat
 extern double ${prefix}_batch_vsin(double) __asm__("sin");
 #pragma omp declare simd notinbranch
 extern double ${prefix}_batch_vcos(double) __asm__("cos");
+/* const: tanh sets no errno (it cannot overflow) and reads no memory; a
+ * call GCC thinks may write memory stops the loop around it from being
+ * vectorised. */
+#pragma omp declare simd notinbranch
+extern double ${prefix}_batch_vtanh(double) __asm__("tanh") __attribute__((const));
 #define ${PREFIX}_BATCH_SIN ${prefix}_batch_vsin
 #define ${PREFIX}_BATCH_COS ${prefix}_batch_vcos
+#define ${PREFIX}_BATCH_TANH ${prefix}_batch_vtanh
 #else
 #define ${PREFIX}_BATCH_SIN sin
 #define ${PREFIX}_BATCH_COS cos
+#define ${PREFIX}_BATCH_TANH tanh
 #endif"""
 
 
@@ -224,7 +248,7 @@ HEADER_NOTE = """/* Batched kernels, <prefix>_batch_<name>(n, inputs..., outputs
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
  * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
  * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin and cos (see the source), then within
+ * the build provides vector sin, cos and tanh (see the source), then within
  * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
  * overlap the inputs. */"""
 

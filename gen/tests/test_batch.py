@@ -11,7 +11,10 @@
   sincos call, which has no vector variant);
 - the kinematic kernels call sin and cos themselves, the others the
   vector-capable names;
-- deterministic: emitting twice gives the same text.
+- deterministic: emitting twice gives the same text;
+- on a model whose drives have Coulomb friction, tanh is called by its
+  vector-capable name and the outputs are multiplied by 1 or NaN, not
+  selected (GCC would branch around the call); without calls, selects.
 (The values are checked in C against the scalar kernels by
 tests/test_batch.c.)
 """
@@ -26,6 +29,7 @@ from prrugen.kernels import kernels
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))))
 PAPER = os.path.join(ROOT, "models", "3prru_paper.json")
+PROTOTYPE = os.path.join(ROOT, "models", "prototype_example.json")
 
 
 class BatchedKernels(unittest.TestCase):
@@ -81,3 +85,23 @@ class BatchedKernels(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class CallsInTheLoop(unittest.TestCase):
+    def test_tanh_vector_name_and_no_select(self):
+        sym.reset()
+        m = model.load(PROTOTYPE)
+        ks = {k.name: k for k in batch.batch_kernels(
+            kernels(dynamics.Derivation(mechanism.build(m), m)))}
+        body = batch.emit_batch(ks["eom_solve"], "prru", "PRRU_BATCH_LOOP",
+                                "PRRU_BATCH_%s").body
+        self.assertIn("PRRU_BATCH_TANH(", body)
+        self.assertNotIn("tanh(", body.replace("PRRU_BATCH_TANH(", ""))
+        self.assertIn("const double okf = ok ? 1.0 : (double)NAN;", body)
+        self.assertNotIn("ok ? t", body)
+        self.assertEqual(body.count("* okf;"), 9 + 3 + 3 + 3)
+        # dynamics has no call in its loop: selects, as before.
+        body = batch.emit_batch(ks["dynamics"], "prru", "PRRU_BATCH_LOOP",
+                                "PRRU_BATCH_%s").body
+        self.assertNotIn("okf", body)
+        self.assertIn(": (double)NAN;", body)
