@@ -93,56 +93,58 @@ static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
 {
   enum { N = PRRU_NACT };
   double W[N][3], V[3][N], beta[3];
-  for (int i = 0; i < N; i++)
-    for (int j = 0; j < 3; j++) W[i][j] = A[3 * i + j];
+  PRRU_UNROLLED for (int i = 0; i < N; i++)
+    PRRU_UNROLLED for (int j = 0; j < 3; j++) W[i][j] = A[3 * i + j];
   if (!prru_finite_n(A, 3 * N)) return 0.0;
   double na = 0;
-  for (int j = 0; j < 3; j++) {
+  PRRU_UNROLLED for (int j = 0; j < 3; j++) {
     double s = 0;
-    for (int i = 0; i < N; i++) s += fabs(W[i][j]);
+    PRRU_UNROLLED for (int i = 0; i < N; i++) s += fabs(W[i][j]);
     if (s > na) na = s;
   }
-  for (int k = 0; k < 3; k++) {
+  PRRU_UNROLLED for (int k = 0; k < 3; k++) {
     /* H_k = I - beta v v^T maps W[k.., k] to (alpha, 0, ...). Scaled by
      * the column's largest entry so that no square over- or underflows. */
     double sc = 0, nx = 0;
-    for (int i = k; i < N; i++) sc = fmax(sc, fabs(W[i][k]));
+    PRRU_UNROLLED for (int i = k; i < N; i++)
+      if (fabs(W[i][k]) > sc) sc = fabs(W[i][k]); /* W is finite: no fmax call */
     if (!(sc > 0)) return 0.0;
-    for (int i = 0; i < N; i++) V[k][i] = i < k ? 0.0 : W[i][k] / sc;
-    for (int i = k; i < N; i++) nx += V[k][i] * V[k][i];
+    PRRU_UNROLLED for (int i = 0; i < N; i++) V[k][i] = i < k ? 0.0 : W[i][k] / sc;
+    PRRU_UNROLLED for (int i = k; i < N; i++) nx += V[k][i] * V[k][i];
     nx = sqrt(nx);
     double alpha = V[k][k] > 0 ? -nx : nx;
     V[k][k] -= alpha;
     double vv = 0;
-    for (int i = k; i < N; i++) vv += V[k][i] * V[k][i];
+    PRRU_UNROLLED for (int i = k; i < N; i++) vv += V[k][i] * V[k][i];
     beta[k] = 2.0 / vv;
-    for (int j = k; j < 3; j++) {
+    PRRU_UNROLLED for (int j = k; j < 3; j++) {
       double s = 0;
-      for (int i = k; i < N; i++) s += V[k][i] * W[i][j];
+      PRRU_UNROLLED for (int i = k; i < N; i++) s += V[k][i] * W[i][j];
       s *= beta[k];
-      for (int i = k; i < N; i++) W[i][j] -= s * V[k][i];
+      PRRU_UNROLLED for (int i = k; i < N; i++) W[i][j] -= s * V[k][i];
     }
     W[k][k] = alpha * sc; /* the rest of column k is 0 */
   }
   /* R = W's upper 3x3; rows 0..2 of Q^T = H_2 H_1 H_0 applied to the
-   * identity's columns, then X = R^-1 (Q^T)_{0..2}. */
-  for (int c = 0; c < N; c++) {
+   * identity's columns, then X = R^-1 (Q^T)_{0..2}. (Divisions, not
+   * reciprocals: the batched maps repeat this arithmetic bit for bit.) */
+  PRRU_UNROLLED for (int c = 0; c < N; c++) {
     double e[N];
-    for (int i = 0; i < N; i++) e[i] = i == c ? 1.0 : 0.0;
-    for (int k = 0; k < 3; k++) {
+    PRRU_UNROLLED for (int i = 0; i < N; i++) e[i] = i == c ? 1.0 : 0.0;
+    PRRU_UNROLLED for (int k = 0; k < 3; k++) {
       double s = 0;
-      for (int i = k; i < N; i++) s += V[k][i] * e[i];
+      PRRU_UNROLLED for (int i = k; i < N; i++) s += V[k][i] * e[i];
       s *= beta[k];
-      for (int i = k; i < N; i++) e[i] -= s * V[k][i];
+      PRRU_UNROLLED for (int i = k; i < N; i++) e[i] -= s * V[k][i];
     }
-    for (int i = 2; i >= 0; i--) {
+    PRRU_UNROLLED for (int i = 2; i >= 0; i--) {
       double s = e[i];
-      for (int j = i + 1; j < 3; j++) s -= W[i][j] * X[N * j + c];
+      PRRU_UNROLLED for (int j = i + 1; j < 3; j++) s -= W[i][j] * X[N * j + c];
       X[N * i + c] = s / W[i][i];
     }
   }
   double nx = 0;
-  for (int c = 0; c < N; c++) {
+  PRRU_UNROLLED for (int c = 0; c < N; c++) {
     double s = fabs(X[c]) + fabs(X[N + c]) + fabs(X[2 * N + c]);
     if (!(s <= nx)) nx = s; /* NaN propagates */
   }

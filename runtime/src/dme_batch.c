@@ -29,13 +29,6 @@
 #ifndef PRRU_BATCH_TARGETS
 #define PRRU_BATCH_TARGETS
 #endif
-/* Complete unrolling of the loops over matrix entries before the
- * vectoriser sees the loop over poses (GCC and Clang). */
-#if defined(__GNUC__)
-#define UNROLLED _Pragma("GCC unroll 16")
-#else
-#define UNROLLED
-#endif
 
 #define N PRRU_NACT
 #define CH PRRU_DME_BATCH_CHUNK
@@ -123,7 +116,7 @@ PRRU_BATCH_TARGETS static void regular_qr(int n, int o, int m, const double *d, 
     /* every slider and every entry of Js finite: x * 0 is +-0 exactly
      * when x is finite */
     double dz = 0.0, jz = 0.0;
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 0; i < N; i++) {
       dz += d[i * (long)n + x] * 0.0;
       ws->W[3 * i][k] = Jd[3 * i * (long)n + x] / L;
@@ -133,62 +126,62 @@ PRRU_BATCH_TARGETS static void regular_qr(int n, int o, int m, const double *d, 
     }
     const int reach = dz == 0.0;
     double ok = jz == 0.0 ? 1.0 : 0.0, na = 0;
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 0; j < 3; j++) {
       double s = 0;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 0; i < N; i++) s += fabs(ws->W[3 * i + j][k]);
       na = s > na ? s : na;
     }
-    UNROLLED
+    PRRU_UNROLLED
     for (int c = 0; c < 3; c++) { /* H_c: W[c.., c] -> (alpha, 0, ...) */
       double sc = 0, nx = 0, vv = 0;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = c; i < N; i++) {
         const double a = fabs(ws->W[3 * i + c][k]);
         sc = a > sc ? a : sc; /* fmax: sc is never NaN */
       }
       ok = sc > 0 ? ok : 0.0;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 0; i < N; i++) ws->V[N * c + i][k] = i < c ? 0.0 : ws->W[3 * i + c][k] / sc;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = c; i < N; i++) nx += ws->V[N * c + i][k] * ws->V[N * c + i][k];
       nx = sqrt(nx);
       const double alpha = ws->V[N * c + c][k] > 0 ? -nx : nx;
       ws->V[N * c + c][k] -= alpha;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = c; i < N; i++) vv += ws->V[N * c + i][k] * ws->V[N * c + i][k];
       ws->beta[c][k] = 2.0 / vv;
-      UNROLLED
+      PRRU_UNROLLED
       for (int j = c; j < 3; j++) {
         double s = 0;
-        UNROLLED
+        PRRU_UNROLLED
         for (int i = c; i < N; i++) s += ws->V[N * c + i][k] * ws->W[3 * i + j][k];
         s *= ws->beta[c][k];
-        UNROLLED
+        PRRU_UNROLLED
         for (int i = c; i < N; i++) ws->W[3 * i + j][k] -= s * ws->V[N * c + i][k];
       }
       ws->W[3 * c + c][k] = alpha * sc;
     }
     /* X = R^-1 (rows 0..2 of Q^T), column by column, into ws->inv */
     double nxm = 0;
-    UNROLLED
+    PRRU_UNROLLED
     for (int col = 0; col < N; col++) {
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 0; i < N; i++) ws->e[i][k] = i == col ? 1.0 : 0.0;
-      UNROLLED
+      PRRU_UNROLLED
       for (int c = 0; c < 3; c++) {
         double s = 0;
-        UNROLLED
+        PRRU_UNROLLED
         for (int i = c; i < N; i++) s += ws->V[N * c + i][k] * ws->e[i][k];
         s *= ws->beta[c][k];
-        UNROLLED
+        PRRU_UNROLLED
         for (int i = c; i < N; i++) ws->e[i][k] -= s * ws->V[N * c + i][k];
       }
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 2; i >= 0; i--) {
         double s = ws->e[i][k];
-        UNROLLED
+        PRRU_UNROLLED
         for (int j = i + 1; j < 3; j++) s -= ws->W[3 * i + j][k] * ws->inv[N * j + col][k];
         ws->inv[N * i + col][k] = s / ws->W[3 * i + i][k];
       }
@@ -198,7 +191,7 @@ PRRU_BATCH_TARGETS static void regular_qr(int n, int o, int m, const double *d, 
     ok = FINITE(nxm) ? ok : 0.0;
     ok = nxm > 0 ? ok : 0.0;
     const double rc = ok != 0.0 ? 1.0 / (na * nxm) : 0.0;
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 0; j < 2 * N; j++) ws->inv[j][k] /= L;
     double pre = rc > 0 ? other_code : (double)PRRU_ESINGULAR;
     pre = rc >= rcond_min ? pre : (double)PRRU_ESINGULAR;
@@ -217,7 +210,7 @@ PRRU_BATCH_TARGETS static void transformed(int n, int o, int m, const double *M,
   PRRU_BATCH_LOOP
   for (int k = 0; k < m; k++) {
     const long x = (long)o + k;
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 0; i < 3; i++) {
       const double m0 = M[3 * i * (long)n + x], m1 = M[(3 * i + 1) * (long)n + x],
                    m2 = M[(3 * i + 2) * (long)n + x];
@@ -225,7 +218,7 @@ PRRU_BATCH_TARGETS static void transformed(int n, int o, int m, const double *M,
                    r2 = JP[(3 * i + 2) * (long)n + x];
       const double t0 = JP[(9 + 3 * i) * (long)n + x], t1 = JP[(10 + 3 * i) * (long)n + x],
                    t2 = JP[(11 + 3 * i) * (long)n + x];
-      UNROLLED
+      PRRU_UNROLLED
       for (int j = 0; j < N; j++) {
         const double v0 = ws->inv[j][k], v1 = ws->inv[N + j][k], v2 = ws->inv[2 * N + j][k];
         ws->tmp[N * i + j][k] = m0 * v0 + m1 * v1 + m2 * v2;
@@ -236,9 +229,9 @@ PRRU_BATCH_TARGETS static void transformed(int n, int o, int m, const double *M,
   }
   PRRU_BATCH_LOOP
   for (int k = 0; k < m; k++) {
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 0; i < N; i++) {
-      UNROLLED
+      PRRU_UNROLLED
       for (int j = i; j < N; j++) {
         const double s = ws->inv[i][k] * ws->tmp[j][k] + ws->inv[N + i][k] * ws->tmp[N + j][k] +
                          ws->inv[2 * N + i][k] * ws->tmp[2 * N + j][k];
@@ -294,7 +287,7 @@ PRRU_BATCH_TARGETS static void range_basis(int n, int o, int m, const double *JP
     q1a /= best;
     q1b /= best;
     q1c /= best;
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 0; j < N; j++) {
       const double r0 = ws->JtR[j][k], r1 = ws->JtR[N + j][k], r2 = ws->JtR[2 * N + j][k];
       ws->c0[j][k] = q0a * r0 + q0b * r1 + q0c * r2;
@@ -312,7 +305,7 @@ PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
   for (int k = 0; k < m; k++) {
     double s00 = ws->c0[0][k] * ws->c0[0][k], s01 = ws->c0[0][k] * ws->c1[0][k],
            s11 = ws->c1[0][k] * ws->c1[0][k];
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 1; j < N; j++) {
       s00 += ws->c0[j][k] * ws->c0[j][k];
       s01 += ws->c0[j][k] * ws->c1[j][k];
@@ -320,10 +313,10 @@ PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
     }
     const double det = s00 * s11 - s01 * s01;
     const double i00 = s11 / det, i01 = -s01 / det, i11 = s00 / det;
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 0; i < N; i++) {
       double mc0 = ws->Mt[N * i][k] * ws->c0[0][k], mc1 = ws->Mt[N * i][k] * ws->c1[0][k];
-      UNROLLED
+      PRRU_UNROLLED
       for (int j = 1; j < N; j++) {
         mc0 += ws->Mt[N * i + j][k] * ws->c0[j][k];
         mc1 += ws->Mt[N * i + j][k] * ws->c1[j][k];
@@ -333,7 +326,7 @@ PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
     }
     double a = ws->g0[0][k] * ws->g0[0][k], b = ws->g1[0][k] * ws->g1[0][k],
            g = ws->g0[0][k] * ws->g1[0][k];
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 1; i < N; i++) {
       a += ws->g0[i][k] * ws->g0[i][k];
       b += ws->g1[i][k] * ws->g1[i][k];
@@ -345,7 +338,7 @@ PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
     const double cs = g != 0.0 ? ct : 1.0, sn = g != 0.0 ? t * ct : 0.0;
     double h0 = cs * ws->g0[0][k] - sn * ws->g1[0][k], h1 = sn * ws->g0[0][k] + cs * ws->g1[0][k];
     double hh0 = h0 * h0, hh1 = h1 * h1;
-    UNROLLED
+    PRRU_UNROLLED
     for (int i = 1; i < N; i++) {
       h0 = cs * ws->g0[i][k] - sn * ws->g1[i][k];
       h1 = sn * ws->g0[i][k] + cs * ws->g1[i][k];
@@ -358,19 +351,19 @@ PRRU_BATCH_TARGETS static void singular_values(int m, prru_dme_batch_ws *ws)
     const double w = sa / sb;
     /* sigma_T = sqrt(mf2) / f2: |JtT|_F^2 by columns, |Mt JtT^T|_F^2 */
     double f2 = 0, mf2 = 0;
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 0; j < N; j++) {
       double cn = 0;
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 0; i < 3; i++) cn += ws->JtT[N * i + j][k] * ws->JtT[N * i + j][k];
       f2 += cn;
     }
-    UNROLLED
+    PRRU_UNROLLED
     for (int j = 0; j < 3; j++) {
-      UNROLLED
+      PRRU_UNROLLED
       for (int i = 0; i < N; i++) {
         double y = ws->Mt[N * i][k] * ws->JtT[N * j][k];
-        UNROLLED
+        PRRU_UNROLLED
         for (int l = 1; l < N; l++) y += ws->Mt[N * i + l][k] * ws->JtT[N * j + l][k];
         mf2 += y * y;
       }

@@ -17,6 +17,16 @@ static inline int prru_finite_n(const double *v, int n)
   return 1;
 }
 
+/* Complete unrolling of a loop over matrix entries (GCC and Clang): the
+ * batched maps need it before the vectoriser sees the loop over poses;
+ * with four actuators, inverse dynamics (J_d^+ by a Householder QR) takes
+ * 216 ns a call unrolled against 298. */
+#if defined(__GNUC__)
+#define PRRU_UNROLLED _Pragma("GCC unroll 16")
+#else
+#define PRRU_UNROLLED
+#endif
+
 /* Failure paths: kept out of line, so that the fast path they branch
  * from saves no registers for them. */
 #if defined(__GNUC__)
