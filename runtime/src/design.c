@@ -468,7 +468,7 @@ static void grid_row(grid_job *j, int i)
   const prru_map_grid *g = &pr->grid;
   struct prru_design_row *r = &j->dd->rows[i];
   const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
-  grid_block b; /* about 40 KB of this thread's stack: no allocation */
+  grid_block b PRRU_ALIGN64; /* about 40 KB of this thread's stack: no allocation */
   memset(r, 0, sizeof *r);
   r->dmin = INFINITY;
   r->dmax = -INFINITY;

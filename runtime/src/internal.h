@@ -27,6 +27,15 @@ static inline int prru_finite_n(const double *v, int n)
 #define PRRU_UNROLLED
 #endif
 
+/* For the buffers the batched kernels work on: 64-byte aligned, each row
+ * (of a multiple of 8 doubles) starts on a cache line, and no AVX-512
+ * access splits one (unaligned, the batched loops ran up to 1.5x slower). */
+#if defined(__GNUC__)
+#define PRRU_ALIGN64 __attribute__((aligned(64)))
+#else
+#define PRRU_ALIGN64
+#endif
+
 /* Failure paths: kept out of line, so that the fast path they branch
  * from saves no registers for them. */
 #if defined(__GNUC__)

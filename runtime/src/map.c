@@ -157,7 +157,10 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   for (int t = 0; t < nt && rc == PRRU_OK; t++) {
     workers[t].job = &job;
     workers[t].is_caller = t == 0;
-    workers[t].block = malloc(sizeof(map_block));
+    /* 64-byte aligned (malloc gives 16), as PRRU_ALIGN64. */
+    void *p = NULL;
+    if (posix_memalign(&p, 64, sizeof(map_block)) != 0) p = NULL;
+    workers[t].block = p;
     if (!workers[t].block) rc = PRRU_ENOMEM;
   }
   if (rc == PRRU_OK) {
