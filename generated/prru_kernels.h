@@ -99,6 +99,7 @@
    tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
 #define PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp) \
   (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
+#define PRRU_REACTION_BASIS_NNZ 167 /* entries of prru_reaction_basis's Q */
 
 #ifdef __cplusplus
 extern "C" {
@@ -155,8 +156,10 @@ void prru_actuator_rates(const double q[3], const double qd[3], double dd[3], do
 /* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). */
 void prru_passive(const double q[3], const double qd[3], double Qp[3]);
 
-/* Q (60x57) mapping the joint reaction coordinates lambda to body wrenches about each centre, so that Phi H qdd + K = Fbar + Q lambda. */
-void prru_reaction_basis(const double q[3], double Q[3420]);
+/* The entries of Q (60x57) that are not identically zero, Q mapping the joint reaction coordinates lambda to body wrenches about each centre (Phi H qdd + K = Fbar + Q lambda): Q[k] is the dense row-major entry whose position is entry k of the index table declared next (167 of 3420; every other entry is 0). */
+void prru_reaction_basis(const double q[3], double Q[167]);
+/* Row-major positions (row * 57 + column) in the dense 60x57 Q of prru_reaction_basis's outputs. */
+extern const int prru_reaction_basis_index[PRRU_REACTION_BASIS_NNZ];
 
 /* eom's M and b, qdd = M^-1 b (M_22, a constant, eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
 void prru_eom_solve(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);

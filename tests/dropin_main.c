@@ -59,7 +59,7 @@ static void check_all_nan(const char *what, const double *got, int n)
  * be NaN: the header promises misuse is visible, never a plausible number. */
 static void check_nan_everywhere(const char *label, const double q[3], const double qd[3])
 {
-  static double H[180], dm[60], JP[18], R[90], p[30], I[90], K[60], Q[3420];
+  static double H[180], dm[60], JP[18], R[90], p[30], I[90], K[60], Q[PRRU_REACTION_BASIS_NNZ];
   double d[3], Jd[9], M[9], h[3], G[3], b[3], E[2], dd[3], ddb[3], Qp[3];
   const double f[3] = {1.0, 2.0, 3.0};
   char name[96];
@@ -86,7 +86,7 @@ static void check_nan_everywhere(const char *label, const double q[3], const dou
   NAN_CHECK(prru_inertia_world(q, I), I, 90);
   NAN_CHECK(prru_wrench_bias(q, qd, K), K, 60);
   NAN_CHECK(prru_energy(q, qd, E), E, 2);
-  NAN_CHECK(prru_reaction_basis(q, Q), Q, 3420);
+  NAN_CHECK(prru_reaction_basis(q, Q), Q, PRRU_REACTION_BASIS_NNZ);
   NAN_CHECK(prru_actuator_rates(q, qd, dd, ddb), dd, 3);
   check_all_nan("  actuator_rates ddb", ddb, 3);
   NAN_CHECK(prru_passive(q, qd, Qp), Qp, 3);

@@ -68,7 +68,7 @@ static void note(int o, const double *kernel, const double *ref, int n)
 typedef struct {
   double d[NA], Jd[3 * NA], d2[NA], Jd2[3 * NA], H[3 * NW], dm[NW], M[9], h[3], G[3], M2[9], h2[3], G2[3];
   double Me[9], be[3], JP[18], R[9 * NB], p[3 * NB], I[9 * NB], K[NW], E[2], dd[NA], ddb[NA];
-  double Qp[3], Q[NW * NL];
+  double Qp[3], Q[NW * NL], Qnz[PRRU_REACTION_BASIS_NNZ];
 } kernel_outputs;
 
 static void eval_all(const double q[3], const double qd[3], const double fd[NA],
@@ -91,7 +91,8 @@ static void eval_all(const double q[3], const double qd[3], const double fd[NA],
   prru_energy(q, qd, o->E);
   prru_actuator_rates(q, qd, o->dd, o->ddb);
   prru_passive(q, qd, o->Qp);
-  prru_reaction_basis(q, o->Q);
+  tu_reaction_basis_dense(q, o->Q);
+  prru_reaction_basis(q, o->Qnz);
 }
 
 /* M x = b by GSL's LU: the kernels' qdd, to compare with the reference's
@@ -378,7 +379,7 @@ static void test_nan_outputs(void)
       {"platform_jacobian", ko.JP, 18}, {"poses R", ko.R, 9 * NB}, {"poses p", ko.p, 3 * NB},
       {"inertia_world", ko.I, 9 * NB}, {"wrench_bias", ko.K, NW}, {"energy", ko.E, 2},
       {"actuator_rates dd", ko.dd, NA}, {"actuator_rates ddb", ko.ddb, NA}, {"passive", ko.Qp, 3},
-      {"reaction_basis", ko.Q, NW * NL}};
+      {"reaction_basis", ko.Qnz, PRRU_REACTION_BASIS_NNZ}};
     for (size_t o = 0; o < sizeof out / sizeof out[0]; o++) {
       char what[112];
       snprintf(what, sizeof what, "q (%g, %g, %g): %s all NaN", q[0], q[1], q[2], out[o].name);
@@ -386,6 +387,36 @@ static void test_nan_outputs(void)
     }
   }
   printf("NaN outputs checked at %d unreachable or non-finite q\n", nbad);
+}
+
+/* prru_reaction_basis returns the entries of Q that are not identically
+ * zero (the comparison with the reference, through the dense Q, shows the
+ * others are zero): its index table is strictly increasing inside the dense
+ * 6 NBODY x NLAMBDA matrix, and every entry it keeps is nonzero at some
+ * state, so the output holds no padding. */
+static void test_reaction_basis_pattern(void)
+{
+  int increasing = 1;
+  for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) {
+    const int at = prru_reaction_basis_index[k];
+    increasing &= at >= 0 && at < NW * NL && (k == 0 || at > prru_reaction_basis_index[k - 1]);
+  }
+  TU_TRUE(increasing, "reaction_basis index table increasing, inside 6 NBODY x NLAMBDA");
+  static int seen[PRRU_REACTION_BASIS_NNZ];
+  for (int s = 0, found = 0; s < 200 && found < 20; s++) {
+    double q[3], nz[PRRU_REACTION_BASIS_NNZ];
+    random_q(q);
+    if (ref_margin(&P, q) < MARGIN) continue;
+    found++;
+    prru_reaction_basis(q, nz);
+    for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) seen[k] |= nz[k] != 0.0;
+  }
+  int zero = 0;
+  for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) zero += !seen[k];
+  char what[96];
+  snprintf(what, sizeof what, "reaction_basis: %d kept entries zero at every state", zero);
+  TU_TRUE(zero == 0, what);
+  printf("reaction_basis: %d of %d entries of Q kept\n", PRRU_REACTION_BASIS_NNZ, NW * NL);
 }
 
 int main(void)
@@ -397,6 +428,7 @@ int main(void)
   test_christoffel();
   test_mirror();
   test_nan_outputs();
+  test_reaction_basis_pattern();
   prru_ref_free(W);
   return tu_finish("test_kernels");
 }

@@ -311,7 +311,7 @@ static void test_reactions(void)
     worst_lambda = fmax(worst_lambda, maxabs(lam, NL));
     prru_jacobians(q, H);
     prru_bias_terms(q, qd, dm);
-    prru_reaction_basis(q, Q);
+    tu_reaction_basis_dense(q, Q);
     prru_poses(q, R, p);
     prru_inertia_world(q, I);
     prru_wrench_bias(q, qd, K);
@@ -400,7 +400,7 @@ static void test_reactions(void)
 static void phi_inv_gram(const double q[3], gsl_matrix *A)
 {
   static double Q[NH * NL], I[9 * NB], Y[NH * NL];
-  prru_reaction_basis(q, Q);
+  tu_reaction_basis_dense(q, Q);
   prru_inertia_world(q, I);
   for (int b = 0; b < NB; b++) {
     double Ib[9], Iinv[9];

@@ -275,7 +275,7 @@ static void test_reactions(void)
     prru_forward_dynamics(&model, &data, q, qd, &l, qdd);
     prru_jacobians(q, H);
     prru_bias_terms(q, qd, dm);
-    prru_reaction_basis(q, Q);
+    tu_reaction_basis_dense(q, Q);
     prru_poses(q, R, p);
     prru_inertia_world(q, I);
     /* H^T Q = 0, relative to |H| |Q| (Frobenius). */

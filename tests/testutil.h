@@ -5,6 +5,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#include "prru_kernels.h"
 
 static int tu_checks, tu_failures;
 
@@ -53,6 +56,16 @@ static inline void tu_cross(const double a[3], const double b[3], double c[3])
 static inline void tu_matvec3(const double A[9], const double x[3], double y[3])
 {
   for (int i = 0; i < 3; i++) y[i] = A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
+}
+
+/* The dense Q (6 NBODY x NLAMBDA, row-major) of prru_reaction_basis, which
+ * returns only its entries that are not identically zero. */
+static inline void tu_reaction_basis_dense(const double q[3], double Q[6 * PRRU_NBODY * PRRU_NLAMBDA])
+{
+  double nz[PRRU_REACTION_BASIS_NNZ];
+  prru_reaction_basis(q, nz);
+  memset(Q, 0, sizeof(double) * 6 * PRRU_NBODY * PRRU_NLAMBDA);
+  for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) Q[prru_reaction_basis_index[k]] = nz[k];
 }
 
 /* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */

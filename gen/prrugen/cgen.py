@@ -212,7 +212,7 @@ class Kernel:
     """One C function: inputs (C array, symbol names), outputs (C array, exprs)."""
 
     def __init__(self, name, doc, inputs, outputs, guards=(), params=None,
-                 witnesses=()):
+                 witnesses=(), pattern=None):
         self.name, self.doc = name, doc
         self.inputs = inputs          # [(array name, [symbol names])]
         self.outputs = outputs        # [(array name, [Expr])]
@@ -221,6 +221,10 @@ class Kernel:
         # Output arrays whose finiteness the runtime tests after a call:
         # unseen_inputs() names the inputs those tests do not cover.
         self.witnesses = tuple(witnesses)
+        # (array, dense rows, dense cols, positions): the one output is
+        # the entries at these row-major positions of a dense matrix whose
+        # other entries are identically zero.
+        self.pattern = pattern
 
 
 class ParamsArg:

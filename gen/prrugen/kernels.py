@@ -74,20 +74,41 @@ def kernels(deriv):
         ("passive", "Generalized drive forces J_d^T (-c dd - f tanh(dd / "
          "v_s)): viscous damping and smoothed Coulomb friction (zero without "
          "drives).", [Q, QD], [("Qp", deriv.passive())]),
-        ("reaction_basis", "Q (%dx%d) mapping the joint reaction "
-         "coordinates lambda to body wrenches about each centre, so that "
-         "Phi H qdd + K = Fbar + Q lambda." % (6 * len(deriv.terms),
-                                                sum(len(j.basis) for j in
-                                                    deriv.mech.joints)),
-         [Q], [("Q", deriv.reaction_basis())]),
+        _reaction_basis(deriv),
     ]
     spec.append(_eom_solve(deriv, m, fd, fp, mp))
     spec.append(_inverse_terms(deriv, d, jd, fp, mp))
     spec += _reaction_kernels(deriv, fd, fp, mp)
     # eom_solve and inverse_terms also name the outputs whose finiteness
-    # the runtime tests after each call (Kernel.witnesses).
-    return [Kernel(k[0], k[1], k[2], k[3], guards, witnesses=k[4] if len(k) > 4 else ())
+    # the runtime tests after each call (Kernel.witnesses); reaction_basis
+    # the dense positions of its entries (Kernel.pattern).
+    return [Kernel(k[0], k[1], k[2], k[3], guards,
+                   witnesses=k[4] if len(k) > 4 else (),
+                   pattern=k[5] if len(k) > 5 else None)
             for k in spec]
+
+
+def nonzero_positions(exprs):
+    """Indices of the entries of exprs that are not identically zero."""
+    return [i for i, e in enumerate(exprs)
+            if not (e.op == "const" and e.args[0] == 0)]
+
+
+def _reaction_basis(deriv):
+    """Q, lambda -> body wrenches, as its structurally nonzero entries: a
+    joint's reaction reaches only the two bodies it joins, so all but a few
+    per cent of the dense 6 NBODY x NLAMBDA matrix is zero."""
+    q = deriv.reaction_basis()
+    rows = 6 * len(deriv.terms)
+    cols = len(q) // rows
+    at = nonzero_positions(q)
+    return ("reaction_basis", "The entries of Q (%dx%d) that are not "
+            "identically zero, Q mapping the joint reaction coordinates "
+            "lambda to body wrenches about each centre (Phi H qdd + K = Fbar "
+            "+ Q lambda): Q[k] is the dense row-major entry whose position "
+            "is entry k of the index table declared next (%d of %d; every "
+            "other entry is 0)." % (rows, cols, len(at), len(q)),
+            [Q], [("Q", [q[i] for i in at])], (), ("Q", rows, cols, at))
 
 
 def _atom(name, x):

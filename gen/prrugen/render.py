@@ -256,6 +256,28 @@ def _unseen_macros(kernel_list, upper, prefix):
     return out
 
 
+def _patterns(kernel_list, upper, prefix):
+    """{kernel name: (macro, declaration, definition)} of the index tables
+    of the kernels whose output is sparse (Kernel.pattern)."""
+    out = {}
+    for k in kernel_list:
+        if k.pattern is None:
+            continue
+        arr, rows, cols, at = k.pattern
+        size = "%s_%s_NNZ" % (upper, k.name.upper())
+        table = "%s_%s_index" % (prefix, k.name)
+        out[k.name] = (
+            "#define %s %d /* entries of %s_%s's %s */" % (size, len(at), prefix,
+                                                         k.name, arr),
+            "/* Row-major positions (row * %d + column) in the dense %dx%d %s "
+            "of %s_%s's outputs. */\nextern const int %s[%s];"
+            % (cols, rows, cols, arr, prefix, k.name, table, size),
+            "const int %s[%s] = {\n%s\n};" % (table, size, "\n".join(
+                "  " + ", ".join(str(i) for i in at[r:r + 12]) + ","
+                for r in range(0, len(at), 12))))
+    return out
+
+
 def render(model, deriv, templates_dir, prefix=None):
     """{file name: text} for the kernels and mechanism descriptor of model,
     and the emitted kernels. prefix: the C prefix (default: model name)."""
@@ -281,9 +303,13 @@ def render(model, deriv, templates_dir, prefix=None):
                for e in emitted]
     kernel_list = kernels(deriv)
     macros += _unseen_macros(kernel_list, upper, prefix)
-    decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
+    patterns = _patterns(kernel_list, upper, prefix)
+    macros += [p[0] for p in patterns.values()]
+    decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature) +
+                        ("\n" + patterns[e.name][1] if e.name in patterns else "")
                         for e in emitted)
-    bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
+    bodies = "\n\n".join((patterns[e.name][2] + "\n\n" if e.name in patterns else "") +
+                         "%s\n{\n%s\n}" % (e.signature, e.body)
                          for e in emitted)
     bdecls, bbodies = _batched(kernel_list, prefix, prefix)
     decls += "\n\n" + bdecls
