@@ -35,7 +35,8 @@
  * Where q is unreachable (an inverse-kinematics acos argument outside
  * [-1, 1]) or not finite, every output element is NaN: callers check
  * reachability themselves, the kernels only make misuse visible.
- * No globals, no allocation, re-entrant; depends only on <math.h>. */
+ * No mutable globals (one constant index table), no allocation, re-entrant;
+ * depends only on <math.h>. */
 
 #define PRRU_NQ 3
 #define PRRU_NACT 3
