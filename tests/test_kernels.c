@@ -91,8 +91,8 @@ static void eval_all(const double q[3], const double qd[3], const double fd[NA],
   prru_energy(q, qd, o->E);
   prru_actuator_rates(q, qd, o->dd, o->ddb);
   prru_passive(q, qd, o->Qp);
-  tu_reaction_basis_dense(q, o->Q);
   prru_reaction_basis(q, o->Qnz);
+  tu_reaction_basis_scatter(o->Qnz, o->Q);
 }
 
 /* M x = b by GSL's LU: the kernels' qdd, to compare with the reference's

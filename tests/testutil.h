@@ -58,14 +58,21 @@ static inline void tu_matvec3(const double A[9], const double x[3], double y[3])
   for (int i = 0; i < 3; i++) y[i] = A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
 }
 
-/* The dense Q (6 NBODY x NLAMBDA, row-major) of prru_reaction_basis, which
- * returns only its entries that are not identically zero. */
+/* The dense Q (6 NBODY x NLAMBDA, row-major) from the entries that
+ * prru_reaction_basis returns, those that are not identically zero. */
+static inline void tu_reaction_basis_scatter(const double nz[PRRU_REACTION_BASIS_NNZ],
+                                             double Q[6 * PRRU_NBODY * PRRU_NLAMBDA])
+{
+  memset(Q, 0, sizeof(double) * 6 * PRRU_NBODY * PRRU_NLAMBDA);
+  for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) Q[prru_reaction_basis_index[k]] = nz[k];
+}
+
+/* The dense Q at q. */
 static inline void tu_reaction_basis_dense(const double q[3], double Q[6 * PRRU_NBODY * PRRU_NLAMBDA])
 {
   double nz[PRRU_REACTION_BASIS_NNZ];
   prru_reaction_basis(q, nz);
-  memset(Q, 0, sizeof(double) * 6 * PRRU_NBODY * PRRU_NLAMBDA);
-  for (int k = 0; k < PRRU_REACTION_BASIS_NNZ; k++) Q[prru_reaction_basis_index[k]] = nz[k];
+  tu_reaction_basis_scatter(nz, Q);
 }
 
 /* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */
