@@ -221,8 +221,8 @@ class Kernel:
         # Output arrays whose finiteness the runtime tests after a call:
         # unseen_inputs() names the inputs those tests do not cover.
         self.witnesses = tuple(witnesses)
-        # (array, dense rows, dense cols, positions): the one output is
-        # the entries at these row-major positions of a dense matrix whose
+        # (dense rows, dense cols, positions): the one output is the
+        # entries at these row-major positions of a dense matrix whose
         # other entries are identically zero.
         self.pattern = pattern
 

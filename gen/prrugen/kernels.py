@@ -108,7 +108,7 @@ def _reaction_basis(deriv):
             "+ Q lambda): Q[k] is the dense row-major entry whose position "
             "is entry k of the index table declared next (%d of %d; every "
             "other entry is 0)." % (rows, cols, len(at), len(q)),
-            [Q], [("Q", [q[i] for i in at])], (), ("Q", rows, cols, at))
+            [Q], [("Q", [q[i] for i in at])], (), (rows, cols, at))
 
 
 def _atom(name, x):

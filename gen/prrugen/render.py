@@ -263,7 +263,8 @@ def _patterns(kernel_list, upper, prefix):
     for k in kernel_list:
         if k.pattern is None:
             continue
-        arr, rows, cols, at = k.pattern
+        rows, cols, at = k.pattern
+        arr = k.outputs[0][0]
         size = "%s_%s_NNZ" % (upper, k.name.upper())
         table = "%s_%s_index" % (prefix, k.name)
         out[k.name] = (
