@@ -19,8 +19,9 @@ static const char eval_help[] =
     "J_R,P^T mp + passive) and lambda (the %d joint reaction coordinates: force\n"
     "(N) and moment (N m) components of what each joint's proximal body exerts\n"
     "on the distal one, named in lambda_labels as JOINT_COMPONENT, e.g. %s).\n"
-    "Velocities and loads default to 0. Exit 1 when q is unreachable or J_d is\n"
-    "singular there, 2 on bad arguments.\n"
+    "Velocities and loads default to 0. Exit 1 when q is unreachable, J_d is\n"
+    "singular there, or q is too near the workspace boundary to trust the\n"
+    "dynamics (the mass matrix's rcond below 1e-6), 2 on bad arguments.\n"
     "%s";
 
 /* The part of the help that only a model with redundant actuators has. */
@@ -96,10 +97,27 @@ int prru_cmd_eval(int argc, char **argv)
   double rcond, M[PRRU_NQ * PRRU_NQ], h[PRRU_NQ], G[PRRU_NQ], passive[PRRU_NQ];
   double lambda[PRRU_NLAMBDA], qdd[PRRU_NQ];
   int st = prru_check_regular(&m, d, q, &rcond);
-  if (st == PRRU_OK) st = prru_reactions(&m, d, q, qd, &l, lambda);
   if (st != PRRU_OK) {
-    prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): %s%s", q[0], q[1], q[2], prru_strerror(st),
-                   st == PRRU_ESINGULAR ? " (rcond below 1e-8)" : "");
+    if (st == PRRU_ESINGULAR)
+      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): J_d is singular there (rcond %.3g below "
+                     "jd_rcond_min %.3g)", q[0], q[1], q[2], rcond, m.jd_rcond_min);
+    else
+      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): %s", q[0], q[1], q[2], prru_strerror(st));
+    free(d);
+    return prru_cli_exit_for(st);
+  }
+  st = prru_reactions(&m, d, q, qd, &l, lambda);
+  if (st != PRRU_OK) {
+    /* The library's diagnosis of the state; where the forward dynamics
+     * are fine, the reactions themselves failed. */
+    char why[320];
+    if (prru_forward_dynamics_why(&m, d, q, qd, &l, why, sizeof why) == PRRU_OK)
+      snprintf(why, sizeof why, "%s",
+               st == PRRU_ESINGULAR ? "the joints cannot carry the loads there (a constraint "
+                                      "singularity)"
+                                    : "the reactions overflow: the velocities or loads are too "
+                                      "large");
+    prru_cli_error("eval", "%s", why);
     free(d);
     return prru_cli_exit_for(st);
   }

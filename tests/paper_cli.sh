@@ -35,6 +35,21 @@ expect 1 "singular" -- eval --q "$QSING"
 jcheck "$tmp/dme.json" "d['status'] == 'singular'" "dme at $QSING"
 expect 1 "stopped at t" -- simulate --q0 0,-0.79,0 --qd0 0,-3,0 --t-end 0.5 --out "$tmp/cross.csv"
 
+# The workspace boundary (issue: eval returned qdd3 = -1.95e19 with exit 0
+# here, where the mass matrix's rcond is 5e-16): refused with the reason.
+expect 1 "too near the workspace boundary to trust the dynamics" -- \
+  eval --q -0.785539441453726,1.0473859219383015,0 --qd 0.3,-0.2,0.1 --fd 50,40,25
+# A run into the boundary: the same diagnosis whichever stepper and step
+# budget (were: step budget exhausted / integrator failed / not reachable),
+# every row before it kept.
+for args in "" "--max-steps 10000000" "--stepper rkf45" "--stepper msbdf" "--rtol 1e-6 --atol 1e-6"; do
+  # shellcheck disable=SC2086
+  expect 1 "the motion reached the workspace boundary at t = 0.447" -- \
+    simulate --q0 0.05,-0.1,-0.7 --fd 60,30,20 --t-end 1 $args --out "$tmp/edge.csv"
+  rows=$(grep -vc '^#' "$tmp/edge.csv")
+  [ "$rows" -eq 449 ] && ok || bad "simulate into the boundary ($args): $rows lines, want a header and 448 rows"
+done
+
 # prru paper on the paper's model: no warning, the model in the summary.
 "$PRRU" paper --out "$tmp/paper" --skip-map >"$tmp/paper.out" 2>"$tmp/paper.err"
 grep -q "warning" "$tmp/paper.err" && bad "paper warns for the paper's model: $(cat "$tmp/paper.err")" || ok

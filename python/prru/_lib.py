@@ -54,8 +54,10 @@ class _MechHead(ctypes.Structure):
 
 
 class _Model(ctypes.Structure):
-    """prru_model: a pointer to the descriptor and the singularity tolerance."""
-    _fields_ = [("mech", ctypes.c_void_p), ("jd_rcond_min", ctypes.c_double)]
+    """prru_model: a pointer to the descriptor and the two tolerances of the
+    trust criterion (J_d's and the mass matrix's conditioning)."""
+    _fields_ = [("mech", ctypes.c_void_p), ("jd_rcond_min", ctypes.c_double),
+                ("mass_rcond_min", ctypes.c_double)]
 
 
 class _MapGrid(ctypes.Structure):

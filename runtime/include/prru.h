@@ -66,6 +66,22 @@ typedef struct {
    * robot of any size. With four actuators J is 4x3 and J^-1 is
    * J^+ = (J^T J)^-1 J^T (prru_check_regular). */
   double jd_rcond_min;
+  /* The trust criterion of the dynamics (docs/model.md section 4): forward
+   * dynamics, the reactions and inverse dynamics return PRRU_ESINGULAR
+   * where the mass matrix is too ill-conditioned for a result worth
+   * having: near the workspace boundary, where an upper link turns
+   * horizontal and its slider moves without bound per unit of platform
+   * motion, M grows like 1/sin^2 of that link's angle in one direction
+   * only, and the rounding of those huge terms swamps the rest (measured:
+   * qdd off by 1e-8 relative at rcond(M_s) = 5e-8, of the wrong sign at
+   * 1e-13). Forward dynamics (and so the reactions and every simulated
+   * state) test prru_mass_rcond(M) >= mass_rcond_min; inverse dynamics,
+   * whose kernel never forms M, tests the cause instead:
+   * prru_stretch(J_d)^2 mass_rcond_min <= 1 (M_s's conditioning is
+   * c / stretch^2 with c of order 1: 0.2 to 5 over the paper model's
+   * workspace). Default 1e-6: qdd and fd then agree with the GSL reference
+   * to 2e-10 relative, and ID(FD(fd)) returns fd to 1e-7 of its terms. */
+  double mass_rcond_min;
 } prru_model;
 
 /* The mechanism the kernels were generated from, default settings. */
@@ -105,6 +121,19 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
  * with a candidate design's own L, so both judge regularity alike. */
 int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
                     double Jdpinv[3 * PRRU_NACT], double *rcond);
+/* The reciprocal 1-norm condition number 1 / (|M_s|_1 |M_s^-1|_1) of
+ * M_s = D^-1 M D^-1, D = diag(L, L, 1) with L the model's length scale (the
+ * mass matrix with rotations measured as arc lengths at the robot's scale,
+ * so that its entries share one unit, kg): in (0, 1], 0 where M (a
+ * prru_dynamics or prru_data.M output) is not positive definite or not
+ * finite. The quantity forward dynamics tests against mass_rcond_min. */
+double prru_mass_rcond(const prru_model *m, const double M[9]);
+/* How far J_d's rows are from the workspace boundary: the largest 1-norm
+ * of a row of J_d diag(1/L, 1/L, 1), metres of slider travel per metre of
+ * platform motion (1 to 3 in the middle of the workspace, without bound
+ * as an upper link turns horizontal); NaN propagates. The quantity
+ * inverse dynamics tests: stretch^2 mass_rcond_min <= 1. */
+double prru_stretch(const prru_model *m, const double Jd[PRRU_NACT * 3]);
 /* With three actuators, the sign (+1 or -1) of det J_d, 0 where it is 0;
  * always 0 with more actuators (J_d has no determinant, and a path meets
  * a rank deficiency of J_d only by exception). det J_d changes sign only
@@ -140,15 +169,28 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
                                 const double seed[3], double q[3], double *residual);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved
  * inside the generated prru_eom_solve; PRRU_ESINGULAR unless M is positive
- * definite (three nested principal minors positive). PRRU_EINPUT for a NaN
+ * definite (three nested principal minors positive) and
+ * prru_mass_rcond(M) >= m->mass_rcond_min (the trust criterion: too near
+ * the workspace boundary, d->M still holds M). PRRU_EINPUT for a NaN
  * or infinite input; d->M, d->b and d->qdd may then hold what the kernel
  * made of it, qdd is untouched. */
 int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const prru_loads *l, double qdd[3]);
+/* Why forward dynamics fails at (q, qd, l), in words for a message that
+ * names the state (no trailing period): q outside the workspace; q on its
+ * boundary; too near it to trust the dynamics (prru_mass_rcond below
+ * mass_rcond_min, given with both numbers); M not positive definite;
+ * velocities or loads that overflow the arithmetic (naming qd and the
+ * loads, not q). Returns prru_forward_dynamics' status there (msg "" when
+ * PRRU_OK). The library's one diagnosis of a state, used by every caller
+ * that reports a failed state (eval, simulate, track). */
+int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[3],
+                              const double qd[3], const prru_loads *l, char *msg, int msglen);
 /* Actuator forces that produce qdd under l->fp, l->mp (l->fd ignored):
  * the solution of J_d^T fd = tau = M qdd - (G + J_T,P^T fp + J_R,P^T mp
  * + passive - h) of least norm, fd = J_d^+T tau (J_d^-T tau for three
- * actuators). With four actuators every fd + t n (n: prru_actuator_null)
+ * actuators). PRRU_ESINGULAR where J_d is singular (prru_check_regular) or
+ * too near the workspace boundary (prru_stretch, see mass_rcond_min). With four actuators every fd + t n (n: prru_actuator_null)
  * gives the same motion; this one has no preload (fd . n = 0). */
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,

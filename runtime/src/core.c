@@ -2,6 +2,7 @@
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
@@ -29,6 +30,7 @@ void prru_model_default(prru_model *m)
 {
   m->mech = &prru_mech;
   m->jd_rcond_min = 1e-8;
+  m->mass_rcond_min = 1e-6;
 }
 
 static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
@@ -79,6 +81,33 @@ double prru_length_scale(const prru_mechanism *me)
   double s = 0;
   for (int i = 0; i < PRRU_NLIMB; i++) s += me->l1[i];
   return s / PRRU_NLIMB;
+}
+
+double prru_mass_rcond(const prru_model *m, const double M[9])
+{
+  const double s = 1.0 / prru_length_scale(m->mech);
+  const double sc[3] = {s, s, 1.0};
+  double a[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) a[3 * i + j] = M[3 * i + j] * sc[i] * sc[j];
+  /* prru_rcond3 rates an indefinite matrix too: Sylvester's criterion first
+   * (NaN fails every comparison). */
+  const double m2 = a[0] * a[4] - a[1] * a[3];
+  const double m3 = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                    a[2] * (a[3] * a[7] - a[4] * a[6]);
+  if (!(a[0] > 0 && m2 > 0 && m3 > 0)) return 0.0;
+  return prru_rcond3(a, NULL);
+}
+
+double prru_stretch(const prru_model *m, const double Jd[PRRU_NACT * 3])
+{
+  const double s = 1.0 / prru_length_scale(m->mech);
+  double big = 0;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double r = (fabs(Jd[3 * i]) + fabs(Jd[3 * i + 1])) * s + fabs(Jd[3 * i + 2]);
+    if (!(r <= big)) big = r; /* NaN propagates */
+  }
+  return big;
 }
 
 #if PRRU_NACT > 3
@@ -255,8 +284,47 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
   if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
       !finite3(d->qdd) || !PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, l->fd, l->fp, l->mp))
     return forward_failure(m, d, q, qd, l, minors);
+  /* The trust criterion (prru_model.mass_rcond_min). */
+  if (!(prru_mass_rcond(m, d->M) >= m->mass_rcond_min)) return PRRU_ESINGULAR;
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
+}
+
+int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[3],
+                              const double qd[3], const prru_loads *l, char *msg, int msglen)
+{
+  double qdd[3];
+  const int st = prru_forward_dynamics(m, d, q, qd, l, qdd);
+  const char *const f = "(%.9g, %.9g, %.9g)";
+  char qs[96];
+  snprintf(qs, sizeof qs, f, q[0], q[1], q[2]);
+  switch (st) {
+  case PRRU_OK:
+    return prru_fail(msg, msglen, st, "%s", "");
+  case PRRU_EUNREACHABLE:
+    return prru_fail(msg, msglen, st, "q = %s is outside the workspace (no inverse kinematics)", qs);
+  case PRRU_ESINGULAR: {
+    if (!finite3(d->b))
+      return prru_fail(msg, msglen, st,
+                       "q = %s is on the workspace boundary (an upper link horizontal)", qs);
+    const double rc = prru_mass_rcond(m, d->M);
+    if (rc > 0)
+      return prru_fail(msg, msglen, st,
+                       "q = %s is too near the workspace boundary to trust the dynamics: the "
+                       "mass matrix's rcond %.3g is below mass_rcond_min %.3g (an upper link "
+                       "nearly horizontal, its slider moving without bound)",
+                       qs, rc, m->mass_rcond_min);
+    return prru_fail(msg, msglen, st, "the mass matrix is not positive definite at q = %s", qs);
+  }
+  default: /* PRRU_EINPUT */
+    if (!finite3(q)) return prru_fail(msg, msglen, st, "q is not finite");
+    if (!finite3(qd) || !loads_finite(l))
+      return prru_fail(msg, msglen, st, "the velocities or the loads are not finite");
+    return prru_fail(msg, msglen, st,
+                     "the dynamics overflow at q = %s: the velocities qd = (%.3g, %.3g, %.3g) or "
+                     "the loads are too large",
+                     qs, qd[0], qd[1], qd[2]);
+  }
 }
 
 #if PRRU_NACT == 3
@@ -281,6 +349,14 @@ static int regular_from_inverse(const double J[9], const double inv[9], double L
 }
 #endif
 
+/* Inverse dynamics' half of the trust criterion (prru_model.mass_rcond_min):
+ * stretch^2 mass_rcond_min <= 1, false for a NaN stretch. */
+static int near_boundary_ok(const prru_model *m, const double Jd[PRRU_NACT * 3])
+{
+  const double r = prru_stretch(m, Jd);
+  return r * r * m->mass_rcond_min <= 1.0;
+}
+
 /* PRRU_EINPUT where an input is not finite, else st: the status of testing
  * every input first. */
 PRRU_COLD static int inverse_failure(int st, const double q[3], const double qd[3],
@@ -304,6 +380,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
   else if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
     st = PRRU_ESINGULAR;
+  else if (!near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
   else st = prru_finite_n(f, 3) ? PRRU_OK : PRRU_EINPUT;
 #else
   /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
@@ -312,6 +389,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, tau);
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
   else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
+  if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
   if (st == PRRU_OK) {
     const double *inv = d->Jdpinv;
     enum { N = PRRU_NACT };

@@ -49,6 +49,7 @@ typedef struct {
   prru_data *d;
   volatile sig_atomic_t *interrupt;
   int status; /* why the right-hand side last failed */
+  double t_fail, y_fail[6]; /* where it did */
 } sim_ctx;
 
 /* When the right-hand side cannot evaluate (a state outside the
@@ -73,6 +74,8 @@ static int rhs(double t, const double y[], double f[], void *p)
   int st = prru_forward_dynamics(c->m, c->d, y, y + 3, &l, f + 3);
   if (st != PRRU_OK) {
     c->status = st;
+    c->t_fail = t;
+    memcpy(c->y_fail, y, sizeof c->y_fail);
     return RHS_STOP;
   }
   return GSL_SUCCESS;
@@ -229,7 +232,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
     free(d); free(drhs); free(s);
     return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
   }
-  sim_ctx c = {m, ls, drhs, o->interrupt, PRRU_OK};
+  sim_ctx c = {m, ls, drhs, o->interrupt, PRRU_OK, 0.0, {0}};
   gsl_odeiv2_system sys = {rhs, jac, 6, &c};
   prru_gsl_init();
   gsl_odeiv2_driver *drv =
@@ -263,31 +266,50 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                   t_last, budget, t, tk);
         break;
       }
+      if (gs == RHS_STOP && c.status != PRRU_OK) {
+        /* A step's trial state whose dynamics failed: every stepper meets
+         * the same edge of the trusted workspace (prru_model.mass_rcond_min)
+         * within a step of the others, so the report names that state and
+         * the library's one diagnosis of it, whichever stepper ran. */
+        char why[256];
+        prru_loads lf;
+        prru_schedule_eval(ls, c.t_fail, &lf);
+        st = prru_forward_dynamics_why(m, d, c.y_fail, c.y_fail + 3, &lf, why, sizeof why);
+        if (st == PRRU_OK) st = c.status; /* not reproduced: report the status */
+        const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR;
+        prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at t = %.9g s: %s", t,
+                  edge ? "the motion reached the workspace boundary"
+                       : "the dynamics failed in the step",
+                  c.t_fail, why[0] ? why : prru_strerror(st));
+        break;
+      }
       if (gs != GSL_SUCCESS) {
-        /* RHS_STOP: c.status is the failed evaluation's reason. */
-        int why = gs == RHS_STOP ? c.status : PRRU_OK;
-        st = why != PRRU_OK ? why : PRRU_ENOCONV;
-        prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s%s", t,
-                  why != PRRU_OK ? prru_strerror(why) : "integrator failed: ",
-                  why != PRRU_OK ? "" : gsl_strerror(gs));
+        st = PRRU_ENOCONV;
+        prru_fail(msg, msglen, st, "stopped at t = %.9g s: integrator failed: %s", t,
+                  gsl_strerror(gs));
         break;
       }
     }
     int ss = make_sample(m, d, ls, o->reactions, tk, y, s);
-    if (ss == PRRU_EINPUT && prru_finite_n(y, 6)) {
-      /* A finite, regular state whose dynamics, reactions or energy
-       * overflow: the velocities or loads are too large, not q. */
-      st = ss;
-      prru_fail(msg, msglen, st,
-                "stopped at t = %.9g s: the dynamics overflow (velocities or loads too large: "
-                "qd = (%.9g, %.9g, %.9g))",
-                tk, y[3], y[4], y[5]);
-      break;
-    }
     if (ss != PRRU_OK) {
-      st = ss;
-      prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)", tk,
-                prru_strerror(ss), y[0], y[1], y[2]);
+      /* The sample's own state: the same diagnosis as a failed step's
+       * (prru_forward_dynamics_why), or, where the forward dynamics are
+       * fine, what make_sample added (J_d singular, the reactions). */
+      char why[256];
+      prru_loads lk;
+      prru_schedule_eval(ls, tk, &lk);
+      st = prru_forward_dynamics_why(m, d, y, y + 3, &lk, why, sizeof why);
+      if (st == PRRU_OK && ss == PRRU_EINPUT) /* the reactions or the energy overflow */
+        snprintf(why, sizeof why,
+                 "the dynamics overflow (velocities or loads too large: qd = (%.9g, %.9g, %.9g))",
+                 y[3], y[4], y[5]);
+      else if (st == PRRU_OK)
+        snprintf(why, sizeof why, "%s at q = (%.9g, %.9g, %.9g)", prru_strerror(ss), y[0], y[1],
+                 y[2]);
+      if (st == PRRU_OK) st = ss;
+      const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR;
+      prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s%s", tk,
+                edge ? "the motion reached the workspace boundary: " : "", why);
       break;
     }
     t_last = tk;
