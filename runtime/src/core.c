@@ -83,20 +83,35 @@ double prru_length_scale(const prru_mechanism *me)
   return s / PRRU_NLIMB;
 }
 
+/* For a symmetric M and s = 1 / L: the 1-norms of M_s = D^-1 M D^-1
+ * (D = diag(L, L, 1)) and of its adjugate, *det = det M_s, and whether M
+ * is positive definite (Sylvester; false for NaN). rcond_1(M_s) =
+ * det / (na ni), with no division: the forward-dynamics step tests
+ * na ni rcond_min <= det directly. */
+static int mass_norms(const double M[9], double s, double *na, double *ni, double *det)
+{
+  const double s2 = s * s;
+  const double a00 = M[0] * s2, a01 = M[1] * s2, a02 = M[2] * s, a11 = M[4] * s2,
+               a12 = M[5] * s, a22 = M[8];
+  const double c00 = a11 * a22 - a12 * a12, c01 = a02 * a12 - a01 * a22,
+               c02 = a01 * a12 - a02 * a11, c11 = a00 * a22 - a02 * a02,
+               c12 = a01 * a02 - a00 * a12, c22 = a00 * a11 - a01 * a01;
+  *det = a00 * c00 + a01 * c01 + a02 * c02;
+  const double n0 = fabs(a00) + fabs(a01) + fabs(a02), n1 = fabs(a01) + fabs(a11) + fabs(a12),
+               n2 = fabs(a02) + fabs(a12) + fabs(a22);
+  const double i0 = fabs(c00) + fabs(c01) + fabs(c02), i1 = fabs(c01) + fabs(c11) + fabs(c12),
+               i2 = fabs(c02) + fabs(c12) + fabs(c22);
+  *na = n0 > n1 ? (n0 > n2 ? n0 : n2) : (n1 > n2 ? n1 : n2);
+  *ni = i0 > i1 ? (i0 > i2 ? i0 : i2) : (i1 > i2 ? i1 : i2);
+  return a00 > 0 && c22 > 0 && *det > 0;
+}
+
 double prru_mass_rcond(const prru_model *m, const double M[9])
 {
-  const double s = 1.0 / prru_length_scale(m->mech);
-  const double sc[3] = {s, s, 1.0};
-  double a[9];
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) a[3 * i + j] = M[3 * i + j] * sc[i] * sc[j];
-  /* prru_rcond3 rates an indefinite matrix too: Sylvester's criterion first
-   * (NaN fails every comparison). */
-  const double m2 = a[0] * a[4] - a[1] * a[3];
-  const double m3 = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-                    a[2] * (a[3] * a[7] - a[4] * a[6]);
-  if (!(a[0] > 0 && m2 > 0 && m3 > 0)) return 0.0;
-  return prru_rcond3(a, NULL);
+  double na, ni, det;
+  if (!mass_norms(M, 1.0 / prru_length_scale(m->mech), &na, &ni, &det)) return 0.0;
+  const double rc = det / (na * ni);
+  return isfinite(rc) ? rc : 0.0;
 }
 
 double prru_stretch(const prru_model *m, const double Jd[PRRU_NACT * 3])
@@ -284,8 +299,12 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
   if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
       !finite3(d->qdd) || !PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, l->fd, l->fp, l->mp))
     return forward_failure(m, d, q, qd, l, minors);
-  /* The trust criterion (prru_model.mass_rcond_min). */
-  if (!(prru_mass_rcond(m, d->M) >= m->mass_rcond_min)) return PRRU_ESINGULAR;
+  /* The trust criterion (prru_model.mass_rcond_min): prru_mass_rcond's
+   * test without its division. */
+  double na, ni, det;
+  if (!mass_norms(d->M, 1.0 / prru_length_scale(m->mech), &na, &ni, &det) ||
+      !(na * ni * m->mass_rcond_min <= det))
+    return PRRU_ESINGULAR;
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }
