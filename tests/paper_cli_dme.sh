@@ -69,7 +69,7 @@ sf = float(re.search(r'singular fraction = (\S+)', text).group(1))
 idx = sum(w - 1 for w in ok) / len(ok)
 if abs(gi - idx) > 1e-9 * idx: errs.append('global index %r, CSV %r' % (gi, idx))
 if abs(sf - (1 - len(ok) / len(rows))) > 1e-6: errs.append('singular fraction %r' % sf)
-# The values of this resolution (README): 0.78818 with 1.10 % not ok
+# The values of this resolution (docs/studies.md, the paper's studies): 0.78818 with 1.10 % not ok
 # (138 singular, 306 other assembly mode of 40401).
 if abs(gi - 0.788183359) > 1e-9 or len(other) != 306 or len(rows) - len(ok) != 444: errs.append('fig. 7 numbers %r %d %d' % (gi, len(other), len(rows) - len(ok)))
 print('; '.join(errs) if errs else 'ok')
