@@ -271,6 +271,22 @@ expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations
 expect 2 "missing column 'qd1'" -- track --ref "$tmp/qonly.csv" --out "$tmp/x.csv"
 expect 2 "--bandwidth excludes" -- track --waypoints "$WP" --durations 1,1 --bandwidth 5 --kp 1,1,1
 [ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# Issue 30 item 2: a failure in an integrator's trial state (gains far too
+# stiff for the step) or in a noisy measurement was blamed on the run's
+# regular state, "not reachable ... at q = (0, 0, 0)". The message names
+# what failed: the trial state and its time, or the measurement and the
+# noise; exit 1 either way.
+for args in "--bandwidth 1e6" "--noise 1e300,0 --period 0.001" "--noise 0,1e300 --period 0.001"; do
+  # shellcheck disable=SC2086
+  expect 1 "" -- track --waypoints '0,0,0;0.1,-0.08,0.02' --durations 0.5 $args --out "$tmp/stiff.csv" \
+    --summary "$tmp/stiff.json"
+  grep -q "at q = (0, 0, 0)" "$tmp/err" && bad "track $args blamed the regular q = 0: $(cat "$tmp/err")" || ok
+  case $args in
+    --bandwidth*) want="trial state at t = " ;;
+    *) want="the sensor noise (q " ;;
+  esac
+  grep -qF "$want" "$tmp/err" && ok || bad "track $args: no '$want': $(cat "$tmp/err")"
+done
 # SIGTERM during a long run (a background job ignores SIGINT): exit 143,
 # whole rows kept, the summary says why.
 "$PRRU" track --waypoints "$WP" --durations 200,200 --out "$tmp/sig.csv" --summary "$tmp/sig.json" 2>"$tmp/sig.err" &
