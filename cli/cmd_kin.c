@@ -354,6 +354,7 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_error("id", "--traj is required (see 'prru id --help')");
     return 2;
   }
+  if (prru_cli_refuse_same_file("id", "traj", traj, "out", out)) return 2;
   double preload = 0.0;
   if (pre && prru_cli_number("id", "preload", pre, &preload)) return 2;
   if ((pre || null_vector) && PRRU_NPRELOAD == 0) {

@@ -683,6 +683,10 @@ int prru_cmd_track(int argc, char **argv)
     prru_cli_error("track", "--plot needs --out FILE.csv (the figure is drawn from it)");
     return 2;
   }
+  if (prru_cli_refuse_same_file("track", "ref", refs, "out", out) ||
+      prru_cli_refuse_same_file("track", "ref", refs, "summary", sums) ||
+      prru_cli_refuse_same_file("track", "ref", refs, "plot", plot))
+    return 2;
   prru_track_options o;
   prru_track_options_default(&o);
   if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;

@@ -271,6 +271,19 @@ expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations
 expect 2 "missing column 'qd1'" -- track --ref "$tmp/qonly.csv" --out "$tmp/x.csv"
 expect 2 "--bandwidth excludes" -- track --waypoints "$WP" --durations 1,1 --bandwidth 5 --kp 1,1,1
 [ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# Issue 30 item 4: id and track wrote their output over their input when
+# the two options named one file. Refused (exit 2, both options named),
+# the file as it was, whatever the spelling: ./f, a symbolic link.
+cp "$tmp/t.csv" "$tmp/same.csv"
+ln -s same.csv "$tmp/same_link.csv"
+for o in "$tmp/same.csv" "$tmp/./same.csv" "$tmp/same_link.csv"; do
+  expect 2 "--traj $tmp/same.csv and --out $o are the same file" -- id --traj "$tmp/same.csv" --out "$o"
+  expect 2 "--ref $tmp/same.csv and --out $o are the same file" -- track --ref "$tmp/same.csv" --out "$o"
+done
+expect 2 "--ref $tmp/same.csv and --summary $tmp/./same.csv are the same file" -- \
+  track --ref "$tmp/same.csv" --out "$tmp/x.csv" --summary "$tmp/./same.csv"
+cmp -s "$tmp/t.csv" "$tmp/same.csv" && ok || bad "id/track changed their input file"
+[ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
 # Issue 30 item 2: a failure in an integrator's trial state (gains far too
 # stiff for the step) or in a noisy measurement was blamed on the run's
 # regular state, "not reachable ... at q = (0, 0, 0)". The message names
