@@ -166,7 +166,8 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
   o->seed = (unsigned long)seed;
   o->check_samples = 20 * o->samples;
   if (*dt > f->period * *periods) {
-    prru_cli_error(c, "--dt: %s is longer than the run (%g s)", a->dt, f->period * *periods);
+    prru_cli_error(c, "--dt: %g s%s is longer than the run (%g s: --period %g s x --periods %d)", *dt,
+                   a->dt ? "" : " (the default)", f->period * *periods, f->period, *periods);
     return 2;
   }
   return 0;
@@ -649,10 +650,14 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
     prru_cli_error("identify", "--out - and the report would both go to stdout: give --report FILE");
     return 2;
   }
-  if (a->report && strcmp(a->report, "-") != 0 && strcmp(a->report, a->out) == 0) {
-    prru_cli_error("identify", "--report and --out are the same file %s", a->out);
+  if (a->report && strcmp(a->report, "-") != 0 &&
+      (strcmp(a->report, a->out) == 0 || prru_cli_same_file(a->report, a->out))) {
+    prru_cli_error("identify", "--report %s and --out %s are the same file", a->report, a->out);
     return 2;
   }
+  if (prru_cli_refuse_same_file("identify", "data", a->data, "out", a->out) ||
+      prru_cli_refuse_same_file("identify", "data", a->data, "report", a->report))
+    return 2;
   snprintf(name, len, "%.13s_id", prru_mech.name);
   if (a->name) {
     if (!valid_name(a->name)) {
