@@ -282,6 +282,14 @@ expect 2 "No such file or directory" -- id --traj "$tmp/nonexistent.csv"
 expect 2 "No such file or directory" -- simulate --scenario "$tmp/nonexistent.txt"
 expect 2 "No such file or directory" -- simulate --loads "$tmp/nonexistent.csv"
 expect 2 "Is a directory" -- simulate --scenario "$tmp"
+# Issue 30 item 6: a bad loads file of a scenario was reported as if it
+# were the scenario ("--scenario /dev/zero"): the message names the
+# scenario file and line, then the loads file and its fault.
+printf '# loads from a device\nloads = /dev/zero\n' >"$tmp/zero.scn"
+expect 2 "--scenario $tmp/zero.scn:2: loads: /dev/zero: larger than" -- simulate --scenario "$tmp/zero.scn"
+printf 't,fd1\n0,1\n' >"$tmp/short_loads.csv"
+printf 'loads = short_loads.csv\n' >"$tmp/short.scn"
+expect 2 "--scenario $tmp/short.scn:1: loads: $tmp/short_loads.csv:1: missing column 'fd2'" -- simulate --scenario "$tmp/short.scn"
 expect 1 "Not a directory" -- paper --out "$tmp/keep.csv"
 expect 1 "Not a directory" -- simulate --t-end 0.01 --out "$tmp/keep.csv/x.csv"
 
