@@ -129,6 +129,24 @@ expect 2 "waypoint 2" -- traj --waypoints '0,0,0;0.1,x,0' --durations 1 --out "$
 expect 2 "at least 2" -- traj --waypoints '0,0,0' --durations 1 --out "$tmp/b.csv"
 expect 2 "--dt" -- traj --waypoints "$WP" --durations 1,1 --dt 0 --out "$tmp/b.csv"
 expect 2 "--waypoints is required" -- traj --durations 1
+# Issue 30 item 1: a first duration of 1e-300 s wrote inf and NaN with exit
+# 0; 1e-12 s lost the t = 0 row and ended moving. Rounding-lost durations
+# are refused (the rule in runtime/src/traj.c), nothing written; a short
+# one that is kept gives the t = 0 row and ends exactly at rest.
+expect 2 "duration 1 (waypoint 1 to 2, 1e-300 s) is lost to rounding" -- \
+  traj --waypoints '0,0,0;0.1,0,0' --durations 1e-300 --out "$tmp/lost.csv"
+[ -e "$tmp/lost.csv" ] && bad "traj wrote a file for a lost duration" || ok
+expect 2 "duration 1 (waypoint 1 to 2, 1e-300 s) is lost to rounding" -- \
+  track --waypoints '0,0,0;0.1,0,0' --durations 1e-300 --out "$tmp/lost.csv"
+"$PRRU" traj --waypoints '0,0,0;0.1,0,0' --durations 1e-12 --out "$tmp/short.csv" 2>"$tmp/err" \
+  || bad "traj with a 1e-12 s segment: $(cat "$tmp/err")"
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1])
+assert len(r) == 2 and r[0][0] == 0 and r[1][0] == 1e-12, [x[0] for x in r]
+assert all(math.isfinite(v) for row in r for v in row)
+assert r[0][1:4] == [0, 0, 0] and r[1][1:4] == [0.1, 0, 0], r
+assert all(v == 0 for row in r for v in row[4:10]), 'qd, qdd not 0 at the ends'
+" "$tmp/short.csv" && ok || bad "traj with a 1e-12 s segment: rows $(cat "$tmp/short.csv")"
 [ -e "$tmp/b.csv" ] && bad "a refused traj wrote its file" || ok
 
 # ---- prru id from q(t) alone ----

@@ -372,7 +372,9 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
   const prru_track_options *o = c->o;
   const double t0 = prru_quintic_t_begin(c->ref), t1 = prru_quintic_t_end(c->ref);
   const double step = c->continuous ? o->dt_out : o->control_period;
-  const long nticks = (long)ceil((t1 - t0) / step - 1e-9);
+  /* t_0 is always a tick, and t_1 (a remainder below 1e-9 step merged
+   * into the last tick): at least two, however short the span. */
+  const long nticks = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9));
   double y[6], t = t0, qd0[3];
   prru_quintic_eval(c->ref, t0, y, qd0, NULL);
   for (int i = 0; i < 3; i++) {
