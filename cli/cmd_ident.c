@@ -419,7 +419,12 @@ static int read_data(const char *path, const prru_diff_options *dopt, ident_data
   char msg[700];
   prru_table t;
   memset(D, 0, sizeof *D);
-  if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
+  int st = prru_table_read(&t, path, msg, sizeof msg);
+  if (prru_cli_interrupted) { /* the caller reports it */
+    if (st == PRRU_OK) prru_table_free(&t);
+    return 0;
+  }
+  if (st != PRRU_OK) {
     prru_cli_error("identify", "--data %s", msg);
     return 2;
   }
@@ -692,6 +697,12 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   }
   int bad = -1, rc = 0;
   int st = prru_identify(&m, b, D->n, D->q, D->qd, D->qdd, D->fd, r, &bad);
+  if (prru_cli_interrupted) {
+    prru_cli_error("identify", "interrupted (%s) during the fit of %s; nothing written",
+                   prru_cli_signal_name(), a->data);
+    free(r), free(pi0);
+    return prru_cli_exit_interrupted();
+  }
   if (st != PRRU_OK) {
     if (bad >= 0)
       prru_cli_error("identify", "%s: data row %d (t = %g): %s; nothing written", a->data, bad + 1, D->t[bad],
@@ -757,10 +768,13 @@ int prru_cmd_identify(int argc, char **argv)
   int rc = identify_options(&a, name, sizeof name, &dopt, &vs);
   if (rc) return rc;
   ident_data D;
+  /* A large file takes a while: a signal meanwhile is reported. */
+  prru_cli_catch_signals();
   rc = read_data(a.data, &dopt, &D);
-  if (rc) {
+  int irc = prru_cli_read_interrupted("identify", "data", a.data);
+  if (rc || irc) {
     data_free(&D);
-    return rc;
+    return irc ? irc : rc;
   }
   prru_model m;
   prru_model_default(&m);

@@ -368,7 +368,14 @@ int prru_cmd_id(int argc, char **argv)
   static const char *const opt[6] = {"fp1", "fp2", "fp3", "mp1", "mp2", "mp3"};
   char msg[512];
   prru_table t;
+  /* A large file takes a while: a signal meanwhile is reported. */
+  prru_cli_catch_signals();
   int st = prru_table_read(&t, traj, msg, sizeof msg);
+  int irc = prru_cli_read_interrupted("id", "traj", traj);
+  if (irc) {
+    if (st == PRRU_OK) prru_table_free(&t);
+    return irc;
+  }
   if (st != PRRU_OK) {
     prru_cli_error("id", "--traj %s", msg);
     return 2;
@@ -405,9 +412,14 @@ int prru_cmd_id(int argc, char **argv)
   if (diff && (id_diff_options(wins, degs, &dopt) ||
                (st = id_differentiate(traj, &t, col, &dopt, &rates_q, note, sizeof note)) != 0)) {
     prru_table_free(&t);
-    return st == 1 ? 1 : 2;
+    irc = prru_cli_read_interrupted("id", "traj", traj);
+    return irc ? irc : st == 1 ? 1 : 2;
   }
-  prru_cli_catch_signals();
+  if ((irc = prru_cli_read_interrupted("id", "traj", traj)) != 0) {
+    prru_table_free(&t);
+    free(rates_q);
+    return irc;
+  }
   prru_cli_out o;
   if (prru_cli_out_open(&o, "id", out)) {
     prru_table_free(&t);

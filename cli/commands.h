@@ -73,6 +73,10 @@ int prru_cli_exit_for(int status);
 int prru_cli_exit_interrupted(void);
 /* "SIGINT", "SIGTERM", "SIGHUP" for prru_cli_interrupted, "a signal" else. */
 const char *prru_cli_signal_name(void);
+/* After reading the input of option opt (path) with the signals caught:
+ * 0, or, when a signal came meanwhile, the exit status after "interrupted
+ * (SIGINT) while reading --opt PATH; nothing written". */
+int prru_cli_read_interrupted(const char *cmd, const char *opt, const char *path);
 /* At exit: flushes and closes stdout and reports a write error on it
  * (with the reason): 0, or 1 after "prru CMD: stdout: write error: REASON". */
 int prru_cli_close_stdout(const char *cmd);

@@ -310,3 +310,11 @@ int prru_cli_refuse_same_file(const char *cmd, const char *in_opt, const char *i
                  "read (give another --%s)", in_opt, in, out_opt, out, out_opt);
   return 2;
 }
+
+int prru_cli_read_interrupted(const char *cmd, const char *opt, const char *path)
+{
+  if (!prru_cli_interrupted) return 0;
+  prru_cli_error(cmd, "interrupted (%s) while reading --%s %s; nothing written", prru_cli_signal_name(),
+                 opt, path);
+  return prru_cli_exit_interrupted();
+}
