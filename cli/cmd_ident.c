@@ -166,7 +166,8 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
   o->seed = (unsigned long)seed;
   o->check_samples = 20 * o->samples;
   if (*dt > f->period * *periods) {
-    prru_cli_error(c, "--dt: %s is longer than the run (%g s)", a->dt, f->period * *periods);
+    prru_cli_error(c, "--dt: %g s%s is longer than the run (%g s: --period %g s x --periods %d)", *dt,
+                   a->dt ? "" : " (the default)", f->period * *periods, f->period, *periods);
     return 2;
   }
   return 0;
@@ -418,7 +419,12 @@ static int read_data(const char *path, const prru_diff_options *dopt, ident_data
   char msg[700];
   prru_table t;
   memset(D, 0, sizeof *D);
-  if (prru_table_read(&t, path, msg, sizeof msg) != PRRU_OK) {
+  int st = prru_table_read(&t, path, msg, sizeof msg);
+  if (prru_cli_interrupted) { /* the caller reports it */
+    if (st == PRRU_OK) prru_table_free(&t);
+    return 0;
+  }
+  if (st != PRRU_OK) {
     prru_cli_error("identify", "--data %s", msg);
     return 2;
   }
@@ -649,10 +655,14 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
     prru_cli_error("identify", "--out - and the report would both go to stdout: give --report FILE");
     return 2;
   }
-  if (a->report && strcmp(a->report, "-") != 0 && strcmp(a->report, a->out) == 0) {
-    prru_cli_error("identify", "--report and --out are the same file %s", a->out);
+  if (a->report && strcmp(a->report, "-") != 0 &&
+      (strcmp(a->report, a->out) == 0 || prru_cli_same_file(a->report, a->out))) {
+    prru_cli_error("identify", "--report %s and --out %s are the same file", a->report, a->out);
     return 2;
   }
+  if (prru_cli_refuse_same_file("identify", "data", a->data, "out", a->out) ||
+      prru_cli_refuse_same_file("identify", "data", a->data, "report", a->report))
+    return 2;
   snprintf(name, len, "%.13s_id", prru_mech.name);
   if (a->name) {
     if (!valid_name(a->name)) {
@@ -687,6 +697,12 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   }
   int bad = -1, rc = 0;
   int st = prru_identify(&m, b, D->n, D->q, D->qd, D->qdd, D->fd, r, &bad);
+  if (prru_cli_interrupted) {
+    prru_cli_error("identify", "interrupted (%s) during the fit of %s; nothing written",
+                   prru_cli_signal_name(), a->data);
+    free(r), free(pi0);
+    return prru_cli_exit_interrupted();
+  }
   if (st != PRRU_OK) {
     if (bad >= 0)
       prru_cli_error("identify", "%s: data row %d (t = %g): %s; nothing written", a->data, bad + 1, D->t[bad],
@@ -752,10 +768,13 @@ int prru_cmd_identify(int argc, char **argv)
   int rc = identify_options(&a, name, sizeof name, &dopt, &vs);
   if (rc) return rc;
   ident_data D;
+  /* A large file takes a while: a signal meanwhile is reported. */
+  prru_cli_catch_signals();
   rc = read_data(a.data, &dopt, &D);
-  if (rc) {
+  int irc = prru_cli_read_interrupted("identify", "data", a.data);
+  if (rc || irc) {
     data_free(&D);
-    return rc;
+    return irc ? irc : rc;
   }
   prru_model m;
   prru_model_default(&m);

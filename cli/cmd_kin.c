@@ -354,6 +354,7 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_error("id", "--traj is required (see 'prru id --help')");
     return 2;
   }
+  if (prru_cli_refuse_same_file("id", "traj", traj, "out", out)) return 2;
   double preload = 0.0;
   if (pre && prru_cli_number("id", "preload", pre, &preload)) return 2;
   if ((pre || null_vector) && PRRU_NPRELOAD == 0) {
@@ -367,7 +368,14 @@ int prru_cmd_id(int argc, char **argv)
   static const char *const opt[6] = {"fp1", "fp2", "fp3", "mp1", "mp2", "mp3"};
   char msg[512];
   prru_table t;
+  /* A large file takes a while: a signal meanwhile is reported. */
+  prru_cli_catch_signals();
   int st = prru_table_read(&t, traj, msg, sizeof msg);
+  int irc = prru_cli_read_interrupted("id", "traj", traj);
+  if (irc) {
+    if (st == PRRU_OK) prru_table_free(&t);
+    return irc;
+  }
   if (st != PRRU_OK) {
     prru_cli_error("id", "--traj %s", msg);
     return 2;
@@ -404,9 +412,14 @@ int prru_cmd_id(int argc, char **argv)
   if (diff && (id_diff_options(wins, degs, &dopt) ||
                (st = id_differentiate(traj, &t, col, &dopt, &rates_q, note, sizeof note)) != 0)) {
     prru_table_free(&t);
-    return st == 1 ? 1 : 2;
+    irc = prru_cli_read_interrupted("id", "traj", traj);
+    return irc ? irc : st == 1 ? 1 : 2;
   }
-  prru_cli_catch_signals();
+  if ((irc = prru_cli_read_interrupted("id", "traj", traj)) != 0) {
+    prru_table_free(&t);
+    free(rates_q);
+    return irc;
+  }
   prru_cli_out o;
   if (prru_cli_out_open(&o, "id", out)) {
     prru_table_free(&t);

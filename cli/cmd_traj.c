@@ -150,7 +150,9 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     return PRRU_ENOMEM;
   }
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
-  const long n = (long)ceil((t1 - t0) / dt - 1e-9);
+  /* The rows t0 + k dt and t1 (a remainder below 1e-9 dt merged into the
+   * last row); at least those two, however short the span. */
+  const long n = (long)fmax(1.0, ceil((t1 - t0) / dt - 1e-9));
   int st = PRRU_OK, sign = 0;
   double t_prev = t0;
   for (long k = 0; k <= n && !o->err; k++) {
@@ -401,7 +403,7 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
-  const long n = (long)ceil((t1 - t0) / step - 1e-9);
+  const long n = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9)); /* as traj_rows */
   int rc = 0, sign = 0;
   *ff_peak = 0;
   for (long k = 0; k <= n && !rc; k++) {
@@ -683,6 +685,10 @@ int prru_cmd_track(int argc, char **argv)
     prru_cli_error("track", "--plot needs --out FILE.csv (the figure is drawn from it)");
     return 2;
   }
+  if (prru_cli_refuse_same_file("track", "ref", refs, "out", out) ||
+      prru_cli_refuse_same_file("track", "ref", refs, "summary", sums) ||
+      prru_cli_refuse_same_file("track", "ref", refs, "plot", plot))
+    return 2;
   prru_track_options o;
   prru_track_options_default(&o);
   if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;

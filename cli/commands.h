@@ -73,6 +73,10 @@ int prru_cli_exit_for(int status);
 int prru_cli_exit_interrupted(void);
 /* "SIGINT", "SIGTERM", "SIGHUP" for prru_cli_interrupted, "a signal" else. */
 const char *prru_cli_signal_name(void);
+/* After reading the input of option opt (path) with the signals caught:
+ * 0, or, when a signal came meanwhile, the exit status after "interrupted
+ * (SIGINT) while reading --opt PATH; nothing written". */
+int prru_cli_read_interrupted(const char *cmd, const char *opt, const char *path);
 /* At exit: flushes and closes stdout and reports a write error on it
  * (with the reason): 0, or 1 after "prru CMD: stdout: write error: REASON". */
 int prru_cli_close_stdout(const char *cmd);
@@ -97,6 +101,14 @@ int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_o
 /* Exactly n comma-separated finite numbers for option `name`: 0, else 2
  * after printing what was wrong. */
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n);
+/* 1 when paths a and b name the same existing file, compared by device
+ * and inode (so "f", "./f", a hard or symbolic link to f alike); 0 when
+ * either is NULL, "-" (stdout) or does not exist. */
+int prru_cli_same_file(const char *a, const char *b);
+/* 0, or 2 after "--IN_OPT IN and --OUT_OPT OUT are the same file ..." when
+ * the output would replace the input (prru_cli_same_file). */
+int prru_cli_refuse_same_file(const char *cmd, const char *in_opt, const char *in,
+                              const char *out_opt, const char *out);
 /* One finite number, 0 or 2. */
 int prru_cli_number(const char *cmd, const char *name, const char *text, double *out);
 /* Writes a JSON number (%.17g) or null when not finite. */

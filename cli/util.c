@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "commands.h"
 #include "prru.h"
@@ -290,4 +291,30 @@ int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const 
   prru_cli_out_numbers(o, v, PRRU_NACT);
   prru_cli_out_printf(o, "\n");
   return prru_cli_out_row(o);
+}
+
+int prru_cli_same_file(const char *a, const char *b)
+{
+  struct stat sa, sb;
+  if (!a || !b || strcmp(a, "-") == 0 || strcmp(b, "-") == 0) return 0;
+  /* A file that does not exist yet is no input's file. */
+  if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
+  return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int prru_cli_refuse_same_file(const char *cmd, const char *in_opt, const char *in,
+                              const char *out_opt, const char *out)
+{
+  if (!prru_cli_same_file(in, out)) return 0;
+  prru_cli_error(cmd, "--%s %s and --%s %s are the same file: writing it would replace what is "
+                 "read (give another --%s)", in_opt, in, out_opt, out, out_opt);
+  return 2;
+}
+
+int prru_cli_read_interrupted(const char *cmd, const char *opt, const char *path)
+{
+  if (!prru_cli_interrupted) return 0;
+  prru_cli_error(cmd, "interrupted (%s) while reading --%s %s; nothing written", prru_cli_signal_name(),
+                 opt, path);
+  return prru_cli_exit_interrupted();
 }

@@ -167,11 +167,25 @@ PY
 expect 1 "not physical" -- identify --data "$tmp/flip.csv" --out "$tmp/keep.json" --report "$tmp/flip_rep.csv"
 [ "$(cat "$tmp/keep.json")" = old ] && ok || bad "a refused identification changed the model file"
 expect 2 "both go to stdout" -- identify --data "$tmp/ex.csv" --out -
+# Issue 30 item 4: the data file as --out or --report (by device and
+# inode: ./f and f alike) is refused, the data as they were.
+cp "$tmp/ex.csv" "$tmp/exs.csv"
+expect 2 "--data $tmp/exs.csv and --out $tmp/./exs.csv are the same file" -- identify --data "$tmp/exs.csv" --out "$tmp/./exs.csv"
+expect 2 "--data $tmp/exs.csv and --report $tmp//exs.csv are the same file" -- identify --data "$tmp/exs.csv" \
+  --out "$tmp/x.json" --report "$tmp//exs.csv"
+echo old >"$tmp/rep_same.csv"
+expect 2 "are the same file" -- identify --data "$tmp/ex.csv" --out "$tmp/rep_same.csv" --report "$tmp/./rep_same.csv"
+cmp -s "$tmp/ex.csv" "$tmp/exs.csv" && [ "$(cat "$tmp/rep_same.csv")" = old ] && ok || bad "identify changed its input or old report"
 expect 2 "--name" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --name Bad-Name
 expect 2 "--coulomb-velocity" -- identify --data "$tmp/ex.csv" --out "$tmp/x.json" --coulomb-velocity 0
 expect 2 "centre" -- excite --centre 3,0,0 --out "$tmp/c.csv"
 expect 2 "--harmonics" -- excite --harmonics 0 --out "$tmp/c.csv"
 expect 2 "--period" -- excite --period -1 --out "$tmp/c.csv"
+# Issue 30 item 3: the default dt longer than the run printed "--dt:
+# (null)" (printf of a NULL string): the message names the dt in effect.
+expect 2 "--dt: 0.01 s (the default) is longer than the run (0.005 s" -- excite --period 0.005 --out "$tmp/c.csv"
+expect 2 "--dt: 0.5 s is longer than the run (0.2 s" -- excite --period 0.1 --periods 2 --dt 0.5 --out "$tmp/c.csv"
+grep -q "(null)" "$tmp/err" && bad "excite --dt message prints (null): $(cat "$tmp/err")" || ok
 expect 2 "--fd-max" -- excite --fd-max 0 --out "$tmp/c.csv"
 expect 2 "--stroke" -- excite --stroke 0.3,0.2 --out "$tmp/c.csv"
 expect 2 "outside its stroke" -- excite --stroke 0.5,0.6 --out "$tmp/c.csv"

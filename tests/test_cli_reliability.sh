@@ -229,6 +229,34 @@ kill -CONT "$pid"
 finish_bg
 [ $rc -eq 143 ] && [ ! -e "$tmp/pnew" ] && ok || bad "paper stopped in a new directory: exit $rc, left $(ls -A "$tmp/pnew" 2>&1)"
 
+# Issue 30 item 5: a signal while id or identify reads a large input
+# killed them (exit 130/143) with no message. The input comes through a
+# FIFO whose writer stays open, so the signal lands while the file is
+# still being read: the message names the option and file, exit 128 +
+# signal, no output written.
+"$PRRU" traj --waypoints '0,0,0;0.1,0,0' --durations 2 --dt 1e-4 --out "$tmp/big.csv" || bad "traj for the big input"
+mkfifo "$tmp/in.fifo"
+for run in "id:traj:INT:130" "identify:data:TERM:143"; do
+  IFS=: read -r cmd opt sig want <<<"$run"
+  rm -f "$tmp/rd.out"
+  start "$cmd" --"$opt" "$tmp/in.fifo" --out "$tmp/rd.out"
+  exec 7<>"$tmp/in.fifo"
+  timeout 60 cat "$tmp/big.csv" >&7
+  # Blocked reading the FIFO for more (where /proc does not say, 2 s).
+  for ((i = 0; i < 100; i++)); do
+    grep -q pipe_read "/proc/$pid/wchan" 2>/dev/null && break
+    sleep 0.02
+  done
+  kill -"$sig" "$pid"
+  sleep 0.1
+  exec 7>&-
+  finish_bg
+  [ "$rc" -eq "$want" ] && grep -qF "interrupted (SIG$sig) while reading --$opt $tmp/in.fifo; nothing written" "$tmp/bg.err" \
+    && ok || bad "$cmd stopped by SIG$sig while reading: exit $rc: $(cat "$tmp/bg.err")"
+  [ -e "$tmp/rd.out" ] && bad "$cmd stopped while reading wrote $tmp/rd.out" || ok
+done
+no_partials "id and identify stopped while reading"
+
 # ---- 5. Outputs are replaced only by a run that has rows ----
 echo "old contents" >"$tmp/old.csv"
 chmod 640 "$tmp/old.csv"
@@ -282,6 +310,14 @@ expect 2 "No such file or directory" -- id --traj "$tmp/nonexistent.csv"
 expect 2 "No such file or directory" -- simulate --scenario "$tmp/nonexistent.txt"
 expect 2 "No such file or directory" -- simulate --loads "$tmp/nonexistent.csv"
 expect 2 "Is a directory" -- simulate --scenario "$tmp"
+# Issue 30 item 6: a bad loads file of a scenario was reported as if it
+# were the scenario ("--scenario /dev/zero"): the message names the
+# scenario file and line, then the loads file and its fault.
+printf '# loads from a device\nloads = /dev/zero\n' >"$tmp/zero.scn"
+expect 2 "--scenario $tmp/zero.scn:2: loads: /dev/zero: larger than" -- simulate --scenario "$tmp/zero.scn"
+printf 't,fd1\n0,1\n' >"$tmp/short_loads.csv"
+printf 'loads = short_loads.csv\n' >"$tmp/short.scn"
+expect 2 "--scenario $tmp/short.scn:1: loads: $tmp/short_loads.csv:1: missing column 'fd2'" -- simulate --scenario "$tmp/short.scn"
 expect 1 "Not a directory" -- paper --out "$tmp/keep.csv"
 expect 1 "Not a directory" -- simulate --t-end 0.01 --out "$tmp/keep.csv/x.csv"
 

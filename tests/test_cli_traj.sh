@@ -129,6 +129,24 @@ expect 2 "waypoint 2" -- traj --waypoints '0,0,0;0.1,x,0' --durations 1 --out "$
 expect 2 "at least 2" -- traj --waypoints '0,0,0' --durations 1 --out "$tmp/b.csv"
 expect 2 "--dt" -- traj --waypoints "$WP" --durations 1,1 --dt 0 --out "$tmp/b.csv"
 expect 2 "--waypoints is required" -- traj --durations 1
+# Issue 30 item 1: a first duration of 1e-300 s wrote inf and NaN with exit
+# 0; 1e-12 s lost the t = 0 row and ended moving. Rounding-lost durations
+# are refused (the rule in runtime/src/traj.c), nothing written; a short
+# one that is kept gives the t = 0 row and ends exactly at rest.
+expect 2 "duration 1 (waypoint 1 to 2, 1e-300 s) is lost to rounding" -- \
+  traj --waypoints '0,0,0;0.1,0,0' --durations 1e-300 --out "$tmp/lost.csv"
+[ -e "$tmp/lost.csv" ] && bad "traj wrote a file for a lost duration" || ok
+expect 2 "duration 1 (waypoint 1 to 2, 1e-300 s) is lost to rounding" -- \
+  track --waypoints '0,0,0;0.1,0,0' --durations 1e-300 --out "$tmp/lost.csv"
+"$PRRU" traj --waypoints '0,0,0;0.1,0,0' --durations 1e-12 --out "$tmp/short.csv" 2>"$tmp/err" \
+  || bad "traj with a 1e-12 s segment: $(cat "$tmp/err")"
+python3 -c "$PYCSV
+h, r = cols(sys.argv[1])
+assert len(r) == 2 and r[0][0] == 0 and r[1][0] == 1e-12, [x[0] for x in r]
+assert all(math.isfinite(v) for row in r for v in row)
+assert r[0][1:4] == [0, 0, 0] and r[1][1:4] == [0.1, 0, 0], r
+assert all(v == 0 for row in r for v in row[4:10]), 'qd, qdd not 0 at the ends'
+" "$tmp/short.csv" && ok || bad "traj with a 1e-12 s segment: rows $(cat "$tmp/short.csv")"
 [ -e "$tmp/b.csv" ] && bad "a refused traj wrote its file" || ok
 
 # ---- prru id from q(t) alone ----
@@ -271,6 +289,35 @@ expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations
 expect 2 "missing column 'qd1'" -- track --ref "$tmp/qonly.csv" --out "$tmp/x.csv"
 expect 2 "--bandwidth excludes" -- track --waypoints "$WP" --durations 1,1 --bandwidth 5 --kp 1,1,1
 [ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# Issue 30 item 4: id and track wrote their output over their input when
+# the two options named one file. Refused (exit 2, both options named),
+# the file as it was, whatever the spelling: ./f, a symbolic link.
+cp "$tmp/t.csv" "$tmp/same.csv"
+ln -s same.csv "$tmp/same_link.csv"
+for o in "$tmp/same.csv" "$tmp/./same.csv" "$tmp/same_link.csv"; do
+  expect 2 "--traj $tmp/same.csv and --out $o are the same file" -- id --traj "$tmp/same.csv" --out "$o"
+  expect 2 "--ref $tmp/same.csv and --out $o are the same file" -- track --ref "$tmp/same.csv" --out "$o"
+done
+expect 2 "--ref $tmp/same.csv and --summary $tmp/./same.csv are the same file" -- \
+  track --ref "$tmp/same.csv" --out "$tmp/x.csv" --summary "$tmp/./same.csv"
+cmp -s "$tmp/t.csv" "$tmp/same.csv" && ok || bad "id/track changed their input file"
+[ -e "$tmp/x.csv" ] && bad "a refused track wrote its CSV" || ok
+# Issue 30 item 2: a failure in an integrator's trial state (gains far too
+# stiff for the step) or in a noisy measurement was blamed on the run's
+# regular state, "not reachable ... at q = (0, 0, 0)". The message names
+# what failed: the trial state and its time, or the measurement and the
+# noise; exit 1 either way.
+for args in "--bandwidth 1e6" "--noise 1e300,0 --period 0.001" "--noise 0,1e300 --period 0.001"; do
+  # shellcheck disable=SC2086
+  expect 1 "" -- track --waypoints '0,0,0;0.1,-0.08,0.02' --durations 0.5 $args --out "$tmp/stiff.csv" \
+    --summary "$tmp/stiff.json"
+  grep -q "at q = (0, 0, 0)" "$tmp/err" && bad "track $args blamed the regular q = 0: $(cat "$tmp/err")" || ok
+  case $args in
+    --bandwidth*) want="trial state at t = " ;;
+    *) want="the sensor noise (q " ;;
+  esac
+  grep -qF "$want" "$tmp/err" && ok || bad "track $args: no '$want': $(cat "$tmp/err")"
+done
 # SIGTERM during a long run (a background job ignores SIGINT): exit 143,
 # whole rows kept, the summary says why.
 "$PRRU" track --waypoints "$WP" --durations 200,200 --out "$tmp/sig.csv" --summary "$tmp/sig.json" 2>"$tmp/sig.err" &

@@ -183,11 +183,11 @@ static void quintic_waypoints(void)
   double q[3], qd[3], qdd[3];
   for (int k = 0; k < 3; k++) {
     prru_quintic_eval(&tr, tr.t[k], q, qd, qdd);
-    /* The last knot is u = 1 of its segment: the sum of the six
-     * coefficients (10, 15, 6 times dq) rounds to a few ulps of dq. */
-    TU_CLOSE(q, wp + 3 * k, 3, k < 2 ? 0.0 : 1e-14, "waypoint reached");
-    TU_TRUE(fabs(qd[0]) + fabs(qd[1]) + fabs(qd[2]) < 1e-15 &&
-                fabs(qdd[0]) + fabs(qdd[1]) + fabs(qdd[2]) < 1e-13,
+    /* Every knot exactly: u = 0 of its segment, the last one stored
+     * (u = 1 would sum the coefficients, rounding to a few ulps of dq). */
+    TU_CLOSE(q, wp + 3 * k, 3, 0.0, "waypoint reached");
+    TU_TRUE(fabs(qd[0]) + fabs(qd[1]) + fabs(qd[2]) == 0.0 &&
+                fabs(qdd[0]) + fabs(qdd[1]) + fabs(qdd[2]) == 0.0,
             "at rest at the waypoint");
   }
   /* Mid-segment: halfway, peak speed 1.875 dq / T; peak acceleration
@@ -219,6 +219,47 @@ static void quintic_waypoints(void)
           "NaN waypoint refused by number");
   TU_TRUE(prru_quintic_waypoints(&tr, 1, wp, dur, 0, msg, sizeof msg) == PRRU_EINPUT,
           "one waypoint refused");
+}
+
+/* Issue 30 item 1: a first segment of 1e-300 s gave inf and NaN rows.
+ * Every segment, the first one included, is refused when rounding loses
+ * it: its knot time does not move, or its square (dividing the
+ * accelerations) is below DBL_MIN, where it no longer carries the rounding
+ * unit's relative accuracy: the bound sqrt(DBL_MIN) = 1.49e-154 s is
+ * checked on both sides. A short segment that is kept ends exactly at
+ * rest on its waypoint. */
+static void quintic_durations_rounding(void)
+{
+  const double wp[9] = {0, 0, 0, 0.1, 0, 0, 0.2, 0, 0};
+  prru_quintic tr;
+  char msg[256];
+  const double tiny[1] = {1e-300}, below[1] = {1e-154}, above[1] = {2e-154};
+  TU_TRUE(prru_quintic_waypoints(&tr, 2, wp, tiny, 0.0, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "duration 1") && strstr(msg, "lost to rounding"),
+          "first duration 1e-300 s refused");
+  TU_TRUE(prru_quintic_waypoints(&tr, 2, wp, below, 0.0, msg, sizeof msg) == PRRU_EINPUT,
+          "first duration 1e-154 s (square below DBL_MIN) refused");
+  TU_TRUE(prru_quintic_waypoints(&tr, 2, wp, above, 0.0, msg, sizeof msg) == PRRU_OK,
+          "first duration 2e-154 s (square above DBL_MIN) kept");
+  if (tr.n) prru_quintic_free(&tr);
+  const double later[2] = {1.0, 1e-16};
+  TU_TRUE(prru_quintic_waypoints(&tr, 3, wp, later, 0.0, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "duration 2"),
+          "later duration below the rounding unit of its start refused");
+  const double short_dur[1] = {1e-12};
+  TU_TRUE(prru_quintic_waypoints(&tr, 2, wp, short_dur, 0.0, msg, sizeof msg) == PRRU_OK,
+          "duration 1e-12 s kept");
+  double q[3], qd[3], qdd[3];
+  prru_quintic_eval(&tr, prru_quintic_t_end(&tr), q, qd, qdd);
+  TU_CLOSE(q, wp + 3, 3, 0.0, "short segment: ends on its waypoint");
+  TU_TRUE(qd[0] == 0.0 && qd[1] == 0.0 && qd[2] == 0.0 && qdd[0] == 0.0 && qdd[1] == 0.0 &&
+              qdd[2] == 0.0,
+          "short segment: ends at rest");
+  prru_quintic_eval(&tr, 0.5e-12, q, qd, qdd);
+  int finite = 1;
+  for (int c = 0; c < 3; c++) finite &= isfinite(q[c]) && isfinite(qd[c]) && isfinite(qdd[c]);
+  TU_TRUE(finite, "short segment: finite inside");
+  prru_quintic_free(&tr);
 }
 
 /* The Hermite interpolation of samples of one quintic P is P. */
@@ -330,6 +371,7 @@ int main(void)
   stated_factor();
   refusals();
   quintic_waypoints();
+  quintic_durations_rounding();
   hermite_reproduces_quintic();
   differentiate_quintic();
   return tu_finish("test_traj");

@@ -82,12 +82,17 @@ int prru_diff_signal(const double *t, int n, const double *y, int dim,
 typedef struct {
   int n;          /* knots (>= 2) */
   double *t;      /* n */
-  double *coef;   /* (n - 1) segments x 3 coordinates x 6 coefficients in u */
+  double *coef;   /* (n - 1) segments x 3 coordinates x 6 coefficients in u,
+                     then the last knot's q, qd, qdd (9, returned exactly) */
 } prru_quintic;
 
 /* From waypoints q_0..q_{n-1} (n x 3 row-major) and the n - 1 segment
  * durations (s, > 0), starting at t0. Allocates (a set-up call);
- * PRRU_EINPUT with msg naming the bad waypoint or duration, PRRU_ENOMEM. */
+ * PRRU_EINPUT with msg naming the bad waypoint or duration, PRRU_ENOMEM.
+ * A duration that rounding loses is refused, the first one as any other:
+ * one that leaves its knot time unchanged, shorter than sqrt(DBL_MIN) =
+ * 1.5e-154 s (its square underflows), or whose peak acceleration
+ * overflows. */
 int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const double *durations,
                            double t0, char *msg, int msglen);
 /* From n samples of t, q, qd, qdd (each n x 3 row-major, t strictly

@@ -60,7 +60,14 @@ int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3]
   prru_param_eom(p, q, qd, fd, zero, zero, M, b);
   for (int i = 0; i < 9; i++)
     if (!isfinite(M[i])) return PRRU_EUNREACHABLE;
-  if (!isfinite(b[0]) || !isfinite(b[1]) || !isfinite(b[2])) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(b, 3)) {
+    /* M finite: q is reachable. b at rest without forces finite: the
+     * velocities or forces overflow b (PRRU_EINPUT); else q lies on the
+     * workspace boundary, where the velocity mapping divides by zero. */
+    static const double zero_fd[PRRU_NACT] = {0};
+    prru_param_eom(p, q, zero, zero_fd, zero, zero, M, b);
+    return prru_finite_n(b, 3) ? PRRU_EINPUT : PRRU_ESINGULAR;
+  }
   return spd3_solve(M, b, qdd) == 0 ? PRRU_OK : PRRU_ESINGULAR;
 }
 
@@ -74,8 +81,10 @@ int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_opt
     qdd_c[i] = qdd_ref[i] + o->kd[i] * (qd_ref[i] - qd[i]) + o->kp[i] * (q_ref[i] - q[i]);
   prru_loads l;
   memset(&l, 0, sizeof l);
+  if (!prru_finite_n(qdd_c, 3)) return PRRU_EINPUT; /* the gains times the errors overflow */
   int st = prru_inverse_dynamics(m, d, q, qd, qdd_c, &l, fd_cmd);
   if (st != PRRU_OK) return st;
+  if (!prru_finite_n(fd_cmd, PRRU_NACT)) return PRRU_EINPUT;
   for (int i = 0; i < PRRU_NACT; i++) {
     double lim = o->f_max[i];
     sat[i] = fabs(fd_cmd[i]) > lim;
@@ -130,6 +139,11 @@ typedef struct {
   int continuous;
   double fd_hold[PRRU_NACT];
   int status; /* why the right-hand side last failed */
+  /* Where it failed: an integrator's trial state (abandoned, so y no
+   * longer holds it) at time t, in the controller or in the plant, and
+   * the largest controller force of the step's evaluations before it. */
+  int in_plant;
+  double fail_t, fail_y[6], fd_step_peak;
 } track_ctx;
 
 /* The integrator may probe a few ulps past the reference's end. */
@@ -155,9 +169,14 @@ static int track_rhs(double t, const double y[], double f[], void *p)
   } else {
     memcpy(fd, c->fd_hold, sizeof fd);
   }
+  c->in_plant = st == PRRU_OK;
+  if (st == PRRU_OK && c->continuous)
+    for (int i = 0; i < PRRU_NACT; i++) c->fd_step_peak = fmax(c->fd_step_peak, fabs(fd_cmd[i]));
   if (st == PRRU_OK) st = prru_plant_accel(&c->o->plant, y, y + 3, fd, f + 3);
   if (st != PRRU_OK) {
     c->status = st;
+    c->fail_t = t;
+    memcpy(c->fail_y, y, sizeof c->fail_y);
     return GSL_EBADFUNC;
   }
   memcpy(f, y + 3, 3 * sizeof y[0]);
@@ -166,8 +185,50 @@ static int track_rhs(double t, const double y[], double f[], void *p)
 
 /* The controller at tick t: fills s (reference, true state, forces) from
  * the measured state (true + noise when rng). */
+/* What a failed evaluation at state y means: the pose out of the
+ * workspace or singular, or (PRRU_EINPUT, y finite) forces that overflow. */
+static const char *failure_text(int st)
+{
+  return st == PRRU_EUNREACHABLE ? "outside the workspace (not reachable)"
+         : st == PRRU_ESINGULAR  ? "singular (J_d singular, or on the workspace boundary)"
+         : st == PRRU_EINPUT     ? "regular, but the forces overflow there"
+                                 : prru_strerror(st);
+}
+
+/* The controller failed at tick t on the measured state meas (y the
+ * true one): the message names the state it ran on, and blames the
+ * sensor noise when only the noisy measurement is at fault. */
+static int tick_failure(track_ctx *c, int st, double t, const double y[6], const double meas[6],
+                        int noisy, char *msg, int msglen)
+{
+  const prru_track_options *o = c->o;
+  double rc;
+  if (noisy && prru_check_regular(c->m, c->d, y, &rc) == PRRU_OK) {
+    char what[200];
+    if (st == PRRU_EINPUT)
+      snprintf(what, sizeof what, "q = (%.3g, %.3g, %.3g), qd = (%.3g, %.3g, %.3g), makes the "
+               "controller's forces overflow", meas[0], meas[1], meas[2], meas[3], meas[4], meas[5]);
+    else
+      snprintf(what, sizeof what, "q = (%.9g, %.9g, %.9g) is %s: the controller's inverse "
+               "dynamics has no forces for it", meas[0], meas[1], meas[2], failure_text(st));
+    return prru_fail(msg, msglen, st,
+                     "stopped at t = %.9g s: the measured state (true state + sensor noise) %s; "
+                     "the true state is regular: the sensor noise (q %g, qd %g) is too large", t,
+                     what, o->noise_q, o->noise_qd);
+  }
+  if (st == PRRU_EINPUT)
+    return prru_fail(msg, msglen, st,
+                     "stopped at t = %.9g s: the controller's forces overflow at the %s state q = "
+                     "(%.9g, %.9g, %.9g), qd = (%.9g, %.9g, %.9g) (gains kp %g, kd %g, or "
+                     "velocities too large)", t, noisy ? "measured" : "true", meas[0], meas[1],
+                     meas[2], meas[3], meas[4], meas[5], o->kp[0], o->kd[0]);
+  return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)%s", t,
+                   prru_strerror(st), meas[0], meas[1], meas[2],
+                   st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
+}
+
 static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
-                      prru_track_sample *s)
+                      prru_track_sample *s, char *msg, int msglen)
 {
   const prru_track_options *o = c->o;
   s->t = t;
@@ -183,10 +244,14 @@ static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
   }
   int st = prru_computed_torque(c->m, c->d, o, s->q_ref, s->qd_ref, s->qdd_ref, meas, meas + 3,
                                 s->fd_cmd, s->fd, s->saturated);
-  if (st != PRRU_OK) return st;
+  if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
   prru_param_ik(&o->plant, y, s->d);
-  return prru_finite_n(s->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
+  if (!prru_finite_n(s->d, PRRU_NACT))
+    return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
+                     "stopped at t = %.9g s: the plant left the workspace: %s at q = (%.9g, "
+                     "%.9g, %.9g)", t, prru_strerror(PRRU_EUNREACHABLE), y[0], y[1], y[2]);
+  return PRRU_OK;
 }
 
 static void summary_add(prru_track_summary *sum, const prru_track_sample *s)
@@ -251,10 +316,37 @@ static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, do
   return GSL_SUCCESS;
 }
 
+/* The right-hand side failed on one of the integrator's trial states
+ * (the step abandoned, the run's state at t regular): the message names
+ * the trial, where it failed and the force that drove it there. A trial
+ * out of the workspace after a regular state means one step moved the
+ * state that far: gains too stiff for the step, or forces that large. */
+static int trial_failure(const track_ctx *c, int st, double t, char *msg, int msglen)
+{
+  const prru_track_options *o = c->o;
+  const double *y = c->fail_y;
+  double peak = c->fd_step_peak;
+  for (int i = 0; i < PRRU_NACT && !c->continuous; i++) peak = fmax(peak, fabs(c->fd_hold[i]));
+  const char *where = c->in_plant ? "the plant's equations of motion" : "the controller's inverse dynamics";
+  char what[200];
+  if (st == PRRU_EINPUT)
+    snprintf(what, sizeof what, "overflow in %s (qd = (%.3g, %.3g, %.3g))", where, y[3], y[4], y[5]);
+  else
+    snprintf(what, sizeof what, "q = (%.9g, %.9g, %.9g) is %s (%s)", y[0], y[1], y[2],
+             failure_text(st), where);
+  return prru_fail(msg, msglen, st,
+                   "stopped at t = %.9g s: the integrator's trial state at t = %.9g s left the "
+                   "run's regular path: %s; the controller's forces reached %.3g N in this step "
+                   "(gains kp %g %g %g, kd %g %g %g): lower the gains or limit the forces",
+                   t, c->fail_t, what, peak, o->kp[0], o->kp[1], o->kp[2], o->kd[0], o->kd[1],
+                   o->kd[2]);
+}
+
 static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk, double y[6],
                       char *msg, int msglen)
 {
   c->status = PRRU_OK;
+  c->fd_step_peak = 0.0;
   gsl_odeiv2_driver_reset(drv);
   int bad = -1, gs = track_advance(drv, c->o, t, tk, y, &bad);
   if (gs == GSL_SUCCESS) return PRRU_OK;
@@ -271,9 +363,7 @@ static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk
     return prru_fail(msg, msglen, st, "interrupted at t = %.9g s", *t);
   if (st == PRRU_ENOCONV)
     return prru_fail(msg, msglen, st, "integrator failed at t = %.9g s: %s", *t, gsl_strerror(gs));
-  return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)%s", *t,
-                   prru_strerror(st), y[0], y[1], y[2],
-                   st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
+  return trial_failure(c, st, *t, msg, msglen);
 }
 
 static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_track_sample *s,
@@ -282,7 +372,9 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
   const prru_track_options *o = c->o;
   const double t0 = prru_quintic_t_begin(c->ref), t1 = prru_quintic_t_end(c->ref);
   const double step = c->continuous ? o->dt_out : o->control_period;
-  const long nticks = (long)ceil((t1 - t0) / step - 1e-9);
+  /* t_0 is always a tick, and t_1 (a remainder below 1e-9 step merged
+   * into the last tick): at least two, however short the span. */
+  const long nticks = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9));
   double y[6], t = t0, qd0[3];
   prru_quintic_eval(c->ref, t0, y, qd0, NULL);
   for (int i = 0; i < 3; i++) {
@@ -295,11 +387,8 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
       int st = track_step(drv, c, &t, tk, y, msg, msglen);
       if (st != PRRU_OK) return st;
     }
-    int st = track_tick(c, rng, tk, y, s);
-    if (st != PRRU_OK)
-      return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g)%s",
-                       tk, prru_strerror(st), y[0], y[1], y[2],
-                       st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
+    int st = track_tick(c, rng, tk, y, s, msg, msglen);
+    if (st != PRRU_OK) return st;
     int bad = stroke_violation(o, s->d);
     if (bad >= 0)
       return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
@@ -323,7 +412,13 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   int st = track_options_check(o, msg, msglen);
   if (st != PRRU_OK) return st;
   prru_gsl_init();
-  track_ctx c = {m, ref, o, malloc(sizeof(prru_data)), o->control_period == 0.0, {0}, PRRU_OK};
+  track_ctx c;
+  memset(&c, 0, sizeof c);
+  c.m = m;
+  c.ref = ref;
+  c.o = o;
+  c.d = malloc(sizeof(prru_data));
+  c.continuous = o->control_period == 0.0;
   prru_track_sample *s = malloc(sizeof *s);
   gsl_odeiv2_system sys = {track_rhs, NULL, 6, &c};
   double h0 = fmin(1e-4, c.continuous ? o->dt_out : o->control_period);

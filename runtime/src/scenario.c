@@ -102,8 +102,10 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
     if (n < 0 || (size_t)n >= sizeof path)
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: loads: path too long", where);
     prru_load_schedule t;
-    int st = prru_schedule_read_csv(&t, path, msg, msglen);
-    if (st != PRRU_OK) return st;
+    char why[600];
+    int st = prru_schedule_read_csv(&t, path, why, (int)sizeof why);
+    /* why names the loads file; where, the scenario file and line. */
+    if (st != PRRU_OK) return prru_fail(msg, msglen, st, "%s: loads: %s", where, why);
     t.base = s->loads.base; /* constant parts given before add to the table */
     s->loads = t;
     s->opt.loads = &s->loads;

@@ -1,5 +1,6 @@
 /* Local polynomial differentiation and piecewise-quintic trajectories
  * (prru_traj.h). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -172,7 +173,8 @@ static int quintic_alloc(prru_quintic *tr, int n, char *msg, int msglen)
   tr->coef = NULL;
   if (n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "a trajectory needs at least 2 points, got %d", n);
   tr->t = malloc((size_t)n * sizeof *tr->t);
-  tr->coef = malloc((size_t)(n - 1) * 18 * sizeof *tr->coef);
+  /* The segments' coefficients, then the last knot's q, qd, qdd. */
+  tr->coef = malloc(((size_t)(n - 1) * 18 + 9) * sizeof *tr->coef);
   if (!tr->t || !tr->coef) {
     prru_quintic_free(tr);
     return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
@@ -207,7 +209,36 @@ int prru_quintic_samples(prru_quintic *tr, int n, const double *t, const double 
       hermite5(t[s + 1] - t[s], q[a], qd[a], qdd[a], q[b], qd[b], qdd[b],
                tr->coef + 18 * s + 6 * c);
     }
+  /* The quintic at u = 1 sums its coefficients, which rounds; the last
+   * knot is given exactly (every other knot is a segment's u = 0, exact). */
+  double *end = tr->coef + 18 * (n - 1);
+  memcpy(end, q + 3 * (n - 1), 3 * sizeof *end);
+  memcpy(end + 3, qd + 3 * (n - 1), 3 * sizeof *end);
+  memcpy(end + 6, qdd + 3 * (n - 1), 3 * sizeof *end);
   return PRRU_OK;
+}
+
+/* Why rounding loses the segment from knot t0 to knot t1 between the
+ * waypoints a and b, or NULL when it keeps it. One rule for every segment,
+ * the first one included:
+ *  - the knot must move: t0 + T rounds to t0 when T is below half the
+ *    rounding unit of t0 (u |t0|, u = DBL_EPSILON / 2);
+ *  - the evaluation divides by T and T^2 (qd = p'(u) / T, qdd = p''(u) /
+ *    T^2). T^2 carries the relative error u of a double only as a normal
+ *    number: below DBL_MIN gradual underflow rounds it with a larger
+ *    relative error, down to 0 (T = 1e-300 s gives qdd = inf, NaN). So
+ *    T^2 >= DBL_MIN, T >= sqrt(DBL_MIN) = 1.5e-154 s;
+ *  - the peak acceleration 5.7735 |dq| / T^2 (prru_traj.h) must be a
+ *    finite double, else it rounds to infinity. */
+static const char *duration_lost(double t0, double t1, const double a[3], const double b[3])
+{
+  if (!(t1 > t0)) return "the knot time does not move";
+  const double T = t1 - t0;
+  if (!(T * T >= DBL_MIN)) return "its square, by which accelerations are divided, underflows";
+  double dq = 0.0;
+  for (int c = 0; c < 3; c++) dq = fmax(dq, fabs(b[c] - a[c]));
+  if (!isfinite(5.7735 * (dq / T) / T)) return "the peak acceleration 5.7735 |dq| / T^2 overflows";
+  return NULL;
 }
 
 int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const double *durations,
@@ -235,10 +266,11 @@ int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const doubl
                      i + 1, durations[i - 1]);
     else if (i > 0) {
       t[i] = t[i - 1] + durations[i - 1];
-      if (!(t[i] > t[i - 1]))
+      const char *why = duration_lost(t[i - 1], t[i], q + 3 * (i - 1), q + 3 * i);
+      if (why)
         st = prru_fail(msg, msglen, PRRU_EINPUT,
-                       "duration %d (%g s) is lost to rounding at t = %g", i, durations[i - 1],
-                       t[i - 1]);
+                       "duration %d (waypoint %d to %d, %g s) is lost to rounding at t = %g s: %s",
+                       i, i, i + 1, durations[i - 1], t[i - 1], why);
     }
   }
   if (st == PRRU_OK) st = prru_quintic_samples(tr, n, t, q, z, z, msg, msglen);
@@ -266,6 +298,13 @@ int prru_quintic_eval(const prru_quintic *tr, double t, double q[3], double qd[3
                       double qdd[3])
 {
   if (!tr || tr->n < 2 || !isfinite(t) || t < tr->t[0] || t > tr->t[tr->n - 1]) return PRRU_EINPUT;
+  if (t == tr->t[tr->n - 1]) {
+    const double *end = tr->coef + 18 * (tr->n - 1);
+    if (q) memcpy(q, end, 3 * sizeof *q);
+    if (qd) memcpy(qd, end + 3, 3 * sizeof *qd);
+    if (qdd) memcpy(qdd, end + 6, 3 * sizeof *qdd);
+    return PRRU_OK;
+  }
   int s = quintic_segment(tr, t);
   double T = tr->t[s + 1] - tr->t[s], u = (t - tr->t[s]) / T;
   for (int c = 0; c < 3; c++) {
