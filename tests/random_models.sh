@@ -11,7 +11,7 @@
 # random-models/) with its build directory build-rand_SEED, and its seed,
 # file and the command that reproduces it are printed. Not repeated per random model (CI
 # runs them on the committed models; the list is printed): those that do
-# not read the model (the generator's unit tests, the package list, the
+# not read the model (the generators' unit tests, the package list, the
 # drop-in build of the committed generated/), and the two that build prru
 # again (the install, the optimised design's regeneration: minutes each).
 # Exit status: 0 all passed, 1 some model failed, 2 usage.
@@ -30,7 +30,7 @@ fi
 keep=${PRRU_RANDOM_KEEP:-random-models}
 mkdir -p "$keep"
 keep=$(cd "$keep" && pwd)
-skipped="gen_unittest test_deps test_dropin test_install test_design_regen"
+skipped="gen_unittest test_deps test_random_model test_dropin test_install test_design_regen"
 skip="^($(echo $skipped | tr ' ' '|'))\$"
 echo "random models: seeds $base..$((base + n - 1)); per model, skipped (run on the committed models): $skipped"
 passed=0
