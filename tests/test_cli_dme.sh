@@ -112,6 +112,8 @@ print('; '.join(errs[:3]) if errs else 'ok' if min(n.values()) > 0 else 'counts 
 PY
 )
   [ "$r" = ok ] && ok || bad "map: other_mode is not the opposite sign of det J_d: $r"
+else
+  echo "note: $nact actuators: J_d is not square (no det J_d sign, no other assembly mode): the other_mode check is skipped"
 fi
 # Progress: a bar only when stderr is a terminal (long grids, or any with
 # --progress); in a log only with --progress, as plain lines (no carriage

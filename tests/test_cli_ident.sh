@@ -4,7 +4,7 @@
 #    given (amplitudes, force limits), byte-identical on a second run, and
 #    its fd columns are what `prru id --traj` computes for its q, qd, qdd;
 #  - identify on excite's own (noise-free) data: every base parameter equals
-#    the model's combination to 1e-9 (relative, or of its resolution), the
+#    the model's combination to 16 eps cond (relative, or of its resolution), the
 #    written model file is accepted by the generator;
 #  - with Gaussian noise (sigma 0.5 N, seeded) on the forces: every base
 #    parameter within 4 of its reported standard errors of the truth, the
@@ -63,12 +63,23 @@ PY
   && ok || bad "identify: $(cat "$tmp/idf.err")"
 [ "$(head -n 1 "$tmp/rep.csv")" = "$csv_comment" ] && ok || bad "identify: report model line"
 # check_report FILE TOL SIGMAS: |estimate - prior| <= TOL max(|prior|,
-# resolution) + SIGMAS se for every base parameter.
+# resolution) + SIGMAS se for every base parameter. TOL "cond" is the
+# rounding of a least-squares fit to exact data: 16 eps cond, cond the
+# report's 2-norm condition number of the column-scaled regressor (a
+# backward-stable solve moves the scaled estimates by ~eps cond times the
+# data's relative rounding, which is a few eps of the forces' terms: 16
+# allows terms 16x the forces they sum to); in units of the resolution
+# (the value giving forces of the data's RMS size) or of the prior.
 check_report() {
   python3 - "$1" "$2" "$3" <<'PY'
-import csv, sys
-rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
-tol, k = float(sys.argv[2]), float(sys.argv[3])
+import csv, re, sys
+text = open(sys.argv[1]).read()
+rows = list(csv.DictReader(l for l in text.splitlines() if not l.startswith('#')))
+k = float(sys.argv[3])
+if sys.argv[2] == 'cond':
+    tol = 16 * sys.float_info.epsilon * float(re.search(r'condition number ([0-9.e+-]+)', text).group(1))
+else:
+    tol = float(sys.argv[2])
 assert len(rows) > 10
 worst = 0
 for r in rows:
@@ -79,7 +90,7 @@ print(worst)
 sys.exit(0 if worst <= 1 else 1)
 PY
 }
-w=$(check_report "$tmp/rep.csv" 1e-9 0) && ok || bad "noise-free identification: worst error / bound $w"
+w=$(check_report "$tmp/rep.csv" cond 0) && ok || bad "noise-free identification: worst error / bound $w"
 python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/id.json" --out "$tmp/gen" --quiet 2>"$tmp/gen.err" \
   && ok || bad "the identified model file is refused by the generator: $(cat "$tmp/gen.err")"
 python3 - "$tmp/id.json" "$PRRU_MODEL" <<'PY' && ok || bad "identified masses differ from the model's"

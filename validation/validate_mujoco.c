@@ -71,7 +71,13 @@
  * (missing at states with velocity) nor exactly aref (the compliance R,
  * which on the ill-conditioned J M^-1 J^T of light platform copies on heavy
  * chains is felt most by the platform's rotation): mj_forward's
- * accelerations differ from the rigid ones by ~1e-4..2e-2. The cost is
+ * accelerations differ from the rigid ones by ~1e-4..2e-2 on the committed
+ * models, and by more on others (a bound measured on some models is no
+ * bound). That difference is the soft welds', whatever it is: so level 2a
+ * checks that mj_forward's qacc is the minimiser of the cost above, built
+ * here from MuJoCo's own M, tau, J, R (efc_R: solimp) and aref (efc_aref:
+ * solref and the state), to the rounding of the solve (soft_model_check),
+ * and reports its distance to the rigid accelerations. The cost is
  * strictly convex for any J (R > 0), so the redundant weld row of four
  * limbs needs nothing special: MuJoCo 2.2.2's Newton solver converges in
  * one iteration as for three limbs, splits the force along e2 evenly
@@ -85,11 +91,13 @@
  * and the extrapolation (4 q(tc/2) - q(tc)) / 3 to rigid welds agrees with
  * ours to ~1e-11 (3 limbs) .. 4e-8 (4 limbs): the remaining difference is
  * MuJoCo's soft welds, not the dynamics. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 #include <mujoco/mujoco.h>
 
@@ -110,15 +118,14 @@ static const double Q_SPREAD[3] = {0.3, 0.4, 0.2};
  * (measured <= 5e-14 on the paper's model, models/prototype_example and the
  * 4-limb models/4prru; the issue asks for ~1e-9, 1e-11 leaves room for
  * other MuJoCo builds and still catches a 1e-7 kg error in one link's mass,
- * which shows as 7e-8). Level 2 bounds are ~2-4x the values measured with
- * MuJoCo 2.2.2: mj_forward on every model; the trajectory as written on
+ * which shows as 7e-8). Level 2b bounds are ~2-4x the values measured with
+ * MuJoCo 2.2.2: the trajectory as written on
  * models/4prru, whose run is the most violent (fd_4 = 0: the platform falls
  * and tilts to q2 = -1.13 rad in 0.48 s; 6.2e-6, the paper's model 1.2e-7,
  * the prototype's damped drives 1.5e-9), and extrapolated to rigid welds
  * on models/4prru (4.3e-8; the 3-limb models ~3e-11). */
 #define TOL_EXACT 1e-11
 #define TOL_STATE 1e-12     /* poses (m, rotation entries), velocities */
-#define TOL_SOFT_ACC 5e-2   /* mj_forward qacc vs rigid, relative */
 /* 1 s run, max |q_mj - q_ours| (rad, m): the 3-limb bound as before; the
  * redundant model's soft welds cost it (see above). */
 #define TOL_TRAJ_Q (PRRU_NACT > 3 ? 2e-5 : 5e-7)
@@ -277,6 +284,110 @@ static int rigid_solve(const mjModel *m, mjData *d, mjData *scratch, double qacc
   return 1;
 }
 
+/* MuJoCo's soft model at the state in d (after mj_forward): the minimiser
+ * of its stated cost (see top),
+ *     qacc = a0 + M^-1 J^T f,  f = -(A + R)^-1 (J a0 - aref),
+ *     a0 = M^-1 tau,  A = J M^-1 J^T,
+ * from MuJoCo's own M, tau, weld rows J and their efc_R and efc_aref (the
+ * solref/solimp of the MJCF and the step). This is the acceleration MuJoCo
+ * must return whatever the softness costs; its distance to the rigid one
+ * is the soft welds' error, and is reported, not bounded. cond receives the
+ * 2-norm condition number of the cost's Hessian M + J^T R^-1 J, which
+ * bounds the rounding of both solvers (MuJoCo's Newton step on it, this
+ * Schur complement). */
+static int soft_solve(const mjModel *m, const mjData *d, double qacc[NV], double *cond)
+{
+  double M[NV * NV], J[NC * NV], R[NC], aref[NC], tau[NV], MJt[NV * NC], A[NC * NC], c[NC];
+  double Hs[NV * NV], ev[NV];
+  if (!weld_jacobian(m, d, J)) return 0;
+  for (int r = 0, row = 0; r < d->nefc; r++)
+    if (d->efc_type[r] == mjCNSTR_EQUALITY && row < NC) {
+      R[row] = d->efc_R[r];
+      aref[row++] = d->efc_aref[r];
+    }
+  mj_fullM(m, M, d->qM);
+  for (int k = 0; k < NV; k++) tau[k] = d->qfrc_applied[k] + d->qfrc_passive[k] - d->qfrc_bias[k];
+  /* the Hessian's spectrum, before M is factorised */
+  for (int i = 0; i < NV; i++)
+    for (int j = 0; j < NV; j++) {
+      double s = M[NV * i + j];
+      for (int r = 0; r < NC; r++) s += J[NV * r + i] * J[NV * r + j] / R[r];
+      Hs[NV * i + j] = s;
+    }
+  gsl_matrix_view Hv = gsl_matrix_view_array(Hs, NV, NV);
+  gsl_vector_view ew = gsl_vector_view_array(ev, NV);
+  gsl_eigen_symm_workspace *ws = gsl_eigen_symm_alloc(NV);
+  int bad = gsl_eigen_symm(&Hv.matrix, &ew.vector, ws);
+  gsl_eigen_symm_free(ws);
+  double lo = INFINITY, hi = 0;
+  for (int i = 0; i < NV; i++) {
+    lo = fmin(lo, ev[i]);
+    hi = fmax(hi, ev[i]);
+  }
+  if (bad || !(lo > 0)) return 0;
+  *cond = hi / lo;
+  /* a0 = M^-1 tau, M^-1 J^T */
+  gsl_matrix_view Mv = gsl_matrix_view_array(M, NV, NV);
+  if (gsl_linalg_cholesky_decomp1(&Mv.matrix) != 0) return 0;
+  gsl_vector_view a0 = gsl_vector_view_array(qacc, NV);
+  memcpy(qacc, tau, sizeof tau);
+  gsl_linalg_cholesky_svx(&Mv.matrix, &a0.vector);
+  for (int r = 0; r < NC; r++) {
+    double col[NV];
+    memcpy(col, J + NV * r, sizeof col);
+    gsl_vector_view cv = gsl_vector_view_array(col, NV);
+    gsl_linalg_cholesky_svx(&Mv.matrix, &cv.vector);
+    for (int k = 0; k < NV; k++) MJt[NC * k + r] = col[k];
+  }
+  /* (A + R) f = -(J a0 - aref) */
+  for (int r = 0; r < NC; r++) {
+    double s = -aref[r];
+    for (int k = 0; k < NV; k++) s += J[NV * r + k] * qacc[k];
+    c[r] = -s;
+    for (int t = 0; t < NC; t++) {
+      double a = 0;
+      for (int k = 0; k < NV; k++) a += J[NV * r + k] * MJt[NC * k + t];
+      A[NC * r + t] = a + (r == t ? R[r] : 0.0);
+    }
+  }
+  gsl_matrix_view Av = gsl_matrix_view_array(A, NC, NC);
+  gsl_vector_view cv = gsl_vector_view_array(c, NC);
+  if (gsl_linalg_cholesky_decomp1(&Av.matrix) != 0 ||
+      gsl_linalg_cholesky_svx(&Av.matrix, &cv.vector) != 0)
+    return 0;
+  for (int k = 0; k < NV; k++)
+    for (int r = 0; r < NC; r++) qacc[k] += MJt[NC * k + r] * c[r];
+  return 1;
+}
+
+typedef struct {
+  double worst;    /* max |qacc_mj - qacc_soft| / max |qacc_soft| */
+  double ratio;    /* max of that over its bound */
+  double cond;     /* largest condition number of the Hessian seen */
+  int failed;      /* states where the soft solve failed */
+} soft_stats;
+
+/* mj_forward's qacc in d against soft_solve's. Both solve the same
+ * quadratic cost from the same terms, so they differ by rounding only:
+ * a backward-stable solve of an NV-dimensional system perturbs its
+ * solution by ~NV eps cond relative (cond: the Hessian's condition
+ * number); the bound is 4x that for the two solvers together. MuJoCo's
+ * Newton solver lands on the minimiser of this quadratic cost in one
+ * step, so its iteration tolerance adds nothing (checked here). */
+static void soft_model_check(const mjModel *m, const mjData *d, soft_stats *st)
+{
+  double qs[NV], cond;
+  if (!soft_solve(m, d, qs, &cond)) {
+    st->failed++;
+    return;
+  }
+  const double bound = 4.0 * NV * DBL_EPSILON * cond;
+  const double e = tu_relerr(d->qacc, qs, NV, 1e-300);
+  st->worst = fmax(st->worst, e);
+  st->ratio = fmax(st->ratio, e / bound);
+  st->cond = fmax(st->cond, cond);
+}
+
 /* d'' (slides) and the angular acceleration of each platform copy for the
  * qacc in d->qacc (MuJoCo's forward recursion, cacc). */
 static void mj_outputs(const mjModel *m, mjData *d, const mjmap *mp, double dd[NLIMB],
@@ -384,6 +495,7 @@ int main(int argc, char **argv)
   double worst_incons = 0, min_kept = 1, max_dropped = 0;
   int rank = -1, rank_varies = 0;
   double worst_dd = 0, worst_w = 0, soft_dd = 0, soft_w = 0, rest_dd = 0, rest_w = 0;
+  soft_stats soft = {0, 0, 0, 0};
   int n = 0, tries = 0;
   while (n < NSTATES && tries++ < 100 * NSTATES) {
     double q[3], rc;
@@ -412,9 +524,11 @@ int main(int argc, char **argv)
     mj_load_forces(m, d, &mp, &l, d->qfrc_applied);
     mj_forward(m, d);
 
-    /* level 2a: MuJoCo's own (soft) accelerations at this state */
+    /* level 2a: MuJoCo's own (soft) accelerations at this state, and the
+     * soft model's minimiser from MuJoCo's terms */
     double dd_soft[NLIMB], w_soft[NLIMB][3];
     mj_outputs(m, d, &mp, dd_soft, w_soft);
+    soft_model_check(m, d, &soft);
 
     /* level 1 */
     double qacc[NV], dd_mj[NLIMB], w_mj[NLIMB][3], dd_ours[PRRU_NACT], w_ours[3];
@@ -455,6 +569,7 @@ int main(int argc, char **argv)
       mj_load_forces(m, d, &mp, &l, d->qfrc_applied);
       mj_forward(m, d);
       mj_outputs(m, d, &mp, dd_soft, w_soft);
+      soft_model_check(m, d, &soft);
       rest_dd = fmax(rest_dd, tu_relerr(dd_soft, dd_ours, NLIMB, 1e-300));
       rest_w = fmax(rest_w, tu_relerr(w_soft[0], w_ours, 3, 1e-300));
     }
@@ -464,12 +579,9 @@ int main(int argc, char **argv)
   tu_check(worst_copy <= TOL_EXACT, "rigid qacc: the platform copies agree", worst_copy,
            TOL_EXACT);
   TU_TRUE(!rank_varies, "the weld rows have the same rank at every state");
-  tu_check(soft_dd <= TOL_SOFT_ACC, "level 2: mj_forward d'' vs rigid", soft_dd, TOL_SOFT_ACC);
-  tu_check(soft_w <= TOL_SOFT_ACC, "level 2: mj_forward angular acc. vs rigid", soft_w,
-           TOL_SOFT_ACC);
-  tu_check(rest_dd <= TOL_SOFT_ACC, "level 2: mj_forward d'' at rest", rest_dd, TOL_SOFT_ACC);
-  tu_check(rest_w <= TOL_SOFT_ACC, "level 2: mj_forward angular acc. at rest", rest_w,
-           TOL_SOFT_ACC);
+  tu_check(soft.failed == 0, "level 2: the soft model's minimiser (regular Hessian)", soft.failed, 0);
+  tu_check(soft.ratio <= 1, "level 2: mj_forward qacc = the soft model's minimiser (error / bound)",
+           soft.ratio, 1);
   printf("state transfer (%d states): poses/velocities %.1e, weld efc_pos %.1e, J qvel %.1e\n",
          n, worst_state, worst_weld, worst_wvel);
   char dropped[64] = "none dropped";
@@ -482,9 +594,11 @@ int main(int argc, char **argv)
          " (bound %.0e); copies agree to %.1e\n",
          NC, rank, NV, NV - rank, NC - rank, min_kept, dropped, worst_kkt, worst_incons,
          worst_dd, worst_w, TOL_EXACT, worst_copy);
-  printf("level 2, mj_forward (soft welds) vs rigid: d'' %.2e, platform alpha %.2e (bound %.0e);\n"
+  printf("level 2, mj_forward = the soft model's minimiser from MuJoCo's M, tau, J, efc_R, efc_aref:\n"
+         "  %.1e relative (%.2g of its bound 4 NV eps cond, Hessian cond <= %.1e);\n"
+         "  the soft welds' error, mj_forward vs rigid: d'' %.2e, platform alpha %.2e;\n"
          "  same states at rest (no J'v, impedance only): d'' %.2e, platform alpha %.2e\n",
-         soft_dd, soft_w, TOL_SOFT_ACC, rest_dd, rest_w);
+         soft.worst, soft.ratio, soft.cond, soft_dd, soft_w, rest_dd, rest_w);
 
   /* ---- level 2b: the paper's 1 s run, mj_step RK4 dt = 1e-4 vs prru_simulate ----
    * The paper's scenario (initial state, loads, 1 s) on this model. A model
