@@ -2,11 +2,19 @@
  * prru_reactions) against the dense reference, eq. 31 with GSL
  * (reference/ref_reactions.c: Q and Phi formed, Cholesky for three limbs,
  * the SVD's least-norm solution for four), at 2000 regular states with
- * velocities and loads: 1e-12 relative to the largest coordinate. For the
+ * velocities and loads, relative to the largest coordinate (at least 1):
+ * within K u kappa_1(M_s) (u = DBL_EPSILON, M_s the scaled mass matrix of
+ * prru_mass_rcond): both sides stand on their own solve of the forward
+ * dynamics, whose qdd carries u kappa(M) of rounding into every inertial
+ * force, and K = 1024 covers the few hundred roundings of each side's
+ * chain of joint equations (measured on the paper model: 157 u kappa at
+ * random states, 236 on the grid; a random valid model's 1.9e-12 broke the
+ * old fixed 1e-12, a bound measured on the committed models). For the
  * redundant 4-PRRU also the null direction against the reference's SVD
  * (same sign convention up to the reference's, which signs the largest
  * component) and lambda . z = 0. Then the statuses: unreachable, NaN,
  * overflow, and lambda untouched on failure. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -57,7 +65,8 @@ static void test_against_reference(void)
       continue;
     }
     n++;
-    e_lam = fmax(e_lam, tu_relerr(lam, ref, NL, 1.0));
+    const double kappa = 1.0 / prru_mass_rcond(&model, data.M);
+    e_lam = fmax(e_lam, tu_relerr(lam, ref, NL, 1.0) / (DBL_EPSILON * kappa));
     /* The kernel itself at the forward dynamics' qdd is what the runtime
      * returns, bit for bit. */
     memcpy(qdd, data.qdd, sizeof qdd);
@@ -83,11 +92,11 @@ static void test_against_reference(void)
 #endif
   }
   prru_ref_free(w);
-  printf("closed form vs dense reference at %d states: lambda %.1e", n, e_lam);
+  printf("closed form vs dense reference at %d states: lambda %.1f u kappa(M_s)", n, e_lam);
   if (PRRU_NREACTION_NULL) printf(", z %.1e, lambda . z / |lambda| %.1e", e_z, e_lz);
   printf("; kernel vs prru_reactions %.1e\n", e_kernel);
   TU_TRUE(ok && n == 2000, "every state solved by both");
-  tu_check(e_lam <= 1e-12, "closed-form lambda = dense eq. 31", e_lam, 1e-12);
+  tu_check(e_lam <= 1024, "closed-form lambda = dense eq. 31 (in u kappa(M_s))", e_lam, 1024);
   tu_check(e_kernel == 0, "prru_reactions = prru_joint_reactions at its qdd", e_kernel, 0);
   if (PRRU_NREACTION_NULL) {
     tu_check(e_z <= 1e-12, "closed-form z = the reference's SVD null vector", e_z, 1e-12);
@@ -111,18 +120,23 @@ static void test_grid(void)
         double q[3] = {-0.8 + 1.6 * i / 24, -1.0 + 1.7 * j / 24, h ? -0.6 : -0.85};
         double qd[3] = {0.4, -0.3, 0.2}, lam[NL], ref[NL];
         if (prru_check_regular(&model, &data, q, NULL) != PRRU_OK) continue;
-        regular++;
         prru_loads l;
         ts_random_loads(&l);
+        /* Poses the trust criterion refuses (too near the edge of reach:
+         * prru_model.mass_rcond_min) do not count as regular. */
+        double qdd[3];
+        if (prru_forward_dynamics(&model, &data, q, qd, &l, qdd) == PRRU_ESINGULAR) continue;
+        regular++;
         if (prru_reactions(&model, &data, q, qd, &l, lam) != PRRU_OK) continue;
         if (prru_ref_reactions(&rp, w, q, qd, l.fd, l.fp, l.mp, ref) != 0) continue;
         solved++;
-        e = fmax(e, tu_relerr(lam, ref, NL, 1.0));
+        const double kappa = 1.0 / prru_mass_rcond(&model, data.M);
+        e = fmax(e, tu_relerr(lam, ref, NL, 1.0) / (DBL_EPSILON * kappa));
       }
   prru_ref_free(w);
-  printf("grid: %d regular poses, %d solved by both, worst %.1e\n", regular, solved, e);
+  printf("grid: %d regular poses, %d solved by both, worst %.1f u kappa(M_s)\n", regular, solved, e);
   TU_TRUE(regular > 400 && solved == regular, "every regular grid pose solved");
-  tu_check(e <= 1e-12, "closed form = dense reference over the grid", e, 1e-12);
+  tu_check(e <= 1024, "closed form = dense reference over the grid (in u kappa(M_s))", e, 1024);
 }
 
 static void test_statuses(void)
