@@ -25,7 +25,8 @@ their (q1, q2) w_min_q, w_max_q."""
 
 
 def _axis(name, value):
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+    value = _convert.ordered(name, value, "(start, stop, count)")
+    if len(value) != 3:
         raise ValueError("%s must be (start, stop, count), got %r" % (name, value))
     lo = _convert.scalar(name + " start", value[0])
     hi = _convert.scalar(name + " stop", value[1])

@@ -132,17 +132,18 @@ def read_scenario(self, path):
 def _table_rows(rows, nact):
     """Table rows as one flat ctypes array of nrows * (nact + 7) doubles."""
     w = nact + 7
-    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__len__") or len(rows) == 0:
-        raise ValueError("table must be a non-empty sequence of rows (t, fd1..fd%d[, fp1..3"
-                         "[, mp1..3]])" % nact)
+    layout = "(t, fd1..fd%d[, fp1..3[, mp1..3]])" % nact
+    rows = _convert.ordered("table", rows, "a sequence of rows " + layout, ndim=2)
+    if len(rows) == 0:
+        raise ValueError("table must be a non-empty sequence of rows " + layout)
     flat = (ctypes.c_double * (w * len(rows)))()
     prev = -math.inf
     for r, row in enumerate(rows):
-        n = len(row) if hasattr(row, "__len__") and not isinstance(row, (str, bytes)) else -1
+        row = _convert.ordered("table[%d]" % r, row, "a sequence of numbers " + layout)
+        n = len(row)
         if n not in (1 + nact, 4 + nact, w):
-            raise ValueError("table[%d] must have %d, %d or %d numbers (t, fd1..fd%d[, fp1..3"
-                             "[, mp1..3]]), got %s" % (r, 1 + nact, 4 + nact, w, nact,
-                                                       n if n >= 0 else type(row).__name__))
+            raise ValueError("table[%d] must have %d, %d or %d numbers %s, got %d"
+                             % (r, 1 + nact, 4 + nact, w, layout, n))
         v = vector("table[%d]" % r, row, n)
         if not v[0] > prev:
             raise ValueError("table[%d]: times must increase strictly (t = %r after %r)"

@@ -616,6 +616,76 @@ class TestErrors(unittest.TestCase):
         with self.assertRaisesRegex(TypeError, "^q must be a sequence of 3 numbers, got generator"):
             MODEL.dynamics(x for x in q)
 
+    def test_unordered_and_non_numeric_containers(self):
+        """A dict gives its keys when read as a sequence and a set has no
+        order: every vector argument of every method refuses them (and
+        strings, bytes, dict views, iterators) with TypeError naming it."""
+        n = MODEL.nact
+        q, z3, zn = [0.0, 0.0, -0.8], [0.0] * 3, [0.0] * n
+        d = MODEL.ik(q)[0]
+        row = [0.0] + [1.0] * n
+        calls = {  # name -> (good value, call with that argument replaced)
+            "check q": (q, lambda v: MODEL.check(v)),
+            "ik q": (q, lambda v: MODEL.ik(v)),
+            "fk d": (d, lambda v: MODEL.fk(v)),
+            "fk seed": (q, lambda v: MODEL.fk(d, seed=v)),
+            "fk_lsq d": (d, lambda v: MODEL.fk_lsq(v)),
+            "fk_lsq seed": (q, lambda v: MODEL.fk_lsq(d, v)),
+            "platform_jacobian q": (q, lambda v: MODEL.platform_jacobian(v)),
+            "poses q": (q, lambda v: MODEL.poses(v)),
+            "dynamics q": (q, lambda v: MODEL.dynamics(v)),
+            "dynamics qd": (z3, lambda v: MODEL.dynamics(q, v)),
+            "passive q": (q, lambda v: MODEL.passive(v, z3)),
+            "passive qd": (z3, lambda v: MODEL.passive(q, v)),
+            "forward_dynamics q": (q, lambda v: MODEL.forward_dynamics(v)),
+            "forward_dynamics qd": (z3, lambda v: MODEL.forward_dynamics(q, v)),
+            "forward_dynamics fd": (zn, lambda v: MODEL.forward_dynamics(q, fd=v)),
+            "forward_dynamics fp": (z3, lambda v: MODEL.forward_dynamics(q, fp=v)),
+            "forward_dynamics mp": (z3, lambda v: MODEL.forward_dynamics(q, mp=v)),
+            "inverse_dynamics q": (q, lambda v: MODEL.inverse_dynamics(v, z3, z3)),
+            "inverse_dynamics qd": (z3, lambda v: MODEL.inverse_dynamics(q, v, z3)),
+            "inverse_dynamics qdd": (z3, lambda v: MODEL.inverse_dynamics(q, z3, v)),
+            "inverse_dynamics fp": (z3, lambda v: MODEL.inverse_dynamics(q, z3, z3, fp=v)),
+            "inverse_dynamics mp": (z3, lambda v: MODEL.inverse_dynamics(q, z3, z3, mp=v)),
+            "actuator_null q": (q, lambda v: MODEL.actuator_null(v)),
+            "reactions q": (q, lambda v: MODEL.reactions(v)),
+            "reactions qd": (z3, lambda v: MODEL.reactions(q, v)),
+            "reactions fd": (zn, lambda v: MODEL.reactions(q, fd=v)),
+            "reactions fp": (z3, lambda v: MODEL.reactions(q, fp=v)),
+            "reactions mp": (z3, lambda v: MODEL.reactions(q, mp=v)),
+            "reaction_null q": (q, lambda v: MODEL.reaction_null(v)),
+            "energy q": (q, lambda v: MODEL.energy(v)),
+            "energy qd": (z3, lambda v: MODEL.energy(q, v)),
+            "dme q": (q, lambda v: MODEL.dme(v)),
+            "w_R q": (q, lambda v: MODEL.w_R(v)),
+            "simulate q0": (q, lambda v: MODEL.simulate(v, t_end=0.01)),
+            "simulate qd0": (z3, lambda v: MODEL.simulate(q, v, t_end=0.01)),
+            "simulate fd": (zn, lambda v: MODEL.simulate(q, fd=v, t_end=0.01)),
+            "simulate fp": (z3, lambda v: MODEL.simulate(q, fp=v, t_end=0.01)),
+            "simulate mp": (z3, lambda v: MODEL.simulate(q, mp=v, t_end=0.01)),
+            "simulate harmonic": ([1.0, 2.0], lambda v: MODEL.simulate(q, harmonic=v,
+                                                                        t_end=0.01)),
+            "simulate table": ([tuple(row), tuple([1.0] + row[1:])],
+                               lambda v: MODEL.simulate(q, table=v, t_end=0.01)),
+            "simulate table[1]": ([1.0] + row[1:],
+                                  lambda v: MODEL.simulate(q, table=[row, v], t_end=0.01)),
+            "map q1": ([-0.1, 0.1, 2], lambda v: MODEL.map(v, (-0.1, 0.1, 2), -0.8)),
+            "map q2": ([-0.1, 0.1, 2], lambda v: MODEL.map((-0.1, 0.1, 2), v, -0.8)),
+        }
+        for key, (good, call) in calls.items():
+            name = key.split(" ", 1)[1]
+            bad = {"dict": dict(enumerate(good)), "set": set(good),
+                   "frozenset": frozenset(good), "dict_values": dict(enumerate(good)).values(),
+                   "str": ",".join(map(str, good)), "bytes": b"\0" * len(good),
+                   "list_iterator": iter(good)}
+            for kind, value in bad.items():
+                with self.subTest(call=key, given=kind):
+                    with self.assertRaisesRegex(TypeError, r"^%s must be .*, got %s$"
+                                                % (re.escape(name), kind)):
+                        call(value)
+        with self.assertRaisesRegex(TypeError, r"^q\[1\] must be a real number, got str$"):
+            MODEL.ik([0.0, "0.1", -0.8])
+
 
 class TestLibrarySearch(unittest.TestCase):
     def test_explicit_file_directory_and_env(self):
@@ -771,6 +841,12 @@ class TestNumpy(unittest.TestCase):
             MODEL.ik(numpy.zeros((3, 1)))
         r = mn.map((-0.2, 0.2, 3), (-0.2, 0.2, 4))
         self.assertEqual(r.w_R.shape, (3, 4))
+        # A load table as a 2-D array (its rows in order), like a list of rows.
+        fd = MODEL.inverse_dynamics([0, 0, -0.8], [0] * 3, [0] * 3)
+        rows = [[0.0] + list(fd), [0.01] + list(fd)]
+        self.assertEqual(bits(mn.simulate([0, 0, -0.8], table=numpy.array(rows),
+                                          t_end=0.01).q.tolist()),
+                         bits(MODEL.simulate([0, 0, -0.8], table=rows, t_end=0.01).q))
 
 
 class TestWithoutNumpy(unittest.TestCase):
