@@ -575,6 +575,71 @@ class TestErrors(unittest.TestCase):
         with self.assertRaisesRegex(prru.InputError, "invalid input"):
             MODEL.energy(q, [1e200, 0, 0])
 
+    def assert_finite_or_raises(self, what, call):
+        """call() raises a PrruError or returns only finite numbers."""
+        try:
+            out = call()
+        except prru.PrruError:
+            return
+        numbers = flat([out] if isinstance(out, float) else out)
+        self.assertTrue(all(map(math.isfinite, numbers)), "%s returned %r" % (what, out))
+
+    def test_no_result_is_silently_non_finite(self):
+        """A result that is not finite cannot be used: it is an error, never
+        returned. dynamics with a huge qd (h overflows) raises InputError
+        naming qd, as forward_dynamics does; and at the edge of the
+        workspace, where check_reachable accepts q but J_d is not finite
+        (a sqrt of the inverse kinematics at 0), the q-only calls raise
+        Singular, as the library's forward dynamics does there."""
+        q = [0.0, 0.2, -0.8]
+        huge = [1e200, 0.0, 0.0]
+        with self.assertRaisesRegex(prru.InputError, r"^dynamics: q = \(.*\), "
+                                    r"qd = \(9.9999999999999997e\+199, 0, 0\): invalid input "
+                                    r".*\(qd too large\)$"):
+            MODEL.dynamics(q, huge)
+        with self.assertRaisesRegex(prru.InputError, r"^forward_dynamics: q = \(.*\), "
+                                    r"qd = \(9.9999999999999997e\+199, 0, 0\), .*invalid input"):
+            MODEL.forward_dynamics(q, huge)
+        # The last reachable q1 (bisection, q2 = 0, q3 = -0.8): the edge.
+        lo, hi = 0.0, 1.55
+        self.assertRaises(prru.Unreachable, MODEL.ik, [hi, 0.0, -0.8])
+        while (lo + hi) / 2 not in (lo, hi):
+            mid = (lo + hi) / 2
+            try:
+                MODEL.ik([mid, 0.0, -0.8])
+                lo = mid
+            except prru.Unreachable:
+                hi = mid
+            except prru.Singular:  # J_d not finite there
+                lo = mid
+        edge = [lo, 0.0, -0.8]
+        z3, zn = [0.0] * 3, [0.0] * MODEL.nact
+        states = [(q, huge, zn), (q, [0.0, 1e160, 0.0], zn), (edge, z3, zn),
+                  (edge, [1.0, 1.0, 1.0], [1.0] * MODEL.nact), (q, z3, [1e307] * MODEL.nact)]
+        for x, xd, fd in states:
+            for what, call in (
+                    ("check", lambda: MODEL.check(x)), ("ik", lambda: MODEL.ik(x)),
+                    ("fk", lambda: MODEL.fk(MODEL.ik(x)[0])),
+                    ("fk_lsq", lambda: MODEL.fk_lsq(MODEL.ik(x)[0])),
+                    ("platform_jacobian", lambda: MODEL.platform_jacobian(x)),
+                    ("poses", lambda: MODEL.poses(x)),
+                    ("dynamics", lambda: MODEL.dynamics(x, xd)),
+                    ("passive", lambda: MODEL.passive(x, xd)),
+                    ("forward_dynamics", lambda: MODEL.forward_dynamics(x, xd, fd)),
+                    ("inverse_dynamics", lambda: MODEL.inverse_dynamics(x, xd, xd)),
+                    ("actuator_null", lambda: MODEL.actuator_null(x)),
+                    ("reactions", lambda: MODEL.reactions(x, xd, fd)),
+                    ("reaction_null", lambda: MODEL.reaction_null(x)),
+                    ("energy", lambda: MODEL.energy(x, xd)),
+                    ("dme", lambda: MODEL.dme(x)), ("w_R", lambda: MODEL.w_R(x))):
+                with self.subTest(call=what, q=x, qd=xd):
+                    self.assert_finite_or_raises(what, call)
+        # A map's summary over no ok point: no number (None), not NaN.
+        r = MODEL.map((1.55, 1.56, 2), (0.0, 0.01, 2), 0.0)
+        self.assertEqual(r.summary["n_ok"], 0)
+        for k in ("index", "index_log", "w_min", "w_max", "w_min_q", "w_max_q"):
+            self.assertIsNone(r.summary[k], k)
+
     def test_argument_checks(self):
         with self.assertRaisesRegex(ValueError, "^q must have 3 elements, got 2$"):
             MODEL.ik([0, 0])
