@@ -45,8 +45,9 @@ class Model:
     load_library(); None searches $PRRU_LIB, beside the package, the source
     tree's build/runtime/ and the system's library path (load_library).
     numpy: return NumPy arrays (matrices 2-D) instead of lists (matrices as
-    lists of rows). Inputs are any sequences of numbers, NumPy arrays
-    included, either way.
+    lists of rows). Inputs are ordered sequences of numbers (list, tuple,
+    array.array, 1-D NumPy arrays, ...) either way; dicts, sets, strings
+    and iterators are refused (TypeError naming the argument).
     jd_rcond_min: the reciprocal condition number of the scaled J_d below
     which a pose counts as singular (library default 1e-8).
 
@@ -59,6 +60,10 @@ class Model:
 
     Failures raise PrruError subclasses carrying the library's message:
     Unreachable, Singular, NoConvergence, InputError (also a ValueError).
+    No method returns a non-finite number: such a result raises InputError
+    naming the rate or load arguments that make it overflow (dynamics with
+    a huge qd), or Singular where J_d itself is not finite (the edge of the
+    workspace, accepted by the reachability check).
     """
 
     def __init__(self, lib=None, *, numpy=False, jd_rcond_min=None):

@@ -242,8 +242,13 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     on_sample(sample): called with every Sample as it is computed; a true
     return value stops the run (the Trajectory then has stopped = True);
     an exception it raises stops the run and is re-raised. Ctrl-C stops
-    the run at the next sample with KeyboardInterrupt. Either exception
-    carries .trajectory, the samples computed until then.
+    the run at once, also in the middle of a long sample interval (the
+    library polls a flag inside every right-hand-side evaluation), with
+    KeyboardInterrupt (or whatever a program's own SIGINT handler raises).
+    Either exception carries .trajectory, the samples delivered until then,
+    and .t_stop, the time of the last one. Called from the main thread,
+    the integration and on_sample run in a worker thread while the main
+    thread waits, where Python can run its SIGINT handler.
 
     When the state leaves the workspace or the integrator fails, raises
     Unreachable, Singular or NoConvergence with the library's message;
@@ -274,17 +279,21 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     col = _Collector(self, q0, qd0, on_sample, reactions)
     opts.on_sample = col.fn
     t_stop, msg = ctypes.c_double(math.nan), ctypes.create_string_buffer(512)
-    with _interrupt.SigintFlag() as sigint:
-        opts.interrupt = sigint.pointer
-        st = self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
-                               ctypes.byref(t_stop), msg, len(msg))
+    # Polled by the library inside every right-hand-side evaluation: set
+    # on Ctrl-C, it stops the run in the middle of a long sample interval.
+    stop = ctypes.c_int(0)
+    opts.interrupt = ctypes.pointer(stop)
+    st, interrupt = _interrupt.call_in_worker(
+        lambda: self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
+                                  ctypes.byref(t_stop), msg, len(msg)),
+        stop, "prru simulate")
     del keep  # the table rows stayed alive for the call
     traj = Trajectory(self, b"".join(col.chunks), len(col.chunks), reactions, col.stopped)
-    if sigint.raised and col.error is None:
-        col.error = KeyboardInterrupt()
+    if interrupt is not None and col.error is None:
+        col.error = interrupt
     if col.error is not None:
         try:
-            col.error.trajectory = traj
+            col.error.trajectory, col.error.t_stop = traj, traj.t_stop
         except AttributeError:
             pass
         raise col.error

@@ -478,7 +478,7 @@ class TestSimulation(unittest.TestCase):
             MODEL.simulate(scenario="paper", t_end=0.1, dt=0.01, on_sample=cb)
         self.assertEqual(e.exception.trajectory.t, [0.0, 0.01, 0.02])
 
-    def test_ctrl_c_stops_at_the_next_sample(self):
+    def test_ctrl_c_stops_a_long_run(self):
         """SIGINT during a long run (sent once the first sample is out):
         KeyboardInterrupt carrying the samples computed so far, long
         before the end of the run."""
@@ -506,6 +506,47 @@ class TestSimulation(unittest.TestCase):
         n, t = out.split()
         self.assertGreater(int(n), 0)
         self.assertLess(float(t), 300)
+
+    def test_ctrl_c_inside_a_long_sample_interval(self):
+        """SIGINT 0.3 s into a run whose first sample interval takes about
+        100 s of integration (50000 s of a swaying robot, rkf45 at the
+        tightest tolerance: ~2 ms per simulated second, unloaded) stops
+        it at once: the library polls the flag inside every right-hand-side
+        evaluation, and the waiting main thread sets it. KeyboardInterrupt
+        carries the one sample delivered (t = 0). The 1 s bound leaves
+        room for a loaded machine: the flag is seen within one evaluation
+        (microseconds) of the main thread's handler, which runs within
+        _interrupt.POLL_SECONDS (0.05 s) of the signal. Before the fix the
+        run stopped only at the next sample, 50000 s of simulated time on."""
+        code = ("import json, os, signal, sys, threading, time, prru\n"
+                "m = prru.Model()\n"
+                "q = [0.0, 0.0, -0.8]\n"
+                "fd = m.inverse_dynamics(q, [0.0] * 3, [0.0] * 3)\n"
+                "sent = []\n"
+                "def send():\n"
+                "    sent.append(time.monotonic())\n"
+                "    os.kill(os.getpid(), signal.SIGINT)\n"
+                "threading.Timer(0.3, send).start()\n"
+                "try:\n"
+                "    m.simulate(q, [1.0, 1.0, 0.0], fd=fd, t_end=1e5, dt=5e4,\n"
+                "               stepper='rkf45', atol=3e-14, rtol=3e-14, max_steps=10**9)\n"
+                "except KeyboardInterrupt as e:\n"
+                "    print(json.dumps([time.monotonic() - sent[0], e.trajectory.t, e.t_stop]))\n"
+                "    sys.exit(3)\n")
+        env = dict(os.environ, PRRU_LIB=LIB, PYTHONPATH=os.path.dirname(HERE))
+        p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                             env=env)
+        try:
+            out, _ = p.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            out = "still running 20 s after it started"
+        finally:
+            p.kill()
+            p.wait()
+        self.assertEqual(p.returncode, 3, out)
+        waited, t, t_stop = json.loads(out)
+        self.assertLess(waited, 1.0, out)
+        self.assertEqual((t, t_stop), ([0.0], 0.0))
 
     def test_leaving_the_workspace_keeps_the_samples(self):
         f = [5000.0, -5000.0] + [0.0] * (MODEL.nact - 2)
