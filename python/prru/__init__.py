@@ -21,7 +21,12 @@ one the library was built from: Model.name, .nact, .body_names,
 Failures raise PrruError subclasses with the library's message:
 InputError (also ValueError), Unreachable, Singular, NoConvergence,
 Interrupted, PrruIOError, ParseError; wrong argument lengths and NaN raise
-ValueError naming the argument.
+ValueError naming the argument, and a vector given as anything but an
+ordered sequence of numbers (a dict, set, string, iterator, ...) TypeError
+naming it. No call returns NaN or an infinity: a result that is not finite
+raises (InputError naming the arguments too large for it, or Singular at
+the edge of the workspace, where J_d is not finite). Ctrl-C stops
+simulate at once, also inside a long sample interval (KeyboardInterrupt).
 """
 
 from .errors import (InputError, Interrupted, LayoutError, LibraryNotFound, NoConvergence,

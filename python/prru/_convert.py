@@ -1,15 +1,20 @@
 """Arguments in, results out.
 
-Inputs are any sequence of real numbers (list, tuple, array.array, a 1-D
-NumPy array, ...); strings and wrong lengths are refused, and so are NaN
-and infinities, with the argument's name in the message. NumPy is never
-imported here for inputs: a NumPy array is read through its tolist().
+Inputs are ordered sequences of real numbers: a list, a tuple, any other
+collections.abc.Sequence (array.array, range, memoryview, ...) or a 1-D
+array read through its tolist() (NumPy; NumPy is never imported here for
+inputs). Everything else is refused with TypeError naming the argument:
+strings and bytes, mappings (a dict's iteration gives its keys, not values
+in coordinate order), sets (no order at all), iterators and generators;
+so are non-numeric elements. Wrong lengths, NaN and infinities raise
+ValueError naming the argument.
 
 Outputs are plain Python lists (matrices as lists of rows) unless the model
 was made with numpy=True, in which case they are NumPy arrays (matrices
 2-D); NumPy is imported only then.
 """
 
+import collections.abc
 import ctypes
 import numbers
 from math import isfinite
@@ -20,20 +25,27 @@ def _check_item(name, i, v):
         raise TypeError("%s[%d] must be a real number, got %s" % (name, i, type(v).__name__))
 
 
-def vector(name, value, n):
-    """value as a ctypes array of n finite doubles; ValueError/TypeError naming name."""
+def ordered(name, value, what, ndim=1):
+    """The elements of value, an ordered sequence (see the module's
+    docstring; an array must have ndim dimensions), as a list or tuple;
+    TypeError naming name, saying that it must be what, for anything else."""
     kind = type(value)
     if kind is list or kind is tuple:  # the common case, checked without ABCs
-        items = value
-    else:
-        if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__len__"):
-            raise TypeError("%s must be a sequence of %d numbers, got %s"
-                            % (name, n, kind.__name__))
-        ndim = getattr(value, "ndim", 1)
-        if ndim != 1:
-            raise ValueError("%s must be a sequence of %d numbers (1-D), got an array of "
-                             "shape %s" % (name, n, tuple(getattr(value, "shape", ()))))
-        items = value.tolist() if hasattr(value, "tolist") else list(value)
+        return value
+    if (isinstance(value, (str, bytes, bytearray, collections.abc.Mapping,
+                           collections.abc.Set, collections.abc.Iterator))
+            or not (isinstance(value, collections.abc.Sequence)
+                    or (hasattr(value, "tolist") and hasattr(value, "ndim")))):
+        raise TypeError("%s must be %s, got %s" % (name, what, kind.__name__))
+    if getattr(value, "ndim", ndim) != ndim:
+        raise ValueError("%s must be %s (%d-D), got an array of shape %s"
+                         % (name, what, ndim, tuple(getattr(value, "shape", ()))))
+    return value.tolist() if hasattr(value, "tolist") else list(value)
+
+
+def vector(name, value, n):
+    """value as a ctypes array of n finite doubles; ValueError/TypeError naming name."""
+    items = ordered(name, value, "a sequence of %d numbers" % n)
     if len(items) != n:
         raise ValueError("%s must have %d elements, got %d" % (name, n, len(items)))
     for i, v in enumerate(items):

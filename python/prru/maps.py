@@ -21,11 +21,13 @@ at home; three actuators only); summary: a dict with n_points, n_ok,
 n_singular (counting the other_mode points too), n_unreachable,
 n_other_mode, index (mean of w_R - 1 over the ok points, the paper's global
 index), index_log (mean of ln w_R), singular_fraction, w_min, w_max and
-their (q1, q2) w_min_q, w_max_q."""
+their (q1, q2) w_min_q, w_max_q. Without an ok point these six are None
+(no number: a mean or extreme of nothing is not defined), not NaN."""
 
 
 def _axis(name, value):
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+    value = _convert.ordered(name, value, "(start, stop, count)")
+    if len(value) != 3:
         raise ValueError("%s must be (start, stop, count), got %r" % (name, value))
     lo = _convert.scalar(name + " start", value[0])
     hi = _convert.scalar(name + " stop", value[1])
@@ -74,6 +76,9 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
                                           "n_other_mode", "index", "index_log",
                                           "singular_fraction", "w_min", "w_max")}
     summary["w_min_q"], summary["w_max_q"] = tuple(s.w_min_q), tuple(s.w_max_q)
+    if s.n_ok == 0:  # the library's NaN: over the ok points, of which there are none
+        for k in ("index", "index_log", "w_min", "w_max", "w_min_q", "w_max_q"):
+            summary[k] = None
     out = self._out
     return MapResult(out.vec(axis1), out.vec(axis2), g.q3, out.mat(w, n1, n2),
                      [names[i * n2:(i + 1) * n2] for i in range(n1)], summary)

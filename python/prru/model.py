@@ -3,6 +3,7 @@
 import collections
 import ctypes
 import threading
+from math import isfinite
 
 from . import _convert, _lib, errors
 from ._convert import optional_vector, vector
@@ -26,6 +27,15 @@ def _fmt(v):
     return "(" + ", ".join("%.17g" % x for x in v) + ")"
 
 
+def _finite(*outputs):
+    """Every number of outputs (ctypes arrays, or floats) finite. (A slice
+    of a ctypes array is a list, read much faster than the array itself.)"""
+    for o in outputs:
+        if not (isfinite(o) if isinstance(o, float) else all(map(isfinite, o[:]))):
+            return False
+    return True
+
+
 class Model:
     """The robot model compiled into one libprru.so.
 
@@ -35,8 +45,9 @@ class Model:
     load_library(); None searches $PRRU_LIB, beside the package, the source
     tree's build/runtime/ and the system's library path (load_library).
     numpy: return NumPy arrays (matrices 2-D) instead of lists (matrices as
-    lists of rows). Inputs are any sequences of numbers, NumPy arrays
-    included, either way.
+    lists of rows). Inputs are ordered sequences of numbers (list, tuple,
+    array.array, 1-D NumPy arrays, ...) either way; dicts, sets, strings
+    and iterators are refused (TypeError naming the argument).
     jd_rcond_min: the reciprocal condition number of the scaled J_d below
     which a pose counts as singular (library default 1e-8).
 
@@ -49,6 +60,10 @@ class Model:
 
     Failures raise PrruError subclasses carrying the library's message:
     Unreachable, Singular, NoConvergence, InputError (also a ValueError).
+    No method returns a non-finite number: such a result raises InputError
+    naming the rate or load arguments that make it overflow (dynamics with
+    a huge qd), or Singular where J_d itself is not finite (the edge of the
+    workspace, accepted by the reachability check).
     """
 
     def __init__(self, lib=None, *, numpy=False, jd_rcond_min=None):
@@ -100,17 +115,23 @@ class Model:
             self.name, self.model_file, self.sha256[:12], self.nact, self.lib.path)
 
     # ---- helpers ----
-    def _fail(self, status, what):
+    def _fail(self, status, what, rates=None):
         """what: the call's description, or a function making it (built
-        only on failure: formatting costs more than the call)."""
+        only on failure: formatting costs more than the call). rates: a
+        function giving the (name, values) of the arguments besides q,
+        named for PRRU_EINPUT (NaN, infinite or out of range: the library
+        does not say which; q is checked finite before the call, so it is
+        one of them, or a result they make overflow)."""
         what = what() if callable(what) else what
+        if status == errors.EINPUT and rates is not None:
+            what += "".join(", %s = %s" % (name, _fmt(v)) for name, v in rates())
         raise errors.make_error(status, "%s: %s" % (what, self.lib.status_text(status)))
 
-    def _call(self, what, fn, *args):
+    def _call(self, what, fn, *args, rates=None):
         with self._lock:
             st = fn(ctypes.byref(self._m), ctypes.byref(self._g.s), *args)
         if st != errors.OK:
-            self._fail(st, what)
+            self._fail(st, what, rates)
 
     def _loads(self, fd, fp, mp):
         return self.lib.types.Loads(optional_vector("fd", fd, self.nact),
@@ -118,6 +139,35 @@ class Model:
 
     def _reachable(self, what, q):
         self._call(lambda: "%s: q = %s" % (what, _fmt(q)), self.lib.check_reachable, q)
+
+    def _require_finite(self, what, q, outputs, rates=()):
+        """Raises unless every number of outputs is finite: a result that is
+        not finite cannot be used, so it is an error, never returned.
+        Where J_d is not finite (the edge of the workspace, where a sqrt
+        of the inverse kinematics reaches 0 while check_reachable still
+        accepts q) the library's forward dynamics reports Singular, and so
+        does this; otherwise the rate and load arguments rates ((name,
+        values) pairs, or a function giving them) are too large for the
+        result to be represented: InputError naming them, as the library's
+        status-checked calls report."""
+        if _finite(*outputs):
+            return
+        n = self.nact
+        d, jd = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
+        self.lib.ik_jd(q, d, jd)
+        if not _finite(d, jd):
+            raise errors.Singular("%s: q = %s: %s: J_d is not finite there (the edge of the "
+                                  "workspace)" % (what, _fmt(q),
+                                                  self.lib.status_text(errors.ESINGULAR)),
+                                  errors.ESINGULAR)
+        rates = rates() if callable(rates) else rates
+        given = "".join(", %s = %s" % (name, _fmt(v)) for name, v in rates)
+        cause = (" or ".join(name for name, _ in rates) + " too large") if rates else \
+            "not finite at this q"
+        raise errors.InputError("%s: q = %s%s: %s: the result is not finite (%s)"
+                                % (what, _fmt(q), given,
+                                   self.lib.status_text(errors.EINPUT), cause),
+                                errors.EINPUT)
 
     # ---- kinematics ----
     def check(self, q):
@@ -128,6 +178,7 @@ class Model:
         rc = ctypes.c_double()
         self._call(lambda: "check: q = %s" % _fmt(q), self.lib.check_regular, q,
                    ctypes.byref(rc))
+        self._require_finite("check", q, (rc.value,))
         return rc.value
 
     def ik(self, q):
@@ -138,6 +189,7 @@ class Model:
         n = self.nact
         d, jd = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
         self.lib.ik_jd(q, d, jd)
+        self._require_finite("ik", q, (d, jd))
         return self._out.vec(d), self._out.mat(jd, n, 3)
 
     def _fk_seed(self, act, seed):
@@ -162,6 +214,7 @@ class Model:
         q = (ctypes.c_double * 3)()
         self._call(lambda: "fk: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
                    self.lib.forward_kinematics, act, seed, q)
+        self._require_finite("fk: d = %s from seed %s" % (_fmt(act), _fmt(seed)), q, (q,))
         return self._out.vec(q)
 
     def fk_lsq(self, d, seed=None):
@@ -173,6 +226,8 @@ class Model:
         q, res = (ctypes.c_double * 3)(), ctypes.c_double()
         self._call(lambda: "fk_lsq: d = %s from seed %s" % (_fmt(act), _fmt(seed)),
                    self.lib.forward_kinematics_lsq, act, seed, q, ctypes.byref(res))
+        self._require_finite("fk_lsq: d = %s from seed %s" % (_fmt(act), _fmt(seed)), q,
+                             (q, res.value))
         return self._out.vec(q), res.value
 
     def platform_jacobian(self, q):
@@ -182,6 +237,7 @@ class Model:
         self._reachable("platform_jacobian", q)
         jp = (ctypes.c_double * 18)()
         self.lib.platform_jacobian(q, jp)
+        self._require_finite("platform_jacobian", q, (jp,))
         return self._out.mat(jp, 3, 3), self._out.mat(jp[9:], 3, 3)
 
     def poses(self, q):
@@ -192,6 +248,7 @@ class Model:
         nb = self.nbody
         r, p = (ctypes.c_double * (9 * nb))(), (ctypes.c_double * (3 * nb))()
         self.lib.poses(q, r, p)
+        self._require_finite("poses", q, (r, p))
         return ([self._out.mat(r[9 * b:9 * b + 9], 3, 3) for b in range(nb)],
                 [self._out.vec(p[3 * b:3 * b + 3]) for b in range(nb)])
 
@@ -204,6 +261,8 @@ class Model:
         self._reachable("dynamics", q)
         M, h, G = (ctypes.c_double * 9)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
         self.lib.dynamics(q, qd, M, h, G)
+        self._require_finite("dynamics", q, (M, G))
+        self._require_finite("dynamics", q, (h,), (("qd", qd),))
         return self._out.mat(M, 3, 3), self._out.vec(h), self._out.vec(G)
 
     def passive(self, q, qd):
@@ -213,6 +272,7 @@ class Model:
         self._reachable("passive", q)
         out = (ctypes.c_double * 3)()
         self.lib.passive(q, qd, out)
+        self._require_finite("passive", q, (out,), (("qd", qd),))
         return self._out.vec(out)
 
     def forward_dynamics(self, q, qd=None, fd=None, fp=None, mp=None):
@@ -222,8 +282,10 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         qdd = (ctypes.c_double * 3)()
+        rates = lambda: (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp))
         self._call(lambda: "forward_dynamics: q = %s" % _fmt(q), self.lib.forward_dynamics,
-                   q, qd, ctypes.byref(l), qdd)
+                   q, qd, ctypes.byref(l), qdd, rates=rates)
+        self._require_finite("forward_dynamics", q, (qdd,), rates)
         return self._out.vec(qdd)
 
     def inverse_dynamics(self, q, qd, qdd, fp=None, mp=None, preload=0.0):
@@ -235,8 +297,12 @@ class Model:
         preload = _convert.scalar("preload", preload)
         l = self._loads(None, fp, mp)
         fd = (ctypes.c_double * self.nact)()
+        rates = lambda: (("qd", qd), ("qdd", qdd), ("fp", l.fp), ("mp", l.mp),
+                         ("preload", (preload,)))
         self._call(lambda: "inverse_dynamics: q = %s" % _fmt(q),
-                   self.lib.inverse_dynamics_preload, q, qd, qdd, ctypes.byref(l), preload, fd)
+                   self.lib.inverse_dynamics_preload, q, qd, qdd, ctypes.byref(l), preload, fd,
+                   rates=rates)
+        self._require_finite("inverse_dynamics", q, (fd,), rates)
         return self._out.vec(fd)
 
     def actuator_null(self, q):
@@ -249,6 +315,7 @@ class Model:
                                     errors.EINPUT)
         n = (ctypes.c_double * self.nact)()
         self._call(lambda: "actuator_null: q = %s" % _fmt(q), self.lib.actuator_null, q, n)
+        self._require_finite("actuator_null", q, (n,))
         return self._out.vec(n)
 
     def reactions(self, q, qd=None, fd=None, fp=None, mp=None, labelled=False):
@@ -259,8 +326,10 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         lam = (ctypes.c_double * self.nlambda)()
+        rates = lambda: (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp))
         self._call(lambda: "reactions: q = %s" % _fmt(q), self.lib.reactions, q, qd,
-                   ctypes.byref(l), lam)
+                   ctypes.byref(l), lam, rates=rates)
+        self._require_finite("reactions", q, (lam,), rates)
         if labelled:
             return dict(zip(self.lambda_labels, lam))
         return self._out.vec(lam)
@@ -274,6 +343,7 @@ class Model:
                                     "no null vector", errors.EINPUT)
         z = (ctypes.c_double * self.nlambda)()
         self._call(lambda: "reaction_null: q = %s" % _fmt(q), self.lib.reaction_null, q, z)
+        self._require_finite("reaction_null", q, (z,))
         return self._out.vec(z)
 
     def energy(self, q, qd=None):
@@ -283,6 +353,7 @@ class Model:
         st = self.lib.energies(ctypes.byref(self._m), q, qd, ctypes.byref(T), ctypes.byref(V))
         if st != errors.OK:
             self._fail(st, "energy: q = %s, qd = %s" % (_fmt(q), _fmt(qd)))
+        self._require_finite("energy", q, (T.value, V.value), (("qd", qd),))
         return T.value, V.value
 
     # ---- manipulability ----
@@ -293,6 +364,9 @@ class Model:
         g = self.lib.types.GuardedDme()
         self._call(lambda: "dme: q = %s" % _fmt(q), self.lib.dme_eval, q, ctypes.byref(g.s))
         o, out, n = g.s, self._out, self.nact
+        self._require_finite("dme", q, (o.w_R, o.jd_rcond, o.sigma, o.semi_axis, o.axis_dir[0],
+                                        o.axis_dir[1], o.sigma_T, o.half_length_T, o.dir_T,
+                                        o.Mt, o.JtR, o.JtT))
         return Dme(o.w_R, o.jd_rcond, out.vec(o.sigma), out.vec(o.semi_axis),
                    [out.vec(o.axis_dir[0]), out.vec(o.axis_dir[1])], o.sigma_T,
                    o.half_length_T, out.vec(o.dir_T), out.mat(o.Mt, n, n),

@@ -132,17 +132,18 @@ def read_scenario(self, path):
 def _table_rows(rows, nact):
     """Table rows as one flat ctypes array of nrows * (nact + 7) doubles."""
     w = nact + 7
-    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__len__") or len(rows) == 0:
-        raise ValueError("table must be a non-empty sequence of rows (t, fd1..fd%d[, fp1..3"
-                         "[, mp1..3]])" % nact)
+    layout = "(t, fd1..fd%d[, fp1..3[, mp1..3]])" % nact
+    rows = _convert.ordered("table", rows, "a sequence of rows " + layout, ndim=2)
+    if len(rows) == 0:
+        raise ValueError("table must be a non-empty sequence of rows " + layout)
     flat = (ctypes.c_double * (w * len(rows)))()
     prev = -math.inf
     for r, row in enumerate(rows):
-        n = len(row) if hasattr(row, "__len__") and not isinstance(row, (str, bytes)) else -1
+        row = _convert.ordered("table[%d]" % r, row, "a sequence of numbers " + layout)
+        n = len(row)
         if n not in (1 + nact, 4 + nact, w):
-            raise ValueError("table[%d] must have %d, %d or %d numbers (t, fd1..fd%d[, fp1..3"
-                             "[, mp1..3]]), got %s" % (r, 1 + nact, 4 + nact, w, nact,
-                                                       n if n >= 0 else type(row).__name__))
+            raise ValueError("table[%d] must have %d, %d or %d numbers %s, got %d"
+                             % (r, 1 + nact, 4 + nact, w, layout, n))
         v = vector("table[%d]" % r, row, n)
         if not v[0] > prev:
             raise ValueError("table[%d]: times must increase strictly (t = %r after %r)"
@@ -241,8 +242,13 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     on_sample(sample): called with every Sample as it is computed; a true
     return value stops the run (the Trajectory then has stopped = True);
     an exception it raises stops the run and is re-raised. Ctrl-C stops
-    the run at the next sample with KeyboardInterrupt. Either exception
-    carries .trajectory, the samples computed until then.
+    the run at once, also in the middle of a long sample interval (the
+    library polls a flag inside every right-hand-side evaluation), with
+    KeyboardInterrupt (or whatever a program's own SIGINT handler raises).
+    Either exception carries .trajectory, the samples delivered until then,
+    and .t_stop, the time of the last one. Called from the main thread,
+    the integration and on_sample run in a worker thread while the main
+    thread waits, where Python can run its SIGINT handler.
 
     When the state leaves the workspace or the integrator fails, raises
     Unreachable, Singular or NoConvergence with the library's message;
@@ -273,17 +279,21 @@ def simulate(self, q0=None, qd0=None, *, scenario=None, reactions=False, on_samp
     col = _Collector(self, q0, qd0, on_sample, reactions)
     opts.on_sample = col.fn
     t_stop, msg = ctypes.c_double(math.nan), ctypes.create_string_buffer(512)
-    with _interrupt.SigintFlag() as sigint:
-        opts.interrupt = sigint.pointer
-        st = self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
-                               ctypes.byref(t_stop), msg, len(msg))
+    # Polled by the library inside every right-hand-side evaluation: set
+    # on Ctrl-C, it stops the run in the middle of a long sample interval.
+    stop = ctypes.c_int(0)
+    opts.interrupt = ctypes.pointer(stop)
+    st, interrupt = _interrupt.call_in_worker(
+        lambda: self.lib.simulate(ctypes.byref(self._m), q0, qd0, ctypes.byref(opts),
+                                  ctypes.byref(t_stop), msg, len(msg)),
+        stop, "prru simulate")
     del keep  # the table rows stayed alive for the call
     traj = Trajectory(self, b"".join(col.chunks), len(col.chunks), reactions, col.stopped)
-    if sigint.raised and col.error is None:
-        col.error = KeyboardInterrupt()
+    if interrupt is not None and col.error is None:
+        col.error = interrupt
     if col.error is not None:
         try:
-            col.error.trajectory = traj
+            col.error.trajectory, col.error.t_stop = traj, traj.t_stop
         except AttributeError:
             pass
         raise col.error

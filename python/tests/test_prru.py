@@ -478,7 +478,7 @@ class TestSimulation(unittest.TestCase):
             MODEL.simulate(scenario="paper", t_end=0.1, dt=0.01, on_sample=cb)
         self.assertEqual(e.exception.trajectory.t, [0.0, 0.01, 0.02])
 
-    def test_ctrl_c_stops_at_the_next_sample(self):
+    def test_ctrl_c_stops_a_long_run(self):
         """SIGINT during a long run (sent once the first sample is out):
         KeyboardInterrupt carrying the samples computed so far, long
         before the end of the run."""
@@ -506,6 +506,47 @@ class TestSimulation(unittest.TestCase):
         n, t = out.split()
         self.assertGreater(int(n), 0)
         self.assertLess(float(t), 300)
+
+    def test_ctrl_c_inside_a_long_sample_interval(self):
+        """SIGINT 0.3 s into a run whose first sample interval takes about
+        100 s of integration (50000 s of a swaying robot, rkf45 at the
+        tightest tolerance: ~2 ms per simulated second, unloaded) stops
+        it at once: the library polls the flag inside every right-hand-side
+        evaluation, and the waiting main thread sets it. KeyboardInterrupt
+        carries the one sample delivered (t = 0). The 1 s bound leaves
+        room for a loaded machine: the flag is seen within one evaluation
+        (microseconds) of the main thread's handler, which runs within
+        _interrupt.POLL_SECONDS (0.05 s) of the signal. Before the fix the
+        run stopped only at the next sample, 50000 s of simulated time on."""
+        code = ("import json, os, signal, sys, threading, time, prru\n"
+                "m = prru.Model()\n"
+                "q = [0.0, 0.0, -0.8]\n"
+                "fd = m.inverse_dynamics(q, [0.0] * 3, [0.0] * 3)\n"
+                "sent = []\n"
+                "def send():\n"
+                "    sent.append(time.monotonic())\n"
+                "    os.kill(os.getpid(), signal.SIGINT)\n"
+                "threading.Timer(0.3, send).start()\n"
+                "try:\n"
+                "    m.simulate(q, [1.0, 1.0, 0.0], fd=fd, t_end=1e5, dt=5e4,\n"
+                "               stepper='rkf45', atol=3e-14, rtol=3e-14, max_steps=10**9)\n"
+                "except KeyboardInterrupt as e:\n"
+                "    print(json.dumps([time.monotonic() - sent[0], e.trajectory.t, e.t_stop]))\n"
+                "    sys.exit(3)\n")
+        env = dict(os.environ, PRRU_LIB=LIB, PYTHONPATH=os.path.dirname(HERE))
+        p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                             env=env)
+        try:
+            out, _ = p.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            out = "still running 20 s after it started"
+        finally:
+            p.kill()
+            p.wait()
+        self.assertEqual(p.returncode, 3, out)
+        waited, t, t_stop = json.loads(out)
+        self.assertLess(waited, 1.0, out)
+        self.assertEqual((t, t_stop), ([0.0], 0.0))
 
     def test_leaving_the_workspace_keeps_the_samples(self):
         f = [5000.0, -5000.0] + [0.0] * (MODEL.nact - 2)
@@ -575,6 +616,71 @@ class TestErrors(unittest.TestCase):
         with self.assertRaisesRegex(prru.InputError, "invalid input"):
             MODEL.energy(q, [1e200, 0, 0])
 
+    def assert_finite_or_raises(self, what, call):
+        """call() raises a PrruError or returns only finite numbers."""
+        try:
+            out = call()
+        except prru.PrruError:
+            return
+        numbers = flat([out] if isinstance(out, float) else out)
+        self.assertTrue(all(map(math.isfinite, numbers)), "%s returned %r" % (what, out))
+
+    def test_no_result_is_silently_non_finite(self):
+        """A result that is not finite cannot be used: it is an error, never
+        returned. dynamics with a huge qd (h overflows) raises InputError
+        naming qd, as forward_dynamics does; and at the edge of the
+        workspace, where check_reachable accepts q but J_d is not finite
+        (a sqrt of the inverse kinematics at 0), the q-only calls raise
+        Singular, as the library's forward dynamics does there."""
+        q = [0.0, 0.2, -0.8]
+        huge = [1e200, 0.0, 0.0]
+        with self.assertRaisesRegex(prru.InputError, r"^dynamics: q = \(.*\), "
+                                    r"qd = \(9.9999999999999997e\+199, 0, 0\): invalid input "
+                                    r".*\(qd too large\)$"):
+            MODEL.dynamics(q, huge)
+        with self.assertRaisesRegex(prru.InputError, r"^forward_dynamics: q = \(.*\), "
+                                    r"qd = \(9.9999999999999997e\+199, 0, 0\), .*invalid input"):
+            MODEL.forward_dynamics(q, huge)
+        # The last reachable q1 (bisection, q2 = 0, q3 = -0.8): the edge.
+        lo, hi = 0.0, 1.55
+        self.assertRaises(prru.Unreachable, MODEL.ik, [hi, 0.0, -0.8])
+        while (lo + hi) / 2 not in (lo, hi):
+            mid = (lo + hi) / 2
+            try:
+                MODEL.ik([mid, 0.0, -0.8])
+                lo = mid
+            except prru.Unreachable:
+                hi = mid
+            except prru.Singular:  # J_d not finite there
+                lo = mid
+        edge = [lo, 0.0, -0.8]
+        z3, zn = [0.0] * 3, [0.0] * MODEL.nact
+        states = [(q, huge, zn), (q, [0.0, 1e160, 0.0], zn), (edge, z3, zn),
+                  (edge, [1.0, 1.0, 1.0], [1.0] * MODEL.nact), (q, z3, [1e307] * MODEL.nact)]
+        for x, xd, fd in states:
+            for what, call in (
+                    ("check", lambda: MODEL.check(x)), ("ik", lambda: MODEL.ik(x)),
+                    ("fk", lambda: MODEL.fk(MODEL.ik(x)[0])),
+                    ("fk_lsq", lambda: MODEL.fk_lsq(MODEL.ik(x)[0])),
+                    ("platform_jacobian", lambda: MODEL.platform_jacobian(x)),
+                    ("poses", lambda: MODEL.poses(x)),
+                    ("dynamics", lambda: MODEL.dynamics(x, xd)),
+                    ("passive", lambda: MODEL.passive(x, xd)),
+                    ("forward_dynamics", lambda: MODEL.forward_dynamics(x, xd, fd)),
+                    ("inverse_dynamics", lambda: MODEL.inverse_dynamics(x, xd, xd)),
+                    ("actuator_null", lambda: MODEL.actuator_null(x)),
+                    ("reactions", lambda: MODEL.reactions(x, xd, fd)),
+                    ("reaction_null", lambda: MODEL.reaction_null(x)),
+                    ("energy", lambda: MODEL.energy(x, xd)),
+                    ("dme", lambda: MODEL.dme(x)), ("w_R", lambda: MODEL.w_R(x))):
+                with self.subTest(call=what, q=x, qd=xd):
+                    self.assert_finite_or_raises(what, call)
+        # A map's summary over no ok point: no number (None), not NaN.
+        r = MODEL.map((1.55, 1.56, 2), (0.0, 0.01, 2), 0.0)
+        self.assertEqual(r.summary["n_ok"], 0)
+        for k in ("index", "index_log", "w_min", "w_max", "w_min_q", "w_max_q"):
+            self.assertIsNone(r.summary[k], k)
+
     def test_argument_checks(self):
         with self.assertRaisesRegex(ValueError, "^q must have 3 elements, got 2$"):
             MODEL.ik([0, 0])
@@ -615,6 +721,76 @@ class TestErrors(unittest.TestCase):
         self.assertEqual(MODEL.dynamics(ArrayLike()), ref)
         with self.assertRaisesRegex(TypeError, "^q must be a sequence of 3 numbers, got generator"):
             MODEL.dynamics(x for x in q)
+
+    def test_unordered_and_non_numeric_containers(self):
+        """A dict gives its keys when read as a sequence and a set has no
+        order: every vector argument of every method refuses them (and
+        strings, bytes, dict views, iterators) with TypeError naming it."""
+        n = MODEL.nact
+        q, z3, zn = [0.0, 0.0, -0.8], [0.0] * 3, [0.0] * n
+        d = MODEL.ik(q)[0]
+        row = [0.0] + [1.0] * n
+        calls = {  # name -> (good value, call with that argument replaced)
+            "check q": (q, lambda v: MODEL.check(v)),
+            "ik q": (q, lambda v: MODEL.ik(v)),
+            "fk d": (d, lambda v: MODEL.fk(v)),
+            "fk seed": (q, lambda v: MODEL.fk(d, seed=v)),
+            "fk_lsq d": (d, lambda v: MODEL.fk_lsq(v)),
+            "fk_lsq seed": (q, lambda v: MODEL.fk_lsq(d, v)),
+            "platform_jacobian q": (q, lambda v: MODEL.platform_jacobian(v)),
+            "poses q": (q, lambda v: MODEL.poses(v)),
+            "dynamics q": (q, lambda v: MODEL.dynamics(v)),
+            "dynamics qd": (z3, lambda v: MODEL.dynamics(q, v)),
+            "passive q": (q, lambda v: MODEL.passive(v, z3)),
+            "passive qd": (z3, lambda v: MODEL.passive(q, v)),
+            "forward_dynamics q": (q, lambda v: MODEL.forward_dynamics(v)),
+            "forward_dynamics qd": (z3, lambda v: MODEL.forward_dynamics(q, v)),
+            "forward_dynamics fd": (zn, lambda v: MODEL.forward_dynamics(q, fd=v)),
+            "forward_dynamics fp": (z3, lambda v: MODEL.forward_dynamics(q, fp=v)),
+            "forward_dynamics mp": (z3, lambda v: MODEL.forward_dynamics(q, mp=v)),
+            "inverse_dynamics q": (q, lambda v: MODEL.inverse_dynamics(v, z3, z3)),
+            "inverse_dynamics qd": (z3, lambda v: MODEL.inverse_dynamics(q, v, z3)),
+            "inverse_dynamics qdd": (z3, lambda v: MODEL.inverse_dynamics(q, z3, v)),
+            "inverse_dynamics fp": (z3, lambda v: MODEL.inverse_dynamics(q, z3, z3, fp=v)),
+            "inverse_dynamics mp": (z3, lambda v: MODEL.inverse_dynamics(q, z3, z3, mp=v)),
+            "actuator_null q": (q, lambda v: MODEL.actuator_null(v)),
+            "reactions q": (q, lambda v: MODEL.reactions(v)),
+            "reactions qd": (z3, lambda v: MODEL.reactions(q, v)),
+            "reactions fd": (zn, lambda v: MODEL.reactions(q, fd=v)),
+            "reactions fp": (z3, lambda v: MODEL.reactions(q, fp=v)),
+            "reactions mp": (z3, lambda v: MODEL.reactions(q, mp=v)),
+            "reaction_null q": (q, lambda v: MODEL.reaction_null(v)),
+            "energy q": (q, lambda v: MODEL.energy(v)),
+            "energy qd": (z3, lambda v: MODEL.energy(q, v)),
+            "dme q": (q, lambda v: MODEL.dme(v)),
+            "w_R q": (q, lambda v: MODEL.w_R(v)),
+            "simulate q0": (q, lambda v: MODEL.simulate(v, t_end=0.01)),
+            "simulate qd0": (z3, lambda v: MODEL.simulate(q, v, t_end=0.01)),
+            "simulate fd": (zn, lambda v: MODEL.simulate(q, fd=v, t_end=0.01)),
+            "simulate fp": (z3, lambda v: MODEL.simulate(q, fp=v, t_end=0.01)),
+            "simulate mp": (z3, lambda v: MODEL.simulate(q, mp=v, t_end=0.01)),
+            "simulate harmonic": ([1.0, 2.0], lambda v: MODEL.simulate(q, harmonic=v,
+                                                                        t_end=0.01)),
+            "simulate table": ([tuple(row), tuple([1.0] + row[1:])],
+                               lambda v: MODEL.simulate(q, table=v, t_end=0.01)),
+            "simulate table[1]": ([1.0] + row[1:],
+                                  lambda v: MODEL.simulate(q, table=[row, v], t_end=0.01)),
+            "map q1": ([-0.1, 0.1, 2], lambda v: MODEL.map(v, (-0.1, 0.1, 2), -0.8)),
+            "map q2": ([-0.1, 0.1, 2], lambda v: MODEL.map((-0.1, 0.1, 2), v, -0.8)),
+        }
+        for key, (good, call) in calls.items():
+            name = key.split(" ", 1)[1]
+            bad = {"dict": dict(enumerate(good)), "set": set(good),
+                   "frozenset": frozenset(good), "dict_values": dict(enumerate(good)).values(),
+                   "str": ",".join(map(str, good)), "bytes": b"\0" * len(good),
+                   "list_iterator": iter(good)}
+            for kind, value in bad.items():
+                with self.subTest(call=key, given=kind):
+                    with self.assertRaisesRegex(TypeError, r"^%s must be .*, got %s$"
+                                                % (re.escape(name), kind)):
+                        call(value)
+        with self.assertRaisesRegex(TypeError, r"^q\[1\] must be a real number, got str$"):
+            MODEL.ik([0.0, "0.1", -0.8])
 
 
 class TestLibrarySearch(unittest.TestCase):
@@ -771,6 +947,12 @@ class TestNumpy(unittest.TestCase):
             MODEL.ik(numpy.zeros((3, 1)))
         r = mn.map((-0.2, 0.2, 3), (-0.2, 0.2, 4))
         self.assertEqual(r.w_R.shape, (3, 4))
+        # A load table as a 2-D array (its rows in order), like a list of rows.
+        fd = MODEL.inverse_dynamics([0, 0, -0.8], [0] * 3, [0] * 3)
+        rows = [[0.0] + list(fd), [0.01] + list(fd)]
+        self.assertEqual(bits(mn.simulate([0, 0, -0.8], table=numpy.array(rows),
+                                          t_end=0.01).q.tolist()),
+                         bits(MODEL.simulate([0, 0, -0.8], table=rows, t_end=0.01).q))
 
 
 class TestWithoutNumpy(unittest.TestCase):
