@@ -157,6 +157,10 @@ void prru_cli_out_printf(prru_cli_out *o, const char *fmt, ...)
 void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n);
 /* ",%.17g" for each of n numbers. */
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n);
+/* s as a JSON string literal: quotes, backslashes and control characters
+ * escaped, a byte that is not well-formed UTF-8 written as U+FFFD (JSON
+ * text is UTF-8). */
+void prru_cli_out_json_string(prru_cli_out *o, const char *s);
 /* Ends a complete line that is not a data row (comment, header); 0 or -1. */
 int prru_cli_out_line(prru_cli_out *o);
 /* Ends a data row (counted in rows); flushes at 64 kB or 0.2 s after the

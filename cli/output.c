@@ -114,6 +114,25 @@ void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)
   for (int i = 0; i < n; i++) prru_cli_out_printf(o, ",%.17g", v[i]);
 }
 
+void prru_cli_out_json_string(prru_cli_out *o, const char *s)
+{
+  prru_cli_out_write(o, "\"", 1);
+  while (*s) {
+    const unsigned char c = (unsigned char)*s;
+    const size_t n = prru_utf8_char(s);
+    if (c == '"' || c == '\\')
+      prru_cli_out_printf(o, "\\%c", c);
+    else if (c < 0x20 || c == 0x7f)
+      prru_cli_out_printf(o, "\\u%04x", c);
+    else if (n == 0)
+      prru_cli_out_write(o, "\\ufffd", 6);
+    else
+      prru_cli_out_write(o, s, n);
+    s += n ? n : 1;
+  }
+  prru_cli_out_write(o, "\"", 1);
+}
+
 int prru_cli_out_line(prru_cli_out *o)
 {
   if (o->err) return -1;
