@@ -868,7 +868,8 @@ static int write_map_file(const char *cmd, const char *path, const char *shown, 
   if (prru_cli_out_open(&o, cmd, path)) return 1;
   o.name = shown;
   prru_cli_out_comment(&o);
-  prru_cli_out_printf(&o, "# design: %s\nq1,q2,q3,w_R,status\n", design);
+  prru_cli_out_comment_line(&o, "design: %s", design);
+  prru_cli_out_printf(&o, "q1,q2,q3,w_R,status\n");
   prru_cli_out_line(&o);
   for (int i = 0; i < g->n1; i++)
     for (int j = 0; j < g->n2; j++) {

@@ -174,6 +174,14 @@ int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const 
 int prru_cli_out_flush(prru_cli_out *o);
 /* The model comment line, as prru_cli_csv_comment. */
 void prru_cli_out_comment(prru_cli_out *o);
+/* The comment line "# TEXT" (a whole line), TEXT formatted as by printf
+ * with every control character in it (a line break) written as '?': user
+ * text in it (a path) never starts a data row. */
+void prru_cli_out_comment_line(prru_cli_out *o, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 /* keep = 1: writes the rest, syncs and renames onto the target; keep = 0:
  * drops what is unwritten and removes the partial file (the target keeps
  * its old contents). 0, or 1 after "prru CMD: FILE: write error: REASON"

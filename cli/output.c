@@ -156,6 +156,32 @@ void prru_cli_out_comment(prru_cli_out *o)
   prru_cli_out_line(o);
 }
 
+void prru_cli_out_comment_line(prru_cli_out *o, const char *fmt, ...)
+{
+  if (o->err) return;
+  prru_cli_out_printf(o, "# ");
+  const size_t start = o->len;
+  for (int pass = 0; pass < 2 && !o->err; pass++) {
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(o->buf + o->len, o->cap - o->len, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+      fail(o, EINVAL);
+      return;
+    }
+    if (o->len + (size_t)n < o->cap) {
+      o->len += (size_t)n;
+      break;
+    }
+    reserve(o, (size_t)n);
+  }
+  for (size_t i = start; i < o->len; i++)
+    if ((unsigned char)o->buf[i] < 0x20 || o->buf[i] == 0x7f) o->buf[i] = '?';
+  prru_cli_out_printf(o, "\n");
+  prru_cli_out_line(o);
+}
+
 /* dir/<base>.partial-XXXXXX for path dir/base (base shortened so that the
  * name stays within NAME_MAX). */
 static char *partial_name(const char *path)
