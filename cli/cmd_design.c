@@ -824,8 +824,10 @@ static int on_iteration(int iter, int evals, const prru_design_eval *best, doubl
 /* The design as a format-2 model file. */
 static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *desc)
 {
-  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n  \"description\": \"%s\",\n", name,
-                      desc);
+  char text[PRRU_DESCRIPTION_SIZE];
+  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n  \"description\": ", name);
+  prru_cli_out_json_string(o, prru_description(text, sizeof text, desc));
+  prru_cli_out_printf(o, ",\n");
   prru_cli_out_printf(o, "  \"gravity\": [%.17g, %.17g, %.17g],\n  \"geometry\": {\n", p->gravity[0],
                       p->gravity[1], p->gravity[2]);
   const char *keys[3] = {"b", "l1", "l2"};
@@ -866,7 +868,8 @@ static int write_map_file(const char *cmd, const char *path, const char *shown, 
   if (prru_cli_out_open(&o, cmd, path)) return 1;
   o.name = shown;
   prru_cli_out_comment(&o);
-  prru_cli_out_printf(&o, "# design: %s\nq1,q2,q3,w_R,status\n", design);
+  prru_cli_out_comment_line(&o, "design: %s", design);
+  prru_cli_out_printf(&o, "q1,q2,q3,w_R,status\n");
   prru_cli_out_line(&o);
   for (int i = 0; i < g->n1; i++)
     for (int j = 0; j < g->n2; j++) {

@@ -596,13 +596,30 @@ static void json_list(prru_cli_out *o, const double *v, int n)
   prru_cli_out_printf(o, "]");
 }
 
+/* The model file's description names the data file, whatever its path
+ * (any bytes, any length): prru_description makes it one the generator
+ * accepts. */
+static void write_description(prru_cli_out *o, const char *data)
+{
+  static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
+  const size_t len = sizeof fmt + strlen(data) + strlen(prru_mech.name);
+  char *text = malloc(len), desc[PRRU_DESCRIPTION_SIZE];
+  if (!text) {
+    prru_cli_out_printf(o, "  \"description\": \"Identified by prru identify\",\n");
+    return;
+  }
+  snprintf(text, len, fmt, data, prru_mech.name);
+  prru_cli_out_printf(o, "  \"description\": ");
+  prru_cli_out_json_string(o, prru_description(desc, sizeof desc, text));
+  prru_cli_out_printf(o, ",\n");
+  free(text);
+}
+
 static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *data)
 {
   prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n", name);
-  prru_cli_out_printf(o, "  \"description\": \"Identified by prru identify from ");
-  for (const char *s = data; *s; s++)
-    prru_cli_out_printf(o, "%c", *s == '"' || *s == '\\' || (unsigned char)*s < 32 ? '_' : *s);
-  prru_cli_out_printf(o, " (prior: model %s)\",\n  \"gravity\": ", prru_mech.name);
+  write_description(o, data);
+  prru_cli_out_printf(o, "  \"gravity\": ");
   json_list(o, p->gravity, 3);
   prru_cli_out_printf(o, ",\n  \"geometry\": {\n    \"b\": ");
   json_list(o, p->b, PRRU_NLIMB);

@@ -169,6 +169,10 @@ void prru_cli_out_printf(prru_cli_out *o, const char *fmt, ...)
 void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n);
 /* ",%.17g" for each of n numbers. */
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n);
+/* s as a JSON string literal: quotes, backslashes and control characters
+ * escaped, a byte that is not well-formed UTF-8 written as U+FFFD (JSON
+ * text is UTF-8). */
+void prru_cli_out_json_string(prru_cli_out *o, const char *s);
 /* Ends a complete line that is not a data row (comment, header); 0 or -1. */
 int prru_cli_out_line(prru_cli_out *o);
 /* Ends a data row (counted in rows); flushes at 64 kB or 0.2 s after the
@@ -182,6 +186,14 @@ int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const 
 int prru_cli_out_flush(prru_cli_out *o);
 /* The model comment line, as prru_cli_csv_comment. */
 void prru_cli_out_comment(prru_cli_out *o);
+/* The comment line "# TEXT" (a whole line), TEXT formatted as by printf
+ * with every control character in it (a line break) written as '?': user
+ * text in it (a path) never starts a data row. */
+void prru_cli_out_comment_line(prru_cli_out *o, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 /* keep = 1: writes the rest, syncs and renames onto the target; keep = 0:
  * drops what is unwritten and removes the partial file (the target keeps
  * its old contents). 0, or 1 after "prru CMD: FILE: write error: REASON"

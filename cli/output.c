@@ -114,6 +114,25 @@ void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)
   for (int i = 0; i < n; i++) prru_cli_out_printf(o, ",%.17g", v[i]);
 }
 
+void prru_cli_out_json_string(prru_cli_out *o, const char *s)
+{
+  prru_cli_out_write(o, "\"", 1);
+  while (*s) {
+    const unsigned char c = (unsigned char)*s;
+    const size_t n = prru_utf8_char(s);
+    if (c == '"' || c == '\\')
+      prru_cli_out_printf(o, "\\%c", c);
+    else if (c < 0x20 || c == 0x7f)
+      prru_cli_out_printf(o, "\\u%04x", c);
+    else if (n == 0)
+      prru_cli_out_write(o, "\\ufffd", 6);
+    else
+      prru_cli_out_write(o, s, n);
+    s += n ? n : 1;
+  }
+  prru_cli_out_write(o, "\"", 1);
+}
+
 int prru_cli_out_line(prru_cli_out *o)
 {
   if (o->err) return -1;
@@ -134,6 +153,32 @@ int prru_cli_out_row(prru_cli_out *o)
 void prru_cli_out_comment(prru_cli_out *o)
 {
   prru_cli_out_printf(o, "# prru %s model %s\n", PRRU_VERSION, prru_cli_model_id());
+  prru_cli_out_line(o);
+}
+
+void prru_cli_out_comment_line(prru_cli_out *o, const char *fmt, ...)
+{
+  if (o->err) return;
+  prru_cli_out_printf(o, "# ");
+  const size_t start = o->len;
+  for (int pass = 0; pass < 2 && !o->err; pass++) {
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(o->buf + o->len, o->cap - o->len, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+      fail(o, EINVAL);
+      return;
+    }
+    if (o->len + (size_t)n < o->cap) {
+      o->len += (size_t)n;
+      break;
+    }
+    reserve(o, (size_t)n);
+  }
+  for (size_t i = start; i < o->len; i++)
+    if ((unsigned char)o->buf[i] < 0x20 || o->buf[i] == 0x7f) o->buf[i] = '?';
+  prru_cli_out_printf(o, "\n");
   prru_cli_out_line(o);
 }
 

@@ -29,6 +29,7 @@ import os
 import re
 import string
 import sys
+from xml.sax.saxutils import escape
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -271,6 +272,31 @@ LIMB_NOTES = (
     "rail at x = -b4, y = 0; hinges along e2; U joint about x4 = -x3, w",
 )
 
+# What XML 1.0 allows in a document (its production Char), less the
+# controls, which would not keep a text on one line (C0 incl. tab, LF and
+# CR; DEL; C1) and the line and paragraph separators.
+_NOT_ONE_LINE_TEXT = re.compile("[^\x20-\x7e\xa0-\u2027\u202a-\ud7ff"
+                                "\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def xml_comment(text):
+    """Any text made safe inside <!-- -->, on one line: characters outside
+    _NOT_ONE_LINE_TEXT's set become spaces, no "--" survives (a space goes
+    between every two '-') and a trailing '-' (before the "-->") gets a
+    space after it. Readable, not reversible."""
+    text = _NOT_ONE_LINE_TEXT.sub(" ", text)
+    text = re.sub("-(?=-)", "- ", text)
+    return text + " " if text.endswith("-") else text
+
+
+def xml_attribute(text):
+    """Any text as the value of a double-quoted attribute: characters XML
+    cannot hold (even as references) become spaces, and markup characters
+    are escaped."""
+    return escape(_NOT_ONE_LINE_TEXT.sub(" ", text),
+                  {'"': "&quot;", "'": "&apos;"})
+
+
 def substitutions(m, path):
     """The template's values: (values of the document, {block name: one
     dict of values per repetition})."""
@@ -281,7 +307,6 @@ def substitutions(m, path):
     platform = (r_p, p_p)
     index = {name: i for i, name in enumerate(m.body_names)}
     world = (IDENTITY, (0.0, 0.0, 0.0))
-    description = m.description.replace("--", "- -")  # "--" ends an XML comment
     nrows = 6 * (n - 1)
     # Every weld row is independent for three limbs. With four, limbs 3 and
     # 4 both hold O' in the plane y = 0: 5 n - 6 (n - 1) = 2, but the
@@ -292,8 +317,12 @@ def substitutions(m, path):
         redundancy = ("%d - %d + 1 = 3: limbs 3 and 4 both hold O' along e2, "
                       "so one\n     weld row is redundant (the %d rows have "
                       "rank %d)." % (5 * n, nrows, nrows, nrows - 1))
-    doc = dict(model_file=os.path.basename(path), model_sha256=m.sha256,
-               description=description, name=m.name,
+    # User text: the file name and description land in the header comment,
+    # the name in an attribute.
+    doc = dict(model_file=xml_comment(os.path.basename(path)),
+               model_sha256=m.sha256,
+               description=xml_comment(m.description),
+               name=xml_attribute(m.name),
                nlimb=str(n), nweld=str(n - 1), nweld_rows=str(nrows),
                ntree=str(5 * n), redundancy=redundancy,
                home_q=", ".join(repr(x) for x in HOME_Q),

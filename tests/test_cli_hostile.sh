@@ -247,4 +247,27 @@ check 0 "" -- simulate --loads "$tmp/l_span.csv" --t-end 0.01 --out "$tmp/out.cs
 if [ $? -eq 0 ] || ! grep -q "not 3 comma-separated finite" "$tmp/stderr"; then ok
 else bad "eval --qd $tiny,0,0: $(cat "$tmp/stderr")"; fi
 
+# ---- User text in CSV comment lines ----
+# optimize names its --out file in the after map's "# design:" comment: a
+# path with a line break, a quote and a fake data row must stay in that
+# one comment line (the map keeps its 13 x 11 rows of 5 fields).
+mkdir "$tmp/opt_hostile"
+hostile_out="$tmp/opt_hostile/m$(printf '\n0,0,0,1,ok\r\n"\\')x.json"
+"$PRRU" optimize --vars l2 --range 5 --q1 -0.2:0.2:13 --q2 -0.25:0.15:11 --max-iter 5 \
+  --out "$hostile_out" --report "$tmp/opt_hostile/rep" >"$tmp/stdout" 2>"$tmp/stderr" \
+  || bad "optimize --out with a line break: $(head -c 300 "$tmp/stderr")"
+for m in before after; do
+  python3 - "$tmp/opt_hostile/rep/${m}_map.csv" <<'PY' && ok || bad "$m map: user text broke a comment line"
+import sys
+lines = open(sys.argv[1], "rb").read().split(b"\n")
+assert lines[-1] == b"", "no final newline"
+body = [l for l in lines[:-1] if not l.startswith(b"#")]
+assert body[0] == b"q1,q2,q3,w_R,status", body[0]
+assert len(body) == 1 + 13 * 11, len(body)
+assert all(len(l.split(b",")) == 5 and b"\r" not in l for l in body[1:])
+PY
+done
+grep -q "^# design: optimised, .*m?0,0,0,1,ok??\"\\\\x.json (name " "$tmp/opt_hostile/rep/after_map.csv" \
+  && ok || bad "after map: the design line lost the file name: $(grep '^# design' "$tmp/opt_hostile/rep/after_map.csv")"
+
 finish test_cli_hostile

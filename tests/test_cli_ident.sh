@@ -100,6 +100,20 @@ for name, body in m["bodies"].items():
     assert abs(a["bodies"][name]["mass"] - body["mass"]) <= 1e-9 * body["mass"], name
 PY
 
+# ---- identify from a data file whose path is hostile to the model file ----
+# The description names the --data path: one with "*/" (a directory ending
+# in '*'), a trigraph "??/", bytes that are not UTF-8, a quote, a backslash,
+# a newline and over 600 characters in all must still give a model file
+# that the generator accepts, its description still ending in the file name.
+hd="$tmp/q??/star*/$(printf 'bad\377\376"\\\nname')/$(printf 'a%.0s' $(seq 200))/$(printf 'b%.0s' $(seq 200))"
+mkdir -p "$hd" && ln -s "$tmp/ex.csv" "$hd/data.csv"
+"$PRRU" identify --data "$hd/data.csv" --out "$tmp/hid.json" --report "$tmp/hrep.csv" 2>"$tmp/hid.err" \
+  && ok || bad "identify from a hostile path: $(cat "$tmp/hid.err")"
+python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/hid.json" --out "$tmp/hgen" --quiet 2>"$tmp/hgen.err" \
+  && ok || bad "a model file identified from a hostile path is refused by the generator: $(cat "$tmp/hgen.err")"
+json "$tmp/hid.json" 'd["description"]' | grep -q "/data.csv (prior: model $model_name)$" \
+  && ok || bad "the description lost the data file's name: $(json "$tmp/hid.json" 'd["description"]')"
+
 # ---- identify with noise ----
 # 4 periods of data: enough samples for the noise to average.
 "$PRRU" excite --evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02 --fd-max "$(nlist 400)" \

@@ -963,9 +963,72 @@ static void test_parsing(void)
   }
 }
 
+/* Code points of s if it is all well-formed UTF-8, -1 otherwise. */
+static long utf8_count(const char *s)
+{
+  long k = 0;
+  for (size_t n; *s; s += n, k++)
+    if ((n = prru_utf8_char(s)) == 0) return -1;
+  return k;
+}
+
+/* prru_description's result must pass the generator's rule for any text
+ * (gen/prrugen/model.py): UTF-8, one line of at most 400 characters
+ * without a star-slash. */
+static int valid_description(const char *d)
+{
+  long k = utf8_count(d);
+  if (k < 0 || k > PRRU_DESCRIPTION_MAX || strstr(d, "*" "/")) return 0;
+  for (const unsigned char *c = (const unsigned char *)d; *c; c++)
+    if (*c < 0x20 || *c == 0x7f) return 0;
+  return 1;
+}
+
+static void test_description(void)
+{
+  char out[PRRU_DESCRIPTION_SIZE], text[3000];
+  TU_TRUE(strcmp(prru_description(out, sizeof out, "plain \xc3\xa9 \xe2\x98\x83 ?\?/ \"q\" \\"),
+                 "plain \xc3\xa9 \xe2\x98\x83 ?\?/ \"q\" \\") == 0,
+          "description: printable text and well-formed UTF-8 kept");
+  TU_TRUE(strcmp(prru_description(out, sizeof out, "a*/b**//\n\t\x7f\xc2\x85"), "a*|b**|/????") == 0,
+          "description: star-slash broken, control characters replaced");
+  /* Malformed: a lone continuation byte, an overlong '/', a surrogate, a
+   * code point beyond U+10FFFF, a truncated sequence at the end. */
+  TU_TRUE(strcmp(prru_description(out, sizeof out, "\x80|\xc0\xaf|\xed\xa0\x80|\xf4\x90\x80\x80|\xe2\x98"),
+                 "?|??|???|????|??") == 0,
+          "description: every byte of a malformed sequence replaced");
+  /* Over 400 characters: start and end kept around "...", 400 in all. */
+  memset(text, 'a', 1000);
+  strcpy(text + 1000, "/data.csv");
+  prru_description(out, sizeof out, text);
+  TU_TRUE(utf8_count(out) == PRRU_DESCRIPTION_MAX && strncmp(out, "aaaa", 4) == 0 && strstr(out, "a...a") &&
+              strcmp(out + strlen(out) - 9, "/data.csv") == 0,
+          "description: a long text shortened in its middle to 400 characters");
+  /* 4-byte characters, star-slashes across the cut, any byte: still valid. */
+  static const char *pieces[] = {"\xf0\x9f\x98\x80", "*", "/", "\xff", "\xe2\x98", "\n", "x"};
+  unsigned long seed = 1;
+  for (int round = 0; round < 200; round++) {
+    size_t n = 0, len = (size_t)(round * 13 % 700);
+    for (size_t i = 0; i < len; i++) {
+      seed = seed * 6364136223846793005UL + 1442695040888963407UL;
+      const unsigned r = (unsigned)(seed >> 33);
+      if (round % 2) /* any byte but NUL */
+        text[n++] = (char)(1 + r % 255);
+      else
+        for (const char *p = pieces[r % 7]; *p; p++) text[n++] = *p;
+    }
+    text[n] = '\0';
+    if (!valid_description(prru_description(out, sizeof out, text)))
+      TU_TRUE(0, "description: valid for any text");
+  }
+  TU_TRUE(valid_description(prru_description(out, 8, "\xf0\x9f\x98\x80\xf0\x9f\x98\x80")) && strlen(out) == 4,
+          "description: a short buffer cut between characters");
+}
+
 int main(void)
 {
   prru_model_default(&model);
+  test_description();
   test_inverse_of_forward();
   test_fk();
   test_bad_input();

@@ -415,6 +415,11 @@ def parse(text, path="<model>"):
             or any(ord(c) < 32 for c in description) or len(description) > 400:
         raise ModelError(path, "description", "must be one line of text "
                          "(at most 400 characters, no '*/')")
+    # A JSON escape "\ud800" alone decodes to a lone surrogate: no UTF-8
+    # (nor C, nor XML) can hold it.
+    if any(0xd800 <= ord(c) < 0xe000 for c in description):
+        raise ModelError(path, "description", "holds a lone UTF-16 surrogate "
+                         "escape (\\udXXX): not text")
     gravity = _gravity(path, data["gravity"], fmt)
     limbs = _geometry1(path, data["geometry"]) if fmt == 1 else \
         _geometry2(path, data["geometry"])

@@ -15,6 +15,7 @@ has to be removed and the case becomes an ordinary regression test.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -160,6 +161,8 @@ CASES = [
      "description", "one line"),
     ("description 401 characters", set_top("description", "d" * 401),
      "description", "400 characters"),
+    ("description with a lone surrogate escape",
+     replaced("Table 1", "Table \\ud800"), "description", "surrogate"),
     # --- missing, extra and duplicated keys ---
     ("no bodies", delete("bodies"), "bodies", "missing"),
     ("no geometry", delete("geometry"), "geometry", "missing"),
@@ -359,6 +362,137 @@ def _regression(content, key, reason, timeout):
 for _name, _content, _key, _reason, _timeout in REGRESSIONS:
     setattr(HostileModels, "test_regression_" + _name,
             _regression(_content, _key, _reason, _timeout))
+
+# Texts that break C if written into it raw: trigraphs (on under -std=c99:
+# "??/" is a backslash), quotes, backslashes, comment delimiters, line
+# splices at the end, control and non-ASCII characters (an octal escape
+# followed by a digit, a hex digit after an escape).
+HOSTILE_TEXTS = [
+    'What??/"',
+    '??/"); system("touch pwned"); ("',
+    "??= ??( ??) ??' ??< ??! ??> ??- ???/ ????/",
+    "ends in a trigraph ??/",
+    "ends in a star and a trigraph *??/",
+    "ends in a backslash \\",
+    "ends in a star and a backslash *\\",
+    "ends in a backslash and spaces \\  ",
+    "a */ int closed_early; /* b",
+    "a /* nested comment",
+    "// line comment \\",
+    '\\" \\\\ \\n \\x41 \\101',
+    "\u00e91 \x7f7 \x01f \u2028 \uffff \u2603 \U0001f600 \x80",
+    "tab\tnew\nline\rreturn",
+    "",
+]
+
+
+def c_compiler():
+    return os.environ.get("CC", "cc")
+
+
+def compile_c(test, sources, out, include=None, link=False):
+    """cc -std=c99 (trigraphs on) -Wall -Werror: every warning about a
+    trigraph, a nested comment or a stray character fails the test."""
+    cmd = [c_compiler(), "-std=c99", "-pedantic", "-Wall", "-Wextra",
+           "-Werror", "-O0", "-o", out] + ([] if link else ["-c"])
+    if include:
+        cmd += ["-I", include]
+    r = subprocess.run(cmd + sources, capture_output=True, text=True,
+                       timeout=600)
+    test.assertEqual(r.returncode, 0, "%s:\n%s" % (" ".join(cmd + sources),
+                                                    r.stderr[-3000:]))
+
+
+@unittest.skipUnless(shutil.which(c_compiler()), "no C compiler")
+class HostileTextInC(unittest.TestCase):
+    """ctext.c_string and c_comment, the one way any text reaches C."""
+
+    def test_literals_hold_the_exact_bytes_and_comments_stay_closed(self):
+        from prrugen.ctext import c_comment, c_string
+        lines = ["#include <stdio.h>"]
+        for t in HOSTILE_TEXTS:
+            # A comment that a splice or a stray "*/" would end early: the
+            # line after it starts with '/', and "int broken;" then stands
+            # outside any comment before a stray "*/" (a syntax error).
+            lines.append("/* %s\n/ int broken; */" % c_comment(t))
+        literals = ", ".join(c_string(t) for t in HOSTILE_TEXTS)
+        literals.encode("ascii")  # octal escapes: the literals are ASCII
+        lines.append("static const char *const texts[] = {%s};" % literals)
+        lines.append("int main(void)\n{\n  for (unsigned i = 0; i < sizeof "
+                     "texts / sizeof texts[0]; i++) {\n    fputs(texts[i], "
+                     "stdout);\n    putchar(0);\n  }\n  return 0;\n}\n")
+        with tempfile.TemporaryDirectory() as d:
+            src, exe = os.path.join(d, "t.c"), os.path.join(d, "t")
+            with open(src, "w", encoding="utf-8") as f:
+                f.write("\n".join(lines))
+            compile_c(self, [src], exe, link=True)
+            got = subprocess.run([exe], capture_output=True, timeout=60)
+        self.assertEqual(got.stdout.split(b"\0")[:-1],
+                         [t.encode("utf-8") for t in HOSTILE_TEXTS])
+
+    def test_comments_hold_no_delimiter_trigraph_or_line_break(self):
+        from prrugen.ctext import c_comment
+        for t in HOSTILE_TEXTS:
+            with self.subTest(t):
+                c = c_comment(t)
+                for bad in ("*/", "/*", "??", "\n", "\r", "\u2028"):
+                    self.assertNotIn(bad, c)
+                self.assertFalse(c.rstrip(" ").endswith("\\"))
+
+
+HOSTILE_DESCRIPTION = ('What??/" ??/"); system("touch pwned"); ("??= ??( ??) '
+                       "??' ??< ??! ??> ??- ???/ /* a \\\" \\\\ \u00e91 "
+                       "\u2603 \U0001f600 \x7f7 \u2028 end *??/")
+HOSTILE_FILE = 'm??=*-->"\\$(touch pwned);`x`??-.json'
+
+
+@unittest.skipUnless(shutil.which(c_compiler()), "no C compiler")
+class HostileDescriptionGenerates(unittest.TestCase):
+    """A valid model whose description and file name are hostile to C: the
+    generated files compile under -std=c99 (trigraphs on) with every
+    warning an error, and the descriptor holds the exact texts."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.model = os.path.join(cls.tmp.name, HOSTILE_FILE)
+        with open(cls.model, "wb") as f:
+            f.write(set_top("description", HOSTILE_DESCRIPTION))
+        cls.out = os.path.join(cls.tmp.name, "out")
+        cls.gen = subprocess.run([sys.executable, ENTRY, cls.model, "--out",
+                                  cls.out, "--quiet"], capture_output=True,
+                                 text=True, timeout=600)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def setUp(self):
+        self.assertEqual(self.gen.returncode, 0, self.gen.stderr)
+
+    def test_every_generated_file_compiles(self):
+        for name in sorted(os.listdir(self.out)):
+            if name.endswith(".c"):
+                with self.subTest(name):
+                    compile_c(self, [os.path.join(self.out, name)],
+                              os.path.join(self.tmp.name, name + ".o"))
+
+    def test_descriptor_holds_the_exact_texts(self):
+        from prrugen.render import _safe_name
+        main = os.path.join(self.tmp.name, "main.c")
+        with open(main, "w") as f:
+            f.write('#include <stdio.h>\n#include "prru_mechanism.h"\n'
+                    "int main(void)\n{\n  printf(\"%s%c%s%c%s%c\", "
+                    "prru_mech.name, 0, prru_mech.description, 0, "
+                    "prru_mech.model_file, 0);\n  return 0;\n}\n")
+        exe = os.path.join(self.tmp.name, "main")
+        compile_c(self, [main, os.path.join(self.out, "prru_mechanism.c")],
+                  exe, include=self.out, link=True)
+        got = subprocess.run([exe], capture_output=True, timeout=60)
+        self.assertEqual(got.stdout.split(b"\0")[:-1],
+                         [b"prru", HOSTILE_DESCRIPTION.encode("utf-8"),
+                          _safe_name(HOSTILE_FILE).encode("ascii")])
+
 
 if __name__ == "__main__":
     unittest.main()

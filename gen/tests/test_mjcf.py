@@ -660,5 +660,97 @@ class Errors(unittest.TestCase):
             ET.fromstring(prru_mjcf.render(path))
 
 
+# Descriptions and file names that break an XML comment written raw: "--"
+# in any form, a '-' before the closing "-->", markup, characters XML 1.0
+# cannot hold at all (DEL and C1 it allows, but not on "one line").
+HOSTILE_DESCRIPTIONS = [
+    "a ---><worldbody><body name=\"evil\"/></worldbody><!-- b",
+    "a --><mujoco/><!-- b",
+    "a --!> <!-- b",
+    "----",
+    "-",
+    "ends in a dash -",
+    "ends in two dashes --",
+    "]]> <![CDATA[ x ]]> &amp; &#0; &lt; < > ' \"",
+    "\x7f \x85 \u2028 \u2029 \ufffe \uffff \U0001f600 \u00e9",
+]
+HOSTILE_FILES = ["m---><x><!--.json", "m-", "m\udcff--.json", "-"]
+
+
+def xml_nodes(text):
+    """(top-level nodes of the document, the element tree without
+    comments): minidom keeps the comment before the root element."""
+    from xml.dom import minidom
+    doc = minidom.parseString(text.encode("utf-8"))
+    return doc.childNodes, ET.tostring(ET.fromstring(text))
+
+
+class HostileText(unittest.TestCase):
+    """User text in the MJCF: the document parses, its elements and
+    attributes are those of the paper model's, and the text stays in the
+    one header comment."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.nodes, cls.tree = xml_nodes(prru_mjcf.render(MODEL))
+
+    def check(self, path, description, file_name):
+        text = prru_mjcf.render(path)
+        nodes, tree = xml_nodes(text)
+        self.assertEqual(tree, self.tree)
+        self.assertEqual([n.nodeType for n in nodes],
+                         [n.nodeType for n in self.nodes])
+        header = nodes[0].data
+        self.assertIn("\n     %s\n" % prru_mjcf.xml_comment(description),
+                      header)
+        self.assertIn("`python3 gen/prru_mjcf.py %s`"
+                      % prru_mjcf.xml_comment(file_name), header)
+        self.assertEqual(len(re.findall("<!--", text)),
+                         len(re.findall("-->", text)))
+
+    def test_descriptions(self):
+        for description in HOSTILE_DESCRIPTIONS:
+            with self.subTest(description), \
+                    tempfile.TemporaryDirectory() as tmp:
+                path = modified_model(tmp, lambda d: d.update(
+                    description=description))
+                self.check(path, description, "model.json")
+
+    def test_file_names(self):
+        for name in HOSTILE_FILES:
+            with self.subTest(name), tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, name)
+                with open(MODEL, "rb") as f, open(path, "wb") as g:
+                    g.write(f.read())
+                self.check(path, prru_mjcf.model_mod.load(MODEL).description,
+                           name)
+
+    def test_written_file_parses(self):
+        # Through the command line: the file is UTF-8 XML (a file name that
+        # is not UTF-8 reaches Python as a lone surrogate).
+        with tempfile.TemporaryDirectory() as tmp:
+            path = modified_model(tmp, lambda d: d.update(
+                description=HOSTILE_DESCRIPTIONS[0]))
+            hostile = os.path.join(tmp, HOSTILE_FILES[2])
+            os.rename(path, hostile)
+            out = os.path.join(tmp, "out.xml")
+            r = run(hostile, "--out", out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(out, "rb") as f:
+                self.assertEqual(xml_nodes(f.read().decode("utf-8"))[1],
+                                 self.tree)
+
+    def test_comment_and_attribute_escaping(self):
+        for t in HOSTILE_DESCRIPTIONS + HOSTILE_FILES:
+            with self.subTest(t):
+                c = prru_mjcf.xml_comment(t)
+                self.assertNotIn("--", c)
+                self.assertFalse(c.endswith("-"))
+                a = prru_mjcf.xml_attribute(t)
+                root = ET.fromstring('<a v="%s"/>' % a)
+                self.assertEqual(root.get("v"), prru_mjcf._NOT_ONE_LINE_TEXT
+                                 .sub(" ", t))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -1,8 +1,12 @@
 """Stopping the generator: a SIGTERM, SIGHUP or SIGINT at any moment
 leaves the output directory with either the old files or the complete new
-set, and no hidden temporary file; a model that assembles only near full
-stretch is generated with a warning."""
+set, and no hidden temporary file; so does a failed write (a full disk),
+which also leaves no directory it created; a model that assembles only
+near full stretch is generated with a warning."""
 
+import contextlib
+import errno
+import io
 import json
 import os
 import signal
@@ -59,6 +63,81 @@ class AtomicWrites(unittest.TestCase):
             with self.assertRaises(output.Terminated):
                 output.write_files_atomically(self.dir, self.new)
         self.assertEqual(listing(self.dir), {"a.c": b"new a", "b.h": b"new b"})
+
+
+class _FullDisk(io.StringIO):
+    def write(self, text):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def full_disk():
+    """Every file the writer opens fails its write with ENOSPC, as on a
+    full file system (no small tmpfs needed)."""
+    def fdopen(fd, *args, **kwargs):
+        os.close(fd)
+        return _FullDisk()
+    return mock.patch.object(output.os, "fdopen", fdopen)
+
+
+def tree(d):
+    """Every path under d, directories and hidden files included."""
+    return sorted(os.path.relpath(os.path.join(folder, n), d)
+                  for folder, dirs, files in os.walk(d) for n in dirs + files)
+
+
+class FailedWrites(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.root = self.tmp.name
+        self.files = {"a.c": "new a", "b.h": "new b"}
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_full_disk_leaves_no_directory_it_created(self):
+        for out in ("out", os.path.join("new", "nested", "out")):
+            with self.subTest(out), full_disk():
+                with self.assertRaises(OSError) as ctx:
+                    output.write_files_atomically(
+                        os.path.join(self.root, out), self.files)
+                self.assertEqual(ctx.exception.errno, errno.ENOSPC)
+                self.assertEqual(tree(self.root), [])
+
+    def test_full_disk_keeps_an_existing_directory_as_it_was(self):
+        out = os.path.join(self.root, "parent", "out")
+        output.write_files_atomically(out, {"a.c": "old a"})
+        with full_disk(), self.assertRaises(OSError):
+            output.write_files_atomically(out, self.files)
+        self.assertEqual(tree(self.root), ["parent", "parent/out",
+                                           "parent/out/a.c"])
+        self.assertEqual(listing(out), {"a.c": b"old a"})
+        # An existing empty directory stays too.
+        os.unlink(os.path.join(out, "a.c"))
+        with full_disk(), self.assertRaises(OSError):
+            output.write_files_atomically(out, self.files)
+        self.assertEqual(tree(self.root), ["parent", "parent/out"])
+
+    def test_new_directory_is_complete_with_the_usual_mode(self):
+        out = os.path.join(self.root, "a", "out")
+        output.write_files_atomically(out, self.files)
+        self.assertEqual(tree(self.root), ["a", "a/out", "a/out/a.c",
+                                           "a/out/b.h"])
+        mask = os.umask(0)
+        os.umask(mask)
+        self.assertEqual(os.stat(out).st_mode & 0o777, 0o777 & ~mask)
+
+    def test_generator_on_a_full_disk(self):
+        import prru_gen
+        out = os.path.join(self.root, "gen", "out")
+        err = io.StringIO()
+        with full_disk(), contextlib.redirect_stderr(err), \
+                mock.patch.object(prru_gen, "generate_model",
+                                  lambda model, prefix: (self.files, [])):
+            rc = prru_gen.main([PAPER, "--out", out, "--quiet"])
+        self.assertEqual(rc, 1)
+        self.assertEqual(err.getvalue(), "prru_gen: error: %s: cannot write: "
+                         "%s\n" % (out, os.strerror(errno.ENOSPC)))
+        self.assertEqual(tree(self.root), [])
 
 
 class KilledGenerator(unittest.TestCase):

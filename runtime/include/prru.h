@@ -402,6 +402,29 @@ int prru_parse_double(const char *s, double *out);
 int prru_parse_value(const char *s, double *out);
 int prru_parse_values(const char *s, double *out, int n);
 
+/* ---- Model files written by programs (prru identify, prru optimize) ----
+ * A model file's "description" is one line of at most
+ * PRRU_DESCRIPTION_MAX characters (Unicode code points) of UTF-8 text
+ * without a star followed by a slash (the generator's rule,
+ * gen/prrugen/model.py); a description built from user text (a file path)
+ * goes through prru_description first. */
+#define PRRU_DESCRIPTION_MAX 400
+/* Bytes that always hold prru_description's result. */
+#define PRRU_DESCRIPTION_SIZE (4 * PRRU_DESCRIPTION_MAX + 1)
+/* text as a valid description, into out (size bytes, at least 1;
+ * PRRU_DESCRIPTION_SIZE always suffice): well-formed UTF-8 is kept, every
+ * byte of a malformed sequence and every control character becomes '?',
+ * the slash after a star becomes '|', and a text of more than
+ * PRRU_DESCRIPTION_MAX characters keeps its start and its end around
+ * "..." (the end of a path names the file). Returns out. A description
+ * still needs its JSON escapes (quotes, backslashes) in the file. */
+char *prru_description(char *out, size_t size, const char *text);
+/* Bytes (1 to 4) of the well-formed UTF-8 sequence of one character at s
+ * (RFC 3629: no overlong form, no surrogate, at most U+10FFFF; ASCII
+ * included, NUL excluded), 0 when s does not start one. For writers of
+ * formats that must be UTF-8 (JSON, XML). */
+size_t prru_utf8_char(const char *s);
+
 #ifdef __cplusplus
 }
 #endif
