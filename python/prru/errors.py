@@ -47,7 +47,9 @@ class Unreachable(PrruError):
 
 
 class Singular(PrruError):
-    """PRRU_ESINGULAR: J_d is singular (rank-deficient) to the model's tolerance."""
+    """PRRU_ESINGULAR: J_d is singular (rank-deficient) to the model's tolerance,
+    or the state is too near the workspace boundary to trust the dynamics (the
+    mass matrix's conditioning: the model's mass_rcond_min)."""
 
     status = ESINGULAR
 
