@@ -514,17 +514,15 @@ static int parse_map_rows(const char *path, char *rows, const prru_map_grid *g, 
     next = next_line(line);
     if (!next) next = line + strlen(line);
     double q[3], v;
-    char stat[32];
-    if (k >= count || sscanf(line, "%lf,%lf,%lf,%lf,%31s", &q[0], &q[1], &q[2], &v, stat) != 5) {
-      prru_cli_error("merge", "%s: row %ld is not a map row of this shard", path, k + 1);
+    int s;
+    const char *why = k < count ? prru_cli_map_parse_row(line, q, &v, &s) : "more rows than the shard has";
+    if (why) {
+      prru_cli_error("merge", "%s: row %ld: %s", path, k + 1, why);
       return 2;
     }
     long idx = first + k;
-    int i = (int)(idx / g->n2), j = (int)(idx % g->n2), s = -1;
-    const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_DME_OTHER_MODE};
-    for (int c = 0; c < 4; c++)
-      if (strcmp(stat, prru_dme_status_name(codes[c])) == 0) s = codes[c];
-    if (s < 0 || q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
+    int i = (int)(idx / g->n2), j = (int)(idx % g->n2);
+    if (q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
         q[1] != prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j) || q[2] != g->q3) {
       prru_cli_error("merge", "%s: row %ld does not belong to this grid", path, k + 1);
       return 2;

@@ -191,7 +191,23 @@ expect 2 "another sweep or settings" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" -
 "$PRRU" map "${M[@]}" --shard 2/2 --out "$tmp/m/b.csv" >/dev/null
 expect 2 "only for sensitivity" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv" --plot "$tmp/m/x.png"
 sed -E '5s/,[a-z_]+$/,bogus/' "$tmp/m/a.csv" >"$tmp/m/c.csv"
-expect 2 "does not belong to this grid" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+expect 2 "c.csv: row 2: expected q1,q2,q3,w_R,status" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+sed -E '5s/^[^,]+,/0.5,/' "$tmp/m/a.csv" >"$tmp/m/c.csv"
+expect 2 "c.csv: row 2 does not belong to this grid" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+# Values no map has (w_R = sigma_1/sigma_2 >= 1, finite where ok, NaN
+# elsewhere) are refused as prru plot refuses them, naming the file and the
+# row, instead of a global index of nan.
+ok_line=$(grep -n ',ok$' "$tmp/m/a.csv" | head -1 | cut -d: -f1)
+ok_row=$((ok_line - 3))
+sing_line=$(grep -n ',NaN,[a-z_]*$' "$tmp/m/a.csv" | head -1 | cut -d: -f1)
+[ -n "$ok_line" ] && [ -n "$sing_line" ] && ok || bad "the map shard has no ok or no other row (test input changed)"
+for v in NaN inf 1e999 -5 0.5; do
+  sed -E "${ok_line}s/,[^,]+,ok\$/,$v,ok/" "$tmp/m/a.csv" >"$tmp/m/c.csv"
+  expect 2 "c.csv: row $ok_row: expected" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+  expect 2 "c.csv:$ok_line: expected" -- plot "$tmp/m/c.csv" --out "$tmp/m/x.png"
+done
+sed -E "${sing_line}s/,NaN,([a-z_]+)\$/,1.5,\1/" "$tmp/m/a.csv" >"$tmp/m/c.csv"
+expect 2 "c.csv: row $((sing_line - 3)): expected" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
 [ -e "$tmp/m/x.csv" ] && bad "a refused map merge wrote its file" || ok
 
 echo "test_cli_design: $pass passed, $fail failed"
