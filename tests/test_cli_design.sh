@@ -77,6 +77,23 @@ ok = ok and abs(new['b'][0] - b1) <= 0.05 * b1 * (1 + 1e-12)
 sys.exit(0 if ok else 1)
 PY
 
+# Tied limbs whose lengths differ (the last limb's l2 set 0.01 m shorter):
+# every limb keeps its own -+ 5 % of its start (tied parameters move by one
+# shift, so the bounds are the intersection of every limb's), within the
+# rounding of the 17-digit model file (1e-12 relative, as above).
+mkdir "$tmp/o3"
+short=0.215
+opt --set "l2_$nact=$short" --out "$tmp/o3/m.json" --report "$tmp/o3/rep" >/dev/null 2>"$tmp/o3/stderr" \
+  || bad "optimize with unequal limbs failed: $(head -c 300 "$tmp/o3/stderr")"
+python3 - "$tmp/o3/m.json" "$PRRU_MODEL" "$short" <<'PY' && ok || bad "a tied limb left its own bounds: $(json "$tmp/o3/m.json" "d['geometry']['l2']")"
+import json, sys
+new = json.load(open(sys.argv[1]))['geometry']['l2']
+old = json.load(open(sys.argv[2]))['geometry']['l2']
+old = list(old) if isinstance(old, list) else [old] * len(new)
+old[-1] = float(sys.argv[3])
+sys.exit(0 if all(abs(x - y) <= 0.05 * y * (1 + 1e-12) for x, y in zip(new, old)) else 1)
+PY
+
 # ---- optimize: bad input, nothing written ----
 mkdir "$tmp/bad"
 B=(--q1 "$Q1" --q2 "$Q2" --out "$tmp/bad/m.json" --report "$tmp/bad/rep")
@@ -154,6 +171,9 @@ expect 2 "not a design parameter" -- sensitivity "${S[@]}" --params b_1,zz --out
 expect 2 "--shard '0/3'" -- sensitivity "${S[@]}" --shard 0/3 --out "$tmp/s/x.csv"
 expect 2 "--shard '4/3'" -- sensitivity "${S[@]}" --shard 4/3 --out "$tmp/s/x.csv"
 expect 2 "--step" -- sensitivity "${S[@]}" --step 0.7 --out "$tmp/s/x.csv"
+# A step that rounding loses (h far below DBL_EPSILON x the value) would
+# give every derivative exactly 0: refused, naming --step.
+expect 2 "--step '1e-300': b_1: the step" -- sensitivity "${S[@]}" --step 1e-300 --out "$tmp/s/x.csv"
 expect 1 "no grid point of the workspace is regular" -- sensitivity "${NOREG[@]}" --out "$tmp/s/x.csv"
 [ -e "$tmp/s/x.csv" ] && bad "a refused sensitivity wrote its file" || ok
 # Broken shard sets: nothing merged.
