@@ -1176,6 +1176,11 @@ int prru_cmd_optimize(int argc, char **argv)
     prru_cli_out_close(&jo, 0);
     return 1;
   }
+  /* The stage becomes DIR: the mode mkdir(DIR, 0777) would give it, not
+   * mkdtemp's private 0700. */
+  mode_t mask = umask(0);
+  umask(mask);
+  chmod(stage, 0777 & ~mask);
   prru_design_data dd;
   prru_design_eval ev0;
   rc = prru_design_data_alloc(&dd, &pr.grid) == PRRU_OK ? 0 : 1;

@@ -83,8 +83,11 @@ PY
 # rounding of the 17-digit model file (1e-12 relative, as above).
 mkdir "$tmp/o3"
 short=0.215
-opt --set "l2_$nact=$short" --out "$tmp/o3/m.json" --report "$tmp/o3/rep" >/dev/null 2>"$tmp/o3/stderr" \
+(umask 022 && opt --set "l2_$nact=$short" --out "$tmp/o3/m.json" --report "$tmp/o3/rep" >/dev/null 2>"$tmp/o3/stderr") \
   || bad "optimize with unequal limbs failed: $(head -c 300 "$tmp/o3/stderr")"
+# The report directory gets the mode mkdir(2) gives under the umask (022:
+# 755, as prru paper's), not the staging directory's private 700.
+[ "$(stat -c %a "$tmp/o3/rep")" = 755 ] && ok || bad "optimize --report under umask 022: mode $(stat -c %a "$tmp/o3/rep")"
 python3 - "$tmp/o3/m.json" "$PRRU_MODEL" "$short" <<'PY' && ok || bad "a tied limb left its own bounds: $(json "$tmp/o3/m.json" "d['geometry']['l2']")"
 import json, sys
 new = json.load(open(sys.argv[1]))['geometry']['l2']
