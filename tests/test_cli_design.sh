@@ -174,6 +174,21 @@ expect 2 "not a design parameter" -- sensitivity "${S[@]}" --params b_1,zz --out
 expect 2 "--shard '0/3'" -- sensitivity "${S[@]}" --shard 0/3 --out "$tmp/s/x.csv"
 expect 2 "--shard '4/3'" -- sensitivity "${S[@]}" --shard 4/3 --out "$tmp/s/x.csv"
 expect 2 "--step" -- sensitivity "${S[@]}" --step 0.7 --out "$tmp/s/x.csv"
+# A bar chart that gnuplot leaves cut short (a full disk: gnuplot still
+# exits 0) is exit 1, and the previous picture stays.
+if command -v gnuplot >/dev/null; then
+  mkdir -p "$tmp/cutbin"
+  printf '#!/bin/sh\n"%s" "$@" || exit $?\nfor f in *.png; do truncate -s 300 "$f"; done\n' \
+    "$(command -v gnuplot)" >"$tmp/cutbin/gnuplot"
+  chmod +x "$tmp/cutbin/gnuplot"
+  echo "old picture" >"$tmp/s/bars.png"
+  PATH="$tmp/cutbin:$PATH" "$PRRU" sensitivity "${S[@]}" --params b_1 --out "$tmp/s/b1.csv" \
+    --plot "$tmp/s/bars.png" >/dev/null 2>"$tmp/err"
+  st=$?
+  [ $st -eq 1 ] && grep -q "sens.png: gnuplot exited 0 but the file is not complete" "$tmp/err" \
+    && [ "$(cat "$tmp/s/bars.png")" = "old picture" ] && ok \
+    || bad "sensitivity --plot cut short: exit $st, $(head -c 300 "$tmp/err")"
+fi
 # A step that rounding loses (h far below DBL_EPSILON x the value) would
 # give every derivative exactly 0: refused, naming --step.
 expect 2 "--step '1e-300': b_1: the step" -- sensitivity "${S[@]}" --step 1e-300 --out "$tmp/s/x.csv"
