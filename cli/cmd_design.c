@@ -257,7 +257,9 @@ static const char sens_help[] =
     "parameter of the design (the paper's influence of the kinematic and inertial\n"
     "parameters on w_R), by central differences with the step h = H x scale\n"
     "(default H 1e-4; scale: the parameter's magnitude, or where it may be 0 the\n"
-    "body's mean principal moment, the mean upper link, the mean slider mass).\n"
+    "body's mean principal moment, the mean upper link, the mean slider mass);\n"
+    "H in (0, 0.5), and h at least 100 x 2.2e-16 (the rounding unit) x the\n"
+    "parameter's magnitude (a smaller step is lost to rounding: exit 2).\n"
     "The design is the model's numbers with the --set changes (names as in\n"
     "'prru optimize --help'); the grid as in 'prru map'; J_d regular where\n"
     "1/(|J|_1 |J^-1|_1) >= R (default 4e-3). --params: the parameters (default:\n"
@@ -367,6 +369,13 @@ int prru_cmd_sensitivity(int argc, char **argv)
   }
   param_list pl;
   int rc = parse_params(cmd, params, &pl);
+  for (int i = 0; i < pl.nparam && !rc; i++) {
+    char msg[512];
+    if (prru_design_step_check(&p, &pl.vars[i], h, msg, sizeof msg) != PRRU_OK) {
+      prru_cli_error(cmd, "--step '%s': %s", steps, msg);
+      rc = 2;
+    }
+  }
   if (rc) {
     free(pl.vars);
     return rc;
@@ -514,17 +523,15 @@ static int parse_map_rows(const char *path, char *rows, const prru_map_grid *g, 
     next = next_line(line);
     if (!next) next = line + strlen(line);
     double q[3], v;
-    char stat[32];
-    if (k >= count || sscanf(line, "%lf,%lf,%lf,%lf,%31s", &q[0], &q[1], &q[2], &v, stat) != 5) {
-      prru_cli_error("merge", "%s: row %ld is not a map row of this shard", path, k + 1);
+    int s;
+    const char *why = k < count ? prru_cli_map_parse_row(line, q, &v, &s) : "more rows than the shard has";
+    if (why) {
+      prru_cli_error("merge", "%s: row %ld: %s", path, k + 1, why);
       return 2;
     }
     long idx = first + k;
-    int i = (int)(idx / g->n2), j = (int)(idx % g->n2), s = -1;
-    const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_DME_OTHER_MODE};
-    for (int c = 0; c < 4; c++)
-      if (strcmp(stat, prru_dme_status_name(codes[c])) == 0) s = codes[c];
-    if (s < 0 || q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
+    int i = (int)(idx / g->n2), j = (int)(idx % g->n2);
+    if (q[0] != prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i) ||
         q[1] != prru_map_axis(g->q2_lo, g->q2_hi, g->n2, j) || q[2] != g->q3) {
       prru_cli_error("merge", "%s: row %ld does not belong to this grid", path, k + 1);
       return 2;
@@ -765,14 +772,6 @@ static const char opt_help[] =
     "with LO >= HI or not around the start, a --report that is a file: exit 2.\n"
     "No regular grid point at the start: exit 1.\n";
 
-/* Bounds -+ pct % of the start value (of the variable's scale at 0). */
-static void default_bounds(const prru_params *p, prru_design_var *v, double pct)
-{
-  double x = prru_design_get(p, v), r = fabs(x) > 0 ? fabs(x) : prru_design_scale(p, v);
-  v->lo = x - pct / 100 * r;
-  v->hi = x + pct / 100 * r;
-}
-
 static int parse_vars(const char *cmd, const char *text, double pct, const prru_params *p,
                       prru_design_var *vars, int *n)
 {
@@ -795,7 +794,7 @@ static int parse_vars(const char *cmd, const char *text, double pct, const prru_
       rc = parse_pair(cmd, opt, eq + 1, &vars[*n].lo, &vars[*n].hi);
       (*n)++;
     } else {
-      default_bounds(p, &vars[(*n)++], pct);
+      prru_design_var_bounds(p, &vars[(*n)++], pct); /* every tied limb within pct % */
     }
   }
   free(buf);
@@ -1180,6 +1179,11 @@ int prru_cmd_optimize(int argc, char **argv)
     prru_cli_out_close(&jo, 0);
     return 1;
   }
+  /* The stage becomes DIR: the mode mkdir(DIR, 0777) would give it, not
+   * mkdtemp's private 0700. */
+  mode_t mask = umask(0);
+  umask(mask);
+  chmod(stage, 0777 & ~mask);
   prru_design_data dd;
   prru_design_eval ev0;
   rc = prru_design_data_alloc(&dd, &pr.grid) == PRRU_OK ? 0 : 1;

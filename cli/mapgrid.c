@@ -111,6 +111,34 @@ int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double
   return prru_cli_map_write_rows(o, g, w, st, 0, nrows, signal_count);
 }
 
+const char *prru_cli_map_parse_row(char *line, double q[3], double *w, int *status)
+{
+  static const char expected[] = "expected q1,q2,q3,w_R,status with finite numbers, a status of "
+                                 "prru map, w_R >= 1 where ok and NaN elsewhere";
+  static const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_DME_OTHER_MODE,
+                              PRRU_EINPUT};
+  char *field[5];
+  int n = 0;
+  for (char *c = line; n < 5; c++) { /* empty fields are fields */
+    field[n++] = c;
+    if (!(c = strchr(c, ','))) break;
+    *c = '\0';
+  }
+  if (n != 5 || strchr(field[4], ',')) return expected;
+  for (int i = 0; i < 3; i++)
+    if (prru_parse_double(field[i], &q[i]) != PRRU_OK) return expected;
+  *status = -1;
+  for (size_t c = 0; c < sizeof codes / sizeof codes[0]; c++)
+    if (strcmp(field[4], prru_dme_status_name(codes[c])) == 0) *status = codes[c];
+  if (*status < 0) return expected;
+  if (*status != PRRU_OK) {
+    *w = NAN;
+    return strcmp(field[3], "NaN") == 0 ? NULL : expected;
+  }
+  /* prru_parse_double refuses NaN, inf and overflow (1e999). */
+  return prru_parse_double(field[3], w) == PRRU_OK && *w >= 1.0 ? NULL : expected;
+}
+
 void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
 {
   fprintf(f, "model: %s\n", prru_cli_model_id());

@@ -60,6 +60,15 @@ int prru_cli_map_write_csv(prru_cli_out *o, const prru_map_grid *g, const double
  * as prru_cli_map_write_csv writes them. */
 int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const double *w,
                             const unsigned char *st, int r0, int r1, int signal_count);
+/* Checks one data row of a map CSV, "q1,q2,q3,w_R,status" as
+ * prru_cli_map_write_rows writes it (line without its end; changed in
+ * place): finite numbers q, a status name of prru_dme_status_name, w_R a
+ * finite number >= 1 (w_R = sigma_1/sigma_2) where ok and NaN elsewhere.
+ * NULL and the fields (*status: PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE,
+ * PRRU_DME_OTHER_MODE, or PRRU_EINPUT for "invalid"; *w NaN where not ok),
+ * else what a row must be (for a message naming the file and the row).
+ * The one check of the rows that prru plot and prru merge read. */
+const char *prru_cli_map_parse_row(char *line, double q[3], double *w, int *status);
 /* The summary `prru map` prints: model, point counts, global index,
  * singular fraction, mean ln w_R, range (key: value lines). */
 void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min);

@@ -18,10 +18,18 @@
 #include "plot.h"
 #include "prru.h"
 
-/* s as a single-quoted gnuplot string; escape_enhanced: with the
- * enhanced-text specials escaped (titles and labels, not file names). A
- * quote is joined in as "'" ('a'."'".'b'): gnuplot 5.4 misreads the
- * doubled quote '' next to another one or at the start of a string. */
+/* s as a gnuplot string expression of single-quoted pieces; escape_enhanced:
+ * for titles and labels (enhanced text), not file names. Single quotes
+ * take every byte as it is but the quote itself, so a quote and the
+ * control characters are joined in as double-quoted octal escapes
+ * ('it'."\047".'s'): a file name keeps every byte. Never a quote
+ * character: gnuplot 5.4 misreads the doubled quote '' next to another
+ * one, and its macro expansion takes the quote in "'" for the end of the
+ * single-quoted string, so that @name later in the text would be replaced
+ * by the variable name's value. In enhanced text a backslash starts an
+ * escape (\101 is A) and _ ^ { } @ & ~ are markup: each gets a backslash
+ * before it so that it prints as itself; a newline breaks the label, other
+ * control characters are dropped. */
 static void put_string(FILE *g, const char *s, int escape_enhanced)
 {
   /* Labels break at the first space after LABEL_WIDTH characters (a title
@@ -30,15 +38,18 @@ static void put_string(FILE *g, const char *s, int escape_enhanced)
   int col = 0;
   fputc('\'', g);
   for (const char *c = s; *c; c++, col++) {
-    if (escape_enhanced && *c == ' ' && col >= LABEL_WIDTH) {
+    unsigned char u = (unsigned char)*c;
+    if (escape_enhanced && (*c == '\n' || (*c == ' ' && col >= LABEL_WIDTH))) {
       fputs("'.\"\\n\".'", g);
       col = -1;
     } else if (*c == '\'')
-      fputs("'.\"'\".'", g);
-    else if (escape_enhanced && strchr("_^{}@&~", *c))
+      fputs("'.\"\\047\".'", g);
+    else if (escape_enhanced && strchr("\\_^{}@&~", *c))
       fprintf(g, "\\%c", *c);
-    else if ((unsigned char)*c >= 0x20)
+    else if (u >= 0x20 && u != 0x7f)
       fputc(*c, g);
+    else if (!escape_enhanced)
+      fprintf(g, "'.\"\\%03o\".'", u);
   }
   fputc('\'', g);
 }
@@ -70,6 +81,7 @@ static void show_messages(const char *log)
 }
 
 static int wait_gnuplot(const char *cmd, pid_t pid, const char *shown);
+static int check_outputs(const char *cmd, const char *dir, const char *shown_dir, const char *script);
 
 /* Writes script to path; 0 or 1 after a message naming shown. */
 static int write_script(const char *cmd, const char *path, const char *shown, const char *script)
@@ -126,7 +138,90 @@ int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
   int rc = wait_gnuplot(cmd, pid, shown);
   if (rc == 1) show_messages(log);
   unlink(log);
-  return rc;
+  /* gnuplot's status alone does not say that a picture is whole. */
+  return rc == 0 ? check_outputs(cmd, dir, shown_dir, script) : rc;
+}
+
+/* ---- the pictures gnuplot wrote ---- */
+
+/* The file name of a gnuplot string expression as put_string writes it
+ * (pieces '...' and "..." joined by '.') at *p, up to the end of the line,
+ * into name; 0, or -1 when the text is not such an expression. */
+static int parse_string(const char *p, char *name, size_t len)
+{
+  size_t n = 0;
+  for (;;) {
+    char q = *p++;
+    if (q != '\'' && q != '"') return -1;
+    while (*p && *p != q && *p != '\n') {
+      char c = *p++;
+      if (q == '"' && c == '\\') { /* only what put_string writes: \ooo */
+        if (!(p[0] >= '0' && p[0] <= '7' && p[1] >= '0' && p[1] <= '7' && p[2] >= '0' && p[2] <= '7'))
+          return -1;
+        c = (char)((p[0] - '0') * 64 + (p[1] - '0') * 8 + (p[2] - '0'));
+        p += 3;
+      }
+      if (n + 1 >= len) return -1;
+      name[n++] = c;
+    }
+    if (*p++ != q) return -1;
+    if (*p != '.') break;
+    p++;
+  }
+  name[n] = '\0';
+  return *p == '\n' || *p == '\0' ? 0 : -1;
+}
+
+/* Whether the file at path ends as a complete picture of its kind must:
+ * a PNG with its signature and its last chunk IEND (length 0, CRC
+ * AE426082), a GIF with its signature and the trailer 0x3B. gnuplot
+ * exits 0 when its writes fail (a full disk): a file cut short at any
+ * point lacks its ending. Another kind of file: not empty. NULL or why not. */
+static const char *picture_problem(const char *path)
+{
+  static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  static const unsigned char png_end[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  FILE *f = fopen(path, "rb");
+  if (!f) return strerror(errno);
+  unsigned char head[8] = {0}, tail[12] = {0};
+  size_t nh = fread(head, 1, sizeof head, f);
+  long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+  size_t nt = size >= 12 && fseek(f, -12, SEEK_END) == 0 ? fread(tail, 1, sizeof tail, f) : 0;
+  fclose(f);
+  size_t n = strlen(path);
+  int png = n >= 4 && strcmp(path + n - 4, ".png") == 0;
+  int gif = n >= 4 && strcmp(path + n - 4, ".gif") == 0;
+  if (size <= 0) return "empty";
+  if (png && (nh < 8 || memcmp(head, png_sig, 8) != 0)) return "not a PNG";
+  if (png && (nt < 12 || memcmp(tail, png_end, 12) != 0)) return "a PNG cut short (no IEND chunk at its end)";
+  if (gif && (nh < 6 || memcmp(head, "GIF8", 4) != 0)) return "not a GIF";
+  if (gif && (nt < 12 || tail[11] != 0x3b)) return "a GIF cut short (no trailer 0x3B at its end)";
+  return NULL;
+}
+
+/* Checks every file the script's `set output` lines name (relative to
+ * dir: every script of plot.c writes its pictures there); 0, or 1 after a
+ * message naming shown_dir/file. */
+static int check_outputs(const char *cmd, const char *dir, const char *shown_dir, const char *script)
+{
+  static const char key[] = "set output ";
+  for (const char *line = script; line && *line; line = strchr(line, '\n'), line = line ? line + 1 : NULL) {
+    while (*line == ' ') line++;
+    if (strncmp(line, key, sizeof key - 1) != 0) continue;
+    char name[PRRU_PLOT_PATH], path[2 * PRRU_PLOT_PATH + 2];
+    if (parse_string(line + sizeof key - 1, name, sizeof name) != 0) {
+      prru_cli_error(cmd, "internal error: a gnuplot script names its output in a way prru cannot check");
+      return 1;
+    }
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    const char *why = picture_problem(path);
+    if (why) {
+      prru_cli_error(cmd, "%s/%s: gnuplot exited 0 but the file is not complete: %s (disk full?)",
+                     shown_dir, name, why);
+      return 1;
+    }
+  }
+  return 0;
 }
 
 /* Waits for gnuplot; the exit status as prru_plot_run returns it. */

@@ -26,7 +26,11 @@
  * script's relative file names (data and PNGs) are dir's. Messages name
  * shown_dir/script_name instead (shown_dir: where the files will end up
  * when dir is a staging directory; pass dir otherwise). Waits while
- * polling prru_cli_interrupted: on a signal gnuplot gets SIGTERM. */
+ * polling prru_cli_interrupted: on a signal gnuplot gets SIGTERM. When
+ * gnuplot exits 0, every file the script's `set output` lines name must
+ * be complete (a PNG ending in its IEND chunk, a GIF in its trailer):
+ * else 1, so that the caller, which renders in a staging or scratch
+ * directory, leaves the previous output as it was. */
 int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
                   const char *script_name, const char *script);
 
@@ -34,12 +38,14 @@ int prru_plot_run(const char *cmd, const char *dir, const char *shown_dir,
  * prru_plot_label writes it). */
 void prru_plot_model_var(FILE *g);
 
-/* Text as a gnuplot string expression: single-quoted, a quote in the text
- * joined in as "'" ('it'."'".'s'), control characters dropped; for where
- * gnuplot takes an expression (assignments, set output).
- * prru_plot_string for file names,
- * prru_plot_label for titles (enhanced-text specials _ ^ { } @ & ~
- * escaped so that they print as themselves). */
+/* Text as a gnuplot string expression: single-quoted pieces, a quote and
+ * control characters joined in as octal escapes ('it'."\047".'s'), no
+ * quote character anywhere that gnuplot's macro expansion could misread;
+ * for where gnuplot takes an expression (assignments, set output).
+ * prru_plot_string for file names (every byte kept),
+ * prru_plot_label for titles (backslash and the enhanced-text specials
+ * _ ^ { } @ & ~ escaped so that they print as themselves, a newline
+ * breaks the line, other control characters dropped). */
 void prru_plot_string(FILE *g, const char *s);
 void prru_plot_label(FILE *g, const char *s);
 

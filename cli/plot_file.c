@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "commands.h"
+#include "mapgrid.h"
 #include "plot.h"
 #include "prru.h"
 
@@ -101,31 +102,15 @@ static int read_head(FILE *f, csv_comments *c, char **header, long *line_no)
 
 /* ---- map CSVs ---- */
 
-/* One map row "q1,q2,q3,w,status": 0 and the fields, else -1. kind: 0 ok,
- * 1 singular or unreachable, 2 other assembly mode. */
-static int parse_map_row(char *line, double q[3], double *w, int *kind)
+/* One map row (prru_cli_map_parse_row): NULL and the fields, else the
+ * reason. kind: 0 ok, 1 singular, unreachable or invalid, 2 other
+ * assembly mode. */
+static const char *parse_map_row(char *line, double q[3], double *w, int *kind)
 {
-  char *field[5], *save = NULL;
-  int n = 0;
-  for (char *tok = strtok_r(line, ",", &save); tok && n < 6; tok = strtok_r(NULL, ",", &save))
-    if (n++ < 5) field[n - 1] = tok;
-  if (n != 5) return -1;
-  for (int i = 0; i < 3; i++)
-    if (prru_parse_double(field[i], &q[i]) != PRRU_OK) return -1;
-  const char *st = field[4];
-  if (strcmp(st, "ok") == 0) {
-    *kind = 0;
-    return prru_parse_double(field[3], w) == PRRU_OK && *w >= 1.0 ? 0 : -1;
-  }
-  if (strcmp(field[3], "NaN") != 0) return -1;
-  *w = NAN;
-  if (strcmp(st, "singular") == 0 || strcmp(st, "unreachable") == 0 || strcmp(st, "invalid") == 0)
-    *kind = 1;
-  else if (strcmp(st, "other_mode") == 0)
-    *kind = 2;
-  else
-    return -1;
-  return 0;
+  int st;
+  const char *why = prru_cli_map_parse_row(line, q, w, &st);
+  *kind = st == PRRU_OK ? 0 : st == PRRU_DME_OTHER_MODE ? 2 : 1;
+  return why;
 }
 
 /* The grid as read: q1 blocks (q1 outer, increasing) of n2 rows with the
@@ -188,9 +173,7 @@ static int convert_map(const char *cmd, const char *path, FILE *f, long line_no,
     if (line[0] == '#') continue;
     double q[3], w;
     int kind;
-    const char *why = parse_map_row(line, q, &w, &kind) ? "expected q1,q2,q3,w_R,status with numbers, "
-                                                          "w_R >= 1 where ok and NaN elsewhere" :
-                                                          NULL;
+    const char *why = parse_map_row(line, q, &w, &kind);
     long n1_before = m->n1;
     if (!why) why = scan_row(m, q, w, kind);
     if (why) {

@@ -1,11 +1,14 @@
 # Installation: `cmake --install BUILD [--prefix DIR]` writes
 #   bin/prru                  the command-line tool
 #   lib/libprru.so*           runtime + kernels, shared            (prru::prru)
+#   lib/libprru.a             runtime + kernels, static: -lprru of
+#                             `pkg-config --static --libs prru`
 #   lib/libprru_runtime.a     the runtime, static, with the next   (prru::prru_static)
 #   lib/libprru_kernels.a     the generated kernels alone, libm    (prru::kernels)
 #   include/prru/*.h          runtime and generated headers
 #   lib/cmake/prru/           find_package(prru): config, version, targets
-#   lib/pkgconfig/prru.pc     pkg-config, for the shared library
+#   lib/pkgconfig/prru.pc     pkg-config: -lprru, shared, or static with
+#                             --static (adds GSL, libpthread, libm)
 #   share/prru/MODEL.json     the model file the kernels come from
 # (lib is GNUInstallDirs' CMAKE_INSTALL_LIBDIR.)
 #
@@ -34,6 +37,13 @@ install(TARGETS prru_shared prru_runtime prru_kernels EXPORT prruTargets
         LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}"
         ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
         INCLUDES DESTINATION "${PRRU_INSTALL_INCLUDEDIR}")
+# libprru.a, the static twin of libprru.so under the name -lprru, so that
+# `pkg-config --static --libs prru` links: the objects prru_runtime and
+# prru_kernels are built from, archived once more (nothing is compiled
+# again). Not exported: CMake users link prru::prru_static.
+add_library(prru_archive STATIC $<TARGET_OBJECTS:prru_runtime> $<TARGET_OBJECTS:prru_kernels>)
+set_target_properties(prru_archive PROPERTIES OUTPUT_NAME prru LINKER_LANGUAGE C)
+install(TARGETS prru_archive ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}")
 # Whole directories, so that a header added to runtime/include or a file
 # pair added to the generator's output is installed without a change here.
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/runtime/include/"
@@ -57,10 +67,23 @@ install(FILES "${PROJECT_BINARY_DIR}/prruConfig.cmake"
 # prru.pc carries absolute paths, and the prefix is only known when
 # installing (cmake --install --prefix DIR overrides CMAKE_INSTALL_PREFIX):
 # everything but the prefix is filled in now, the prefix by the install
-# script.
+# script. A path in prru.pc is escaped as pkg-config reads it (pkgconf
+# splits Cflags and Libs like a shell: a backslash before a space, tab,
+# quote, backslash or '#' keeps it in the word, and pkg-config prints it so
+# escaped, for the shell that runs the compiler: a Makefile's recipe, or
+# `eval`). prru_pc_escape.cmake escapes pc_path in place, for the paths
+# known now and for the prefix at install time (one text for both).
+file(WRITE "${PROJECT_BINARY_DIR}/prru_pc_escape.cmake" [=[
+string(REPLACE "\\" "\\\\" pc_path "${pc_path}")
+foreach(c " " "\t" "\"" "'" "#")
+  string(REPLACE "${c}" "\\${c}" pc_path "${pc_path}")
+endforeach()
+]=])
 foreach(kind LIB INCLUDE)
   if(IS_ABSOLUTE "${CMAKE_INSTALL_${kind}DIR}")
-    set(PRRU_PC_${kind}DIR "${CMAKE_INSTALL_${kind}DIR}")
+    set(pc_path "${CMAKE_INSTALL_${kind}DIR}")
+    include("${PROJECT_BINARY_DIR}/prru_pc_escape.cmake")
+    set(PRRU_PC_${kind}DIR "${pc_path}")
   else()
     set(PRRU_PC_${kind}DIR "\${prefix}/${CMAKE_INSTALL_${kind}DIR}")
   endif()
@@ -74,6 +97,8 @@ else()
 endif()
 # file(INSTALL) adds DESTDIR, the manifest entry and the "Installing:" line.
 install(CODE "
-  set(PRRU_PC_PREFIX \"\${CMAKE_INSTALL_PREFIX}\")
+  set(pc_path \"\${CMAKE_INSTALL_PREFIX}\")
+  include(\"${PROJECT_BINARY_DIR}/prru_pc_escape.cmake\")
+  set(PRRU_PC_PREFIX \"\${pc_path}\")
   configure_file(\"${PROJECT_BINARY_DIR}/prru.pc.in\" \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" @ONLY)
   file(INSTALL \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" DESTINATION \"${prru_pc_destination}\")")

@@ -77,6 +77,26 @@ ok = ok and abs(new['b'][0] - b1) <= 0.05 * b1 * (1 + 1e-12)
 sys.exit(0 if ok else 1)
 PY
 
+# Tied limbs whose lengths differ (the last limb's l2 set 0.01 m shorter):
+# every limb keeps its own -+ 5 % of its start (tied parameters move by one
+# shift, so the bounds are the intersection of every limb's), within the
+# rounding of the 17-digit model file (1e-12 relative, as above).
+mkdir "$tmp/o3"
+short=0.215
+(umask 022 && opt --set "l2_$nact=$short" --out "$tmp/o3/m.json" --report "$tmp/o3/rep" >/dev/null 2>"$tmp/o3/stderr") \
+  || bad "optimize with unequal limbs failed: $(head -c 300 "$tmp/o3/stderr")"
+# The report directory gets the mode mkdir(2) gives under the umask (022:
+# 755, as prru paper's), not the staging directory's private 700.
+[ "$(stat -c %a "$tmp/o3/rep")" = 755 ] && ok || bad "optimize --report under umask 022: mode $(stat -c %a "$tmp/o3/rep")"
+python3 - "$tmp/o3/m.json" "$PRRU_MODEL" "$short" <<'PY' && ok || bad "a tied limb left its own bounds: $(json "$tmp/o3/m.json" "d['geometry']['l2']")"
+import json, sys
+new = json.load(open(sys.argv[1]))['geometry']['l2']
+old = json.load(open(sys.argv[2]))['geometry']['l2']
+old = list(old) if isinstance(old, list) else [old] * len(new)
+old[-1] = float(sys.argv[3])
+sys.exit(0 if all(abs(x - y) <= 0.05 * y * (1 + 1e-12) for x, y in zip(new, old)) else 1)
+PY
+
 # ---- optimize: bad input, nothing written ----
 mkdir "$tmp/bad"
 B=(--q1 "$Q1" --q2 "$Q2" --out "$tmp/bad/m.json" --report "$tmp/bad/rep")
@@ -154,6 +174,24 @@ expect 2 "not a design parameter" -- sensitivity "${S[@]}" --params b_1,zz --out
 expect 2 "--shard '0/3'" -- sensitivity "${S[@]}" --shard 0/3 --out "$tmp/s/x.csv"
 expect 2 "--shard '4/3'" -- sensitivity "${S[@]}" --shard 4/3 --out "$tmp/s/x.csv"
 expect 2 "--step" -- sensitivity "${S[@]}" --step 0.7 --out "$tmp/s/x.csv"
+# A bar chart that gnuplot leaves cut short (a full disk: gnuplot still
+# exits 0) is exit 1, and the previous picture stays.
+if command -v gnuplot >/dev/null; then
+  mkdir -p "$tmp/cutbin"
+  printf '#!/bin/sh\n"%s" "$@" || exit $?\nfor f in *.png; do truncate -s 300 "$f"; done\n' \
+    "$(command -v gnuplot)" >"$tmp/cutbin/gnuplot"
+  chmod +x "$tmp/cutbin/gnuplot"
+  echo "old picture" >"$tmp/s/bars.png"
+  PATH="$tmp/cutbin:$PATH" "$PRRU" sensitivity "${S[@]}" --params b_1 --out "$tmp/s/b1.csv" \
+    --plot "$tmp/s/bars.png" >/dev/null 2>"$tmp/err"
+  st=$?
+  [ $st -eq 1 ] && grep -q "sens.png: gnuplot exited 0 but the file is not complete" "$tmp/err" \
+    && [ "$(cat "$tmp/s/bars.png")" = "old picture" ] && ok \
+    || bad "sensitivity --plot cut short: exit $st, $(head -c 300 "$tmp/err")"
+fi
+# A step that rounding loses (h far below DBL_EPSILON x the value) would
+# give every derivative exactly 0: refused, naming --step.
+expect 2 "--step '1e-300': b_1: the step" -- sensitivity "${S[@]}" --step 1e-300 --out "$tmp/s/x.csv"
 expect 1 "no grid point of the workspace is regular" -- sensitivity "${NOREG[@]}" --out "$tmp/s/x.csv"
 [ -e "$tmp/s/x.csv" ] && bad "a refused sensitivity wrote its file" || ok
 # Broken shard sets: nothing merged.
@@ -191,7 +229,23 @@ expect 2 "another sweep or settings" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" -
 "$PRRU" map "${M[@]}" --shard 2/2 --out "$tmp/m/b.csv" >/dev/null
 expect 2 "only for sensitivity" -- merge --in "$tmp/m/a.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv" --plot "$tmp/m/x.png"
 sed -E '5s/,[a-z_]+$/,bogus/' "$tmp/m/a.csv" >"$tmp/m/c.csv"
-expect 2 "does not belong to this grid" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+expect 2 "c.csv: row 2: expected q1,q2,q3,w_R,status" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+sed -E '5s/^[^,]+,/0.5,/' "$tmp/m/a.csv" >"$tmp/m/c.csv"
+expect 2 "c.csv: row 2 does not belong to this grid" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+# Values no map has (w_R = sigma_1/sigma_2 >= 1, finite where ok, NaN
+# elsewhere) are refused as prru plot refuses them, naming the file and the
+# row, instead of a global index of nan.
+ok_line=$(grep -n ',ok$' "$tmp/m/a.csv" | head -1 | cut -d: -f1)
+ok_row=$((ok_line - 3))
+sing_line=$(grep -n ',NaN,[a-z_]*$' "$tmp/m/a.csv" | head -1 | cut -d: -f1)
+[ -n "$ok_line" ] && [ -n "$sing_line" ] && ok || bad "the map shard has no ok or no other row (test input changed)"
+for v in NaN inf 1e999 -5 0.5; do
+  sed -E "${ok_line}s/,[^,]+,ok\$/,$v,ok/" "$tmp/m/a.csv" >"$tmp/m/c.csv"
+  expect 2 "c.csv: row $ok_row: expected" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
+  expect 2 "c.csv:$ok_line: expected" -- plot "$tmp/m/c.csv" --out "$tmp/m/x.png"
+done
+sed -E "${sing_line}s/,NaN,([a-z_]+)\$/,1.5,\1/" "$tmp/m/a.csv" >"$tmp/m/c.csv"
+expect 2 "c.csv: row $((sing_line - 3)): expected" -- merge --in "$tmp/m/c.csv,$tmp/m/b.csv" --out "$tmp/m/x.csv"
 [ -e "$tmp/m/x.csv" ] && bad "a refused map merge wrote its file" || ok
 
 echo "test_cli_design: $pass passed, $fail failed"

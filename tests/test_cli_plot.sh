@@ -139,6 +139,68 @@ sub = [l for l in open(sys.argv[1]) if l.startswith("sub = ")][0]
 parts = sub[len("sub = "):].strip().split("'.\"\\n\".'")
 assert len(parts) >= 3 and max(len(p) for p in parts) <= 130, [len(p) for p in parts]
 PY
+# gnuplot's work is checked, not only its exit status: a gnuplot that
+# fails, or one that exits 0 with its pictures cut short (as on a full
+# disk, where gnuplot 5.4 still exits 0) or empty, is exit 1 and leaves
+# the previous picture as it was, for every command that draws.
+fake_gnuplot() { # NAME SHELL-LINES-AFTER-THE-REAL-GNUPLOT
+  mkdir -p "$tmp/$1"
+  printf '#!/bin/sh\n"%s" "$@" || exit $?\n%s\n' "$real_gnuplot" "$2" >"$tmp/$1/gnuplot"
+  chmod +x "$tmp/$1/gnuplot"
+}
+fake_gnuplot failbin 'exit 1'
+fake_gnuplot cutbin 'for f in *.png *.gif; do [ -f "$f" ] && truncate -s 300 "$f"; done; exit 0'
+fake_gnuplot emptybin 'for f in *.png *.gif; do [ -f "$f" ] && : >"$f"; done; exit 0'
+keep_check() { # BIN WHAT NEEDLE FILE ARGS...: exit 1, the message, FILE as it was
+  local bin=$1 what=$2 needle=$3 file=$4; shift 4
+  echo "old picture" >"$file"
+  PATH="$tmp/$bin:$PATH" "$PRRU" "$@" >/dev/null 2>"$tmp/err"
+  local st=$?
+  [ $st -eq 1 ] && grep -qF -- "$needle" "$tmp/err" && [ "$(cat "$file")" = "old picture" ] \
+    && ok || bad "$what with $bin: exit $st, $(head -c 300 "$tmp/err")"
+}
+keep_check failbin "plot" "gnuplot failed" "$tmp/k.png" plot "$tmp/run.csv" --out "$tmp/k.png"
+for b in cutbin emptybin; do
+  keep_check $b "plot of a simulation" "plot.png: gnuplot exited 0 but the file is not complete" \
+    "$tmp/k.png" plot "$tmp/run.csv" --out "$tmp/k.png"
+  keep_check $b "plot of a map" "not complete" "$tmp/k.png" plot "$tmp/map.csv" --out "$tmp/k.png"
+  keep_check $b "animate" "anim.gif: gnuplot exited 0 but the file is not complete" "$tmp/k.gif" \
+    animate "$tmp/run.csv" --frames 3 --out "$tmp/k.gif"
+  keep_check $b "track --plot" "not complete" "$tmp/k.png" track --ref "$tmp/traj.csv" --dt 0.005 \
+    --out "$tmp/k.csv" --plot "$tmp/k.png"
+done
+keep_check cutbin "animate" "a GIF cut short (no trailer 0x3B" "$tmp/k.gif" animate "$tmp/run.csv" --frames 3 --out "$tmp/k.gif"
+keep_check cutbin "plot" "a PNG cut short (no IEND chunk" "$tmp/k.png" plot "$tmp/run.csv" --out "$tmp/k.png"
+# prru paper: a figure cut short is exit 1 and DIR is not changed.
+mkdir -p "$tmp/pd"
+echo "old picture" >"$tmp/pd/fig_q.png"
+PATH="$tmp/cutbin:$PATH" "$PRRU" paper --out "$tmp/pd" --skip-map >/dev/null 2>"$tmp/err"
+st=$?
+[ $st -eq 1 ] && grep -q "pd/fig_q.png: gnuplot exited 0 but the file is not complete" "$tmp/err" \
+  && [ "$(cat "$tmp/pd/fig_q.png")" = "old picture" ] && [ "$(ls "$tmp/pd")" = fig_q.png ] \
+  && ok || bad "paper with pictures cut short: exit $st, $(ls "$tmp/pd") $(head -c 300 "$tmp/err")"
+
+# Text from users lands in gnuplot scripts escaped: a file name keeps every
+# byte (quotes, backslashes, a newline, $), and a title from comment lines
+# shows every character as itself in enhanced text (gnuplot's dumb
+# terminal draws the script's own title string as the PNG would).
+hostile="$tmp/it's a \"b\\101\"
+\$HOME \`x\`.csv"
+cp "$tmp/traj.csv" "$hostile"
+PATH="$tmp/fakebin:$PATH" "$PRRU" plot "$hostile" --out "$tmp/hostile.png" 2>"$tmp/err" \
+  && [ "$(png_size "$tmp/hostile.png")" = "1000 1000" ] && ok || bad "plot of a hostile file name: $(head -c 300 "$tmp/err")"
+printf '%s\n' "$(grep '^f = ' "$tmp/script.gp")" 'set print "-"' 'print f' >"$tmp/name.gp"
+[ "$("$real_gnuplot" "$tmp/name.gp" 2>&1)" = "$(realpath "$hostile")" ] && ok \
+  || bad "the file name in the script is not the file's: $(head -c 300 "$tmp/name.gp")"
+title='it'"'"'s "q" a\101 b\\c x_1 y^2 {z} @w &v ~u %s end'
+{ echo "# $title"; grep -v '^#' "$tmp/traj.csv"; } >"$tmp/title.csv"
+PATH="$tmp/fakebin:$PATH" "$PRRU" plot "$tmp/title.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/title.png")" = "1000 1000" ] \
+  && ok || bad "plot of a hostile title: $(head -c 300 "$tmp/err")"
+# (w is set first: gnuplot's macro expansion must not see @w outside a string.)
+printf '%s\n' "w = 'MACRO'" "$(grep '^sub = ' "$tmp/script.gp")" 'set term dumb enhanced size 200,5' 'set title sub' \
+  'unset border; unset tics' 'plot [0:1][0:1] NaN notitle' >"$tmp/title.gp"
+"$real_gnuplot" "$tmp/title.gp" 2>&1 | grep -qF -- "$title" && ok \
+  || bad "the title is not drawn as written: $("$real_gnuplot" "$tmp/title.gp" 2>&1 | grep -v '^ *$' | head -c 300)"
 # Bad files of these kinds: exit 2 naming the file and the reason.
 h_track=$(grep -m1 '^t,' "$tmp/track.csv") h_traj=$(grep -m1 '^t,' "$tmp/traj.csv")
 h_id=$(grep -m1 '^t,' "$tmp/id.csv") h_excite=$(grep -m1 '^t,' "$tmp/excite.csv")

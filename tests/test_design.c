@@ -4,6 +4,7 @@
  * sensitivities agree between two steps; invalid designs and variables
  * are refused with reasons; the optimiser keeps its bounds, never worsens
  * the start and is deterministic. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -362,6 +363,79 @@ static void optimizer(void)
           "a parameter in two variables refused");
 }
 
+/* Tied parameters whose values differ (the last limb's l2 10 % shorter,
+ * as a model file may have it): the bounds prru_design_var_bounds gives
+ * keep every limb within its own -+ 5 %, one of them on its edge, and
+ * the optimiser's design stays inside them on every limb. Rounding: the
+ * shift x - x0 and the sum x_k + shift are two roundings of numbers of
+ * the size of l2, so a limb may pass its edge by 2 DBL_EPSILON l2 at most. */
+static void tied_bounds(void)
+{
+  const double pct = 5, eps = 2 * DBL_EPSILON;
+  prru_params p = prru_params_model;
+  p.l2[PRRU_NLIMB - 1] *= 0.9;
+  prru_design_var v;
+  prru_design_var_parse("l2", &v, NULL, 0);
+  TU_TRUE(prru_design_var_bounds(&p, &v, pct) == PRRU_OK && v.lo < p.l2[0] && p.l2[0] < v.hi,
+          "bounds of a tied variable around its value");
+  TU_TRUE(prru_design_var_bounds(&p, &v, 0) == PRRU_EINPUT && prru_design_var_bounds(&p, &v, 100) ==
+                                                                   PRRU_EINPUT,
+          "a percentage outside (0, 100) refused");
+  prru_design_var_bounds(&p, &v, pct);
+  double worst = 0;
+  for (int e = 0; e < 2; e++) {
+    prru_params q = p;
+    prru_design_set(&q, &p, &v, e ? v.hi : v.lo);
+    for (int k = 0; k < PRRU_NLIMB; k++)
+      worst = fmax(worst, fabs(q.l2[k] - p.l2[k]) / (pct / 100 * p.l2[k]));
+  }
+  TU_TRUE(worst <= 1 + eps / (pct / 100) && worst >= 1 - eps / (pct / 100),
+          "every limb within its own 5 %, the shortest on its edge");
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_options o;
+  prru_design_options_default(&o);
+  o.max_iter = 40;
+  prru_design_result r;
+  char msg[512] = "";
+  TU_TRUE(prru_design_optimize(&pr, &p, &v, 1, &o, &r, msg, sizeof msg) == PRRU_OK, "optimize tied l2");
+  int inside = 1;
+  for (int k = 0; k < PRRU_NLIMB; k++)
+    if (!(fabs(r.best.l2[k] - p.l2[k]) <= pct / 100 * p.l2[k] + eps * p.l2[k])) inside = 0;
+  TU_TRUE(inside, "the optimised l2 of every limb within its own 5 %");
+}
+
+/* Steps that rounding loses are refused (prru_design_step_check: h at
+ * least 100 DBL_EPSILON times the magnitude): 1e-300 would give every
+ * derivative exactly 0. */
+static void tiny_steps(void)
+{
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &home);
+  prru_design_data dd;
+  TU_TRUE(prru_design_data_alloc(&dd, &home) == PRRU_OK, "alloc");
+  prru_design_var b, arm;
+  prru_design_var_parse("b_1", &b, NULL, 0);
+  prru_design_var_parse("armature_1", &arm, NULL, 0);
+  prru_design_sens s;
+  char msg[512] = "";
+  TU_TRUE(prru_design_sensitivity(&pr, &prru_params_model, &b, 1e-300, &dd, &s) == PRRU_EINPUT,
+          "sensitivity with the step 1e-300 refused");
+  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 1e-300, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "b_1") && strstr(msg, "lost to rounding"),
+          "the message names the parameter and the reason");
+  /* b_1 is its own scale: the smallest relative step is 100 DBL_EPSILON. */
+  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 0.99 * 100 * DBL_EPSILON, NULL, 0) == PRRU_EINPUT &&
+              prru_design_step_check(&prru_params_model, &b, 1.01 * 100 * DBL_EPSILON, NULL, 0) == PRRU_OK,
+          "the limit is 100 DBL_EPSILON of the value");
+  TU_TRUE(prru_design_step_check(&prru_params_model, &arm, 1e-300, NULL, 0) == PRRU_EINPUT,
+          "a parameter at 0: the step is measured against its scale");
+  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 1e-4, NULL, 0) == PRRU_OK &&
+              prru_design_step_check(&prru_params_model, &b, 0.5, NULL, 0) == PRRU_EINPUT,
+          "the default step passes, 0.5 does not");
+  prru_design_data_free(&dd);
+}
+
 int main(void)
 {
   objective_equals_map();
@@ -371,5 +445,7 @@ int main(void)
   variables();
   validity();
   optimizer();
+  tied_bounds();
+  tiny_steps();
   return tu_finish("test_design");
 }

@@ -5,7 +5,9 @@
 #     the installed `prru` is this build's (same --version);
 #  2. a separate project finds it with find_package(prru) and builds one
 #     program per exported target (prru::prru shared, prru::prru_static,
-#     prru::kernels); another builds with `pkg-config --cflags --libs prru`;
+#     prru::kernels); another builds with `pkg-config --cflags --libs prru`,
+#     and one links fully static with `pkg-config --static` (libprru.a);
+#     the prefix has a space in it, which prru.pc must escape;
 #  3. a parent project builds prru with add_subdirectory(prru) and links
 #     prru::prru, without taking prru's tests into its own;
 # and every program computes slider positions and a forward-dynamics
@@ -37,14 +39,16 @@ consumer_cmake=(-DCMAKE_C_COMPILER="$CC_BUILD" -DCMAKE_C_FLAGS="$C_FLAGS"
                 -DCMAKE_EXE_LINKER_FLAGS="$LD_FLAGS")
 
 # ---- 1. install ----
-prefix="$tmp/prefix"
+# A prefix with a space: every consumer below must cope (prru.pc escapes it
+# as pkg-config reads it).
+prefix="$tmp/my prefix"
 cmake --install "$PRRU_BUILD_DIR" --prefix "$prefix" >"$tmp/install.log" 2>&1 ||
   die "cmake --install $PRRU_BUILD_DIR --prefix $prefix" "$tmp/install.log"
 libdir=$(cache CMAKE_INSTALL_LIBDIR)
 libdir=${libdir:-lib}
 model_base=$(basename "$PRRU_MODEL")
 missing=""
-for f in bin/prru "$libdir/libprru.so" "$libdir/libprru_runtime.a" "$libdir/libprru_kernels.a" \
+for f in bin/prru "$libdir/libprru.so" "$libdir/libprru.a" "$libdir/libprru_runtime.a" "$libdir/libprru_kernels.a" \
          include/prru/prru.h include/prru/prru_dme.h include/prru/prru_kernels.h \
          include/prru/prru_mechanism.h "$libdir/cmake/prru/prruConfig.cmake" \
          "$libdir/cmake/prru/prruConfigVersion.cmake" "$libdir/cmake/prru/prruTargets.cmake" \
@@ -197,9 +201,16 @@ else
     fail "pkg-config --modversion prru: '$pc_version', prru --version: '$(head -n 1 "$tmp/v.build")'"
   [ "$(pkg-config --variable=model_sha256 prru)" = "$sha" ] && ok "pkg-config: model_sha256" ||
     fail "pkg-config --variable=model_sha256 prru: $(pkg-config --variable=model_sha256 prru)"
-  # shellcheck disable=SC2046,SC2086  # word splitting of the flags is meant
+  # pkg-config prints a space in a path escaped with a backslash, for the
+  # shell that runs the compiler (a Makefile's recipe): eval reads it so.
+  pc_flags() { eval "pc=($(pkg-config "$@" prru))"; }
+  pc_flags --cflags
+  [ ${#pc[@]} = 1 ] && [ "${pc[0]}" = "-I$prefix/include/prru" ] && ok "pkg-config --cflags: -I with the prefix's space kept" ||
+    fail "pkg-config --cflags prru: $(pkg-config --cflags prru)"
+  pc_flags --cflags --libs
+  # shellcheck disable=SC2086  # word splitting of the build's flags is meant
   if "$CC_BUILD" -std=c99 -Wall -Wextra -Wpedantic -Werror $C_FLAGS "$tmp/consumer.c" \
-       -o "$tmp/use_pc" $(pkg-config --cflags --libs prru) $LD_FLAGS >"$tmp/pc.log" 2>&1; then
+       -o "$tmp/use_pc" "${pc[@]}" $LD_FLAGS >"$tmp/pc.log" 2>&1; then
     if LD_LIBRARY_PATH="$prefix/$libdir" "$tmp/use_pc" >"$tmp/use_pc.out" 2>&1; then
       check "pkg-config: cc \$(pkg-config --cflags --libs prru)" "$tmp/use_pc.out"
     else
@@ -208,6 +219,24 @@ else
   else
     fail "pkg-config: compile and link"; tail -n 30 "$tmp/pc.log"
   fi
+  # --static: -lprru is libprru.a, and the private libraries (GSL, libm,
+  # libpthread) complete a fully static link. A sanitizer build cannot link
+  # -static (its runtime is shared).
+  case "$C_FLAGS $LD_FLAGS" in
+  *-fsanitize*) ok "pkg-config --static: not tried (sanitizer build)" ;;
+  *)
+    pc_flags --static --cflags --libs
+    if "$CC_BUILD" -std=c99 -static "$tmp/consumer.c" -o "$tmp/use_pc_static" "${pc[@]}" \
+         >"$tmp/pcs.log" 2>&1 && ! ldd "$tmp/use_pc_static" >/dev/null 2>&1; then
+      if "$tmp/use_pc_static" >"$tmp/use_pc_static.out" 2>&1; then
+        check "pkg-config: cc -static \$(pkg-config --static --cflags --libs prru)" "$tmp/use_pc_static.out"
+      else
+        fail "pkg-config --static: use_pc_static exits $?"; cat "$tmp/use_pc_static.out"
+      fi
+    else
+      fail "pkg-config --static: a static link"; tail -n 30 "$tmp/pcs.log"
+    fi ;;
+  esac
 fi
 
 # ---- 3. add_subdirectory(prru) ----

@@ -82,6 +82,13 @@ void prru_design_set(prru_params *p, const prru_params *base, const prru_design_
  * (centres of mass), the mean slider mass (armature). */
 double prru_design_scale(const prru_params *p, const prru_design_var *v);
 
+/* Bounds of v: -+ pct % (0 < pct < 100) of the value of every parameter v
+ * ties (of its prru_design_scale where it is 0). Tied parameters move by
+ * one shift (prru_design_set), so the bounds of the value are the
+ * intersection of every parameter's: no tied parameter leaves its own
+ * -+ pct %, whatever the limbs' values. PRRU_OK, or PRRU_EINPUT (pct). */
+int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct);
+
 /* The design's length scale: the mean upper link (prru_length_scale). */
 double prru_design_length_scale(const prru_params *p);
 
@@ -224,11 +231,18 @@ typedef struct {
   int set_changed;
 } prru_design_sens;
 
+/* Is rel_step a usable relative step for v at p: in (0, 0.5), and the
+ * step h = rel_step * scale not lost to rounding (value +- h, for every
+ * tied parameter, must differ by 2 h to within 1 %). PRRU_OK, or
+ * PRRU_EINPUT with msg giving the smallest step that is. */
+int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
+                           int msglen);
 /* Central difference of the objective with respect to v at p. Perturbed
  * designs are evaluated without prru_design_check (a parameter at 0, such
  * as an armature, is differentiated through 0); p itself must be valid.
- * PRRU_OK, PRRU_EINPUT (p invalid, rel_step not in (0, 0.5)) or PRRU_ESINGULAR (no
- * regular grid point at value +- h). */
+ * PRRU_OK, PRRU_EINPUT (p invalid, rel_step refused by
+ * prru_design_step_check) or PRRU_ESINGULAR (no regular grid point at
+ * value +- h). */
 int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
                             const prru_design_var *v, double rel_step, prru_design_data *dd,
                             prru_design_sens *s);

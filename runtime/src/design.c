@@ -239,6 +239,32 @@ double prru_design_scale(const prru_params *p, const prru_design_var *v)
   return x;
 }
 
+/* v's k-th parameter alone (for its own value and scale). */
+static prru_design_var member(const prru_design_var *v, int k)
+{
+  prru_design_var m = *v;
+  m.n = 1;
+  m.offset[0] = v->offset[k];
+  return m;
+}
+
+int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct)
+{
+  if (!(pct > 0 && pct < 100)) return PRRU_EINPUT;
+  /* Every parameter's bounds are symmetric, x_k -+ pct % r_k: the shifts
+   * all of them allow are -+ pct % of the smallest r_k. */
+  double r = INFINITY;
+  for (int k = 0; k < v->n; k++) {
+    prru_design_var m = member(v, k);
+    double x = fabs(prru_design_get(p, &m));
+    r = fmin(r, x > 0 ? x : prru_design_scale(p, &m));
+  }
+  double x0 = prru_design_get(p, v);
+  v->lo = x0 - pct / 100 * r;
+  v->hi = x0 + pct / 100 * r;
+  return PRRU_OK;
+}
+
 /* ---- Validity ---- */
 
 static int in_file_range(double x)
@@ -763,12 +789,43 @@ static double objective_unchecked(const prru_design_problem *pr, const prru_para
   return objective_of(pr, &sum);
 }
 
+/* The step must be at least STEP_ROUNDING DBL_EPSILON M, M the largest
+ * magnitude the perturbed sums involve: every tied parameter's value and
+ * the variable's scale (an armature at 0 is added to the slider's mass,
+ * of that scale). A rounding to doubles near M errs by at most
+ * DBL_EPSILON M / 2; the step actually taken, (x_k + h) - (x_k - h),
+ * passes through four (the ends, and the shift prru_design_set forms for
+ * a tied parameter), so it is off 2 h by at most 2 DBL_EPSILON M: at most
+ * 1 % when h >= 100 DBL_EPSILON M. Below, the difference quotient
+ * measures rounding, and a step far below (1e-300) is lost entirely:
+ * every derivative exactly 0. */
+#define STEP_ROUNDING 100.0
+
+int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
+                           int msglen)
+{
+  if (!(rel_step > 0 && rel_step < 0.5))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "step %.17g: must be in (0, 0.5)", rel_step);
+  double scale = prru_design_scale(p, v), big = scale;
+  for (int k = 0; k < v->n; k++) {
+    prru_design_var m = member(v, k);
+    big = fmax(big, fabs(prru_design_get(p, &m)));
+  }
+  double h_min = STEP_ROUNDING * DBL_EPSILON * big;
+  if (!(rel_step * scale >= h_min))
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "%s: the step %.3g would be lost to rounding next to the magnitude %.3g; the "
+                     "smallest relative step is %.3g (100 x 2.2e-16 x magnitude / scale)",
+                     v->name, rel_step * scale, big, h_min / scale);
+  return PRRU_OK;
+}
+
 int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
                             const prru_design_var *v, double rel_step, prru_design_data *dd,
                             prru_design_sens *s)
 {
   memset(s, 0, sizeof *s);
-  if (!(rel_step > 0 && rel_step < 0.5) || prru_design_check(p, NULL, 0) != PRRU_OK)
+  if (prru_design_check(p, NULL, 0) != PRRU_OK || prru_design_step_check(p, v, rel_step, NULL, 0) != PRRU_OK)
     return PRRU_EINPUT;
   s->value = prru_design_get(p, v);
   s->scale = prru_design_scale(p, v);
