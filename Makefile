@@ -11,8 +11,9 @@ PYTHON  ?= python3
 FUZZ_SECONDS ?= 60
 
 # Debian packages, per target: each installs only what it uses.
-#   demo (and build, bench, compare-designs): the build and the plots;
-#   test: + g++ and clang (tests/test_dropin.sh), pkg-config
+#   demo (and build, bench, compare-designs): the build (GSL; jansson,
+#         found by pkg-config, for the model file loader) and the plots;
+#   test: + g++ and clang (tests/test_dropin.sh), pkg-config (demo has it)
 #         (tests/test_install.sh), MuJoCo (validation/), NumPy (the
 #         Python binding's array path, python/tests), SymPy (the bench's
 #         peer of the dynamics kernel, bench/sympy_peer.py);
@@ -21,10 +22,10 @@ FUZZ_SECONDS ?= 60
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
-DEPS_DEMO = cmake gcc make python3 libgsl-dev gnuplot-nox
-DEPS_TEST = $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev python3-numpy python3-sympy
+DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox
+DEPS_TEST = $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy
 DEPS_ASAN = $(DEPS_TEST) valgrind
-DEPS_FUZZ = clang clang-runtime libgsl-dev
+DEPS_FUZZ = clang clang-runtime libgsl-dev libjansson-dev pkg-config
 DEPS_DRY_RUN ?=
 SKIP_DEPS ?=
 DEPS = PRRU_DEPS_DRY_RUN=$(DEPS_DRY_RUN) PRRU_SKIP_DEPS=$(SKIP_DEPS) bash cmake/debian_deps.sh

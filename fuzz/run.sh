@@ -82,7 +82,7 @@ build() { # harness
   fi
   objs=("$work"/obj_*.o)
   "$CC" "${cflags[@]}" "${sanitize[@]}" "$here/fuzz_$name.c" "${objs[@]}" \
-    -lgsl -lgslcblas -lm -lpthread -o "$work/fuzz_$name"
+    -lgsl -lgslcblas -ljansson -lm -lpthread -o "$work/fuzz_$name"
 }
 
 if [ "${1:-}" = --repro ]; then

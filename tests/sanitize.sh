@@ -69,7 +69,7 @@ for h in "$SRC"/fuzz/fuzz_*.c; do
   exe="$asan/replay_$name"
   # shellcheck disable=SC2086
   gcc -std=c99 -O1 -g $san_flags -I"$SRC/generated" -I"$SRC/runtime/include" \
-    "$h" "$SRC/fuzz/replay.c" "${rt_objs[@]}" -lgsl -lgslcblas -lm -lpthread -o "$exe" ||
+    "$h" "$SRC/fuzz/replay.c" "${rt_objs[@]}" -lgsl -lgslcblas -ljansson -lm -lpthread -o "$exe" ||
     { echo "FAIL: compile replay_$name"; exit 1; }
   inputs=()
   for f in "$SRC/fuzz/corpus/$name"/* "$SRC/fuzz/regressions/$name"/*; do

@@ -27,7 +27,7 @@ PY
   gcc -std=c99 -O2 -I"$dir" -I"$SRC/runtime/include" -I"$SRC/runtime/src" \
     "$SRC/tests/scale_main.c" "$SRC"/runtime/src/*.c "$dir/prru_kernels.c" "$dir/prru_mechanism.c" \
     "$dir/prru_param_kernels.c" "$dir/prru_regressor.c" \
-    -lgsl -lgslcblas -lm -lpthread -o "$tmp/scale_$s"
+    -lgsl -lgslcblas -ljansson -lm -lpthread -o "$tmp/scale_$s"
 }
 
 for s in 1 1e-7 1e5; do

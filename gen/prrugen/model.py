@@ -18,6 +18,7 @@ import hashlib
 import json
 import math
 import re
+import struct
 from decimal import Decimal, InvalidOperation
 from fractions import Fraction
 
@@ -40,6 +41,14 @@ BODY_KEYS = ("mass", "inertia")
 BODY2_KEYS = ("mass", "inertia", "com")
 ACTUATOR_KEYS = ("armature", "damping", "coulomb", "coulomb_velocity")
 MAX_BYTES = 1 << 20
+# Bounds the C loader (runtime/src/model_file.c) shares, so that it decides
+# every file as this module does with fixed-size exact arithmetic: at most
+# MAX_DIGITS significant digits per number (a double holds 17), JSON nested
+# at most MAX_DEPTH deep (a model is 4 deep), an exponent of at most
+# MAX_EXPONENT_DIGITS digits (beyond, Decimal refuses some and not others).
+MAX_DIGITS = 40
+MAX_DEPTH = 32
+MAX_EXPONENT_DIGITS = 9
 # |cos| of the upper link's angle at q = 0 above which a model is warned
 # about: within 5 % of full stretch the limb tolerates almost no tilt.
 NEAR_STRETCH = Fraction(95, 100)
@@ -135,7 +144,9 @@ def _pairs_no_duplicates(pairs):
     seen = {}
     for key, value in pairs:
         if key in seen:
-            raise ValueError("duplicate key %r" % key)
+            raise ValueError("duplicate key %s" % (
+                "'%s'" % key if re.fullmatch(r"[A-Za-z0-9_]{1,40}", key)
+                else _key_text(key)))
         seen[key] = value
     return seen
 
@@ -148,16 +159,32 @@ class _OutOfRange:
         self.text = text if len(text) <= 40 else text[:20] + "..." + text[-10:]
 
 
+class _TooPrecise(_OutOfRange):
+    """A JSON number with more than MAX_DIGITS significant digits."""
+
+
+_NUMBER = re.compile(r"-?(\d+)(?:\.(\d+))?(?:[eE][-+]?0*(\d*))?")
+
+
 def _parse_number(text):
     """json.loads hook for every number: exact Fraction via Decimal, which
-    reads the exponent without expanding the value."""
-    try:
-        d = Decimal(text)
-    except InvalidOperation:
-        raise ValueError("bad number %r" % text[:40]) from None
-    if d.is_finite() and (d == 0 or -30 <= d.adjusted() <= 30):
-        return Fraction(d)
-    return _OutOfRange(text)
+    reads the exponent without expanding the value. Zero is zero whatever
+    its exponent; a longer exponent than MAX_EXPONENT_DIGITS is out of
+    range (Decimal itself refuses some of those and not others)."""
+    m = _NUMBER.fullmatch(text)
+    if m is None:
+        raise ValueError("bad number %r" % text[:40])
+    digits = (m.group(1) + (m.group(2) or "")).strip("0")
+    if not digits:
+        return Fraction(0)
+    if len(m.group(3) or "") > MAX_EXPONENT_DIGITS:
+        return _OutOfRange(text)
+    d = Decimal(text)
+    if not -30 <= d.adjusted() <= 30:
+        return _OutOfRange(text)
+    if len(digits) > MAX_DIGITS:
+        return _TooPrecise(text)
+    return Fraction(d)
 
 
 def _json_text(value):
@@ -172,6 +199,9 @@ def _json_text(value):
 
 
 def _number(path, key, value):
+    if isinstance(value, _TooPrecise):
+        raise ModelError(path, key, "has more than %d significant digits "
+                         "(got %s)" % (MAX_DIGITS, value.text))
     if isinstance(value, _OutOfRange):
         raise ModelError(path, key, "magnitude %s is outside [1e-9, 1e6]"
                          % value.text)
@@ -377,17 +407,69 @@ def _actuators(path, value, nlimb):
     return lists[0], lists[1], lists[2], vs if any(lists[2]) else None
 
 
+_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]', re.S)
+
+
+def _depth(text):
+    """Deepest bracket nesting outside strings, on any text (valid JSON or
+    not): the C loader scans the same way before its parser runs."""
+    depth = deepest = 0
+    for m in _TOKEN.finditer(text):
+        c = m.group()
+        if c in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif c in "]}":
+            depth -= 1
+    return deepest
+
+
+def _strings(value):
+    """Every key and string value of parsed JSON."""
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield k
+            yield from _strings(v)
+    elif isinstance(value, list):
+        for v in value:
+            yield from _strings(v)
+
+
+def _keys(value):
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield k
+            yield from _keys(v)
+    elif isinstance(value, list):
+        for v in value:
+            yield from _keys(v)
+
+
 def _load_json(text, path):
     if len(text) > MAX_BYTES:
         raise ModelError(path, None, "file is %d bytes; a model file is at "
                          "most %d" % (len(text), MAX_BYTES))
+    if _depth(text) > MAX_DEPTH:
+        raise ModelError(path, None, "not valid JSON: nested deeper than %d "
+                         "levels" % MAX_DEPTH)
     try:
-        return json.loads(text, parse_float=_parse_number,
+        data = json.loads(text, parse_float=_parse_number,
                           parse_int=_parse_number,
                           parse_constant=_reject_constant,
                           object_pairs_hook=_pairs_no_duplicates)
     except (ValueError, RecursionError) as exc:
         raise ModelError(path, None, "not valid JSON: %s" % exc) from None
+    # A JSON escape "\ud800" alone decodes to a lone surrogate: no UTF-8
+    # (nor C, nor XML) can hold it, and the C loader's parser refuses it.
+    if any(0xd800 <= ord(c) < 0xe000 for s in _strings(data) for c in s):
+        raise ModelError(path, None, "not valid JSON: a string holds a lone "
+                         "UTF-16 surrogate escape (\\udXXX): not text")
+    if any("\0" in k for k in _keys(data)):
+        raise ModelError(path, None, "not valid JSON: an object key holds "
+                         "U+0000")
+    return data
 
 
 def parse(text, path="<model>"):
@@ -457,6 +539,37 @@ def load(path):
     except UnicodeDecodeError:
         raise ModelError(path, None, "not UTF-8 text") from None
     return parse(text, path)
+
+
+CANONICAL_MAGIC = b"prru-model-canonical-1\n"
+
+
+def canonical_bytes(model):
+    """The parsed numbers in a fixed order, for a hash that ignores layout:
+    the magic, the format and the number of limbs as one byte each, then
+    IEEE-754 binary64 little-endian of float() of each exact value: gravity
+    (3); per limb b, l1, l2, a; per body (body_names order) mass, com (3),
+    inertia (Ixx, Iyy, Izz, Ixy, Ixz, Iyz); per actuator armature, damping,
+    coulomb; coulomb_velocity (0 when none). Name and description are not
+    numbers of the dynamics and are left out. runtime/src/model_file.c
+    writes the same bytes (docs/model-files.md)."""
+    numbers = list(model.gravity)
+    for limb in model.limbs:
+        numbers += [limb.b, limb.l1, limb.l2, limb.a]
+    for i in range(len(model.masses)):
+        numbers += [model.masses[i]] + list(model.coms[i]) \
+            + list(model.inertias[i])
+    for i in range(model.nlimb):
+        numbers += [model.armature[i], model.damping[i], model.coulomb[i]]
+    numbers.append(model.coulomb_velocity or 0)
+    return CANONICAL_MAGIC + bytes((model.format, model.nlimb)) + b"".join(
+        struct.pack("<d", float(x)) for x in numbers)
+
+
+def canonical_sha256(model):
+    """SHA-256 (hex) of canonical_bytes: the same for a whitespace or key
+    order edit of the file, different for any change of a parsed number."""
+    return hashlib.sha256(canonical_bytes(model)).hexdigest()
 
 
 def c_double(value):

@@ -161,8 +161,10 @@ CASES = [
      "description", "one line"),
     ("description 401 characters", set_top("description", "d" * 401),
      "description", "400 characters"),
+    # refused at the JSON layer, wherever it stands, as the C loader's
+    # parser (jansson) refuses it (tests/model_conformance.py)
     ("description with a lone surrogate escape",
-     replaced("Table 1", "Table \\ud800"), "description", "surrogate"),
+     replaced("Table 1", "Table \\ud800"), None, "surrogate"),
     # --- missing, extra and duplicated keys ---
     ("no bodies", delete("bodies"), "bodies", "missing"),
     ("no geometry", delete("geometry"), "geometry", "missing"),
