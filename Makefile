@@ -85,17 +85,22 @@ test-asan: deps-asan build
 fuzz: deps-fuzz
 	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run.sh
 
-# Fails when the committed generated/ (the paper model's kernels) is not
-# what the generator makes now, whichever MODEL the build uses.
+# Fails when the committed generated/ (the paper model's kernels and the
+# topology kernels prru_p3_*, prru_p4_* of every build) is not what the
+# generator makes now, whichever MODEL the build uses.
+TOPOLOGIES = 3 4
 check-generated:
 	@tmp=$$(mktemp -d) && \
 	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) --out $$tmp --quiet && \
+	for n in $(TOPOLOGIES); do $(PYTHON) gen/prru_gen.py --topology $$n --out $$tmp --quiet || \
+	  { rm -rf $$tmp; exit 1; }; done && \
 	if diff -r -q $$tmp generated >/dev/null; then echo "generated/ is up to date"; rm -rf $$tmp; \
 	else diff -r -u generated $$tmp | head -40; rm -rf $$tmp; \
 	  echo "generated/ is stale: run 'make regenerate' and commit"; exit 1; fi
 
 regenerate:
 	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) --out generated
+	for n in $(TOPOLOGIES); do $(PYTHON) gen/prru_gen.py --topology $$n --out generated || exit 1; done
 
 bench: build
 	$(BUILD)/bench/prru_bench

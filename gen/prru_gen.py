@@ -1,14 +1,20 @@
 #!/usr/bin/env python3
 """Generate the C dynamics kernels of a 3-PRRU model file.
 
-usage: python3 gen/prru_gen.py MODEL.json --out DIR [--quiet]
+usage: python3 gen/prru_gen.py MODEL.json --out DIR [--prefix NAME] [--quiet]
+       python3 gen/prru_gen.py --topology {3,4} --out DIR [--quiet]
 
 Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
 (the mechanism descriptor) and DIR/<prefix>_param_kernels.{h,c} (the kernels
 with the model's numbers as a run-time argument) and DIR/<prefix>_regressor.{h,c}
 (the dynamics as a linear function of the inertial and drive parameters, for
 identification), where <prefix> is the model's "name" unless
---prefix says otherwise. Nothing in DIR changes unless generation succeeds.
+--prefix says otherwise. With --topology N instead of a model file, writes
+DIR/prru_pN_kernels.{h,c}: every kernel with every number of the model read
+from a prru_paramsN argument, derived from the structure of the N-limb
+machine alone (the same files whatever model a build uses; the library of
+every build carries both). Nothing in DIR changes unless generation
+succeeds.
 """
 
 import argparse
@@ -24,8 +30,8 @@ from prrugen import model as model_mod  # noqa: E402
 from prrugen import mechanism, dynamics, output, params, regressor, \
     render, sym  # noqa: E402
 
-TEMPLATES = os.path.join(os.path.dirname(os.path.dirname(
-    os.path.abspath(__file__))), "templates")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TEMPLATES = os.path.join(ROOT, "templates")
 
 
 def generate(model_path, templates_dir=TEMPLATES, prefix=None):
@@ -59,6 +65,23 @@ def generate_model(model, templates_dir=TEMPLATES, prefix=None):
     return files, emitted + pemitted + remitted
 
 
+def generate_topology(nlimb, templates_dir=TEMPLATES):
+    """(files {name: text}, emitted kernels) of the topology kernels of
+    nlimb limbs (params.Topology): from the structure alone; the reference
+    model (params.TOPOLOGY_REFERENCE) supplies only the initializer of
+    prru_p<n>_params_reference."""
+    reference = model_mod.load(os.path.join(
+        ROOT, params.TOPOLOGY_REFERENCE[nlimb]))
+    if reference.nlimb != nlimb:
+        raise model_mod.ModelError(reference.path, "geometry",
+                                   "has %d limbs, the topology %d"
+                                   % (reference.nlimb, nlimb))
+    sym.reset()
+    pmodel = params.ParamModel(params.Topology(nlimb))
+    deriv = dynamics.Derivation(mechanism.build(pmodel), pmodel)
+    return render.render_topology(reference, pmodel, deriv, templates_dir)
+
+
 def _prefix(text):
     if not re.fullmatch(r"[a-z][a-z0-9_]{0,15}", text):
         raise argparse.ArgumentTypeError("must be a lower-case C identifier "
@@ -71,8 +94,12 @@ def main(argv=None):
         prog="prru_gen.py",
         description="Generate C dynamics kernels (prefix = the model's name) "
                     "from a 3-PRRU model file.")
-    parser.add_argument("model", help="model file (JSON), e.g. "
+    parser.add_argument("model", nargs="?", help="model file (JSON), e.g. "
                         "models/3prru_paper.json")
+    parser.add_argument("--topology", type=int, choices=(3, 4),
+                        help="instead of a model file: the kernels of every "
+                        "model with this many limbs, the numbers a run-time "
+                        "argument (writes prru_p<N>_kernels.{h,c})")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing)")
     parser.add_argument("--prefix", metavar="NAME", type=_prefix,
@@ -81,20 +108,30 @@ def main(argv=None):
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
+    if (args.model is None) == (args.topology is None):
+        parser.error("give a model file or --topology, not %s"
+                     % ("both" if args.model else "neither"))
+    if args.topology is not None and args.prefix:
+        parser.error("--prefix applies to a model file's kernels only "
+                     "(the topology kernels are prru_p<N>_*)")
     return output.run_stoppable("prru_gen", args.out, lambda: _run(args))
 
 
 def _run(args):
     start = time.perf_counter()
     try:
-        model = model_mod.load(args.model)
+        if args.topology is not None:
+            files, emitted = generate_topology(args.topology)
+        else:
+            model = model_mod.load(args.model)
     except model_mod.ModelError as exc:
         print("prru_gen: error: %s" % exc, file=sys.stderr)
         return 1
-    for warning in model.warnings():
-        print("prru_gen: warning: %s: %s" % (args.model, warning),
-              file=sys.stderr)
-    files, emitted = generate_model(model, prefix=args.prefix)
+    if args.topology is None:
+        for warning in model.warnings():
+            print("prru_gen: warning: %s: %s" % (args.model, warning),
+                  file=sys.stderr)
+        files, emitted = generate_model(model, prefix=args.prefix)
     try:
         output.write_files_atomically(args.out, files)
     except OSError as exc:

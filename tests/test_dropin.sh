@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Drop-in quality of the committed generated kernels: a user copies
-# generated/ (the kernels, the descriptor, the runtime-parameter kernels)
+# generated/ (the kernels, the descriptor, the runtime-parameter kernels,
+# the topology kernels prru_p3_*, prru_p4_*)
 # into their own controller and builds it with their compiler and
 # their warning flags. So copy ONLY generated/ (plus tests/dropin_main.c as
 # main.c) into an empty directory, build with nothing but -lm under strict
@@ -27,7 +28,7 @@ skipped=()
 # runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"'
+  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"|"prru_p[34]_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then

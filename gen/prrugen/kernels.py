@@ -127,7 +127,14 @@ def _eom_solve(deriv, m, fd, fp, mp):
     ma = [_atom("M%d" % k, x) for k, x in enumerate(m)]
     ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
     e = [[ma[3 * i + j] for j in range(3)] for i in range(3)]
-    pivots = [k for k in range(3) if e[k][k].op == "const"]
+    # A diagonal entry that is the same at every state: a number in a
+    # model's kernels; in the runtime-parameter kernels an expression of
+    # the parameters alone (M_22, the q3 direction moving every body as one
+    # rigid translation, is the total mass plus the armatures for any
+    # parameters), decided from the expressions, never from values.
+    state = frozenset(x.id for x in list(deriv.mech.q) + list(deriv.mech.qd))
+    pivots = [k for k in range(3)
+              if e[k][k].op == "const" or not sym.free_symbols(m[4 * k]) & state]
     if pivots:
         qdd, minors, how_sets = _pivot_solve(e, ba, pivots[-1])
     else:
@@ -164,8 +171,10 @@ def _pivot_solve(e, b, k):
     # (b_k - M_kk (u_i x_i + u_j x_j)) / M_kk, a multiply more.
     x[k] = _atom("y%d" % k, b[k] * r) - ui * x[i] - uj * x[j]
     minors = [e[k][k], e[k][k] * sii, e[k][k] * det]
-    return x, minors, ("M_%d%d, a constant, eliminated first, then the 2x2 "
-                       "Schur complement S by its adjugate" % (k, k),
+    what = "a constant" if e[k][k].op == "const" else \
+        "constant in q and qd for any parameters (one division by it)"
+    return x, minors, ("M_%d%d, %s, eliminated first, then the 2x2 "
+                       "Schur complement S by its adjugate" % (k, k, what),
                        "{%d}, {%d, %d}, {0, 1, 2}" % (k, k, i))
 
 

@@ -18,7 +18,7 @@ from fractions import Fraction
 from . import sym
 from .cgen import Kernel, ParamsArg
 from .kernels import kernels
-from .model import Limb, c_double
+from .model import Limb, body_names, c_double
 
 # Kernels generated in the parameter form, in header order: those an
 # optimizer or a sensitivity study evaluates (kinematics, dynamics, energy),
@@ -42,6 +42,22 @@ def local_name(symbol_name):
     'p_com_2_0'."""
     return "p_" + re.sub(r"[^A-Za-z0-9]+", "_",
                          symbol_name[len(_PREFIX):]).strip("_")
+
+
+class Topology:
+    """What ParamModel reads of a model, the structure alone: the number of
+    limbs (and so the bodies). The topology kernels are derived from it, so
+    no model file's numbers can reach them."""
+
+    def __init__(self, nlimb):
+        self.nlimb = nlimb
+        self.body_names = body_names(nlimb)
+
+
+# The model file whose numbers initialise prru_p<n>_params_reference, per
+# topology (relative to the source tree): a valid model of that topology
+# for tests and examples; the kernels do not depend on it.
+TOPOLOGY_REFERENCE = {3: "models/3prru_paper.json", 4: "models/4prru.json"}
 
 
 class ParamModel:
@@ -112,3 +128,14 @@ def param_kernels(deriv, pmodel, prefix):
     arg = ParamsArg("%s_params" % prefix, pmodel.order, local_name, _access)
     return [Kernel(k.name, k.doc, k.inputs, k.outputs, k.guards, arg)
             for k in kernels(deriv) if k.name in PARAM_KERNELS]
+
+
+def topology_kernels(deriv, pmodel, ctype):
+    """Every kernel of deriv, the derivation of ParamModel pmodel, each with
+    the leading `const <ctype> *p` argument: the topology kernels."""
+    arg = ParamsArg(ctype, pmodel.order, local_name, _access)
+    # p is the parameters: poses' output p (the centres) becomes pos.
+    return [Kernel(k.name, k.doc, k.inputs,
+                   [("pos" if arr == "p" else arr, x) for arr, x in k.outputs],
+                   k.guards, arg, k.witnesses, k.pattern)
+            for k in kernels(deriv)]
