@@ -1,0 +1,99 @@
+// Drives a page of `prru view` in headless chromium (playwright-core from
+// web/node_modules, the browser given by $PRRU_CHROMIUM) for
+// tests/test_cli_view.sh, and writes what it saw as JSON:
+//   node view_browser.js PAGE.html OUT.json [SCREENSHOT.png]
+// OUT.json: console and page errors, the frame count, the non-background
+// pixels of the 3-D canvas at the first frame, the pixels that changed when
+// the slider was moved to the last frame (with the keyboard, as a user
+// would), whether Play advanced the frame, and for frames 0, the middle and
+// the last: what the page holds (prruView.poseAt) and how the bodies are
+// placed as drawn (prruView.drawn, three.js matrices), all as the page's
+// JavaScript numbers.
+'use strict';
+const { chromium } = require('playwright-core');
+const fs = require('fs');
+const path = require('path');
+
+async function main() {
+  const [page_file, out_file, shot] = process.argv.slice(2);
+  const browser = await chromium.launch({
+    executablePath: process.env.PRRU_CHROMIUM || '/usr/bin/chromium',
+    headless: true,
+    // root in a container has no user namespace sandbox; WebGL through
+    // SwiftShader (no GPU here).
+    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+  const r = { errors: [], warnings: [] };
+  try {
+    const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    page.on('console', (m) => {
+      if (m.type() === 'error') r.errors.push(`console: ${m.text()}`);
+      if (m.type() === 'warning') r.warnings.push(m.text());
+    });
+    page.on('pageerror', (e) => r.errors.push(`page: ${e.message}`));
+    // Offline by construction: any request but the page itself is an error.
+    page.on('request', (q) => {
+      if (q.url() !== 'file://' + path.resolve(page_file) && !q.url().startsWith('blob:'))
+        r.errors.push(`request: ${q.url()}`);
+    });
+    await page.goto('file://' + path.resolve(page_file));
+    await page.waitForFunction(() => window.prruView && window.prruView.ready, null, { timeout: 30000 });
+    r.nframes = await page.evaluate(() => window.prruView.nframes);
+    r.title = await page.title();
+    r.info = await page.evaluate(() => document.getElementById('info').textContent);
+    r.map_shown = await page.evaluate(() => !document.getElementById('map-panel').hidden);
+    // The canvas's pixels (RGBA) through a 2-D copy of the WebGL canvas.
+    const pixels = () => page.evaluate(() => {
+      const c = document.getElementById('view3d'), t = document.createElement('canvas');
+      t.width = c.width;
+      t.height = c.height;
+      const g = t.getContext('2d');
+      g.drawImage(c, 0, 0);
+      return Array.from(g.getImageData(0, 0, t.width, t.height).data);
+    });
+    const p0 = await pixels();
+    r.pixels = p0.length / 4;
+    r.non_background = 0;
+    for (let i = 0; i < p0.length; i += 4) if (p0[i] < 250 || p0[i + 1] < 250 || p0[i + 2] < 250) r.non_background++;
+    if (shot) await page.screenshot({ path: shot });
+    // Scrub with the keyboard: the slider to its end.
+    await page.focus('#scrub');
+    await page.keyboard.press('End');
+    r.frame_after_scrub = await page.evaluate(() => window.prruView.frame());
+    const p1 = await pixels();
+    r.changed = 0;
+    for (let i = 0; i < p0.length; i += 4)
+      if (p0[i] !== p1[i] || p0[i + 1] !== p1[i + 1] || p0[i + 2] !== p1[i + 2]) r.changed++;
+    // Play from the start for a while.
+    await page.keyboard.press('Home');
+    await page.click('#play');
+    await page.waitForTimeout(400);
+    await page.click('#play');
+    r.frame_after_play = await page.evaluate(() => window.prruView.frame());
+    // The arrows toggle, when the run has reactions.
+    r.arrows = await page.evaluate(() => !document.getElementById('arrows-label').hidden);
+    if (r.arrows) {
+      await page.check('#arrows');
+      const p2 = await pixels();
+      const p3 = await (async () => { await page.uncheck('#arrows'); return pixels(); })();
+      r.arrow_pixels = 0;
+      for (let i = 0; i < p2.length; i += 4) if (p2[i] !== p3[i] || p2[i + 1] !== p3[i + 1]) r.arrow_pixels++;
+    }
+    r.poses = [];
+    for (const k of [0, Math.floor(r.nframes / 2), r.nframes - 1]) {
+      await page.evaluate((k) => window.prruView.setFrame(k), k);
+      r.poses.push(await page.evaluate((k) => {
+        const v = window.prruView, d = v.poseAt(k);
+        return { k, row: d.row, t: d.t, q: Array.from(d.q), R: Array.from(d.R), p: Array.from(d.p),
+          is_array: Array.isArray(d.R) && Array.isArray(d.p), drawn: v.drawn() };
+      }, k));
+    }
+  } catch (e) {
+    r.errors.push(`driver: ${e.message}`);
+  } finally {
+    await browser.close();
+  }
+  fs.writeFileSync(out_file, JSON.stringify(r));
+}
+
+main().catch((e) => { console.error(e); process.exit(1); });
