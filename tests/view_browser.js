@@ -41,43 +41,62 @@ async function main() {
     r.nframes = await page.evaluate(() => window.prruView.nframes);
     r.title = await page.title();
     r.info = await page.evaluate(() => document.getElementById('info').textContent);
+    r.pwned = await page.evaluate(() => window.pwned);
     r.map_shown = await page.evaluate(() => !document.getElementById('map-panel').hidden);
-    // The canvas's pixels (RGBA) through a 2-D copy of the WebGL canvas.
-    const pixels = () => page.evaluate(() => {
-      const c = document.getElementById('view3d'), t = document.createElement('canvas');
-      t.width = c.width;
-      t.height = c.height;
-      const g = t.getContext('2d');
-      g.drawImage(c, 0, 0);
-      return Array.from(g.getImageData(0, 0, t.width, t.height).data);
+    // The canvas's pixels, kept in the page (shipping megabytes of RGBA
+    // to node is slow): snap(name) stores them, the counts come back.
+    await page.evaluate(() => {
+      const shots = {};
+      window.__test = {
+        snap(name) {
+          const c = document.getElementById('view3d'), t = document.createElement('canvas');
+          t.width = c.width;
+          t.height = c.height;
+          const g = t.getContext('2d');
+          g.drawImage(c, 0, 0);
+          shots[name] = g.getImageData(0, 0, t.width, t.height).data;
+          return shots[name].length / 4;
+        },
+        nonWhite(name) {
+          const a = shots[name];
+          let n = 0;
+          for (let i = 0; i < a.length; i += 4) if (a[i] < 250 || a[i + 1] < 250 || a[i + 2] < 250) n++;
+          return n;
+        },
+        diff(x, y) {
+          const a = shots[x], b = shots[y];
+          let n = 0;
+          for (let i = 0; i < a.length; i += 4) if (a[i] !== b[i] || a[i + 1] !== b[i + 1] || a[i + 2] !== b[i + 2]) n++;
+          return n;
+        },
+      };
     });
-    const p0 = await pixels();
-    r.pixels = p0.length / 4;
-    r.non_background = 0;
-    for (let i = 0; i < p0.length; i += 4) if (p0[i] < 250 || p0[i + 1] < 250 || p0[i + 2] < 250) r.non_background++;
+    r.pixels = await page.evaluate(() => window.__test.snap('first'));
+    r.non_background = await page.evaluate(() => window.__test.nonWhite('first'));
     if (shot) await page.screenshot({ path: shot });
     // Scrub with the keyboard: the slider to its end.
     await page.focus('#scrub');
     await page.keyboard.press('End');
     r.frame_after_scrub = await page.evaluate(() => window.prruView.frame());
-    const p1 = await pixels();
-    r.changed = 0;
-    for (let i = 0; i < p0.length; i += 4)
-      if (p0[i] !== p1[i] || p0[i + 1] !== p1[i + 1] || p0[i + 2] !== p1[i + 2]) r.changed++;
+    await page.evaluate(() => window.__test.snap('last'));
+    r.changed = await page.evaluate(() => window.__test.diff('first', 'last'));
     // Play from the start for a while.
     await page.keyboard.press('Home');
     await page.click('#play');
-    await page.waitForTimeout(400);
+    r.frame_after_play = 0;
+    try {
+      await page.waitForFunction(() => window.prruView.frame() > 0, null, { timeout: 10000 });
+      r.frame_after_play = await page.evaluate(() => window.prruView.frame());
+    } catch (e) { /* stays 0: reported by the test */ }
     await page.click('#play');
-    r.frame_after_play = await page.evaluate(() => window.prruView.frame());
     // The arrows toggle, when the run has reactions.
     r.arrows = await page.evaluate(() => !document.getElementById('arrows-label').hidden);
     if (r.arrows) {
       await page.check('#arrows');
-      const p2 = await pixels();
-      const p3 = await (async () => { await page.uncheck('#arrows'); return pixels(); })();
-      r.arrow_pixels = 0;
-      for (let i = 0; i < p2.length; i += 4) if (p2[i] !== p3[i] || p2[i + 1] !== p3[i + 1]) r.arrow_pixels++;
+      await page.evaluate(() => window.__test.snap('on'));
+      await page.uncheck('#arrows');
+      await page.evaluate(() => window.__test.snap('off'));
+      r.arrow_pixels = await page.evaluate(() => window.__test.diff('on', 'off'));
     }
     r.poses = [];
     for (const k of [0, Math.floor(r.nframes / 2), r.nframes - 1]) {
