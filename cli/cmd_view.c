@@ -463,6 +463,12 @@ static double plate_half(void)
   return h > 0.1 * l ? h : 0.25 * l;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
 /* Per frame: row, t, q, R (9 NBODY), p (3 NBODY); the U-joint centres and
  * forces when the run has them. */
 static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
@@ -499,16 +505,24 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
     prru_cli_out_printf(o, "null");
     return;
   }
-  double fmax = 0.0;
-  for (long k = 0; k < f->n; k++)
-    for (int i = 0; i < PRRU_NLIMB; i++) {
-      const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
-      double fx = r[f->react_col[i][0]], fy = r[f->react_col[i][1]], fz = r[f->react_col[i][2]];
-      double n = sqrt(fx * fx + fy * fy + fz * fz);
-      if (n > fmax) fmax = n;
-    }
-  /* The largest force as long as the mean upper link. */
-  prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fmax > 0 ? prru_cli_length_scale() / fmax : 0.0);
+  /* A force at the 90th percentile of the run's as long as the mean upper
+   * link (the largest, at a jerk of the start, would make most arrows
+   * invisible). */
+  double *mag = malloc((size_t)f->n * PRRU_NLIMB * sizeof *mag), fref = 0.0;
+  if (mag) {
+    for (long k = 0; k < f->n; k++)
+      for (int i = 0; i < PRRU_NLIMB; i++) {
+        const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
+        double fx = r[f->react_col[i][0]], fy = r[f->react_col[i][1]], fz = r[f->react_col[i][2]];
+        mag[k * PRRU_NLIMB + i] = sqrt(fx * fx + fy * fy + fz * fz);
+      }
+    qsort(mag, (size_t)f->n * PRRU_NLIMB, sizeof *mag, cmp_double);
+    fref = mag[(size_t)(0.9 * (double)(f->n * PRRU_NLIMB - 1))];
+    free(mag);
+  } else {
+    o->err = ENOMEM;
+  }
+  prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_cli_length_scale() / fref : 0.0);
   for (int i = 0; i < PRRU_NLIMB; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
     out_script_string(o, prru_mech.joint[u_joint(i)].name);

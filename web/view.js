@@ -43,7 +43,7 @@ const camera = new THREE.PerspectiveCamera(35, 1, size / 100, size * 100);
 camera.up.set(0, 0, 1);
 
 // Orbit with the mouse (drag), zoom with the wheel.
-const orbit = { az: -0.9, el: 0.35, r: 2.6 * size };
+const orbit = { az: -0.9, el: 0.35, r: 2.2 * size };
 function placeCamera() {
   const c = Math.cos(orbit.el);
   camera.position.set(centre.x + orbit.r * c * Math.cos(orbit.az), centre.y + orbit.r * c * Math.sin(orbit.az),
@@ -224,7 +224,7 @@ function viridis(x) {
   return `rgb(${c[0]},${c[1]},${c[2]})`;
 }
 const M = D.map;
-const MAP_BOX = { x: 46, y: 10, w: 230, h: 240 };
+const MAP_BOX = { x: 46, y: 10, w: 210, h: 240 };
 let mapImage = null;
 function mapToPixel(q1, q2) {
   const n1 = M.q1.length, n2 = M.q2.length;
@@ -234,14 +234,20 @@ function mapToPixel(q1, q2) {
 }
 function drawMap() {
   const cv = $('map2d'), g = cv.getContext('2d');
-  const n1 = M.q1.length, n2 = M.q2.length, lw = Math.log(M.w_max);
+  const n1 = M.q1.length, n2 = M.q2.length;
+  // Colours on a log scale from the smallest ok w_R to the 98th
+  // percentile (the few values near the singular locus would wash out the
+  // rest); larger ones are yellow.
+  const ok = M.w.filter((w, i) => M.status[i] === 'ok').sort((a, b) => a - b);
+  const wlo = ok.length ? ok[0] : 1, whi = ok.length ? ok[Math.floor(0.98 * (ok.length - 1))] : 1;
+  const l0 = Math.log(wlo), lw = Math.log(whi) - l0;
   g.fillStyle = '#fff';
   g.fillRect(0, 0, cv.width, cv.height);
   const cw = MAP_BOX.w / n1, ch = MAP_BOX.h / n2;
   for (let i = 0; i < n1; i++) {
     for (let j = 0; j < n2; j++) {
       const w = M.w[i * n2 + j], st = M.status[i * n2 + j];
-      g.fillStyle = st === 'ok' ? viridis(lw > 0 ? Math.log(w) / lw : 0) : st === 'other_mode' ? '#777' : '#ccc';
+      g.fillStyle = st === 'ok' ? viridis(lw > 0 ? (Math.log(w) - l0) / lw : 0) : st === 'other_mode' ? '#777' : '#ccc';
       g.fillRect(MAP_BOX.x + i * cw, MAP_BOX.y + MAP_BOX.h - (j + 1) * ch, cw + 0.5, ch + 0.5);
     }
   }
@@ -256,15 +262,16 @@ function drawMap() {
   g.rotate(-Math.PI / 2);
   g.fillText(`q2 (rad): ${M.q2[0].toPrecision(3)} .. ${M.q2[n2 - 1].toPrecision(3)}`, 0, 0);
   g.restore();
-  // Colour bar: w_R on a log scale from 1 to the largest ok value.
+  // Colour bar (log scale).
   const bx = MAP_BOX.x + MAP_BOX.w + 14;
   for (let y = 0; y < MAP_BOX.h; y++) {
     g.fillStyle = viridis(1 - y / MAP_BOX.h);
     g.fillRect(bx, MAP_BOX.y + y, 12, 1.5);
   }
   g.textAlign = 'left';
-  g.fillText(`${M.w_max.toPrecision(3)}`, bx + 16, MAP_BOX.y + 8);
-  g.fillText('1', bx + 16, MAP_BOX.y + MAP_BOX.h);
+  g.fillStyle = '#222';
+  g.fillText(`${whi < M.w_max ? '\u2265 ' : ''}${whi.toPrecision(3)}`, bx + 16, MAP_BOX.y + 8);
+  g.fillText(`${wlo.toPrecision(3)}`, bx + 16, MAP_BOX.y + MAP_BOX.h);
   g.fillText('w_R', bx + 16, MAP_BOX.y + MAP_BOX.h / 2);
   g.fillText('grey: singular/unreachable,', MAP_BOX.x, MAP_BOX.y + MAP_BOX.h + 32);
   g.fillText('dark: other assembly mode; red: the run', MAP_BOX.x, MAP_BOX.y + MAP_BOX.h + 45);
