@@ -26,8 +26,8 @@ FUZZ_SECONDS ?= 60
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
 DEPS_DEMO = cmake gcc make python3 libgsl-dev gnuplot-nox
-DEPS_TEST = $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev python3-numpy python3-sympy \
-            chromium nodejs $(if $(shell command -v npm),,npm)
+DEPS_TEST = $(strip $(DEPS_DEMO) g++ clang pkg-config libmujoco-dev python3-numpy python3-sympy \
+            chromium nodejs $(if $(shell command -v npm),,npm))
 DEPS_ASAN = $(DEPS_TEST) valgrind
 DEPS_FUZZ = clang clang-runtime libgsl-dev
 DEPS_DRY_RUN ?=
