@@ -31,10 +31,11 @@ async function main() {
       if (m.type() === 'warning') r.warnings.push(m.text());
     });
     page.on('pageerror', (e) => r.errors.push(`page: ${e.message}`));
-    // Offline by construction: any request but the page itself is an error.
+    // Offline by construction: a request for anything but the page itself
+    // and the blob: of three.js is an error.
+    const self = new URL('file://' + path.resolve(page_file)).href;
     page.on('request', (q) => {
-      if (q.url() !== 'file://' + path.resolve(page_file) && !q.url().startsWith('blob:'))
-        r.errors.push(`request: ${q.url()}`);
+      if (q.url() !== self && !q.url().startsWith('blob:')) r.errors.push(`request: ${q.url()}`);
     });
     await page.goto('file://' + path.resolve(page_file));
     await page.waitForFunction(() => window.prruView && window.prruView.ready, null, { timeout: 30000 });
