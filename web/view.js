@@ -9,10 +9,8 @@
 const $ = (id) => document.getElementById(id);
 const D = JSON.parse($('prru-data').textContent);
 
-function fail(msg) {
-  $('error').textContent = msg;
-  throw new Error(msg);
-}
+// Any failure is also said in the page, not only in the console.
+window.addEventListener('error', (e) => { $('error').textContent = `prru view: ${e.message}`; });
 
 // three.js (the pinned build/three.module.min.js) travels as text in the
 // page: a module of its own through a blob: URL, so nothing is fetched.
@@ -26,7 +24,13 @@ const COLORS = { rail: 0x9a9a9a, slider: 0x222222, upper: 0x2f6fd6, lower: 0xe88
 
 // ---- scene ----
 const canvas = $('view3d');
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+let renderer;
+try {
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+} catch (e) {
+  $('error').textContent = `prru view: this browser cannot draw WebGL here (${e.message}); the data is in the page's prru-data script`;
+  throw e;
+}
 renderer.setPixelRatio(window.devicePixelRatio || 1);
 renderer.setClearColor(0xffffff, 1);
 const scene = new THREE.Scene();
