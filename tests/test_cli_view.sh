@@ -79,7 +79,7 @@ page="$tmp/page.html"
 "$PRRU" view "$run" --frames 5 2>"$tmp/err" && [ -s "$tmp/run.html" ] && ok || bad "view without --out: $(cat "$tmp/err")"
 # The page has the template's three script elements and nothing else that
 # opens or closes one, and no comment opener; the JSON data parses.
-python3 - "$page" "$evil" <<'PY' && ok || bad "page structure: see above"
+python3 - "$page" "$evil" "$PRRU_MODEL" <<'PY' && ok || bad "page structure: see above"
 import json, re, sys
 html = open(sys.argv[1], encoding='utf-8').read()
 low = html.lower()
@@ -93,6 +93,11 @@ d = json.loads(data)
 assert d['source']['file'].endswith(sys.argv[2] + '/run.csv'), d['source']['file']
 assert any('window.pwned=2' in c for c in d['source']['comments']), d['source']['comments']
 assert '\u2028' not in data and '\u2029' not in data
+# The model's own text (a model with a hostile description, built with
+# `make test MODEL=...`, gets the checks above through it) comes back as is.
+model = json.load(open(sys.argv[3], encoding='utf-8'))
+assert d['model']['description'] == model['description'], d['model']['description']
+assert d['model']['name'] == model['name'], d['model']['name']
 PY
 # The embedded three.js is the registry's three@0.170.0 (when npm fetched it).
 if [ -f "$web/node_modules/three/package.json" ]; then
