@@ -16,21 +16,26 @@ FUZZ_SECONDS ?= 60
 #   test: + g++ and clang (tests/test_dropin.sh), pkg-config (demo has it)
 #         (tests/test_install.sh), MuJoCo (validation/), NumPy (the
 #         Python binding's array path, python/tests), SymPy (the bench's
-#         peer of the dynamics kernel, bench/sympy_peer.py);
+#         peer of the dynamics kernel, bench/sympy_peer.py), chromium and
+#         Node.js with npm (prru view's page in a real browser,
+#         tests/test_cli_view.sh; npm only when no npm command is there:
+#         Debian's nodejs lacks it, NodeSource's has it and conflicts with
+#         Debian's npm package);
 #   test-asan: + valgrind (gcc's own sanitizers need nothing more);
 #   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
 DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox
-DEPS_TEST = $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy
+DEPS_TEST = $(strip $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy \
+            chromium nodejs $(if $(shell command -v npm),,npm))
 DEPS_ASAN = $(DEPS_TEST) valgrind
 DEPS_FUZZ = clang clang-runtime libgsl-dev libjansson-dev pkg-config
 DEPS_DRY_RUN ?=
 SKIP_DEPS ?=
 DEPS = PRRU_DEPS_DRY_RUN=$(DEPS_DRY_RUN) PRRU_SKIP_DEPS=$(SKIP_DEPS) bash cmake/debian_deps.sh
 
-.PHONY: all deps deps-demo deps-test deps-asan deps-fuzz build demo compare-designs optimize-design test \
+.PHONY: all deps deps-demo deps-test deps-asan deps-fuzz web-deps build demo compare-designs optimize-design test \
         test-asan fuzz check-generated regenerate bench clean
 # Two package installations must never run at once (dpkg's lock); the
 # compilers run in parallel inside cmake --build.
@@ -73,8 +78,21 @@ optimize-design: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=$(PAPER_BUILD)
 	studies/optimize_paper.sh $(PAPER_BUILD) $(RESULTS)/optimize
 
-test: deps-test build check-generated
+test: deps-test build check-generated web-deps
 	cd $(BUILD) && ctest --output-on-failure -j 2
+
+# The browser test's driver, playwright-core, and three.js (to check that
+# web/vendor/three.module.min.js, which the build embeds, is the npm
+# registry's three@0.170.0) at the versions web/package-lock.json pins,
+# into web/node_modules; again only when the lock file changed. Without npm
+# the step says so and tests/test_cli_view.sh skips (fails under CI=true).
+web-deps: deps-test
+	@if ! command -v npm >/dev/null 2>&1; then \
+	  echo "make web-deps: npm not found: the browser test of prru view will be skipped"; \
+	elif [ ! -f web/node_modules/.package-lock.json ] || \
+	     [ web/package-lock.json -nt web/node_modules/.package-lock.json ]; then \
+	  cd web && npm ci --ignore-scripts --no-audit --no-fund; \
+	fi
 
 # AddressSanitizer + UBSan build and ctest, fuzz corpus replay, valgrind on
 # `prru paper` (own build directories; `make test` first for the Release one).

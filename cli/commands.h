@@ -32,6 +32,7 @@ int prru_cmd_dme(int argc, char **argv);
 int prru_cmd_map(int argc, char **argv);
 int prru_cmd_plot(int argc, char **argv);
 int prru_cmd_animate(int argc, char **argv);
+int prru_cmd_view(int argc, char **argv);
 int prru_cmd_traj(int argc, char **argv);
 int prru_cmd_track(int argc, char **argv);
 int prru_cmd_optimize(int argc, char **argv);

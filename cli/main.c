@@ -23,6 +23,7 @@ static const struct {
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},
     {"plot", prru_cmd_plot, "PNG of a CSV prru wrote: time series, tracking errors, w_R map"},
     {"animate", prru_cmd_animate, "animated GIF of the mechanism moving through a simulated run"},
+    {"view", prru_cmd_view, "self-contained HTML page: the run in 3-D in a browser, w_R map"},
     {"optimize", prru_cmd_optimize, "choose geometry/inertia so w_R is nearest 1 over a workspace"},
     {"sensitivity", prru_cmd_sensitivity, "d(global index)/d(parameter) for every parameter, CSV"},
     {"merge", prru_cmd_merge, "join the --shard K/N outputs of map or sensitivity"},
