@@ -31,16 +31,13 @@
  * escape (\101 is A) and _ ^ { } @ & ~ are markup: each gets a backslash
  * before it so that it prints as itself; a newline breaks the label, other
  * control characters are dropped. */
-static void put_string(FILE *g, const char *s, int escape_enhanced)
+static void put_string_width(FILE *g, const char *s, int escape_enhanced, int width)
 {
-  /* Labels break at the first space after LABEL_WIDTH characters (a title
-   * made of a file's comment lines would run off a 1000-pixel image). */
-  enum { LABEL_WIDTH = 110 };
   int col = 0;
   fputc('\'', g);
   for (const char *c = s; *c; c++, col++) {
     unsigned char u = (unsigned char)*c;
-    if (escape_enhanced && (*c == '\n' || (*c == ' ' && col >= LABEL_WIDTH))) {
+    if (escape_enhanced && (*c == '\n' || (*c == ' ' && col >= width))) {
       fputs("'.\"\\n\".'", g);
       col = -1;
     } else if (*c == '\'')
@@ -53,6 +50,28 @@ static void put_string(FILE *g, const char *s, int escape_enhanced)
       fprintf(g, "'.\"\\%03o\".'", u);
   }
   fputc('\'', g);
+}
+
+/* Labels break at the first space after LABEL_WIDTH characters (a title
+ * made of a file's comment lines would run off a 1000-pixel image); the
+ * footer, in smaller type, after FOOTER_WIDTH. */
+enum { LABEL_WIDTH = 110, FOOTER_WIDTH = 150 };
+
+static void put_string(FILE *g, const char *s, int escape_enhanced)
+{
+  put_string_width(g, s, escape_enhanced, LABEL_WIDTH);
+}
+
+/* The number of lines put_string_width breaks s into. */
+static int count_lines(const char *s, int width)
+{
+  int lines = 1, col = 0;
+  for (const char *c = s; *c; c++, col++)
+    if (*c == '\n' || (*c == ' ' && col >= width)) {
+      lines++;
+      col = -1;
+    }
+  return lines;
 }
 
 void prru_plot_string(FILE *g, const char *s) { put_string(g, s, 0); }
@@ -145,7 +164,7 @@ void prru_plot_provenance(char *buf, size_t len, const char *cmd)
 }
 
 /* The footer's label (of the variable footer). */
-static const char footer_label[] = "set label 1000 footer at screen 0.005, screen 0.012 left font ',8' tc rgb '#505050' front\n";
+static const char footer_label[] = "set label 1000 footer at screen 0.005, screen 0 offset 0, character footer_up left font ',8' tc rgb '#505050' front\n";
 
 /* The footer: provenance in small grey type at the bottom left, where no
  * panel reaches (the figures keep their bottom 3 % free). A screen label
@@ -153,8 +172,10 @@ static const char footer_label[] = "set label 1000 footer at screen 0.005, scree
 void prru_plot_footer(FILE *g, const char *text)
 {
   fputs("footer = ", g);
-  prru_plot_label(g, text);
-  fputc('\n', g);
+  put_string_width(g, text, 1, FOOTER_WIDTH);
+  /* The label's position is its first line's: lines go up from the edge
+   * (in characters of the 11-point font: a line of 8 points is 3/4 of one). */
+  fprintf(g, "\nfooter_up = %.2f\n", 0.5 + 0.75 * (count_lines(text, FOOTER_WIDTH) - 1));
   fputs(footer_label, g);
 }
 
@@ -557,7 +578,7 @@ static const char fig7_script[] =
     "# colour key says so).\n"
     "set output 'fig7_contour.png'\n"
     "set terminal pngcairo size 1000,850 enhanced font 'Sans,11'\n"
-    "set label 1000 footer at screen 0.005, screen 0.012 left font ',8' tc rgb '#505050' front\n"
+    "set label 1000 footer at screen 0.005, screen 0 offset 0, character footer_up left font ',8' tc rgb '#505050' front\n"
     "set contour base\n"
     "set cntrparam levels discrete 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0, 2.1, 2.5, 3, 5, 10\n"
     "unset surface\n"
@@ -581,7 +602,7 @@ static const char fig7_script[] =
     "# Fig. 7a: ellipse outlines in (a.e1, a.v) and segment half-lengths.\n"
     "set output 'fig7a_ellipses.png'\n"
     "set terminal pngcairo size 1300,650 enhanced font 'Sans,11'\n"
-    "set label 1000 footer at screen 0.005, screen 0.012 left font ',8' tc rgb '#505050' front\n"
+    "set label 1000 footer at screen 0.005, screen 0 offset 0, character footer_up left font ',8' tc rgb '#505050' front\n"
     "set key default\n"
     "unset colorbox\n"
     "unset logscale\n"
@@ -864,17 +885,20 @@ char *prru_plot_animation_script(const char *dat, const char *gif, const char *t
   fputs("set linetype 1 lc rgb '#b0b0b0'\nset linetype 2 lc rgb '#000000'\n"
         "set linetype 3 lc rgb '#0072b2'\nset linetype 4 lc rgb '#e69f00'\n"
         "set linetype 5 lc rgb '#009e73'\n", g);
-  /* One scale on all axes, the box a little larger than the mechanism. */
+  /* One scale on x and y, the box a little larger than the mechanism; z
+   * on its own scale (a long run's fall would shrink the mechanism to a
+   * speck in a cube). */
   double c[3], half = 0.0;
-  for (int k = 0; k < 3; k++) {
+  for (int k = 0; k < 2; k++) {
     c[k] = 0.5 * (lo[k] + hi[k]);
     if (0.5 * (hi[k] - lo[k]) > half) half = 0.5 * (hi[k] - lo[k]);
   }
   half *= 1.05;
   fprintf(g, "set xrange [%.6g:%.6g]\nset yrange [%.6g:%.6g]\nset zrange [%.6g:%.6g]\n", c[0] - half,
-          c[0] + half, c[1] - half, c[1] + half, lo[2], lo[2] + 2 * half);
+          c[0] + half, c[1] - half, c[1] + half, lo[2] - 0.01 * (hi[2] - lo[2]),
+          hi[2] + 0.01 * (hi[2] - lo[2])); /* a vector touching the range's end is dropped whole */
   /* Depth: the floor at the rails' foot, each segment's shadow on it. */
-  fprintf(g, "ZF = %.9g\nset view equal xyz\nset view 65, 35\nset xyplane at ZF\n", lo[2]);
+  fprintf(g, "ZF = %.9g\nset view equal xy\nset view 65, 35\nset xyplane at ZF\n", lo[2]);
   fputs("set xlabel 'x (m)'\nset ylabel 'y (m)'\nset zlabel 'z (m)'\nset grid\nunset key\n"
         "set tics font ',8'\n", g);
   fprintf(g, "array T[%ld] = [", n);
@@ -883,7 +907,7 @@ char *prru_plot_animation_script(const char *dat, const char *gif, const char *t
   fprintf(g, "do for [i = 0:%ld] {\n"
              "  set title sprintf(\"model %%s, t = %%.3f s\\nrails grey, sliders black, upper links blue, "
              "lower links orange, platform green\", model, T[i + 1])\n"
-             "  splot f index i using 1:2:(ZF):4:5:(0) with vectors nohead lc rgb '#d8d8d8' lw 3 notitle, \\\n"
+             "  splot f index i using 1:2:(ZF):4:5:(0) with vectors nohead lc rgb '#b8b8b8' lw 3 notitle, \\\n"
              "        f index i using 1:2:($7 == 5 ? NaN : $3):4:5:6:7 with vectors nohead lc variable lw 3 "
              "notitle, \\\n"
              "        f index i using 1:2:($7 == 5 ? $3 : NaN):4:5:6 with vectors nohead lt 5 lw 5 notitle\n"
