@@ -981,7 +981,7 @@ char *prru_plot_optimize_script(const prru_map_grid *grid, double rcond_min, dou
         "set title sprintf(\"before: %s\\nglobal index %.4g, %.4g %% not ok\", model, ib, sb)\n"
         "plot 'before.dat' using 1:2:($3 > CLIP ? CLIP : $3) with image\n"
         "unset label 1000\n"
-        "set colorbox user origin screen 0.89, screen 0.12 size screen 0.02, screen 0.72\n"
+        "set colorbox user origin screen 0.8, screen 0.12 size screen 0.02, screen 0.72\n"
         "set title sprintf(\"after: %s\\nglobal index %.4g, %.4g %% not ok\", opt, ia, sa)\n"
         "plot 'after.dat' using 1:2:($3 > CLIP ? CLIP : $3) with image\n"
         "unset multiplot\n",
