@@ -187,7 +187,7 @@ deps_of() { # TARGET: the distinct package lists make -n TARGET passes
   make -n -s -C "$PRRU_SOURCE_DIR" "$1" BUILD="$tmp/never-built" RESULTS="$tmp/never" 2>/dev/null |
     sed -n 's/.*debian_deps.sh [a-z-]* //p' | sort -u
 }
-demo_list="cmake gcc make python3 libgsl-dev gnuplot-nox"
+demo_list="cmake gcc make python3 libgsl-dev gnuplot-nox help2man" # help2man: the man pages
 test_list="$demo_list g++ clang pkg-config libmujoco-dev python3-numpy python3-sympy"
 for case in "demo|$demo_list" "deps|$demo_list" "bench|$demo_list" \
             "test|$demo_list
