@@ -508,7 +508,7 @@ char *prru_plot_paper_sim_script(const char *csv)
   fputs("f = ", g);
   prru_plot_string(g, csv);
   fputs("\nset output 'fig_q.png'\n", g);
-  put_layout(g, 2, 700, "\"Paper study (section 4.3): generalized coordinates, model \".model");
+  put_layout(g, 2, 700, "\"Generalized coordinates in the paper's study (section 4.3; not one of its figures), model \".model");
   fputs("set ylabel 'rotation (rad)'\n"
         "plot f using 't':'q1' with lines lt 1 title 'q_1', '' using 't':'q2' with lines lt 2 title 'q_2'\n", g);
   put_footer_done(g);
@@ -518,20 +518,20 @@ char *prru_plot_paper_sim_script(const char *csv)
         "unset multiplot\n"
         "set output 'fig_d.png'\n", g);
   fputs(footer_label, g);
-  put_layout(g, 1, 700, "\"Paper study (section 4.3): slider heights, model \".model");
+  put_layout(g, 1, 700, "\"Slider heights in the paper's study (section 4.3; not one of its figures), model \".model");
   fputs("set xlabel 'time t (s)'\nset ylabel 'slider height d_i (m)'\nplot ", g);
   for (int i = 1; i <= PRRU_NACT; i++)
     fprintf(g, "%s't':'d%d' with lines lt %d title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i, i);
   fputs("\nunset multiplot\n", g);
   joint_figure(g, 'U', 'f', "fig4_u_joint_forces.png",
-               "\"Paper fig. 4: U-joint reaction forces (lower link on platform, frame S), model \".model",
+               "\"U-joint reaction forces, paper fig. 4 (lower link on platform, frame S), model \".model",
                "force (N)");
   joint_figure(g, 'P', 'f', "fig5_p_joint_forces.png",
-               "\"Paper fig. 5: prismatic-joint reaction forces (rail on slider, frame S), model \".model."
+               "\"Prismatic-joint reaction forces, paper fig. 5 (rail on slider, frame S), model \".model."
                "\"\\nf_z is not shown: z is the drive axis, along which the actuator force f_d acts\"",
                "force (N)");
   joint_figure(g, 'P', 'm', "fig6_p_joint_moments.png",
-               "\"Paper fig. 6: prismatic-joint reaction moments (rail on slider, frame S), model \".model",
+               "\"Prismatic-joint reaction moments, paper fig. 6 (rail on slider, frame S), model \".model",
                "moment (N m)");
   return close_script(g, &buf);
 }
