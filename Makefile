@@ -12,7 +12,8 @@ FUZZ_SECONDS ?= 60
 
 # Debian packages, per target: each installs only what it uses.
 #   demo (and build, bench, compare-designs): the build (GSL; jansson,
-#         found by pkg-config, for the model file loader) and the plots;
+#         found by pkg-config, for the model file loader), the plots and
+#         the man pages (help2man; without it the build writes plain pages);
 #   test: + g++ and clang (tests/test_dropin.sh), pkg-config (demo has it)
 #         (tests/test_install.sh), MuJoCo (validation/), NumPy (the
 #         Python binding's array path, python/tests), SymPy (the bench's
@@ -26,7 +27,7 @@ FUZZ_SECONDS ?= 60
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
-DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox
+DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox help2man
 DEPS_TEST = $(strip $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy \
             chromium nodejs $(if $(shell command -v npm),,npm))
 DEPS_ASAN = $(DEPS_TEST) valgrind

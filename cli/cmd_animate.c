@@ -23,7 +23,8 @@ static const char animate_help[] =
     "over the run (default 50, at most the number of rows, 2 to 1000), shown\n"
     "at F frames per second (default 25, 1 to 100): the rails (grey), the\n"
     "sliders (black), the upper links (blue), the lower links (orange) and\n"
-    "the platform (green, with its normal), in metres in the base frame {S}.\n"
+    "the platform (green: its plate, normal and outline through the U joints),\n"
+    "in metres in the base frame {S}, with their shadows on the floor.\n"
     "The poses are this build's model's; a FILE whose first line names another\n"
     "model (a different sha256) is refused. Writes FILE.gif beside FILE.csv\n"
     "unless --out says where (--out -: stdout); the GIF is replaced only when\n"
@@ -136,6 +137,14 @@ static int frame(FILE *out, const double q[3], extent *e)
   }
   for (int k = 0; k < 4; k++) seg(out, corner[k], corner[(k + 1) % 4], COL_PLATFORM);
   seg(out, O, normal, COL_PLATFORM);
+  /* The platform's outline through its U joints: the plate of side 2a
+   * alone is small beside the links. */
+  for (int i = 0; i < PRRU_NLIMB; i++) {
+    double A[3], B[3], C[3], A2[3], B2[3], C2[3];
+    limb_points(R, p, i, A, B, C);
+    limb_points(R, p, (i + 1) % PRRU_NLIMB, A2, B2, C2);
+    seg(out, C, C2, COL_PLATFORM);
+  }
   fputs("\n\n", out); /* frames are gnuplot data blocks (index) */
   return 0;
 }
@@ -292,7 +301,7 @@ int prru_cmd_animate(int argc, char **argv)
     return 1;
   }
   char *script = NULL;
-  int rc = write_frames("animate", &t, dir, nframes, fps, prru_cli_model_id(), &script);
+  int rc = write_frames("animate", &t, dir, nframes, fps, prru_mech.name, &script);
   prru_table_free(&t);
   if (rc == 0) rc = prru_plot_run("animate", dir, dir, "anim.gp", script);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {

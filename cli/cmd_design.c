@@ -734,7 +734,7 @@ static const char opt_help[] =
     "                     --report DIR [--range PCT] [--objective mean|max|log]\n"
     "                     [--rcond-min R] [--stroke LO:HI] [--set NAME=VALUE,...]\n"
     "                     [--max-iter N] [--penalty W] [--name NAME] [--threads N]\n"
-    "                     [--progress]\n"
+    "                     [--progress] [--clip W]\n"
     "Chooses the design variables within their bounds so that the rotational\n"
     "dynamic manipulability w_R comes as close to 1 (isotropy) as it can over the\n"
     "workspace rectangle (grid as in 'prru map'), the paper's purpose for w_R.\n"
@@ -766,7 +766,9 @@ static const char opt_help[] =
     "is singular, unreachable or in the other assembly mode, slider range;\n"
     "every variable before, after and its bounds; iterations),\n"
     "before_map.csv and after_map.csv (as 'prru map' writes them) and\n"
-    "optimize_maps.png (both w_R maps side by side). Nothing is written unless a\n"
+    "optimize_maps.png (both w_R maps side by side on one viridis scale, colours\n"
+    "clipped at --clip W, default the 99th percentile of both maps' w_R: the\n"
+    "colour key says which). Nothing is written unless a\n"
     "feasible design is found (exit 1 otherwise); the files are built aside and\n"
     "renamed. Bad options, a start design that is not a buildable robot, bounds\n"
     "with LO >= HI or not around the start, a --report that is a file: exit 2.\n"
@@ -928,6 +930,7 @@ typedef struct {
   const prru_params *start;
   const char *out, *name;
   const char *set;
+  double clip; /* the maps' colour clip, NaN: the percentile */
 } opt_report;
 
 static int write_report(const char *path, const opt_report *rp)
@@ -1012,6 +1015,27 @@ static int publish_report(const char *cmd, const char *stage, const char *dir)
   return 0;
 }
 
+/* The colour clip of the two maps a and b (one colour scale): clip when
+ * given, else the percentile of both maps' ok values; NaN: no memory. */
+static double map_clip(const prru_map_grid *g, const prru_design_data *a, const prru_design_data *b,
+                       double clip)
+{
+  const size_t n = (size_t)g->n1 * (size_t)g->n2;
+  double *ok = malloc(2 * n * sizeof *ok), w_max = 1.0;
+  if (!ok) return isnan(clip) ? NAN : clip;
+  size_t m = 0;
+  const prru_design_data *dd[2] = {a, b};
+  for (int s = 0; s < 2; s++)
+    for (size_t k = 0; k < n; k++)
+      if (dd[s]->status[k] == PRRU_OK) {
+        ok[m++] = dd[s]->w_R[k];
+        if (dd[s]->w_R[k] > w_max) w_max = dd[s]->w_R[k];
+      }
+  double c = prru_plot_clip_value(clip, ok, m, w_max);
+  free(ok);
+  return c;
+}
+
 /* Report files into stage; 0, 1 or 128 + signal (PNG missing without
  * gnuplot: a note, still 0). */
 static int stage_report(const char *cmd, const char *stage, const char *dir, const opt_report *rp)
@@ -1051,8 +1075,12 @@ static int stage_report(const char *cmd, const char *stage, const char *dir, con
     }
   }
   if (!rc) {
-    char *script = prru_plot_optimize_script(&pr->grid, pr->rcond_min, ea.sum.index, eb.sum.index,
-                                             ea.sum.singular_fraction, eb.sum.singular_fraction, rp->name);
+    char *script = NULL;
+    double clip = map_clip(&pr->grid, &a, &b, rp->clip), w_max = fmax(ea.sum.w_max, eb.sum.w_max);
+    if (!isnan(clip))
+      script = prru_plot_optimize_script(&pr->grid, pr->rcond_min, ea.sum.index, eb.sum.index,
+                                         ea.sum.singular_fraction, eb.sum.singular_fraction, rp->name,
+                                         clip, isnan(rp->clip), w_max);
     rc = script ? prru_plot_run(cmd, stage, dir, "optimize_maps.gp", script) : 1;
     free(script);
     if (rc == PRRU_PLOT_NO_GNUPLOT) {
@@ -1093,7 +1121,7 @@ int prru_cmd_optimize(int argc, char **argv)
   const char *cmd = "optimize";
   problem_text t = {0};
   const char *vars_s = NULL, *out = NULL, *report = NULL, *range = NULL, *iters = NULL, *pen = NULL,
-             *name_s = NULL, *ths = NULL;
+             *name_s = NULL, *ths = NULL, *clip_s = NULL;
   int help = 0, progress = 0;
   prru_cli_option opts[] = {
       {"vars", 1, &vars_s, NULL},      {"q1", 1, &t.q1, NULL},       {"q2", 1, &t.q2, NULL},
@@ -1101,12 +1129,15 @@ int prru_cmd_optimize(int argc, char **argv)
       {"range", 1, &range, NULL},      {"objective", 1, &t.objective, NULL},
       {"rcond-min", 1, &t.rcond, NULL}, {"stroke", 1, &t.stroke, NULL}, {"set", 1, &t.set, NULL},
       {"max-iter", 1, &iters, NULL},   {"penalty", 1, &pen, NULL},   {"name", 1, &name_s, NULL},
-      {"threads", 1, &ths, NULL},      {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help}};
+      {"threads", 1, &ths, NULL},      {"progress", 0, NULL, &progress}, {"clip", 1, &clip_s, NULL},
+      {"help", 0, NULL, &help}};
   if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (help) {
     printf(opt_help);
     return 0;
   }
+  double clip;
+  if (prru_plot_parse_clip(cmd, clip_s, &clip)) return 2;
   const char *missing = !vars_s ? "--vars" : !t.q1 ? "--q1" : !t.q2 ? "--q2" : !out ? "--out"
                         : !report ? "--report" : NULL;
   if (missing) {
@@ -1216,7 +1247,7 @@ int prru_cmd_optimize(int argc, char **argv)
   if (!rc) {
     describe(desc, sizeof desc, &pr, vars, nvar);
     write_model(&jo, &r->best, name, desc);
-    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set};
+    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip};
     rc = stage_report(cmd, stage, report, &rp);
   }
   if (prru_cli_out_close(&jo, rc == 0 && !jo.err) && !rc) rc = 1;

@@ -16,7 +16,7 @@
 #include "prru.h"
 
 static const char paper_help[] =
-    "usage: prru paper --out DIR [--skip-map]\n"
+    "usage: prru paper --out DIR [--skip-map] [--clip W]\n"
     "Reproduces the paper's studies (Chen et al. 2017, section 4.3 and fig. 7):\n"
     "1 s from q(0) = (0, pi/6, -0.8) m/rad at rest under fd = (50, 40, 25) N and\n"
     "the platform force fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N, then the w_R map.\n"
@@ -30,6 +30,8 @@ static const char paper_help[] =
     "SIGHUP: exit 130, 143, 129) leaves DIR as it was. Without gnuplot the\n"
     "CSVs, scripts and summary are moved in, the PNGs of an earlier run removed,\n"
     "and the exit status is 1. --skip-map leaves earlier fig7_* files alone.\n"
+    "--clip W: fig. 7's colours and surface stop at w_R = W (default: the 99th\n"
+    "percentile of w_R over the map; the colour key says which).\n"
     "Every file names the model the build computes; with a model other than the\n"
     "paper's (models/3prru_paper.json) the study runs on that model and a warning\n"
     "says that the figures are not the paper's results.\n"
@@ -216,7 +218,7 @@ static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, doubl
 
 /* The whole study into stage; an exit status, or PRRU_PLOT_NO_GNUPLOT when
  * everything but the PNGs is there. */
-static int run_paper(const char *stage, const char *out, int skip_map, int is_paper)
+static int run_paper(const char *stage, const char *out, int skip_map, int is_paper, double clip)
 {
   char path[4400], shown[4400], msg[600];
   prru_model m;
@@ -289,7 +291,7 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
   }
   if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
   if (rc == 0 && !skip_map) {
-    rc = prru_paper_fig7(stage, out, sum);
+    rc = prru_paper_fig7(stage, out, sum, clip);
     if (rc == PRRU_PLOT_NO_GNUPLOT) {
       no_gnuplot = 1;
       rc = 0;
@@ -315,9 +317,11 @@ static int run_paper(const char *stage, const char *out, int skip_map, int is_pa
 int prru_cmd_paper(int argc, char **argv)
 {
   const char *out = NULL;
+  const char *clip_s = NULL;
   int help = 0, skip_map = 0;
-  prru_cli_option opts[] = {{"out", 1, &out, NULL}, {"skip-map", 0, NULL, &skip_map}, {"help", 0, NULL, &help}};
-  if (prru_cli_parse("paper", argc, argv, opts, 3)) return 2;
+  prru_cli_option opts[] = {{"out", 1, &out, NULL}, {"skip-map", 0, NULL, &skip_map},
+                            {"clip", 1, &clip_s, NULL}, {"help", 0, NULL, &help}};
+  if (prru_cli_parse("paper", argc, argv, opts, 4)) return 2;
   if (help) {
     char extra[sizeof paper_help_redundant + 200] = "";
     if (PRRU_NACT > 3)
@@ -325,6 +329,8 @@ int prru_cmd_paper(int argc, char **argv)
     printf(paper_help, extra);
     return 0;
   }
+  double clip;
+  if (prru_plot_parse_clip("paper", clip_s, &clip)) return 2;
   if (!out) {
     prru_cli_error("paper", "--out DIR is required (see 'prru paper --help')");
     return 2;
@@ -351,7 +357,7 @@ int prru_cmd_paper(int argc, char **argv)
     if (created) rmdir(out);
     return 1;
   }
-  int rc = run_paper(stage, out, skip_map, is_paper);
+  int rc = run_paper(stage, out, skip_map, is_paper, clip);
   int no_gnuplot = rc == PRRU_PLOT_NO_GNUPLOT;
   if (rc == 0 || no_gnuplot) {
     if (no_gnuplot) {

@@ -515,7 +515,9 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
     return 1;
   }
   if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
-  char *buf = prru_plot_track_script(abs_csv, "track.png", NULL, PRRU_NACT, o->f_max);
+  char footer[1200];
+  prru_plot_provenance(footer, sizeof footer, "track");
+  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_mech.name, footer, PRRU_NACT, o->f_max);
   int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
   if (!buf) prru_cli_error("track", "--plot: out of memory");
   free(buf);

@@ -33,7 +33,7 @@ static const struct {
 static void usage(FILE *f)
 {
   fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n"
-             "       prru --version\n\n"
+             "       prru --help | --version\n\n"
              "Dynamics of the %d-PRRU 1T2R parallel manipulator%s:\n"
              "q = (q1, q2) rad rotations of the platform about x then y', q3 its height\n"
              "(m); d the %d slider heights (m).\n"
@@ -51,7 +51,10 @@ static void usage(FILE *f)
              "file, 130/143/129 stopped by SIGINT/SIGTERM/SIGHUP (simulate, id, map,\n"
              "paper: rows computed so far are kept, every file ends with a whole row).\n"
              "Output files are built beside their name and renamed when done: a run\n"
-             "that fails before its first row leaves an existing file as it was.\n");
+             "that fails before its first row leaves an existing file as it was.\n\n"
+             "global options:\n"
+             "  -h, --help     this text (prru COMMAND --help: the command's)\n"
+             "  --version      version and model (also prru COMMAND --version)\n");
 }
 
 /* Every command's stdout (JSON, summaries, help) is checked once flushed
@@ -80,6 +83,11 @@ int main(int argc, char **argv)
     prru_cli_print_version(stdout);
     return finish("version", 0);
   }
+  for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+    if (strcmp(argv[1], commands[i].name) == 0 && argc == 3 && strcmp(argv[2], "--version") == 0) {
+      prru_cli_print_version(stdout); /* every command answers --version (help2man) */
+      return finish(commands[i].name, 0);
+    }
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     if (strcmp(argv[1], commands[i].name) == 0)
       return finish(commands[i].name, commands[i].run(argc - 2, argv + 2));

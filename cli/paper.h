@@ -9,6 +9,6 @@
  * summary lines appended to summary and printed. Returns 0, 1 (message
  * printed), 128 + signal, or PRRU_PLOT_NO_GNUPLOT (everything but the PNGs
  * made). */
-int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary);
+int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary, double clip);
 
 #endif

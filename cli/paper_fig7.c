@@ -103,7 +103,7 @@ static int fig7_status(int st)
   return st == PRRU_OK ? 0 : prru_cli_exit_for(st);
 }
 
-int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
+int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary, double clip)
 {
   const fig7_dirs dirs = {stage, outdir};
   prru_model m;
@@ -187,7 +187,15 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary)
   free(d);
   if (rc == 0 && prru_cli_interrupted) rc = prru_cli_exit_interrupted();
   if (rc == 0) {
-    char *script = prru_plot_fig7_script(FIG7A_NPOSE, FIG7_RCOND_MIN);
+    /* The clip from the ok values (the percentile), unless --clip. */
+    size_t n_ok = 0, n = (size_t)g.n1 * (size_t)g.n2;
+    double *ok_w = malloc(n * sizeof *ok_w);
+    for (size_t k = 0; ok_w && k < n; k++)
+      if (st[k] == PRRU_OK) ok_w[n_ok++] = w[k];
+    double cv = ok_w || !isnan(clip) ? prru_plot_clip_value(clip, ok_w, n_ok, sum->w_max) : NAN;
+    free(ok_w);
+    char *script = isnan(cv) ? NULL : prru_plot_fig7_script(FIG7A_NPOSE, FIG7_RCOND_MIN, cv, isnan(clip),
+                                                            sum->w_max);
     if (!script) {
       prru_cli_error("paper", "out of memory for the fig. 7 script");
       rc = 1;

@@ -58,17 +58,30 @@ static int header_kind(const char *header)
   return CSV_UNKNOWN;
 }
 
-/* The '#' lines of a file, joined for a title (at most 3, 400 bytes). */
+/* The '#' lines of a file: all of them joined for the footer (at most 3,
+ * 400 bytes), and the model named by the first ("# prru VERSION model
+ * NAME (FILE, sha256 HASH)") for the title. */
 typedef struct {
   char text[400];
+  char model[200];
   int count;
 } csv_comments;
+
+/* NAME out of "prru VERSION model NAME (...": "" when line is not so. */
+static void model_name(const char *line, char *name, size_t len)
+{
+  const char *m = strncmp(line, "prru ", 5) == 0 ? strstr(line, " model ") : NULL;
+  const char *end = m ? strstr(m + 7, " (") : NULL;
+  name[0] = '\0';
+  if (end) snprintf(name, len, "%.*s", (int)(end - (m + 7)), m + 7);
+}
 
 static void add_comment(csv_comments *c, const char *line)
 {
   if (c->count++ >= 3) return;
   size_t used = strlen(c->text);
   while (*line == '#' || *line == ' ') line++;
+  if (c->count == 1) model_name(line, c->model, sizeof c->model);
   snprintf(c->text + used, sizeof c->text - used, "%s%s", used ? "; " : "", line);
 }
 
@@ -120,6 +133,8 @@ typedef struct {
   double q3, q1_last;
   double *q2; /* the first block's q2 values */
   double w_max;
+  double *ok_w; /* the ok values of w_R, n_ok of them (for the clip) */
+  long n_ok, cap_ok;
 } map_scan;
 
 /* Checks one row against the grid read so far; NULL or the reason. */
@@ -149,6 +164,16 @@ static const char *scan_row(map_scan *m, const double q[3], double w, int kind)
     return "the q2 values differ from the first q1 block's (not a grid)";
   }
   if (kind == 0 && w > m->w_max) m->w_max = w;
+  if (kind == 0) {
+    if (m->n_ok == m->cap_ok) {
+      long cap = m->cap_ok ? 2 * m->cap_ok : 1024;
+      double *v = realloc(m->ok_w, (size_t)cap * sizeof *v);
+      if (!v) return "out of memory";
+      m->ok_w = v;
+      m->cap_ok = cap;
+    }
+    m->ok_w[m->n_ok++] = w;
+  }
   m->n_sing += kind == 1;
   m->n_other += kind == 2;
   m->cur++;
@@ -251,7 +276,7 @@ static void track_limits(const prru_table *t, int nact, double *f_max)
  * reader and writes its script (the CSV by its absolute path abs) into
  * *script; 0, 1 (no memory) or 2 after a message. */
 static int series_script(const char *cmd, const char *path, const char *abs, int kind,
-                         const char *subtitle, char **script)
+                         const char *model, const char *footer, char **script)
 {
   prru_table t;
   char msg[600];
@@ -276,15 +301,15 @@ static int series_script(const char *cmd, const char *path, const char *abs, int
   if (rc == 0 && kind == CSV_EXCITE) rc = need_columns(cmd, path, kind, &t, "fd", nact);
   if (rc == 0) {
     if (kind == CSV_SIMULATION)
-      *script = prru_plot_series_script(abs, "plot.png", subtitle, nact,
+      *script = prru_plot_series_script(abs, "plot.png", model, footer, nact,
                                         prru_table_column(&t, "T") >= 0 && prru_table_column(&t, "V") >= 0);
     else if (kind == CSV_TRACK) {
       track_limits(&t, nact, f_max);
-      *script = prru_plot_track_script(abs, "plot.png", subtitle, nact, f_max);
+      *script = prru_plot_track_script(abs, "plot.png", model, footer, nact, f_max);
     } else if (kind == CSV_ID)
-      *script = prru_plot_forces_script(abs, "plot.png", subtitle, nact);
+      *script = prru_plot_forces_script(abs, "plot.png", model, footer, nact);
     else
-      *script = prru_plot_motion_script(abs, "plot.png", subtitle, nact, kind == CSV_EXCITE);
+      *script = prru_plot_motion_script(abs, "plot.png", model, footer, nact, kind == CSV_EXCITE);
     if (!*script) {
       prru_cli_error(cmd, "out of memory");
       rc = 1;
@@ -355,7 +380,17 @@ void prru_plot_default_out(const char *in, const char *ext, char *out, size_t le
   snprintf(out, len, "%.*s%s", (int)n, in, ext);
 }
 
-int prru_plot_csv(const char *cmd, const char *in, const char *out)
+/* The footer of a figure of the file in: its name and its comment lines,
+ * numbers and hashes shortened. */
+static void csv_footer(const char *in, const csv_comments *com, char *footer, size_t len)
+{
+  char text[1000];
+  const char *base = strrchr(in, '/');
+  snprintf(text, sizeof text, "prru plot %s: %s", base ? base + 1 : in, com->text);
+  prru_plot_shorten(text, footer, len);
+}
+
+int prru_plot_csv(const char *cmd, const char *in, const char *out, double clip)
 {
   FILE *f = fopen(in, "r");
   if (!f) {
@@ -379,6 +414,14 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
     return 2;
   }
   free(header);
+  if (kind != CSV_MAP && !isnan(clip)) {
+    prru_cli_error(cmd, "--clip: only for a map CSV (%s is %s CSV)", in, kind_name[kind]);
+    fclose(f);
+    return 2;
+  }
+  char footer[1000];
+  csv_footer(in, &com, footer, sizeof footer);
+  const char *model = com.model[0] ? com.model : "(not named in the file)";
   char dir[PRRU_PLOT_PATH], path[PRRU_PLOT_PATH + 64], abs_in[PRRU_PLOT_PATH];
   static const char *const scratch[] = {"map.dat", "contours.dat", "plot.gp", "plot.png"};
   if (prru_plot_scratch(cmd, dir, sizeof dir)) {
@@ -398,11 +441,13 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
       rc = 1;
     }
     if (rc == 0) {
-      prru_plot_map_info info = {m.q3, m.w_max, m.n1, m.n2, m.n_sing, m.n_other};
-      script = prru_plot_map_script("map.dat", "plot.png", com.text, &info);
+      prru_plot_map_info info = {m.q3, m.w_max, m.n1, m.n2, m.n_sing, m.n_other,
+                                 prru_plot_clip_value(clip, m.ok_w, (size_t)m.n_ok, m.w_max), isnan(clip)};
+      script = prru_plot_map_script("map.dat", "plot.png", model, footer, &info);
       if (!script) rc = 1;
     }
     free(m.q2);
+    free(m.ok_w);
     fclose(f);
   } else {
     fclose(f);
@@ -410,7 +455,7 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out)
       prru_cli_error(cmd, "%s: %s", in, strerror(errno));
       rc = 2;
     }
-    if (rc == 0) rc = series_script(cmd, in, abs_in, kind, com.text, &script);
+    if (rc == 0) rc = series_script(cmd, in, abs_in, kind, model, footer, &script);
   }
   if (rc == 0) rc = prru_plot_run(cmd, dir, dir, "plot.gp", script);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {

@@ -10,6 +10,10 @@
 #   lib/pkgconfig/prru.pc     pkg-config: -lprru, shared, or static with
 #                             --static (adds GSL, libpthread, libm)
 #   share/prru/MODEL.json     the model file the kernels come from
+#   lib/python3/dist-packages/prru/   the Python binding (PRRU_INSTALL_PYTHONDIR),
+#                             finding ../../../LIBDIR/libprru.so by itself
+#                             (prru/_installed.py): PYTHONPATH=that directory
+#   share/man/man1/prru.1, prru-COMMAND.1   man pages (help2man when found)
 # (lib is GNUInstallDirs' CMAKE_INSTALL_LIBDIR.)
 #
 # The kernels, and with them the array sizes in the runtime's structs
@@ -102,3 +106,38 @@ install(CODE "
   set(PRRU_PC_PREFIX \"\${pc_path}\")
   configure_file(\"${PROJECT_BINARY_DIR}/prru.pc.in\" \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" @ONLY)
   file(INSTALL \"${PROJECT_BINARY_DIR}/pkgconfig/prru.pc\" DESTINATION \"${prru_pc_destination}\")")
+
+# ---- the Python binding ----
+# Into the directory Debian's python3 searches under /usr, relative to the
+# prefix (another prefix: PYTHONPATH=PREFIX/lib/python3/dist-packages).
+set(PRRU_INSTALL_PYTHONDIR "lib/python3/dist-packages" CACHE STRING
+    "where cmake --install puts the Python package prru (relative: under the prefix)")
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/python/prru/" DESTINATION "${PRRU_INSTALL_PYTHONDIR}/prru"
+        FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
+# prru/_installed.py: where the installed library is, relative to the
+# package when both directories are under the prefix (the install can be
+# moved, or staged with DESTDIR), else absolute.
+if(IS_ABSOLUTE "${PRRU_INSTALL_PYTHONDIR}" OR IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  set(prru_py_lib "${CMAKE_INSTALL_FULL_LIBDIR}/libprru.so")
+  set(prru_py_relative False)
+else()
+  file(RELATIVE_PATH prru_py_lib "/prefix/${PRRU_INSTALL_PYTHONDIR}/prru" "/prefix/${CMAKE_INSTALL_LIBDIR}/libprru.so")
+  set(prru_py_relative True)
+endif()
+file(WRITE "${PROJECT_BINARY_DIR}/python/_installed.py"
+     "\"\"\"Written by cmake --install: where the installed libprru.so is.\"\"\"\n"
+     "LIBRARY = \"${prru_py_lib}\"\n"
+     "RELATIVE = ${prru_py_relative}  # LIBRARY relative to this package's directory\n")
+install(FILES "${PROJECT_BINARY_DIR}/python/_installed.py" DESTINATION "${PRRU_INSTALL_PYTHONDIR}/prru")
+
+# ---- man pages ----
+find_program(PRRU_HELP2MAN help2man)
+set(prru_man_dir "${PROJECT_BINARY_DIR}/man")
+add_custom_command(OUTPUT "${prru_man_dir}/prru.1"
+  COMMAND "${CMAKE_COMMAND}" -DPRRU=$<TARGET_FILE:prru> "-DOUT=${prru_man_dir}"
+          "-DHELP2MAN=$<$<BOOL:${PRRU_HELP2MAN}>:${PRRU_HELP2MAN}>"
+          -P "${CMAKE_CURRENT_LIST_DIR}/prru_man.cmake"
+  DEPENDS prru "${CMAKE_CURRENT_LIST_DIR}/prru_man.cmake"
+  COMMENT "Man pages of prru")
+add_custom_target(prru_man ALL DEPENDS "${prru_man_dir}/prru.1")
+install(DIRECTORY "${prru_man_dir}/" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1" FILES_MATCHING PATTERN "*.1")

@@ -3,7 +3,7 @@
 # limb 3 so that q2 is driven by two limbs, bring the rotational dynamic
 # manipulability index w_R closer to 1?
 #
-# usage: studies/compare_designs.sh BUILD3 BUILD4 OUTDIR
+# usage: studies/compare_designs.sh BUILD3 BUILD4 OUTDIR [--clip W]
 #   BUILD3, BUILD4: build directories of the 3-limb and the 4-limb model
 #   (`make compare-designs` makes both: build/ and build-4prru/).
 # Both prru binaries map w_R over the paper's fig. 7 rectangle (q1 in
@@ -14,10 +14,19 @@
 # and other-assembly-mode points are left out of the index, reported as one
 # share and drawn white. Writes
 # OUTDIR/{3prru,4prru}_map.csv and _summary.txt, compare_wR.png (the two
-# maps side by side on one colour scale) and summary.txt.
+# maps side by side on one viridis colour scale, clipped at --clip W or by
+# default at the 99th percentile of both maps' w_R, as prru's own maps) and
+# summary.txt.
 set -euo pipefail
-[ $# -eq 3 ] || { echo "usage: $0 BUILD3 BUILD4 OUTDIR" >&2; exit 2; }
-b3=$1 b4=$2 out=$3
+usage() { echo "usage: $0 BUILD3 BUILD4 OUTDIR [--clip W]" >&2; exit 2; }
+[ $# -eq 3 ] || [ $# -eq 5 ] || usage
+b3=$1 b4=$2 out=$3 clip=
+if [ $# -eq 5 ]; then
+  [ "$4" = --clip ] || usage
+  clip=$5
+  python3 -c "import math, sys; v = float(sys.argv[1]); sys.exit(not (math.isfinite(v) and v > 1))" "$clip" 2>/dev/null ||
+    { echo "$0: --clip '$clip': must be a number above 1" >&2; exit 2; }
+fi
 for b in "$b3" "$b4"; do
   [ -x "$b/cli/prru" ] || { echo "$0: $b/cli/prru: not built" >&2; exit 2; }
 done
@@ -56,29 +65,53 @@ l3=$(field "$out/3prru_summary.txt" index_log) l4=$(field "$out/4prru_summary.tx
 cat "$out/summary.txt"
 
 if command -v gnuplot >/dev/null 2>&1; then
-  (cd "$out" && gnuplot) <<'GP'
+  # The clip and its note (the colour key), the footer: from the maps.
+  read -r CLIP CLIPNOTE <<<"$(python3 - "$out/3prru_map.csv" "$out/4prru_map.csv" "$clip" <<'PY'
+import csv, sys
+w = [float(r[3]) for f in sys.argv[1:3] for r in csv.reader(l for l in open(f) if l[:1] not in '#q') if r[4] == 'ok']
+w.sort()
+if sys.argv[3]:
+    print(repr(float(sys.argv[3])), '(--clip)')
+else:
+    x = 0.99 * (len(w) - 1); i = int(x)
+    c = w[i] + (x - i) * (w[min(i + 1, len(w) - 1)] - w[i])
+    print(repr(max(c, 1.001)), '(the 99th percentile, --clip W sets it)')
+print(end='')
+PY
+)"
+  WMAX=$(python3 -c "import csv, sys; print(max(float(r[3]) for f in sys.argv[1:] for r in csv.reader(l for l in open(f) if l[:1] not in '#q') if r[4] == 'ok'))" "$out/3prru_map.csv" "$out/4prru_map.csv")
+  FOOTER="studies/compare_designs.sh: $(head -1 "$out/3prru_map.csv" | sed -E 's/^# //; s/(sha256 [0-9a-f]{12})[0-9a-f]{52}/\1.../') vs $(head -1 "$out/4prru_map.csv" | sed -E 's/^# prru [^ ]+ //; s/(sha256 [0-9a-f]{12})[0-9a-f]{52}/\1.../')"
+  # Text from files reaches gnuplot through the environment, never as code.
+  (cd "$out" && CLIP="$CLIP" CLIPNOTE="$CLIPNOTE" WMAX="$WMAX" FOOTER="$FOOTER" gnuplot) <<'GP'
 set datafile separator ','
-set terminal pngcairo size 1400,620 enhanced font 'Sans,11'
+set encoding utf8
+set terminal pngcairo size 1400,640 enhanced font 'Sans,11'
 set output 'compare_wR.png'
-set multiplot layout 1,2 title "Rotational dynamic manipulability index w_R, q_3 = 0 (paper fig. 7 rectangle): 3 limbs vs 4 limbs\nwhite: J_d singular (cond_1 > 250), unreachable or the other assembly mode; one colour scale"
-set view map
+CLIP = real(system('printf %s "$CLIP"'))
+WMAX = real(system('printf %s "$WMAX"'))
+note = system('printf %s "$CLIPNOTE"')
+footer = system('printf %s "$FOOTER"')
+set label 1000 footer noenhanced at screen 0.005, screen 0.015 left font ',8' tc rgb '#505050' front
+set multiplot layout 1,2 margins screen 0.06, 0.86, 0.12, 0.84 spacing screen 0.07, 0 title "w_R over the paper's fig. 7 rectangle, q_3 = 0 m: 3 limbs vs 4 limbs\nwhite: J_d singular (cond_1 > 250), unreachable or the other assembly mode; one colour scale"
 set xlabel 'q_1 (rad)'
 set ylabel 'q_2 (rad)'
-set cblabel 'w_R'
-set logscale cb
-set cbrange [1:5]
-set cbtics (1, 1.2, 1.5, 2, 3, 5)
-set palette rgbformulae 22,13,-31
-set xrange [-0.5236:0.5236]
-set yrange [-0.7854:0.5236]
+set palette defined (0 '#440154', 0.125 '#472d7b', 0.25 '#3b528b', 0.375 '#2c728e', 0.5 '#21918c', 0.625 '#28ae80', 0.75 '#5ec962', 0.875 '#addc30', 1 '#fde725')
+set cbrange [1:CLIP]
+set cblabel (WMAX > CLIP ? sprintf("w_R (-), colours clipped at %.4g\n%s; max %.4g", CLIP, note, WMAX) : 'w_R (-)')
+set xrange [-pi/6:pi/6]
+set yrange [-pi/4:pi/6]
+set size ratio -1
 unset key
-ok(w) = (strcol(5) eq 'ok') ? w : NaN
-# pm3d wants a blank line between scans (rows of constant q1)
+unset colorbox
+ok(w) = (strcol(5) eq 'ok') ? (w > CLIP ? CLIP : w) : NaN
+# image wants a blank line between scans (rows of constant q1)
 scans(f) = sprintf("< awk -F, 'NR > 2 { if (NR > 3 && $1 != p) print \"\"; p = $1; print }' %s", f)
 set title '3 limbs (the paper)'
-splot scans('3prru_map.csv') using 1:2:(ok($4)) with pm3d
+plot scans('3prru_map.csv') using 1:2:(ok($4)) with image
+unset label 1000
+set colorbox user origin screen 0.8, screen 0.12 size screen 0.02, screen 0.72
 set title '4 limbs (limb 4 mirrors limb 3)'
-splot scans('4prru_map.csv') using 1:2:(ok($4)) with pm3d
+plot scans('4prru_map.csv') using 1:2:(ok($4)) with image
 unset multiplot
 GP
   echo "wrote $out/compare_wR.png"

@@ -107,7 +107,7 @@ WP='0,0,-0.8;0.1,0.05,-0.78'
   || bad "excite failed"
 # Each by its header, at its own size (track 2 panels, traj and excite 4,
 # id 1), with nothing said on stderr.
-for c in "track 1000 800" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
+for c in "track 1000 1300" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
   set -- $c
   "$PRRU" plot "$tmp/$1.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/$1.png")" = "$2 $3" ] && [ ! -s "$tmp/err" ] \
     && ok || bad "plot of a $1 CSV: $(png_size "$tmp/$1.png") $(head -c 300 "$tmp/err")"
@@ -115,7 +115,7 @@ done
 # track --plot still makes its figure, the size of prru plot's.
 "$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax 40 --q0-offset 0.01,0,0 --out "$tmp/track2.csv" \
   --summary "$tmp/track2.json" --plot "$tmp/track2.png" 2>"$tmp/err" \
-  && [ "$(png_size "$tmp/track2.png")" = "1000 800" ] && cmp -s "$tmp/track.csv" "$tmp/track2.csv" \
+  && [ "$(png_size "$tmp/track2.png")" = "1000 1300" ] && cmp -s "$tmp/track.csv" "$tmp/track2.csv" \
   && ok || bad "track --plot: $(png_size "$tmp/track2.png") $(head -c 300 "$tmp/err")"
 # Titles keep quotes whatever their neighbours: the track CSV's settings
 # line says mismatch '' (gnuplot misreads doubled quotes side by side).
@@ -123,9 +123,9 @@ grep -q "mismatch ''" "$tmp/track.csv" && ok || bad "the track CSV no longer say
 sed "1s/\$/ it's '''' quoted/" "$tmp/traj.csv" >"$tmp/quotes.csv"
 "$PRRU" plot "$tmp/quotes.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/quotes.png")" = "1000 1000" ] \
   && ok || bad "plot of a CSV with quotes in its comments: $(head -c 300 "$tmp/err")"
-# A title made of long comment lines breaks into lines of about 110
+# A footer made of long comment lines breaks into lines of about 150
 # characters instead of running off the image: the script gnuplot gets
-# (caught by a gnuplot on PATH that keeps a copy) has its subtitle in parts.
+# (caught by a gnuplot on PATH that keeps a copy) has its footer in parts.
 mkdir -p "$tmp/fakebin"
 real_gnuplot=$(command -v gnuplot)
 printf '#!/bin/sh\ncp "$1" "%s/script.gp"\nexec "%s" "$@"\n' "$tmp" "$real_gnuplot" >"$tmp/fakebin/gnuplot"
@@ -135,9 +135,9 @@ sed "1s/\$/ $long/" "$tmp/traj.csv" >"$tmp/long.csv"
 PATH="$tmp/fakebin:$PATH" "$PRRU" plot "$tmp/long.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/long.png")" = "1000 1000" ] \
   && python3 - "$tmp/script.gp" <<'PY' && ok || bad "long title: $(head -c 300 "$tmp/err")"
 import re, sys
-sub = [l for l in open(sys.argv[1]) if l.startswith("sub = ")][0]
-parts = sub[len("sub = "):].strip().split("'.\"\\n\".'")
-assert len(parts) >= 3 and max(len(p) for p in parts) <= 130, [len(p) for p in parts]
+sub = [l for l in open(sys.argv[1]) if l.startswith("footer = ")][0]
+parts = sub[len("footer = "):].strip().split("'.\"\\n\".'")
+assert len(parts) >= 2 and max(len(p) for p in parts) <= 170, [len(p) for p in parts]
 PY
 # gnuplot's work is checked, not only its exit status: a gnuplot that
 # fails, or one that exits 0 with its pictures cut short (as on a full
@@ -197,7 +197,7 @@ title='it'"'"'s "q" a\101 b\\c x_1 y^2 {z} @w &v ~u %s end'
 PATH="$tmp/fakebin:$PATH" "$PRRU" plot "$tmp/title.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/title.png")" = "1000 1000" ] \
   && ok || bad "plot of a hostile title: $(head -c 300 "$tmp/err")"
 # (w is set first: gnuplot's macro expansion must not see @w outside a string.)
-printf '%s\n' "w = 'MACRO'" "$(grep '^sub = ' "$tmp/script.gp")" 'set term dumb enhanced size 200,5' 'set title sub' \
+printf '%s\n' "w = 'MACRO'" "$(grep '^footer = ' "$tmp/script.gp")" 'set term dumb enhanced size 200,5' 'set title footer' \
   'unset border; unset tics' 'plot [0:1][0:1] NaN notitle' >"$tmp/title.gp"
 "$real_gnuplot" "$tmp/title.gp" 2>&1 | grep -qF -- "$title" && ok \
   || bad "the title is not drawn as written: $("$real_gnuplot" "$tmp/title.gp" 2>&1 | grep -v '^ *$' | head -c 300)"
@@ -220,6 +220,76 @@ bad_file exciteone "$h_excite\n$(grep -m1 '^0,' "$tmp/excite.csv")\n" "an excita
 # traj's and excite's columns begin alike: the columns after d decide.
 bad_file motionother "$(echo "$h_traj" | sed 's/,dd[0-9]*//g'),x1\n" \
   "not a CSV of prru simulate, map, track, traj, excite or id"
+
+# ---- figures fit for a paper (issue 31) ----
+# picture_ok FILE...: each non-empty and whole (a PNG's signature and its
+# IEND chunk last, a GIF's signature and trailer), else the first bad one.
+picture_ok() {
+  python3 - "$@" <<'PY'
+import sys
+for p in sys.argv[1:]:
+    b = open(p, 'rb').read()
+    good = len(b) > 0 and (
+        b[:8] == b'\x89PNG\r\n\x1a\n' and b[-12:] == b'\0\0\0\0IEND\xaeB`\x82' if p.endswith('.png') else
+        b[:6] in (b'GIF89a', b'GIF87a') and b[-1:] == b';')
+    if not good: print(p); sys.exit()
+print('ok')
+PY
+}
+# scripts of: prru ARGS..., each gnuplot script it runs kept in $tmp/gp.N.
+mkdir -p "$tmp/keepbin"
+printf '#!/bin/sh\nn=$(ls "%s"/gp.* 2>/dev/null | wc -l)\ncp "$1" "%s/gp.$n"\nexec "%s" "$@"\n' "$tmp" "$tmp" \
+  "$real_gnuplot" >"$tmp/keepbin/gnuplot"
+chmod +x "$tmp/keepbin/gnuplot"
+scripts() { rm -f "$tmp"/gp.*; PATH="$tmp/keepbin:$PATH" "$PRRU" "$@"; }
+# Every figure kind, each file checked.
+scripts paper --out "$tmp/fig" >/dev/null 2>"$tmp/err" || bad "paper: $(head -c 300 "$tmp/err")"
+cat "$tmp"/gp.* >"$tmp/paper.gp"
+"$PRRU" animate "$tmp/run.csv" --frames 3 --out "$tmp/kinds.gif" || bad "animate"
+r=$(picture_ok "$tmp"/{run,m,track,traj,excite,id,track2}.png "$tmp/kinds.gif" "$tmp"/fig/*.png)
+[ "$r" = ok ] && [ "$(ls "$tmp"/fig/*.png | wc -l)" = 8 ] && ok || bad "a figure is not a whole picture: $r"
+# One perceptually uniform colour map (viridis) for every map, and the
+# clip said in the colour key: by default the 99th percentile of w_R.
+grep -q "#440154.*#fde725" "$tmp/paper.gp" && ! grep -q rgbformulae "$tmp/paper.gp" && ok || bad "fig. 7 not in viridis"
+grep -q "cblabel.*colours clipped at.*99th percentile" "$tmp/paper.gp" && ok || bad "fig. 7's key does not say the clip"
+# No fake wall: the surface is cut at the z range, never flattened there.
+grep -q "pm3d depthorder clip z" "$tmp/paper.gp" && ! grep -q "capped(" "$tmp/paper.gp" && ok \
+  || bad "fig. 7's surface is clipped flat"
+# --clip on each map-drawing command; bad values are exit 2.
+scripts plot "$tmp/map.csv" --clip 1.7 --out "$tmp/clip.png" 2>"$tmp/err" && grep -q "CLIP = 1.7$" "$tmp"/gp.* \
+  && grep -q "cblabel.*(--clip)" "$tmp"/gp.* && [ "$(picture_ok "$tmp/clip.png")" = ok ] && ok \
+  || bad "plot --clip 1.7: $(head -c 300 "$tmp/err")"
+scripts paper --out "$tmp/fig2" --clip 2.5 >/dev/null 2>"$tmp/err" && grep -q "CLIP = 2.5$" "$tmp"/gp.* && ok \
+  || bad "paper --clip 2.5: $(head -c 300 "$tmp/err")"
+for v in 1 0.5 x nan inf; do expect 2 "--clip '$v': must be a number above 1" -- plot "$tmp/map.csv" --clip "$v"; done
+expect 2 "--clip '0.9': must be a number above 1" -- paper --out "$tmp/fig3" --clip 0.9
+expect 2 "--clip '1': must be a number above 1" -- optimize --clip 1
+expect 2 "--clip: only for a map CSV" -- plot "$tmp/run.csv" --clip 2
+# Short titles, provenance in the footer: no whole SHA-256 and no 17-digit
+# number in any label of any figure (the CSV comment lines keep them).
+scripts plot "$tmp/traj.csv" --out "$tmp/t.png" && cat "$tmp"/gp.* >>"$tmp/paper.gp"
+scripts plot "$tmp/excite.csv" --out "$tmp/t.png" && cat "$tmp"/gp.* >>"$tmp/paper.gp"
+grep -q "0.29999999999999999" "$tmp/traj.csv" && ok || bad "the traj CSV no longer keeps 17 digits (test input changed)"
+python3 - "$tmp/paper.gp" <<'PY' && ok || bad "a figure's text has a long number or a whole hash"
+import re, sys
+text = [l for l in open(sys.argv[1]) if re.match(r'(footer|model|sub|opt) = |set (title|label|cblabel|multiplot)', l)]
+assert any(l.startswith('footer = ') and 'sha256 ' in l and 'paper; model' in l for l in text), 'no footer'
+# (sprintf's arguments keep full precision: its format prints them %.4g.)
+shown = [re.sub(r'(["\'])\s*,[^"\']*\)\s*$', r'\1', l) if 'sprintf(' in l else l for l in text]
+bad = [l for l in shown if re.search(r'[0-9a-f]{64}|\d\.\d{9,}', l)]
+assert not bad, bad[:2]
+PY
+# Lines survive greyscale: every line type has its own dash pattern.
+grep -c "^set linetype [0-9] .* dt " "$tmp/gp.0" | grep -qx 6 && ok || bad "line types without dash patterns"
+# The track figure: the reference drawn, rad and m on separate axes, the
+# limits labelled with their value.
+scripts plot "$tmp/track.csv" --out "$tmp/t.png"
+grep -q "'qr1' with lines.*title 'reference'" "$tmp/gp.0" && grep -q "title sprintf('limit .*%.4g N', 40)" "$tmp/gp.0" \
+  && ! grep -q "rad, m" "$tmp/gp.0" && ok || bad "track figure: reference, limits or units"
+# Panels aligned (fixed margins), the time axis the run's span.
+grep -q "layout 5,1 margins screen" "$tmp/gp.0" && grep -q "autoscale xfix" "$tmp/gp.0" && ok || bad "track panels"
+# Fig. 5 says why f_z is not there.
+grep -q "f_z is not shown: z is the drive axis" "$tmp/paper.gp" && ok || bad "fig. 5 does not say why f_z is missing"
 
 # ---- animate: a GIF of the mechanism moving ----
 "$PRRU" animate "$tmp/run.csv" --frames 7 --fps 10 2>"$tmp/err" && [ "$(gif_frames "$tmp/run.gif")" = "7 differ" ] \
@@ -259,7 +329,12 @@ for f in frames:
         if not all(close(lo[c], up[c] + up[c + 3]) for c in range(3)): errs.append('limb %d: links not joined' % k)
         if not close(length(lo), per(g['l2'], k)): errs.append('limb %d: lower link %.12g' % (k, length(lo)))
         if not (all(close(arm[c] + arm[c + 3], lo[c] + lo[c + 3]) for c in range(3)) and abs(length(arm) - a[k]) <= 1e-9): errs.append('limb %d: arm %.12g' % (k, length(arm)))
-    if len(f) != 5 * n + 5: errs.append('%d segments' % len(f))
+    # The plate (4 edges and its normal), then its outline through the U joints.
+    if len(f) != 6 * n + 5: errs.append('%d segments' % len(f))
+    for k in range(n):
+        e, lo_k, lo_n = f[5 * n + 5 + k], f[5 * k + 3], f[5 * ((k + 1) % n) + 3]
+        if not all(close(e[c], lo_k[c] + lo_k[c + 3]) and close(e[c] + e[c + 3], lo_n[c] + lo_n[c + 3]) for c in range(3)):
+            errs.append('outline edge %d' % k)
 print('; '.join(errs[:3]) if errs else 'ok')
 PY
 )

@@ -187,8 +187,9 @@ deps_of() { # TARGET: the distinct package lists make -n TARGET passes
   make -n -s -C "$PRRU_SOURCE_DIR" "$1" BUILD="$tmp/never-built" RESULTS="$tmp/never" 2>/dev/null |
     sed -n 's/.*debian_deps.sh [a-z-]* //p' | sort -u
 }
-demo_list="cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox"
-# npm only where no npm command is found (NodeSource's nodejs has one).
+# help2man: the man pages; npm only where no npm command is found
+# (NodeSource's nodejs has one).
+demo_list="cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox help2man"
 test_list="$demo_list g++ clang libmujoco-dev python3-numpy python3-sympy chromium nodejs"
 command -v npm >/dev/null 2>&1 || test_list="$test_list npm"
 for case in "demo|$demo_list" "deps|$demo_list" "bench|$demo_list" \

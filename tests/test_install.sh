@@ -69,6 +69,52 @@ if "$PRRU" --version >"$tmp/v.build" 2>&1 && "$prefix/bin/prru" --version >"$tmp
 else
   fail "installed prru --version differs:"; diff "$tmp/v.build" "$tmp/v.inst" | head
 fi
+# ---- 1b. the Python package, importable from the prefix alone ----
+# A clean environment (env -i): only PATH and PYTHONPATH, the installed
+# package's directory; the binding must load the installed libprru.so
+# (found through prru/_installed.py), not the build's or the source tree's.
+pydir=$(cache PRRU_INSTALL_PYTHONDIR)
+pydir=${pydir:-lib/python3/dist-packages}
+[ "${pydir#/}" = "$pydir" ] && pydir="$prefix/$pydir"
+if command -v python3 >/dev/null 2>&1; then
+  if (cd / && env -i PATH="$PATH" PYTHONPATH="$pydir" python3 -c '
+import os, sys, prru
+m = prru.Model()
+w = m.w_R([0.0, 0.0, 0.0])
+print(os.path.realpath(prru.__file__)); print(os.path.realpath(m.lib.path)); print(repr(w))
+' >"$tmp/py.out" 2>&1); then
+    py_pkg=$(sed -n 1p "$tmp/py.out") py_lib=$(sed -n 2p "$tmp/py.out") py_w=$(sed -n 3p "$tmp/py.out")
+    real_prefix=$(realpath "$prefix")
+    case "$py_pkg|$py_lib" in
+    "$real_prefix"/*"|$real_prefix"/*) ok "python: import prru from $pydir, w_R(0) = $py_w with the installed library" ;;
+    *) fail "python: the package or library is not the installed one: $py_pkg, $py_lib" ;;
+    esac
+    [ "$py_w" = "$("$PRRU" dme --q 0,0,0 | python3 -c 'import json, sys; print(repr(json.load(sys.stdin)["w_R"]))')" ] &&
+      ok "python: w_R(0) is prru dme's" || fail "python: w_R(0) = $py_w differs from prru dme's"
+  else
+    fail "python: import prru from $pydir in a clean environment:"; cat "$tmp/py.out"
+  fi
+else
+  fail "python3 not installed"
+fi
+
+# ---- 1c. man pages: prru.1 and one per command, rendered ----
+mandir=$(cache CMAKE_INSTALL_MANDIR)
+mandir=${mandir:-share/man}
+[ "${mandir#/}" = "$mandir" ] && mandir="$prefix/$mandir"
+render() { if command -v man >/dev/null 2>&1; then MANWIDTH=80 man -l "$1"; else groff -man -Tutf8 "$1"; fi 2>&1; }
+man_bad=""
+for cmd in "" $("$PRRU" --help | sed -n '/^commands:/,/^$/s/^  \([a-z][a-z0-9-]*\) .*/\1/p' | grep -vx version); do
+  page="$mandir/man1/prru${cmd:+-$cmd}.1"
+  if [ ! -s "$page" ]; then man_bad="$man_bad missing:${page#"$prefix"/}"; continue; fi
+  # The page renders, with its name and the command's usage line.
+  render "$page" >"$tmp/man.txt"
+  grep -q "usage: prru${cmd:+ $cmd}" "$tmp/man.txt" && grep -q "^NAME" "$tmp/man.txt" ||
+    man_bad="$man_bad bad:${page#"$prefix"/}"
+done
+[ -z "$man_bad" ] && ok "man pages: prru.1 and prru-COMMAND.1 for every command, rendered" ||
+  fail "man pages:$man_bad"
+
 nact=$(sed -n 's/^model actuators: //p' "$tmp/v.build")
 sha=$(sed -n 's/^model sha256: //p' "$tmp/v.build")
 [ -n "$nact" ] && [ -n "$sha" ] || die "prru --version: no actuator count or sha256"

@@ -374,6 +374,18 @@ class Library:
 _cache = {}
 
 
+def _installed_library(here):
+    """The library `cmake --install` put beside this package's install
+    (named in the _installed.py it writes), or None in a source tree."""
+    try:
+        from . import _installed
+    except ImportError:
+        return None
+    if _installed.RELATIVE:
+        return os.path.normpath(os.path.join(here, _installed.LIBRARY))
+    return _installed.LIBRARY
+
+
 def _candidates(explicit):
     """(source, path) pairs to try, in order."""
     if explicit is not None:
@@ -385,6 +397,9 @@ def _candidates(explicit):
         return out
     here = os.path.dirname(os.path.abspath(__file__))
     out.append(("beside the package", os.path.join(here, LIB_NAME)))
+    installed = _installed_library(here)
+    if installed:
+        out.append(("the installed library (prru/_installed.py)", installed))
     root = os.path.dirname(os.path.dirname(here))
     out.append(("the source tree's build/", os.path.join(root, "build", "runtime", LIB_NAME)))
     out.append(("the system's library path", ctypes.util.find_library("prru")))
@@ -405,8 +420,10 @@ def load_library(path=None):
     """The prru library at path (a file, or a build directory holding
     runtime/libprru.so); without a path, $PRRU_LIB (when set, the only
     place tried: a wrong setting is an error, not a fallback), then
-    libprru.so beside this package, then build/runtime/libprru.so of the
-    source tree the package sits in, then the system's library path.
+    libprru.so beside this package, then the library installed with it
+    (`cmake --install` writes its place into prru/_installed.py), then
+    build/runtime/libprru.so of the source tree the package sits in, then
+    the system's library path.
 
     Raises LibraryNotFound naming every place tried and why it failed, and
     LayoutError when the library's structs differ from this package's."""
