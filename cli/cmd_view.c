@@ -85,31 +85,6 @@ static int read_comments(const char *opt, const char *path, csv_source *s)
 
 /* ---- text into the page ---- */
 
-/* A JSON string literal that is also safe inside <script>: besides JSON's
- * own escapes, '<', '>' and '&' as \u escapes (no "</script>" or "<!--"
- * can end or change the element), U+2028/2029 escaped, a byte that is not
- * well-formed UTF-8 written as U+FFFD. */
-static void out_script_string(prru_cli_out *o, const char *s)
-{
-  prru_cli_out_write(o, "\"", 1);
-  while (*s) {
-    const unsigned char c = (unsigned char)*s;
-    const size_t n = prru_utf8_char(s);
-    if (c == '"' || c == '\\')
-      prru_cli_out_printf(o, "\\%c", c);
-    else if (c < 0x20 || c == 0x7f || c == '<' || c == '>' || c == '&')
-      prru_cli_out_printf(o, "\\u%04x", c);
-    else if (n == 0)
-      prru_cli_out_write(o, "\\ufffd", 6);
-    else if (n == 3 && c == 0xe2 && (unsigned char)s[1] == 0x80 && ((unsigned char)s[2] & 0xfe) == 0xa8)
-      prru_cli_out_printf(o, "\\u%04x", 0x2000 + ((unsigned char)s[2] - 0x80));
-    else
-      prru_cli_out_write(o, s, n);
-    s += n ? n : 1;
-  }
-  prru_cli_out_write(o, "\"", 1);
-}
-
 /* Text as HTML character data (the title): markup characters as
  * references, control characters as '?', ill-formed UTF-8 as U+FFFD. */
 static void out_html_text(prru_cli_out *o, const char *s)
@@ -409,11 +384,11 @@ static int read_map(const char *path, view_map *m)
 static void out_source(prru_cli_out *o, const csv_source *s)
 {
   prru_cli_out_write(o, "\"file\":", 7);
-  out_script_string(o, s->path);
+  prru_cli_out_json_string(o, s->path);
   prru_cli_out_write(o, ",\"comments\":[", 13);
   for (int i = 0; i < s->ncomments; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
-    out_script_string(o, s->comment[i]);
+    prru_cli_out_json_string(o, s->comment[i]);
   }
   prru_cli_out_write(o, "]", 1);
 }
@@ -441,7 +416,7 @@ static void out_bodies(prru_cli_out *o, const frames *f)
       }
     }
     prru_cli_out_printf(o, "%s{\"name\":", b ? "," : "");
-    out_script_string(o, prru_mech.body_names[b]);
+    prru_cli_out_json_string(o, prru_mech.body_names[b]);
     prru_cli_out_printf(o, ",\"kind\":\"%s\",\"limb\":%d,\"com\":", kind, i);
     out_array(o, prru_mech.com[b], 3);
     prru_cli_out_printf(o, ",\"axis\":");
@@ -525,7 +500,7 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
   prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_cli_length_scale() / fref : 0.0);
   for (int i = 0; i < PRRU_NLIMB; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
-    out_script_string(o, prru_mech.joint[u_joint(i)].name);
+    prru_cli_out_json_string(o, prru_mech.joint[u_joint(i)].name);
   }
   prru_cli_out_printf(o, "],\"at\":[");
   for (long k = 0; k < f->n; k++) {
@@ -577,15 +552,15 @@ static void out_data(prru_cli_out *o, const prru_table *t, const frames *f, cons
                      const view_map *m, const csv_source *ms)
 {
   prru_cli_out_printf(o, "{\"format\":1,\"prru\":");
-  out_script_string(o, PRRU_VERSION);
+  prru_cli_out_json_string(o, PRRU_VERSION);
   prru_cli_out_printf(o, ",\"model\":{\"name\":");
-  out_script_string(o, prru_mech.name);
+  prru_cli_out_json_string(o, prru_mech.name);
   prru_cli_out_printf(o, ",\"description\":");
-  out_script_string(o, prru_mech.description);
+  prru_cli_out_json_string(o, prru_mech.description);
   prru_cli_out_printf(o, ",\"file\":");
-  out_script_string(o, prru_mech.model_file);
+  prru_cli_out_json_string(o, prru_mech.model_file);
   prru_cli_out_printf(o, ",\"sha256\":");
-  out_script_string(o, prru_mech.sha256);
+  prru_cli_out_json_string(o, prru_mech.sha256);
   prru_cli_out_printf(o, "},\n\"source\":{");
   out_source(o, run);
   prru_cli_out_printf(o, ",\"rows\":%d},\n", t->nrows);

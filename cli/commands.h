@@ -172,7 +172,9 @@ void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n);
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n);
 /* s as a JSON string literal: quotes, backslashes and control characters
  * escaped, a byte that is not well-formed UTF-8 written as U+FFFD (JSON
- * text is UTF-8). */
+ * text is UTF-8); also safe inside an HTML <script> (prru view): '<', '>',
+ * '&' and U+2028/2029 as \u escapes, so no "</script>" or "<!--" can end
+ * or change the element (every JSON reader decodes them back). */
 void prru_cli_out_json_string(prru_cli_out *o, const char *s);
 /* Ends a complete line that is not a data row (comment, header); 0 or -1. */
 int prru_cli_out_line(prru_cli_out *o);
