@@ -221,18 +221,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
                                           c_string(e.summary()))
                for e in emitted]
-    macros += _unseen_macros(kernel_list, upper, prefix)
-    patterns = _patterns(kernel_list, upper, prefix)
-    macros += [p[0] for p in patterns.values()]
-    decls = "\n\n".join("/* %s Parameters from *p. */\n%s;" % (e.doc, e.signature) +
-                        ("\n" + patterns[e.name][1] if e.name in patterns else "")
-                        for e in emitted)
-    bodies = "\n\n".join((patterns[e.name][2] + "\n\n" if e.name in patterns else "") +
-                         "%s\n{\n%s\n}" % (e.signature, e.body)
-                         for e in emitted)
-    bdecls, bbodies = _batched(kernel_list, prefix, prefix)
-    decls += "\n\n" + bdecls
-    bodies += "\n\n" + bbodies
+    decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros,
+                             " Parameters from *p.")
     mech = deriv.mech
     labels = lambda_labels(mech)
     values = dict(banner=banner, prefix=prefix, PREFIX=upper, ctype=ctype,
@@ -280,6 +270,23 @@ def render_regressor(model, rmodel, deriv, templates_dir, prefix=None):
                       ("regressor.c.in", "%s_regressor.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
     return files, emitted
+
+
+def _sources(emitted, kernel_list, upper, prefix, macros, doc_suffix):
+    """The declarations and the function bodies of a kernel file, scalar
+    kernels then batched ones; appends the finiteness-witness and pattern
+    macros to macros (in place)."""
+    macros += _unseen_macros(kernel_list, upper, prefix)
+    patterns = _patterns(kernel_list, upper, prefix)
+    macros += [p[0] for p in patterns.values()]
+    decls = "\n\n".join("/* %s%s */\n%s;" % (e.doc, doc_suffix, e.signature) +
+                        ("\n" + patterns[e.name][1] if e.name in patterns else "")
+                        for e in emitted)
+    bodies = "\n\n".join((patterns[e.name][2] + "\n\n" if e.name in patterns else "") +
+                         "%s\n{\n%s\n}" % (e.signature, e.body)
+                         for e in emitted)
+    bdecls, bbodies = _batched(kernel_list, prefix, prefix)
+    return decls + "\n\n" + bdecls, bodies + "\n\n" + bbodies
 
 
 def _batched(kernel_list, prefix, file_prefix):
@@ -372,18 +379,7 @@ def render(model, deriv, templates_dir, prefix=None):
                                           c_string(e.summary()))
                for e in emitted]
     kernel_list = kernels(deriv)
-    macros += _unseen_macros(kernel_list, upper, prefix)
-    patterns = _patterns(kernel_list, upper, prefix)
-    macros += [p[0] for p in patterns.values()]
-    decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature) +
-                        ("\n" + patterns[e.name][1] if e.name in patterns else "")
-                        for e in emitted)
-    bodies = "\n\n".join((patterns[e.name][2] + "\n\n" if e.name in patterns else "") +
-                         "%s\n{\n%s\n}" % (e.signature, e.body)
-                         for e in emitted)
-    bdecls, bbodies = _batched(kernel_list, prefix, prefix)
-    decls += "\n\n" + bdecls
-    bodies += "\n\n" + bbodies
+    decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros, "")
     values = dict(banner=banner, head=head + " */", prefix=prefix,
                   PREFIX=upper, macros="\n".join(macros),
                   declarations=decls, functions=bodies,
