@@ -107,8 +107,10 @@ man_bad=""
 for cmd in "" $("$PRRU" --help | sed -n '/^commands:/,/^$/s/^  \([a-z][a-z0-9-]*\) .*/\1/p' | grep -vx version); do
   page="$mandir/man1/prru${cmd:+-$cmd}.1"
   if [ ! -s "$page" ]; then man_bad="$man_bad missing:${page#"$prefix"/}"; continue; fi
-  # The page renders, with its name and the command's usage line.
-  render "$page" >"$tmp/man.txt"
+  # The page renders, with its name and the command's usage line (spaces
+  # squeezed: help2man fills a usage line that runs into its paragraph,
+  # and man justifies it with double spaces).
+  render "$page" | tr -s ' ' >"$tmp/man.txt"
   grep -q "usage: prru${cmd:+ $cmd}" "$tmp/man.txt" && grep -q "^NAME" "$tmp/man.txt" ||
     man_bad="$man_bad bad:${page#"$prefix"/}"
 done
