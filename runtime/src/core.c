@@ -16,7 +16,9 @@ const char *prru_strerror(int status)
   case PRRU_OK: return "success";
   case PRRU_EINPUT: return "invalid input (NaN, infinite or out of range)";
   case PRRU_EUNREACHABLE: return "configuration not reachable (no inverse kinematics)";
-  case PRRU_ESINGULAR: return "singular configuration (J_d rank-deficient)";
+  case PRRU_ESINGULAR:
+    return "singular configuration (J_d rank-deficient, or too near the workspace boundary to "
+           "trust the dynamics)";
   case PRRU_ENOCONV: return "iteration did not converge";
   case PRRU_EINTERRUPTED: return "interrupted";
   case PRRU_EIO: return "input/output error";
