@@ -289,7 +289,7 @@ static const num *find_num(const ctx *c, const json_t *v)
 {
   num key;
   key.node = (json_t *)v;
-  return bsearch(&key, c->nums, c->nnum, sizeof key, by_node);
+  return c->nnum > 0 ? bsearch(&key, c->nums, c->nnum, sizeof key, by_node) : NULL;
 }
 
 static double num_value(const ctx *c, const json_t *v)
@@ -1321,7 +1321,8 @@ static prru_status parse_checked(ctx *c, const char *text, size_t len,
     return fail(c, NULL, "internal error: %d numbers parsed, %d scanned", (int)k,
                 (int)c->nnum);
   }
-  qsort(c->nums, c->nnum, sizeof *c->nums, by_node);
+  if (c->nnum > 0) /* a file without numbers: nums may be NULL, which qsort must not get */
+    qsort(c->nums, c->nnum, sizeof *c->nums, by_node);
   memset(&m, 0, sizeof m);
   st = validate(c, data, &m);
   json_decref(data);
