@@ -100,7 +100,17 @@ PATH=/nonexistent "$PRRU" plot "$tmp/run.csv" --out "$tmp/ng.png" 2>"$tmp/err"
 # ---- plot: the CSVs of track, traj, excite and id ----
 WP='0,0,-0.8;0.1,0.05,-0.78'
 "$PRRU" traj --waypoints "$WP" --durations 0.3 --dt 0.005 --out "$tmp/traj.csv" || bad "traj failed"
-"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax 40 --q0-offset 0.01,0,0 --out "$tmp/track.csv" \
+# A force limit the run reaches on any model, so that the track CSV holds
+# it (sat = 1 rows): half the largest force the motion needs (prru id),
+# to two digits (the paper's model: 40 N).
+"$PRRU" id --traj "$tmp/traj.csv" --out "$tmp/id_fmax.csv" || bad "id failed"
+FMAX=$(python3 -c '
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+cols = [i for i, n in enumerate(rows[0]) if n.startswith("fd")]
+peak = max(abs(float(r[i])) for r in rows[1:] for i in cols)
+print("%.17g" % float("%.2g" % (0.5 * peak)))' "$tmp/id_fmax.csv")
+"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax "$FMAX" --q0-offset 0.01,0,0 --out "$tmp/track.csv" \
   --summary "$tmp/track.json" || bad "track failed"
 "$PRRU" id --traj "$tmp/traj.csv" --out "$tmp/id.csv" || bad "id failed"
 "$PRRU" excite --period 1 --harmonics 1 --evals 20 --samples 50 --dt 0.01 --out "$tmp/excite.csv" 2>/dev/null \
@@ -113,7 +123,7 @@ for c in "track 1000 1300" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
     && ok || bad "plot of a $1 CSV: $(png_size "$tmp/$1.png") $(head -c 300 "$tmp/err")"
 done
 # track --plot still makes its figure, the size of prru plot's.
-"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax 40 --q0-offset 0.01,0,0 --out "$tmp/track2.csv" \
+"$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax "$FMAX" --q0-offset 0.01,0,0 --out "$tmp/track2.csv" \
   --summary "$tmp/track2.json" --plot "$tmp/track2.png" 2>"$tmp/err" \
   && [ "$(png_size "$tmp/track2.png")" = "1000 1300" ] && cmp -s "$tmp/track.csv" "$tmp/track2.csv" \
   && ok || bad "track --plot: $(png_size "$tmp/track2.png") $(head -c 300 "$tmp/err")"
@@ -289,7 +299,7 @@ grep -c "^set linetype [0-9] .* dt " "$tmp/gp.0" | grep -qx 6 && ok || bad "line
 # The track figure: the reference drawn, rad and m on separate axes, the
 # limits labelled with their value.
 scripts plot "$tmp/track.csv" --out "$tmp/t.png"
-grep -q "'qr1' with lines.*title 'reference'" "$tmp/gp.0" && grep -q "title sprintf('limit .*%.4g N', 40)" "$tmp/gp.0" \
+grep -q "'qr1' with lines.*title 'reference'" "$tmp/gp.0" && grep -q "title sprintf('limit .*%.4g N', $FMAX)" "$tmp/gp.0" \
   && ! grep -q "rad, m" "$tmp/gp.0" && ok || bad "track figure: reference, limits or units"
 # Panels aligned (fixed margins), the time axis the run's span.
 grep -q "layout 5,1 margins screen" "$tmp/gp.0" && grep -q "autoscale xfix" "$tmp/gp.0" && ok || bad "track panels"
