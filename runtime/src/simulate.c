@@ -306,8 +306,10 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
       else if (st == PRRU_OK)
         snprintf(why, sizeof why, "%s at q = (%.9g, %.9g, %.9g)", prru_strerror(ss), y[0], y[1],
                  y[2]);
-      if (st == PRRU_OK) st = ss;
+      /* Only a state whose own dynamics fail is the workspace's edge; a
+       * singular J_d there (make_sample's test) is a singularity inside. */
       const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR;
+      if (st == PRRU_OK) st = ss;
       prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s%s", tk,
                 edge ? "the motion reached the workspace boundary: " : "", why);
       break;
