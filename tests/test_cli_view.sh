@@ -136,10 +136,16 @@ PRRU_CHROMIUM="$chromium_bin" NODE_PATH="$web/node_modules" \
 # have them, is off by up to 2^-24 |x| ~ 1e-8 for the positions of about
 # 0.2 m here, and a recomputation of the kinematics in the page would not
 # match the row's q either: both fail this check.
+# A sanitizer build's libprru.so cannot load into an uninstrumented python3
+# (tests/CMakeLists.txt, python_prru): there the poses are not compared, and
+# the Release build's run of this test compares them.
+case "$(sed -n 's/^CMAKE_C_FLAGS:[A-Z]*=//p' "$PRRU_BUILD_DIR/CMakeCache.txt" | head -n 1)" in
+*-fsanitize*) with_lib=0 ;;
+*) with_lib=1 ;;
+esac
 PRRU_LIB="$PRRU_BUILD_DIR/runtime/libprru.so" PYTHONPATH="$PRRU_SOURCE_DIR/python" \
-python3 - "$tmp/seen.json" "$hrun" "$evil" <<'PY' && ok || bad "the browser's view: see above"
+python3 - "$tmp/seen.json" "$hrun" "$evil" "$with_lib" <<'PY' && ok || bad "the browser's view: see above"
 import csv, json, sys
-import prru
 r = json.load(open(sys.argv[1]))
 fails = []
 def need(cond, what):
@@ -161,6 +167,12 @@ need(sys.argv[3] in r['title'] and sys.argv[3] in r['info'] and 'window.pwned=2'
 rows = [row for row in csv.reader(l for l in open(sys.argv[2], encoding='latin-1') if not l.startswith('#'))]
 head, rows = rows[0], rows[1:]
 ix = {n: head.index(n) for n in ('t', 'q1', 'q2', 'q3')}
+if sys.argv[4] != '1':
+    print('poses: not compared with the kernel (sanitizer build: libprru.so cannot load into python3)')
+    for w in fails:
+        print('FAIL:', w)
+    sys.exit(1 if fails else 0)
+import prru
 m = prru.Model()
 worst = 0.0
 for f in r['poses']:
