@@ -21,7 +21,9 @@ FUZZ_SECONDS ?= 60
 #         Node.js with npm (prru view's page in a real browser,
 #         tests/test_cli_view.sh; npm only when no npm command is there:
 #         Debian's nodejs lacks it, NodeSource's has it and conflicts with
-#         Debian's npm package);
+#         Debian's npm package), slurm-wlm and munge (a single-node Slurm
+#         cluster that runs the docs' job-array example, tests/test_slurm.sh;
+#         the test starts and stops its own daemons, not the system's);
 #   test-asan: + valgrind (gcc's own sanitizers need nothing more);
 #   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
@@ -29,7 +31,7 @@ FUZZ_SECONDS ?= 60
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
 DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox help2man
 DEPS_TEST = $(strip $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy \
-            chromium nodejs $(if $(shell command -v npm),,npm))
+            chromium nodejs $(if $(shell command -v npm),,npm) slurm-wlm munge)
 DEPS_ASAN = $(DEPS_TEST) valgrind
 DEPS_FUZZ = clang clang-runtime libgsl-dev libjansson-dev pkg-config
 DEPS_DRY_RUN ?=
