@@ -478,8 +478,25 @@ static void combination(const prru_base *b, int i, char *buf, size_t len)
   }
 }
 
+/* The base parameters furthest from the estimate: "#3 P.m at 5.2 se, ...". */
+static void worst_deviations(const prru_base *b, const prru_consistent_result *c, char *buf, size_t len)
+{
+  int used[PRRU_NREG] = {0};
+  size_t k = 0;
+  buf[0] = 0;
+  for (int n = 0; n < 5 && n < b->nbase && k < len; n++) {
+    int w = -1;
+    for (int i = 0; i < b->nbase; i++)
+      if (!used[i] && (w < 0 || fabs(c->t[i]) > fabs(c->t[w]))) w = i;
+    used[w] = 1;
+    k += (size_t)snprintf(buf + k, len - k, "%s#%d %s at %.3g se", n ? ", " : "", w + 1,
+                          prru_regressor_names[b->col[w]], c->t[w]);
+  }
+}
+
 static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_result *r, const double *prior,
-                         const int *kept)
+                         const prru_consistent_options *co, const prru_consistent_result *c, const double *pi0,
+                         const double *pi)
 {
   prru_cli_out_comment(o);
   prru_cli_out_printf(o, "# identify: %d samples, %d rows, %d base parameters of %d, %d degrees of freedom; "
@@ -488,59 +505,59 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   prru_cli_out_line(o);
   prru_cli_out_printf(o, "# residual RMS per actuator (N):");
   for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, " %.6g", r->rms[i]);
-  prru_cli_out_printf(o, "\n# no effect on any actuator force (kept from the prior):");
+  prru_cli_out_printf(o, "\n# no effect on any actuator force (set by the prior):");
   prru_cli_out_line(o);
   for (int j = 0; j < PRRU_NREG; j++)
     if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
-  prru_cli_out_printf(o, "\n# only in combinations (kept from the prior):");
+  prru_cli_out_printf(o, "\n# only in combinations (split by the prior):");
   for (int j = 0; j < PRRU_NREG; j++)
     if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
-  int nkept = 0;
-  for (int i = 0; i < b->nbase; i++) nkept += kept[i];
-  if (nkept) {
-    prru_cli_out_printf(o, "\n# within 3 se of the prior, written as the prior's value so that every body is "
-                        "physical:");
-    for (int i = 0; i < b->nbase; i++)
-      if (kept[i]) prru_cli_out_printf(o, " %d", i + 1);
+  prru_cli_out_printf(o, "\n# physically consistent model (docs/control.md): %s; Mahalanobis distance^2 of its "
+                      "base parameters to the estimate %.4g, chi^2 quantile (%d dof, 1 - %g) %.4g, sigma_w %.4g N "
+                      "= max(sigma sqrt(inflation), %g rms(y)); distance to the prior %.4g (pseudo-inertia norm); smallest "
+                      "pseudo-inertia eigenvalue %.3g of the prior's; %d Newton steps; residual variance inflation %.4g (%d lags, "
+                      "Newey-West)\n",
+                      c->how == PRRU_CONSISTENT_EXACT ?
+                        "the estimate's own base parameters (a consistent robot has them)" :
+                        "no consistent robot has the estimate's base parameters: the consistent set nearest "
+                        "them within their covariance",
+                      c->d2, b->nbase, co->alpha, c->d2_max, c->sigma_w, co->sigma_floor, c->prior_dist, c->margin,
+                      c->newton, r->inflation, r->hac_lags);
+  prru_cli_out_line(o);
+  char worst[512];
+  worst_deviations(b, c, worst, sizeof worst);
+  prru_cli_out_printf(o, "# largest deviations of the model's base parameters from the estimate: %s\n", worst);
+  prru_cli_out_line(o);
+  prru_cli_out_printf(o, "# standard parameters moved from the prior (relative change):");
+  int moved = 0;
+  for (int j = 0; j < PRRU_NREG; j++) {
+    /* Relative to the prior's value, or to the drive's weight where
+     * the prior has none; below 1e-9 it is rounding. */
+    const double ref = c->w[j] > 0 ? fmax(fabs(pi0[j]), c->w[j]) : fabs(pi0[j]);
+    if (fabs(pi[j] - pi0[j]) <= 1e-9 * ref) continue;
+    if (ref > 0)
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior %.4g, %+.3g %%)", prru_regressor_names[j], pi[j], pi0[j],
+                          100 * (pi[j] - pi0[j]) / ref);
+    else
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior 0)", prru_regressor_names[j], pi[j]);
+    moved++;
   }
-  prru_cli_out_printf(o, "\nindex,parameter,estimate,se,prior,resolution,combination\n");
+  if (!moved) prru_cli_out_printf(o, " none");
+  prru_cli_out_printf(o, "\nindex,parameter,estimate,se,prior,resolution,model,t,combination\n");
   prru_cli_out_line(o);
   for (int i = 0; i < b->nbase; i++) {
     char comb[4096];
     combination(b, i, comb, sizeof comb);
-    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%s\n", i + 1, prru_regressor_names[b->col[i]],
-                        r->beta[i], r->se[i], prior[i], r->scale[i], comb);
+    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%s\n", i + 1, prru_regressor_names[b->col[i]],
+                        r->beta[i], r->se[i], prior[i], r->scale[i], c->beta[i], c->t[i], comb);
     prru_cli_out_row(o);
   }
 }
 
-static int to_params(const prru_base *b, const prru_ident_result *r, const double *pi, prru_params *p,
-                     char *why, size_t len);
-
-/* The model file's numbers: the estimates put into the prior
- * (prru_base_to_standard); when that makes a body or drive non-physical,
- * once more with every base parameter that lies within 3 standard errors
- * of the prior's value (no significant evidence against the prior) at the
- * prior's value, kept[i] = 1 for those. 0, or 1 with why. */
-static int model_params(const prru_base *b, const prru_ident_result *r, const double *pi0, const double *prior,
-                        double *pi, int *kept, prru_params *p, char *why, size_t len)
-{
-  double beta[PRRU_NREG];
-  memset(kept, 0, sizeof(int) * PRRU_NREG);
-  prru_base_to_standard(b, r->beta, pi0, pi);
-  if (!to_params(b, r, pi, p, why, len)) return 0;
-  for (int i = 0; i < b->nbase; i++) {
-    kept[i] = fabs(r->beta[i] - prior[i]) <= 3 * r->se[i];
-    beta[i] = kept[i] ? prior[i] : r->beta[i];
-  }
-  prru_base_to_standard(b, beta, pi0, pi);
-  return to_params(b, r, pi, p, why, len);
-}
-
-/* The identified standard parameters as model numbers in p; 0, or 1 with
- * why naming the first non-physical body or drive. */
-static int to_params(const prru_base *b, const prru_ident_result *r, const double *pi, prru_params *p,
-                     char *why, size_t len)
+/* The consistent standard parameters as model numbers in p; 0, or 1 with
+ * why naming a body or drive that is not physical (a guard: never for the
+ * output of prru_ident_consistent). */
+static int to_params(const prru_base *b, const double *pi, prru_params *p, char *why, size_t len)
 {
   *p = prru_params_model;
   for (int k = 0; k < PRRU_NBODY; k++) {
@@ -553,7 +570,7 @@ static int to_params(const prru_base *b, const prru_ident_result *r, const doubl
     const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
                       I[4] * (I[3] * I[5] - I[1] * I[4]);
     if (!(I[0] > 0 && m2 > 0 && m3 > 0)) {
-      snprintf(why, len, "body %s: the identified inertia about the centre of mass is not positive definite",
+      snprintf(why, len, "body %s: the inertia about the centre of mass is not positive definite",
                prru_mech.body_names[k]);
       return 1;
     }
@@ -565,15 +582,9 @@ static int to_params(const prru_base *b, const prru_ident_result *r, const doubl
   static const char *const dn[3] = {"armature", "damping", "coulomb"};
   for (int g = 0; g < 3; g++)
     for (int i = 0; i < PRRU_NACT; i++) {
-      const int j = PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i;
-      double v = pi[j], se = 0, res = 0;
-      for (int k = 0; k < b->nbase; k++)
-        if (b->col[k] == j) se = r->se[k], res = r->scale[k];
-      /* Within 3 standard errors (or rounding) of 0: a drive without this
-       * term. */
-      if (v < 0 && v >= -3 * se - 1e-9 * res) v = 0;
-      if (v < 0) {
-        snprintf(why, len, "%s%d = %.6g is negative (standard error %.3g)", dn[g], i + 1, pi[j], se);
+      const double v = pi[PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i];
+      if (!(v >= 0)) {
+        snprintf(why, len, "%s%d = %.6g is negative", dn[g], i + 1, v);
         return 1;
       }
       dr[g][i] = v;
@@ -737,18 +748,44 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   prru_ident_standard(&prru_mech, pi0);
   prru_base_params(b, pi0, prior);
   prru_params p;
-  char why[300];
-  int kept[PRRU_NREG];
-  const int unphysical = model_params(b, r, pi0, prior, pi, kept, &p, why, sizeof why);
+  char why[300] = "";
+  prru_consistent_options co;
+  prru_consistent_options_default(&co);
+  prru_consistent_result *c = malloc(sizeof *c);
+  if (!c) {
+    free(r), free(pi0);
+    prru_cli_error("identify", "out of memory");
+    return 1;
+  }
+  const int cst = prru_ident_consistent(&m, b, r, pi0, &co, pi, c);
+  /* PRRU_ESINGULAR (data against physics) comes with a solution: reported. */
+  const int solved = cst == PRRU_OK || cst == PRRU_ESINGULAR;
+  const int unphysical = solved && to_params(b, pi, &p, why, sizeof why);
   prru_cli_out ro;
-  if (prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
-  if (!rc) {
-    write_report(&ro, b, r, prior, kept);
+  if (solved && prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
+  if (solved && !rc) {
+    write_report(&ro, b, r, prior, &co, c, pi0, pi);
     if (prru_cli_out_close(&ro, !ro.err)) rc = 1;
   }
-  if (!rc && unphysical) {
-    prru_cli_error("identify", "the identified parameters are not physical: %s; %s not written (see the "
-                   "report; more or better excitation data, or a check of the force signs)", why, a->out);
+  if (!rc && !solved) {
+    prru_cli_error("identify", "%s; %s not written",
+                   cst == PRRU_EINPUT ? "the built model's own parameters are not physical (a body's pseudo-inertia "
+                                        "not positive definite or a negative drive coefficient): no prior to "
+                                        "start from" :
+                                        "the physically consistent fit did not converge", a->out);
+    rc = 1;
+  } else if (!rc && cst == PRRU_ESINGULAR) {
+    char worst[512];
+    worst_deviations(b, c, worst, sizeof worst);
+    prru_cli_error("identify", "the data contradict physics: no physically consistent robot has base parameters "
+                   "within the estimate's covariance (Mahalanobis distance^2 %.4g, above the chi^2 quantile %.4g "
+                   "of %d degrees of freedom at 1 - %g); furthest from the estimate: %s; check the signs and "
+                   "directions of the forces, the gear ratios and the units of fd; %s not written (see the report)",
+                   c->d2, c->d2_max, b->nbase, co.alpha, worst, a->out);
+    rc = 1;
+  } else if (!rc && unphysical) {
+    prru_cli_error("identify", "internal error: the consistent parameters are not physical: %s; %s not written",
+                   why, a->out);
     rc = 1;
   }
   prru_cli_out mo;
@@ -760,7 +797,7 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   if (!rc)
     fprintf(stderr, "identify: %d base parameters from %d samples, residual sigma %.6g N, condition number "
                     "%.6g; model %s written to %s\n", b->nbase, D->n, r->sigma, r->cond, name, a->out);
-  free(r), free(pi0);
+  free(r), free(pi0), free(c);
   return rc;
 }
 

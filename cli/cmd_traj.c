@@ -284,12 +284,14 @@ static const char track_help[] =
     "Output: the model line, a line with the settings, then\n"
     "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,\n"
     "  %s,%s,\n"
-    "  %s,%s\n"
+    "  %s,%s,qdd1,qdd2,qdd3\n"
     "(qr the reference, fdc the controller's forces before clipping, sat 1 where\n"
-    "clipped, d the slider heights) to --out or stdout; a JSON summary (RMS and\n"
-    "largest error per coordinate, largest force and saturated fraction of the\n"
-    "samples per actuator, the feed-forward force peak along the reference) to\n"
-    "--summary, else to stdout, or stderr when the CSV goes to stdout. --plot\n"
+    "clipped, d the slider heights, qdd the plant's accelerations under fd:\n"
+    "with q, qd and fd, exact identification data) to --out or stdout; a JSON\n"
+    "summary (RMS and largest error per coordinate, largest force and saturated\n"
+    "fraction of the samples per actuator, the feed-forward force peak along the\n"
+    "reference) to --summary, else to stdout, or stderr when the CSV goes to\n"
+    "stdout. --plot\n"
     "FILE.png draws the errors and forces (needs --out FILE and gnuplot).\n"
     "SIGINT/SIGTERM/SIGHUP stop with exit 130/143/129, the rows kept.\n";
 
@@ -310,6 +312,7 @@ static int track_row(const prru_track_sample *s, void *ctx)
   prru_cli_out_numbers(o, s->fd_cmd, PRRU_NACT);
   for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, ",%d", s->saturated[i]);
   prru_cli_out_numbers(o, s->d, PRRU_NACT);
+  prru_cli_out_numbers(o, s->qdd, 3);
   prru_cli_out_printf(o, "\n");
   return prru_cli_out_row(o) == 0 ? PRRU_OK : PRRU_EIO;
 }
@@ -727,8 +730,8 @@ int prru_cmd_track(int argc, char **argv)
                       step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], mism ? mism : "",
                       o.noise_q, o.noise_qd, o.seed);
   prru_cli_out_line(&co);
-  prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s\n", fdn, fdcn,
-                      satn, dn);
+  prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s,qdd1,qdd2,qdd3\n", fdn,
+                      fdcn, satn, dn);
   prru_cli_out_line(&co);
   track_output to = {&co};
   o.on_sample = track_row;

@@ -93,12 +93,35 @@ PY
 w=$(check_report "$tmp/rep.csv" cond 0) && ok || bad "noise-free identification: worst error / bound $w"
 python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/id.json" --out "$tmp/gen" --quiet 2>"$tmp/gen.err" \
   && ok || bad "the identified model file is refused by the generator: $(cat "$tmp/gen.err")"
+# The masses: the model's own, to the consistent fit's accuracy in the
+# directions no motion reveals: the prior-nearest problem is solved to a
+# duality gap of 1e-14 in the squared prior norm, whose Hessian is >= the
+# norm itself, so |pi - pi*|_W <= 1e-7, and a mass enters that norm
+# relative to the prior body's (T_b normalises it): 1e-7 m.
 python3 - "$tmp/id.json" "$PRRU_MODEL" <<'PY' && ok || bad "identified masses differ from the model's"
 import json, sys
 a = json.load(open(sys.argv[1])); m = json.load(open(sys.argv[2]))
 for name, body in m["bodies"].items():
-    assert abs(a["bodies"][name]["mass"] - body["mass"]) <= 1e-9 * body["mass"], name
+    assert abs(a["bodies"][name]["mass"] - body["mass"]) <= 1e-7 * body["mass"], name
 PY
+
+# ---- issue 27 item 2: the most common CAD error ----
+# The true robot's masses x1.05: prru track's plant as the robot, its log
+# (q, qd, the plant's qdd, fd: exact rates) as data. The least-squares
+# change of each base parameter loaded onto one standard parameter made
+# armature3 negative (exit 1, no model); the consistent fit writes a model
+# the generator accepts, whose base parameters are the estimate's within
+# rounding: d^2 <= 1 (the model without drives puts the truth on the
+# drives' bound, so the estimate is a rounding outside it; the fit moves
+# it back by ~1e-12 of the drives' scale, d^2 ~ 1e-5 on the paper model).
+"$PRRU" excite --out "$tmp/exd.csv" 2>/dev/null
+"$PRRU" track --ref "$tmp/exd.csv" --mismatch mass=1.05 --out "$tmp/cad.csv" >/dev/null 2>&1
+"$PRRU" identify --data "$tmp/cad.csv" --out "$tmp/cad.json" --report "$tmp/cadrep.csv" 2>"$tmp/cad.err" \
+  && ok || bad "identify, masses x1.05: $(cat "$tmp/cad.err")"
+python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/cad.json" --out "$tmp/cadgen" --quiet 2>"$tmp/cadgen.err" \
+  && ok || bad "the model identified with masses x1.05 is refused by the generator: $(cat "$tmp/cadgen.err")"
+d2=$(sed -n 's/.*Mahalanobis distance^2 of its base parameters to the estimate \([^,]*\),.*/\1/p' "$tmp/cadrep.csv")
+awk -v d="$d2" 'BEGIN { exit !(d != "" && d + 0 <= 1) }' && ok || bad "masses x1.05: d^2 '$d2' > 1"
 
 # ---- identify from a data file whose path is hostile to the model file ----
 # The description names the --data path: one with "*/" (a directory ending
@@ -189,7 +212,8 @@ for l in open(sys.argv[1]).read().splitlines():
     out.append(','.join(v))
 open(sys.argv[2], 'w').write('\n'.join(out) + '\n')
 PY
-expect 1 "not physical" -- identify --data "$tmp/flip.csv" --out "$tmp/keep.json" --report "$tmp/flip_rep.csv"
+expect 1 "the data contradict physics" -- identify --data "$tmp/flip.csv" --out "$tmp/keep.json" --report "$tmp/flip_rep.csv"
+grep -q "Mahalanobis distance^2 .*above the chi^2 quantile" "$tmp/err" && ok || bad "flipped signs: no evidence: $(cat "$tmp/err")"
 [ "$(cat "$tmp/keep.json")" = old ] && ok || bad "a refused identification changed the model file"
 expect 2 "both go to stdout" -- identify --data "$tmp/ex.csv" --out -
 # Issue 30 item 4: the data file as --out or --report (by device and

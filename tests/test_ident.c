@@ -386,6 +386,228 @@ static void check_excite(const prru_base *b)
           "an unreachable centre is refused by name");
 }
 
+/* ---- physically consistent identification ---- */
+
+/* 0 when the body's inertia about its centre of mass is physical: m > 0
+ * and 0.5 tr(I_c) E - I_c (its second moment) positive definite by its
+ * leading minors, which holds the triangle inequalities. For drawing
+ * truths (well inside, so the determinants are not near rounding). */
+static int body_consistent(double m, const double I[6])
+{
+  const double t = 0.5 * (I[0] + I[1] + I[2]);
+  const double S[9] = {t - I[0], -I[3], -I[4], -I[3], t - I[1], -I[5], -I[4], -I[5], t - I[2]};
+  const double m2 = S[0] * S[4] - S[1] * S[3];
+  const double m3 = S[0] * (S[4] * S[8] - S[5] * S[7]) - S[1] * (S[3] * S[8] - S[5] * S[6]) +
+                    S[2] * (S[3] * S[7] - S[4] * S[6]);
+  return m > 0 && S[0] > 0 && m2 > 0 && m3 > 0 ? 0 : 1;
+}
+
+/* 0 when pi is physically consistent: every body's pseudo-inertia
+ * [[S, m c], [m c^T, m]] (S = 0.5 tr(I_O) E - I_O), formed from pi
+ * directly, has a Cholesky factor, and every drive coefficient is >= 0.
+ * Not through m, c, I_c: an identified body may lie near the boundary (a
+ * rod), where I_c's determinants are at the level of the conversion's
+ * rounding; the model files' validators decide exactly. */
+static int pi_consistent(const double *pi)
+{
+  for (int k = 0; k < NB; k++) {
+    const double *p = pi + PRRU_NBODYPAR * k, h = 0.5 * (p[4] + p[5] + p[6]);
+    const double J[4][4] = {{h - p[4], -p[7], -p[8], p[1]}, {-p[7], h - p[5], -p[9], p[2]},
+                            {-p[8], -p[9], h - p[6], p[3]}, {p[1], p[2], p[3], p[0]}};
+    double L[4][4] = {{0}};
+    for (int j = 0; j < 4; j++) {
+      double d = J[j][j];
+      for (int i = 0; i < j; i++) d -= L[j][i] * L[j][i];
+      if (!(d > 0)) return 1;
+      L[j][j] = sqrt(d);
+      for (int i = j + 1; i < 4; i++) {
+        double s = J[i][j];
+        for (int l = 0; l < j; l++) s -= L[i][l] * L[j][l];
+        L[i][j] = s / L[j][j];
+      }
+    }
+  }
+  for (int j = PRRU_NBODYPAR * NB; j < PRRU_NREG; j++)
+    if (!(pi[j] >= 0)) return 1;
+  return 0;
+}
+
+/* A consistent truth near the model: masses x U(0.9, 1.1), every inertia
+ * entry about the centre +-20 % (products by 20 % of the body's mean
+ * moment), the centre of mass moved by up to 20 % of the body's radius of
+ * gyration per axis, drives x U(0.7, 1.3); redrawn until consistent. */
+static void consistent_truth(prru_params *p)
+{
+  *p = prru_params_model;
+  for (int b = 0; b < NB; b++) {
+    const double *I0 = prru_params_model.inertia[b], m0 = prru_params_model.mass[b];
+    const double mean = (I0[0] + I0[1] + I0[2]) / 3, rho = sqrt(1.5 * mean / m0);
+    do {
+      p->mass[b] = m0 * tu_uniform(0.9, 1.1);
+      for (int k = 0; k < 3; k++) p->inertia[b][k] = I0[k] * tu_uniform(0.8, 1.2);
+      for (int k = 3; k < 6; k++) p->inertia[b][k] = I0[k] + 0.2 * mean * tu_uniform(-1, 1);
+    } while (body_consistent(p->mass[b], p->inertia[b]));
+    for (int k = 0; k < 3; k++) p->com[b][k] = prru_params_model.com[b][k] + 0.2 * rho * tu_uniform(-1, 1);
+  }
+  for (int i = 0; i < NA; i++) {
+    p->armature[i] *= tu_uniform(0.7, 1.3);
+    p->damping[i] *= tu_uniform(0.7, 1.3);
+    p->coulomb[i] *= tu_uniform(0.7, 1.3);
+  }
+}
+
+/* A truth's drives, where the model has none: armature up to 0.3 slider
+ * masses, damping up to 3 N s/m per kg of slider, Coulomb up to 0.5 N per
+ * kg (the prior's 0 is then off by the whole value). A truth with every
+ * drive coefficient > 0 lies inside the consistent set, so some consistent
+ * pi has the estimate's base parameters (noise-free): the exact path. */
+static void add_drives(prru_params *p)
+{
+  for (int i = 0; i < NA; i++) {
+    const double ms = p->mass[prru_mech.slider[i]];
+    if (p->armature[i] == 0) p->armature[i] = 0.3 * ms * tu_uniform(0.2, 1);
+    if (p->damping[i] == 0) p->damping[i] = 3 * ms * tu_uniform(0.2, 1);
+    if (p->coulomb[i] == 0) p->coulomb[i] = 0.5 * ms * tu_uniform(0.2, 1);
+  }
+}
+
+static void standard_of(const prru_params *p, double pi[PRRU_NREG])
+{
+  prru_mechanism me = prru_mech;
+  memcpy(me.mass, p->mass, sizeof me.mass);
+  memcpy(me.com, p->com, sizeof me.com);
+  const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  for (int k = 0; k < NB; k++)
+    for (int e = 0; e < 6; e++)
+      me.inertia[k][3 * at[e][0] + at[e][1]] = me.inertia[k][3 * at[e][1] + at[e][0]] = p->inertia[k][e];
+  memcpy(me.armature, p->armature, sizeof me.armature);
+  memcpy(me.damping, p->damping, sizeof me.damping);
+  memcpy(me.coulomb, p->coulomb, sizeof me.coulomb);
+  prru_ident_standard(&me, pi);
+}
+
+/* RMS over held-out states (random ones, not the excitation's) of the
+ * forces Y_base beta_a and of Y_base (beta_a - beta_b): J_d^T fd units. */
+static void held_out(const prru_base *b, const double *ba, const double *bb, double *rms, double *err)
+{
+  double s = 0, e = 0, vs = b->vs;
+  for (int k = 0; k < 200; k++) {
+    double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG];
+    random_state(q, qd, qdd);
+    prru_regressor(q, qd, qdd, &vs, Y);
+    prru_base_regressor(b, Y, 3, Yb);
+    for (int r = 0; r < 3; r++) {
+      double fa = 0, fe = 0;
+      for (int i = 0; i < b->nbase; i++) fa += Yb[r * b->nbase + i] * ba[i], fe += Yb[r * b->nbase + i] * (ba[i] - bb[i]);
+      s += fa * fa, e += fe * fe;
+    }
+  }
+  *rms = sqrt(s / 600), *err = sqrt(e / 600);
+}
+
+static void check_consistent(const prru_base *b)
+{
+  enum { N = 1000, TRIALS = 10, NOISY = 40 };
+  double *q = malloc(sizeof(double) * 3 * N), *qd = malloc(sizeof(double) * 3 * N);
+  double *qdd = malloc(sizeof(double) * 3 * N), *fd = malloc(sizeof(double) * NA * N);
+  prru_ident_result *r = malloc(sizeof *r);
+  prru_consistent_result *c = malloc(sizeof *c);
+  if (!TU_TRUE(q && qd && qdd && fd && r && c, "memory")) return;
+  prru_consistent_options o;
+  prru_consistent_options_default(&o);
+  double pi0[PRRU_NREG], pi[PRRU_NREG], pit[PRRU_NREG], bt[PRRU_NREG];
+  prru_ident_standard(&prru_mech, pi0);
+  prru_params p;
+  truth = &p;
+  tu_rng_state = 4242;
+  /* Noise-free: the truth's base parameters to 1e-8 of each one's
+   * resolution (the report's column) and held-out forces to 1e-8 of their
+   * RMS. The fit's own floor: d^2 <= lambda |pi* - pi0|_w^2 with sigma_w
+   * = 1e-8 rms(y), i.e. |R e| <= 1e-3 |pi* - pi0|_w 1e-8 rms(y), far
+   * below both bounds for prior distances of order 1. */
+  double worst = 0, worst_f = 0, worst_d2 = 0;
+  int fails = 0, inconsistent = 0, iters = 0, exact = 0;
+  int with_drives = 0;
+  for (int k = 0; k < TRIALS; k++) {
+    consistent_truth(&p);
+    /* Every other truth with drives of its own. */
+    if (k % 2) add_drives(&p), with_drives++;
+    p.coulomb_velocity = b->vs;
+    standard_of(&p, pit);
+    prru_base_params(b, pit, bt);
+    int bad;
+    if (make_data(N, 0, q, qd, qdd, fd) || prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad) != PRRU_OK) {
+      fails++;
+      continue;
+    }
+    const int st = prru_ident_consistent(&model, b, r, pi0, &o, pi, c);
+    fails += st != PRRU_OK;
+    inconsistent += pi_consistent(pi);
+    iters = iters > c->newton ? iters : c->newton;
+    exact += c->how == PRRU_CONSISTENT_EXACT && k % 2;
+    for (int i = 0; i < b->nbase; i++) worst = fmax(worst, fabs(c->beta[i] - bt[i]) / r->scale[i]);
+    double rms, err;
+    held_out(b, c->beta, bt, &rms, &err);
+    worst_f = fmax(worst_f, err / rms);
+    worst_d2 = fmax(worst_d2, c->d2);
+  }
+  printf("consistent, noise-free, %d consistent truths: %d refused, %d inconsistent, %d with the estimate's own "
+         "base parameters; worst base error %.2e of the resolution, held-out force error %.2e of the RMS, "
+         "d^2 %.2e; up to %d Newton steps\n", TRIALS, fails, inconsistent, exact, worst, worst_f, worst_d2, iters);
+  TU_TRUE(fails == 0, "every noise-free consistent truth gives a model");
+  TU_TRUE(exact == with_drives, "a truth inside the consistent set: the estimate's own base parameters");
+  TU_TRUE(inconsistent == 0, "the returned parameters are physically consistent");
+  tu_check(worst <= 1e-8, "base parameters within 1e-8 of their resolution", worst, 1e-8);
+  tu_check(worst_f <= 1e-8, "held-out forces within 1e-8 of their RMS", worst_f, 1e-8);
+
+  /* A flipped force sign: every base parameter negated, masses too. */
+  for (int s = 0; s < N * NA; s++) fd[s] = -fd[s];
+  int bad;
+  prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad);
+  const int st = prru_ident_consistent(&model, b, r, pi0, &o, pi, c);
+  printf("flipped force signs: status %d, d^2 %.3g against the quantile %.3g\n", st, c->d2, c->d2_max);
+  TU_TRUE(st == PRRU_ESINGULAR && c->d2 > c->d2_max, "flipped force signs refused: d^2 above the quantile");
+  TU_TRUE(pi_consistent(pi) == 0, "even then the nearest set found is consistent");
+
+  /* Noise on the forces only, sigma 0.5 N: NOISY trials. Per trial the
+   * residual chi^2 = |r|^2 / sigma^2 = dof s^2 / sigma^2 is chi^2(dof):
+   * within 4 sd, sqrt(2 dof), of dof. Pairs (trial, base parameter) whose
+   * model's base parameter lies within 3 se of the truth's: >= 95 % (the
+   * least-squares estimate alone gives 99.7 %). */
+  const double sigma = 0.5;
+  int within = 0, pairs = 0, refused = 0, chi_bad = 0;
+  double chi_worst = 0;
+  for (int k = 0; k < NOISY; k++) {
+    consistent_truth(&p);
+    if (k % 2) add_drives(&p);
+    p.coulomb_velocity = b->vs;
+    standard_of(&p, pit);
+    prru_base_params(b, pit, bt);
+    if (make_data(N, sigma, q, qd, qdd, fd) || prru_identify(&model, b, N, q, qd, qdd, fd, r, &bad) != PRRU_OK) {
+      refused++;
+      continue;
+    }
+    const double chi = r->dof * r->sigma * r->sigma / (sigma * sigma), z = (chi - r->dof) / sqrt(2.0 * r->dof);
+    chi_worst = fmax(chi_worst, fabs(z));
+    chi_bad += fabs(z) > 4;
+    const int cs = prru_ident_consistent(&model, b, r, pi0, &o, pi, c);
+    if (cs != PRRU_OK || pi_consistent(pi))
+      printf("  trial %d: status %d, d^2 %.4g, consistent %d\n", k, cs, c->d2, !pi_consistent(pi));
+    if (cs != PRRU_OK || pi_consistent(pi)) {
+      refused++;
+      continue;
+    }
+    for (int i = 0; i < b->nbase; i++, pairs++) within += fabs(c->beta[i] - bt[i]) <= 3 * r->se[i];
+  }
+  printf("consistent, noise %.1f N, %d trials: %d refused; %d of %d (trial, base parameter) pairs within 3 se "
+         "(%.1f %%); worst chi^2 deviation %.2f sd\n", sigma, NOISY, refused, within, pairs,
+         100.0 * within / (pairs ? pairs : 1), chi_worst);
+  tu_check(within >= 0.95 * pairs && pairs > 0, "95 % of the pairs within 3 se", within, 0.95 * pairs);
+  TU_TRUE(chi_bad == 0, "each trial's chi^2 within 4 sd of its degrees of freedom");
+  truth = NULL;
+  free(q), free(qd), free(qdd), free(fd), free(r), free(c);
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -409,6 +631,7 @@ int main(void)
   printf("-- data from a perturbed model, the built one as the prior:\n");
   check_identify(b);
   truth = NULL;
+  check_consistent(b);
   free(b);
   return tu_finish("test_ident");
 }

@@ -50,6 +50,10 @@ typedef struct {
   double fd[PRRU_NACT];       /* applied (after clipping) actuator forces, N */
   double fd_cmd[PRRU_NACT];   /* the controller's forces before clipping */
   double d[PRRU_NACT];        /* the plant's slider positions, m */
+  /* The plant's acceleration at t under fd (the force it sees from t on):
+   * (q, qd, qdd, fd) satisfy the plant's equations of motion exactly, as
+   * identification data with exact rates. */
+  double qdd[3];
   int saturated[PRRU_NACT];   /* 1 where |fd_cmd_i| > f_max_i */
 } prru_track_sample;
 

@@ -106,6 +106,19 @@ typedef struct {
   double sigma;               /* residual standard deviation s (N) */
   double rms[PRRU_NACT];      /* residual RMS per row of a sample (N) */
   double cond;                /* 2-norm condition number of the column-scaled X */
+  double yrms;                /* RMS of the rows' forces y (N) */
+  /* The residuals' variance inflation f >= 1: sigma^2 (R^T R)^-1 is the
+   * covariance for white residuals; residuals correlated in time (the
+   * truncation error of differentiated q, slow drifts) make the estimate
+   * vary more, by about f = 1 + 2 sum_k (1 - k / (L + 1)) rho_k over
+   * hac_lags = L sample lags (Newey-West), 1 where they are white or
+   * anticorrelated. prru_ident_consistent judges with it. */
+  double inflation;
+  int hac_lags;
+  /* X = Q R (R: nbase x nbase upper triangular, row stride PRRU_NREG), so
+   * that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2: the
+   * covariance of beta^ is s^2 (R^T R)^-1. */
+  double R[PRRU_NREG * PRRU_NREG];
 } prru_ident_result;
 
 /* Least squares of the base parameters from n samples (q, qd, qdd, fd:
@@ -117,6 +130,84 @@ typedef struct {
  * PRRU_ENOMEM. Allocates. */
 int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
                   const double *qdd, const double *fd, prru_ident_result *r, int *bad);
+
+/* ---- Physically consistent parameters ----
+ * The least-squares estimate beta^ may belong to no physical robot: a
+ * slider's mass change, loaded onto its armature, makes that negative.
+ * prru_ident_consistent returns standard parameters pi that are
+ * physically consistent and whose base parameters B pi agree with beta^:
+ *   - consistent: each body's pseudo-inertia
+ *       J(pi_b) = [[S, m c], [m c^T, m]], S = tr(I_O)/2 E - I_O = int r r^T dm,
+ *     positive definite (Wensing, Kim and Slotine, IEEE RA-L 3(1), 2018:
+ *     equivalent to a positive mass, an inertia about the centre of mass
+ *     that is positive definite and meets the triangle inequalities), with
+ *     a margin: T_b^-1 J T_b^-T >= eps I, T_b T_b^T the prior body's
+ *     pseudo-inertia (regularised by 1e-6 tr(S_c)/3 on its S block so that
+ *     a planar prior body qualifies); armature, damping and Coulomb >= 0
+ *     (>= 1e-12 w_k, w_k below, so that rounding cannot make them negative);
+ *   - exact where possible: when some consistent pi has B pi = beta^
+ *     (a phase-I problem decides it), pi is the one nearest the prior pi0,
+ *     and its base parameters are the estimate's to rounding;
+ *   - otherwise within the covariance: pi minimises
+ *       d^2 + mu |pi - pi0|_W^2,  d^2 = |R (B pi - beta^)|^2 / sigma_w^2,
+ *     the squared Mahalanobis distance of B pi to beta^ under the
+ *     covariance sigma_w^2 (R^T R)^-1, sigma_w = max(s sqrt(inflation),
+ *     sigma_floor yrms) (data exact to sigma_floor of their RMS are treated
+ *     as that exact);
+ *     mu small, so the prior moves B pi by at most sqrt(mu) |pi* - pi0|_W
+ *     standard deviations (pi* any consistent set); then, at those base
+ *     parameters, the consistent pi nearest the prior (the directions no
+ *     motion reveals, as in the exact case). When d^2 exceeds the chi^2 quantile of
+ *     nbase degrees of freedom at 1 - alpha, no physical robot explains
+ *     the data within their noise: the data contradict physics (a force
+ *     sign, a gear ratio, a unit).
+ * The norm to the prior is |pi - pi0|_W^2 = sum_b |T_b^-1 (J(pi_b) -
+ * J(pi0_b)) T_b^-T|_F^2 + sum_k ((x_k - x0_k) / w_k)^2 over the drive
+ * coefficients x_k, with w_k = max(|x0_k|, the limb's slider mass m_s,
+ * m_s / tau, m_s g) for armature, damping and Coulomb (tau = sqrt(L / g),
+ * L the length scale; g 9.81 m/s^2 where the model has no gravity): the
+ * pseudo-inertia part is the same for a body of any size or shape and
+ * invariant to rotations of its frame.
+ * Each problem is convex (linear matrix inequalities) and solved by a
+ * log-barrier interior-point method (Boyd and Vandenberghe, Convex
+ * Optimization, ch. 11) with damped Newton steps; the same formulation as
+ * the semidefinite programs of Wensing et al. and of Lee, Wensing and
+ * Park (IEEE T-RO 36(2), 2020), without an SDP library. */
+typedef struct {
+  double mu;           /* prior weight within the covariance, > 0 */
+  double alpha;        /* refusal level of the chi^2 test, in (0, 1) */
+  double sigma_floor;  /* sigma_w >= sigma_floor yrms, >= 0 */
+  double eps;          /* the pseudo-inertia margin, in [0, 1e-3] */
+  int max_newton;      /* Newton steps in all, > 0 */
+} prru_consistent_options;
+
+/* mu 1e-6, alpha 1e-3, sigma_floor 1e-8, eps 1e-9, 5000 Newton steps. */
+void prru_consistent_options_default(prru_consistent_options *o);
+
+enum { PRRU_CONSISTENT_EXACT = 0, PRRU_CONSISTENT_COVARIANCE = 1 };
+
+typedef struct {
+  int how;                   /* PRRU_CONSISTENT_EXACT or _COVARIANCE */
+  double beta[PRRU_NREG];    /* B pi, nbase values */
+  double t[PRRU_NREG];       /* (B pi - beta^)_i / (sigma_w sqrt(C_ii)), C = (R^T R)^-1 */
+  double w[PRRU_NREG];       /* drive weights w_k at the drive parameters, else 0 */
+  double d2, d2_max;         /* d^2 and the chi^2 quantile */
+  double sigma_w;            /* N */
+  double prior_dist;         /* |pi - pi0|_W */
+  double margin;             /* smallest eigenvalue of T_b^-1 J T_b^-T over the bodies */
+  int newton;                /* Newton steps taken */
+} prru_consistent_result;
+
+/* Consistent standard parameters pi from the fit r (prru_identify) and
+ * the prior pi0 (the model's, prru_ident_standard). PRRU_OK with pi and c
+ * filled; PRRU_ESINGULAR (pi and c filled: the consistent set nearest the
+ * estimate) when d^2 > d2_max, the data contradicting physics; PRRU_EINPUT
+ * for bad options or a prior with a mass <= 0, a non-finite value or a
+ * negative drive coefficient; PRRU_ENOCONV when the Newton budget runs
+ * out; PRRU_ENOMEM. Allocates. */
+int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
+                          const double pi0[PRRU_NREG], const prru_consistent_options *o,
+                          double pi[PRRU_NREG], prru_consistent_result *c);
 
 /* ---- Periodic excitation ----
  * q_k(t) = c_k + sum_{l=1..L} (a_kl sin(l w t) + b_kl cos(l w t)),

@@ -246,6 +246,10 @@ static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
                                 s->fd_cmd, s->fd, s->saturated);
   if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
+  st = prru_plant_accel(&o->plant, y, y + 3, s->fd, s->qdd);
+  if (st != PRRU_OK)
+    return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g) (the plant's "
+                     "equations of motion)", t, prru_strerror(st), y[0], y[1], y[2]);
   prru_param_ik(&o->plant, y, s->d);
   if (!prru_finite_n(s->d, PRRU_NACT))
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,

@@ -324,6 +324,44 @@ static int unit_covariance(const gsl_matrix *X, gsl_matrix *C, double *cond)
   return st;
 }
 
+/* The variance inflation of correlated residuals (prru_ident_result):
+ * rho_k the residuals' autocorrelation at a lag of k samples, pooled over
+ * the actuators, and Bartlett's weights over L = floor(4 (n / 100)^(2/9))
+ * lags (Newey and West, Econometrica 55(3), 1987, with their rule for L). */
+static void residual_inflation(const gsl_vector *res, int n, prru_ident_result *r)
+{
+  int L = (int)floor(4 * pow(n / 100.0, 2.0 / 9.0));
+  if (L > n - 1) L = n - 1;
+  double c0 = 0, f = 1;
+  for (size_t j = 0; j < res->size; j++) c0 += gsl_vector_get(res, j) * gsl_vector_get(res, j);
+  for (int k = 1; k <= L && c0 > 0; k++) {
+    double ck = 0;
+    for (size_t j = 0; j + (size_t)k * PRRU_NACT < res->size; j++)
+      ck += gsl_vector_get(res, j) * gsl_vector_get(res, j + (size_t)k * PRRU_NACT);
+    f += 2 * (1 - k / (L + 1.0)) * ck / c0;
+  }
+  r->hac_lags = L;
+  r->inflation = fmax(1, f);
+}
+
+/* r->R: the R of a Householder QR of X (prru_ident_result). */
+static int triangular_factor(const gsl_matrix *X, prru_ident_result *r)
+{
+  const size_t p = X->size2;
+  gsl_matrix *A = gsl_matrix_alloc(X->size1, p);
+  gsl_vector *tau = gsl_vector_alloc(p);
+  int st = A && tau ? PRRU_OK : PRRU_ENOMEM;
+  if (st == PRRU_OK) {
+    gsl_matrix_memcpy(A, X);
+    if (gsl_linalg_QR_decomp(A, tau) != GSL_SUCCESS) st = PRRU_ESINGULAR;
+    memset(r->R, 0, sizeof r->R);
+    for (size_t i = 0; i < p && st == PRRU_OK; i++)
+      for (size_t j = i; j < p; j++) r->R[i * PRRU_NREG + j] = gsl_matrix_get(A, i, j);
+  }
+  gsl_matrix_free(A), gsl_vector_free(tau);
+  return st;
+}
+
 static int solve(const gsl_matrix *X, const gsl_vector *y, int n, const prru_base *b,
                  prru_ident_result *r)
 {
@@ -349,6 +387,7 @@ static int solve(const gsl_matrix *X, const gsl_vector *y, int n, const prru_bas
     }
     gsl_vector_const_view yv = gsl_vector_const_subvector(y, 0, y->size);
     const double yn = gsl_blas_dnrm2(&yv.vector);
+    r->yrms = yn / sqrt((double)y->size);
     for (size_t i = 0; i < p; i++) {
       gsl_vector_const_view col = gsl_matrix_const_column(X, i);
       const double xn = gsl_blas_dnrm2(&col.vector);
@@ -362,7 +401,9 @@ static int solve(const gsl_matrix *X, const gsl_vector *y, int n, const prru_bas
       }
       r->rms[i] = sqrt(s / n);
     }
+    residual_inflation(res, n, r);
   }
+  if (st == PRRU_OK) st = triangular_factor(X, r);
   gsl_vector_free(c), gsl_vector_free(res), gsl_matrix_free(cov), gsl_matrix_free(C);
   if (w) gsl_multifit_linear_free(w);
   return st;
