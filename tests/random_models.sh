@@ -30,7 +30,7 @@ fi
 keep=${PRRU_RANDOM_KEEP:-random-models}
 mkdir -p "$keep"
 keep=$(cd "$keep" && pwd)
-skipped="gen_unittest test_deps test_random_model test_dropin test_install test_design_regen"
+skipped="gen_unittest test_deps test_random_model test_dropin test_install test_design_regen test_slurm test_cli_view"
 skip="^($(echo $skipped | tr ' ' '|'))\$"
 echo "random models: seeds $base..$((base + n - 1)); per model, skipped (run on the committed models): $skipped"
 passed=0
