@@ -226,7 +226,7 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary, double
       fprintf(s, "  mean ln w_R = %.10g; w_R from %.6g at (%.4f, %.4f) to %.6g at (%.4f, %.4f)\n",
               sum->index_log, sum->w_min, sum->w_min_q[0], sum->w_min_q[1], sum->w_max,
               sum->w_max_q[0], sum->w_max_q[1]);
-      if (prru_map_home_mode(&g) != 0)
+      if (prru_map_home_mode(&m, &g) != 0)
         fputs("  other assembly mode: det J_d of the opposite sign to the home pose's, beyond the "
               "singular locus\n", s);
       fprintf(s, "with the numerical tolerance only (rcond < %g): global index = %.10g, not-ok "

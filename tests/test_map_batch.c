@@ -53,7 +53,7 @@ static void check_grid(const char *what, const prru_model *m, prru_map_grid g)
   const long n = (long)g.n1 * g.n2;
   double *w = malloc((size_t)n * sizeof *w);
   unsigned char *st = malloc((size_t)n);
-  const int home = prru_map_home_mode(&g);
+  const int home = prru_map_home_mode(m, &g);
   long bad_w = 0, bad_st = 0, first_bad = -1, local[4] = {0, 0, 0, 0};
   for (int nt = 1; nt <= 2; nt++) {
     prru_map_options o;

@@ -57,8 +57,56 @@ typedef enum {
 /* A short, stable description of a status code. */
 const char *prru_strerror(int status);
 
+/* The code a model evaluates with. MuJoCo's Model holds its numbers; a
+ * prru_model also chooses its kernels: the specialised set, constant-folded
+ * from the build's model file (prru_kernels.h), or the parameter set of
+ * the build's topology (prru_p3_kernels.h or prru_p4_kernels.h), which
+ * reads the numbers of a model file loaded at run time (prru_model_load).
+ * Each entry has the arguments and outputs of the prru_kernels.h kernel of
+ * its name after p, the table's parameters (kernel_params of the model;
+ * ignored by the specialised set); arrays as sized by this build's PRRU_N*
+ * macros. The unseen_* entries are the generated finiteness witnesses
+ * (PRRU_UNSEEN_FINITE_*) of the same set. */
+typedef struct prru_kernel_table {
+  const char *path; /* "specialised" or "parameter" */
+  void (*ik)(const void *p, const double q[3], double d[PRRU_NACT]);
+  void (*jd)(const void *p, const double q[3], double Jd[PRRU_NACT * 3]);
+  void (*ik_jd)(const void *p, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3]);
+  void (*mass)(const void *p, const double q[3], double M[9]);
+  void (*dynamics)(const void *p, const double q[3], const double qd[3], double M[9], double h[3],
+                   double G[3]);
+  void (*eom)(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+              const double fp[3], const double mp[3], double M[9], double b[3]);
+  void (*eom_solve)(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                    const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3],
+                    double minors[3]);
+  int (*unseen_finite_eom_solve)(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                                 const double fp[3], const double mp[3]);
+  /* Three actuators: d, J_d, J_d^-1 and fd = J_d^-T tau (out, 3 values);
+   * four: d, J_d and tau (out, 3 values), Jdinv unused. */
+  void (*inverse_terms)(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                        const double fp[3], const double mp[3], double d[PRRU_NACT],
+                        double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3]);
+  int (*unseen_finite_inverse_terms)(const double q[3], const double qd[3], const double qdd[3],
+                                     const double fp[3], const double mp[3]);
+  /* z (the null vector of Q) only with four actuators; NULL otherwise. */
+  void (*joint_reactions)(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                          const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                          double lambda[PRRU_NLAMBDA], double z[PRRU_NLAMBDA]);
+  void (*platform_jacobian)(const void *p, const double q[3], double JP[18]);
+  void (*poses)(const void *p, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY]);
+  void (*energy)(const void *p, const double q[3], const double qd[3], double E[2]);
+  void (*actuator_rates)(const void *p, const double q[3], const double qd[3], double dd[PRRU_NACT],
+                         double ddb[PRRU_NACT]);
+  void (*passive)(const void *p, const double q[3], const double qd[3], double Qp[3]);
+  void (*batch_dme_terms)(const void *p, int n, const double *q, double *d, double *Jd, double *M,
+                          double *JP);
+} prru_kernel_table;
+
 typedef struct {
-  const prru_mechanism *mech;      /* the generated descriptor: &prru_mech */
+  /* The descriptor: &prru_mech (the build's model), or a loaded model's
+   * own copy (prru_model_load): names, sizes and numbers. */
+  const prru_mechanism *mech;
   /* J_d counts as singular when the reciprocal condition number
    * 1 / (|J|_1 |J^-1|_1) of J = J_d diag(1/L, 1/L, 1) is below this
    * (default 1e-8); L, the mean upper-link length, measures rotations as arc
@@ -82,10 +130,50 @@ typedef struct {
    * workspace). Default 1e-6: qdd and fd then agree with the GSL reference
    * to 2e-10 relative, and ID(FD(fd)) returns fd to 1e-7 of its terms. */
   double mass_rcond_min;
+  const prru_kernel_table *kernels; /* the code (see prru_kernel_table) */
+  const void *kernel_params;        /* its numbers (NULL: specialised) */
+  void *own;                        /* a loaded model's storage, else NULL */
 } prru_model;
 
-/* The mechanism the kernels were generated from, default settings. */
+/* The mechanism the kernels were generated from, default settings,
+ * specialised kernels. */
 void prru_model_default(prru_model *m);
+/* Reads the model file at path (format 1 or 2, spec sections 11-13; the
+ * generator's validation and messages, prru_model_file.h) into m with
+ * default settings. Its kernels: the specialised set when every number
+ * equals the build's model's (names and descriptions aside: the same
+ * robot, so a whitespace or comment edit keeps the fast path), else the
+ * parameter set of the build's topology. PRRU_OK; PRRU_EIO or PRRU_EPARSE
+ * with msg "path: key: reason"; PRRU_EINPUT with msg when the file has
+ * another number of limbs than this build (whose data sizes are fixed at
+ * compile time); PRRU_ENOMEM. m is untouched on failure: nothing is
+ * computed with a partly loaded model. Allocates: prru_model_free (m must
+ * not hold a loaded model already: free it first). */
+int prru_model_load(prru_model *m, const char *path, char *msg, int msglen);
+/* Frees a loaded model's storage (nothing for prru_model_default's);
+ * then m is prru_model_default's. */
+void prru_model_free(prru_model *m);
+/* Whether m's numbers are the build's model's: the kernels that exist only
+ * for it (the identification regressor, prru_regressor.h) apply. The
+ * inertial and drive numbers may differ when only_geometry is non-zero
+ * (the regressor depends on geometry and gravity alone). */
+int prru_model_is_built(const prru_model *m, int only_geometry);
+/* m's kernels of the same names (prru_kernel_table), for callers that
+ * need a kernel's raw outputs (NaN where q is unreachable, no status):
+ * the CLI and the Python binding. */
+void prru_model_ik_jd(const prru_model *m, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3]);
+void prru_model_dynamics(const prru_model *m, const double q[3], const double qd[3], double M[9], double h[3],
+                         double G[3]);
+void prru_model_passive(const prru_model *m, const double q[3], const double qd[3], double Qp[3]);
+void prru_model_platform_jacobian(const prru_model *m, const double q[3], double JP[18]);
+void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY]);
+void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
+                               double ddb[PRRU_NACT]);
+/* "model NAME (FILE, sha256 HEX, KERNELS kernels)": the identity every
+ * output states (KERNELS "specialised" or "parameter"); buf holds at least
+ * len bytes, truncated with a NUL. FILE as given at load (any bytes; a
+ * caller writing it where newlines or quotes matter escapes it). */
+void prru_model_identity(const prru_model *m, char *buf, size_t len);
 
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */

@@ -42,6 +42,11 @@
 extern "C" {
 #endif
 
+/* A model's numbers in the layout the parameter kernels read (the plant of
+ * prru_track, a design's starting point): prru_params_model for the built
+ * model; coulomb_velocity 1 m/s where the model has no Coulomb force. */
+void prru_model_params(const prru_model *m, prru_params *p);
+
 typedef struct {
   double t;                   /* s */
   double q_ref[3], qd_ref[3], qdd_ref[3];

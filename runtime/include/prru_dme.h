@@ -204,7 +204,7 @@ int prru_map_check(const prru_map_grid *g);
 /* The model's assembly mode at the grid's home pose (0, 0, q3):
  * prru_assembly_mode there, 0 when not told (no point of the map is then
  * in the other mode). */
-int prru_map_home_mode(const prru_map_grid *g);
+int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
 
 /* Evaluates w_R at every grid point: index k = i n2 + j for (q1_i, q2_j)
  * (q1 outer). status[k] is PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESINGULAR or

@@ -28,13 +28,6 @@ const char *prru_strerror(int status)
   }
 }
 
-void prru_model_default(prru_model *m)
-{
-  m->mech = &prru_mech;
-  m->jd_rcond_min = 1e-8;
-  m->mass_rcond_min = 1e-6;
-}
-
 static pthread_once_t gsl_once = PTHREAD_ONCE_INIT;
 
 static void gsl_handler_off(void) { gsl_set_error_handler_off(); }
@@ -45,9 +38,8 @@ static int finite3(const double v[3]) { return prru_finite_n(v, 3); }
 
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
 {
-  (void)m;
   if (!finite3(q)) return PRRU_EINPUT;
-  prru_ik(q, d->d);
+  KERNEL(m, ik)(m->kernel_params, q, d->d);
   /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
   return prru_finite_n(d->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
 }
@@ -239,7 +231,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
 {
   if (rcond) *rcond = 0.0;
   if (!finite3(q)) return PRRU_EINPUT;
-  prru_ik_jd(q, d->d, d->Jd);
+  KERNEL(m, ik_jd)(m->kernel_params, q, d->d, d->Jd);
   if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
   return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
@@ -266,7 +258,7 @@ static int classify_failure(const prru_model *m, prru_data *d, const double q[3]
   int st = prru_check_reachable(m, d, q);
   if (st != PRRU_OK) return st;
   double M[9], b[3];
-  prru_eom(q, zero, zero_fd, zero, zero, M, b);
+  KERNEL(m, eom)(m->kernel_params, q, zero, zero_fd, zero, zero, M, b);
   return finite3(b) ? PRRU_EINPUT : PRRU_ESINGULAR;
 }
 
@@ -291,7 +283,7 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * positive definite is Sylvester's criterion on the nested principal
    * minors the kernel returns: otherwise qdd is not used. */
   double minors[3];
-  prru_eom_solve(q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
+  KERNEL(m, eom_solve)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
   /* The inputs are tested through the outputs, not one by one before the
    * call: the generator proves that a NaN or an infinity in any input but
    * the few PRRU_UNSEEN_FINITE_EOM_SOLVE tests makes b or qdd non-finite
@@ -299,7 +291,7 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * them examined, to name the cause: the statuses are those of testing
    * every input first. */
   if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
-      !finite3(d->qdd) || !PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, l->fd, l->fp, l->mp))
+      !finite3(d->qdd) || !KERNEL(m, unseen_finite_eom_solve)(q, qd, l->fd, l->fp, l->mp))
     return forward_failure(m, d, q, qd, l, minors);
   /* The trust criterion (prru_model.mass_rcond_min): prru_mass_rcond's
    * test without its division. */
@@ -397,7 +389,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   /* One kernel gives d, J_d, J_d^-1 and fd = J_d^-T (M qdd - b); here only
    * prru_check_regular's test, on that J_d and J_d^-1. */
   double f[3];
-  prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
+  KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
   else if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
     st = PRRU_ESINGULAR;
@@ -407,7 +399,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
    * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
   double tau[3], f[PRRU_NACT];
-  prru_inverse_terms(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, tau);
+  KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau);
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
   else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
   if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
@@ -421,7 +413,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   }
 #endif
   /* Inputs tested through the outputs, as in prru_forward_dynamics. */
-  if (st != PRRU_OK || !PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, l->fp, l->mp))
+  if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_terms)(q, qd, qdd, l->fp, l->mp))
     return inverse_failure(st, q, qd, qdd, l);
   memcpy(fd, f, sizeof f);
   return PRRU_OK;
@@ -508,15 +500,14 @@ int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const doubl
 int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
                   double *V)
 {
-  (void)m;
   if (!finite3(q) || !finite3(qd)) return PRRU_EINPUT;
   double E[2];
-  prru_energy(q, qd, E);
+  KERNEL(m, energy)(m->kernel_params, q, qd, E);
   if (!isfinite(E[0]) || !isfinite(E[1])) {
     /* NaN where q is out of reach; at a reachable q only an overflow of
      * huge velocities (bad input) makes the energy infinite. */
     double act[PRRU_NACT];
-    prru_ik(q, act);
+    KERNEL(m, ik)(m->kernel_params, q, act);
     return isfinite(act[0]) ? PRRU_EINPUT : PRRU_EUNREACHABLE;
   }
   *T = E[0];

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal.h"
 #include "prru_dme.h"
 
 const char *prru_dme_status_name(int status)
@@ -98,8 +99,8 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
 
   /* regular: prru_check_regular left J_d^+ (J_d^-1 for three actuators) */
   double jp[18];
-  prru_mass(q, d->M);
-  prru_platform_jacobian(q, jp);
+  KERNEL(m, mass)(m->kernel_params, q, d->M);
+  KERNEL(m, platform_jacobian)(m->kernel_params, q, jp);
   return prru_dme_from(d->M, d->Jdpinv, jp, out);
 }
 

@@ -107,13 +107,14 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
 #if PRRU_NACT == 3
 typedef struct {
   const double *act;
+  const prru_model *m;
 } fk_ctx;
 
 static int fk_f(const gsl_vector *x, void *p, gsl_vector *f)
 {
   const fk_ctx *c = p;
   double q[3] = {gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2)}, d[3];
-  prru_ik(q, d);
+  KERNEL(c->m, ik)(c->m->kernel_params, q, d);
   for (int i = 0; i < 3; i++) {
     /* Outside the reachable set the solver must back off, not diverge. */
     if (!isfinite(d[i])) return GSL_EDOM;
@@ -126,7 +127,7 @@ static int fk_fdf(const gsl_vector *x, void *p, gsl_vector *f, gsl_matrix *J)
 {
   const fk_ctx *c = p;
   double q[3] = {gsl_vector_get(x, 0), gsl_vector_get(x, 1), gsl_vector_get(x, 2)}, d[3], Jd[9];
-  prru_ik_jd(q, d, Jd);
+  KERNEL(c->m, ik_jd)(c->m->kernel_params, q, d, Jd);
   for (int i = 0; i < 3; i++) {
     if (!isfinite(d[i])) return GSL_EDOM;
     gsl_vector_set(f, (size_t)i, d[i] - c->act[i]);
@@ -148,7 +149,7 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   if (!isfinite(act[0]) || !isfinite(act[1]) || !isfinite(act[2])) return PRRU_EINPUT;
   int st = prru_check_regular(m, d, seed, NULL);
   if (st != PRRU_OK) return st;
-  fk_ctx c = {act};
+  fk_ctx c = {act, m};
   gsl_multiroot_function_fdf fn = {fk_f, fk_df, fk_fdf, 3, &c};
   double x0[3] = {seed[0], seed[1], seed[2]};
   gsl_vector_view xv = gsl_vector_view_array(x0, 3);

@@ -6,6 +6,11 @@
 
 #include "prru.h"
 
+/* The build's two kernel tables (kernels.c). */
+extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter;
+/* A model's kernel K with its parameters: K(m, ik)(m->kernel_params, ...). */
+#define KERNEL(m, k) ((m)->kernels->k)
+
 /* C99 has no M_PI. */
 #define PRRU_PI 3.14159265358979323846
 

@@ -86,7 +86,7 @@ static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
     b->q[n + c] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + c);
     b->q[2 * n + c] = g->q3;
   }
-  prru_batch_dme_terms(n, b->q, b->d, b->Jd, b->M, b->JP);
+  KERNEL(j->m, batch_dme_terms)(j->m->kernel_params, n, b->q, b->d, b->Jd, b->M, b->JP);
   const long k = (long)(row - j->row_begin) * g->n2 + c0;
   prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, j->w + k,
                  j->st ? j->st + k : b->st, NULL, NULL);
@@ -149,7 +149,7 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   const int nrows = row_end - row_begin;
   int nt = o->nthreads > nrows ? nrows : o->nthreads;
   map_job job = {m, g, w_R, status, o, PTHREAD_MUTEX_INITIALIZER, row_begin, row_end, 0, row_begin,
-                 prru_map_home_mode(g), prru_length_scale(m->mech), 0};
+                 prru_map_home_mode(m, g), prru_length_scale(m->mech), 0};
   map_worker *workers = calloc((size_t)nt, sizeof *workers);
   pthread_t *tid = calloc((size_t)nt, sizeof *tid);
   int rc = PRRU_OK, started = 0;
@@ -183,10 +183,10 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
   return rc;
 }
 
-int prru_map_home_mode(const prru_map_grid *g)
+int prru_map_home_mode(const prru_model *m, const prru_map_grid *g)
 {
   double d[PRRU_NACT], Jd[PRRU_NACT * 3];
-  prru_ik_jd((const double[3]){0.0, 0.0, g->q3}, d, Jd);
+  KERNEL(m, ik_jd)(m->kernel_params, (const double[3]){0.0, 0.0, g->q3}, d, Jd);
   return prru_assembly_mode(d, Jd);
 }
 

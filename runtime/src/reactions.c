@@ -43,15 +43,15 @@ static void orient_null(double z[NL])
 #endif
 
 /* The closed form into lam (and d->lambda_null). */
-static void closed_form(prru_data *d, const double q[3], const double qd[3], const double qdd[3],
+static void closed_form(const prru_model *m, prru_data *d, const double q[3], const double qd[3], const double qdd[3],
                         const double fd[PRRU_NACT], const double fp[3], const double mp[3],
                         double lam[NL])
 {
 #if PRRU_NREACTION_NULL == 0
-  prru_joint_reactions(q, qd, qdd, fd, fp, mp, lam);
+  KERNEL(m, joint_reactions)(m->kernel_params, q, qd, qdd, fd, fp, mp, lam, NULL);
   memset(d->lambda_null, 0, sizeof d->lambda_null);
 #else
-  prru_joint_reactions(q, qd, qdd, fd, fp, mp, lam, d->lambda_null);
+  KERNEL(m, joint_reactions)(m->kernel_params, q, qd, qdd, fd, fp, mp, lam, d->lambda_null);
   orient_null(d->lambda_null);
 #endif
 }
@@ -61,11 +61,11 @@ static void closed_form(prru_data *d, const double q[3], const double qd[3], con
  * equations' divisors vanish: a U joint's constraint axis normal to its
  * limb's hinges, an upper link horizontal), which shows at rest too; or
  * loads and velocities so large that the arithmetic overflows. */
-static int classify_failure(prru_data *d, const double q[3])
+static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
 {
   static const double zero[3] = {0, 0, 0}, zero_fd[PRRU_NACT] = {0};
   double lam[NL];
-  closed_form(d, q, zero, zero, zero_fd, zero, zero, lam);
+  closed_form(m, d, q, zero, zero, zero_fd, zero, zero, lam);
   int rest_ok = prru_finite_n(lam, NL);
 #if PRRU_NREACTION_NULL == 1
   rest_ok = rest_ok && prru_finite_n(d->lambda_null, NL);
@@ -96,13 +96,13 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
   double qdd[3];
   int st = prru_forward_dynamics(m, d, q, qd, l, qdd);
   if (st != PRRU_OK) return st;
-  closed_form(d, q, qd, qdd, l->fd, l->fp, l->mp, d->r);
+  closed_form(m, d, q, qd, qdd, l->fd, l->fp, l->mp, d->r);
   int ok = prru_finite_n(d->r, NL);
 #if PRRU_NREACTION_NULL == 1
   ok = ok && prru_finite_n(d->lambda_null, NL);
 #endif
   if (!ok) {
-    st = classify_failure(d, q);
+    st = classify_failure(m, d, q);
     memset(d->lambda_null, 0, sizeof d->lambda_null);
     return st;
   }

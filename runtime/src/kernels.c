@@ -1,0 +1,218 @@
+/* The two kernel tables of a build (prru_kernel_table in prru.h): the
+ * specialised kernels of the build's model, and the parameter kernels of
+ * its topology, which a model loaded at run time evaluates with. Thin
+ * adapters to one signature; the topology is the build's (its data sizes
+ * are compile-time constants), the only place the runtime chooses between
+ * the three- and four-limb kernel sets. */
+#include <math.h>
+#include <stddef.h>
+
+#include "internal.h"
+#include "prru.h"
+#include "prru_param_kernels.h"
+
+#if PRRU_NLIMB == 3
+#include "prru_p3_kernels.h"
+#define P(name) prru_p3_##name
+#define UNSEEN_P(name) PRRU_P3_UNSEEN_FINITE_##name
+typedef prru_params3 topo_params;
+#elif PRRU_NLIMB == 4
+#include "prru_p4_kernels.h"
+#define P(name) prru_p4_##name
+#define UNSEEN_P(name) PRRU_P4_UNSEEN_FINITE_##name
+typedef prru_params4 topo_params;
+#else
+#error "prru: a build's model has 3 or 4 limbs"
+#endif
+
+/* The loaded numbers are stored as prru_params (the build's layout) and
+ * read as the topology's: the same members in the same order. */
+typedef char params_layout_check[sizeof(topo_params) == sizeof(prru_params) ? 1 : -1];
+
+#define TP(p) ((const topo_params *)(p))
+
+/* ---- specialised: the constant-folded kernels, p ignored ---- */
+static void s_ik(const void *p, const double q[3], double d[PRRU_NACT]) { (void)p, prru_ik(q, d); }
+static void s_jd(const void *p, const double q[3], double Jd[PRRU_NACT * 3]) { (void)p, prru_jd(q, Jd); }
+static void s_ik_jd(const void *p, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
+{
+  (void)p, prru_ik_jd(q, d, Jd);
+}
+static void s_mass(const void *p, const double q[3], double M[9]) { (void)p, prru_mass(q, M); }
+static void s_dynamics(const void *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3])
+{
+  (void)p, prru_dynamics(q, qd, M, h, G);
+}
+static void s_eom(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                  const double fp[3], const double mp[3], double M[9], double b[3])
+{
+  (void)p, prru_eom(q, qd, fd, fp, mp, M, b);
+}
+static void s_eom_solve(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                        const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3],
+                        double minors[3])
+{
+  (void)p, prru_eom_solve(q, qd, fd, fp, mp, M, b, qdd, minors);
+}
+static int s_unseen_eom_solve(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                              const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
+  return PRRU_UNSEEN_FINITE_EOM_SOLVE(q, qd, fd, fp, mp);
+}
+static void s_inverse_terms(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                            const double fp[3], const double mp[3], double d[PRRU_NACT],
+                            double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3])
+{
+  (void)p;
+#if PRRU_NACT == 3
+  prru_inverse_terms(q, qd, qdd, fp, mp, d, Jd, Jdinv, out);
+#else
+  (void)Jdinv;
+  prru_inverse_terms(q, qd, qdd, fp, mp, d, Jd, out);
+#endif
+}
+static int s_unseen_inverse_terms(const double q[3], const double qd[3], const double qdd[3],
+                                  const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
+  return PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp);
+}
+static void s_joint_reactions(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                              const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                              double lambda[PRRU_NLAMBDA], double z[PRRU_NLAMBDA])
+{
+  (void)p;
+#if PRRU_NACT == 3
+  (void)z;
+  prru_joint_reactions(q, qd, qdd, fd, fp, mp, lambda);
+#else
+  prru_joint_reactions(q, qd, qdd, fd, fp, mp, lambda, z);
+#endif
+}
+static void s_platform_jacobian(const void *p, const double q[3], double JP[18])
+{
+  (void)p, prru_platform_jacobian(q, JP);
+}
+static void s_poses(const void *p, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY])
+{
+  (void)p, prru_poses(q, R, pos);
+}
+static void s_energy(const void *p, const double q[3], const double qd[3], double E[2])
+{
+  (void)p, prru_energy(q, qd, E);
+}
+static void s_actuator_rates(const void *p, const double q[3], const double qd[3], double dd[PRRU_NACT],
+                             double ddb[PRRU_NACT])
+{
+  (void)p, prru_actuator_rates(q, qd, dd, ddb);
+}
+static void s_passive(const void *p, const double q[3], const double qd[3], double Qp[3])
+{
+  (void)p, prru_passive(q, qd, Qp);
+}
+static void s_batch_dme_terms(const void *p, int n, const double *q, double *d, double *Jd, double *M, double *JP)
+{
+  (void)p, prru_batch_dme_terms(n, q, d, Jd, M, JP);
+}
+
+const prru_kernel_table prru_kernels_specialised = {
+  "specialised",  s_ik,      s_jd,
+  s_ik_jd,        s_mass,    s_dynamics,
+  s_eom,          s_eom_solve, s_unseen_eom_solve,
+  s_inverse_terms, s_unseen_inverse_terms, s_joint_reactions,
+  s_platform_jacobian, s_poses, s_energy,
+  s_actuator_rates, s_passive, s_batch_dme_terms,
+};
+
+/* ---- parameter: the topology's kernels, p a prru_params ---- */
+static void p_ik(const void *p, const double q[3], double d[PRRU_NACT]) { P(ik)(TP(p), q, d); }
+static void p_jd(const void *p, const double q[3], double Jd[PRRU_NACT * 3]) { P(jd)(TP(p), q, Jd); }
+static void p_ik_jd(const void *p, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
+{
+  P(ik_jd)(TP(p), q, d, Jd);
+}
+static void p_mass(const void *p, const double q[3], double M[9]) { P(mass)(TP(p), q, M); }
+static void p_dynamics(const void *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3])
+{
+  P(dynamics)(TP(p), q, qd, M, h, G);
+}
+static void p_eom(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                  const double fp[3], const double mp[3], double M[9], double b[3])
+{
+  P(eom)(TP(p), q, qd, fd, fp, mp, M, b);
+}
+static void p_eom_solve(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                        const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3],
+                        double minors[3])
+{
+  P(eom_solve)(TP(p), q, qd, fd, fp, mp, M, b, qdd, minors);
+}
+static int p_unseen_eom_solve(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                              const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
+  return UNSEEN_P(EOM_SOLVE)(q, qd, fd, fp, mp);
+}
+static void p_inverse_terms(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                            const double fp[3], const double mp[3], double d[PRRU_NACT],
+                            double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3])
+{
+#if PRRU_NACT == 3
+  P(inverse_terms)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, out);
+#else
+  (void)Jdinv;
+  P(inverse_terms)(TP(p), q, qd, qdd, fp, mp, d, Jd, out);
+#endif
+}
+static int p_unseen_inverse_terms(const double q[3], const double qd[3], const double qdd[3],
+                                  const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
+  return UNSEEN_P(INVERSE_TERMS)(q, qd, qdd, fp, mp);
+}
+static void p_joint_reactions(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                              const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                              double lambda[PRRU_NLAMBDA], double z[PRRU_NLAMBDA])
+{
+#if PRRU_NACT == 3
+  (void)z;
+  P(joint_reactions)(TP(p), q, qd, qdd, fd, fp, mp, lambda);
+#else
+  P(joint_reactions)(TP(p), q, qd, qdd, fd, fp, mp, lambda, z);
+#endif
+}
+static void p_platform_jacobian(const void *p, const double q[3], double JP[18])
+{
+  P(platform_jacobian)(TP(p), q, JP);
+}
+static void p_poses(const void *p, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY])
+{
+  P(poses)(TP(p), q, R, pos);
+}
+static void p_energy(const void *p, const double q[3], const double qd[3], double E[2])
+{
+  P(energy)(TP(p), q, qd, E);
+}
+static void p_actuator_rates(const void *p, const double q[3], const double qd[3], double dd[PRRU_NACT],
+                             double ddb[PRRU_NACT])
+{
+  P(actuator_rates)(TP(p), q, qd, dd, ddb);
+}
+static void p_passive(const void *p, const double q[3], const double qd[3], double Qp[3])
+{
+  P(passive)(TP(p), q, qd, Qp);
+}
+static void p_batch_dme_terms(const void *p, int n, const double *q, double *d, double *Jd, double *M, double *JP)
+{
+  P(batch_dme_terms)(TP(p), n, q, d, Jd, M, JP);
+}
+
+const prru_kernel_table prru_kernels_parameter = {
+  "parameter",    p_ik,      p_jd,
+  p_ik_jd,        p_mass,    p_dynamics,
+  p_eom,          p_eom_solve, p_unseen_eom_solve,
+  p_inverse_terms, p_unseen_inverse_terms, p_joint_reactions,
+  p_platform_jacobian, p_poses, p_energy,
+  p_actuator_rates, p_passive, p_batch_dme_terms,
+};

@@ -1,0 +1,205 @@
+/* Models as run-time data (prru.h): prru_model_load reads a model file
+ * into a descriptor of its own and picks the kernels that evaluate it. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "prru.h"
+#include "prru_control.h"
+#include "prru_model_file.h"
+
+/* A loaded model's storage (prru_model.own). */
+typedef struct {
+  prru_mechanism mech;
+  prru_params params;
+  char name[PRRU_MODEL_NAME_MAX + 1];
+  char description[4 * PRRU_MODEL_DESCRIPTION_MAX + 1];
+  char sha256[65];
+  char *path;
+} loaded_model;
+
+void prru_model_default(prru_model *m)
+{
+  m->mech = &prru_mech;
+  m->jd_rcond_min = 1e-8;
+  m->mass_rcond_min = 1e-6;
+  m->kernels = &prru_kernels_specialised;
+  m->kernel_params = NULL;
+  m->own = NULL;
+}
+
+void prru_model_free(prru_model *m)
+{
+  loaded_model *l = m->own;
+  if (l) free(l->path);
+  free(l);
+  prru_model_default(m);
+}
+
+/* The inverse of a symmetric positive definite 3 x 3 (the inertia
+ * tensors the loader accepted). */
+static void inverse3(const double a[9], double inv[9])
+{
+  const double c0 = a[4] * a[8] - a[5] * a[7], c1 = a[2] * a[7] - a[1] * a[8], c2 = a[1] * a[5] - a[2] * a[4];
+  const double det = a[0] * c0 + a[3] * c1 + a[6] * c2;
+  const double c[9] = {c0, c1, c2, a[5] * a[6] - a[3] * a[8], a[0] * a[8] - a[2] * a[6], a[2] * a[3] - a[0] * a[5],
+                       a[3] * a[7] - a[4] * a[6], a[1] * a[6] - a[0] * a[7], a[0] * a[4] - a[1] * a[3]};
+  for (int i = 0; i < 9; i++) inv[i] = c[i] / det;
+}
+
+/* The spec's numbers into a copy of the build's descriptor (names, joints
+ * and layout are the topology's, hence the build's). */
+static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
+{
+  prru_mechanism *me = &l->mech;
+  *me = prru_mech;
+  memcpy(l->name, s->name, sizeof l->name);
+  memcpy(l->description, s->description, sizeof l->description);
+  memcpy(l->sha256, s->sha256, sizeof l->sha256);
+  me->name = l->name;
+  me->description = l->description;
+  me->model_file = l->path;
+  me->sha256 = l->sha256;
+  me->format = s->format;
+  memcpy(me->gravity, s->gravity, sizeof me->gravity);
+  me->total_mass = 0;
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    const double *I = s->inertia[b];
+    const double T[9] = {I[0], I[3], I[4], I[3], I[1], I[5], I[4], I[5], I[2]};
+    me->mass[b] = s->mass[b];
+    me->total_mass += s->mass[b];
+    memcpy(me->com[b], s->com[b], sizeof me->com[b]);
+    memcpy(me->inertia[b], T, sizeof T);
+    inverse3(T, me->inertia_inv[b]);
+  }
+  for (int i = 0; i < PRRU_NLIMB; i++) {
+    me->b[i] = s->limb[i].b, me->l1[i] = s->limb[i].l1;
+    me->l2[i] = s->limb[i].l2, me->a[i] = s->limb[i].a;
+    me->armature[i] = s->armature[i];
+    me->damping[i] = s->damping[i];
+    me->coulomb[i] = s->coulomb[i];
+  }
+  me->coulomb_velocity = s->coulomb_velocity;
+}
+
+void prru_model_params(const prru_model *m, prru_params *p)
+{
+  const prru_mechanism *me = m->mech;
+  for (int i = 0; i < PRRU_NLIMB; i++) {
+    p->b[i] = me->b[i], p->l1[i] = me->l1[i], p->l2[i] = me->l2[i], p->a[i] = me->a[i];
+    p->armature[i] = me->armature[i], p->damping[i] = me->damping[i], p->coulomb[i] = me->coulomb[i];
+  }
+  memcpy(p->gravity, me->gravity, sizeof p->gravity);
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    const double *T = me->inertia[b];
+    const double I[6] = {T[0], T[4], T[8], T[1], T[2], T[5]};
+    p->mass[b] = me->mass[b];
+    memcpy(p->com[b], me->com[b], sizeof p->com[b]);
+    memcpy(p->inertia[b], I, sizeof I);
+  }
+  /* The parameter kernels divide by v_s even where no Coulomb force acts
+   * (prru_params_model likewise holds 1 m/s there). */
+  p->coulomb_velocity = me->coulomb_velocity > 0 ? me->coulomb_velocity : 1.0;
+}
+
+static int same(const double *a, const double *b, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (a[i] != b[i]) return 0;
+  return 1;
+}
+
+int prru_model_is_built(const prru_model *m, int only_geometry)
+{
+  const prru_mechanism *a = m->mech, *b = &prru_mech;
+  if (a == b) return 1;
+  int ok = same(a->gravity, b->gravity, 3) && same(a->b, b->b, PRRU_NLIMB) && same(a->l1, b->l1, PRRU_NLIMB) &&
+           same(a->l2, b->l2, PRRU_NLIMB) && same(a->a, b->a, PRRU_NLIMB);
+  if (!ok || only_geometry) return ok;
+  for (int k = 0; k < PRRU_NBODY && ok; k++)
+    ok = a->mass[k] == b->mass[k] && same(a->com[k], b->com[k], 3) && same(a->inertia[k], b->inertia[k], 9);
+  return ok && same(a->armature, b->armature, PRRU_NACT) && same(a->damping, b->damping, PRRU_NACT) &&
+         same(a->coulomb, b->coulomb, PRRU_NACT) && a->coulomb_velocity == b->coulomb_velocity;
+}
+
+int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
+{
+  if (msg && msglen > 0) msg[0] = 0;
+  prru_model_spec *s = malloc(sizeof *s);
+  loaded_model *l = calloc(1, sizeof *l);
+  char *p = path ? malloc(strlen(path) + 1) : NULL;
+  if (!s || !l || !p) {
+    free(s), free(l), free(p);
+    if (msg && msglen > 0) snprintf(msg, (size_t)msglen, "%s: out of memory", path ? path : "(null)");
+    return PRRU_ENOMEM;
+  }
+  strcpy(p, path);
+  int st = prru_model_file_read(path, s, msg, msglen);
+  if (st == PRRU_OK && s->nlimb != PRRU_NLIMB) {
+    snprintf(msg, (size_t)msglen,
+             "%s: a model with %d limbs; this build evaluates %d-limb models (its data sizes are fixed at "
+             "compile time): use a build of a %d-limb model (make build MODEL=%s)",
+             path, s->nlimb, PRRU_NLIMB, s->nlimb, path);
+    st = PRRU_EINPUT;
+  }
+  if (st != PRRU_OK) {
+    free(s), free(l), free(p);
+    return st;
+  }
+  l->path = p;
+  fill_mechanism(s, l);
+  free(s);
+  prru_model tmp;
+  prru_model_default(&tmp);
+  tmp.mech = &l->mech;
+  tmp.own = l;
+  prru_model_params(&tmp, &l->params);
+  if (!prru_model_is_built(&tmp, 0)) {
+    tmp.kernels = &prru_kernels_parameter;
+    tmp.kernel_params = &l->params;
+  }
+  /* Settings kept from m only where it was a model already: a fresh
+   * struct is defaults. */
+  *m = tmp;
+  return PRRU_OK;
+}
+
+void prru_model_ik_jd(const prru_model *m, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
+{
+  KERNEL(m, ik_jd)(m->kernel_params, q, d, Jd);
+}
+
+void prru_model_dynamics(const prru_model *m, const double q[3], const double qd[3], double M[9], double h[3],
+                         double G[3])
+{
+  KERNEL(m, dynamics)(m->kernel_params, q, qd, M, h, G);
+}
+
+void prru_model_passive(const prru_model *m, const double q[3], const double qd[3], double Qp[3])
+{
+  KERNEL(m, passive)(m->kernel_params, q, qd, Qp);
+}
+
+void prru_model_platform_jacobian(const prru_model *m, const double q[3], double JP[18])
+{
+  KERNEL(m, platform_jacobian)(m->kernel_params, q, JP);
+}
+
+void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY])
+{
+  KERNEL(m, poses)(m->kernel_params, q, R, pos);
+}
+
+void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
+                               double ddb[PRRU_NACT])
+{
+  KERNEL(m, actuator_rates)(m->kernel_params, q, qd, dd, ddb);
+}
+
+void prru_model_identity(const prru_model *m, char *buf, size_t len)
+{
+  if (len == 0) return;
+  snprintf(buf, len, "model %s (%s, sha256 %s, %s kernels)", m->mech->name, m->mech->model_file, m->mech->sha256,
+           m->kernels->path);
+}
