@@ -54,10 +54,12 @@ class _MechHead(ctypes.Structure):
 
 
 class _Model(ctypes.Structure):
-    """prru_model: a pointer to the descriptor and the two tolerances of the
-    trust criterion (J_d's and the mass matrix's conditioning)."""
+    """prru_model: a pointer to the descriptor, the two tolerances of the
+    trust criterion (J_d's and the mass matrix's conditioning), the kernel
+    table with its parameters, and a loaded model's storage."""
     _fields_ = [("mech", ctypes.c_void_p), ("jd_rcond_min", ctypes.c_double),
-                ("mass_rcond_min", ctypes.c_double)]
+                ("mass_rcond_min", ctypes.c_double), ("kernels", ctypes.c_void_p),
+                ("kernel_params", ctypes.c_void_p), ("own", ctypes.c_void_p)]
 
 
 class _MapGrid(ctypes.Structure):
@@ -200,6 +202,9 @@ class Library:
         lp, vp = ctypes.POINTER(t.Loads), c_double_p
         self.strerror = _declare(dll, "prru_strerror", ctypes.c_char_p, i)
         self.model_default = _declare(dll, "prru_model_default", None, mp)
+        self.model_load = _declare(dll, "prru_model_load", i, mp, ctypes.c_char_p,
+                                   ctypes.c_char_p, i)
+        self.model_free = _declare(dll, "prru_model_free", None, mp)
         self.check_reachable = _declare(dll, "prru_check_reachable", i, mp, dp, vp)
         self.check_regular = _declare(dll, "prru_check_regular", i, mp, dp, vp, vp)
         self.actuators = _declare(dll, "prru_actuators", i, mp, dp, vp, vp)
@@ -213,7 +218,15 @@ class Library:
         self.reactions = _declare(dll, "prru_reactions", i, mp, dp, vp, vp, lp, vp)
         self.reaction_null = _declare(dll, "prru_reaction_null", i, mp, dp, vp, vp)
         self.energies = _declare(dll, "prru_energies", i, mp, vp, vp, vp, vp)
-        # Generated kernels (prru_kernels.h): NaN outputs where q is unreachable.
+        # A model's kernels (prru_model_*: the specialised ones or, for a
+        # loaded model, the parameter ones): NaN outputs where q is unreachable.
+        self.model_ik_jd = _declare(dll, "prru_model_ik_jd", None, mp, vp, vp, vp)
+        self.model_dynamics = _declare(dll, "prru_model_dynamics", None, mp, vp, vp, vp, vp, vp)
+        self.model_passive = _declare(dll, "prru_model_passive", None, mp, vp, vp, vp)
+        self.model_platform_jacobian = _declare(dll, "prru_model_platform_jacobian", None,
+                                                mp, vp, vp)
+        self.model_poses = _declare(dll, "prru_model_poses", None, mp, vp, vp, vp)
+        # Generated kernels (prru_kernels.h), for the layout self-check.
         self.ik_jd = _declare(dll, "prru_ik_jd", None, vp, vp, vp)
         self.dynamics = _declare(dll, "prru_dynamics", None, vp, vp, vp, vp, vp)
         self.passive = _declare(dll, "prru_passive", None, vp, vp, vp)
@@ -241,12 +254,27 @@ class Library:
     def status_text(self, status):
         return self.strerror(status).decode()
 
-    def new_model(self, jd_rcond_min=None):
+    def new_model(self, jd_rcond_min=None, path=None):
+        """A prru_model: the built-in one, or the model file at path
+        (prru_model_load; its status's exception with the library's message:
+        PrruIOError unreadable, ParseError refused, InputError another
+        number of limbs than the library's)."""
         m = _Model()
-        self.model_default(ctypes.byref(m))
+        if path is None:
+            self.model_default(ctypes.byref(m))
+        else:
+            msg = ctypes.create_string_buffer(1024)
+            st = self.model_load(ctypes.byref(m), os.fsencode(path), msg, len(msg))
+            if st != 0:
+                text = msg.value.decode("utf-8", "replace") or self.status_text(st)
+                raise errors.make_error(st, text)
         if jd_rcond_min is not None:
             m.jd_rcond_min = jd_rcond_min
         return m
+
+    def mechanism(self, m):
+        """The descriptor m points at (the built model's, or a loaded one's)."""
+        return ctypes.cast(m.mech, ctypes.POINTER(self.types.Mechanism)).contents
 
     def new_data(self):
         g = self.types.GuardedData()

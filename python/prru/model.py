@@ -2,6 +2,7 @@
 
 import collections
 import ctypes
+import os
 import threading
 from math import isfinite
 
@@ -39,11 +40,19 @@ def _finite(*outputs):
 class Model:
     """The robot model compiled into one libprru.so.
 
-    Model(lib=None, *, numpy=False, jd_rcond_min=None)
+    Model(lib=None, *, model=None, numpy=False, jd_rcond_min=None)
+    Model("robot.json", ...)
 
     lib: a path to libprru.so or to a build directory, or a Library from
     load_library(); None searches $PRRU_LIB, beside the package, the source
     tree's build/runtime/ and the system's library path (load_library).
+    model: a model file (format 1 or 2) read at run time by the library
+    (prru_model_load), with the same validation and messages as the
+    generator; a first argument ending in ".json" is taken as model. It
+    must have the library's number of limbs. The kernels: "specialised"
+    (the library's constant-folded ones) when its numbers are the
+    library's model's, else "parameter" (the attribute kernels says
+    which). None: the library's own model.
     numpy: return NumPy arrays (matrices 2-D) instead of lists (matrices as
     lists of rows). Inputs are ordered sequences of numbers (list, tuple,
     array.array, 1-D NumPy arrays, ...) either way; dicts, sets, strings
@@ -66,19 +75,30 @@ class Model:
     workspace, accepted by the reachability check).
     """
 
-    def __init__(self, lib=None, *, numpy=False, jd_rcond_min=None):
+    def __init__(self, lib=None, *, model=None, numpy=False, jd_rcond_min=None):
+        # Model("robot.json"): a model file, read with the library found as
+        # for lib=None.
+        if model is None and isinstance(lib, (str, bytes, os.PathLike)) and \
+                os.fsdecode(lib).endswith(".json"):
+            model, lib = lib, None
         self.lib = lib if isinstance(lib, _lib.Library) else _lib.load_library(lib)
         self._out = _convert.Output(numpy)
         if jd_rcond_min is not None:
             jd_rcond_min = _convert.scalar("jd_rcond_min", jd_rcond_min, positive=True)
-        self._m = self.lib.new_model(jd_rcond_min)
+        self._m = self.lib.new_model(jd_rcond_min, model)
         self._g = self.lib.new_data()
         self._lock = threading.Lock()
         self._read_descriptor()
 
+    def __del__(self):
+        m = getattr(self, "_m", None)
+        if m is not None and m.own:
+            self.lib.model_free(ctypes.byref(m))
+
     # ---- the descriptor ----
     def _read_descriptor(self):
-        me, out = self.lib.mech, self._out
+        me, out = self.lib.mechanism(self._m), self._out
+        self.kernels = ctypes.cast(self._m.kernels, ctypes.POINTER(ctypes.c_char_p))[0].decode()
         s = lambda b: b.decode("utf-8", "replace")
         self.name, self.description = s(me.name), s(me.description)
         self.model_file, self.sha256, self.format = s(me.model_file), s(me.sha256), me.format
@@ -154,7 +174,7 @@ class Model:
             return
         n = self.nact
         d, jd = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
-        self.lib.ik_jd(q, d, jd)
+        self.lib.model_ik_jd(ctypes.byref(self._m), q, d, jd)
         if not _finite(d, jd):
             raise errors.Singular("%s: q = %s: %s: J_d is not finite there (the edge of the "
                                   "workspace)" % (what, _fmt(q),
@@ -188,7 +208,7 @@ class Model:
         self._reachable("ik", q)
         n = self.nact
         d, jd = (ctypes.c_double * n)(), (ctypes.c_double * (3 * n))()
-        self.lib.ik_jd(q, d, jd)
+        self.lib.model_ik_jd(ctypes.byref(self._m), q, d, jd)
         self._require_finite("ik", q, (d, jd))
         return self._out.vec(d), self._out.mat(jd, n, 3)
 
@@ -198,7 +218,7 @@ class Model:
         # At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0): the height matching the mean.
         zero, d0 = (ctypes.c_double * 3)(), (ctypes.c_double * self.nact)()
         jd = (ctypes.c_double * (3 * self.nact))()
-        self.lib.ik_jd(zero, d0, jd)
+        self.lib.model_ik_jd(ctypes.byref(self._m), zero, d0, jd)
         s = (ctypes.c_double * 3)()
         s[2] = sum(act[i] - d0[i] for i in range(self.nact)) / self.nact
         return s
@@ -236,7 +256,7 @@ class Model:
         q = vector("q", q, 3)
         self._reachable("platform_jacobian", q)
         jp = (ctypes.c_double * 18)()
-        self.lib.platform_jacobian(q, jp)
+        self.lib.model_platform_jacobian(ctypes.byref(self._m), q, jp)
         self._require_finite("platform_jacobian", q, (jp,))
         return self._out.mat(jp, 3, 3), self._out.mat(jp[9:], 3, 3)
 
@@ -247,7 +267,7 @@ class Model:
         self._reachable("poses", q)
         nb = self.nbody
         r, p = (ctypes.c_double * (9 * nb))(), (ctypes.c_double * (3 * nb))()
-        self.lib.poses(q, r, p)
+        self.lib.model_poses(ctypes.byref(self._m), q, r, p)
         self._require_finite("poses", q, (r, p))
         return ([self._out.mat(r[9 * b:9 * b + 9], 3, 3) for b in range(nb)],
                 [self._out.vec(p[3 * b:3 * b + 3]) for b in range(nb)])
@@ -260,7 +280,7 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         self._reachable("dynamics", q)
         M, h, G = (ctypes.c_double * 9)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
-        self.lib.dynamics(q, qd, M, h, G)
+        self.lib.model_dynamics(ctypes.byref(self._m), q, qd, M, h, G)
         self._require_finite("dynamics", q, (M, G))
         self._require_finite("dynamics", q, (h,), (("qd", qd),))
         return self._out.mat(M, 3, 3), self._out.vec(h), self._out.vec(G)
@@ -271,7 +291,7 @@ class Model:
         q, qd = vector("q", q, 3), vector("qd", qd, 3)
         self._reachable("passive", q)
         out = (ctypes.c_double * 3)()
-        self.lib.passive(q, qd, out)
+        self.lib.model_passive(ctypes.byref(self._m), q, qd, out)
         self._require_finite("passive", q, (out,), (("qd", qd),))
         return self._out.vec(out)
 

@@ -11,6 +11,7 @@ tree). Works for any model the library was built for (3 or 4 actuators).
 
 import ctypes
 import json
+import shutil
 import math
 import os
 import random
@@ -110,7 +111,7 @@ class TestIdentity(unittest.TestCase):
     def test_descriptor_matches_cli(self):
         out = parse(cli("eval", "--q", "0,0,-0.8"))
         self.assertEqual(out["model"], {"name": MODEL.name, "file": MODEL.model_file,
-                                        "sha256": MODEL.sha256})
+                                        "sha256": MODEL.sha256, "kernels": MODEL.kernels})
         self.assertEqual(list(MODEL.lambda_labels), out["lambda_labels"])
         self.assertEqual(len(out["d"]), MODEL.nact)
         version = cli("--version")
@@ -146,6 +147,79 @@ class TestIdentity(unittest.TestCase):
                              spec["bodies"][name]["mass"])
         g = spec["gravity"]
         self.assertEqual(list(MODEL.gravity), g if isinstance(g, list) else [0.0, 0.0, -g])
+
+
+class TestModelFile(unittest.TestCase):
+    """Model("file.json"): a model file read by the library at run time."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.built = os.environ.get("PRRU_MODEL")
+        if not cls.built:
+            raise unittest.SkipTest("PRRU_MODEL (the build's model file) not set; ctest sets it")
+        cls.tmp = tempfile.mkdtemp(prefix="prru-model-")
+        with open(cls.built) as f:
+            cls.spec = json.load(f)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def write(self, name, spec, indent=None):
+        path = os.path.join(self.tmp, name)
+        with open(path, "w") as f:
+            json.dump(spec, f, indent=indent)
+        return path
+
+    def test_same_numbers_specialised(self):
+        """The build's model re-spelt (other whitespace): the same robot, the
+        specialised kernels, bit for bit the built-in model's results."""
+        path = self.write("respelt.json", self.spec, indent=7)
+        m = prru.Model(path)  # a first argument ending in .json: a model file
+        self.assertIs(m.lib, MODEL.lib)  # the library from $PRRU_LIB
+        self.assertEqual(m.kernels, "specialised")
+        self.assertEqual(MODEL.kernels, "specialised")
+        self.assertEqual(m.model_file, path)
+        for q, qd, fd, fp, mp in random_states(5, 11):
+            self.assertEqual(bits(m.dynamics(q, qd)), bits(MODEL.dynamics(q, qd)))
+            self.assertEqual(bits(m.forward_dynamics(q, qd, fd, fp, mp)),
+                             bits(MODEL.forward_dynamics(q, qd, fd, fp, mp)))
+
+    def test_other_numbers_parameter(self):
+        """The platform 0.5 kg heavier: the parameter kernels; at q1 = q2 =
+        0 the generalized gravity along q3 changes by exactly that weight
+        (O' moves with q3 one to one; gravity (0, 0, -g) or the model's
+        vector's z), to the rounding of G's terms."""
+        spec = json.loads(json.dumps(self.spec))
+        spec["bodies"]["P"]["mass"] += 0.5
+        m = prru.Model(model=self.write("heavier.json", spec), lib=MODEL.lib)
+        self.assertEqual(m.kernels, "parameter")
+        self.assertEqual(m.mass[m.platform], MODEL.mass[MODEL.platform] + 0.5)
+        for z in (-0.9, -0.75, -0.6):
+            q = [0.0, 0.0, z]
+            try:
+                MODEL.check(q)
+            except (prru.Unreachable, prru.Singular):
+                continue
+            g1, g0 = m.dynamics(q)[2], MODEL.dynamics(q)[2]
+            scale = sum(abs(x) for x in g0) + 1.0
+            self.assertLessEqual(abs((g1[2] - g0[2]) - 0.5 * MODEL.gravity[2]), 64 * 2.2e-16 * scale)
+            self.assertLessEqual(abs(g1[0] - g0[0]), 64 * 2.2e-16 * scale)
+
+    def test_refusals(self):
+        with self.assertRaises(prru.PrruIOError) as e:
+            prru.Model(model=os.path.join(self.tmp, "missing.json"), lib=MODEL.lib)
+        self.assertIn("missing.json", str(e.exception))
+        spec = json.loads(json.dumps(self.spec))
+        spec["bodies"]["P"]["mass"] = -1.0
+        with self.assertRaises(prru.ParseError) as e:
+            prru.Model(model=self.write("negative.json", spec), lib=MODEL.lib)
+        self.assertIn("mass", str(e.exception))
+        other = os.path.join(SOURCE_DIR, "models",
+                             "3prru_paper.json" if MODEL.nlimb == 4 else "4prru.json")
+        with self.assertRaises(prru.InputError) as e:
+            prru.Model(model=other, lib=MODEL.lib)
+        self.assertIn("limbs", str(e.exception))
 
 
 class TestAgainstCli(unittest.TestCase):
