@@ -37,7 +37,7 @@ from .model import Dme, Joint, Model
 from .simulation import Sample, Scenario, Trajectory
 from .maps import MapResult
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult",
            "Library", "load_library", "PrruError", "InputError", "Unreachable", "Singular",
