@@ -122,10 +122,10 @@ static int chol4(const double *F, double *L)
   return 1;
 }
 
-/* F^-1 from its Cholesky factor L. */
-static void chol4_inverse(const double *L, double *S)
+/* L^-1 of a lower triangular 4 x 4 with a positive diagonal. */
+static void lower_inverse4(const double *L, double *Li)
 {
-  double Li[16] = {0};
+  memset(Li, 0, 16 * sizeof(double));
   for (int j = 0; j < 4; j++) {
     Li[5 * j] = 1 / L[5 * j];
     for (int i = j + 1; i < 4; i++) {
@@ -134,12 +134,6 @@ static void chol4_inverse(const double *L, double *S)
       Li[4 * i + j] = s / L[5 * i];
     }
   }
-  for (int i = 0; i < 4; i++)
-    for (int j = 0; j < 4; j++) {
-      double s = 0;
-      for (int k = 0; k < 4; k++) s += Li[4 * k + i] * Li[4 * k + j];
-      S[4 * i + j] = s;
-    }
 }
 
 static void block_at(const barrier *p, int b, const double *x, double *F)
@@ -199,32 +193,40 @@ static void derivatives(barrier *p, double t, const double *x)
     }
     p->g[i] = t * (qx + p->c[i]);
   }
-  double F[16], L[16], S[16];
+  double F[16], L[16], Li[16];
   for (int b = 0; b < p->nlmi; b++) {
     block_at(p, b, x, F);
     chol4(F, L);
-    chol4_inverse(L, S);
+    lower_inverse4(L, Li);
     const int cnt = p->cnt[b];
     const int *idx = p->idx + (size_t)b * n;
-    /* A_m = S F_bi: the gradient -tr(A_m), the Hessian tr(A_m A_l). */
+    /* With F = L L^T and B_m = L^-1 F_bm L^-T (symmetric): the gradient of
+     * -log det F is -tr(B_m), its Hessian <B_m, B_l> (Frobenius): a Gram
+     * matrix, positive semidefinite as computed, however ill-conditioned
+     * F is (tr(F^-1 F_m F^-1 F_l) formed as written is not). */
     for (int m = 0; m < cnt; m++) {
       const double *Fi = p->F + ((size_t)b * n + idx[m]) * 16;
-      double *Am = p->A + (size_t)m * 16, tr = 0;
+      double T[16], *Bm = p->A + (size_t)m * 16, tr = 0;
       for (int r = 0; r < 4; r++)
         for (int q = 0; q < 4; q++) {
           double s = 0;
-          for (int k = 0; k < 4; k++) s += S[4 * r + k] * Fi[4 * k + q];
-          Am[4 * r + q] = s;
+          for (int k = 0; k <= r; k++) s += Li[4 * r + k] * Fi[4 * k + q];
+          T[4 * r + q] = s;
         }
-      for (int r = 0; r < 4; r++) tr += Am[5 * r];
+      for (int r = 0; r < 4; r++)
+        for (int q = 0; q <= r; q++) {
+          double s = 0;
+          for (int k = 0; k <= q; k++) s += T[4 * r + k] * Li[4 * q + k];
+          Bm[4 * r + q] = Bm[4 * q + r] = s;
+        }
+      for (int r = 0; r < 4; r++) tr += Bm[5 * r];
       p->g[idx[m]] -= tr;
     }
     for (int m = 0; m < cnt; m++)
       for (int l = 0; l <= m; l++) {
-        const double *Am = p->A + (size_t)m * 16, *Al = p->A + (size_t)l * 16;
+        const double *Bm = p->A + (size_t)m * 16, *Bl = p->A + (size_t)l * 16;
         double s = 0;
-        for (int r = 0; r < 4; r++)
-          for (int q = 0; q < 4; q++) s += Am[4 * r + q] * Al[4 * q + r];
+        for (int q = 0; q < 16; q++) s += Bm[q] * Bl[q];
         p->H[(size_t)idx[m] * n + idx[l]] += s;
         if (l != m) p->H[(size_t)idx[l] * n + idx[m]] += s;
       }
@@ -304,6 +306,11 @@ static int barrier_solve(barrier *p, double *x, double gap_tol, int *steps)
     const int st = centre(p, t, x, steps);
     if (st != PRRU_OK) return st;
     if (p->phase1 && x[p->n - 1] >= p->s_goal) return PRRU_OK;
+    /* Phase I: at a centred point the optimum s* <= s + theta / t, so once
+     * that is negative the set is empty: the answer, without the last
+     * digits of s* (which cost the ill-conditioned Newton steps of a
+     * boundary the answer does not need). */
+    if (p->phase1 && x[p->n - 1] + theta / t < 0) return PRRU_OK;
     /* Absolute, or relative where the optimum is large (data far from any
      * physical robot: its size, not its last digits, is the answer). */
     if (theta / t <= fmax(gap_tol, 1e-12 * fabs(objective(p, x)))) return PRRU_OK;
