@@ -249,6 +249,22 @@ static int make_data(int n, double sigma, double *q, double *qd, double *qdd, do
   return 0;
 }
 
+/* The standard parameters of a parameter set (the mechanism's layout). */
+static void standard_of(const prru_params *p, double pi[PRRU_NREG])
+{
+  prru_mechanism me = prru_mech;
+  memcpy(me.mass, p->mass, sizeof me.mass);
+  memcpy(me.com, p->com, sizeof me.com);
+  const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  for (int k = 0; k < NB; k++)
+    for (int e = 0; e < 6; e++)
+      me.inertia[k][3 * at[e][0] + at[e][1]] = me.inertia[k][3 * at[e][1] + at[e][0]] = p->inertia[k][e];
+  memcpy(me.armature, p->armature, sizeof me.armature);
+  memcpy(me.damping, p->damping, sizeof me.damping);
+  memcpy(me.coulomb, p->coulomb, sizeof me.coulomb);
+  prru_ident_standard(&me, pi);
+}
+
 static void check_identify(const prru_base *b)
 {
   enum { N = 2000 };
@@ -256,19 +272,10 @@ static void check_identify(const prru_base *b)
   double *qdd = malloc(sizeof(double) * 3 * N), *fd = malloc(sizeof(double) * NA * N);
   prru_ident_result *r = malloc(sizeof *r);
   double pi[PRRU_NREG], beta[PRRU_NREG];
-  prru_mechanism me = prru_mech;
-  if (truth) {
-    memcpy(me.mass, truth->mass, sizeof me.mass);
-    memcpy(me.com, truth->com, sizeof me.com);
-    const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-    for (int k = 0; k < NB; k++)
-      for (int e = 0; e < 6; e++)
-        me.inertia[k][3 * at[e][0] + at[e][1]] = me.inertia[k][3 * at[e][1] + at[e][0]] = truth->inertia[k][e];
-    memcpy(me.armature, truth->armature, sizeof me.armature);
-    memcpy(me.damping, truth->damping, sizeof me.damping);
-    memcpy(me.coulomb, truth->coulomb, sizeof me.coulomb);
-  }
-  prru_ident_standard(&me, pi);
+  if (truth)
+    standard_of(truth, pi);
+  else
+    prru_ident_standard(&prru_mech, pi);
   prru_base_params(b, pi, beta);
   if (!TU_TRUE(q && qd && qdd && fd && r && !make_data(N, 0, q, qd, qdd, fd), "excitation data")) return;
   int bad = -2;
@@ -471,20 +478,6 @@ static void add_drives(prru_params *p)
   }
 }
 
-static void standard_of(const prru_params *p, double pi[PRRU_NREG])
-{
-  prru_mechanism me = prru_mech;
-  memcpy(me.mass, p->mass, sizeof me.mass);
-  memcpy(me.com, p->com, sizeof me.com);
-  const int at[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-  for (int k = 0; k < NB; k++)
-    for (int e = 0; e < 6; e++)
-      me.inertia[k][3 * at[e][0] + at[e][1]] = me.inertia[k][3 * at[e][1] + at[e][0]] = p->inertia[k][e];
-  memcpy(me.armature, p->armature, sizeof me.armature);
-  memcpy(me.damping, p->damping, sizeof me.damping);
-  memcpy(me.coulomb, p->coulomb, sizeof me.coulomb);
-  prru_ident_standard(&me, pi);
-}
 
 /* RMS over held-out states (random ones, not the excitation's) of the
  * forces Y_base beta_a and of Y_base (beta_a - beta_b): J_d^T fd units. */

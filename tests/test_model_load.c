@@ -33,25 +33,6 @@
 static prru_data data;
 static prru_ref_ws *W;
 
-static double norm1(const double *A, int rows, int cols)
-{
-  double big = 0;
-  for (int j = 0; j < cols; j++) {
-    double s = 0;
-    for (int i = 0; i < rows; i++) s += fabs(A[cols * i + j]);
-    if (!(s <= big)) big = s;
-  }
-  return big;
-}
-
-static double norm_inf(const double *v, int n)
-{
-  double big = 0;
-  for (int i = 0; i < n; i++)
-    if (!(fabs(v[i]) <= big)) big = fabs(v[i]);
-  return big;
-}
-
 static void ref_params_of(const prru_mechanism *me, prru_ref_params *p)
 {
   memset(p, 0, sizeof *p);
@@ -114,7 +95,7 @@ static double terms_scale(const prru_model *m, const double q[3], const double q
     for (int i = 0; i < PRRU_NACT; i++) s[j] += fabs(Jd[3 * i + j] * l->fd[i]);
     for (int i = 0; i < 6; i++) s[j] += fabs(JP[3 * i + j] * w[i]);
   }
-  return norm_inf(h, 3) + norm_inf(G, 3) + norm_inf(s, 3) + norm_inf(Qp, 3);
+  return tu_norm_inf(h, 3) + tu_norm_inf(G, 3) + tu_norm_inf(s, 3) + tu_norm_inf(Qp, 3);
 }
 
 typedef struct {
@@ -132,15 +113,8 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
   double M[9], h[3], G[3], Minv[9];
   prru_model_dynamics(m, q, qd, M, h, G);
   const double S = terms_scale(m, q, qd, l, h, G);
-  double c[9];
-  c[0] = M[4] * M[8] - M[5] * M[7], c[1] = M[2] * M[7] - M[1] * M[8];
-  c[2] = M[1] * M[5] - M[2] * M[4], c[3] = M[5] * M[6] - M[3] * M[8];
-  c[4] = M[0] * M[8] - M[2] * M[6], c[5] = M[2] * M[3] - M[0] * M[5];
-  c[6] = M[3] * M[7] - M[4] * M[6], c[7] = M[1] * M[6] - M[0] * M[7];
-  c[8] = M[0] * M[4] - M[1] * M[3];
-  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
-  for (int i = 0; i < 9; i++) Minv[i] = c[i] / det;
-  const double u = DBL_EPSILON, nM = norm1(M, 3, 3), nMi = norm1(Minv, 3, 3), nq = norm_inf(qdd, 3);
+  tu_inverse3(M, Minv);
+  const double u = DBL_EPSILON, nM = tu_norm1(M, 3, 3), nMi = tu_norm1(Minv, 3, 3), nq = tu_norm_inf(qdd, 3);
   char what[600];
   if (prru_ref_forward_dynamics(P, W, q, qd, l->fd, l->fp, l->mp, qdd_ref) != GSL_SUCCESS) {
     snprintf(what, sizeof what, "%s: the reference solves the forward dynamics", file);
@@ -158,7 +132,7 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
    * (minimum-norm with four actuators, as the runtime's). */
   if (prru_inverse_dynamics(m, &data, q, qd, qdd, l, fd) == PRRU_OK &&
       prru_ref_inverse_dynamics(P, W, q, qd, qdd, l->fp, l->mp, fd_ref) == GSL_SUCCESS) {
-    const double nJ = norm1(data.Jdpinv, 3, PRRU_NACT);
+    const double nJ = tu_norm1(data.Jdpinv, 3, PRRU_NACT);
     double r = 0;
     for (int i = 0; i < PRRU_NACT; i++) r = fmax(r, fabs(fd[i] - fd_ref[i]));
     const double bid = u * nJ * (nM * nq + S);

@@ -34,25 +34,6 @@ static prru_ref_ws *W;
 
 #define K 256.0
 
-static double norm1(const double *A, int rows, int cols)
-{
-  double big = 0;
-  for (int j = 0; j < cols; j++) {
-    double s = 0;
-    for (int i = 0; i < rows; i++) s += fabs(A[cols * i + j]);
-    if (!(s <= big)) big = s;
-  }
-  return big;
-}
-
-static double norm_inf(const double *v, int n)
-{
-  double big = 0;
-  for (int i = 0; i < n; i++)
-    if (!(fabs(v[i]) <= big)) big = fabs(v[i]);
-  return big;
-}
-
 /* S: the size of the terms whose sum is b (see the header). */
 static double terms_scale(const double q[3], const double qd[3], const prru_loads *l,
                           const double h[3], const double G[3])
@@ -66,7 +47,7 @@ static double terms_scale(const double q[3], const double qd[3], const prru_load
     for (int i = 0; i < PRRU_NACT; i++) s[j] += fabs(Jd[3 * i + j] * l->fd[i]);
     for (int i = 0; i < 6; i++) s[j] += fabs(JP[3 * i + j] * w[i]);
   }
-  return norm_inf(h, 3) + norm_inf(G, 3) + norm_inf(s, 3) + norm_inf(Qp, 3);
+  return tu_norm_inf(h, 3) + tu_norm_inf(G, 3) + tu_norm_inf(s, 3) + tu_norm_inf(Qp, 3);
 }
 
 static int refused(int st) { return st == PRRU_ESINGULAR || st == PRRU_EUNREACHABLE; }
@@ -94,15 +75,8 @@ static void check_state(const double q[3], const double qd[3], const prru_loads 
   const double S = terms_scale(q, qd, l, h, G);
   /* M^-1 by the adjugate: M is well conditioned enough here (the
    * criterion holds) for its own rounding not to matter to the bound. */
-  double c[9];
-  c[0] = M[4] * M[8] - M[5] * M[7], c[1] = M[2] * M[7] - M[1] * M[8];
-  c[2] = M[1] * M[5] - M[2] * M[4], c[3] = M[5] * M[6] - M[3] * M[8];
-  c[4] = M[0] * M[8] - M[2] * M[6], c[5] = M[2] * M[3] - M[0] * M[5];
-  c[6] = M[3] * M[7] - M[4] * M[6], c[7] = M[1] * M[6] - M[0] * M[7];
-  c[8] = M[0] * M[4] - M[1] * M[3];
-  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
-  for (int i = 0; i < 9; i++) Minv[i] = c[i] / det;
-  const double nM = norm1(M, 3, 3), nMi = norm1(Minv, 3, 3), nq = norm_inf(qdd, 3);
+  tu_inverse3(M, Minv);
+  const double nM = tu_norm1(M, 3, 3), nMi = tu_norm1(Minv, 3, 3), nq = tu_norm_inf(qdd, 3);
   const double u = DBL_EPSILON;
 
   TU_TRUE(prru_ref_forward_dynamics(&P, W, q, qd, l->fd, l->fp, l->mp, qdd_ref) == GSL_SUCCESS,
@@ -129,7 +103,7 @@ static void check_state(const double q[3], const double qd[3], const prru_loads 
     for (int i = 0; i < PRRU_NACT; i++) t += fr[i] * n[i];
     for (int i = 0; i < PRRU_NACT; i++) fr[i] -= t * n[i];
   }
-  const double nJ = norm1(data.Jdpinv, 3, PRRU_NACT);
+  const double nJ = tu_norm1(data.Jdpinv, 3, PRRU_NACT);
   double r = 0;
   for (int i = 0; i < PRRU_NACT; i++) r = fmax(r, fabs(fd[i] - fr[i]));
   const double brt = u * nJ * (nM * nq + S);

@@ -39,6 +39,41 @@ static inline int tu_check(int ok, const char *what, double value, double bound)
        tu_check(tu_e_ <= (rtol), (what), tu_e_, (rtol)); } while (0)
 #define TU_TRUE(cond, what) tu_check(!!(cond), (what), 0.0, 0.0)
 
+/* The 1-norm of a rows x cols matrix (row-major) and the infinity norm of
+ * a vector; NaN propagates (the tolerance checks then fail). */
+static inline double tu_norm1(const double *A, int rows, int cols)
+{
+  double big = 0;
+  for (int j = 0; j < cols; j++) {
+    double s = 0;
+    for (int i = 0; i < rows; i++) s += fabs(A[cols * i + j]);
+    if (!(s <= big)) big = s;
+  }
+  return big;
+}
+
+static inline double tu_norm_inf(const double *v, int n)
+{
+  double big = 0;
+  for (int i = 0; i < n; i++)
+    if (!(fabs(v[i]) <= big)) big = fabs(v[i]);
+  return big;
+}
+
+/* The inverse of a 3 x 3 by its adjugate (for a well-conditioned matrix;
+ * no pivoting). */
+static inline void tu_inverse3(const double M[9], double inv[9])
+{
+  double c[9];
+  c[0] = M[4] * M[8] - M[5] * M[7], c[1] = M[2] * M[7] - M[1] * M[8];
+  c[2] = M[1] * M[5] - M[2] * M[4], c[3] = M[5] * M[6] - M[3] * M[8];
+  c[4] = M[0] * M[8] - M[2] * M[6], c[5] = M[2] * M[3] - M[0] * M[5];
+  c[6] = M[3] * M[7] - M[4] * M[6], c[7] = M[1] * M[6] - M[0] * M[7];
+  c[8] = M[0] * M[4] - M[1] * M[3];
+  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
+  for (int i = 0; i < 9; i++) inv[i] = c[i] / det;
+}
+
 static inline int tu_finish(const char *suite)
 {
   printf("%s: %d passed, %d failed\n", suite, tu_checks - tu_failures, tu_failures);

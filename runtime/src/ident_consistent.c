@@ -345,21 +345,14 @@ static int prior_geometry(const prru_model *m, const double *pi0, geometry *G)
   memset(G, 0, sizeof *G);
   for (int b = 0; b < PRRU_NBODY; b++) {
     const double *pb = pi0 + PRRU_NBODYPAR * b;
-    double J[16], L[16], Li[16] = {0};
+    double J[16], L[16], Li[16];
     if (!(pb[0] > 0)) return PRRU_EINPUT;
     pseudo_inertia(pb, J);
     /* tr(S_c) = tr(S) - m |c|^2, S_c the second moment about the centre. */
     const double trc = J[0] + J[5] + J[10] - (pb[1] * pb[1] + pb[2] * pb[2] + pb[3] * pb[3]) / pb[0];
     for (int i = 0; i < 3; i++) J[5 * i] += 1e-6 * trc / 3;
     if (!(trc > 0) || !chol4(J, L)) return PRRU_EINPUT;
-    for (int j = 0; j < 4; j++) {
-      Li[5 * j] = 1 / L[5 * j];
-      for (int i = j + 1; i < 4; i++) {
-        double s = 0;
-        for (int k = j; k < i; k++) s -= L[4 * i + k] * Li[4 * k + j];
-        Li[4 * i + j] = s / L[5 * i];
-      }
-    }
+    lower_inverse4(L, Li);
     for (int k = 0; k < PRRU_NBODYPAR; k++) {
       double e[PRRU_NBODYPAR] = {0}, Je[16], T1[16];
       e[k] = 1;
