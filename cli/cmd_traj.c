@@ -142,8 +142,7 @@ static const char traj_help[] =
 
 static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *why, size_t whylen)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) {
     snprintf(why, whylen, "out of memory");
@@ -184,7 +183,7 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     }
     if (s) sign = s;
     t_prev = t;
-    prru_actuator_rates(q, qd, dd, ddb);
+    prru_model_actuator_rates(&m, q, qd, dd, ddb);
     prru_cli_out_motion_row(o, t, q, qd, qdd, d->d, dd);
   }
   free(d);
@@ -401,8 +400,7 @@ static int csv_reference(const char *path, prru_quintic *tr)
 static int check_reference(const prru_quintic *tr, const prru_track_options *o, double step,
                            double *ff_peak)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
@@ -520,7 +518,7 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
   if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
   char footer[1200];
   prru_plot_provenance(footer, sizeof footer, "track");
-  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_mech.name, footer, PRRU_NACT, o->f_max);
+  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_cli_model()->mech->name, footer, PRRU_NACT, o->f_max);
   int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
   if (!buf) prru_cli_error("track", "--plot: out of memory");
   free(buf);
@@ -696,6 +694,9 @@ int prru_cmd_track(int argc, char **argv)
     return 2;
   prru_track_options o;
   prru_track_options_default(&o);
+  /* The plant is the current model (--model's) unless --mismatch scales
+   * its numbers. */
+  prru_model_params(prru_cli_model(), &o.plant);
   if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;
   if (mism && parse_mismatch(mism, &o.plant)) return 2;
   prru_quintic tr;
@@ -739,8 +740,7 @@ int prru_cmd_track(int argc, char **argv)
   o.interrupt = &prru_cli_interrupted;
   prru_track_summary sum;
   char msg[600];
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   int st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
   prru_quintic_free(&tr);
   long rows = co.rows;
