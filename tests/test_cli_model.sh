@@ -110,7 +110,7 @@ print("rms tracking error: built-in model %.3g, identified model %.3g" % (e0, e1
 # 1e-9 leaves three orders of magnitude of margin above it.
 assert e0 > 1e-5 and e1 < 1e-9, (e0, e1)
 PY
-head -1 "$tmp/t1.csv" | grep -qF "model prru_id ($tmp/id.json, sha256 $(sha256sum "$tmp/id.json" | cut -d' ' -f1), parameter kernels)" \
+head -1 "$tmp/t1.csv" | grep -qF "model ${model_name:0:13}_id ($tmp/id.json, sha256 $(sha256sum "$tmp/id.json" | cut -d' ' -f1), parameter kernels)" \
   && ok || bad "track --model id.json: model line '$(head -1 "$tmp/t1.csv")'"
 # With --model, track's plant is that model: the controller knows it exactly.
 "$PRRU" --model "$tmp/true.json" track --ref "$tmp/ex.csv" --summary "$tmp/s2.json" --out /dev/null 2>/dev/null \
