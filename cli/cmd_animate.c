@@ -25,7 +25,7 @@ static const char animate_help[] =
     "sliders (black), the upper links (blue), the lower links (orange) and\n"
     "the platform (green: its plate, normal and outline through the U joints),\n"
     "in metres in the base frame {S}, with their shadows on the floor.\n"
-    "The poses are this build's model's; a FILE whose first line names another\n"
+    "The poses are the current model's; a FILE whose first line names another\n"
     "model (a different sha256) is refused. Writes FILE.gif beside FILE.csv\n"
     "unless --out says where (--out -: stdout); the GIF is replaced only when\n"
     "the new one is complete. --segments also writes what is drawn: one line\n"
@@ -42,7 +42,7 @@ enum { COL_RAIL = 1, COL_SLIDER, COL_UPPER, COL_LOWER, COL_PLATFORM };
 static void frame_origin(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_NBODY], int b,
                          double o[3])
 {
-  const double *Rb = R + 9 * b, *cb = prru_mech.com[b];
+  const double *Rb = R + 9 * b, *cb = prru_cli_model()->mech->com[b];
   for (int c = 0; c < 3; c++)
     o[c] = p[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
 }
@@ -54,9 +54,9 @@ static void limb_points(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_
                         double A[3], double B[3], double C[3])
 {
   double u[3], l[3];
-  frame_origin(R, p, prru_mech.slider[i], A);
-  frame_origin(R, p, prru_mech.upper[i], u);
-  frame_origin(R, p, prru_mech.lower[i], l);
+  frame_origin(R, p, prru_cli_model()->mech->slider[i], A);
+  frame_origin(R, p, prru_cli_model()->mech->upper[i], u);
+  frame_origin(R, p, prru_cli_model()->mech->lower[i], l);
   for (int c = 0; c < 3; c++) {
     B[c] = 2.0 * u[c] - A[c];
     C[c] = 2.0 * l[c] - B[c];
@@ -90,8 +90,8 @@ static double plate_half(void)
 {
   double h = 0.0, l = 0.0;
   for (int i = 0; i < PRRU_NLIMB; i++) {
-    if (prru_mech.a[i] > h) h = prru_mech.a[i];
-    l += prru_mech.l1[i] / PRRU_NLIMB;
+    if (prru_cli_model()->mech->a[i] > h) h = prru_cli_model()->mech->a[i];
+    l += prru_cli_model()->mech->l1[i] / PRRU_NLIMB;
   }
   return h > 0.1 * l ? h : 0.25 * l;
 }
@@ -101,10 +101,10 @@ static double plate_half(void)
 static int frame(FILE *out, const double q[3], extent *e)
 {
   double R[9 * PRRU_NBODY], p[3 * PRRU_NBODY];
-  prru_poses(q, R, p);
+  prru_model_poses(prru_cli_model(), q, R, p);
   for (int k = 0; k < 3 * PRRU_NBODY; k++)
     if (!isfinite(p[k])) return -1;
-  const int P = prru_mech.platform;
+  const int P = prru_cli_model()->mech->platform;
   const double *RP = R + 9 * P, h = plate_half();
   double O[3];
   frame_origin(R, p, P, O);
@@ -159,11 +159,11 @@ static int check_model(const char *path)
   size_t cap = 0;
   int rc = 0;
   if (getline(&line, &cap, f) > 0 && line[0] == '#') {
-    const char *h = strstr(line, "sha256 ");
-    if (h && strncmp(h + 7, prru_mech.sha256, strlen(prru_mech.sha256)) != 0) {
+    const char *h = strstr(line, "sha256 "), *sha = prru_cli_model()->mech->sha256;
+    if (h && strncmp(h + 7, sha, strlen(sha)) != 0) {
       line[strcspn(line, "\r\n")] = '\0';
       prru_cli_error("animate", "%s was computed with another model (%s); this prru draws %s: "
-                     "use the prru built from that model", path, line + (line[1] == ' ' ? 2 : 1),
+                     "give that model's file as --model, or use the prru built from it", path, line + (line[1] == ' ' ? 2 : 1),
                      prru_cli_model_id());
       rc = 2;
     }
@@ -301,7 +301,7 @@ int prru_cmd_animate(int argc, char **argv)
     return 1;
   }
   char *script = NULL;
-  int rc = write_frames("animate", &t, dir, nframes, fps, prru_mech.name, &script);
+  int rc = write_frames("animate", &t, dir, nframes, fps, prru_cli_model()->mech->name, &script);
   prru_table_free(&t);
   if (rc == 0) rc = prru_plot_run("animate", dir, dir, "anim.gp", script);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {

@@ -15,6 +15,7 @@
 #include "plot.h"
 #include "shard.h"
 #include "prru.h"
+#include "prru_control.h"
 #include "prru_design.h"
 #include "prru_dme.h"
 
@@ -106,7 +107,7 @@ static int parse_problem(const char *cmd, const problem_text *t, prru_design_pro
     prru_cli_error(cmd, "--objective '%s': one of mean, max, log", t->objective);
     return 2;
   }
-  *start = prru_params_model;
+  prru_model_params(prru_cli_model(), start); /* the current (--model's) numbers */
   if (t->set && parse_set(cmd, t->set, start)) return 2;
   char msg[512];
   if (prru_design_check(start, msg, sizeof msg) != PRRU_OK) {
@@ -840,7 +841,7 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
   }
   prru_cli_out_printf(o, "    \"a\": [%.17g, %.17g]\n  },\n  \"bodies\": {\n", p->a[0], p->a[1]);
   for (int b = 0; b < PRRU_NBODY; b++) {
-    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": [%.17g, %.17g, %.17g],\n", prru_mech.body_names[b],
+    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": [%.17g, %.17g, %.17g],\n", prru_cli_model()->mech->body_names[b],
                         p->mass[b], p->com[b][0], p->com[b][1], p->com[b][2]);
     prru_cli_out_printf(o, "      \"inertia\": [");
     for (int e = 0; e < 6; e++) prru_cli_out_printf(o, "%s%.17g", e ? ", " : "", p->inertia[b][e]);
@@ -1110,7 +1111,7 @@ static void describe(char *buf, size_t len, const prru_design_problem *pr, const
   const prru_map_grid *g = &pr->grid;
   int n = snprintf(buf, len, "%s optimised by prru optimize (%s over q1 in [%.4g, %.4g], q2 in [%.4g, %.4g], "
                              "q3 = %.4g; variables",
-                   prru_mech.name, objective_text(pr->objective), g->q1_lo, g->q1_hi, g->q2_lo, g->q2_hi, g->q3);
+                   prru_cli_model()->mech->name, objective_text(pr->objective), g->q1_lo, g->q1_hi, g->q2_lo, g->q2_hi, g->q3);
   for (int i = 0; i < nvar && n > 0 && (size_t)n < len - 40; i++)
     n += snprintf(buf + n, len - (size_t)n, " %s", vars[i].name);
   if (n > 0 && (size_t)n < len - 2) snprintf(buf + n, len - (size_t)n, ")");
@@ -1175,7 +1176,7 @@ int prru_cmd_optimize(int argc, char **argv)
     if (check_name(cmd, name_s)) return 2;
     snprintf(name, sizeof name, "%s", name_s);
   } else {
-    snprintf(name, sizeof name, "%.12s_opt", prru_mech.name);
+    snprintf(name, sizeof name, "%.12s_opt", prru_cli_model()->mech->name);
   }
   prru_design_var vars[PRRU_DESIGN_MAX_VARS];
   int nvar = 0, rc = parse_vars(cmd, vars_s, pct, &start, vars, &nvar);

@@ -20,7 +20,7 @@ static const char dme_help[] =
     "w_R = sigma_1/sigma_2 (>= 1). The translational segment runs along z with\n"
     "half-length 1/sigma_T (m/s^2 per N).\n"
     "%s"
-    "Prints JSON: model (name, file, sha256), q, status (\"ok\", \"singular\" or\n"
+    "Prints JSON: model (name, file, sha256, ...), q, status (\"ok\", \"singular\" or\n"
     "\"unreachable\"), w_R, Jd_rcond,\n"
     "sigma, semi_axes (minor, major), axis_directions, sigma_T,\n"
     "translational_half_length, translational_direction, Mt (%dx%d), JtR and\n"
@@ -70,8 +70,7 @@ int prru_cmd_dme(int argc, char **argv)
   }
   double q[PRRU_NQ];
   if (prru_cli_numbers("dme", "q", qs, q, PRRU_NQ)) return 2;
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   if (prru_cli_parse_rcond("dme", rcs, &m)) return 2;
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;

@@ -10,7 +10,7 @@
 static const char eval_help[] =
     "usage: prru eval --q q1,q2,q3 [--qd qd1,qd2,qd3] [--fd %s]\n"
     "                 [--fp fx,fy,fz] [--mp mx,my,mz]\n"
-    "Prints JSON with model (name, file, sha256 of the model the build computes),\n"
+    "Prints JSON with model (name, file, sha256, ... of the model computed with),\n"
     "q, qd, M (3x3), h, G, passive (the drives' damping and friction as\n"
     "generalized forces; zero for a model without them), d, Jd (one row per\n"
     "actuator, one column per coordinate; every matrix is a list of rows),\n"
@@ -76,7 +76,7 @@ int prru_cmd_eval(int argc, char **argv)
     char redundant[sizeof eval_help_redundant + 32] = "";
     if (PRRU_NACT > 3) snprintf(redundant, sizeof redundant, eval_help_redundant, PRRU_NACT, PRRU_NACT);
     printf(eval_help, prru_cli_names(fd_names, sizeof fd_names, "f", PRRU_NACT, ","), PRRU_NLAMBDA,
-           prru_mech.lambda_labels[0], redundant);
+           prru_cli_model()->mech->lambda_labels[0], redundant);
     return 0;
   }
   if (!qs) {
@@ -90,8 +90,7 @@ int prru_cmd_eval(int argc, char **argv)
       read_vec("eval", "mp", mps, l.mp, 3))
     return 2;
 
-  prru_model m;
-  prru_model_default(&m);
+  const prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   double rcond, M[PRRU_NQ * PRRU_NQ], h[PRRU_NQ], G[PRRU_NQ], passive[PRRU_NQ];
@@ -136,11 +135,11 @@ int prru_cmd_eval(int argc, char **argv)
     }
     for (int i = 0; i < PRRU_NACT; i++) preload += l.fd[i] * n[i];
   }
-  prru_dynamics(q, qd, M, h, G);
-  prru_passive(q, qd, passive);
+  prru_model_dynamics(&m, q, qd, M, h, G);
+  prru_model_passive(&m, q, qd, passive);
   double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ];
-  prru_ik_jd(q, act, Jd);
-  const char *const *labels = prru_mech.lambda_labels;
+  prru_model_ik_jd(&m, q, act, Jd);
+  const char *const *labels = m.mech->lambda_labels;
 
   printf("{");
   prru_cli_json_model(stdout);

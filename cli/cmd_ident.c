@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "prru_control.h"
 #include "prru_ident.h"
 #include "prru_param_kernels.h"
 #include "prru_traj.h"
@@ -14,7 +15,7 @@
  * else the model's, else 1 mm/s. */
 static int coulomb_velocity(const char *cmd, const char *text, double *vs)
 {
-  *vs = prru_mech.coulomb_velocity > 0 ? prru_mech.coulomb_velocity : 1e-3;
+  *vs = prru_cli_model()->mech->coulomb_velocity > 0 ? prru_cli_model()->mech->coulomb_velocity : 1e-3;
   if (!text) return 0;
   if (prru_cli_number(cmd, "coulomb-velocity", text, vs)) return 2;
   if (!(*vs > 0)) {
@@ -22,6 +23,21 @@ static int coulomb_velocity(const char *cmd, const char *text, double *vs)
     return 2;
   }
   return 0;
+}
+
+/* 0, or 2 after the reason when the current model (--model's) has
+ * another geometry or gravity than the build's: the identification
+ * regressor (prru_regressor.h) is generated for the build's alone; the
+ * masses, inertias and drives may differ (they are what is identified). */
+static int require_built_geometry(const char *cmd)
+{
+  const prru_model *m = prru_cli_model();
+  if (prru_model_is_built(m, 1)) return 0;
+  prru_cli_error(cmd, "model %s (--model or PRRU_MODEL): its geometry or gravity differs from the build's "
+                 "model (%s, %s); the identification regressor exists only for the build's geometry and "
+                 "gravity: identification needs a build of that model: make build MODEL=%s",
+                 m->mech->model_file, prru_mech.name, prru_mech.model_file, m->mech->model_file);
+  return 2;
 }
 
 static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_base **b)
@@ -250,13 +266,13 @@ int prru_cmd_excite(int argc, char **argv)
            prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","));
     return 0;
   }
+  if (require_built_geometry("excite")) return 2;
   prru_excite_options o;
   prru_fourier f;
   int periods;
   double dt, vs;
   if (excite_options(&a, &o, &f, &periods, &dt) || coulomb_velocity("excite", a.vs, &vs)) return 2;
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_base *b;
   if (base_or_fail("excite", &m, vs, &b)) {
     free(b);
@@ -393,8 +409,7 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
 /* q of every row by forward kinematics from the slider columns. */
 static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, ident_data *D)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   double seed[3] = {0, 0, 0};
   int rc = d ? 0 : 1;
@@ -559,11 +574,13 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
  * output of prru_ident_consistent). */
 static int to_params(const prru_base *b, const double *pi, prru_params *p, char *why, size_t len)
 {
-  *p = prru_params_model;
+  /* Geometry and gravity: the current model's, which are the build's
+   * (require_built_geometry). */
+  prru_model_params(prru_cli_model(), p);
   for (int k = 0; k < PRRU_NBODY; k++) {
     double m, c[3], I[6];
     if (prru_ident_body(pi + PRRU_NBODYPAR * k, &m, c, I) != PRRU_OK) {
-      snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_mech.body_names[k], pi[PRRU_NBODYPAR * k]);
+      snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_cli_model()->mech->body_names[k], pi[PRRU_NBODYPAR * k]);
       return 1;
     }
     const double m2 = I[0] * I[1] - I[3] * I[3];
@@ -571,7 +588,7 @@ static int to_params(const prru_base *b, const double *pi, prru_params *p, char 
                       I[4] * (I[3] * I[5] - I[1] * I[4]);
     if (!(I[0] > 0 && m2 > 0 && m3 > 0)) {
       snprintf(why, len, "body %s: the inertia about the centre of mass is not positive definite",
-               prru_mech.body_names[k]);
+               prru_cli_model()->mech->body_names[k]);
       return 1;
     }
     p->mass[k] = m;
@@ -613,13 +630,13 @@ static void json_list(prru_cli_out *o, const double *v, int n)
 static void write_description(prru_cli_out *o, const char *data)
 {
   static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
-  const size_t len = sizeof fmt + strlen(data) + strlen(prru_mech.name);
+  const size_t len = sizeof fmt + strlen(data) + strlen(prru_cli_model()->mech->name);
   char *text = malloc(len), desc[PRRU_DESCRIPTION_SIZE];
   if (!text) {
     prru_cli_out_printf(o, "  \"description\": \"Identified by prru identify\",\n");
     return;
   }
-  snprintf(text, len, fmt, data, prru_mech.name);
+  snprintf(text, len, fmt, data, prru_cli_model()->mech->name);
   prru_cli_out_printf(o, "  \"description\": ");
   prru_cli_out_json_string(o, prru_description(desc, sizeof desc, text));
   prru_cli_out_printf(o, ",\n");
@@ -642,7 +659,7 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
   json_list(o, p->a, 2);
   prru_cli_out_printf(o, "\n  },\n  \"bodies\": {\n");
   for (int b = 0; b < PRRU_NBODY; b++) {
-    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": ", prru_mech.body_names[b],
+    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": ", prru_cli_model()->mech->body_names[b],
                         model_number(p->mass[b]));
     json_list(o, p->com[b], 3);
     prru_cli_out_printf(o, ",\n      \"inertia\": ");
@@ -691,7 +708,7 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
   if (prru_cli_refuse_same_file("identify", "data", a->data, "out", a->out) ||
       prru_cli_refuse_same_file("identify", "data", a->data, "report", a->report))
     return 2;
-  snprintf(name, len, "%.13s_id", prru_mech.name);
+  snprintf(name, len, "%.13s_id", prru_cli_model()->mech->name);
   if (a->name) {
     if (!valid_name(a->name)) {
       prru_cli_error("identify", "--name: '%s' must be a lower-case C identifier of at most 16 characters",
@@ -714,8 +731,7 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
 /* Fit and outputs once the data are read; the exit status. */
 static int identify_run(const identify_args *a, const char *name, const ident_data *D, prru_base *b)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_ident_result *r = malloc(sizeof *r);
   double *pi0 = malloc(sizeof(double) * PRRU_NREG * 3), *pi = pi0 + PRRU_NREG, *prior = pi + PRRU_NREG;
   if (!r || !pi0) {
@@ -745,7 +761,7 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
     free(r), free(pi0);
     return 1;
   }
-  prru_ident_standard(&prru_mech, pi0);
+  prru_ident_standard(m.mech, pi0); /* the prior: the current model's numbers */
   prru_base_params(b, pi0, prior);
   prru_params p;
   char why[300] = "";
@@ -769,7 +785,7 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   }
   if (!rc && !solved) {
     prru_cli_error("identify", "%s; %s not written",
-                   cst == PRRU_EINPUT ? "the built model's own parameters are not physical (a body's pseudo-inertia "
+                   cst == PRRU_EINPUT ? "the model's own parameters (the prior) are not physical (a body's pseudo-inertia "
                                         "not positive definite or a negative drive coefficient): no prior to "
                                         "start from" :
                                         "the physically consistent fit did not converge", a->out);
@@ -816,6 +832,7 @@ int prru_cmd_identify(int argc, char **argv)
            prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","));
     return 0;
   }
+  if (require_built_geometry("identify")) return 2;
   char name[32];
   prru_diff_options dopt;
   double vs;
@@ -830,8 +847,7 @@ int prru_cmd_identify(int argc, char **argv)
     data_free(&D);
     return irc ? irc : rc;
   }
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_base *b = NULL;
   if (base_or_fail("identify", &m, vs, &b))
     rc = 1;

@@ -11,8 +11,8 @@
 
 static const char ik_help[] =
     "usage: prru ik --q q1,q2,q3\n"
-    "Prints JSON with model (name, file, sha256), q, the actuator displacements d\n"
-    "(m, slider heights), J_d = dd/dq (a list of rows: one per actuator, one\n"
+    "Prints JSON with model (name, file, sha256, ...), q, the actuator displacements\n"
+    "d (m, slider heights), J_d = dd/dq (a list of rows: one per actuator, one\n"
     "column per coordinate), its reciprocal condition number and whether J_d\n"
     "is singular there; with redundant actuators (more sliders than\n"
     "coordinates) also actuator_null, the unit n with J_d^T n = 0 and a\n"
@@ -35,8 +35,7 @@ int prru_cmd_ik(int argc, char **argv)
     return 2;
   }
   if (prru_cli_numbers("ik", "q", qs, q, PRRU_NQ)) return 2;
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   double rcond;
@@ -80,7 +79,7 @@ static const char fk_help[] =
     "(J_d^T J_d)^-1 J_d^T: the pose of least squared residual is printed\n"
     "whatever the residual (measured or rounded slider positions), with\n"
     "consistent: false when the residual exceeds the tolerance.\n"
-    "Prints JSON with model (name, file, sha256), d, q, residual, method\n"
+    "Prints JSON with model (name, file, sha256, ...), d, q, residual, method\n"
     "(\"newton\" or \"least-squares\") and, for least squares, consistent.\n"
     "Exit 1 when d is out of reach or the iteration meets a singularity%s.\n";
 
@@ -125,16 +124,15 @@ int prru_cmd_fk(int argc, char **argv)
     return 2;
   }
   if (prru_cli_numbers("fk", "d", ds, act, PRRU_NACT)) return 2;
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   if (seeds) {
     if (prru_cli_numbers("fk", "seed", seeds, seed, PRRU_NQ)) { free(d); return 2; }
   } else {
     /* At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0). */
-    double zero[PRRU_NQ] = {0, 0, 0}, d0[PRRU_NACT], sum = 0.0;
-    prru_ik(zero, d0);
+    double zero[PRRU_NQ] = {0, 0, 0}, d0[PRRU_NACT], Jd0[PRRU_NACT * PRRU_NQ], sum = 0.0;
+    prru_model_ik_jd(&m, zero, d0, Jd0);
     for (int i = 0; i < PRRU_NACT; i++) sum += act[i] - d0[i];
     seed[0] = seed[1] = 0.0;
     seed[2] = sum / PRRU_NACT;
@@ -156,9 +154,9 @@ int prru_cmd_fk(int argc, char **argv)
     return 1;
   }
   if (!use_lsq) {
-    double dq[PRRU_NACT];
+    double dq[PRRU_NACT], Jdq[PRRU_NACT * PRRU_NQ];
     res = 0;
-    prru_ik(q, dq);
+    prru_model_ik_jd(&m, q, dq, Jdq);
     for (int i = 0; i < PRRU_NACT; i++) res = fmax(res, fabs(dq[i] - act[i]));
   }
   /* |d(q) - d|^2 overflows for |d| beyond ~1e154 m: no step of the
@@ -361,7 +359,7 @@ int prru_cmd_id(int argc, char **argv)
     prru_cli_error("id", "%s: model %s has %d actuators for 3 coordinates, so the actuator forces "
                    "are unique and no internal preload exists; it needs a model with a redundant "
                    "actuator such as models/4prru.json (see 'prru id --help')",
-                   pre ? "--preload" : "--null-vector", prru_mech.name, PRRU_NACT);
+                   pre ? "--preload" : "--null-vector", prru_cli_model()->mech->name, PRRU_NACT);
     return 2;
   }
   static const char *const need[10] = {"t", "q1", "q2", "q3", "qd1", "qd2", "qd3", "qdd1", "qdd2", "qdd3"};
@@ -426,8 +424,7 @@ int prru_cmd_id(int argc, char **argv)
     free(rates_q);
     return 1;
   }
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   st = d ? PRRU_OK : PRRU_ENOMEM;
   prru_cli_out_comment(&o);
@@ -445,7 +442,7 @@ int prru_cmd_id(int argc, char **argv)
   if (derivs) prru_cli_out_printf(&o, ",qd1,qd2,qd3,qdd1,qdd2,qdd3");
   if (rates) prru_cli_out_printf(&o, ",%s,%s", dd_names, pow_names);
   for (int k = 0; reactions && k < PRRU_NLAMBDA; k++)
-    prru_cli_out_printf(&o, ",%s", prru_mech.lambda_labels[k]);
+    prru_cli_out_printf(&o, ",%s", prru_cli_model()->mech->lambda_labels[k]);
   prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
   char why[700] = "";
@@ -474,7 +471,7 @@ int prru_cmd_id(int argc, char **argv)
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
     double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
     if (st == PRRU_OK && rates) {
-      prru_actuator_rates(v + 1, v + 4, dd, ddb);
+      prru_model_actuator_rates(&m, v + 1, v + 4, dd, ddb);
       for (int k = 0; k < PRRU_NACT; k++) pw[k] = fd[k] * dd[k];
     }
     if (st == PRRU_OK && reactions) {

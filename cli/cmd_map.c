@@ -25,7 +25,7 @@ static const char map_help[] =
     "without passing a singularity.\n"
     "%s"
     "w_R is NaN unless the status is ok.\n"
-    "Prints the model (name, file, sha256) and the global index: the mean of\n"
+    "Prints the model (name, file, sha256, ...) and the global index: the mean of\n"
     "w_R - 1 over the ok points, with the share of the grid that is not ok (the\n"
     "index alone favours a design that loses workspace); also the mean of ln w_R\n"
     "and the range of w_R; to stdout, or to stderr when the CSV goes to stdout.\n"
@@ -89,8 +89,7 @@ int prru_cmd_map(int argc, char **argv)
     }
     nthreads = (int)v;
   }
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   m.jd_rcond_min = PRRU_CLI_MAP_RCOND_MIN;
   if (prru_cli_parse_rcond("map", rcs, &m)) return 2;
   if (shs) {

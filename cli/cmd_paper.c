@@ -32,7 +32,7 @@ static const char paper_help[] =
     "and the exit status is 1. --skip-map leaves earlier fig7_* files alone.\n"
     "--clip W: fig. 7's colours and surface stop at w_R = W (default: the 99th\n"
     "percentile of w_R over the map; the colour key says which).\n"
-    "Every file names the model the build computes; with a model other than the\n"
+    "Every file names the model it computes with; with a model other than the\n"
     "paper's (models/3prru_paper.json) the study runs on that model and a warning\n"
     "says that the figures are not the paper's results.\n"
     "%s";
@@ -65,10 +65,11 @@ static int on_sample(const prru_sample *s, void *ctx)
   paper_run *r = ctx;
   prru_loads l;
   prru_schedule_eval(r->csv.loads, s->t, &l);
-  double Jd[PRRU_NACT * PRRU_NQ], JP[6 * PRRU_NQ], Qp[PRRU_NQ], power = 0, passive = 0;
-  prru_jd(s->q, Jd);
-  prru_platform_jacobian(s->q, JP);
-  prru_passive(s->q, s->qd, Qp);
+  const prru_model *m = prru_cli_model();
+  double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ], JP[6 * PRRU_NQ], Qp[PRRU_NQ], power = 0, passive = 0;
+  prru_model_ik_jd(m, s->q, act, Jd);
+  prru_model_platform_jacobian(m, s->q, JP);
+  prru_model_passive(m, s->q, s->qd, Qp);
   for (int i = 0; i < PRRU_NACT; i++) {
     double dd = 0;
     for (int k = 0; k < PRRU_NQ; k++) dd += Jd[PRRU_NQ * i + k] * s->qd[k];
@@ -190,7 +191,7 @@ static void remove_stale(const char *out, const char *const *names, int n)
 static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, double t_stop,
                       int is_paper)
 {
-  const char *const *labels = prru_mech.lambda_labels;
+  const char *const *labels = prru_cli_model()->mech->lambda_labels;
   const prru_sample *a = &r->first, *b = &r->last;
   fprintf(f, "Model: %s%s\n", prru_cli_model_id(),
           is_paper ? ", the paper's" : "; not the paper's model: the results below are this model's");
@@ -221,8 +222,7 @@ static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, doubl
 static int run_paper(const char *stage, const char *out, int skip_map, int is_paper, double clip)
 {
   char path[4400], shown[4400], msg[600];
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_scenario s;
   prru_scenario_paper(&s);
   paper_run *r = calloc(1, sizeof *r);
@@ -344,7 +344,7 @@ int prru_cmd_paper(int argc, char **argv)
   int is_paper = prru_cli_is_paper_model();
   if (!is_paper)
     prru_cli_error("paper", "warning: model %s is not the paper's; the figures show this model, "
-                   "not the paper's results", prru_mech.name);
+                   "not the paper's results", prru_cli_model()->mech->name);
   /* Handlers first: no signal leaves the staging directory behind. */
   prru_cli_catch_signals();
   int created;

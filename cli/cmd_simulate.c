@@ -14,7 +14,7 @@ typedef char prru_cli_loads_fd_is_nact[sizeof ((prru_loads *)0)->fd == PRRU_NACT
 
 void prru_cli_csv_header(prru_cli_csv *c)
 {
-  const char *const *labels = prru_mech.lambda_labels;
+  const char *const *labels = prru_cli_model()->mech->lambda_labels;
   char names[256];
   prru_cli_out_comment(c->out);
   prru_cli_out_printf(c->out, "t,q1,q2,q3,qd1,qd2,qd3,%s",
@@ -73,8 +73,8 @@ static const char simulate_help[] =
     "forces from (q0, qd0) with an adaptive integrator (--stepper: rk8pd, the\n"
     "Runge-Kutta Prince-Dormand 8(9) pair; rkf45 Fehlberg 4(5); rkck Cash-Karp\n"
     "4(5); msbdf, a multistep BDF method for stiff runs) and writes a CSV: a\n"
-    "first line `# prru VERSION model NAME (FILE, sha256 HASH)`, the header,\n"
-    "then one row per sample (every dt, last at t-end):\n"
+    "first line `# prru VERSION model NAME (FILE, sha256 HASH, KERNELS kernels)`,\n"
+    "the header, then one row per sample (every dt, last at t-end):\n"
     "  t,q1,q2,q3,qd1,qd2,qd3,%s,\n"
     "  the %d joint reaction coordinates (columns JOINT_COMPONENT, e.g. %s,\n"
     "  joint by joint in the order %s;\n"
@@ -127,10 +127,10 @@ int prru_cmd_simulate(int argc, char **argv)
     joints[0] = '\0';
     for (int j = 0; j < PRRU_NJOINT && used < sizeof joints; j++)
       used += (size_t)snprintf(joints + used, sizeof joints - used, "%s%.12s", j ? " " : "",
-                               prru_mech.joint[j].name);
+                               prru_cli_model()->mech->joint[j].name);
     prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
     prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
-    printf(simulate_help, dn, PRRU_NLAMBDA, prru_mech.lambda_labels[0], joints, fdn,
+    printf(simulate_help, dn, PRRU_NLAMBDA, prru_cli_model()->mech->lambda_labels[0], joints, fdn,
            prru_cli_paper_fd_text(),
            PRRU_NACT > 3 ? "\n(the redundant actuator gets limb 3's force, see 'prru paper --help')"
                          : "",
@@ -235,8 +235,7 @@ int prru_cmd_simulate(int argc, char **argv)
   }
   /* Check everything the run needs before the output is created: the
    * initial state must be regular and its dynamics and energies finite. */
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = bad ? NULL : malloc(sizeof *d);
   if (!bad && !d) {
     prru_cli_error("simulate", "out of memory");

@@ -142,8 +142,7 @@ static const char traj_help[] =
 
 static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *why, size_t whylen)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) {
     snprintf(why, whylen, "out of memory");
@@ -184,7 +183,7 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     }
     if (s) sign = s;
     t_prev = t;
-    prru_actuator_rates(q, qd, dd, ddb);
+    prru_model_actuator_rates(&m, q, qd, dd, ddb);
     prru_cli_out_motion_row(o, t, q, qd, qdd, d->d, dd);
   }
   free(d);
@@ -246,7 +245,8 @@ int prru_cmd_traj(int argc, char **argv)
 static const char track_help[] =
     "usage: prru track (--ref FILE.csv | --waypoints 'q;q;..' --durations T1,..)\n"
     "                  [--bandwidth W | --kp K1,K2,K3 --kd D1,D2,D3] [--period S]\n"
-    "                  [--dt S] [--mismatch KEY=F[,KEY=F..]] [--noise SQ,SQD]\n"
+    "                  [--dt S] [--plant MODEL.json] [--mismatch KEY=F[,KEY=F..]]\n"
+    "                  [--noise SQ,SQD]\n"
     "                  [--seed N] [--fmax F|%s] [--stroke LO,HI|LO1,HI1,..]\n"
     "                  [--q0-offset E1,E2,E3] [--atol X] [--rtol X]\n"
     "                  [--out FILE.csv|-] [--summary FILE.json] [--plot FILE.png]\n"
@@ -265,9 +265,11 @@ static const char track_help[] =
     "the integrator, with rows every --dt (default 1 ms); --period S > 0 is a\n"
     "digital controller that samples the state every S seconds and holds its\n"
     "forces until the next sample (zero-order hold), one row per sample.\n"
-    "Plant: the same equations of motion, with --mismatch scaling its parameters\n"
-    "against the controller's model: mass (every body's mass and inertia),\n"
-    "inertia, armature, damping, coulomb, gravity, e.g. --mismatch mass=1.1.\n"
+    "Plant: the same equations of motion with the controller's model's numbers\n"
+    "(the built-in model, or --model's), or --plant's (a model file with as\n"
+    "many limbs: the robot the controller does not know exactly), with\n"
+    "--mismatch scaling them: mass (every body's mass and inertia), inertia,\n"
+    "armature, damping, coulomb, gravity, e.g. --mismatch mass=1.1.\n"
     "--noise SQ,SQD: Gaussian sensor noise on q and qd (standard deviations,\n"
     "rad or m, and per s; needs --period > 0), from a generator seeded by\n"
     "--seed (default 1): the same seed gives the same run.\n"
@@ -401,8 +403,7 @@ static int csv_reference(const char *path, prru_quintic *tr)
 static int check_reference(const prru_quintic *tr, const prru_track_options *o, double step,
                            double *ff_peak)
 {
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
@@ -445,7 +446,7 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
 }
 
 static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_options *o,
-                         const char *mismatch, double ff_peak, const char *status)
+                         const char *plant, const char *mismatch, double ff_peak, const char *status)
 {
   fputc('{', f);
   prru_cli_json_model(f);
@@ -455,7 +456,9 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   prru_cli_json_array(f, o->kp, 3);
   fputs(", \"kd\": ", f);
   prru_cli_json_array(f, o->kd, 3);
-  fputs(",\n \"mismatch\": ", f);
+  fputs(",\n \"plant\": ", f);
+  prru_cli_json_string(f, plant ? plant : "");
+  fputs(", \"mismatch\": ", f);
   prru_cli_json_string(f, mismatch ? mismatch : "");
   fputs(", \"noise\": ", f);
   double nz[2] = {o->noise_q, o->noise_qd};
@@ -485,18 +488,18 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
 /* The summary to --summary (never half-written), else to stdout, or to
  * stderr when the CSV went to stdout. 0 or 1 after a message. */
 static int write_summary(const char *sums, const char *out, const prru_track_summary *s,
-                         const prru_track_options *o, const char *mismatch, double ff_peak,
-                         const char *status)
+                         const prru_track_options *o, const char *plant, const char *mismatch,
+                         double ff_peak, const char *status)
 {
   if (!sums) {
-    json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, mismatch, ff_peak, status);
+    json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, plant, mismatch, ff_peak, status);
     return 0;
   }
   char *buf = NULL;
   size_t len = 0;
   FILE *g = open_memstream(&buf, &len);
   if (!g) return 1;
-  json_summary(g, s, o, mismatch, ff_peak, status);
+  json_summary(g, s, o, plant, mismatch, ff_peak, status);
   fclose(g);
   prru_cli_out so;
   int rc = prru_cli_out_open(&so, "track", sums);
@@ -520,7 +523,7 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
   if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
   char footer[1200];
   prru_plot_provenance(footer, sizeof footer, "track");
-  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_mech.name, footer, PRRU_NACT, o->f_max);
+  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_cli_model()->mech->name, footer, PRRU_NACT, o->f_max);
   int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
   if (!buf) prru_cli_error("track", "--plot: out of memory");
   free(buf);
@@ -650,10 +653,31 @@ static int parse_track_settings(const char **a, prru_track_options *o)
   return 0;
 }
 
+/* The plant's numbers before --mismatch: the current model's (built in or
+ * --model's), or the model file plant's (--plant). 0, or 2 after the
+ * loader's message. */
+static int plant_params(const char *plant, prru_params *p)
+{
+  if (!plant) {
+    prru_model_params(prru_cli_model(), p);
+    return 0;
+  }
+  prru_model pm;
+  prru_model_default(&pm);
+  char msg[1024];
+  if (prru_model_load(&pm, plant, msg, sizeof msg) != PRRU_OK) {
+    prru_cli_error("track", "--plant: %s", msg);
+    return 2;
+  }
+  prru_model_params(&pm, p);
+  prru_model_free(&pm);
+  return 0;
+}
+
 int prru_cmd_track(int argc, char **argv)
 {
   const char *refs = NULL, *wps = NULL, *durs = NULL, *mism = NULL, *fmaxs = NULL,
-             *strokes = NULL, *out = NULL, *sums = NULL, *plot = NULL;
+             *strokes = NULL, *out = NULL, *sums = NULL, *plot = NULL, *plants = NULL;
   const char *a[10] = {NULL};
   int help = 0;
   prru_cli_option opts[] = {
@@ -663,7 +687,7 @@ int prru_cmd_track(int argc, char **argv)
       {"noise", 1, &a[5], NULL},      {"seed", 1, &a[6], NULL},      {"fmax", 1, &fmaxs, NULL},
       {"stroke", 1, &strokes, NULL},  {"q0-offset", 1, &a[7], NULL}, {"atol", 1, &a[8], NULL},
       {"rtol", 1, &a[9], NULL},       {"out", 1, &out, NULL},        {"summary", 1, &sums, NULL},
-      {"plot", 1, &plot, NULL},       {"help", 0, NULL, &help}};
+      {"plot", 1, &plot, NULL},       {"plant", 1, &plants, NULL},   {"help", 0, NULL, &help}};
   if (prru_cli_parse("track", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   char fdn[256], fdcn[256], satn[256], dn[256];
   prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
@@ -696,6 +720,7 @@ int prru_cmd_track(int argc, char **argv)
     return 2;
   prru_track_options o;
   prru_track_options_default(&o);
+  if (plant_params(plants, &o.plant)) return 2;
   if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;
   if (mism && parse_mismatch(mism, &o.plant)) return 2;
   prru_quintic tr;
@@ -724,12 +749,13 @@ int prru_cmd_track(int argc, char **argv)
   }
   const char *name = co.name;
   prru_cli_out_comment(&co);
-  prru_cli_out_printf(&co, "# computed torque, %s%.9g s, kp %g %g %g, kd %g %g %g, mismatch '%s', "
-                      "noise %g %g, seed %lu\n",
-                      o.control_period > 0 ? "zero-order hold every " : "continuous, rows every ",
-                      step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], mism ? mism : "",
-                      o.noise_q, o.noise_qd, o.seed);
-  prru_cli_out_line(&co);
+  /* The --plant path (any bytes) stays on the line: comment_line. */
+  prru_cli_out_comment_line(&co, "computed torque, %s%.9g s, kp %g %g %g, kd %g %g %g, %s%s%smismatch '%s', "
+                            "noise %g %g, seed %lu",
+                            o.control_period > 0 ? "zero-order hold every " : "continuous, rows every ",
+                            step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], plants ? "plant " : "",
+                            plants ? plants : "", plants ? ", " : "", mism ? mism : "", o.noise_q, o.noise_qd,
+                            o.seed);
   prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s,qdd1,qdd2,qdd3\n", fdn,
                       fdcn, satn, dn);
   prru_cli_out_line(&co);
@@ -739,8 +765,7 @@ int prru_cmd_track(int argc, char **argv)
   o.interrupt = &prru_cli_interrupted;
   prru_track_summary sum;
   char msg[600];
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   int st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
   prru_quintic_free(&tr);
   long rows = co.rows;
@@ -752,7 +777,7 @@ int prru_cmd_track(int argc, char **argv)
     else
       prru_cli_error("track", "%s; %ld rows written to %s", msg, rows, name);
   }
-  if (write_summary(sums, out, &sum, &o, mism, ff_peak, st == PRRU_OK ? "complete" : msg)) return 1;
+  if (write_summary(sums, out, &sum, &o, plants, mism, ff_peak, st == PRRU_OK ? "complete" : msg)) return 1;
   if (st != PRRU_OK) return prru_cli_exit_for(st);
   if (plot) return track_plot(out, plot, &o);
   return 0;

@@ -67,10 +67,10 @@ static int read_comments(const char *opt, const char *path, csv_source *s)
   int rc = 0;
   while (s->ncomments < VIEW_MAX_COMMENTS && getline(&line, &cap, f) > 0 && line[0] == '#') {
     line[strcspn(line, "\r\n")] = '\0';
-    const char *h = strstr(line, "sha256 ");
-    if (s->ncomments == 0 && h && strncmp(h + 7, prru_mech.sha256, strlen(prru_mech.sha256)) != 0) {
-      prru_cli_error("view", "%s%s was computed with another model (%s); this prru draws %s: use the prru "
-                     "built from that model", opt, path, line + (line[1] == ' ' ? 2 : 1), prru_cli_model_id());
+    const char *h = strstr(line, "sha256 "), *sha = prru_cli_model()->mech->sha256;
+    if (s->ncomments == 0 && h && strncmp(h + 7, sha, strlen(sha)) != 0) {
+      prru_cli_error("view", "%s%s was computed with another model (%s); this prru draws %s: give that model's "
+                     "file as --model, or use the prru built from it", opt, path, line + (line[1] == ' ' ? 2 : 1), prru_cli_model_id());
       rc = 2;
       break;
     }
@@ -135,7 +135,7 @@ static void out_array(prru_cli_out *o, const double *v, int n)
 /* The origin of body b's frame (prru_poses gives the centre of mass). */
 static void frame_origin(const double *R, const double *p, int b, double o[3])
 {
-  const double *Rb = R + 9 * b, *cb = prru_mech.com[b];
+  const double *Rb = R + 9 * b, *cb = prru_cli_model()->mech->com[b];
   for (int c = 0; c < 3; c++)
     o[c] = p[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
 }
@@ -145,9 +145,9 @@ static void frame_origin(const double *R, const double *p, int b, double o[3])
 static void limb_points(const double *R, const double *p, int i, double A[3], double B[3], double C[3])
 {
   double u[3], l[3];
-  frame_origin(R, p, prru_mech.slider[i], A);
-  frame_origin(R, p, prru_mech.upper[i], u);
-  frame_origin(R, p, prru_mech.lower[i], l);
+  frame_origin(R, p, prru_cli_model()->mech->slider[i], A);
+  frame_origin(R, p, prru_cli_model()->mech->upper[i], u);
+  frame_origin(R, p, prru_cli_model()->mech->lower[i], l);
   for (int c = 0; c < 3; c++) {
     B[c] = 2.0 * u[c] - A[c];
     C[c] = 2.0 * l[c] - B[c];
@@ -194,7 +194,7 @@ static void grow(frames *f, const double x[3])
 static int u_joint(int i)
 {
   for (int j = 0; j < PRRU_NJOINT; j++)
-    if (prru_mech.joint[j].type == 'U' && prru_mech.joint[j].limb == i) return j;
+    if (prru_cli_model()->mech->joint[j].type == 'U' && prru_cli_model()->mech->joint[j].limb == i) return j;
   return -1;
 }
 
@@ -222,7 +222,7 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
     const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
     const double q[3] = {r[cq[0]], r[cq[1]], r[cq[2]]};
     double *R = f->R + (size_t)k * 9 * PRRU_NBODY, *p = f->p + (size_t)k * 3 * PRRU_NBODY;
-    prru_poses(q, R, p);
+    prru_model_poses(prru_cli_model(), q, R, p);
     int finite = 1;
     for (int i = 0; i < 9 * PRRU_NBODY; i++) finite &= isfinite(R[i]) != 0;
     for (int i = 0; i < 3 * PRRU_NBODY; i++) finite &= isfinite(p[i]) != 0;
@@ -243,7 +243,7 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
   for (int i = 0; i < PRRU_NLIMB; i++) {
     int j = u_joint(i);
     for (int c = 0; c < 3; c++) {
-      f->react_col[i][c] = j < 0 ? -1 : prru_table_column(t, prru_mech.lambda_labels[prru_mech.joint[j].lambda_offset + c]);
+      f->react_col[i][c] = j < 0 ? -1 : prru_table_column(t, prru_cli_model()->mech->lambda_labels[prru_cli_model()->mech->joint[j].lambda_offset + c]);
       if (f->react_col[i][c] < 0) f->reactions = 0;
     }
   }
@@ -400,25 +400,25 @@ static void out_bodies(prru_cli_out *o, const frames *f)
   const double *R = f->R, *p = f->p;
   prru_cli_out_printf(o, "\"bodies\":[");
   for (int b = 0; b < PRRU_NBODY; b++) {
-    int i = prru_mech.body_limb[b];
-    const char *kind = b == prru_mech.platform ? "platform" : "link";
+    int i = prru_cli_model()->mech->body_limb[b];
+    const char *kind = b == prru_cli_model()->mech->platform ? "platform" : "link";
     double axis[3] = {0, 0, 1}, len = 0, A[3], B[3], C[3];
     if (i >= 0) {
       limb_points(R, p, i, A, B, C);
-      if (b == prru_mech.slider[i]) kind = "slider";
-      if (b == prru_mech.upper[i]) {
+      if (b == prru_cli_model()->mech->slider[i]) kind = "slider";
+      if (b == prru_cli_model()->mech->upper[i]) {
         kind = "upper";
         link_axis(R + 9 * b, A, B, axis, &len);
       }
-      if (b == prru_mech.lower[i]) {
+      if (b == prru_cli_model()->mech->lower[i]) {
         kind = "lower";
         link_axis(R + 9 * b, B, C, axis, &len);
       }
     }
     prru_cli_out_printf(o, "%s{\"name\":", b ? "," : "");
-    prru_cli_out_json_string(o, prru_mech.body_names[b]);
+    prru_cli_out_json_string(o, prru_cli_model()->mech->body_names[b]);
     prru_cli_out_printf(o, ",\"kind\":\"%s\",\"limb\":%d,\"com\":", kind, i);
-    out_array(o, prru_mech.com[b], 3);
+    out_array(o, prru_cli_model()->mech->com[b], 3);
     prru_cli_out_printf(o, ",\"axis\":");
     out_array(o, axis, 3);
     prru_cli_out_printf(o, ",\"length\":%.17g}", len);
@@ -432,8 +432,8 @@ static double plate_half(void)
 {
   double h = 0.0, l = 0.0;
   for (int i = 0; i < PRRU_NLIMB; i++) {
-    if (prru_mech.a[i] > h) h = prru_mech.a[i];
-    l += prru_mech.l1[i] / PRRU_NLIMB;
+    if (prru_cli_model()->mech->a[i] > h) h = prru_cli_model()->mech->a[i];
+    l += prru_cli_model()->mech->l1[i] / PRRU_NLIMB;
   }
   return h > 0.1 * l ? h : 0.25 * l;
 }
@@ -500,7 +500,7 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
   prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_cli_length_scale() / fref : 0.0);
   for (int i = 0; i < PRRU_NLIMB; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
-    prru_cli_out_json_string(o, prru_mech.joint[u_joint(i)].name);
+    prru_cli_out_json_string(o, prru_cli_model()->mech->joint[u_joint(i)].name);
   }
   prru_cli_out_printf(o, "],\"at\":[");
   for (long k = 0; k < f->n; k++) {
@@ -554,13 +554,15 @@ static void out_data(prru_cli_out *o, const prru_table *t, const frames *f, cons
   prru_cli_out_printf(o, "{\"format\":1,\"prru\":");
   prru_cli_out_json_string(o, PRRU_VERSION);
   prru_cli_out_printf(o, ",\"model\":{\"name\":");
-  prru_cli_out_json_string(o, prru_mech.name);
+  prru_cli_out_json_string(o, prru_cli_model()->mech->name);
   prru_cli_out_printf(o, ",\"description\":");
-  prru_cli_out_json_string(o, prru_mech.description);
+  prru_cli_out_json_string(o, prru_cli_model()->mech->description);
   prru_cli_out_printf(o, ",\"file\":");
-  prru_cli_out_json_string(o, prru_mech.model_file);
+  prru_cli_out_json_string(o, prru_cli_model()->mech->model_file);
   prru_cli_out_printf(o, ",\"sha256\":");
-  prru_cli_out_json_string(o, prru_mech.sha256);
+  prru_cli_out_json_string(o, prru_cli_model()->mech->sha256);
+  prru_cli_out_printf(o, ",\"kernels\":");
+  prru_cli_out_json_string(o, prru_cli_model()->kernels->path);
   prru_cli_out_printf(o, "},\n\"source\":{");
   out_source(o, run);
   prru_cli_out_printf(o, ",\"rows\":%d},\n", t->nrows);
@@ -606,7 +608,7 @@ static void out_page(prru_cli_out *o, const prru_table *t, const frames *f, cons
       prru_cli_out_printf(o, "prru view: ");
       out_html_text(o, run->path);
       prru_cli_out_printf(o, " (model ");
-      out_html_text(o, prru_mech.name);
+      out_html_text(o, prru_cli_model()->mech->name);
       prru_cli_out_printf(o, ")");
     } else if (strncmp(mark, "@PRRU_DATA@", n) == 0) {
       out_data(o, t, f, run, m, ms);

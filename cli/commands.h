@@ -16,8 +16,9 @@
 #endif
 
 /* The CLI writes q as q1,q2,q3 (names, help texts): the 3-PRRU's three
- * coordinates. Everything else sized by the mechanism uses prru_mech and
- * the PRRU_N* macros. */
+ * coordinates. Everything else sized by the mechanism uses the PRRU_N*
+ * macros (the build's topology) and the current model's descriptor
+ * (prru_cli_model()->mech: names and numbers). */
 typedef char prru_cli_nq_is_3[PRRU_NQ == 3 ? 1 : -1];
 
 int prru_cmd_eval(int argc, char **argv);
@@ -40,8 +41,20 @@ int prru_cmd_sensitivity(int argc, char **argv);
 int prru_cmd_merge(int argc, char **argv);
 
 /* Shared helpers (cli/util.c). */
+/* The model every command computes with: the one main loaded from
+ * --model FILE or $PRRU_MODEL (prru_cli_load_model), else the built-in
+ * one (prru_model_default). A command that changes settings copies it
+ * (prru_model m = *prru_cli_model()): the copy shares the loaded storage,
+ * which lives until prru_cli_free_model at exit. */
+const prru_model *prru_cli_model(void);
+/* Loads path as the current model: 0, or 2 (1 out of memory) after
+ * "prru: FILE: key: reason" (the library's message) on stderr, the
+ * current model unchanged. */
+int prru_cli_load_model(const char *path);
+/* Frees a loaded model (the built-in one again). */
+void prru_cli_free_model(void);
 /* `prru --version`: program version and the model's name, file, format,
- * number of actuators and SHA-256, one per line. */
+ * number of actuators, SHA-256 and kernels, one per line. */
 void prru_cli_print_version(FILE *f);
 /* 1 when the kernels were generated from the paper's model file
  * (models/3prru_paper.json, by its SHA-256), 0 otherwise. */
@@ -56,11 +69,14 @@ const char *prru_cli_paper_fd_text(void);
  * runtime uses it for its tolerances (prru_model). */
 double prru_cli_length_scale(void);
 /* Model identity in outputs. JSON: the member
- * "model": {"name": .., "file": .., "sha256": ..} (no separator around it);
- * CSV: the first line "# prru VERSION model NAME (FILE, sha256 HASH)". */
+ * "model": {"name": .., "file": .., "sha256": .., "kernels": ..} (no
+ * separator around it); CSV: the first line
+ * "# prru VERSION model NAME (FILE, sha256 HASH, KERNELS kernels)"
+ * (prru_model_identity; KERNELS "specialised" or "parameter"). */
 void prru_cli_json_model(FILE *f);
 void prru_cli_csv_comment(FILE *f);
-/* "NAME (FILE, sha256 HASH)", control characters replaced by '?'. */
+/* "NAME (FILE, sha256 HASH, KERNELS kernels)" of the current model,
+ * control characters replaced by '?'. */
 const char *prru_cli_model_id(void);
 /* JSON string literal with escapes. */
 void prru_cli_json_string(FILE *f, const char *s);
@@ -210,7 +226,7 @@ int prru_cli_out_finish(prru_cli_out *o, int st, const char *why);
 
 /* CSV of simulation samples: the model comment line, then the header
  * t,q1..3,qd1..3,d1..dNACT, the PRRU_NLAMBDA reactions (named by
- * prru_mech.lambda_labels, when computed), qdd1..3, fd1..fdNACT, fp1..3,
+ * the model's lambda_labels, when computed), qdd1..3, fd1..fdNACT, fp1..3,
  * mp1..3, T, V. */
 typedef struct {
   prru_cli_out *out;

@@ -1,5 +1,6 @@
 /* prru: dynamics of the 3-PRRU parallel manipulator from the command line. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "commands.h"
@@ -32,17 +33,22 @@ static const struct {
 
 static void usage(FILE *f)
 {
-  fprintf(f, "usage: prru COMMAND [OPTIONS]   (prru COMMAND --help for its options)\n"
-             "       prru --help | --version\n\n"
+  fprintf(f, "usage: prru [--model FILE] COMMAND [OPTIONS]\n"
+             "       prru --help | --version\n"
+             "(prru COMMAND --help for the command's options)\n\n"
              "Dynamics of the %d-PRRU 1T2R parallel manipulator%s:\n"
              "q = (q1, q2) rad rotations of the platform about x then y', q3 its height\n"
              "(m); d the %d slider heights (m).\n"
-             "Model: %s (%s), built in (see prru --version).\n"
-             "Every JSON output names it in \"model\", every CSV in its first line\n"
-             "(# prru VERSION model NAME (FILE, sha256 HASH)).\n\n"
+             "Model: %s (%s), built in, or a %d-limb model file given by\n"
+             "--model FILE (see prru --version). Every JSON output names it in\n"
+             "\"model\", every CSV in its first line:\n"
+             "  # prru VERSION model NAME (FILE, sha256 HASH, KERNELS kernels)\n"
+             "KERNELS: specialised (the built-in model's numbers, folded into the code\n"
+             "when it was built: the fastest) or parameter (any other numbers, read\n"
+             "from FILE).\n\n"
              "commands:\n",
           PRRU_NLIMB, PRRU_NACT > 3 ? " (redundantly actuated)" : "", PRRU_NACT, prru_mech.name,
-          prru_mech.model_file);
+          prru_mech.model_file, PRRU_NLIMB);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
   fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
@@ -54,7 +60,17 @@ static void usage(FILE *f)
              "that fails before its first row leaves an existing file as it was.\n\n"
              "global options:\n"
              "  -h, --help     this text (prru COMMAND --help: the command's)\n"
-             "  --version      version and model (also prru COMMAND --version)\n");
+             "  --version      version and model (also prru COMMAND --version)\n"
+             "  --model FILE   compute with the model file FILE (format of models/*.json,\n"
+             "                 %d limbs, as this build) instead of the built-in model;\n"
+             "                 before the command or among its options (--model=FILE\n"
+             "                 too). A file the model checks refuse: exit 2, nothing\n"
+             "                 computed. identify and excite need the built-in model's\n"
+             "                 geometry and gravity.\n\n"
+             "environment:\n"
+             "  PRRU_MODEL     the model file when no --model is given (empty: the\n"
+             "                 built-in model)\n",
+          PRRU_NLIMB);
 }
 
 /* Every command's stdout (JSON, summaries, help) is checked once flushed
@@ -65,7 +81,62 @@ static int finish(const char *cmd, int rc)
   return rc;
 }
 
-int main(int argc, char **argv)
+/* argv[i] is --model FILE or --model=FILE: its value (NULL when none
+ * follows) and how many arguments it spans; 0 when argv[i] is no --model. */
+static int model_option(int argc, char **argv, int i, const char **file)
+{
+  if (strcmp(argv[i], "--model") == 0) {
+    *file = i + 1 < argc ? argv[i + 1] : NULL;
+    return *file ? 2 : 1;
+  }
+  if (strncmp(argv[i], "--model=", 8) == 0) {
+    *file = argv[i] + 8;
+    return 1;
+  }
+  return 0;
+}
+
+/* Takes the global --model out of argv (before the command or anywhere
+ * among its arguments: every command's options are its own, so "--model"
+ * there is never another option's value unless written --opt=--model),
+ * argc updated. 0, or 2 after the reason. */
+static int take_model_option(int *argc, char **argv, const char **file)
+{
+  int n = 1;
+  *file = NULL;
+  for (int i = 1; i < *argc;) {
+    const char *f = NULL;
+    const int k = model_option(*argc, argv, i, &f);
+    if (k == 0) {
+      argv[n++] = argv[i++];
+      continue;
+    }
+    if (!f || !*f) {
+      fprintf(stderr, "prru: --model needs a model file (--model FILE; see prru --help)\n");
+      return 2;
+    }
+    if (*file) {
+      fprintf(stderr, "prru: --model given twice ('%s' and '%s')\n", *file, f);
+      return 2;
+    }
+    *file = f;
+    i += k;
+  }
+  *argc = n;
+  argv[n] = NULL;
+  return 0;
+}
+
+/* The model of --model, else $PRRU_MODEL, else the built-in one: loaded
+ * once, before any command runs. 0, or the exit status after the reason. */
+static int load_model(const char *file)
+{
+  if (!file) file = getenv("PRRU_MODEL");
+  if (!file || !*file) return 0;
+  return prru_cli_load_model(file);
+}
+
+static int run(int argc, char **argv)
 {
   if (argc < 2) {
     usage(stderr);
@@ -94,4 +165,14 @@ int main(int argc, char **argv)
   fprintf(stderr, "prru: unknown command '%s'\n\n", argv[1]);
   usage(stderr);
   return 2;
+}
+
+int main(int argc, char **argv)
+{
+  const char *file;
+  int rc = take_model_option(&argc, argv, &file);
+  if (rc == 0) rc = load_model(file);
+  if (rc == 0) rc = run(argc, argv);
+  prru_cli_free_model();
+  return rc;
 }

@@ -106,8 +106,7 @@ static int fig7_status(int st)
 int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary, double clip)
 {
   const fig7_dirs dirs = {stage, outdir};
-  prru_model m;
-  prru_model_default(&m);
+  prru_model m = *prru_cli_model();
   const double rcond_numeric = m.jd_rcond_min;
   m.jd_rcond_min = FIG7_RCOND_MIN;
   prru_map_grid g = {-FIG7_PI / 6, FIG7_PI / 6, -FIG7_PI / 4, FIG7_PI / 6, 0.0, 201, 201};

@@ -81,7 +81,7 @@ void prru_plot_label(FILE *g, const char *s) { put_string(g, s, 1); }
 void prru_plot_model_var(FILE *g)
 {
   fputs("model = ", g);
-  prru_plot_label(g, prru_mech.name);
+  prru_plot_label(g, prru_cli_model()->mech->name);
   fputc('\n', g);
 }
 
@@ -437,10 +437,10 @@ static void put_subscripted(FILE *g, const char *name)
  * panel. */
 static void plot_components(FILE *g, int j, char kind)
 {
-  const prru_joint_info *jt = &prru_mech.joint[j];
+  const prru_joint_info *jt = &prru_cli_model()->mech->joint[j];
   int first = 1;
   for (int k = 0; k < jt->lambda_count; k++) {
-    const char *label = prru_mech.lambda_labels[jt->lambda_offset + k];
+    const char *label = prru_cli_model()->mech->lambda_labels[jt->lambda_offset + k];
     const char *comp = strchr(label, '_');
     comp = comp ? comp + 1 : label;
     if (comp[0] != kind) continue;
@@ -460,17 +460,17 @@ static void joint_figure(FILE *g, char type, char kind, const char *png, const c
                          const char *unit)
 {
   int n = 0;
-  for (int j = 0; j < PRRU_NJOINT; j++) n += prru_mech.joint[j].type == type;
+  for (int j = 0; j < PRRU_NJOINT; j++) n += prru_cli_model()->mech->joint[j].type == type;
   const int px = 130 + 210 * (n ? n : 1);
   fprintf(g, "set output '%s'\nset terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", png, px);
   fputs(footer_label, g);
   fputs("unset xlabel\n", g);
   put_layout(g, n ? n : 1, px, title);
   for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
-    if (prru_mech.joint[j].type != type) continue;
+    if (prru_cli_model()->mech->joint[j].type != type) continue;
     if (++p == n) fputs("set xlabel 'time t (s)'\n", g);
     fputs("set ylabel '", g);
-    put_subscripted(g, prru_mech.joint[j].name);
+    put_subscripted(g, prru_cli_model()->mech->joint[j].name);
     fprintf(g, " %s'\n", unit);
     plot_components(g, j, kind);
     if (p == 1) put_footer_done(g);

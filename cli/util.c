@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -189,14 +190,21 @@ const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, con
 
 void prru_cli_json_string(FILE *f, const char *s)
 {
+  /* A byte that is not well-formed UTF-8 (a --model path holds any
+   * bytes) as U+FFFD: JSON text is UTF-8. */
   fputc('"', f);
-  for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
-    if (*c == '"' || *c == '\\')
-      fprintf(f, "\\%c", *c);
-    else if (*c < 0x20 || *c == 0x7f)
-      fprintf(f, "\\u%04x", *c);
+  while (*s) {
+    const unsigned char c = (unsigned char)*s;
+    const size_t n = prru_utf8_char(s);
+    if (c == '"' || c == '\\')
+      fprintf(f, "\\%c", c);
+    else if (c < 0x20 || c == 0x7f)
+      fprintf(f, "\\u%04x", c);
+    else if (n == 0)
+      fputs("\\ufffd", f);
     else
-      fputc(*c, f);
+      fwrite(s, 1, n, f);
+    s += n ? n : 1;
   }
   fputc('"', f);
 }
@@ -209,17 +217,67 @@ static void put_plain(char *out, size_t len, size_t *used, const char *s)
   out[*used] = '\0';
 }
 
+/* The model every command computes with: the built-in one until main
+ * loads --model's (prru_cli_load_model), then that one until exit. */
+static prru_model cli_model;
+static int cli_model_set;
+static char *cli_model_id;
+
+const prru_model *prru_cli_model(void)
+{
+  if (!cli_model_set) {
+    prru_model_default(&cli_model);
+    cli_model_set = 1;
+  }
+  return &cli_model;
+}
+
+int prru_cli_load_model(const char *path)
+{
+  char msg[1024];
+  prru_model m;
+  prru_model_default(&m);
+  int st = prru_model_load(&m, path, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    /* The library's message names the file, the key and the reason; the
+     * path may hold any bytes. */
+    char plain[sizeof msg];
+    size_t used = 0;
+    put_plain(plain, sizeof plain, &used, msg[0] ? msg : prru_strerror(st));
+    fprintf(stderr, "prru: %s\n", plain);
+    return st == PRRU_ENOMEM ? 1 : 2;
+  }
+  prru_cli_free_model();
+  cli_model = m;
+  cli_model_set = 1;
+  return 0;
+}
+
+void prru_cli_free_model(void)
+{
+  if (cli_model_set) prru_model_free(&cli_model);
+  free(cli_model_id);
+  cli_model_id = NULL;
+}
+
 const char *prru_cli_model_id(void)
 {
-  static char id[1024];
+  if (cli_model_id) return cli_model_id;
+  const prru_model *m = prru_cli_model();
+  /* prru_model_identity's text without its leading "model ", control
+   * characters replaced so that it stays on one line. */
+  const size_t len = strlen(m->mech->name) + strlen(m->mech->model_file) + strlen(m->mech->sha256) +
+                     strlen(m->kernels->path) + 64;
+  char *raw = malloc(len), *id = malloc(len);
+  if (!raw || !id) {
+    free(raw), free(id);
+    return "(out of memory)";
+  }
+  prru_model_identity(m, raw, len);
   size_t used = 0;
-  id[0] = '\0';
-  put_plain(id, sizeof id, &used, prru_mech.name);
-  put_plain(id, sizeof id, &used, " (");
-  put_plain(id, sizeof id, &used, prru_mech.model_file);
-  put_plain(id, sizeof id, &used, ", sha256 ");
-  put_plain(id, sizeof id, &used, prru_mech.sha256);
-  put_plain(id, sizeof id, &used, ")");
+  put_plain(id, len, &used, strncmp(raw, "model ", 6) == 0 ? raw + 6 : raw);
+  free(raw);
+  cli_model_id = id;
   return id;
 }
 
@@ -237,31 +295,40 @@ const char *prru_cli_paper_fd_text(void)
 
 double prru_cli_length_scale(void)
 {
+  const prru_mechanism *me = prru_cli_model()->mech;
   double s = 0;
-  for (int i = 0; i < PRRU_NLIMB; i++) s += prru_mech.l1[i];
+  for (int i = 0; i < PRRU_NLIMB; i++) s += me->l1[i];
   return s / PRRU_NLIMB;
 }
 
-int prru_cli_is_paper_model(void) { return strcmp(prru_mech.sha256, PRRU_PAPER_SHA256) == 0; }
+int prru_cli_is_paper_model(void) { return strcmp(prru_cli_model()->mech->sha256, PRRU_PAPER_SHA256) == 0; }
 
 void prru_cli_print_version(FILE *f)
 {
+  const prru_model *m = prru_cli_model();
+  char plain[4096];
+  size_t used = 0;
+  put_plain(plain, sizeof plain, &used, m->mech->model_file);
   fprintf(f, "prru %s\n", PRRU_VERSION);
-  fprintf(f, "model: %s\n", prru_mech.name);
-  fprintf(f, "model file: %s\n", prru_mech.model_file);
-  fprintf(f, "model format: %d\n", prru_mech.format);
+  fprintf(f, "model: %s\n", m->mech->name);
+  fprintf(f, "model file: %s\n", plain);
+  fprintf(f, "model format: %d\n", m->mech->format);
   fprintf(f, "model actuators: %d\n", PRRU_NACT);
-  fprintf(f, "model sha256: %s\n", prru_mech.sha256);
+  fprintf(f, "model sha256: %s\n", m->mech->sha256);
+  fprintf(f, "model kernels: %s\n", m->kernels->path);
 }
 
 void prru_cli_json_model(FILE *f)
 {
+  const prru_model *m = prru_cli_model();
   fputs("\"model\": {\"name\": ", f);
-  prru_cli_json_string(f, prru_mech.name);
+  prru_cli_json_string(f, m->mech->name);
   fputs(", \"file\": ", f);
-  prru_cli_json_string(f, prru_mech.model_file);
+  prru_cli_json_string(f, m->mech->model_file);
   fputs(", \"sha256\": ", f);
-  prru_cli_json_string(f, prru_mech.sha256);
+  prru_cli_json_string(f, m->mech->sha256);
+  fputs(", \"kernels\": ", f);
+  prru_cli_json_string(f, m->kernels->path);
   fputc('}', f);
 }
 

@@ -22,8 +22,17 @@ model_file=$(basename "$PRRU_MODEL")
 model_sha=$(sha256sum "$PRRU_MODEL" | cut -d' ' -f1)
 paper_sha=$(sha256sum "$PRRU_SOURCE_DIR/models/3prru_paper.json" | cut -d' ' -f1)
 prru_version=$(sed -n 's/^project(prru VERSION \([0-9][0-9.]*\).*/\1/p' "$PRRU_SOURCE_DIR/CMakeLists.txt")
-csv_comment="# prru $prru_version model $model_name ($model_file, sha256 $model_sha)"
-export model_name model_file model_sha
+# model_id: the model as every output names it (the built-in model, so its
+# specialised kernels; prru_model_identity without its leading "model ").
+model_kernels=specialised
+model_id="$model_name ($model_file, sha256 $model_sha, $model_kernels kernels)"
+csv_comment="# prru $prru_version model $model_id"
+export model_name model_file model_sha model_kernels
+# PRRU_MODEL names the build's model file for the scripts (ctest sets it);
+# prru itself reads a PRRU_MODEL in its environment as the model to load
+# (prru --help): unexported, so that every run computes with the built-in
+# model unless a test says otherwise.
+export -n PRRU_MODEL
 
 # The number of actuators (sliders) of the model the binary computes, as
 # `prru --version` says it; 3 for the 3-PRRU, 4 for a redundantly actuated
@@ -72,7 +81,8 @@ jcheck() {
   python3 -c "
 import json, math, os, sys
 d = json.load(open(sys.argv[1]))
-model = {'name': os.environ['model_name'], 'file': os.environ['model_file'], 'sha256': os.environ['model_sha']}
+model = {'name': os.environ['model_name'], 'file': os.environ['model_file'], 'sha256': os.environ['model_sha'],
+         'kernels': os.environ['model_kernels']}
 sys.exit(0 if eval(sys.argv[2]) else 1)" "$1" "$2" && ok || bad "$3: $(head -c 400 "$1")"
 }
 # below X LIMIT WHAT: the number X is below LIMIT.

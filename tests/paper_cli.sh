@@ -53,7 +53,7 @@ done
 # prru paper on the paper's model: no warning, the model in the summary.
 "$PRRU" paper --out "$tmp/paper" --skip-map >"$tmp/paper.out" 2>"$tmp/paper.err"
 grep -q "warning" "$tmp/paper.err" && bad "paper warns for the paper's model: $(cat "$tmp/paper.err")" || ok
-grep -qF "Model: prru (3prru_paper.json, sha256 $paper_sha), the paper's" "$tmp/paper/summary.txt" && ok || bad "summary.txt: model line"
+grep -qF "Model: prru (3prru_paper.json, sha256 $paper_sha, specialised kernels), the paper's" "$tmp/paper/summary.txt" && ok || bad "summary.txt: model line"
 grep -qF "fd = (50, 40, 25) N," "$tmp/paper/summary.txt" && grep -qF "fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N" "$tmp/paper/summary.txt" \
   && ok || bad "summary.txt: the paper's loads"
 

@@ -21,8 +21,8 @@ FD=$(fdlist 50 40 25)
 # ---- Model identity ----
 [ -n "$prru_version" ] && ok || bad "no project version in $PRRU_SOURCE_DIR/CMakeLists.txt"
 "$PRRU" --version >"$tmp/v.txt" 2>"$tmp/v.err" && ok || bad "--version failed: $(cat "$tmp/v.err")"
-printf 'prru %s\nmodel: %s\nmodel file: %s\nmodel format: %s\nmodel actuators: %s\nmodel sha256: %s\n' \
-  "$prru_version" "$model_name" "$model_file" "$model_format" "$nact" "$model_sha" >"$tmp/v.want"
+printf 'prru %s\nmodel: %s\nmodel file: %s\nmodel format: %s\nmodel actuators: %s\nmodel sha256: %s\nmodel kernels: %s\n' \
+  "$prru_version" "$model_name" "$model_file" "$model_format" "$nact" "$model_sha" "$model_kernels" >"$tmp/v.want"
 cmp -s "$tmp/v.txt" "$tmp/v.want" && ok || bad "--version: got '$(cat "$tmp/v.txt")', want '$(cat "$tmp/v.want")'"
 "$PRRU" version >"$tmp/v2.txt" && cmp -s "$tmp/v2.txt" "$tmp/v.want" && ok || bad "'prru version' differs from --version"
 expect 2 "takes no arguments" -- --version extra
@@ -43,8 +43,13 @@ grep -qi "spec" "$tmp"/help_*.txt && bad "help text talks of 'spec'" || ok
 for c in plot animate traj track excite identify optimize sensitivity merge; do
   "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"
 done
-{ grep -n -i -E "gsl|odeiv|hybridsj|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" "$tmp"/help_*.txt "$tmp/h.txt"
-  grep -n -E "PRRU_|DBL_" "$tmp"/help_*.txt "$tmp/h.txt"; } >"$tmp/jargon.txt"
+# The words of the model identity (KERNELS kernels, the JSON member
+# "kernels") and the environment variable PRRU_MODEL are the user's.
+user_words='s/PRRU_MODEL//g; s/KERNELS kernels//g; s/^KERNELS: //; s/sha256, kernels/sha256/g'
+for f in "$tmp"/help_*.txt "$tmp/h.txt"; do
+  sed "$user_words" "$f" | grep -n -i -E "gsl|odeiv|hybridsj|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" | sed "s|^|$f:|"
+  sed "$user_words" "$f" | grep -n -E "PRRU_|DBL_" | sed "s|^|$f:|"
+done >"$tmp/jargon.txt"
 [ -s "$tmp/jargon.txt" ] && bad "help texts with internal names: $(head -c 300 "$tmp/jargon.txt")" || ok
 grep -qF -- "--fd $(act_names f)" "$tmp/help_eval.txt" && grep -qF -- "--d $(act_names d) " "$tmp/help_fk.txt" \
   && grep -qF "t,$(act_names fd) (N)" "$tmp/help_id.txt" && ok || bad "help texts do not list the model's $nact actuators"
@@ -132,7 +137,7 @@ expect 2 "dup.csv:2: column 't' appears twice" -- id --traj "$tmp/dup.csv"
 "$PRRU" map --q1 -0.2:0.2:3 --q2 -0.2:0.2:3 --q3 -0.8 --out "$tmp/map.csv" >"$tmp/map.txt" || bad "map failed"
 [ "$(head -1 "$tmp/map.csv")" = "$csv_comment" ] && ok || bad "map: CSV comment line"
 [ "$(sed -n 2p "$tmp/map.csv")" = "q1,q2,q3,w_R,status" ] && ok || bad "map: CSV header"
-grep -qxF "model: $model_name ($model_file, sha256 $model_sha)" "$tmp/map.txt" && ok || bad "map summary lacks the model: $(cat "$tmp/map.txt")"
+grep -qxF "model: $model_id" "$tmp/map.txt" && ok || bad "map summary lacks the model: $(cat "$tmp/map.txt")"
 
 # ---- paper: runs with any model, names it, warns unless it is the paper's ----
 "$PRRU" paper --out "$tmp/paper" --skip-map >"$tmp/paper.out" 2>"$tmp/paper.err"
@@ -146,7 +151,7 @@ if [ "$model_sha" = "$paper_sha" ]; then
 else
   [ "$n" -eq 1 ] && ok || bad "paper: want the warning once for model $model_name: $(cat "$tmp/paper.err")"
 fi
-grep -qF "Model: $model_name ($model_file, sha256 $model_sha)" "$tmp/paper/summary.txt" && ok || bad "summary.txt lacks the model"
+grep -qF "Model: $model_id" "$tmp/paper/summary.txt" && ok || bad "summary.txt lacks the model"
 [ "$(head -1 "$tmp/paper/paper_sim.csv")" = "$csv_comment" ] && ok || bad "paper_sim.csv: comment line"
 [ "$(grep -vc '^#' "$tmp/paper/paper_sim.csv")" -eq 1002 ] && ok || bad "paper_sim.csv: 1001 samples expected"
 # Each figure says which of the paper's figures it is, or that it is none.

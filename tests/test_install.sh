@@ -20,6 +20,10 @@
 # (the sanitizer build's instrumented libraries need an instrumented program).
 set -u
 : "${PRRU:?}" "${PRRU_SOURCE_DIR:?}" "${PRRU_BUILD_DIR:?}" "${PRRU_MODEL:?}"
+# prru reads PRRU_MODEL from its environment as a model to load (prru
+# --help): kept for this script, not for the binaries it runs, which are
+# checked with their built-in model.
+export -n PRRU_MODEL
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/prru-install.XXXXXX") || exit 2
 trap 'rm -rf "$tmp"' EXIT
 fails=0
