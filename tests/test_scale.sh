@@ -24,9 +24,12 @@ PY
   # json.dump of Decimal as strings: turn them back into numbers.
   sed -i -E 's/"(-?[0-9.]+(E[-+]?[0-9]+)?)"/\1/g' "$tmp/model_$s.json"
   python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru --quiet || return 1
-  gcc -std=c99 -O2 -I"$dir" -I"$SRC/runtime/include" -I"$SRC/runtime/src" \
+  # The topology kernels (any model's numbers at run time) are the
+  # committed ones of every build; $dir comes first for the model's own.
+  gcc -std=c99 -O2 -I"$dir" -I"$SRC/runtime/include" -I"$SRC/runtime/src" -I"$SRC/generated" \
     "$SRC/tests/scale_main.c" "$SRC"/runtime/src/*.c "$dir/prru_kernels.c" "$dir/prru_mechanism.c" \
     "$dir/prru_param_kernels.c" "$dir/prru_regressor.c" \
+    "$SRC/generated/prru_p3_kernels.c" "$SRC/generated/prru_p4_kernels.c" \
     -lgsl -lgslcblas -ljansson -lm -lpthread -o "$tmp/scale_$s"
 }
 

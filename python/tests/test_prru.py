@@ -154,9 +154,9 @@ class TestModelFile(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.built = os.environ.get("PRRU_MODEL")
+        cls.built = os.environ.get("PRRU_BUILD_MODEL")
         if not cls.built:
-            raise unittest.SkipTest("PRRU_MODEL (the build's model file) not set; ctest sets it")
+            raise unittest.SkipTest("PRRU_BUILD_MODEL (the build's model file) not set; ctest sets it")
         cls.tmp = tempfile.mkdtemp(prefix="prru-model-")
         with open(cls.built) as f:
             cls.spec = json.load(f)
