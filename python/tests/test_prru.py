@@ -186,25 +186,33 @@ class TestModelFile(unittest.TestCase):
                              bits(MODEL.forward_dynamics(q, qd, fd, fp, mp)))
 
     def test_other_numbers_parameter(self):
-        """The platform 0.5 kg heavier: the parameter kernels; at q1 = q2 =
-        0 the generalized gravity along q3 changes by exactly that weight
-        (O' moves with q3 one to one; gravity (0, 0, -g) or the model's
-        vector's z), to the rounding of G's terms."""
+        """The platform 0.5 and 1 kg heavier: the parameter kernels. G is
+        linear in the platform's mass, so the first change is half the
+        second; at q1 = q2 = 0 the platform's centre of mass moves with q3
+        one to one (dp_c/dq3 = e3, whatever its offset), so G3 changes by
+        0.5 g_z exactly. Both to the rounding of G's terms."""
         spec = json.loads(json.dumps(self.spec))
-        spec["bodies"]["P"]["mass"] += 0.5
-        m = prru.Model(model=self.write("heavier.json", spec), lib=MODEL.lib)
-        self.assertEqual(m.kernels, "parameter")
-        self.assertEqual(m.mass[m.platform], MODEL.mass[MODEL.platform] + 0.5)
+        models = []
+        for dm in (0.5, 1.0):
+            spec["bodies"]["P"]["mass"] = self.spec["bodies"]["P"]["mass"] + dm
+            models.append(prru.Model(model=self.write("heavier%g.json" % dm, spec), lib=MODEL.lib))
+        half, one = models
+        self.assertEqual(half.kernels, "parameter")
+        self.assertEqual(half.mass[half.platform], MODEL.mass[MODEL.platform] + 0.5)
+        checked = 0
         for z in (-0.9, -0.75, -0.6):
             q = [0.0, 0.0, z]
             try:
                 MODEL.check(q)
             except (prru.Unreachable, prru.Singular):
                 continue
-            g1, g0 = m.dynamics(q)[2], MODEL.dynamics(q)[2]
-            scale = sum(abs(x) for x in g0) + 1.0
-            self.assertLessEqual(abs((g1[2] - g0[2]) - 0.5 * MODEL.gravity[2]), 64 * 2.2e-16 * scale)
-            self.assertLessEqual(abs(g1[0] - g0[0]), 64 * 2.2e-16 * scale)
+            g0, gh, g1 = (m.dynamics(q)[2] for m in (MODEL, half, one))
+            scale = 64 * 2.2e-16 * (sum(abs(x) for x in g1) + 1.0)
+            self.assertLessEqual(abs((gh[2] - g0[2]) - 0.5 * MODEL.gravity[2]), scale)
+            for i in range(3):
+                self.assertLessEqual(abs((gh[i] - g0[i]) - 0.5 * (g1[i] - g0[i])), scale)
+            checked += 1
+        self.assertGreater(checked, 0)
 
     def test_refusals(self):
         with self.assertRaises(prru.PrruIOError) as e:
