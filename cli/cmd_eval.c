@@ -95,13 +95,14 @@ int prru_cmd_eval(int argc, char **argv)
   if (!d) return 1;
   double rcond, M[PRRU_NQ * PRRU_NQ], h[PRRU_NQ], G[PRRU_NQ], passive[PRRU_NQ];
   double lambda[PRRU_NLAMBDA], qdd[PRRU_NQ];
+  char qtext[128];
   int st = prru_check_regular(&m, d, q, &rcond);
   if (st != PRRU_OK) {
     if (st == PRRU_ESINGULAR)
-      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): J_d is singular there (rcond %.3g below "
-                     "jd_rcond_min %.3g)", q[0], q[1], q[2], rcond, m.jd_rcond_min);
+      prru_cli_error("eval", "q = %s: J_d is singular there (rcond %.3g below jd_rcond_min %.3g)",
+                     prru_cli_vec(qtext, sizeof qtext, q, 3), rcond, m.jd_rcond_min);
     else
-      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): %s", q[0], q[1], q[2], prru_strerror(st));
+      prru_cli_error("eval", "q = %s: %s", prru_cli_vec(qtext, sizeof qtext, q, 3), prru_strerror(st));
     free(d);
     return prru_cli_exit_for(st);
   }
@@ -128,8 +129,8 @@ int prru_cmd_eval(int argc, char **argv)
     memcpy(z, d->lambda_null, sizeof z);
     st = prru_actuator_null(&m, d, q, n);
     if (st != PRRU_OK) {
-      prru_cli_error("eval", "q = (%.17g, %.17g, %.17g): actuator null vector: %s", q[0], q[1],
-                     q[2], prru_strerror(st));
+      prru_cli_error("eval", "q = %s: actuator null vector: %s", prru_cli_vec(qtext, sizeof qtext, q, 3),
+                     prru_strerror(st));
       free(d);
       return prru_cli_exit_for(st);
     }

@@ -41,7 +41,8 @@ int prru_cmd_ik(int argc, char **argv)
   double rcond;
   int st = prru_check_regular(&m, d, q, &rcond);
   if (st != PRRU_OK && st != PRRU_ESINGULAR) {
-    prru_cli_error("ik", "q = (%.17g, %.17g, %.17g): %s", q[0], q[1], q[2], prru_strerror(st));
+    char qtext[128];
+    prru_cli_error("ik", "q = %s: %s", prru_cli_vec(qtext, sizeof qtext, q, 3), prru_strerror(st));
     free(d);
     return 1;
   }
@@ -142,13 +143,10 @@ int prru_cmd_fk(int argc, char **argv)
   double res = NAN, tol = fk_tolerance(act);
   int st = use_lsq ? prru_forward_kinematics_lsq(&m, d, act, seed, q, &res)
                    : prru_forward_kinematics(&m, d, act, seed, q);
-  char dtext[64 * PRRU_NACT];
-  size_t used = 0;
-  for (int i = 0; i < PRRU_NACT && used < sizeof dtext; i++)
-    used += (size_t)snprintf(dtext + used, sizeof dtext - used, "%s%.17g", i ? ", " : "", act[i]);
+  char dtext[32 * PRRU_NACT], qs[128];
+  prru_cli_vec(dtext, sizeof dtext, act, PRRU_NACT);
   if (st != PRRU_OK) {
-    prru_cli_error("fk", "d = (%s) from seed (%.6g, %.6g, %.6g): %s%s", dtext, seed[0], seed[1],
-                   seed[2], prru_strerror(st),
+    prru_cli_error("fk", "d = %s from seed %s: %s%s", dtext, prru_cli_vec(qs, sizeof qs, seed, 3), prru_strerror(st),
                    st == PRRU_ENOCONV ? " (d out of reach, or a singularity near the path; try another --seed)" : "");
     free(d);
     return 1;
@@ -163,16 +161,16 @@ int prru_cmd_fk(int argc, char **argv)
    * least-squares iteration can then be judged and it stops at the seed
    * as if stationary. Such sliders are out of any robot's reach. */
   if (use_lsq && !isfinite(res * res * PRRU_NACT)) {
-    prru_cli_error("fk", "d = (%s): out of reach (the squared residual overflows)", dtext);
+    prru_cli_error("fk", "d = %s: out of reach (the squared residual overflows)", dtext);
     free(d);
     return 1;
   }
   int consistent = res <= tol;
   if (use_lsq && !lsq && !consistent) {
-    prru_cli_error("fk", "d = (%s): no pose reproduces all %d slider positions, they are "
-                   "inconsistent (or out of reach): the best least-squares fit q = (%.17g, %.17g, "
-                   "%.17g) leaves a residual of %.3g m, tolerance %.3g m; --lsq accepts that fit",
-                   dtext, PRRU_NACT, q[0], q[1], q[2], res, tol);
+    prru_cli_error("fk", "d = %s: no pose reproduces all %d slider positions, they are "
+                   "inconsistent (or out of reach): the best least-squares fit q = %s leaves a "
+                   "residual of %.3g m, tolerance %.3g m; --lsq accepts that fit",
+                   dtext, PRRU_NACT, prru_cli_vec(qs, sizeof qs, q, 3), res, tol);
     free(d);
     return 1;
   }

@@ -227,8 +227,9 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
     for (int i = 0; i < 9 * PRRU_NBODY; i++) finite &= isfinite(R[i]) != 0;
     for (int i = 0; i < 3 * PRRU_NBODY; i++) finite &= isfinite(p[i]) != 0;
     if (!finite) {
-      prru_cli_error("view", "%s: row %ld (t = %g s): q = (%.17g, %.17g, %.17g) is out of reach of this "
-                     "model", path, f->row[k] + 1, r[ct], q[0], q[1], q[2]);
+      char qs[128];
+      prru_cli_error("view", "%s: row %ld (t = %g s): q = %s is out of reach of this model", path, f->row[k] + 1,
+                     r[ct], prru_cli_vec(qs, sizeof qs, q, 3));
       return 1;
     }
     for (int i = 0; i < PRRU_NLIMB; i++) {

@@ -83,6 +83,10 @@ void prru_cli_json_string(FILE *f, const char *s);
 /* prefix1<sep>prefix2<sep>...prefixN into buf ("f1,f2,f3"); returns buf. */
 const char *prru_cli_names(char *buf, size_t len, const char *prefix, int n, const char *sep);
 void prru_cli_error(const char *cmd, const char *fmt, ...);
+/* "(a, b, c)": each number with the fewest digits that read back as it
+ * (0.2, not 0.20000000000000001), for messages that name a state; buf of
+ * len bytes (32 n suffices). */
+const char *prru_cli_vec(char *buf, size_t len, const double *v, int n);
 /* Status code of a runtime call turned into an exit status: 1, or 128 +
  * the signal caught (130 when none was recorded) for PRRU_EINTERRUPTED. */
 int prru_cli_exit_for(int status);

@@ -385,3 +385,20 @@ int prru_cli_read_interrupted(const char *cmd, const char *opt, const char *path
                  opt, path);
   return prru_cli_exit_interrupted();
 }
+
+const char *prru_cli_vec(char *buf, size_t len, const double *v, int n)
+{
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int i = 0; i < n && used + 1 < len; i++) {
+    /* The fewest significant digits that read back as v[i] (0.2, not
+     * 0.20000000000000001): exact, and as the user typed it. */
+    char num[32];
+    for (int p = 1; p <= 17; p++) {
+      snprintf(num, sizeof num, "%.*g", p, v[i]);
+      if (strtod(num, NULL) == v[i] || v[i] != v[i]) break;
+    }
+    used += (size_t)snprintf(buf + used, len - used, "%s%s%s", i ? ", " : "(", num, i == n - 1 ? ")" : "");
+  }
+  return buf;
+}
