@@ -230,6 +230,24 @@ class TestModelFile(unittest.TestCase):
         self.assertIn("limbs", str(e.exception))
 
 
+class TestExamples(unittest.TestCase):
+    def test_body_frames_figure(self):
+        """python/examples/body_frames.py (docs/img/body_frames.png) draws
+        the library's model: a PNG of its stated size."""
+        if not shutil.which("gnuplot"):
+            self.skipTest("gnuplot not installed (make demo installs gnuplot-nox)")
+        with tempfile.TemporaryDirectory() as tmp:
+            png = os.path.join(tmp, "frames.png")
+            script = os.path.join(SOURCE_DIR, "python", "examples", "body_frames.py")
+            p = subprocess.run([sys.executable, script, png], capture_output=True, text=True)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(png, "rb") as f:
+                head = f.read(24)
+            self.assertEqual(head[:8], b"\x89PNG\r\n\x1a\n")
+            self.assertEqual((int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")),
+                             (1100, 900))
+
+
 class TestAgainstCli(unittest.TestCase):
     """Every value bit for bit as `prru eval`, `ik`, `fk`, `dme` print it."""
 
