@@ -72,7 +72,8 @@ build() { # harness
   local name=$1 objs=() src obj
   if [ ! -f "$work/runtime.stamp" ]; then
     for src in "$root"/runtime/src/*.c "$root/generated/prru_kernels.c" "$root/generated/prru_mechanism.c" \
-        "$root/generated/prru_param_kernels.c" "$root/generated/prru_regressor.c"; do
+        "$root/generated/prru_param_kernels.c" "$root/generated/prru_regressor.c" \
+        "$root/generated/prru_p3_kernels.c" "$root/generated/prru_p4_kernels.c"; do
       obj="$work/obj_$(basename "$src" .c).o"
       # fuzzer-no-link: coverage instrumentation without a second main()
       "$CC" "${cflags[@]}" -fsanitize=fuzzer-no-link,address,undefined \

@@ -56,7 +56,8 @@ fi
 echo "== fuzz corpus and regression replay (gcc, ASan/UBSan)"
 rt_objs=()
 for src in "$SRC"/runtime/src/*.c "$SRC/generated/prru_kernels.c" "$SRC/generated/prru_mechanism.c" \
-  "$SRC/generated/prru_param_kernels.c" "$SRC/generated/prru_regressor.c"; do
+  "$SRC/generated/prru_param_kernels.c" "$SRC/generated/prru_regressor.c" \
+  "$SRC/generated/prru_p3_kernels.c" "$SRC/generated/prru_p4_kernels.c"; do
   obj="$asan/replay_$(basename "$src" .c).o"
   # shellcheck disable=SC2086
   gcc -std=c99 -O1 -g $san_flags -I"$SRC/generated" -I"$SRC/runtime/include" \
