@@ -448,8 +448,8 @@ static void constraints(const geometry *G, const affine *a, double eps, double d
   barrier_index(p);
 }
 
-/* mu |pi(x) - pi0|_W^2 added to p's objective. */
-static void add_prior(const geometry *G, const affine *a, const double *pi0, double mu, barrier *p)
+/* mu |pi(x) - pi0|_W^2 added to p's objective; PRRU_ENOMEM. */
+static int add_prior(const geometry *G, const affine *a, const double *pi0, double mu, barrier *p)
 {
   const int n = a->n;
   double r0[NP], Wr[NP];
@@ -464,7 +464,7 @@ static void add_prior(const geometry *G, const affine *a, const double *pi0, dou
   p->f0 += mu * f0;
   /* Q += 2 mu P^T W P, c += 2 mu P^T W r0. */
   double *WP = malloc(sizeof(double) * NP * (size_t)n);
-  if (!WP) return; /* the callers allocated far more: not reached in practice */
+  if (!WP) return PRRU_ENOMEM;
   for (int j = 0; j < NP; j++)
     for (int i = 0; i < n; i++) {
       double s = 0;
@@ -482,6 +482,7 @@ static void add_prior(const geometry *G, const affine *a, const double *pi0, dou
     }
   }
   free(WP);
+  return PRRU_OK;
 }
 
 static void apply(const affine *a, const double *x, double *pi)
@@ -620,8 +621,8 @@ static int nearest_prior(const geometry *G, const affine *a, const double *pi0, 
   int st = barrier_alloc(&p, a->n, 2 * PRRU_NBODY, 2 * NDRV);
   if (st != PRRU_OK) return st;
   constraints(G, a, eps, DRIVE_MARGIN, 0, &p);
-  add_prior(G, a, pi0, 1, &p);
-  st = barrier_solve(&p, x, 1e-14, steps);
+  st = add_prior(G, a, pi0, 1, &p);
+  if (st == PRRU_OK) st = barrier_solve(&p, x, 1e-14, steps);
   barrier_free(&p);
   return st;
 }
@@ -652,7 +653,7 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
   /* Twice the margins: the prior-nearest step that follows, at these base
    * parameters, then starts with the margins' worth of room. */
   constraints(G, &a, 2 * o->eps, 2 * DRIVE_MARGIN, 0, &p);
-  add_prior(G, &a, pi0, o->mu, &p);
+  st = add_prior(G, &a, pi0, o->mu, &p);
   for (int i = 0; i < nb; i++) p.Q[(size_t)(nz + i) * n + nz + i] += 2;
   /* Start at the prior with each drive coefficient at least 1e-3 of its
    * weight (strictly inside); pi -> (x, y) inverts the map. */
@@ -672,7 +673,7 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
     const int j = b->col[nb + i];
     x[i] = (ps[j] - a.p0[j]) / a0->P[(size_t)j * nz + i];
   }
-  st = barrier_solve(&p, x, 1e-10, steps);
+  if (st == PRRU_OK) st = barrier_solve(&p, x, 1e-10, steps);
   apply(&a, x, pi);
   barrier_free(&p);
   free(a.P), free(x);
