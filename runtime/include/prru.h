@@ -175,6 +175,19 @@ void prru_model_actuator_rates(const prru_model *m, const double q[3], const dou
  * caller writing it where newlines or quotes matter escapes it). */
 void prru_model_identity(const prru_model *m, char *buf, size_t len);
 
+/* The drives' limits (spec section 13), per actuator, as every command
+ * that plans, tracks, excites or optimises applies them: a rail force
+ * |f_i| <= force_max[i] (N), a slider speed |d_i'| <= speed_max[i] (m/s)
+ * and the stroke d_min[i] <= d_i <= d_max[i] (m). No limit is INFINITY
+ * (-INFINITY for d_min). */
+typedef struct {
+  double force_max[PRRU_NACT];
+  double speed_max[PRRU_NACT];
+  double d_min[PRRU_NACT], d_max[PRRU_NACT];
+} prru_limits;
+/* Every limit off. */
+void prru_limits_none(prru_limits *l);
+
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */
   double fp[3]; /* force on the platform at O', {S} (N) */

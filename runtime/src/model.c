@@ -19,6 +19,14 @@ typedef struct {
   char *path;
 } loaded_model;
 
+void prru_limits_none(prru_limits *l)
+{
+  for (int i = 0; i < PRRU_NACT; i++) {
+    l->force_max[i] = l->speed_max[i] = l->d_max[i] = INFINITY;
+    l->d_min[i] = -INFINITY;
+  }
+}
+
 void prru_model_default(prru_model *m)
 {
   m->mech = &prru_mech;
