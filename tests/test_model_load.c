@@ -32,6 +32,7 @@
 
 static prru_data data;
 static prru_ref_ws *W;
+static int energy_checked; /* files whose work-energy balance was checked */
 
 static void ref_params_of(const prru_mechanism *me, prru_ref_params *p)
 {
@@ -99,7 +100,7 @@ static double terms_scale(const prru_model *m, const double q[3], const double q
 }
 
 typedef struct {
-  double fd, id, lam;
+  double fd, id, rt, lam, energy;
   int states;
 } worst;
 
@@ -139,6 +140,23 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
     w->id = fmax(w->id, r / bid);
     snprintf(what, sizeof what, "%s: |fd - fd_ref| / (u |J_d^+| (|M| |qdd| + S))", file);
     tu_check(r <= K * bid, what, r / bid, K);
+    /* The round trip ID(FD(fd)) = fd, compared as generalised forces
+     * J_d^T fd (with four actuators ID returns fd less its component along
+     * the null vector of J_d^T, which J_d^T removes). Bound: qdd carries
+     * FD's error, at most K bfd (above); ID maps it through |J_d^+| |M|
+     * and adds its own K bid; J_d^T multiplies by |J_d^T|_1. */
+    double d[PRRU_NACT], Jd[PRRU_NACT * 3], Q[3] = {0, 0, 0};
+    prru_model_ik_jd(m, q, d, Jd);
+    for (int i = 0; i < PRRU_NACT; i++)
+      for (int j = 0; j < 3; j++) Q[j] += Jd[3 * i + j] * (fd[i] - l->fd[i]);
+    double nJt = 0; /* |J_d^T|_1: the largest row sum of J_d */
+    for (int i = 0; i < PRRU_NACT; i++)
+      nJt = fmax(nJt, fabs(Jd[3 * i]) + fabs(Jd[3 * i + 1]) + fabs(Jd[3 * i + 2]));
+    const double brt = nJt * (nJ * nM * bfd + bid);
+    const double rt = tu_norm_inf(Q, 3);
+    w->rt = fmax(w->rt, rt / brt);
+    snprintf(what, sizeof what, "%s: |J_d^T (ID(FD(fd)) - fd)| / (|J_d^T| (|J_d^+| |M| bfd + bid))", file);
+    tu_check(rt <= K * brt, what, rt / brt, K);
   }
 
   if (reactions && prru_reactions(m, &data, q, qd, l, lam) == PRRU_OK &&
@@ -150,6 +168,83 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
     tu_check(er <= KR, what, er, KR);
   }
   w->states++;
+}
+
+/* The work-energy balance on the loaded model (test_runtime's, there on
+ * the build's own): along a motion under constant loads, d/dt (T + V) is
+ * the power of the actuator forces and the drives' damping and friction,
+ * P = fd . d' + Q_p . qd (gravity is in V). Classical RK4 carries (q, qd,
+ * W) over half the model's time scale tau = sqrt(L / |g|) from a regular
+ * state, with the actuator forces that hold it at rest plus a push, and
+ * initial rates of 0.3 / tau (0.3 L / tau for q3): sizes 0.1x to 10x meet
+ * the same problem in their own units. Bound, derived: RK4 is of order 4,
+ * so the balance residual r_2n with 2n steps is (r_n - r_2n) / 15 of
+ * truncation, allowed twice that, plus rounding of at most 4 u per stage
+ * (16 u per step)
+ * in the largest of |T|, |V|, |W|. A dynamics whose energy kernel
+ * disagrees with its forward dynamics leaves a residual that does not
+ * shrink with the step, and fails. check_energy returns 1 when checked,
+ * 0 when the motion left the regular workspace (reported, not checked). */
+static void work_rhs(const prru_model *m, const prru_loads *l, const double y[7], double f[7])
+{
+  double d[PRRU_NACT], Jd[3 * PRRU_NACT], Qp[3], dd[PRRU_NACT], ddb[PRRU_NACT];
+  memcpy(f, y + 3, 3 * sizeof f[0]);
+  if (prru_forward_dynamics(m, &data, y, y + 3, l, f + 3) != PRRU_OK) f[3] = NAN;
+  prru_model_ik_jd(m, y, d, Jd);
+  prru_model_passive(m, y, y + 3, Qp);
+  prru_model_actuator_rates(m, y, y + 3, dd, ddb);
+  double p = 0;
+  for (int i = 0; i < 3; i++) p += Qp[i] * y[3 + i];
+  for (int i = 0; i < PRRU_NACT; i++) p += l->fd[i] * dd[i];
+  f[6] = p;
+}
+
+static double balance_residual(const prru_model *m, const prru_loads *l, const double q0[3], const double qd0[3],
+                               double t_end, int n, double *scale)
+{
+  double y[7] = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], 0}, k1[7], k2[7], k3[7], k4[7], yt[7];
+  const double h = t_end / n;
+  for (int s = 0; s < n; s++) {
+    work_rhs(m, l, y, k1);
+    for (int j = 0; j < 7; j++) yt[j] = y[j] + 0.5 * h * k1[j];
+    work_rhs(m, l, yt, k2);
+    for (int j = 0; j < 7; j++) yt[j] = y[j] + 0.5 * h * k2[j];
+    work_rhs(m, l, yt, k3);
+    for (int j = 0; j < 7; j++) yt[j] = y[j] + h * k3[j];
+    work_rhs(m, l, yt, k4);
+    for (int j = 0; j < 7; j++) y[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+    if (!isfinite(y[3])) return NAN;
+  }
+  double T0, V0, T1, V1;
+  if (prru_energies(m, q0, qd0, &T0, &V0) != PRRU_OK || prru_energies(m, y, y + 3, &T1, &V1) != PRRU_OK) return NAN;
+  *scale = fmax(fmax(fabs(T0), fabs(T1)), fmax(fmax(fabs(V0), fabs(V1)), fabs(y[6])));
+  return T1 + V1 - T0 - V0 - y[6];
+}
+
+static int check_energy(const prru_model *m, const double q0[3], double L, const char *file, double *ratio)
+{
+  const double g = sqrt(m->mech->gravity[0] * m->mech->gravity[0] + m->mech->gravity[1] * m->mech->gravity[1] +
+                        m->mech->gravity[2] * m->mech->gravity[2]);
+  const double tau = sqrt(L / g), zero[3] = {0, 0, 0};
+  const double qd0[3] = {0.3 / tau, -0.2 / tau, 0.3 * L / tau};
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  if (prru_inverse_dynamics(m, &data, q0, zero, zero, &l, l.fd) != PRRU_OK) return 0;
+  for (int i = 0; i < PRRU_NACT; i++) l.fd[i] *= 1.0 + 0.05 * (i + 1); /* a push: the forces do work */
+  const int n = 200;
+  double s1 = 0, s2 = 0;
+  const double r1 = balance_residual(m, &l, q0, qd0, 0.5 * tau, n, &s1);
+  const double r2 = balance_residual(m, &l, q0, qd0, 0.5 * tau, 2 * n, &s2);
+  if (!isfinite(r1) || !isfinite(r2)) {
+    printf("%s: energy balance not checked: the motion left the regular workspace\n", file);
+    return 0;
+  }
+  const double bound = 2 * fabs(r1 - r2) / 15 + 16 * DBL_EPSILON * 2 * n * s2;
+  *ratio = fabs(r2) / bound;
+  char what[600];
+  snprintf(what, sizeof what, "%s: work-energy balance |r_2n| / (2 |r_n - r_2n| / 15 + 16 u 2n max(T, V, W))", file);
+  tu_check(fabs(r2) <= bound, what, *ratio, 1.0);
+  return 1;
 }
 
 /* Whether the file's numbers are the build's model's, decided here by the
@@ -214,7 +309,7 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   ref_params_of(m.mech, &P);
   const double L = (m.mech->l1[0] + m.mech->l1[1] + m.mech->l1[2]) / 3;
   double q3 = 0;
-  worst w = {0, 0, 0, 0};
+  worst w = {0, 0, 0, 0, 0, 0};
   if (!home_height(&m, L, &q3)) {
     printf("%s: SKIPPED the dynamics: no regular pose at q1 = q2 = 0\n", path);
   } else {
@@ -224,9 +319,14 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
       if (!random_state(&m, &P, L, q3, q, qd, &l)) break;
       check_state(&m, &P, q, qd, &l, &w, path, reactions);
     }
+    printf("home %s 0,0,%.17g\n", path, q3); /* the CLI check of test_random_loaded.sh starts there */
+    const double q0[3] = {0.05, -0.05, q3};
+    energy_checked += check_energy(&m, q0, L, path, &w.energy);
   }
-  printf("%-60s %s, %.3f ms to load; %d states: FD %.1f, ID %.1f u-bounds, reactions %.1f u kappa%s\n", path,
-         m.kernels->path, ms, w.states, w.fd, w.id, w.lam, reactions ? "" : " (not compared: see main)");
+  printf("%-60s %s, %.3f ms to load; %d states: FD %.1f, ID %.1f, ID(FD) %.1f u-bounds, reactions %.1f u kappa%s; "
+         "energy %.2g of its bound\n",
+         path, m.kernels->path, ms, w.states, w.fd, w.id, w.rt, w.lam, reactions ? "" : " (not compared: see main)",
+         w.energy);
   snprintf(what, sizeof what, "%s: dynamics compared at regular states", path);
   TU_TRUE(w.states >= STATES / 2, what);
   prru_model_free(&m);
@@ -256,12 +356,33 @@ static void check_dir(const char *dir, int *loaded, int *other, int *specialised
   if (n > 0) free(list);
 }
 
-int main(void)
+/* test_model_load FILE...: only the given files (tests/test_random_loaded.sh
+ * passes random valid models of the build's topology), each of which must
+ * load, evaluate on the parameter kernels and pass every check above,
+ * reactions and the energy balance included. */
+static int check_given(int n, char **files)
+{
+  int loaded = 0, other = 0, specialised = 0;
+  for (int i = 0; i < n; i++) {
+    const int before = tu_failures, energy_before = energy_checked;
+    check_file(files[i], &loaded, &other, &specialised, 1);
+    char what[600];
+    snprintf(what, sizeof what, "%s: the work-energy balance checked", files[i]);
+    TU_TRUE(energy_checked == energy_before + 1, what);
+    if (tu_failures != before) printf("FAILED: %s\n", files[i]);
+  }
+  TU_TRUE(loaded == n && other == 0 && specialised == 0, "every file loaded, on the parameter kernels");
+  prru_ref_free(W);
+  return tu_finish("test_model_load");
+}
+
+int main(int argc, char **argv)
 {
   const char *src = getenv("PRRU_SOURCE_DIR"), *built = getenv("PRRU_MODEL");
-  if (!TU_TRUE(src && built, "PRRU_SOURCE_DIR and PRRU_MODEL set (ctest sets them)")) return tu_finish("test_model_load");
   W = prru_ref_alloc();
   tu_rng_state = 20261126;
+  if (argc > 1) return check_given(argc - 1, argv + 1);
+  if (!TU_TRUE(src && built, "PRRU_SOURCE_DIR and PRRU_MODEL set (ctest sets them)")) return tu_finish("test_model_load");
   int loaded = 0, other = 0, specialised = 0;
   char dir[2048];
   check_file(built, &loaded, &other, &specialised, 1);
