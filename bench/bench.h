@@ -132,8 +132,17 @@ typedef struct {
 typedef struct {
   bench_stats batched_ns, scalar_ns, speedup; /* per state; speedup: scalar / batched */
 } bench_batch_row;
+/* The same model's numbers through the runtime on the specialised kernels
+ * and loaded from its file onto the parameter kernels
+ * (prru_model_use_parameter_kernels): ns per call, and per repetition
+ * parameter / specialised. */
+typedef struct {
+  bench_stats specialised_ns, parameter_ns, ratio;
+} bench_path_row;
 typedef struct {
   bench_mode_row dynamics, forward, inverse;
+  int paths_measured;             /* the model file loaded */
+  bench_path_row path_forward, path_inverse;
   bench_batch_row batch_dynamics, batch_eom_solve, batch_dme_terms, batch_w_r;
   int ncpu, scaling_measured;
   double idle_second_core; /* of the second most idle CPU, just before */

@@ -82,6 +82,58 @@ static double run_inverse(bench_ctx *c, long n, int chained)
   return t / (double)n;
 }
 
+/* ---- the specialised against the parameter path ---- */
+
+/* Throughput of forward (kind 0) or inverse (kind 1) dynamics on model m,
+ * ns per call; every output feeds the sink. */
+static double run_path(bench_ctx *c, const prru_model *m, int kind, long n)
+{
+  double out[PRRU_NACT > 3 ? PRRU_NACT : 3], acc = 0.0;
+  double t0 = bench_now_ns();
+  for (long i = 0; i < n; i++) {
+    const bench_state *s = &c->st[i & (NSTATES - 1)];
+    c->failures += (kind == 0 ? prru_forward_dynamics(m, c->d, s->q, s->qd, &s->l, out)
+                              : prru_inverse_dynamics(m, c->d, s->q, s->qd, s->qdd, &s->l, out)) != PRRU_OK;
+    acc += out[0] + out[1] + out[2];
+  }
+  double t = bench_now_ns() - t0;
+  bench_sink = bench_sink + acc;
+  return t / (double)n;
+}
+
+static void time_paths(bench_ctx *c, const prru_model *param, int kind, long n, int reps, bench_path_row *r)
+{
+  double a[MAXREPS], b[MAXREPS], ratio[MAXREPS];
+  for (int i = -2; i < reps; i++) { /* two warm-up rounds */
+    const double ts = run_path(c, &c->m, kind, n), tp = run_path(c, param, kind, n);
+    if (i < 0) continue;
+    a[i] = ts;
+    b[i] = tp;
+    ratio[i] = tp / ts;
+  }
+  r->specialised_ns = bench_stats_of(a, reps);
+  r->parameter_ns = bench_stats_of(b, reps);
+  r->ratio = bench_stats_of(ratio, reps);
+}
+
+/* The bench's model file loaded at run time and switched to the
+ * parameter kernels: what a user's own model costs against a build of it. */
+static void time_loaded(bench_ctx *c, long n, int reps, bench_modes *m)
+{
+  prru_model param;
+  char msg[512];
+  prru_model_default(&param);
+  if (prru_model_load(&param, PRRU_BENCH_MODEL, msg, sizeof msg) != PRRU_OK ||
+      prru_model_use_parameter_kernels(&param) != PRRU_OK) {
+    fprintf(stderr, "prru_bench: the parameter path not timed: %s\n", msg);
+    return;
+  }
+  time_paths(c, &param, 0, n, reps, &m->path_forward);
+  time_paths(c, &param, 1, n, reps, &m->path_inverse);
+  m->paths_measured = 1;
+  prru_model_free(&param);
+}
+
 typedef double (*mode_fn)(bench_ctx *c, long n, int chained);
 
 static void time_modes(bench_ctx *c, mode_fn f, long n, int reps, bench_mode_row *r)
@@ -289,6 +341,7 @@ void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m)
   time_modes(c, run_dynamics, n, reps, &m->dynamics);
   time_modes(c, run_forward, n, reps, &m->forward);
   time_modes(c, run_inverse, n, reps, &m->inverse);
+  time_loaded(c, n, reps, m);
   fill_soa(c);
   time_batched(c, 0, reps, &m->batch_dynamics);
   time_batched(c, 1, reps, &m->batch_eom_solve);
@@ -322,6 +375,12 @@ static void batch_row(const char *name, const bench_batch_row *r)
          r->speedup.max);
 }
 
+static void path_row(const char *name, const bench_path_row *r)
+{
+  printf("  %-17s %7.1f ns specialised, %7.1f parameter: %.2fx [%.2f-%.2f]\n", name, r->specialised_ns.median,
+         r->parameter_ns.median, r->ratio.median, r->ratio.min, r->ratio.max);
+}
+
 void bench_modes_print_table(const bench_modes *m)
 {
   printf("latency (each call's input depends on the last output, as an integrator) and\n"
@@ -329,6 +388,12 @@ void bench_modes_print_table(const bench_modes *m)
   row("dynamics", &m->dynamics);
   row("forward_dynamics", &m->forward);
   row("inverse_dynamics", &m->inverse);
+  if (m->paths_measured) {
+    printf("the model's numbers on the specialised kernels and loaded onto the parameter kernels\n"
+           "(prru_model_load + prru_model_use_parameter_kernels), throughput per call:\n");
+    path_row("forward_dynamics", &m->path_forward);
+    path_row("inverse_dynamics", &m->path_inverse);
+  }
   printf("batched kernels (%d states a call, one thread) against the scalar loop:\n", NB);
   batch_row("dynamics", &m->batch_dynamics);
   batch_row("eom_solve", &m->batch_eom_solve);
@@ -366,13 +431,30 @@ static void json_batch(const char *name, const bench_batch_row *r, int last)
   printf("}%s", last ? "" : ", ");
 }
 
+static void json_path(const char *name, const bench_path_row *r, int last)
+{
+  printf("\"%s\": {\"specialised_ns\": %.4g, \"parameter_ns\": %.4g, ", name, r->specialised_ns.median,
+         r->parameter_ns.median);
+  json_stats("parameter_over_specialised", &r->ratio);
+  printf("}%s", last ? "" : ", ");
+}
+
 void bench_modes_print_json(const bench_modes *m)
 {
   printf(", \"modes\": {");
   json_mode("dynamics", &m->dynamics, 0);
   json_mode("forward_dynamics", &m->forward, 0);
   json_mode("inverse_dynamics", &m->inverse, 1);
-  printf("}, \"batched\": {\"states_per_call\": %d, ", NB);
+  printf("}, \"loaded_paths\": ");
+  if (m->paths_measured) {
+    printf("{");
+    json_path("forward_dynamics", &m->path_forward, 0);
+    json_path("inverse_dynamics", &m->path_inverse, 1);
+    printf("}");
+  } else {
+    printf("null");
+  }
+  printf(", \"batched\": {\"states_per_call\": %d, ", NB);
   json_batch("dynamics", &m->batch_dynamics, 0);
   json_batch("eom_solve", &m->batch_eom_solve, 0);
   json_batch("dme_terms", &m->batch_dme_terms, 0);

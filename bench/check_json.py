@@ -98,6 +98,16 @@ def main():
                 isinstance(c["constant_arith"], int) and
                 c["param_arith"] >= c["constant_arith"] > 0):
             fail("param_cost %r: operation counts %r" % (const, c))
+    # The model file loaded onto the parameter kernels, against the
+    # specialised ones (both timed in the same run).
+    paths = doc.get("loaded_paths")
+    if not isinstance(paths, dict) or set(paths) != {"forward_dynamics", "inverse_dynamics"}:
+        fail("'loaded_paths' must time forward and inverse dynamics: %r" % (paths,))
+    for name, r in paths.items():
+        s = r.get("parameter_over_specialised", {})
+        if not (positive(r.get("specialised_ns")) and positive(r.get("parameter_ns"))
+                and positive(s.get("min")) and s["min"] <= s.get("median", 0) <= s.get("max", 0)):
+            fail("loaded_paths %r: %r" % (name, r))
     sim = doc.get("simulated_second")
     if not isinstance(sim, dict) or not positive(sim.get("generated_s")):
         fail("simulated_second missing")

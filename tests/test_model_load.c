@@ -100,14 +100,14 @@ static double terms_scale(const prru_model *m, const double q[3], const double q
 }
 
 typedef struct {
-  double fd, id, rt, lam, energy;
+  double fd, id, rt, lam, energy, paths;
   int states;
 } worst;
 
 /* One state: forward and inverse dynamics and the reactions against the
  * reference from the loaded numbers; refusals by the trust criterion skip. */
 static void check_state(const prru_model *m, const prru_ref_params *P, const double q[3], const double qd[3],
-                        const prru_loads *l, worst *w, const char *file, int reactions)
+                        const prru_loads *l, worst *w, const char *file, int reactions, const prru_model *alt)
 {
   double qdd[3], qdd_ref[3], fd[PRRU_NACT], fd_ref[PRRU_NACT], lam[PRRU_NLAMBDA], lam_ref[PRRU_NLAMBDA];
   if (prru_forward_dynamics(m, &data, q, qd, l, qdd) != PRRU_OK) return;
@@ -128,6 +128,18 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
   w->fd = fmax(w->fd, e / bfd);
   snprintf(what, sizeof what, "%s: |qdd - qdd_ref| / (u (kappa |qdd| + |M^-1| S))", file);
   tu_check(e <= K * bfd, what, e / bfd, K);
+  /* The specialised and the parameter path on the same numbers: each is
+   * within K bfd of the exact qdd, so they differ by at most twice that;
+   * likewise ID below. */
+  double qdd_alt[3], fd_alt[PRRU_NACT];
+  if (alt && prru_forward_dynamics(alt, &data, q, qd, l, qdd_alt) == PRRU_OK) {
+    double ea = 0;
+    for (int i = 0; i < 3; i++) ea = fmax(ea, fabs(qdd[i] - qdd_alt[i]));
+    w->paths = fmax(w->paths, ea / bfd);
+    snprintf(what, sizeof what, "%s: specialised vs parameter kernels, |qdd - qdd_p| / (u (kappa |qdd| + |M^-1| S))",
+             file);
+    tu_check(ea <= 2 * K * bfd, what, ea / bfd, 2 * K);
+  }
 
   /* Inverse dynamics at the same state and qdd, against the reference's
    * (minimum-norm with four actuators, as the runtime's). */
@@ -140,6 +152,14 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
     w->id = fmax(w->id, r / bid);
     snprintf(what, sizeof what, "%s: |fd - fd_ref| / (u |J_d^+| (|M| |qdd| + S))", file);
     tu_check(r <= K * bid, what, r / bid, K);
+    if (alt && prru_inverse_dynamics(alt, &data, q, qd, qdd, l, fd_alt) == PRRU_OK) {
+      double ra = 0;
+      for (int i = 0; i < PRRU_NACT; i++) ra = fmax(ra, fabs(fd[i] - fd_alt[i]));
+      w->paths = fmax(w->paths, ra / bid);
+      snprintf(what, sizeof what, "%s: specialised vs parameter kernels, |fd - fd_p| / (u |J_d^+| (|M| |qdd| + S))",
+               file);
+      tu_check(ra <= 2 * K * bid, what, ra / bid, 2 * K);
+    }
     /* The round trip ID(FD(fd)) = fd, compared as generalised forces
      * J_d^T fd (with four actuators ID returns fd less its component along
      * the null vector of J_d^T, which J_d^T removes). Bound: qdd carries
@@ -309,7 +329,18 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   ref_params_of(m.mech, &P);
   const double L = (m.mech->l1[0] + m.mech->l1[1] + m.mech->l1[2]) / 3;
   double q3 = 0;
-  worst w = {0, 0, 0, 0, 0, 0};
+  worst w = {0, 0, 0, 0, 0, 0, 0};
+  /* The build's own numbers: the same file again, on the parameter
+   * kernels, compared state by state with the specialised path. */
+  prru_model alt;
+  prru_model_default(&alt);
+  const int two_paths = built && prru_model_load(&alt, path, msg, sizeof msg) == PRRU_OK &&
+                        prru_model_use_parameter_kernels(&alt) == PRRU_OK &&
+                        strcmp(alt.kernels->path, "parameter") == 0;
+  if (built) {
+    snprintf(what, sizeof what, "%s: a second copy switched to the parameter kernels", path);
+    TU_TRUE(two_paths, what);
+  }
   if (!home_height(&m, L, &q3)) {
     printf("%s: SKIPPED the dynamics: no regular pose at q1 = q2 = 0\n", path);
   } else {
@@ -317,7 +348,7 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
       double q[3], qd[3];
       prru_loads l;
       if (!random_state(&m, &P, L, q3, q, qd, &l)) break;
-      check_state(&m, &P, q, qd, &l, &w, path, reactions);
+      check_state(&m, &P, q, qd, &l, &w, path, reactions, two_paths ? &alt : NULL);
     }
     printf("home %s 0,0,%.17g\n", path, q3); /* the CLI check of test_random_loaded.sh starts there */
     const double q0[3] = {0.05, -0.05, q3};
@@ -327,6 +358,8 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
          "energy %.2g of its bound\n",
          path, m.kernels->path, ms, w.states, w.fd, w.id, w.rt, w.lam, reactions ? "" : " (not compared: see main)",
          w.energy);
+  if (two_paths) printf("  specialised vs parameter kernels: %.2f u-bounds (FD, ID)\n", w.paths);
+  prru_model_free(&alt);
   snprintf(what, sizeof what, "%s: dynamics compared at regular states", path);
   TU_TRUE(w.states >= STATES / 2, what);
   prru_model_free(&m);
@@ -408,6 +441,9 @@ int main(int argc, char **argv)
   prru_model m;
   prru_model_default(&m);
   char msg[1024];
+  TU_TRUE(prru_model_use_parameter_kernels(&m) == PRRU_EINPUT && m.kernel_params == NULL &&
+              strcmp(m.kernels->path, "specialised") == 0,
+          "the built-in model has no parameter set: switching it is refused, the model untouched");
   TU_TRUE(prru_model_load(&m, "/nonexistent/model.json", msg, sizeof msg) == PRRU_EIO &&
               strstr(msg, "/nonexistent/model.json") && m.own == NULL,
           "a missing file: PRRU_EIO naming it, the model untouched");

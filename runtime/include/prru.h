@@ -150,6 +150,12 @@ void prru_model_default(prru_model *m);
  * computed with a partly loaded model. Allocates: prru_model_free (m must
  * not hold a loaded model already: free it first). */
 int prru_model_load(prru_model *m, const char *path, char *msg, int msglen);
+/* Switches a loaded model to the parameter kernels even where its numbers
+ * are the build's: to measure what the fast path saves (bench/) and to
+ * check both paths against each other (test_model_load). PRRU_EINPUT for
+ * a model not loaded from a file (prru_model_default's has no parameter
+ * set of its own). */
+int prru_model_use_parameter_kernels(prru_model *m);
 /* Frees a loaded model's storage (nothing for prru_model_default's);
  * then m is prru_model_default's. */
 void prru_model_free(prru_model *m);

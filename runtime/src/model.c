@@ -173,6 +173,15 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   return PRRU_OK;
 }
 
+int prru_model_use_parameter_kernels(prru_model *m)
+{
+  loaded_model *l = m->own;
+  if (!l) return PRRU_EINPUT;
+  m->kernels = &prru_kernels_parameter;
+  m->kernel_params = &l->params;
+  return PRRU_OK;
+}
+
 void prru_model_ik_jd(const prru_model *m, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
 {
   KERNEL(m, ik_jd)(m->kernel_params, q, d, Jd);
