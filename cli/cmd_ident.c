@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "prru_model_file.h"
 #include "prru_control.h"
 #include "prru_ident.h"
 #include "prru_param_kernels.h"
@@ -325,14 +326,19 @@ int prru_cmd_excite(int argc, char **argv)
 static const char identify_help[] =
     "usage: prru identify --data FILE.csv --out MODEL.json [--report FILE.csv|-]\n"
     "         [--name NAME] [--coulomb-velocity VS] [--window M] [--degree P]\n"
+    "         [--d-resolution R]\n"
     "Least-squares identification of the base inertial parameters from measured\n"
     "motion and actuator forces. FILE (header row, '#' lines skipped, columns in\n"
     "any order) has t (s, increasing), the forces %s (N) and the pose as\n"
     "q1,q2,q3 or as the slider positions %s (m, turned into q by forward\n"
-    "kinematics from the previous row's pose). Velocities and accelerations are\n"
-    "the columns qd1..qd3 and qdd1..qdd3 when present (prru excite writes the\n"
-    "exact ones), else derivatives of q by a local polynomial fit (Savitzky-Golay,\n"
-    "2M+1 samples, degree P; default M = 4, P = 4). The platform must carry no\n"
+    "kinematics from the previous row's pose; with four sliders quantised\n"
+    "readings disagree by up to the encoders' resolution: give it as\n"
+    "--d-resolution R (m), and the least-squares pose is accepted within R).\n"
+    "Velocities and accelerations are the columns qd1..qd3 and qdd1..qdd3 when\n"
+    "present (prru excite writes the exact ones, prru track the plant's), else\n"
+    "derivatives of q by a local polynomial fit (Savitzky-Golay, 2M+1 samples,\n"
+    "degree P; default M = 4, P = 4; prru measure suggests M and P for a\n"
+    "simulated run of the motion). The platform must carry no\n"
     "load. Each sample gives J_d^T fd = Y(q, qd, qdd) pi, pi the standard\n"
     "parameters (per body m, m c, inertia about the body-frame origin; per\n"
     "actuator armature, damping, Coulomb force for the smoothing velocity VS,\n"
@@ -341,29 +347,33 @@ static const char identify_help[] =
     "actuator forces (linear least squares) with standard errors from the\n"
     "residual variance.\n"
     "--out: a format-2 model file named NAME (default: this model's name + _id):\n"
-    "this model's geometry and gravity, and its inertial and drive parameters\n"
-    "(the prior) changed only where the data say: each base parameter's own\n"
-    "standard parameter takes the value that makes the combination equal the\n"
-    "estimate; parameters that no motion reveals keep the prior's values. When\n"
-    "that makes a body non-physical, the base parameters whose estimates lie\n"
-    "within 3 standard errors of the prior's (the data do not contradict it)\n"
-    "keep the prior's values (listed in the report).\n"
+    "this model's geometry and gravity, and a physically consistent parameter\n"
+    "set (every body's pseudo-inertia positive definite, drive coefficients\n"
+    "nonnegative): the estimate's base parameters when a consistent robot has\n"
+    "them, else the consistent ones nearest them within their covariance\n"
+    "(Mahalanobis distance^2 at most the chi^2 quantile at 1 - 0.001); among\n"
+    "those, the set nearest the prior (this model's numbers) in the\n"
+    "pseudo-inertia norm, so parameters no motion reveals keep the prior's.\n"
     "--report (default stdout): comment lines with the fit (samples, residual\n"
-    "sigma, condition number, parameters kept from the prior), then\n"
-    "index,parameter,estimate,se,prior,resolution,combination per base\n"
+    "sigma, condition number, the distance to the estimate, the standard\n"
+    "parameters moved), then\n"
+    "index,parameter,estimate,se,prior,resolution,model,t,combination per base\n"
     "parameter (prior: the combination at this model's numbers; resolution:\n"
-    "the value at which it alone would give forces of the data's RMS size).\n"
+    "the value at which it alone would give forces of the data's RMS size;\n"
+    "model: the written model's; t: (model - estimate) / se).\n"
     "Model files hold no magnitude below 1e-9 but 0: smaller values are\n"
-    "written as 0.\n"
+    "written as 0 (a principal moment of inertia as 1e-9).\n"
     "Exit 2 for bad options or a malformed FILE, 1 when a row is unreachable or\n"
     "singular (named), the data do not excite every base parameter, or the\n"
-    "result is not physical (a mass <= 0, an inertia not positive definite, a\n"
-    "negative drive coefficient beyond 3 standard errors; the report is written,\n"
-    "the model file is not). Nothing is half-written.\n";
+    "data contradict physics (no consistent robot within the covariance: a\n"
+    "force sign, a gear ratio, or differentiated rates' error; the report is\n"
+    "written, the model file is not). Nothing is half-written.\n";
 
 typedef struct {
   int n;
   double *t, *q, *qd, *qdd, *fd;
+  int differentiated; /* qd, qdd from q by dopt (the file has no rates) */
+  prru_diff_options dopt;
 } ident_data;
 
 static void data_free(ident_data *D)
@@ -407,7 +417,11 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
 }
 
 /* q of every row by forward kinematics from the slider columns. */
-static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, ident_data *D)
+/* A least-squares pose is the sliders' when its residual is within the
+ * encoders' resolution dres (with four quantised sliders the true pose
+ * leaves each within dres / 2, so the least-squares one within dres in the
+ * 2-norm over four) plus the solver's tolerance. */
+static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, double dres, ident_data *D)
 {
   prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
@@ -418,9 +432,11 @@ static int poses_from_sliders(const char *path, const prru_table *t, const int *
     double act[PRRU_NACT], res;
     for (int k = 0; k < PRRU_NACT; k++) act[k] = row[cd[k]];
     int st = prru_forward_kinematics_lsq(&m, d, act, seed, D->q + 3 * i, &res);
-    if (st != PRRU_OK || !(res <= 1e-9 * (1 + fabs(act[0])))) {
+    if (st != PRRU_OK || !(res <= dres + 1e-9 * (1 + fabs(act[0])))) {
       prru_cli_error("identify", "%s: data row %d: no pose for the sliders (%s)", path, i + 1,
-                     st != PRRU_OK ? prru_strerror(st) : "inconsistent slider positions");
+                     st != PRRU_OK ? prru_strerror(st) :
+                     dres > 0 ? "inconsistent slider positions: beyond --d-resolution" :
+                                "inconsistent slider positions: quantised readings? give --d-resolution");
       rc = 1;
     }
     memcpy(seed, D->q + 3 * i, sizeof seed);
@@ -429,7 +445,7 @@ static int poses_from_sliders(const char *path, const prru_table *t, const int *
   return rc;
 }
 
-static int read_data(const char *path, const prru_diff_options *dopt, ident_data *D)
+static int read_data(const char *path, const prru_diff_options *dopt, double dres, ident_data *D)
 {
   char msg[700];
   prru_table t;
@@ -472,7 +488,9 @@ static int read_data(const char *path, const prru_diff_options *dopt, ident_data
       rc = 2;
     }
   }
-  if (!rc && cq[0] < 0) rc = poses_from_sliders(path, &t, cd, D);
+  if (!rc && cq[0] < 0) rc = poses_from_sliders(path, &t, cd, dres, D);
+  D->differentiated = cv[0] < 0;
+  D->dopt = *dopt;
   if (!rc && cv[0] < 0 &&
       prru_diff_signal(D->t, D->n, D->q, 3, dopt, NULL, D->qd, D->qdd, NULL, NULL, msg, sizeof msg) != PRRU_OK) {
     prru_cli_error("identify", "%s: differentiating q: %s", path, msg);
@@ -583,6 +601,14 @@ static int to_params(const prru_base *b, const double *pi, prru_params *p, char 
       snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_cli_model()->mech->body_names[k], pi[PRRU_NBODYPAR * k]);
       return 1;
     }
+    /* A model file holds no magnitude below 1e-9 but 0 (model_number):
+     * a principal moment the fit left smaller (a body on the consistent
+     * set's boundary, a line mass: noisy data can put it there) is raised
+     * to 1e-9 kg m^2, which adds at most 1e-9 kg m^2 of inertia and keeps
+     * the body consistent (its second moments about the centre change by
+     * +-5e-10); the loader's check of the written file (identify_run)
+     * catches anything this misses. */
+    for (int d = 0; d < 3; d++) I[d] = fmax(I[d], 1e-9);
     const double m2 = I[0] * I[1] - I[3] * I[3];
     const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
                       I[4] * (I[3] * I[5] - I[1] * I[4]);
@@ -686,7 +712,7 @@ static int valid_name(const char *s)
 }
 
 typedef struct {
-  const char *data, *out, *report, *name, *vs, *window, *degree;
+  const char *data, *out, *report, *name, *vs, *window, *degree, *dres;
   int help;
 } identify_args;
 
@@ -726,6 +752,19 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
     return 2;
   }
   return coulomb_velocity("identify", a->vs, vs);
+}
+
+/* --d-resolution: the encoders' resolution R (m, > 0), 0 when not given. */
+static int d_resolution(const identify_args *a, double *r)
+{
+  *r = 0;
+  if (!a->dres) return 0;
+  if (prru_cli_number("identify", "d-resolution", a->dres, r)) return 2;
+  if (!(*r > 0)) {
+    prru_cli_error("identify", "--d-resolution: %s must be positive (m)", a->dres);
+    return 2;
+  }
+  return 0;
 }
 
 /* Fit and outputs once the data are read; the exit status. */
@@ -791,13 +830,20 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
                                         "the physically consistent fit did not converge", a->out);
     rc = 1;
   } else if (!rc && cst == PRRU_ESINGULAR) {
-    char worst[512];
+    char worst[512], diff[400] = "";
     worst_deviations(b, c, worst, sizeof worst);
+    /* Differentiated rates carry a truncation error the covariance does
+     * not hold: with quantised encoders a too narrow window alone produces
+     * this refusal (docs/guide.md, measurements), so say so first. */
+    if (D->differentiated)
+      snprintf(diff, sizeof diff, "qd and qdd were differentiated from q (--window %d --degree %d), whose error "
+               "the covariance does not hold: try the window 'prru measure' suggests for a simulated run of "
+               "this motion (a wider window for quantised encoders); else ", D->dopt.half_width, D->dopt.degree);
     prru_cli_error("identify", "the data contradict physics: no physically consistent robot has base parameters "
                    "within the estimate's covariance (Mahalanobis distance^2 %.4g, above the chi^2 quantile %.4g "
-                   "of %d degrees of freedom at 1 - %g); furthest from the estimate: %s; check the signs and "
+                   "of %d degrees of freedom at 1 - %g); furthest from the estimate: %s; %scheck the signs and "
                    "directions of the forces, the gear ratios and the units of fd; %s not written (see the report)",
-                   c->d2, c->d2_max, b->nbase, co.alpha, worst, a->out);
+                   c->d2, c->d2_max, b->nbase, co.alpha, worst, diff, a->out);
     rc = 1;
   } else if (!rc && unphysical) {
     prru_cli_error("identify", "internal error: the consistent parameters are not physical: %s; %s not written",
@@ -808,7 +854,22 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   if (!rc && prru_cli_out_open(&mo, "identify", a->out)) rc = 1;
   if (!rc) {
     write_model(&mo, &p, name, a->data);
-    if (prru_cli_out_close(&mo, !mo.err)) rc = 1;
+    /* The whole file is still in the buffer (prru_cli_out_line flushes
+     * at 64 kB; a model file is a few kB): the loader reads it before it
+     * replaces anything, so identify never writes a model nothing can
+     * load. */
+    prru_model_spec *spec = malloc(sizeof *spec);
+    char lmsg[700] = "out of memory";
+    const int ok = spec && prru_model_file_parse(mo.buf, mo.len, a->out, spec, lmsg, sizeof lmsg) == PRRU_OK;
+    free(spec);
+    if (!ok) {
+      prru_cli_error("identify", "internal error: the identified model does not load: %s; %s not written", lmsg,
+                     a->out);
+      prru_cli_out_close(&mo, 0);
+      rc = 1;
+    } else if (prru_cli_out_close(&mo, !mo.err)) {
+      rc = 1;
+    }
   }
   if (!rc)
     fprintf(stderr, "identify: %d base parameters from %d samples, residual sigma %.6g N, condition number "
@@ -824,7 +885,8 @@ int prru_cmd_identify(int argc, char **argv)
   prru_cli_option opts[] = {{"data", 1, &a.data, NULL},     {"out", 1, &a.out, NULL},
                             {"report", 1, &a.report, NULL}, {"name", 1, &a.name, NULL},
                             {"coulomb-velocity", 1, &a.vs, NULL}, {"window", 1, &a.window, NULL},
-                            {"degree", 1, &a.degree, NULL}, {"help", 0, NULL, &a.help}};
+                            {"degree", 1, &a.degree, NULL}, {"d-resolution", 1, &a.dres, NULL},
+                            {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("identify", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (a.help) {
     char dn[256], fn[256];
@@ -836,12 +898,14 @@ int prru_cmd_identify(int argc, char **argv)
   char name[32];
   prru_diff_options dopt;
   double vs;
+  double dres;
   int rc = identify_options(&a, name, sizeof name, &dopt, &vs);
+  if (!rc) rc = d_resolution(&a, &dres);
   if (rc) return rc;
   ident_data D;
   /* A large file takes a while: a signal meanwhile is reported. */
   prru_cli_catch_signals();
-  rc = read_data(a.data, &dopt, &D);
+  rc = read_data(a.data, &dopt, dres, &D);
   int irc = prru_cli_read_interrupted("identify", "data", a.data);
   if (rc || irc) {
     data_free(&D);

@@ -27,6 +27,7 @@ int prru_cmd_ik(int argc, char **argv);
 int prru_cmd_fk(int argc, char **argv);
 int prru_cmd_id(int argc, char **argv);
 int prru_cmd_excite(int argc, char **argv);
+int prru_cmd_measure(int argc, char **argv);
 int prru_cmd_identify(int argc, char **argv);
 int prru_cmd_paper(int argc, char **argv);
 int prru_cmd_dme(int argc, char **argv);

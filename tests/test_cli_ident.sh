@@ -11,6 +11,9 @@
 #    residual sigma within 5 % of 0.5 N;
 #  - from t, the sliders d and fd alone (forward kinematics and
 #    Savitzky-Golay derivatives at 2 ms): within 1e-5;
+#  - prru measure on a tracked run (quantised d, noisy forces, 500 Hz):
+#    readings against the run, the suggested window, and identify from them
+#    writing a model that loads, within 4 se of the exact-rate fit;
 #  - bad input: messages naming the option, file and row, exit 2 or 1, and
 #    no model file written (an old one kept).
 # shellcheck source=tests/cli_lib.sh
@@ -134,6 +137,98 @@ python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$tmp/cad.json" --out "$tmp/cadgen" -
   && ok || bad "the model identified with masses x1.05 is refused by the generator: $(cat "$tmp/cadgen.err")"
 d2=$(sed -n 's/.*Mahalanobis distance^2 of its base parameters to the estimate \([^,]*\),.*/\1/p' "$tmp/cadrep.csv")
 awk -v d="$d2" 'BEGIN { exit !(d != "" && d + 0 <= 1) }' && ok || bad "masses x1.05: d^2 '$d2' > 1"
+
+# ---- issue 27 item 3: measurements (prru measure) ----
+# The masses-x1.05 run as the sensors see it: encoders of 1 um on d, 0.2 N
+# of force noise, 500 Hz (every other row of track's 1 ms).
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/meas.csv" --rate 500 --d-resolution 1e-6 --force-noise 0.2 \
+  --seed 3 2>"$tmp/meas.err" && ok || bad "measure: $(cat "$tmp/meas.err")"
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/meas2.csv" --rate 500 --d-resolution 1e-6 --force-noise 0.2 \
+  --seed 3 2>/dev/null && cmp -s "$tmp/meas.csv" "$tmp/meas2.csv" && ok || bad "measure: a seed gives other bytes"
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/meas3.csv" --rate 500 --d-resolution 1e-6 --force-noise 0.2 \
+  --seed 4 2>/dev/null && ! cmp -s "$tmp/meas.csv" "$tmp/meas3.csv" && ok || bad "measure: seeds 3 and 4 agree"
+# The readings against the run: every other row; d on the 1 um grid and
+# within half a count of the truth; the force errors' mean and standard
+# deviation those of N(0, 0.2^2) over n samples (within 5 standard errors:
+# 5 sigma / sqrt(n) for the mean, 5 sigma / sqrt(2 n) for the deviation);
+# the suggested window's qdd error at most the default's.
+python3 - "$tmp/cad.csv" "$tmp/meas.csv" "$nact" <<'PY' && ok || bad "measure: readings (above)"
+import csv, math, sys
+def rows(f):
+    return list(csv.DictReader(l for l in open(f) if not l.startswith('#')))
+run, meas, nact = rows(sys.argv[1]), rows(sys.argv[2]), int(sys.argv[3])
+lines = open(sys.argv[2]).read().splitlines()
+assert lines[2].startswith('# for identify: --window'), lines[2]
+w = lines[2].split()
+best, default = float(w[11]), float(w[-1].rstrip(')'))
+assert best <= default, (best, default)
+assert list(meas[0]) == ['t'] + ['d%d' % (i + 1) for i in range(nact)] + ['fd%d' % (i + 1) for i in range(nact)]
+assert len(meas) == (len(run) - 1) // 2 + 1, (len(meas), len(run))
+errs = []
+for k, m in enumerate(meas):
+    r = run[2 * k]
+    assert float(m['t']) == float(r['t']), (k, m['t'], r['t'])
+    for i in range(1, nact + 1):
+        d, dt = float(m['d%d' % i]), float(r['d%d' % i])
+        assert abs(d / 1e-6 - round(d / 1e-6)) < 1e-6 and abs(d - dt) <= 0.5e-6 * (1 + 1e-9), (k, i, d, dt)
+        errs.append(float(m['fd%d' % i]) - float(r['fd%d' % i]))
+n = len(errs)
+mean = sum(errs) / n
+sd = math.sqrt(sum((e - mean) ** 2 for e in errs) / (n - 1))
+assert abs(mean) <= 5 * 0.2 / math.sqrt(n), mean
+assert abs(sd - 0.2) <= 5 * 0.2 / math.sqrt(2 * n), sd
+PY
+win=$(sed -n 's/^# for identify: \(--window [0-9]* --degree [0-9]* --d-resolution [0-9.e+-]*\) .*/\1/p' "$tmp/meas.csv")
+# identify with the suggested window writes a model that loads (the fit
+# left L3 on the consistent set's boundary, a principal moment below the
+# file's 1e-9, written as 0: a model nothing could load), and its base
+# parameters lie within 4 standard errors of the exact-rate fit's
+# (cadrep.csv: the truth's own, to rounding).
+# shellcheck disable=SC2086
+"$PRRU" identify --data "$tmp/meas.csv" $win --out "$tmp/mid.json" --report "$tmp/midrep.csv" 2>"$tmp/mid.err" \
+  && ok || bad "identify on measured data ($win): $(cat "$tmp/mid.err")"
+"$PRRU" --model "$tmp/mid.json" version >/dev/null 2>"$tmp/midv.err" && ok \
+  || bad "the model identified from measured data does not load: $(cat "$tmp/midv.err")"
+python3 - "$tmp/cadrep.csv" "$tmp/midrep.csv" <<'PY' && ok || bad "measured identification: base parameters (above)"
+import csv, sys
+def rd(f):
+    return {r['parameter']: r for r in csv.DictReader(l for l in open(f) if not l.startswith('#'))}
+exact, meas = rd(sys.argv[1]), rd(sys.argv[2])
+worst = max((abs(float(meas[k]['estimate']) - float(exact[k]['estimate'])) / float(meas[k]['se']), k) for k in exact)
+assert worst[0] <= 4, worst
+PY
+# The default window on quantised encoders: identify's refusal now names
+# the differentiation, not only the force signs.
+"$PRRU" identify --data "$tmp/meas.csv" --d-resolution 1e-6 --out "$tmp/mid4.json" --report "$tmp/mid4rep.csv" 2>"$tmp/mid4.err"
+st=$?
+if [ $st = 0 ]; then ok; else
+  [ $st = 1 ] && grep -q "differentiated from q (--window 4 --degree 4).*prru measure" "$tmp/mid4.err" && ok \
+    || bad "identify's refusal on differentiated data: exit $st: $(cat "$tmp/mid4.err")"
+fi
+# Four quantised sliders disagree by up to the resolution: without
+# --d-resolution the first row has no pose, and the message says what to give.
+if [ "$nact" = 4 ]; then
+  "$PRRU" identify --data "$tmp/meas.csv" --out "$tmp/mid5.json" --report "$tmp/mid5rep.csv" 2>"$tmp/mid5.err"
+  [ $? = 1 ] && grep -q "data row 1: no pose for the sliders.*give --d-resolution" "$tmp/mid5.err" && ok \
+    || bad "4 quantised sliders without --d-resolution: $(cat "$tmp/mid5.err")"
+fi
+"$PRRU" identify --data "$tmp/meas.csv" --d-resolution 0 --out "$tmp/mid6.json" 2>"$tmp/mid6.err"
+[ $? = 2 ] && grep -q -- "--d-resolution: 0 must be positive" "$tmp/mid6.err" && ok \
+  || bad "identify --d-resolution 0: $(cat "$tmp/mid6.err")"
+# Bad input: named, exit 2, the old output kept.
+echo keep >"$tmp/keep.csv"
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/keep.csv" --rate 300 2>"$tmp/e1"
+[ $? = 2 ] && grep -q "rate 300: no row at t = " "$tmp/e1" && [ "$(cat "$tmp/keep.csv")" = keep ] && ok \
+  || bad "measure --rate off the run's clock: $(cat "$tmp/e1")"
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/keep.csv" --force-noise -1 2>"$tmp/e2"
+[ $? = 2 ] && grep -q -- "--force-noise" "$tmp/e2" && [ "$(cat "$tmp/keep.csv")" = keep ] && ok \
+  || bad "measure --force-noise -1: $(cat "$tmp/e2")"
+cut -d, -f1-4 "$tmp/cad.csv" >"$tmp/nofd.csv"
+"$PRRU" measure --run "$tmp/nofd.csv" --out "$tmp/keep.csv" 2>"$tmp/e3"
+[ $? = 2 ] && grep -q "nofd.csv: missing column 'd1'" "$tmp/e3" && [ "$(cat "$tmp/keep.csv")" = keep ] && ok \
+  || bad "measure on a run without d, fd: $(cat "$tmp/e3")"
+"$PRRU" measure --run "$tmp/cad.csv" --out "$tmp/cad.csv" 2>"$tmp/e4"
+[ $? = 2 ] && ok || bad "measure --out onto --run: $(cat "$tmp/e4")"
 
 # ---- identify from a data file whose path is hostile to the model file ----
 # The description names the --data path: one with "*/" (a directory ending
