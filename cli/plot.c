@@ -859,6 +859,37 @@ char *prru_plot_forces_script(const char *csv, const char *png, const char *mode
   return close_script(g, &buf);
 }
 
+char *prru_plot_ident_script(const char *dat, const char *png, const char *model, const char *footer, long n)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  /* Wide enough for one readable tick label per base parameter. */
+  const long px = n * 26 + 260 > 1000 ? n * 26 + 260 : 1000;
+  fprintf(g, "set encoding utf8\nset terminal pngcairo size %ld,650 enhanced font 'Sans,11'\nset output ", px);
+  prru_plot_string(g, png);
+  fputs("\nrep = ", g);
+  prru_plot_string(g, dat);
+  fputs("\nmodel = ", g);
+  prru_plot_label(g, model);
+  fputc('\n', g);
+  prru_plot_footer(g, footer);
+  /* Black estimates with bars and open vermilion squares for the model:
+   * apart by shape in greyscale. The prior is the dashed zero line. */
+  fprintf(g, "set title 'Identified base parameters against the prior, model '.model\n"
+             "set xrange [0.3:%ld.7]\nset xtics 1 rotate by 60 right noenhanced font ',9'\n"
+             "set ylabel '(value - prior) / max(|prior|, resolution)'\nset xlabel 'base parameter' offset 0,0.5\n"
+             "set grid ytics\nset key outside top right\nset bmargin 11\nset rmargin 22\n"
+             "set offsets 0, 0, graph 0.05, graph 0.05\nset ytics format '%%g'\n"
+             "plot 0 with lines lc rgb '#000000' dt (6,4) lw 1.5 title 'prior', \\\n"
+             "     rep using 1:2:3:xticlabels(5) with yerrorbars pt 7 ps 0.9 lc rgb '#000000' lw 1.5 "
+             "title 'estimate {/Symbol \\261} 3 se', \\\n"
+             "     rep using 1:4 with points pt 4 ps 1.6 lw 2 lc rgb '#d55e00' title 'written model'\n",
+          n);
+  return close_script(g, &buf);
+}
+
 /* ---- prru animate ---- */
 
 char *prru_plot_animation_script(const char *dat, const char *gif, const char *title, long n,

@@ -139,6 +139,10 @@ char *prru_plot_motion_script(const char *csv, const char *png, const char *mode
                               int nact, int forces);
 /* The actuator forces fd1..fd<nact> of a `prru id` CSV over time.
  * Malloc'ed, NULL: no memory. */
+/* identify's report: per base parameter the estimate with 3 se and the
+ * written model's value, relative to the prior (columns of dat: index,
+ * (estimate - prior) / s, 3 se / s, (model - prior) / s, name). */
+char *prru_plot_ident_script(const char *dat, const char *png, const char *model, const char *footer, long n);
 char *prru_plot_forces_script(const char *csv, const char *png, const char *model, const char *footer,
                               int nact);
 

@@ -6,6 +6,7 @@
  * sees it, so that a bad file is a message with its line, not a gnuplot
  * error. */
 #define _XOPEN_SOURCE 700 /* getline, mkdtemp, realpath */
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -20,7 +21,7 @@
 #include "prru.h"
 
 /* What a CSV holds, from its header. */
-enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP, CSV_TRACK, CSV_TRAJ, CSV_EXCITE, CSV_ID };
+enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP, CSV_TRACK, CSV_TRAJ, CSV_EXCITE, CSV_ID, CSV_IDENT };
 
 /* The header of a map CSV, and the start of the others'. */
 static const char map_header[] = "q1,q2,q3,w_R,status";
@@ -28,6 +29,8 @@ static const char sim_header[] = "t,q1,q2,q3,qd1,qd2,qd3,d1,";
 static const char track_header[] = "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,fd1,";
 static const char motion_header[] = "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,d1,"; /* traj, excite */
 static const char id_header[] = "t,fd1,";
+/* prru identify's report (its base parameters). */
+static const char ident_header[] = "index,parameter,estimate,se,prior,resolution,model,t,combination";
 
 /* Whether the comma-separated header has the column name. */
 static int has_column(const char *header, const char *name)
@@ -55,6 +58,7 @@ static int header_kind(const char *header)
   if (starts_with(header, motion_header) && has_column(header, "dd1")) return CSV_TRAJ;
   if (starts_with(header, motion_header) && has_column(header, "fd1")) return CSV_EXCITE;
   if (starts_with(header, id_header)) return CSV_ID;
+  if (strcmp(header, ident_header) == 0) return CSV_IDENT;
   return CSV_UNKNOWN;
 }
 
@@ -224,11 +228,72 @@ static int convert_map(const char *cmd, const char *path, FILE *f, long line_no,
   return rc;
 }
 
+/* ---- identify's report ---- */
+
+/* One report row "index,parameter,estimate,se,prior,resolution,model,t,
+ * combination" into its name and numbers; NULL or why not. */
+static const char *parse_ident_row(char *line, long want_index, char *name, size_t len, double v[6])
+{
+  char *end;
+  errno = 0;
+  long index = strtol(line, &end, 10);
+  if (end == line || *end != ',' || index != want_index) return "the index is not the row's number";
+  char *p = end + 1, *comma = strchr(p, ',');
+  if (!comma || comma == p || (size_t)(comma - p) >= len) return "no parameter name";
+  for (char *c = p; c < comma; c++)
+    if (!(isalnum((unsigned char)*c) || *c == '.' || *c == '_')) return "the parameter name is not a name";
+  snprintf(name, len, "%.*s", (int)(comma - p), p);
+  p = comma + 1;
+  for (int k = 0; k < 6; k++) {
+    v[k] = strtod(p, &end);
+    if (end == p || *end != ',' || !isfinite(v[k])) return "estimate, se, prior, resolution, model and t must be finite numbers";
+    p = end + 1;
+  }
+  if (!(v[1] >= 0) || !(v[3] > 0)) return "se must be >= 0 and the resolution > 0";
+  return NULL;
+}
+
+/* The report's rows into dat: index, (estimate - prior) / s, 3 se / s,
+ * (model - prior) / s, name; s = max(|prior|, resolution), so drives with
+ * a prior of 0 are measured by what the data resolve. 0, or 2 after a
+ * message naming path and line; *n the rows. */
+static int convert_ident(const char *cmd, const char *path, FILE *f, long line_no, FILE *dat, long *n)
+{
+  char *line = NULL, name[128];
+  size_t cap = 0;
+  int rc = 0;
+  *n = 0;
+  while (getline(&line, &cap, f) > 0) {
+    ++line_no;
+    chomp(line);
+    if (line[0] == '#') continue;
+    double v[6];
+    const char *why = parse_ident_row(line, *n + 1, name, sizeof name, v);
+    if (why) {
+      prru_cli_error(cmd, "%s:%ld: %s", path, line_no, why);
+      rc = 2;
+      break;
+    }
+    const double s = fmax(fabs(v[2]), v[3]);
+    fprintf(dat, "%ld %.17g %.17g %.17g %s\n", ++*n, (v[0] - v[2]) / s, 3 * v[1] / s, (v[4] - v[2]) / s, name);
+  }
+  free(line);
+  if (rc == 0 && ferror(f)) {
+    prru_cli_error(cmd, "%s: read error: %s", path, strerror(errno));
+    rc = 2;
+  }
+  if (rc == 0 && *n == 0) {
+    prru_cli_error(cmd, "%s: no base parameters (no rows after the header)", path);
+    rc = 2;
+  }
+  return rc;
+}
+
 /* ---- time series CSVs (simulate, track, traj, excite, id) ---- */
 
 /* What each kind is called in messages, by the enum. */
 static const char *const kind_name[] = {"", "a simulation", "a map", "a tracking", "a trajectory",
-                                        "an excitation", "an inverse dynamics"};
+                                        "an excitation", "an inverse dynamics", "an identification report"};
 
 /* The number of columns <prefix>1, <prefix>2, ... of t. */
 static int count_columns(const prru_table *t, const char *prefix)
@@ -403,12 +468,12 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out, double clip)
   int kind = read_head(f, &com, &header, &line_no);
   if (kind == CSV_UNKNOWN) {
     if (header)
-      prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate, map, track, traj, excite or id "
+      prru_cli_error(cmd, "%s:%ld: not a CSV of prru simulate, map, track, traj, excite, id or an identify report "
                      "(their headers: see 'prru plot --help'): the header is '%.60s'", in, line_no,
                      header);
     else
       prru_cli_error(cmd, "%s: no header line (%s): not a CSV of prru simulate, map, track, traj, "
-                     "excite or id", in, line_no ? "only comments" : "empty");
+                     "excite, id or an identify report", in, line_no ? "only comments" : "empty");
     free(header);
     fclose(f);
     return 2;
@@ -430,7 +495,19 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out, double clip)
   }
   int rc = 0;
   char *script = NULL;
-  if (kind == CSV_MAP) {
+  if (kind == CSV_IDENT) {
+    snprintf(path, sizeof path, "%s/map.dat", dir);
+    FILE *dat = fopen(path, "w");
+    long n = 0;
+    rc = dat ? convert_ident(cmd, in, f, line_no, dat, &n) : 1;
+    if (!dat) prru_cli_error(cmd, "%s: %s", path, strerror(errno));
+    if (dat && fclose(dat) != 0 && rc == 0) {
+      prru_cli_error(cmd, "%s: write error: %s", path, strerror(errno));
+      rc = 1;
+    }
+    if (rc == 0 && !(script = prru_plot_ident_script("map.dat", "plot.png", model, footer, n))) rc = 1;
+    fclose(f);
+  } else if (kind == CSV_MAP) {
     snprintf(path, sizeof path, "%s/map.dat", dir);
     FILE *dat = fopen(path, "w");
     map_scan m = {0};

@@ -122,6 +122,19 @@ for c in "track 1000 1300" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
   "$PRRU" plot "$tmp/$1.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/$1.png")" = "$2 $3" ] && [ ! -s "$tmp/err" ] \
     && ok || bad "plot of a $1 CSV: $(png_size "$tmp/$1.png") $(head -c 300 "$tmp/err")"
 done
+# identify's report (its format, rows written here): one tick per base
+# parameter, 1000 x 650 for a few.
+{ echo "# prru 0.2.0 model prru (x.json, sha256 $(printf '0%.0s' $(seq 64)), parameter kernels)"
+  echo "index,parameter,estimate,se,prior,resolution,model,t,combination"
+  echo "1,P.m,1.86,0.01,1.77,0.5,1.859,-0.1,P.m + 1 L1.m - 0.25 S1.m"
+  echo "2,armature1,0.001,0.002,0,0.01,0.0009,-0.05,armature1"; } >"$tmp/ident.csv"
+"$PRRU" plot "$tmp/ident.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/ident.png")" = "1000 650" ] && [ ! -s "$tmp/err" ] \
+  && ok || bad "plot of an identify report: $(png_size "$tmp/ident.png") $(head -c 300 "$tmp/err")"
+h_ident="index,parameter,estimate,se,prior,resolution,model,t,combination"
+bad_file identskip "$h_ident\n1,P.m,1,0.1,1,1,1,0,P.m\n3,L1.m,1,0.1,1,1,1,0,L1.m\n" "identskip.csv:3: the index is not the row's number"
+bad_file identnan "$h_ident\n1,P.m,nan,0.1,1,1,1,0,P.m\n" "identnan.csv:2: estimate, se, prior, resolution, model and t must be finite"
+bad_file identname "$h_ident\n1,P m;x,1,0.1,1,1,1,0,P.m\n" "identname.csv:2: the parameter name is not a name"
+bad_file identnone "# x\n$h_ident\n" "identnone.csv: no base parameters"
 # track --plot still makes its figure, the size of prru plot's.
 "$PRRU" track --ref "$tmp/traj.csv" --dt 0.005 --fmax "$FMAX" --q0-offset 0.01,0,0 --out "$tmp/track2.csv" \
   --summary "$tmp/track2.json" --plot "$tmp/track2.png" 2>"$tmp/err" \
@@ -229,7 +242,7 @@ bad_file idone "$h_id\n$(grep -m1 '^0,' "$tmp/id.csv")\n" "an inverse dynamics C
 bad_file exciteone "$h_excite\n$(grep -m1 '^0,' "$tmp/excite.csv")\n" "an excitation CSV with fewer than 2 rows"
 # traj's and excite's columns begin alike: the columns after d decide.
 bad_file motionother "$(echo "$h_traj" | sed 's/,dd[0-9]*//g'),x1\n" \
-  "not a CSV of prru simulate, map, track, traj, excite or id"
+  "not a CSV of prru simulate, map, track, traj, excite, id or an identify report"
 
 # ---- figures fit for a paper (issue 31) ----
 # picture_ok FILE...: each non-empty and whole (a PNG's signature and its
@@ -256,7 +269,7 @@ scripts() { rm -f "$tmp"/gp.*; PATH="$tmp/keepbin:$PATH" "$PRRU" "$@"; }
 scripts paper --out "$tmp/fig" >/dev/null 2>"$tmp/err" || bad "paper: $(head -c 300 "$tmp/err")"
 cat "$tmp"/gp.* >"$tmp/paper.gp"
 "$PRRU" animate "$tmp/run.csv" --frames 3 --out "$tmp/kinds.gif" || bad "animate"
-r=$(picture_ok "$tmp"/{run,m,track,traj,excite,id,track2}.png "$tmp/kinds.gif" "$tmp"/fig/*.png)
+r=$(picture_ok "$tmp"/{run,m,track,traj,excite,id,ident,track2}.png "$tmp/kinds.gif" "$tmp"/fig/*.png)
 [ "$r" = ok ] && [ "$(ls "$tmp"/fig/*.png | wc -l)" = 8 ] && ok || bad "a figure is not a whole picture: $r"
 # One perceptually uniform colour map (viridis) for every map, and the
 # clip said in the colour key: by default the 99th percentile of w_R.
