@@ -36,6 +36,7 @@ from ._lib import Library, load_library
 from .model import Dme, Joint, Model
 from .simulation import Sample, Scenario, Trajectory
 from .maps import MapResult
+from .measurements import Measurement
 
 __version__ = "0.2.0"
 

@@ -87,6 +87,20 @@ class _MapOptions(ctypes.Structure):
                 ("ctx", ctypes.c_void_p), ("interrupt", c_int_p)]
 
 
+class _MeasureOptions(ctypes.Structure):
+    _fields_ = [("rate", ctypes.c_double), ("d_resolution", ctypes.c_double),
+                ("force_sigma", ctypes.c_double), ("seed", ctypes.c_ulong)]
+
+
+class _DiffOptions(ctypes.Structure):
+    _fields_ = [("half_width", ctypes.c_int), ("degree", ctypes.c_int)]
+
+
+class _DiffChoice(ctypes.Structure):
+    _fields_ = [("best", _DiffOptions), ("best_error", ctypes.c_double),
+                ("default_error", ctypes.c_double), ("tried", ctypes.c_int)]
+
+
 # prru_stepper and prru_load_kind values.
 STEPPERS = ("rk8pd", "rkf45", "rkck", "msbdf")
 LOAD_CONSTANT, LOAD_HARMONIC, LOAD_TABLE = 0, 1, 2
@@ -250,6 +264,13 @@ class Library:
         self.map_eval = _declare(dll, "prru_map_eval", i, mp, ctypes.POINTER(_MapGrid),
                                  ctypes.POINTER(_MapOptions), vp,
                                  ctypes.POINTER(ctypes.c_ubyte), ctypes.POINTER(_MapSummary))
+
+        mo = ctypes.POINTER(_MeasureOptions)
+        self.measure_rows = _declare(dll, "prru_measure_rows", i, vp, i, mo, c_int_p, c_int_p,
+                                     ctypes.c_char_p, i)
+        self.measure_apply = _declare(dll, "prru_measure_apply", i, mo, i, i, vp, vp, ctypes.c_char_p, i)
+        self.measure_best_diff = _declare(dll, "prru_measure_best_diff", i, mp, i, vp, vp, vp,
+                                          ctypes.POINTER(_DiffChoice), ctypes.c_char_p, i)
 
     def status_text(self, status):
         return self.strerror(status).decode()

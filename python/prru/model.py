@@ -399,3 +399,4 @@ class Model:
     # Simulation and maps live in their own modules.
     from .simulation import simulate, paper_scenario, read_scenario  # noqa: E402
     from .maps import map  # noqa: E402
+    from .measurements import measure  # noqa: E402

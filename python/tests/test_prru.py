@@ -10,6 +10,7 @@ tree). Works for any model the library was built for (3 or 4 actuators).
 """
 
 import ctypes
+import csv
 import json
 import shutil
 import math
@@ -365,6 +366,39 @@ class TestAgainstCli(unittest.TestCase):
         index = float(re.search(r"global_index: (\S+)", text).group(1))
         self.assertEqual("%.10g" % r.summary["index"], "%.10g" % index)
         self.assertEqual(r.summary["n_points"], 20)
+
+    def test_measure(self):
+        # The binding's measure against prru measure on the same tracked
+        # run: the same rows, quantised sliders and seeded noise to the bit,
+        # and the same differentiation setting.
+        n = MODEL.nact
+        with tempfile.TemporaryDirectory() as tmp:
+            traj, run, meas = (os.path.join(tmp, f) for f in ("traj.csv", "run.csv", "meas.csv"))
+            cli("traj", "--waypoints", "0,0,-0.8;0.1,0.05,-0.78", "--durations", "0.3", "--dt", "0.001",
+                "--out", traj)
+            cli("track", "--ref", traj, "--dt", "0.001", "--out", run)
+            cli("measure", "--run", run, "--out", meas, "--rate", "500", "--d-resolution", "1e-6",
+                "--force-noise", "0.2", "--seed", "7")
+            rows = list(csv.DictReader(l for l in read(run).splitlines() if not l.startswith("#")))
+            text = read(meas)
+        col = lambda r, p, k: [float(r["%s%d" % (p, i + 1)]) for i in range(k)]
+        m = MODEL.measure([float(r["t"]) for r in rows], [col(r, "d", n) for r in rows],
+                          [col(r, "fd", n) for r in rows], rate=500, d_resolution=1e-6,
+                          force_noise=0.2, seed=7, qdd=[col(r, "qdd", 3) for r in rows])
+        out = [l.split(",") for l in text.splitlines() if not l.startswith("#")][1:]
+        self.assertEqual(len(out), len(m.t))
+        for k, r in enumerate(out):
+            self.assertEqual(bits([m.t[k]] + list(m.d[k]) + list(m.fd[k])), bits([float(x) for x in r]))
+        w = re.search(r"--window (\d+) --degree (\d+)", text)
+        self.assertEqual((m.window, m.degree), (int(w.group(1)), int(w.group(2))))
+        self.assertLessEqual(m.qdd_error, m.default_error)
+        t = [float(r["t"]) for r in rows]
+        with self.assertRaisesRegex(prru.InputError, "no row at t = "):
+            MODEL.measure(t, [col(r, "d", n) for r in rows], [col(r, "fd", n) for r in rows], rate=300)
+        with self.assertRaisesRegex(ValueError, "as many rows"):
+            MODEL.measure(t[:-1], [col(r, "d", n) for r in rows], [col(r, "fd", n) for r in rows])
+        with self.assertRaisesRegex(ValueError, "force_noise must be non-negative"):
+            MODEL.measure(t, [col(r, "d", n) for r in rows], [col(r, "fd", n) for r in rows], force_noise=-1)
 
     def test_map_other_mode(self):
         # A grid reaching past the singular locus: the binding's statuses
