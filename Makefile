@@ -39,6 +39,7 @@ SKIP_DEPS ?=
 DEPS = PRRU_DEPS_DRY_RUN=$(DEPS_DRY_RUN) PRRU_SKIP_DEPS=$(SKIP_DEPS) bash cmake/debian_deps.sh
 
 .PHONY: all deps deps-demo deps-test deps-asan deps-fuzz web-deps build demo compare-designs optimize-design test \
+        docs-cli \
         test-asan fuzz check-generated regenerate bench clean
 # Two package installations must never run at once (dpkg's lock); the
 # compilers run in parallel inside cmake --build.
@@ -122,6 +123,12 @@ check-generated:
 regenerate:
 	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) --out generated
 	for n in $(TOPOLOGIES); do $(PYTHON) gen/prru_gen.py --topology $$n --out generated || exit 1; done
+
+# docs/cli.md, the command-line reference, from the help texts of the
+# paper model's build (tests/paper_cli_doc.sh fails when it is stale).
+docs-cli: deps-demo
+	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=build
+	$(PYTHON) docs/gen_cli.py build/cli/prru --out docs/cli.md
 
 bench: build
 	$(BUILD)/bench/prru_bench

@@ -97,6 +97,20 @@ static int model_option(int argc, char **argv, int i, const char **file)
   return 0;
 }
 
+static void version_usage(FILE *f)
+{
+  fprintf(f, "usage: prru version   (the same: prru --version, prru COMMAND --version)\n"
+             "The program's version, then the model it computes with, a line each:\n"
+             "  prru VERSION\n"
+             "  model: NAME\n"
+             "  model file: FILE\n"
+             "  model format: 1 or 2\n"
+             "  model actuators: N\n"
+             "  model sha256: HASH (of FILE's bytes)\n"
+             "  model kernels: specialised or parameter (see prru --help)\n"
+             "The model is the built-in one, or --model FILE / PRRU_MODEL.\n");
+}
+
 /* Takes the global --model out of argv (before the command or anywhere
  * among its arguments: every command's options are its own, so "--model"
  * there is never another option's value unless written --opt=--model),
@@ -146,6 +160,11 @@ static int run(int argc, char **argv)
   if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
     usage(stdout);
     return finish("help", 0);
+  }
+  if (strcmp(argv[1], "version") == 0 && argc == 3 &&
+      (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0)) {
+    version_usage(stdout); /* every command prru --help lists answers --help */
+    return finish("version", 0);
   }
   if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
     if (argc > 2) {

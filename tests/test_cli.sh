@@ -31,6 +31,12 @@ file_nact=$(python3 -c 'import json, sys; print(sum(1 for b in json.load(open(sy
 [ "$nact" = "$file_nact" ] && ok || bad "--version says $nact actuators, the model file has $file_nact sliders"
 "$PRRU" --help >"$tmp/h.txt" && grep -q -- "--version" "$tmp/h.txt" && grep -qF "$model_name ($model_file)" "$tmp/h.txt" \
   && ok || bad "usage does not mention --version and the model: $(head -c 300 "$tmp/h.txt")"
+# Every command the usage lists answers COMMAND --help with its usage
+# (docs/cli.md is made of them; `version --help` was exit 2).
+for c in $(sed -n '/^commands:/,/^$/s/^  \([a-z][a-z0-9-]*\) .*/\1/p' "$tmp/h.txt"); do
+  "$PRRU" $c --help >"$tmp/hc.txt" 2>&1 && grep -q "^usage: prru $c" "$tmp/hc.txt" && ok ||
+    bad "$c --help: no usage line: $(head -c 200 "$tmp/hc.txt")"
+done
 # No help text counts reactions or actuators with another model's numbers.
 for c in eval simulate ik fk id dme map paper; do
   "$PRRU" $c --help >"$tmp/help_$c.txt" || bad "$c --help failed"
