@@ -117,7 +117,7 @@ mandir=${mandir:-share/man}
 [ "${mandir#/}" = "$mandir" ] && mandir="$prefix/$mandir"
 render() { if command -v man >/dev/null 2>&1; then MANWIDTH=80 man -l "$1"; else groff -man -Tutf8 "$1"; fi 2>&1; }
 man_bad=""
-for cmd in "" $("$PRRU" --help | sed -n '/^commands:/,/^$/s/^  \([a-z][a-z0-9-]*\) .*/\1/p' | grep -vx version); do
+for cmd in "" $("$PRRU" --help | sed -n '/^commands:/,/^$/s/^  \([a-z][a-z0-9-]*\) .*/\1/p' ); do
   page="$mandir/man1/prru${cmd:+-$cmd}.1"
   if [ ! -s "$page" ]; then man_bad="$man_bad missing:${page#"$prefix"/}"; continue; fi
   # The page renders, with its name and the command's usage line (spaces
