@@ -3,7 +3,7 @@
 # every finding fatal) and runs each for a bounded time from the committed
 # seed corpus, after replaying every committed regression input once.
 #
-#   fuzz/run.sh [harness...]      default: parse parse_pi table schedule scenario
+#   fuzz/run.sh [harness...]      default: parse parse_pi table schedule scenario model_file
 #   FUZZ_SECONDS   seconds per harness (default 30)
 #   FUZZ_BUILD     build/work directory (default: a fresh temporary one)
 #   FUZZ_JOBS      libFuzzer -fork workers (default 1; the CI box has 2 cores)
@@ -22,7 +22,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
 seconds=${FUZZ_SECONDS:-30}
 jobs=${FUZZ_JOBS:-1}
-all=(parse parse_pi table schedule scenario)
+all=(parse parse_pi table schedule scenario model_file)
 
 CC=${FUZZ_CC:-clang}
 if ! command -v "$CC" >/dev/null 2>&1; then
@@ -115,8 +115,10 @@ for name in "${all[@]}"; do
   fi
   mkdir -p "$work/corpus_$name" "$work/artifacts_$name"
   echo "== fuzz_$name: fuzz ${seconds} s"
-  # -max_len 4096: the parsers are line-oriented and a longer input only
-  # repeats lines; -timeout 10: a single input taking seconds is a hang.
+  # -max_len 4096: the line-oriented parsers gain nothing from a longer
+  # input (it only repeats lines), and the committed model files, the
+  # model_file seeds, are under 3.6 kB; -timeout 10: a single input taking
+  # seconds is a hang.
   "$work/fuzz_$name" "$work/corpus_$name" "$here/corpus/$name" \
     -max_total_time="$seconds" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$work/artifacts_$name/" \
