@@ -107,6 +107,11 @@ void bench_time_cost(bench_ctx *c, bench_kernel *p, const bench_kernel *k, int r
 typedef struct {
   int ok;
   bench_stats gen_s, ref_s; /* wall seconds */
+  /* The same run on the model file loaded onto the parameter kernels
+   * (prru_model_use_parameter_kernels): wall seconds, and per repetition
+   * parameter / specialised; param_ok 0 when the file did not load. */
+  int param_ok;
+  bench_stats param_s, param_ratio;
   double q[3], qd[3];       /* generated path's final state */
   double dq, dqd;           /* max |generated - reference| at t_end */
   unsigned long ref_steps;

@@ -93,9 +93,14 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
     printf(", \"generated_s\": %.4g, \"reference_s\": %.4g, "
            "\"ratio\": %.4g, \"stepper\": \"rk8pd\", \"rel_tol\": %g, \"abs_tol\": %g, "
            "\"reference_steps\": %lu, \"final_q\": [%.15g, %.15g, %.15g], "
-           "\"max_abs_diff_q\": %.3g, \"max_abs_diff_qd\": %.3g}",
+           "\"max_abs_diff_q\": %.3g, \"max_abs_diff_qd\": %.3g",
            sim->gen_s.median, sim->ref_s.median, sim->ref_s.median / sim->gen_s.median, sim->tol,
            sim->tol, sim->ref_steps, sim->q[0], sim->q[1], sim->q[2], sim->dq, sim->dqd);
+    if (sim->param_ok)
+      printf(", \"parameter_s\": %.4g, \"parameter_over_specialised\": {\"median\": %.4g, \"min\": %.4g, "
+             "\"max\": %.4g}", sim->param_s.median, sim->param_ratio.median, sim->param_ratio.min,
+             sim->param_ratio.max);
+    printf("}");
   } else
     printf(", \"simulated_second\": null");
   if (map->ok) {
@@ -172,6 +177,10 @@ void bench_print_table(const bench_options *op, const char *cpu, const sim_resul
     printf("  ratio %.1fx; final q = (%.12f, %.12f, %.12f); max |diff| q %.2e, qd %.2e\n",
            sim->ref_s.median / sim->gen_s.median, sim->q[0], sim->q[1], sim->q[2], sim->dq,
            sim->dqd);
+    if (sim->param_ok)
+      printf("  parameter  %.3f ms: the model file loaded onto the parameter kernels, %.2fx [%.2f-%.2f] of "
+             "generated\n", 1e3 * sim->param_s.median, sim->param_ratio.median, sim->param_ratio.min,
+             sim->param_ratio.max);
   } else {
     printf("simulated second: failed (see above)\n");
   }

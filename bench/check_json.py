@@ -113,6 +113,10 @@ def main():
         fail("simulated_second missing")
     if sim.get("scenario") != "paper section 4.3":
         fail("simulated second: scenario %r" % sim.get("scenario"))
+    ps = sim.get("parameter_over_specialised", {})
+    if not (positive(sim.get("parameter_s")) and positive(ps.get("min"))
+            and ps["min"] <= ps.get("median", 0) <= ps.get("max", 0)):
+        fail("simulated second: the parameter path %r" % (sim,))
     if not sim.get("max_abs_diff_q", 1.0) <= 1e-7:
         fail("simulated second: final q differs by %r" % sim.get("max_abs_diff_q"))
     bound = doc.get("bound")
