@@ -562,7 +562,7 @@ int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], dou
   for (int i = 0; i < 3; i++) {
     const double dq = qb[i] - qa[i];
     if (q) q[i] = qa[i] + s * dq;
-    if (qd) qd[i] = dq * v;
+    if (qd) qd[i] = dq * v + 0.0; /* no -0 at rest */
     if (qdd) qdd[i] = dq * u;
   }
   return PRRU_OK;
