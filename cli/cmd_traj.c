@@ -368,6 +368,12 @@ static int topp_settings(const topp_args *a, double *q, int *n, prru_limits *lim
     prru_cli_error("traj", "--waypoints: %d waypoint given, at least 2 needed", *n);
     return 2;
   }
+  for (int k = 1; k < *n; k++)
+    if (q[3 * k] == q[3 * k - 3] && q[3 * k + 1] == q[3 * k - 2] && q[3 * k + 2] == q[3 * k - 1]) {
+      prru_cli_error("traj", "--waypoints: waypoints %d and %d coincide (a segment of length 0)", k,
+                     k + 1);
+      return 2;
+    }
   if (topp_limits(&a->lim, lim, &forces, &speeds)) return 2;
   if (!forces) {
     if (speeds)
