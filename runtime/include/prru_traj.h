@@ -199,8 +199,9 @@ void prru_topp_free(prru_topp *tp);
  * slider speeds (either may be NULL), *ratio the largest of |fd_i| /
  * force_max_i and |dd_i| / speed_max_i (0 with no finite limit), *which
  * its actuator (0-based) and *kind 0 force, 1 speed (NULL if not wanted).
- * The stroke is not part of it (prru_topp_solve checks it at the grid).
- * The statuses of prru_inverse_dynamics. */
+ * The stroke is not part of it (prru_topp_solve checks it at the grid);
+ * d->d and d->Jd hold the pose's sliders and J_d afterwards. The statuses
+ * of prru_inverse_dynamics. */
 int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
                       const double q[3], const double qd[3], const double qdd[3],
                       double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
@@ -213,7 +214,8 @@ int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
  * segment's time is <= 1, by bisection on T to 1e-9 relative (doubling
  * from 1 s to bracket it). durations: n - 1. PRRU_EINPUT with msg when
  * no duration up to 2^60 s meets the limits (the static loads exceed
- * them) and for the poses prru_topp_solve refuses. */
+ * them), and with inverse dynamics' status where it refuses a pose. The
+ * stroke is not checked here (the path's poses are prru_topp_solve's). */
 int prru_quintic_fastest(const prru_model *m, int n, const double *q, const prru_limits *lim,
                          int samples, double *durations, char *msg, int msglen);
 
