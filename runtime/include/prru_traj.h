@@ -142,9 +142,13 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
  * (the x from which rest at the segment's end can still be reached; a
  * two-variable linear programme per grid point), the forward pass picks
  * the largest u_j keeping x_{j+1} in K_{j+1} from x_0 = 0. The drive term
- * h, not linear in x, enters as its secant through x = 0, h(x0)/x0 x,
- * exact at the linearisation point x0; x0 is the previous pass's x
- * (the first pass leaves h out), repeated until x settles. The result is
+ * h, not linear in x, enters linearised at x0, the previous pass's x (the
+ * first pass leaves h out): as its secant through x = 0, h(x0)/x0 x, until
+ * x moves by less than 5 % between passes, then as its tangent (Newton's
+ * method; back to secants, switching ten times later, should a pass on
+ * tangents find the path infeasible), repeated until x moves by less
+ * than 1e-6 of its largest value. The linearisation is exact at x0, and
+ * whatever it leaves is caught by the check: the result is
  * then checked with the exact inverse dynamics at 9 points of every
  * interval, and where a force or speed exceeds its limit by more than
  * PRRU_TOPP_CHECK_TOL (relative), that limit is tightened at the
@@ -152,7 +156,7 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
  * PRRU_TOPP_MAX_ITER times, else PRRU_ENOCONV). */
 #define PRRU_TOPP_GRID_DEFAULT 400
 #define PRRU_TOPP_CHECK_TOL 1e-9
-#define PRRU_TOPP_MAX_ITER 60
+#define PRRU_TOPP_MAX_ITER 200
 
 typedef struct {
   int nseg;     /* segments (waypoints - 1) */
