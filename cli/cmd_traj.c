@@ -128,7 +128,7 @@ static const char topp_help[] =
     "rail force |fd_i| <= --force-max (N; --fmax and --fd-max are the same\n"
     "option), each slider speed |dd_i| <= --speed-max (m/s), each slider within\n"
     "--stroke (m); one value for every actuator or one each. The forces are\n"
-    "the model's inverse dynamics without platform loads, drives included%s.\n"
+    "the model's inverse dynamics without platform loads, drives included.\n%s"
     "At least one force limit is needed (speed limits alone leave the\n"
     "accelerations unbounded). --no-limits starts from no limits (the model's\n"
     "own, once model files carry them) before the options apply.\n"
@@ -140,7 +140,8 @@ static const char topp_help[] =
     "active; the fastest uniformly time-scaled quintic under the same limits,\n"
     "checked at 2001 points per segment; peak forces and speeds against their\n"
     "limits) and the columns\n"
-    "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s,%s\n"
+    "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,\n"
+    "  %s,%s,%s\n"
     "every dt (default 1 ms; the last row at the end) or, with --dt grid, at\n"
     "the grid points; every row is checked again (a limit exceeded by more\n"
     "than 1e-6 of it is an error, exit 1). Limits that the path cannot meet\n"
@@ -553,8 +554,10 @@ int prru_cmd_traj(int argc, char **argv)
   prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
   prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
   if (help && topp) {
-    printf(topp_help, PRRU_NACT > 3 ? " (the forces of least norm: no internal preload)" : "", dn,
-           ddn, fn);
+    printf(topp_help,
+           PRRU_NACT > 3 ? "With redundant actuators, the forces of least norm (no internal preload).\n"
+                         : "",
+           dn, ddn, fn);
     return 0;
   }
   if (help) {
