@@ -116,6 +116,344 @@ static const char *pose_problem(int st)
                                  : prru_strerror(st);
 }
 
+/* ---- prru traj --time-optimal ---- */
+
+static const char topp_help[] =
+    "usage: prru traj --time-optimal --waypoints 'q1,q2,q3;q1,q2,q3;...'\n"
+    "                 [--force-max F|F1,..] [--speed-max V|V1,..]\n"
+    "                 [--stroke LO,HI|LO1,HI1,..] [--no-limits] [--grid N]\n"
+    "                 [--dt S|grid] [--out FILE.csv|-]\n"
+    "The fastest motion along the same path as the quintic trajectory (straight\n"
+    "lines in q, at rest at every waypoint) within the drives' limits: each\n"
+    "rail force |fd_i| <= --force-max (N; --fmax and --fd-max are the same\n"
+    "option), each slider speed |dd_i| <= --speed-max (m/s), each slider within\n"
+    "--stroke (m); one value for every actuator or one each. The forces are\n"
+    "the model's inverse dynamics without platform loads, drives included.\n%s"
+    "At least one force limit is needed (speed limits alone leave the\n"
+    "accelerations unbounded). --no-limits starts from no limits (the model's\n"
+    "own, once model files carry them) before the options apply.\n"
+    "Method: reachability analysis on a grid of N intervals per segment\n"
+    "(default 400), constant path acceleration on each, every interval\n"
+    "checked with the exact inverse dynamics at 9 points and tightened where\n"
+    "a limit is exceeded by more than 1e-9 of it. Writes the model line,\n"
+    "summary lines (duration; share of the grid intervals on which a limit is\n"
+    "active; the fastest uniformly time-scaled quintic under the same limits,\n"
+    "checked at 2001 points per segment; peak forces and speeds against their\n"
+    "limits) and the columns\n"
+    "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,\n"
+    "  %s,%s,%s\n"
+    "every dt (default 1 ms; the last row at the end) or, with --dt grid, at\n"
+    "the grid points; every row is checked again (a limit exceeded by more\n"
+    "than 1e-6 of it is an error, exit 1). Limits that the path cannot meet\n"
+    "(a pose outside the stroke or the workspace, a static load above\n"
+    "--force-max) stop with a message naming the first such grid point\n"
+    "(segment, s, limit) and exit 1, nothing written. Bad options exit 2.\n";
+
+typedef struct {
+  const char *force[3]; /* --force-max, --fmax, --fd-max */
+  const char *speed, *stroke;
+  int none;
+} topp_limit_args;
+
+/* One positive value for every actuator or one each ("F" or "F1,..,Fn"). */
+static int per_actuator(const char *name, const char *text, double out[PRRU_NACT])
+{
+  double v[PRRU_NACT];
+  int n;
+  if (parse_number_list("traj", name, text, v, PRRU_NACT, &n)) return 2;
+  if (n != 1 && n != PRRU_NACT) {
+    prru_cli_error("traj", "--%s: give 1 limit or %d (one per actuator), not %d", name, PRRU_NACT, n);
+    return 2;
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    out[i] = v[n == 1 ? 0 : i];
+    if (!(out[i] > 0)) {
+      prru_cli_error("traj", "--%s: limit %g of actuator %d is not > 0", name, out[i], i + 1);
+      return 2;
+    }
+  }
+  return 0;
+}
+
+/* The limits from the options: none to start with (until model files
+ * carry limits: then the model's, unless --no-limits), then each option
+ * given replaces its kind. *given: whether any force or speed limit is
+ * set. 0 or 2. */
+static int topp_limits(const topp_limit_args *a, prru_limits *lim, int *forces, int *speeds)
+{
+  static const char *const names[3] = {"force-max", "fmax", "fd-max"};
+  prru_limits_none(lim);
+  int nf = 0, which = 0;
+  for (int k = 0; k < 3; k++)
+    if (a->force[k]) nf++, which = k;
+  if (nf > 1) {
+    prru_cli_error("traj", "--force-max, --fmax and --fd-max are one option: give it once");
+    return 2;
+  }
+  if (nf && per_actuator(names[which], a->force[which], lim->force_max)) return 2;
+  if (a->speed && per_actuator("speed-max", a->speed, lim->speed_max)) return 2;
+  if (a->stroke) {
+    double v[2 * PRRU_NACT];
+    int n;
+    if (parse_number_list("traj", "stroke", a->stroke, v, 2 * PRRU_NACT, &n)) return 2;
+    if (n != 2 && n != 2 * PRRU_NACT) {
+      prru_cli_error("traj", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per "
+                     "slider), not %d", 2 * PRRU_NACT, n);
+      return 2;
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      lim->d_min[i] = v[n == 2 ? 0 : 2 * i];
+      lim->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
+      if (!(lim->d_min[i] < lim->d_max[i])) {
+        prru_cli_error("traj", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)",
+                       i + 1, lim->d_min[i], lim->d_max[i]);
+        return 2;
+      }
+    }
+  }
+  *forces = *speeds = 0;
+  for (int i = 0; i < PRRU_NACT; i++)
+    *forces += isfinite(lim->force_max[i]), *speeds += isfinite(lim->speed_max[i]);
+  return 0;
+}
+
+/* Peak |fd_i| / force_max_i and |dd_i| / speed_max_i over the rows (and
+ * the peaks themselves), each row re-checked with the exact inverse
+ * dynamics: a row beyond a limit by more than 1e-6 of it is an error. */
+typedef struct {
+  double f[PRRU_NACT], v[PRRU_NACT];
+} topp_peaks;
+
+static int topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp,
+                    double t, double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT],
+                    double dd[PRRU_NACT], topp_peaks *pk, char *why, size_t whylen)
+{
+  double r;
+  int which, kind;
+  prru_topp_eval(tp, t, q, qd, qdd);
+  int st = prru_limits_ratio(m, d, lim, q, qd, qdd, fd, dd, &r, &which, &kind);
+  if (st != PRRU_OK) {
+    snprintf(why, whylen, "t = %.9g s: inverse dynamics refuses q = (%.9g, %.9g, %.9g) (%s)", t,
+             q[0], q[1], q[2], prru_strerror(st));
+    return st;
+  }
+  if (r > 1 + 1e-6) {
+    snprintf(why, whylen, "t = %.9g s: the %s of actuator %d exceeds its limit by %.3g of it; the "
+             "profile cannot be trusted", t, kind ? "slider speed" : "force", which + 1, r - 1);
+    return PRRU_ENOCONV;
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    if (!(d->d[i] >= lim->d_min[i] && d->d[i] <= lim->d_max[i])) {
+      snprintf(why, whylen, "t = %.9g s: slider %d at d = %.9g m is outside its stroke between "
+               "two grid points", t, i + 1, d->d[i]);
+      return PRRU_ENOCONV;
+    }
+    pk->f[i] = fmax(pk->f[i], fabs(fd[i]));
+    pk->v[i] = fmax(pk->v[i], fabs(dd[i]));
+  }
+  return PRRU_OK;
+}
+
+/* The row times: every dt from 0 and the end, or (dt = 0) the grid's
+ * distinct times. */
+static long topp_nrows(const prru_topp *tp, double dt)
+{
+  if (dt > 0) return (long)fmax(1.0, ceil(tp->duration / dt - 1e-9)) + 1;
+  return (long)tp->nseg * tp->grid + 1;
+}
+
+static double topp_time(const prru_topp *tp, double dt, long k, long n)
+{
+  if (dt > 0) return k == n - 1 ? tp->duration : (double)k * dt;
+  const long N = tp->grid;
+  if (k == n - 1) return tp->duration;
+  return tp->t[(k / N) * (N + 1) + k % N];
+}
+
+/* The rows (out NULL: only the check and the peaks). */
+static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *lim,
+                     const prru_topp *tp, double dt, topp_peaks *pk, char *why, size_t whylen)
+{
+  prru_data *d = malloc(sizeof *d);
+  if (!d) {
+    snprintf(why, whylen, "out of memory");
+    return PRRU_ENOMEM;
+  }
+  memset(pk, 0, sizeof *pk);
+  const long n = topp_nrows(tp, dt);
+  int st = PRRU_OK;
+  for (long k = 0; k < n && st == PRRU_OK && !(o && o->err); k++) {
+    double q[3], qd[3], qdd[3], fd[PRRU_NACT], dd[PRRU_NACT];
+    const double t = topp_time(tp, dt, k, n);
+    if (prru_cli_interrupted) {
+      st = PRRU_EINTERRUPTED;
+      snprintf(why, whylen, "interrupted (%s) before row %ld", prru_cli_signal_name(), k + 1);
+      break;
+    }
+    st = topp_row(m, d, lim, tp, t, q, qd, qdd, fd, dd, pk, why, whylen);
+    if (st != PRRU_OK || !o) continue;
+    prru_cli_out_printf(o, "%.17g", t);
+    prru_cli_out_numbers(o, q, 3);
+    prru_cli_out_numbers(o, qd, 3);
+    prru_cli_out_numbers(o, qdd, 3);
+    prru_cli_out_numbers(o, d->d, PRRU_NACT);
+    prru_cli_out_numbers(o, dd, PRRU_NACT);
+    prru_cli_out_numbers(o, fd, PRRU_NACT);
+    prru_cli_out_printf(o, "\n");
+    prru_cli_out_row(o);
+  }
+  free(d);
+  return st;
+}
+
+/* "a,b,c" of n numbers to %.6g ("inf" for none). */
+static const char *list6(char *buf, size_t len, const double *v, int n)
+{
+  size_t k = 0;
+  buf[0] = '\0';
+  for (int i = 0; i < n && k < len; i++)
+    k += (size_t)snprintf(buf + k, len - k, isnan(v[i]) ? "%s-" : "%s%.6g", i ? "," : "", v[i]);
+  return buf;
+}
+
+static void topp_summary(prru_cli_out *o, const prru_topp *tp, const prru_limits *lim,
+                         const double *qdur, const topp_peaks *pk, FILE *err)
+{
+  char a[400], b[400];
+  double qsum = 0, rf[PRRU_NACT], rv[PRRU_NACT];
+  for (int k = 0; k < tp->nseg; k++) qsum += qdur[k];
+  for (int i = 0; i < PRRU_NACT; i++)
+    rf[i] = isfinite(lim->force_max[i]) ? pk->f[i] / lim->force_max[i] : NAN,
+    rv[i] = isfinite(lim->speed_max[i]) ? pk->v[i] / lim->speed_max[i] : NAN;
+  char lines[5][900];
+  snprintf(lines[0], sizeof lines[0], "time-optimal (reachability analysis): %d waypoints, "
+           "%.9g s; %d grid intervals per segment, a limit active on %.2f%% of them",
+           tp->nseg + 1, tp->duration, tp->grid, 100 * tp->active_fraction);
+  snprintf(lines[1], sizeof lines[1], "fastest uniformly time-scaled quintic within the same "
+           "limits: %.9g s (%.3gx the time-optimal)", qsum, qsum / tp->duration);
+  snprintf(lines[2], sizeof lines[2], "limits: force_max (N) %s; speed_max (m/s) %s",
+           list6(a, sizeof a, lim->force_max, PRRU_NACT), list6(b, sizeof b, lim->speed_max, PRRU_NACT));
+  snprintf(lines[3], sizeof lines[3], "peak |fd| (N) %s, of force_max %s%s",
+           list6(a, sizeof a, pk->f, PRRU_NACT), list6(b, sizeof b, rf, PRRU_NACT),
+           strchr(b, '-') ? " (- no limit)" : "");
+  snprintf(lines[4], sizeof lines[4], "peak |dd| (m/s) %s, of speed_max %s%s",
+           list6(a, sizeof a, pk->v, PRRU_NACT), list6(b, sizeof b, rv, PRRU_NACT),
+           strchr(b, '-') ? " (- no limit)" : "");
+  for (int k = 0; k < 5; k++) {
+    prru_cli_out_comment_line(o, "%s", lines[k]);
+    if (err) fprintf(err, "prru traj: %s\n", lines[k]);
+  }
+}
+
+typedef struct {
+  const char *wps, *durs, *dts, *out, *grid;
+  topp_limit_args lim;
+} topp_args;
+
+/* The waypoints and the settings: 0, or 2 after a message. */
+static int topp_settings(const topp_args *a, double *q, int *n, prru_limits *lim, int *grid,
+                         double *dt)
+{
+  int forces, speeds;
+  if (!a->wps) {
+    prru_cli_error("traj", "--waypoints is required (see 'prru traj --help')");
+    return 2;
+  }
+  if (a->durs) {
+    prru_cli_error("traj", "--durations does not apply with --time-optimal (the limits set the "
+                   "times)");
+    return 2;
+  }
+  if (parse_waypoints("traj", a->wps, q, n)) return 2;
+  if (*n < 2) {
+    prru_cli_error("traj", "--waypoints: %d waypoint given, at least 2 needed", *n);
+    return 2;
+  }
+  for (int k = 1; k < *n; k++)
+    if (q[3 * k] == q[3 * k - 3] && q[3 * k + 1] == q[3 * k - 2] && q[3 * k + 2] == q[3 * k - 1]) {
+      prru_cli_error("traj", "--waypoints: waypoints %d and %d coincide (a segment of length 0)", k,
+                     k + 1);
+      return 2;
+    }
+  if (topp_limits(&a->lim, lim, &forces, &speeds)) return 2;
+  if (!forces) {
+    if (speeds)
+      prru_cli_error("traj", "--time-optimal: --speed-max alone leaves the accelerations "
+                     "unbounded: give --force-max as well");
+    else
+      prru_cli_error("traj", "--time-optimal needs at least one force or speed limit, and none "
+                     "is given: --force-max F (N), with or without --speed-max V (m/s)");
+    return 2;
+  }
+  double g = 0;
+  if (a->grid && (prru_cli_number("traj", "grid", a->grid, &g) || !(g >= 2 && g <= 100000) ||
+                  g != floor(g))) {
+    prru_cli_error("traj", "--grid: '%s' is not a whole number of intervals from 2 to 100000",
+                   a->grid);
+    return 2;
+  }
+  *grid = (int)g;
+  *dt = 1e-3;
+  if (a->dts && strcmp(a->dts, "grid") == 0)
+    *dt = 0;
+  else if (a->dts && (prru_cli_number("traj", "dt", a->dts, dt) || !(*dt > 0))) {
+    prru_cli_error("traj", "--dt: '%s' is not a positive time step (s) or 'grid'", a->dts);
+    return 2;
+  }
+  return 0;
+}
+
+static int traj_time_optimal(const topp_args *a)
+{
+  static double q[3 * MAX_WAYPOINTS], qdur[MAX_WAYPOINTS];
+  prru_limits lim;
+  int n, grid;
+  double dt;
+  if (topp_settings(a, q, &n, &lim, &grid, &dt)) return 2;
+  const prru_model *m = prru_cli_model();
+  char msg[600], why[600] = "";
+  prru_topp tp;
+  prru_cli_catch_signals();
+  int st = prru_topp_solve(&tp, m, n, q, &lim, grid, msg, sizeof msg);
+  if (st == PRRU_OK) st = prru_quintic_fastest(m, n, q, &lim, 2000, qdur, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    prru_topp_free(&tp);
+    prru_cli_error("traj", "--time-optimal: %s; nothing written", msg);
+    return 1;
+  }
+  if (dt > 0 && !(tp.duration / dt <= 1e8)) {
+    prru_cli_error("traj", "--dt: %g s gives more than 1e8 rows over %g s", dt, tp.duration);
+    prru_topp_free(&tp);
+    return 2;
+  }
+  /* The rows twice: checked first (the summary needs their peaks), then
+   * written. */
+  topp_peaks pk;
+  st = topp_rows(NULL, m, &lim, &tp, dt, &pk, why, sizeof why);
+  if (st != PRRU_OK) {
+    prru_topp_free(&tp);
+    prru_cli_error("traj", "--time-optimal: %s; nothing written", why);
+    return prru_cli_exit_for(st);
+  }
+  prru_cli_out o;
+  if (prru_cli_out_open(&o, "traj", a->out)) {
+    prru_topp_free(&tp);
+    return 1;
+  }
+  char dn[256], ddn[256], fn[256];
+  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+  prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
+  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_out_comment(&o);
+  const int to_stdout = !a->out || strcmp(a->out, "-") == 0;
+  topp_summary(&o, &tp, &lim, qdur, &pk, to_stdout ? NULL : stderr);
+  prru_cli_out_printf(&o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s,%s\n", dn, ddn, fn);
+  prru_cli_out_line(&o);
+  st = topp_rows(&o, m, &lim, &tp, dt, &pk, why, sizeof why);
+  prru_topp_free(&tp);
+  return prru_cli_out_finish(&o, st, why);
+}
+
 /* ---- prru traj ---- */
 
 static const char traj_help[] =
@@ -126,7 +464,8 @@ static const char traj_help[] =
     "s = 10 u^3 - 15 u^4 + 6 u^5 (u the fraction of the segment's time), which\n"
     "starts and ends every segment at rest (zero velocity and acceleration);\n"
     "the peak speed is 1.875 |dq| / T, the peak acceleration 5.77 |dq| / T^2.\n"
-    "(--quintic names this profile, the only one.) Angles may be written as\n"
+    "(--quintic names this profile; 'prru traj --time-optimal --help' tells of\n"
+    "the fastest one within the drives' limits.) Angles may be written as\n"
     "multiples of pi (pi/12). Writes the model line, a line naming the\n"
     "waypoints, and the columns\n"
     "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n"
@@ -193,17 +532,50 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
 int prru_cmd_traj(int argc, char **argv)
 {
   const char *wps = NULL, *durs = NULL, *dts = NULL, *out = NULL;
-  int help = 0, quintic = 0;
-  prru_cli_option opts[] = {{"quintic", 0, NULL, &quintic}, {"waypoints", 1, &wps, NULL},
-                            {"durations", 1, &durs, NULL},  {"dt", 1, &dts, NULL},
-                            {"out", 1, &out, NULL},         {"help", 0, NULL, &help}};
-  if (prru_cli_parse("traj", argc, argv, opts, 6)) return 2;
-  char dn[256], ddn[256];
+  int help = 0, quintic = 0, topp = 0;
+  topp_args ta = {NULL, NULL, NULL, NULL, NULL, {{NULL, NULL, NULL}, NULL, NULL, 0}};
+  prru_cli_option opts[] = {{"quintic", 0, NULL, &quintic},
+                            {"waypoints", 1, &wps, NULL},
+                            {"durations", 1, &durs, NULL},
+                            {"dt", 1, &dts, NULL},
+                            {"out", 1, &out, NULL},
+                            {"help", 0, NULL, &help},
+                            {"time-optimal", 0, NULL, &topp},
+                            {"force-max", 1, &ta.lim.force[0], NULL},
+                            {"fmax", 1, &ta.lim.force[1], NULL},
+                            {"fd-max", 1, &ta.lim.force[2], NULL},
+                            {"speed-max", 1, &ta.lim.speed, NULL},
+                            {"stroke", 1, &ta.lim.stroke, NULL},
+                            {"no-limits", 0, NULL, &ta.lim.none},
+                            {"grid", 1, &ta.grid, NULL}};
+  if (prru_cli_parse("traj", argc, argv, opts, (int)(sizeof opts / sizeof *opts))) return 2;
+  char dn[256], ddn[256], fn[256];
   prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
   prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
+  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  if (help && topp) {
+    printf(topp_help,
+           PRRU_NACT > 3 ? "With redundant actuators, the forces of least norm (no internal preload).\n"
+                         : "",
+           dn, ddn, fn);
+    return 0;
+  }
   if (help) {
     printf(traj_help, dn, ddn);
     return 0;
+  }
+  if (topp && quintic) {
+    prru_cli_error("traj", "--quintic and --time-optimal are two profiles: give one");
+    return 2;
+  }
+  if (topp) {
+    ta.wps = wps, ta.durs = durs, ta.dts = dts, ta.out = out;
+    return traj_time_optimal(&ta);
+  }
+  if (ta.lim.force[0] || ta.lim.force[1] || ta.lim.force[2] || ta.lim.speed || ta.lim.stroke ||
+      ta.lim.none || ta.grid) {
+    prru_cli_error("traj", "the limits and --grid apply only with --time-optimal");
+    return 2;
   }
   if (!wps) {
     prru_cli_error("traj", "--waypoints is required (see 'prru traj --help')");

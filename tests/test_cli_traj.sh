@@ -8,6 +8,10 @@
 # mismatch error falling with the bandwidth, saturation reported and never
 # exceeded, seeded noise reproducible, the CSV reference equal to the
 # waypoints, and every kind of bad input refused with nothing written.
+# traj --time-optimal: every row within the limits by prru id's exact
+# inverse dynamics, faster than the scaled quintic, a limit active on >= 95 %
+# of the grid, on the built model and (three actuators) the prototype's
+# drives; infeasible limits named by grid point, bad options exit 2.
 # Needs $PRRU, $PRRU_MODEL, $PRRU_SOURCE_DIR (cli_lib.sh).
 . "$(dirname "$0")/cli_lib.sh"
 
@@ -335,6 +339,115 @@ h, r = cols(sys.argv[1])
 assert 100 < len(r) < 400001 and all(len(x) == len(h) for x in r), len(r)
 assert all(math.isfinite(v) for row in r for v in row)
 " "$tmp/sig.csv" && jcheck "$tmp/sig.json" "'interrupted' in d['status'] and d['samples'] > 100" "track SIGTERM: rows or summary"
+
+# ---- prru traj --time-optimal ----
+# The static load at the start, from the refusal of a force limit far below
+# it (which names it); limits a few times that are reached at accelerations
+# of a few g on every model.
+"$PRRU" traj --time-optimal --waypoints "$WP" --force-max 1e-3 --out "$tmp/to.csv" 2>"$tmp/err"
+st=$?
+[ $st -eq 1 ] && grep -qF "infeasible at segment 1 (waypoint 1 to 2), s = 0 (grid point 0 of 400): no acceleration holds the forces within force_max at rest; force_max of actuator" "$tmp/err" \
+  && grep -qF "nothing written" "$tmp/err" && [ ! -e "$tmp/to.csv" ] && ok \
+  || bad "time-optimal below the static load: exit $st, $(cat "$tmp/err")"
+load=$(sed -n 's/.*its static load there is \(-\?[0-9.e+-]*\) N.*/\1/p' "$tmp/err" | tr -d -)
+FLIM=$(python3 -c "print(2.5 * $load)")
+# PYTOPP: checks a time-optimal CSV (argv 1) against prru id's exact
+# inverse dynamics of its rows (argv 2), the limits F, V (argv 3, 4; 'inf'
+# for none) and the waypoints: every row within 1e-6 of the limits (the
+# library checks 9 points per grid interval to 1e-9, and the forces vary
+# smoothly in between: test_topp.c); its forces are id's (the same
+# computation, to 1e-9 of the limit); the duration is below the scaled
+# quintic's and the active share >= 95 %; at rest at both ends.
+PYTOPP="$PYCSV
+F, V = float(sys.argv[3]), float(sys.argv[4])
+h, r = cols(sys.argv[1])
+hi, ri = cols(sys.argv[2])
+n = $nact
+ix = {c: i for i, c in enumerate(h)}
+jx = {c: i for i, c in enumerate(hi)}
+assert len(r) == len(ri) > 10, (len(r), len(ri))
+worst = 0
+for a, b in zip(r, ri):
+    assert a[0] == b[0]
+    for i in range(1, n + 1):
+        f, v = b[jx['fd%d' % i]], b[jx['dd%d' % i]]
+        worst = max(worst, abs(f) / F, abs(v) / V)
+        assert abs(a[ix['fd%d' % i]] - f) <= 1e-9 * F, ('fd differs from id', a[0], i)
+assert worst <= 1 + 1e-6, ('a limit exceeded', worst)
+com = [l for l in open(sys.argv[1]) if l.startswith('#')]
+dur = float([l for l in com if 'time-optimal (reachability' in l][0].split(' waypoints, ')[1].split(' s;')[0])
+act = float([l for l in com if 'a limit active on' in l][0].split('active on ')[1].split('%')[0])
+qt = float([l for l in com if 'scaled quintic' in l][0].split('limits: ')[1].split(' s ')[0])
+# The summary's 9 significant digits: 5e-9 relative.
+assert abs(r[-1][0] - dur) <= 5e-9 * dur and r[-1][0] < qt, (r[-1][0], dur, qt)
+assert act >= 95, act
+wp = [float(x) for x in sys.argv[5].replace(';', ',').split(',')]
+for row, k in ((r[0], 0), (r[-1], len(wp) // 3 - 1)):
+    assert max(abs(row[1 + c] - wp[3 * k + c]) for c in range(3)) < 1e-14, ('waypoint', k, row[:4])
+    assert max(abs(v) for v in row[4:7]) < 1e-12, ('not at rest', k, row[4:7])
+assert all(math.isfinite(v) for row in r for v in row)
+print('%.6g %.6g %.2f' % (dur, qt, act))
+"
+topp_case() { # NAME MODEL-ARGS... -- TRAJ-ARGS... (F and V as FLIM and VLIM)
+  local name=$1 margs=() targs=()
+  shift
+  while [ "$1" != -- ]; do margs+=("$1"); shift; done
+  shift
+  "$PRRU" "${margs[@]}" traj --time-optimal --waypoints "$WP" "$@" --out "$tmp/to.csv" 2>"$tmp/err" \
+    || { bad "time-optimal $name: $(cat "$tmp/err")"; return; }
+  "$PRRU" "${margs[@]}" id --traj "$tmp/to.csv" --rates --out "$tmp/toid.csv" 2>"$tmp/err" \
+    || { bad "time-optimal $name: id: $(cat "$tmp/err")"; return; }
+  python3 -c "$PYTOPP" "$tmp/to.csv" "$tmp/toid.csv" "$FLIM" "$VLIM" "$WP" >"$tmp/to.out" 2>&1 \
+    && ok || bad "time-optimal $name: $(tail -3 "$tmp/to.out")"
+}
+VLIM=inf
+topp_case "force limit" -- --force-max "$FLIM"
+topp_case "force limit, rows at the grid" -- --fmax "$(nlist "$FLIM")" --dt grid
+VLIM=0.05
+topp_case "force and speed limits" -- --fd-max "$FLIM" --speed-max "$VLIM" --dt 2e-3
+if [ "$nact" -eq 3 ]; then
+  # The prototype: drives with damping and (smoothed) Coulomb friction.
+  proto="$PRRU_SOURCE_DIR/models/prototype_example.json"
+  VLIM=inf
+  topp_case "prototype, force limit" --model "$proto" -- --force-max "$FLIM"
+  VLIM=0.1
+  topp_case "prototype, force and speed limits" --model "$proto" -- --force-max "$FLIM" --speed-max "$VLIM"
+fi
+# The summary on stderr with --out FILE, on the paper numbers.
+"$PRRU" traj --time-optimal --waypoints "$WP" --force-max "$FLIM" --out "$tmp/to.csv" 2>"$tmp/err" \
+  && grep -q "^prru traj: time-optimal (reachability analysis): 3 waypoints, " "$tmp/err" \
+  && grep -q "^prru traj: fastest uniformly time-scaled quintic" "$tmp/err" \
+  && grep -q "^prru traj: peak |fd| (N) .*, of force_max .*1" "$tmp/err" && ok \
+  || bad "time-optimal summary on stderr: $(cat "$tmp/err")"
+# Infeasible limits: exit 1 naming the grid point and the limit, an
+# existing output unchanged.
+echo keep >"$tmp/keep.csv"
+# A stroke of +-1 nm around the first waypoint's sliders: left at once.
+"$PRRU" ik --q 0,0,0 >"$tmp/ik0.json" 2>"$tmp/err" || bad "ik at q = 0: $(cat "$tmp/err")"
+stroke=$(python3 -c "import json, sys; d = json.load(open(sys.argv[1]))['d']
+print(','.join('%r,%r' % (x - 1e-9, x + 1e-9) for x in d))" "$tmp/ik0.json")
+expect 1 "segment 1 (waypoint 1 to 2), s = 0.0025 (grid point 1 of 400): slider" -- traj --time-optimal \
+  --waypoints "$WP" --force-max "$FLIM" --stroke "$stroke" --out "$tmp/keep.csv"
+[ "$(cat "$tmp/keep.csv")" = keep ] && ok || bad "a refused time-optimal run changed its output file"
+# Bad options: exit 2.
+expect 2 "needs at least one force or speed limit, and none is given" -- traj --time-optimal --waypoints "$WP"
+expect 2 "needs at least one force or speed limit" -- traj --time-optimal --waypoints "$WP" --no-limits
+expect 2 "--speed-max alone leaves the accelerations unbounded" -- traj --time-optimal --waypoints "$WP" --speed-max 1
+expect 2 "--durations does not apply with --time-optimal" -- traj --time-optimal --waypoints "$WP" --durations 1,1 --fmax 100
+expect 2 "--force-max, --fmax and --fd-max are one option" -- traj --time-optimal --waypoints "$WP" --fmax 100 --fd-max 100
+expect 2 "--fmax: limit 0 of actuator 1 is not > 0" -- traj --time-optimal --waypoints "$WP" --fmax 0
+expect 2 "--speed-max: give 1 limit or $nact" -- traj --time-optimal --waypoints "$WP" --fmax 100 --speed-max 1,2
+expect 2 "--stroke: slider 1's range" -- traj --time-optimal --waypoints "$WP" --fmax 100 --stroke 0.3,0.2
+expect 2 "--grid: '1' is not a whole number" -- traj --time-optimal --waypoints "$WP" --fmax 100 --grid 1
+expect 2 "--grid: '2.5' is not a whole number" -- traj --time-optimal --waypoints "$WP" --fmax 100 --grid 2.5
+expect 2 "--dt: 'x' is not a positive time step (s) or 'grid'" -- traj --time-optimal --waypoints "$WP" --fmax 100 --dt x
+expect 2 "waypoints 1 and 2 coincide" -- traj --time-optimal --waypoints '0,0,0;0,0,0' --fmax 100
+expect 2 "apply only with --time-optimal" -- traj --waypoints "$WP" --durations 1,1 --fmax 100
+expect 2 "two profiles" -- traj --quintic --time-optimal --waypoints "$WP" --fmax 100
+"$PRRU" traj --time-optimal --help >"$tmp/help_topp.txt" && grep -qF "$(act_names fd)" "$tmp/help_topp.txt" \
+  && awk 'length > 80 { bad = 1 } END { exit bad }' "$tmp/help_topp.txt" \
+  && ! grep -q -i -E "gsl|kernel|runtime|prru_[a-z]|PRRU_" "$tmp/help_topp.txt" && ok \
+  || bad "traj --time-optimal --help: $(head -c 300 "$tmp/help_topp.txt")"
 
 # The figure, where gnuplot is installed.
 if command -v gnuplot >/dev/null; then

@@ -116,6 +116,113 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
  * signs of det J_d (prru_jd_det_sign, prru.h) show that crossing whatever
  * the sampling (prru traj and prru track refuse such a path). */
 
+/* ---- Time-optimal path parameterisation (TOPP-RA) ----
+ * The path of prru_quintic_waypoints (straight lines in q from waypoint to
+ * waypoint, at rest at every waypoint) traversed as fast as the drives'
+ * limits (prru_limits: rail force, slider speed, stroke) allow. Segment k
+ * is q(s) = q_k + s (q_{k+1} - q_k), s in [0, 1], and each segment is a
+ * rest-to-rest problem of its own. Along it qd = q' s', qdd = q' s'' and
+ * the actuator forces of inverse dynamics (prru_inverse_dynamics, no
+ * platform loads; with four actuators the minimum-norm forces, no preload)
+ * are
+ *     f(s) = a(s) s'' + b(s) s'^2 + c(s) + h(s, s'),
+ * a, b, c taken from the inverse dynamics itself (affine in qdd, even part
+ * quadratic in qd; the armature is in a and b) and h the odd part, the
+ * drives' damping and smoothed Coulomb friction (nonlinear in s').
+ *
+ * Method (Pham & Pham, IEEE T-RO 2018). On a grid of N intervals per
+ * segment with x = s'^2 and a constant u = s'' on each interval (so x is
+ * linear in s and x_{j+1} = x_j + 2 (s_{j+1} - s_j) u_j), every
+ * interval's (u_j, x_j) is confined by linear inequalities: the force
+ * limits at both ends of the interval (at s_j with x_j and at s_{j+1}
+ * with x_j + 2 Delta u_j, the "interpolation" discretisation, so that the
+ * forces are within the limits where the acceleration jumps), the speed
+ * limits |dd_i/ds| s' <= speed_max_i as bounds on x at both ends, x >= 0.
+ * The backward pass computes the controllable sets K_j = [lo_j, hi_j]
+ * (the x from which rest at the segment's end can still be reached; a
+ * two-variable linear programme per grid point), the forward pass picks
+ * the largest u_j keeping x_{j+1} in K_{j+1} from x_0 = 0. The drive term
+ * h, not linear in x, enters linearised at x0, the previous pass's x (the
+ * first pass leaves h out): as its secant through x = 0, h(x0)/x0 x, until
+ * x moves by less than 5 % between passes, then as its tangent (Newton's
+ * method; back to secants, switching ten times later, should a pass on
+ * tangents find the path infeasible), repeated until x moves by less
+ * than 1e-6 of its largest value. The linearisation is exact at x0, and
+ * whatever it leaves is caught by the check: the result is
+ * then checked with the exact inverse dynamics at 9 points of every
+ * interval, and where a force or speed exceeds its limit by more than
+ * PRRU_TOPP_CHECK_TOL (relative), that limit is tightened at the
+ * interval's ends by the excess and the passes run again (at most
+ * PRRU_TOPP_MAX_ITER times, else PRRU_ENOCONV). */
+#define PRRU_TOPP_GRID_DEFAULT 400
+#define PRRU_TOPP_CHECK_TOL 1e-9
+#define PRRU_TOPP_MAX_ITER 200
+
+typedef struct {
+  int nseg;     /* segments (waypoints - 1) */
+  int grid;     /* intervals per segment, N */
+  double *q;    /* the waypoints, (nseg + 1) x 3 */
+  /* Per grid point, nseg x (N + 1), segment-major: s'^2, the constant s''
+   * of the interval that starts there (0 at a segment's last point) and
+   * the time (s, from 0; a segment's last point and the next one's first
+   * share theirs). */
+  double *x, *u, *t;
+  double duration;        /* s */
+  /* The share of intervals on which some limit is within 1e-3 (relative)
+   * of its bound at one of the interval's ends (the exact inverse
+   * dynamics), and the passes run. */
+  double active_fraction;
+  int iterations;
+} prru_topp;
+
+/* The time-optimal parameterisation of the path through the n waypoints
+ * q (n x 3) under lim, on grid intervals per segment (0: the default
+ * PRRU_TOPP_GRID_DEFAULT; 2 .. 100000). Needs a finite force_max on at
+ * least one actuator (the speed limits alone leave the accelerations
+ * unbounded). PRRU_EINPUT with msg for bad arguments and for an
+ * infeasible path, naming the first infeasible grid point (segment, s,
+ * grid point) and the limit: a pose outside the workspace, singular, or
+ * (three actuators) across a sign change of det J_d; a slider outside
+ * its stroke; no acceleration that holds the forces within force_max
+ * there (at rest, or on the way from rest to rest). PRRU_ESINGULAR where
+ * inverse dynamics refuses a pose (too near the workspace boundary),
+ * PRRU_ENOCONV when the check does not pass after PRRU_TOPP_MAX_ITER
+ * tightenings, PRRU_ENOMEM. Allocates: prru_topp_free (also after a
+ * failure, which leaves tp empty). */
+int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
+                    const prru_limits *lim, int grid, char *msg, int msglen);
+/* q, qd, qdd at time t in [0, duration] (any output NULL if not wanted):
+ * s(t) integrated exactly with the constant s'' of t's interval (the
+ * interval that starts at or before t; the last one at t = duration).
+ * PRRU_EINPUT outside [0, duration]. */
+int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], double qdd[3]);
+void prru_topp_free(prru_topp *tp);
+
+/* The exact check of one state against lim (no platform loads): fd the
+ * inverse dynamics' forces (minimum norm with four actuators), dd the
+ * slider speeds (either may be NULL), *ratio the largest of |fd_i| /
+ * force_max_i and |dd_i| / speed_max_i (0 with no finite limit), *which
+ * its actuator (0-based) and *kind 0 force, 1 speed (NULL if not wanted).
+ * The stroke is not part of it (prru_topp_solve checks it at the grid);
+ * d->d and d->Jd hold the pose's sliders and J_d afterwards. The statuses
+ * of prru_inverse_dynamics. */
+int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
+                      const double q[3], const double qd[3], const double qdd[3],
+                      double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
+                      int *kind);
+
+/* The fastest point-to-point quintic (prru_quintic_waypoints' time law)
+ * through the same waypoints whose every segment is uniformly time-scaled
+ * to meet lim: per segment the shortest duration T for which the largest
+ * prru_limits_ratio over samples + 1 evenly spaced points in the
+ * segment's time is <= 1, by bisection on T to 1e-9 relative (doubling
+ * from 1 s to bracket it). durations: n - 1. PRRU_EINPUT with msg when
+ * no duration up to 2^60 s meets the limits (the static loads exceed
+ * them), and with inverse dynamics' status where it refuses a pose. The
+ * stroke is not checked here (the path's poses are prru_topp_solve's). */
+int prru_quintic_fastest(const prru_model *m, int n, const double *q, const prru_limits *lim,
+                         int samples, double *durations, char *msg, int msglen);
+
 #ifdef __cplusplus
 }
 #endif
