@@ -78,6 +78,13 @@ def render(prru):
         text = help_text(prru, [c])
         check_no_paths("prru " + c, text, prru)
         parts.append(f"## prru {c}\n\n" + fenced(text))
+        # A mode with help of its own, which the command's help names as
+        # 'prru COMMAND --MODE --help' (traj --time-optimal).
+        for mode in dict.fromkeys(re.findall(r"'prru %s (--[a-z][a-z-]*) --help'" % re.escape(c),
+                                             text.replace("\n", " "))):
+            sub = help_text(prru, [c, mode])
+            check_no_paths(f"prru {c} {mode}", sub, prru)
+            parts.append(f"### prru {c} {mode}\n\n" + fenced(sub))
     return "\n".join(parts)
 
 
