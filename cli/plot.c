@@ -110,9 +110,16 @@ static const char line_styles[] =
  * up whatever the width of the tick labels), the key to the right, the
  * title two lines high, room at the bottom for the last x label and the
  * footer. title: a gnuplot string expression. */
+/* Lines of the footer the script being written draws (prru_plot_footer
+ * sets it; the figures are made one at a time). */
+static int footer_lines = 1;
+
 static void put_layout(FILE *g, int rows, int px, const char *title)
 {
-  double bottom = 78.0 / px, top = 1.0 - 62.0 / px, spacing = 34.0 / px;
+  /* 78 px hold the x label and a footer of two lines; each further line
+   * of 8-point type takes 12 px more, so the label never meets it. */
+  double bottom = (78.0 + 12.0 * (footer_lines > 2 ? footer_lines - 2 : 0)) / px, top = 1.0 - 62.0 / px,
+         spacing = 34.0 / px;
   fprintf(g, "set multiplot layout %d,1 margins screen 0.11, 0.83, %.4f, %.4f spacing screen 0, %.4f "
              "title %s\n", rows, bottom, top, spacing, title);
 }
@@ -175,7 +182,8 @@ void prru_plot_footer(FILE *g, const char *text)
   put_string_width(g, text, 1, FOOTER_WIDTH);
   /* The label's position is its first line's: lines go up from the edge
    * (in characters of the 11-point font: a line of 8 points is 3/4 of one). */
-  fprintf(g, "\nfooter_up = %.2f\n", 0.5 + 0.75 * (count_lines(text, FOOTER_WIDTH) - 1));
+  footer_lines = count_lines(text, FOOTER_WIDTH);
+  fprintf(g, "\nfooter_up = %.2f\n", 0.5 + 0.75 * (footer_lines - 1));
   fputs(footer_label, g);
 }
 
@@ -725,7 +733,9 @@ static void put_series_figure(FILE *g, const char *csv, const char *png, int px,
   fputs(line_styles, g);
   prru_plot_footer(g, footer);
   /* The time axis is the run's span, not the next round number. */
-  fputs("set grid\nset key outside right top\nset autoscale xfix\nset offsets 0, 0, graph 0.05, graph 0.05\n"
+  /* Short key samples: the key's column (right of the panels) then holds
+   * "limit +-100 N" without running into the panel. */
+  fputs("set grid\nset key outside right top samplen 2\nset autoscale xfix\nset offsets 0, 0, graph 0.05, graph 0.05\n"
         "set ytics format '%g'\n", g);
 }
 
@@ -775,20 +785,24 @@ char *prru_plot_series_script(const char *csv, const char *png, const char *mode
 
 /* The force limits as lines at +-f_max[i] (finite ones), each with a key
  * entry saying its value, grey, dash-dotted: "...", without the line end. */
-static void put_limits(FILE *g, int nact, const double *f_max)
+/* The +-limit lines of a panel (unit in the key: "N", "m/s"), one key
+ * entry for equal limits; a non-finite limit draws nothing. */
+static void put_limits_unit(FILE *g, int nact, const double *lim, const char *unit)
 {
   for (int i = 0; i < nact; i++) {
-    if (!isfinite(f_max[i])) continue;
-    int same = 0; /* one key entry for equal limits */
-    for (int k = 0; k < i; k++) same |= f_max[k] == f_max[i];
-    fprintf(g, ", %.17g with lines lc rgb '#707070' lw 1.5 dt (6,3,1,3) ", f_max[i]);
+    if (!isfinite(lim[i])) continue;
+    int same = 0;
+    for (int k = 0; k < i; k++) same |= lim[k] == lim[i];
+    fprintf(g, ", %.17g with lines lc rgb '#707070' lw 1.5 dt (6,3,1,3) ", lim[i]);
     if (same)
       fputs("notitle", g);
     else
-      fprintf(g, "title sprintf('limit \xc2\xb1%%.4g N', %.17g)", f_max[i]);
-    fprintf(g, ", %.17g with lines lc rgb '#707070' lw 1.5 dt (6,3,1,3) notitle", -f_max[i]);
+      fprintf(g, "title sprintf('limit \xc2\xb1%%.4g %s', %.17g)", unit, lim[i]);
+    fprintf(g, ", %.17g with lines lc rgb '#707070' lw 1.5 dt (6,3,1,3) notitle", -lim[i]);
   }
 }
+
+static void put_limits(FILE *g, int nact, const double *f_max) { put_limits_unit(g, nact, f_max, "N"); }
 
 char *prru_plot_track_script(const char *csv, const char *png, const char *model, const char *footer,
                              int nact, const double *f_max)
@@ -887,6 +901,30 @@ char *prru_plot_ident_script(const char *dat, const char *png, const char *model
              "title 'estimate {/Symbol \\261} 3 se', \\\n"
              "     rep using 1:4 with points pt 4 ps 1.6 lw 2 lc rgb '#d55e00' title 'written model'\n",
           n);
+  return close_script(g, &buf);
+}
+
+char *prru_plot_topp_script(const char *csv, const char *png, const char *model, const char *footer, int nact,
+                            const double *f_max, const double *v_max)
+{
+  char *buf;
+  size_t len;
+  FILE *g = open_script(&buf, &len);
+  if (!g) return NULL;
+  const int px = 120 + 220 * 4;
+  put_series_figure(g, csv, png, px, model, footer);
+  put_layout(g, 4, px, "'Time-optimal trajectory, model '.model");
+  fputs("set ylabel 'rotation (rad)'\n"
+        "plot f using 't':'q1' with lines lt 1 title 'q_1', '' using 't':'q2' with lines lt 2 title 'q_2'\n", g);
+  put_footer_done(g);
+  fputs("set ylabel 'height (m)'\nplot f using 't':'q3' with lines lt 1 title 'q_3'\n"
+        "set ylabel 'slider velocity (m/s)'\n", g);
+  put_series(g, "dd", "v_{d", "}", nact);
+  put_limits_unit(g, nact, v_max, "m/s");
+  fputs("\nset xlabel 'time t (s)'\nset ylabel 'actuator force (N)'\n", g);
+  put_series(g, "fd", "f_{d", "}", nact);
+  put_limits_unit(g, nact, f_max, "N");
+  fputs("\nunset multiplot\n", g);
   return close_script(g, &buf);
 }
 

@@ -139,6 +139,10 @@ char *prru_plot_motion_script(const char *csv, const char *png, const char *mode
                               int nact, int forces);
 /* The actuator forces fd1..fd<nact> of a `prru id` CSV over time.
  * Malloc'ed, NULL: no memory. */
+/* prru traj --time-optimal's CSV: q1 and q2, q3, the slider velocities
+ * with +-v_max, the actuator forces with +-f_max (non-finite: no limit). */
+char *prru_plot_topp_script(const char *csv, const char *png, const char *model, const char *footer, int nact,
+                            const double *f_max, const double *v_max);
 /* identify's report: per base parameter the estimate with 3 se and the
  * written model's value, relative to the prior (columns of dat: index,
  * (estimate - prior) / s, 3 se / s, (model - prior) / s, name). */

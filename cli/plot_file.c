@@ -21,7 +21,7 @@
 #include "prru.h"
 
 /* What a CSV holds, from its header. */
-enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP, CSV_TRACK, CSV_TRAJ, CSV_EXCITE, CSV_ID, CSV_IDENT };
+enum { CSV_UNKNOWN, CSV_SIMULATION, CSV_MAP, CSV_TRACK, CSV_TRAJ, CSV_EXCITE, CSV_ID, CSV_IDENT, CSV_TOPP };
 
 /* The header of a map CSV, and the start of the others'. */
 static const char map_header[] = "q1,q2,q3,w_R,status";
@@ -55,6 +55,8 @@ static int header_kind(const char *header)
   if (strcmp(header, map_header) == 0) return CSV_MAP;
   if (starts_with(header, sim_header)) return CSV_SIMULATION;
   if (starts_with(header, track_header)) return CSV_TRACK;
+  if (starts_with(header, motion_header) && has_column(header, "dd1") && has_column(header, "fd1"))
+    return CSV_TOPP;
   if (starts_with(header, motion_header) && has_column(header, "dd1")) return CSV_TRAJ;
   if (starts_with(header, motion_header) && has_column(header, "fd1")) return CSV_EXCITE;
   if (starts_with(header, id_header)) return CSV_ID;
@@ -69,6 +71,7 @@ typedef struct {
   char text[400];
   char model[200];
   int count;
+  char limits[400]; /* the line "# limits: ..." of a time-optimal trajectory, else "" */
 } csv_comments;
 
 /* NAME out of "prru VERSION model NAME (...": "" when line is not so. */
@@ -106,6 +109,7 @@ static int read_head(FILE *f, csv_comments *c, char **header, long *line_no)
     ++*line_no;
     chomp(*header);
     if ((*header)[0] == '#') {
+      if (starts_with(*header, "# limits: ")) snprintf(c->limits, sizeof c->limits, "%s", *header + 10);
       add_comment(c, *header);
       continue;
     }
@@ -293,7 +297,8 @@ static int convert_ident(const char *cmd, const char *path, FILE *f, long line_n
 
 /* What each kind is called in messages, by the enum. */
 static const char *const kind_name[] = {"", "a simulation", "a map", "a tracking", "a trajectory",
-                                        "an excitation", "an inverse dynamics", "an identification report"};
+                                        "an excitation", "an inverse dynamics", "an identification report",
+                                        "a time-optimal trajectory"};
 
 /* The number of columns <prefix>1, <prefix>2, ... of t. */
 static int count_columns(const prru_table *t, const char *prefix)
@@ -336,12 +341,35 @@ static void track_limits(const prru_table *t, int nact, double *f_max)
   }
 }
 
+/* The limits of a time-optimal trajectory's line "force_max (N) F1,F2,..;
+ * speed_max (m/s) V1,V2,..": each list as written, NAN where a kind is not
+ * named (no limit of that kind: no line drawn). */
+static void topp_limits(const char *line, int nact, double *f_max, double *v_max)
+{
+  static const char *const key[2] = {"force_max (N) ", "speed_max (m/s) "};
+  double *out[2] = {f_max, v_max};
+  for (int k = 0; k < 2; k++) {
+    for (int i = 0; i < nact; i++) out[k][i] = NAN;
+    const char *p = strstr(line, key[k]);
+    if (!p) continue;
+    p += strlen(key[k]);
+    for (int i = 0; i < nact; i++) {
+      char *end;
+      const double v = strtod(p, &end);
+      if (end == p) break;
+      out[k][i] = v > 0 ? v : NAN;
+      if (*end != ',') break;
+      p = end + 1;
+    }
+  }
+}
+
 /* Checks a time series CSV of the kind (every row as long as the header,
  * finite numbers, the columns the figure draws) with the runtime's table
  * reader and writes its script (the CSV by its absolute path abs) into
  * *script; 0, 1 (no memory) or 2 after a message. */
 static int series_script(const char *cmd, const char *path, const char *abs, int kind,
-                         const char *model, const char *footer, char **script)
+                         const char *model, const char *footer, const char *limits, char **script)
 {
   prru_table t;
   char msg[600];
@@ -356,14 +384,17 @@ static int series_script(const char *cmd, const char *path, const char *abs, int
     rc = 2;
   }
   int nact = count_columns(&t, kind == CSV_TRACK || kind == CSV_ID ? "fd" : "d");
+  double v_max[64];
   double f_max[64];
-  if (rc == 0 && kind == CSV_TRACK && nact > (int)(sizeof f_max / sizeof f_max[0])) {
+  if (rc == 0 && (kind == CSV_TRACK || kind == CSV_TOPP) && nact > (int)(sizeof f_max / sizeof f_max[0])) {
     prru_cli_error(cmd, "%s: more than %d actuators", path, (int)(sizeof f_max / sizeof f_max[0]));
     rc = 2;
   }
   if (rc == 0 && kind == CSV_TRACK) rc = need_columns(cmd, path, kind, &t, "sat", nact);
   if (rc == 0 && kind == CSV_TRAJ) rc = need_columns(cmd, path, kind, &t, "dd", nact);
   if (rc == 0 && kind == CSV_EXCITE) rc = need_columns(cmd, path, kind, &t, "fd", nact);
+  if (rc == 0 && kind == CSV_TOPP) rc = need_columns(cmd, path, kind, &t, "dd", nact);
+  if (rc == 0 && kind == CSV_TOPP) rc = need_columns(cmd, path, kind, &t, "fd", nact);
   if (rc == 0) {
     if (kind == CSV_SIMULATION)
       *script = prru_plot_series_script(abs, "plot.png", model, footer, nact,
@@ -371,6 +402,9 @@ static int series_script(const char *cmd, const char *path, const char *abs, int
     else if (kind == CSV_TRACK) {
       track_limits(&t, nact, f_max);
       *script = prru_plot_track_script(abs, "plot.png", model, footer, nact, f_max);
+    } else if (kind == CSV_TOPP) {
+      topp_limits(limits, nact, f_max, v_max);
+      *script = prru_plot_topp_script(abs, "plot.png", model, footer, nact, f_max, v_max);
     } else if (kind == CSV_ID)
       *script = prru_plot_forces_script(abs, "plot.png", model, footer, nact);
     else
@@ -532,7 +566,7 @@ int prru_plot_csv(const char *cmd, const char *in, const char *out, double clip)
       prru_cli_error(cmd, "%s: %s", in, strerror(errno));
       rc = 2;
     }
-    if (rc == 0) rc = series_script(cmd, in, abs_in, kind, model, footer, &script);
+    if (rc == 0) rc = series_script(cmd, in, abs_in, kind, model, footer, com.limits, &script);
   }
   if (rc == 0) rc = prru_plot_run(cmd, dir, dir, "plot.gp", script);
   if (rc == PRRU_PLOT_NO_GNUPLOT) {

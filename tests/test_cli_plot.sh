@@ -122,6 +122,29 @@ for c in "track 1000 1300" "traj 1000 1000" "excite 1000 1000" "id 1000 600"; do
   "$PRRU" plot "$tmp/$1.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/$1.png")" = "$2 $3" ] && [ ! -s "$tmp/err" ] \
     && ok || bad "plot of a $1 CSV: $(png_size "$tmp/$1.png") $(head -c 300 "$tmp/err")"
 done
+# A time-optimal trajectory: the slider velocities and the forces with
+# their limits, read from its '# limits:' line (the gnuplot script kept).
+# Limits any model meets: twice the largest force the quintic needs (so
+# the path is feasible), half its largest slider speed (so that limit acts).
+LIMS=$(python3 -c '
+import csv, sys
+def peak(f, p):
+    rows = [r for r in csv.reader(l for l in open(f) if not l.startswith("#"))]
+    cols = [i for i, n in enumerate(rows[0]) if n.startswith(p) and n[len(p):].isdigit()]
+    return max(abs(float(r[i])) for r in rows[1:] for i in cols)
+print("--force-max %.6g --speed-max %.6g" % (2 * peak(sys.argv[1], "fd"), 0.5 * peak(sys.argv[2], "dd")))' \
+  "$tmp/id_fmax.csv" "$tmp/traj.csv")
+# shellcheck disable=SC2086
+"$PRRU" traj --time-optimal --waypoints "$WP" $LIMS --out "$tmp/topp.csv" 2>"$tmp/err" \
+  || bad "traj --time-optimal $LIMS: $(cat "$tmp/err")"
+rm -f "$tmp"/gp.*
+mkdir -p "$tmp/keepbin0"
+printf '#!/bin/sh\ncp "$1" "%s/topp.gp"\nexec "%s" "$@"\n' "$tmp" "$(command -v gnuplot)" >"$tmp/keepbin0/gnuplot"
+chmod +x "$tmp/keepbin0/gnuplot"
+PATH="$tmp/keepbin0:$PATH" "$PRRU" plot "$tmp/topp.csv" 2>"$tmp/err" && [ "$(png_size "$tmp/topp.png")" = "1000 1000" ] \
+  && [ ! -s "$tmp/err" ] && grep -q "title sprintf('limit .*%.4g m/s', " "$tmp/topp.gp" \
+  && grep -q "title sprintf('limit .*%.4g N', " "$tmp/topp.gp" && grep -q "Time-optimal trajectory" "$tmp/topp.gp" \
+  && ok || bad "plot of a time-optimal trajectory: $(png_size "$tmp/topp.png") $(head -c 300 "$tmp/err")"
 # identify's report (its format, rows written here): one tick per base
 # parameter, 1000 x 650 for a few.
 { echo "# prru 0.2.0 model prru (x.json, sha256 $(printf '0%.0s' $(seq 64)), parameter kernels)"
@@ -269,7 +292,7 @@ scripts() { rm -f "$tmp"/gp.*; PATH="$tmp/keepbin:$PATH" "$PRRU" "$@"; }
 scripts paper --out "$tmp/fig" >/dev/null 2>"$tmp/err" || bad "paper: $(head -c 300 "$tmp/err")"
 cat "$tmp"/gp.* >"$tmp/paper.gp"
 "$PRRU" animate "$tmp/run.csv" --frames 3 --out "$tmp/kinds.gif" || bad "animate"
-r=$(picture_ok "$tmp"/{run,m,track,traj,excite,id,ident,track2}.png "$tmp/kinds.gif" "$tmp"/fig/*.png)
+r=$(picture_ok "$tmp"/{run,m,track,traj,excite,id,ident,topp,track2}.png "$tmp/kinds.gif" "$tmp"/fig/*.png)
 [ "$r" = ok ] && [ "$(ls "$tmp"/fig/*.png | wc -l)" = 8 ] && ok || bad "a figure is not a whole picture: $r"
 # One perceptually uniform colour map (viridis) for every map, and the
 # clip said in the colour key: by default the 99th percentile of w_R.
