@@ -444,7 +444,8 @@ int prru_cmd_id(int argc, char **argv)
   prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
   char why[700] = "";
-  int sign = 0; /* det J_d's sign at the rows so far (0 with four actuators) */
+  prru_path_side side;
+  prru_path_side_init(&side);
   double t_prev = 0;
   for (int i = 0; st == PRRU_OK && !o.err && i < t.nrows; i++) {
     if (prru_cli_interrupted) {
@@ -465,7 +466,8 @@ int prru_cmd_id(int argc, char **argv)
     memcpy(l.mp, v + 13, sizeof l.mp);
     double n[PRRU_NACT];
     st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
-    const int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0; /* J_d of this row */
+    /* J_d of this row: on the side of the rows before? */
+    const int crossed = st == PRRU_OK && prru_path_side_crossed(&side, d->Jd);
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
     double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
     if (st == PRRU_OK && rates) {
@@ -483,14 +485,13 @@ int prru_cmd_id(int argc, char **argv)
     /* Each row is regular on its own, but the motion between two rows
      * passed a singular pose when det J_d changed sign (as in 'prru traj'):
      * what it would take is not these forces. */
-    if (s * sign < 0) {
+    if (crossed) {
       st = PRRU_ESINGULAR;
       snprintf(why, sizeof why, "%s: data row %d (t = %g): the motion crosses a singularity "
                "(J_d singular) after the row before (t = %g): det J_d changes sign at q = (%.9g, "
                "%.9g, %.9g)", traj, i + 1, v[0], t_prev, v[1], v[2], v[3]);
       break;
     }
-    if (s) sign = s;
     t_prev = v[0];
     prru_cli_out_printf(&o, "%.17g", v[0]);
     prru_cli_out_numbers(&o, fd, PRRU_NACT);

@@ -491,7 +491,9 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
   /* The rows t0 + k dt and t1 (a remainder below 1e-9 dt merged into the
    * last row); at least those two, however short the span. */
   const long n = (long)fmax(1.0, ceil((t1 - t0) / dt - 1e-9));
-  int st = PRRU_OK, sign = 0;
+  int st = PRRU_OK, crossed;
+  prru_path_side side;
+  prru_path_side_init(&side);
   double t_prev = t0;
   for (long k = 0; k <= n && !o->err; k++) {
     double t = k == n ? t1 : t0 + (double)k * dt, q[3], qd[3], qdd[3], dd[PRRU_NACT],
@@ -502,13 +504,11 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
       break;
     }
     prru_quintic_eval(tr, t, q, qd, qdd);
-    st = prru_traj_pose_ok(&m, d, q, &rc);
-    int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0;
-    if (st != PRRU_OK || s * sign < 0) {
+    st = prru_path_sample(&side, &m, d, q, &rc, &crossed);
+    if (st != PRRU_OK) {
       int seg = 0;
       while (seg + 2 < tr->n && tr->t[seg + 1] <= t) seg++;
-      if (st == PRRU_OK) {
-        st = PRRU_ESINGULAR;
+      if (crossed) {
         snprintf(why, whylen, "sample %ld (t = %.9g s, segment %d: waypoint %d to %d): the path "
                  "crosses a singularity (J_d singular) after t = %.9g s: det J_d changes sign "
                  "at q = (%.9g, %.9g, %.9g)", k + 1, t, seg + 1, seg + 1, seg + 2, t_prev, q[0],
@@ -520,7 +520,6 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
       }
       break;
     }
-    if (s) sign = s;
     t_prev = t;
     prru_model_actuator_rates(&m, q, qd, dd, ddb);
     prru_cli_out_motion_row(o, t, q, qd, qdd, d->d, dd);
@@ -780,21 +779,21 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
   if (!d) return 1;
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
   const long n = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9)); /* as traj_rows */
-  int rc = 0, sign = 0;
+  int rc = 0, crossed;
+  prru_path_side side;
+  prru_path_side_init(&side);
   *ff_peak = 0;
   for (long k = 0; k <= n && !rc; k++) {
     double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
     prru_quintic_eval(tr, t, q, qd, qdd);
-    int st = prru_traj_pose_ok(&m, d, q, &rcond);
-    int s = st == PRRU_OK ? prru_jd_det_sign(d->Jd) : 0;
-    if (s * sign < 0) {
+    int st = prru_path_sample(&side, &m, d, q, &rcond, &crossed);
+    if (crossed) {
       prru_cli_error("track", "reference at sample %ld (t = %.9g s): the path crosses a "
                      "singularity (det J_d changes sign) before q = (%.9g, %.9g, %.9g); nothing "
                      "written", k + 1, t, q[0], q[1], q[2]);
       rc = 2;
       break;
     }
-    if (s) sign = s;
     if (st != PRRU_OK) {
       prru_cli_error("track", "reference at sample %ld (t = %.9g s): q = (%.9g, %.9g, %.9g) is %s; "
                      "nothing written", k + 1, t, q[0], q[1], q[2], pose_problem(st));

@@ -19,7 +19,7 @@ static const struct {
     {"traj", prru_cmd_traj, "quintic point-to-point trajectory through waypoints, CSV"},
     {"track", prru_cmd_track, "computed-torque tracking of a trajectory, simulated, CSV"},
     {"excite", prru_cmd_excite, "optimised periodic excitation trajectory for identification, CSV"},
-    {"measure", prru_cmd_measure, "a simulated run as the sensors see it: quantised d, noisy forces, CSV"},
+    {"measure", prru_cmd_measure, "a simulated run as sensors see it: quantised d, noisy forces, CSV"},
     {"identify", prru_cmd_identify, "base inertial parameters from measured motion and forces (model)"},
     {"dme", prru_cmd_dme, "dynamic manipulability ellipsoid and w_R at one pose (JSON)"},
     {"map", prru_cmd_map, "w_R over a (q1, q2) grid, CSV, and the global index"},

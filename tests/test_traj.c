@@ -361,8 +361,31 @@ static void differentiate_quintic(void)
   prru_quintic_free(&tr);
 }
 
+/* prru_path_side: a sign change of det J_d between regular samples is a
+ * crossing; a singular sample (det 0) neither records nor crosses; with
+ * four actuators (no determinant) nothing is ever crossed. */
+static void path_side(void)
+{
+  double Jp[PRRU_NACT * 3], Jn[PRRU_NACT * 3], J0[PRRU_NACT * 3];
+  memset(Jp, 0, sizeof Jp);
+  for (int i = 0; i < 3; i++) Jp[4 * i] = 1; /* rows 1..3 the identity */
+  memcpy(Jn, Jp, sizeof Jn);
+  Jn[0] = -1;
+  memcpy(J0, Jp, sizeof J0);
+  J0[0] = 0;
+  prru_path_side s;
+  prru_path_side_init(&s);
+  const int square = PRRU_NACT == 3;
+  TU_TRUE(!prru_path_side_crossed(&s, J0), "path side: a singular first sample records nothing");
+  TU_TRUE(!prru_path_side_crossed(&s, Jp) && s.sign == (square ? 1 : 0), "path side: the first sign");
+  TU_TRUE(!prru_path_side_crossed(&s, J0) && !prru_path_side_crossed(&s, Jp), "path side: the same side");
+  TU_TRUE(prru_path_side_crossed(&s, Jn) == square, "path side: the other side is a crossing (three actuators)");
+  TU_TRUE(s.sign == (square ? 1 : 0), "path side: a crossing keeps the sign before it");
+}
+
 int main(void)
 {
+  path_side();
   polynomial_exact(4, 4);
   polynomial_exact(3, 2);
   polynomial_exact(6, 5);

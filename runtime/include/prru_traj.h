@@ -114,7 +114,24 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
 /* Samples of a path are regular one by one even where the path crosses
  * the singular set between two of them; two regular samples with opposite
  * signs of det J_d (prru_jd_det_sign, prru.h) show that crossing whatever
- * the sampling (prru traj and prru track refuse such a path). */
+ * the sampling (prru traj, track, id and the time-optimal planner refuse
+ * such a path). prru_path_side follows the sign along the samples, in
+ * order; with four actuators J_d has no determinant and nothing is
+ * crossed. */
+typedef struct {
+  int sign; /* det J_d's sign at the regular samples so far, 0 before */
+} prru_path_side;
+/* Before the first sample. */
+void prru_path_side_init(prru_path_side *s);
+/* 1 when the regular sample's J_d has the opposite sign to the samples
+ * before (the path crossed the singular set since the last one; the sign
+ * kept), else 0 (the sign recorded). */
+int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3]);
+/* The next sample q of a path: prru_traj_pose_ok's status (d filled as
+ * there), or PRRU_ESINGULAR with *crossed = 1 when the pose is regular but
+ * on the other side of the singular set (crossed may be NULL). */
+int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const double q[3], double *rcond,
+                     int *crossed);
 
 /* ---- Time-optimal path parameterisation (TOPP-RA) ----
  * The path of prru_quintic_waypoints (straight lines in q from waypoint to

@@ -41,7 +41,9 @@ typedef struct {
   const prru_model *m;
   prru_data *d;
   const prru_limits *lim;
-  int N, seg, det_sign, drives;
+  int N, seg;
+  prru_path_side side; /* det J_d's side of the singular set along the path */
+  int drives;
   int tangent;        /* how the drives are linearised */
   double tangent_from; /* tangents once x moves less than this (relative) */
   const double *qa, *qb;
@@ -117,12 +119,10 @@ static int point_terms(topp_ctx *c, int j)
                      st == PRRU_EUNREACHABLE ? "outside the workspace"
                      : st == PRRU_ESINGULAR  ? "at a singularity (J_d singular)"
                                              : prru_strerror(st));
-  int sg = prru_jd_det_sign(c->d->Jd);
-  if (sg && c->det_sign && sg != c->det_sign)
+  if (prru_path_side_crossed(&c->side, c->d->Jd))
     return prru_fail(c->msg, c->msglen, PRRU_EINPUT,
                      "%s: the path crosses a singularity before q = (%.9g, %.9g, %.9g) (det J_d "
                      "changes sign)", at, q[0], q[1], q[2]);
-  if (sg) c->det_sign = sg;
   for (int i = 0; i < PRRU_NACT; i++) {
     if (!(c->d->d[i] >= c->lim->d_min[i] && c->d->d[i] <= c->lim->d_max[i]))
       return prru_fail(c->msg, c->msglen, PRRU_EINPUT,
@@ -549,7 +549,7 @@ int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
   if (st != PRRU_OK) return st;
   const int N = grid ? grid : PRRU_TOPP_GRID_DEFAULT;
   const size_t np = (size_t)(n - 1) * (size_t)(N + 1);
-  topp_ctx c = {m, NULL, lim, N, 0, 0, has_drives(m), 0, 0.05, NULL, NULL, {0}, NULL, NULL, NULL,
+  topp_ctx c = {m, NULL, lim, N, 0, {0}, has_drives(m), 0, 0.05, NULL, NULL, {0}, NULL, NULL, NULL,
                 NULL, NULL, NULL, msg, msglen};
   c.d = malloc(sizeof *c.d);
   c.p = malloc((size_t)(N + 1) * sizeof *c.p);

@@ -336,3 +336,26 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
 {
   return prru_check_regular(m, d, q, rcond);
 }
+
+void prru_path_side_init(prru_path_side *s) { s->sign = 0; }
+
+int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3])
+{
+  const int sg = prru_jd_det_sign(Jd);
+  if (sg * s->sign < 0) return 1;
+  if (sg) s->sign = sg;
+  return 0;
+}
+
+int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const double q[3], double *rcond,
+                     int *crossed)
+{
+  if (crossed) *crossed = 0;
+  const int st = prru_traj_pose_ok(m, d, q, rcond);
+  if (st != PRRU_OK) return st;
+  if (prru_path_side_crossed(s, d->Jd)) {
+    if (crossed) *crossed = 1;
+    return PRRU_ESINGULAR;
+  }
+  return PRRU_OK;
+}
