@@ -1,5 +1,6 @@
 """Filling the C templates: file headers, kernels, mechanism descriptor."""
 
+import math
 import os
 import re
 from string import Template
@@ -64,6 +65,12 @@ def _block(values, indent="    "):
     return "\n".join(lines)
 
 
+def _limit(x):
+    """A limit in rail units as C: INFINITY where the model sets none."""
+    return ("INFINITY" if x > 0 else "-INFINITY") if math.isinf(x) \
+        else c_double(x)
+
+
 def _descriptor(model, mech, prefix, labels):
     """Initializer fields of the mechanism descriptor, in struct order."""
     nb, nl = len(mech.bodies), len(mech.limbs)
@@ -80,6 +87,7 @@ def _descriptor(model, mech, prefix, labels):
         offset += n
     inertia = [_tensor3(i) for i in model.inertias]
     num = lambda v: c_double(v)  # noqa: E731
+    dr = model.drives
     fields = [
         ("name", c_string(model.name)),
         ("description", c_string(model.description)),
@@ -117,6 +125,13 @@ def _descriptor(model, mech, prefix, labels):
         ("coulomb_velocity", num(model.coulomb_velocity or 0)),
         ("joint", "{\n      " + ",\n      ".join(joints) + "}"),
         ("lambda_labels", _block([c_string(l) for l in labels])),
+        ("lead", _block([num(x or 0) for x in dr.lead])),
+        ("gear", _block([num(x) for x in dr.gear])),
+        ("torque_constant", _block([num(x or 0) for x in dr.torque_constant])),
+        ("force_max", _block([_limit(dr.force_limit(i)) for i in range(nl)])),
+        ("speed_max", _block([_limit(dr.speed_limit(i)) for i in range(nl)])),
+        ("d_min", _block([_limit(dr.stroke_limits(i)[0]) for i in range(nl)])),
+        ("d_max", _block([_limit(dr.stroke_limits(i)[1]) for i in range(nl)])),
     ]
     return ",\n".join("  /* .%s = */ %s" % f for f in fields)
 

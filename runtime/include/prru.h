@@ -187,6 +187,20 @@ typedef struct {
 } prru_limits;
 /* Every limit off. */
 void prru_limits_none(prru_limits *l);
+/* The model's own limits (its file's actuators keys, spec 13, in rail
+ * units: torque_max and motor_speed_max converted through the lead and
+ * gear); none where the file sets none. */
+void prru_model_limits(const prru_model *m, prru_limits *out);
+/* Whether every actuator has a screw lead (the file's actuators.lead):
+ * only then do rail quantities convert to the motor. */
+int prru_model_has_lead(const prru_model *m);
+/* Rail forces f (N) to the ideal motor torques tau_i = f_i lead_i /
+ * (2 pi gear_i) (N m) and, where current is non-NULL, the motor currents
+ * tau_i / k_t,i (A; NaN for an actuator without torque_constant). tau
+ * may be NULL. PRRU_EINPUT (outputs untouched) when an actuator has no
+ * lead (prru_model_has_lead); else PRRU_OK. */
+int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
+                           double current[PRRU_NACT]);
 
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */

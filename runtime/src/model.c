@@ -27,6 +27,36 @@ void prru_limits_none(prru_limits *l)
   }
 }
 
+void prru_model_limits(const prru_model *m, prru_limits *out)
+{
+  const prru_mechanism *me = m->mech;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    out->force_max[i] = me->force_max[i], out->speed_max[i] = me->speed_max[i];
+    out->d_min[i] = me->d_min[i], out->d_max[i] = me->d_max[i];
+  }
+}
+
+int prru_model_has_lead(const prru_model *m)
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(m->mech->lead[i] > 0)) return 0;
+  return 1;
+}
+
+int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
+                           double current[PRRU_NACT])
+{
+  const prru_mechanism *me = m->mech;
+  if (!prru_model_has_lead(m)) return PRRU_EINPUT;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    /* tau_m = f lead / (2 pi gear): the drive's ideal transmission */
+    double t = f[i] / prru_drive_ratio(me->lead[i], me->gear[i]);
+    if (tau) tau[i] = t;
+    if (current) current[i] = me->torque_constant[i] > 0 ? t / me->torque_constant[i] : NAN;
+  }
+  return PRRU_OK;
+}
+
 void prru_model_default(prru_model *m)
 {
   m->mech = &prru_mech;
@@ -89,6 +119,12 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
     me->coulomb[i] = s->coulomb[i];
   }
   me->coulomb_velocity = s->coulomb_velocity;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    me->lead[i] = s->lead[i], me->gear[i] = s->gear[i];
+    me->torque_constant[i] = s->torque_constant[i];
+    me->force_max[i] = s->force_max[i], me->speed_max[i] = s->speed_max[i];
+    me->d_min[i] = s->d_min[i], me->d_max[i] = s->d_max[i];
+  }
 }
 
 void prru_model_params(const prru_model *m, prru_params *p)
