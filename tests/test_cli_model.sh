@@ -164,4 +164,29 @@ expect 2 "its geometry or gravity differs" -- excite --model "$tmp/geo.json" --o
 "$PRRU" --model "$F" excite --evals 20 --period 4 --out "$tmp/hex.csv" 2>/dev/null && ok \
   || bad "excite with the build's geometry and another mass refused"
 
+# ---- drives and limits (spec 13): the stroke bounds the workspace ----
+# models/prototype_drives.json: stroke [-0.05, 0.45] m, sliders near
+# d = 0.21 m at q = 0; q3 = 0.3 puts slider 1 at 0.512 m (beyond d_max),
+# q3 = -0.2 falls under gravity to d_min within 0.13 s.
+if [ "$nact" -eq 3 ]; then
+  D="$PRRU_SOURCE_DIR/models/prototype_drives.json"
+  E="$PRRU_SOURCE_DIR/models/prototype_example.json"
+  expect 1 "q = (0, 0, 0.3): out_of_stroke: slider 1 at d = 0.512424928 m is outside its stroke [-0.05, 0.45] m" \
+    -- --model "$D" eval --q 0,0,0.3
+  "$PRRU" --model "$E" eval --q 0,0,0.3 >/dev/null 2>&1 && ok || bad "eval beyond the stroke of a model without one"
+  "$PRRU" --model "$D" eval --q 0,0,0.2 >/dev/null 2>&1 && ok || bad "eval inside the stroke refused"
+  "$PRRU" --model "$D" map --q1 -0.2:0.2:5 --q2 -0.2:0.2:5 --q3 0.235 --out "$tmp/smap.csv" >"$tmp/smap.txt" 2>&1 \
+    || bad "map across the stroke end: $(cat "$tmp/smap.txt")"
+  [ "$(grep -c ',NaN,out_of_stroke$' "$tmp/smap.csv")" -eq 22 ] && [ "$(grep -c ',ok$' "$tmp/smap.csv")" -eq 3 ] \
+    && ok || bad "map: 22 points out_of_stroke, 3 ok expected: $(cut -d, -f5 "$tmp/smap.csv" | sort | uniq -c)"
+  grep -qF "unreachable 22" "$tmp/smap.txt" && ok || bad "map summary: $(cat "$tmp/smap.txt")"
+  "$PRRU" --model "$E" map --q1 -0.2:0.2:5 --q2 -0.2:0.2:5 --q3 0.235 --out "$tmp/emap.csv" >/dev/null 2>&1 \
+    && ! grep -q out_of_stroke "$tmp/emap.csv" && ok || bad "map without a stroke reports out_of_stroke"
+  printf 'q0 = 0, 0, -0.2\nt_end = 0.5\ndt = 0.01\n' >"$tmp/fall.scn"
+  expect 1 "the motion reached the workspace boundary at t = " \
+    -- --model "$D" simulate --scenario "$tmp/fall.scn" --out "$tmp/fall.csv"
+  grep -qF "is out_of_stroke: slider 1 at d = -0.05" "$tmp/err" && ok || bad "simulate: $(cat "$tmp/err")"
+  [ "$(tail -n 1 "$tmp/fall.csv" | cut -d, -f1)" = 0.12 ] && ok || bad "simulate: samples up to the stroke end kept"
+fi
+
 finish test_cli_model

@@ -51,7 +51,10 @@ typedef enum {
   PRRU_EINTERRUPTED = 5, /* stopped on request (SIGINT) */
   PRRU_EIO = 6,          /* a file could not be read or written */
   PRRU_ENOMEM = 7,
-  PRRU_EPARSE = 8        /* malformed number, list, CSV or scenario */
+  PRRU_EPARSE = 8,       /* malformed number, list, CSV or scenario */
+  PRRU_ESTROKE = 9       /* a slider outside its stroke (the model's
+                            actuators.stroke, spec 13): the stroke ends
+                            bound the workspace like the reach does */
 } prru_status;
 
 /* A short, stable description of a status code. */
@@ -222,13 +225,26 @@ typedef struct {
   double lambda_null[PRRU_NLAMBDA];
 } prru_data;
 
-/* PRRU_OK, PRRU_EINPUT (non-finite q) or PRRU_EUNREACHABLE; fills d->d. */
+/* PRRU_OK, PRRU_EINPUT (non-finite q), PRRU_EUNREACHABLE or PRRU_ESTROKE
+ * (a slider outside its stroke, prru_stroke_actuator); fills d->d. */
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
+/* The first actuator (0-based) whose displacement d_i lies outside the
+ * model's stroke [d_min_i, d_max_i] (m->mech, ends included), -1 when
+ * none does (NaN d_i: none; unreachability is tested apart). Every
+ * reachability test of the library applies it: prru_check_reachable,
+ * prru_check_regular, the dynamics, prru_simulate, the maps. */
+int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT]);
+/* At a q whose sliders are at d: PRRU_ESTROKE and msg "slider I at d = X m
+ * is outside its stroke [D_MIN, D_MAX] m" (I 1-based), else PRRU_OK and
+ * msg "". */
+int prru_stroke_why(const prru_model *m, const double d[PRRU_NACT], char *msg, int msglen);
 /* Reachable and J_d regular (full column rank 3); fills d->d, d->Jd,
  * d->Jdpinv (when regular); *rcond if non-NULL: 1 / (|J|_1 |J^+|_1) for
  * J = J_d diag(1/L, 1/L, 1) (see prru_model), which for three actuators is
  * 1 / (|J|_1 |J^-1|_1). J^+ comes from a Householder QR of J for four. */
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
+/* (prru_check_regular: PRRU_ESTROKE before the regularity test, as
+ * prru_check_reachable.) */
 /* The regularity test of prru_check_regular on a given J_d (finite), for a
  * mechanism of length scale L (m) and tolerance rcond_min: PRRU_OK and
  * Jdpinv = J_d^+, or PRRU_ESINGULAR; *rcond as there. prru_check_regular is

@@ -74,7 +74,7 @@ VALID = {
     "f2_drives_motor_forms": acts(DRIVES, lead=[0.02, 0.01, 0.005],
                                   gear=[1, 2, 3.5], torque_max=[0.64, 0.5, 0.3],
                                   motor_speed_max=[3000, 4500, 6000]),
-    "f2_drives_gear_stroke_only": acts(gear=2, stroke=[-0.001, 1e-9]),
+    "f2_drives_gear_stroke_only": acts(gear=2, stroke=[-1, 1]),
     "f2_drives_four_limbs": setk("actuators", {
         "lead": 0.01, "rotor_inertia": [1e-6, 2e-6, 3e-6, 4e-6],
         "stroke": [[-0.1, 0.5]] * 4, "force_max": [100, 100, 200, 200],
