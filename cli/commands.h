@@ -122,6 +122,24 @@ int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_o
 /* Exactly n comma-separated finite numbers for option `name`: 0, else 2
  * after printing what was wrong. */
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n);
+
+/* The drives' limits of a run (spec 13): the model's unless overridden.
+ * One set of options for every command that plans, tracks, excites or
+ * optimises: --no-limits, --force-max F|F1,..., --speed-max V|V1,...,
+ * --stroke LO,HI|LO1,HI1,...; alias: the command's older name of
+ * --force-max (--fd-max, --fmax; NULL: none). */
+typedef struct {
+  const char *force_max, *alias, *speed_max, *stroke;
+  int none;
+} prru_cli_limit_args;
+/* The entries of a command's option table (the alias's, {NAME, 1,
+ * &a.alias, NULL}, beside them where the command has one). */
+#define PRRU_CLI_LIMIT_OPTIONS(a)                                                                              \
+  {"force-max", 1, &(a).force_max, NULL}, {"speed-max", 1, &(a).speed_max, NULL},                             \
+      {"stroke", 1, &(a).stroke, NULL}, {"no-limits", 0, NULL, &(a).none}
+/* prru_limits_for_run with the options: 0, or 2 after the message naming
+ * the option (also when --force-max and its alias are both given). */
+int prru_cli_limits(const char *cmd, const char *alias_name, const prru_cli_limit_args *a, prru_limits *out);
 /* 1 when paths a and b name the same existing file, compared by device
  * and inode (so "f", "./f", a hard or symbolic link to f alike); 0 when
  * either is NULL, "-" (stdout) or does not exist. */

@@ -202,7 +202,8 @@ echo old >"$tmp/keep.json"
 expect 2 "--data and --out are required" -- identify --data "$tmp/ex.csv"
 cut -d, -f1-13 "$tmp/ex.csv" >"$tmp/nofd.csv"
 expect 2 "missing column 'fd1'" -- identify --data "$tmp/nofd.csv" --out "$tmp/keep.json"
-awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$2=2.5} {print}' "$tmp/ex.csv" >"$tmp/far.csv"
+# (ex.csv: the model line, the limits line, 4 comment lines, the header, then data rows)
+awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==10 {$2=2.5} {print}' "$tmp/ex.csv" >"$tmp/far.csv"
 expect 1 "data row 3" -- identify --data "$tmp/far.csv" --out "$tmp/keep.json"
 grep -q "not reachable" "$tmp/err" && ok || bad "unreachable row: reason missing: $(cat "$tmp/err")"
 awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$1=0} {print}' "$tmp/ex.csv" >"$tmp/time.csv"
@@ -253,5 +254,53 @@ expect 2 "outside its stroke" -- excite --stroke 0.5,0.6 --out "$tmp/c.csv"
 expect 1 "no feasible excitation" -- excite --fd-max 1 --evals 50 --out "$tmp/c.csv"
 [ ! -e "$tmp/c.csv" ] && ok || bad "a refused excite wrote its output"
 [ ! -e "$tmp/x.json" ] && ok || bad "a refused identify wrote its output"
+
+# ---- the drives' limits (spec 13) act by default; options override ----
+# The build's model with a stroke and a force limit (format 2 keeps the
+# build's geometry, so excite accepts it). The default 30-evaluation
+# excitation ($EX) leaves [0.19, 0.235] m (paper model): that stroke
+# of [0.19, 0.235] m must shrink it; --no-limits must not.
+python3 - "$PRRU_MODEL" "$tmp/lim.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+if d.get("format", 1) == 1:
+    g = d["geometry"]
+    n = 3
+    d["geometry"] = {"b": [g["b12"], g["b12"], g["b3"]], "l1": g["l1"], "l2": g["l2"], "a": g["a"]}
+    d["format"] = 2
+d.setdefault("actuators", {})
+d["actuators"].update({"stroke": [0.19, 0.235], "force_max": 60})
+json.dump(d, open(sys.argv[2], "w"), indent=1)
+PY
+slider_range() { python3 -c '
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+v = [float(r[h.index(sys.argv[2])]) for r in rows[1:]]
+print(min(v), max(v))' "$1" "$2"; }
+if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1])).get("name") == "prru" else 1)' "$PRRU_MODEL"; then
+  EX="--evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --out "$tmp/lim.csv" 2>"$tmp/lim.err" \
+    || bad "excite with the model's limits: $(cat "$tmp/lim.err")"
+  grep -qx "# limits: force_max 60 N, speed_max none, stroke \[0.19, 0.235\] m" "$tmp/lim.csv" && ok \
+    || bad "excite: limits line: $(grep limits "$tmp/lim.csv")"
+  read -r lo hi <<<"$(slider_range "$tmp/lim.csv" d1)"
+  python3 -c "import sys; sys.exit(0 if 0.19 <= $lo and $hi <= 0.235 else 1)" && ok \
+    || bad "excite: slider 1 over [$lo, $hi] m, outside the model's stroke [0.19, 0.235]"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --no-limits --out "$tmp/nolim.csv" 2>/dev/null \
+    && grep -qx "# limits: force_max 500 N, speed_max none, stroke none (force: excite's default where the run has none)" \
+      "$tmp/nolim.csv" && ok || bad "excite --no-limits: $(grep limits "$tmp/nolim.csv")"
+  read -r lo hi <<<"$(slider_range "$tmp/nolim.csv" d1)"
+  python3 -c "import sys; sys.exit(0 if $lo < 0.19 else 1)" && ok \
+    || bad "excite --no-limits: slider 1 kept within the dropped stroke ([$lo, $hi] m)"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --fd-max 400 --stroke 0.1:0.3 --speed-max 2 \
+    --out "$tmp/ovr.csv" 2>/dev/null \
+    && grep -qx "# limits: force_max 400 N, speed_max 2 m/s, stroke \[0.1, 0.3\] m" "$tmp/ovr.csv" && ok \
+    || bad "excite --fd-max (alias) --stroke LO:HI --speed-max: $(grep limits "$tmp/ovr.csv")"
+  expect 2 "--force-max and --fd-max are the same limit: give one" \
+    -- excite --force-max 1 --fd-max 1 --out "$tmp/c.csv"
+  expect 2 "--speed-max: '-1' is not a positive number" -- excite --speed-max -1 --out "$tmp/c.csv"
+  expect 2 "--stroke: '1,2,3': give LO,HI for all sliders or 6 numbers" -- excite --stroke 1,2,3 --out "$tmp/c.csv"
+fi
 
 finish test_cli_ident

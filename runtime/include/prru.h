@@ -204,6 +204,30 @@ int prru_model_has_lead(const prru_model *m);
  * lead (prru_model_has_lead); else PRRU_OK. */
 int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
                            double current[PRRU_NACT]);
+/* A run's overrides of the model's limits, as given on a command line
+ * (--no-limits, --force-max, --speed-max, --stroke); NULL text: not given. */
+typedef struct {
+  int none;              /* drop every limit of the model first (--no-limits) */
+  const char *force_max; /* "F" for every actuator or "F1,..,FN" (N, > 0) */
+  const char *speed_max; /* likewise, m/s */
+  const char *stroke;    /* "LO,HI" (or "LO:HI") for every slider, or
+                            "LO1,HI1,..,LON,HIN" (m, LO < HI) */
+} prru_limit_args;
+/* The limits a run applies: the model's (prru_model_limits), all none if
+ * a->none, then each limit given in a replaces that kind for every
+ * actuator. PRRU_OK; PRRU_EINPUT with msg naming the option
+ * ("--force-max: ...") and out untouched. a may be NULL (the model's). */
+int prru_limits_for_run(const prru_model *m, const prru_limit_args *a, prru_limits *out, char *msg,
+                        int msglen);
+/* One line for a run's header: "force_max F N, speed_max V m/s, stroke
+ * [LO, HI] m" (one value when every actuator has the same, else a list
+ * per actuator; "none" for a kind that is off), into buf (len bytes). */
+void prru_limits_describe(const prru_limits *l, char *buf, size_t len);
+/* out: src with l's limits in a descriptor of its own (the stroke then
+ * bounds every reachability test of out, prru_stroke_actuator); src's
+ * numbers, kernels and settings otherwise. Allocates: prru_model_free(out)
+ * (src may be freed first). PRRU_OK or PRRU_ENOMEM (out untouched). */
+int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_limits *l);
 
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */
