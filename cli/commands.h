@@ -137,6 +137,10 @@ typedef struct {
 #define PRRU_CLI_LIMIT_OPTIONS(a)                                                                              \
   {"force-max", 1, &(a).force_max, NULL}, {"speed-max", 1, &(a).speed_max, NULL},                             \
       {"stroke", 1, &(a).stroke, NULL}, {"no-limits", 0, NULL, &(a).none}
+/* --units rail|motor (NULL: rail): *motor = 1 for motor units, *current
+ * = 1 when the model also gives torque_constant. 0, or 2 after the
+ * message (an unknown unit; motor units without the model's lead). */
+int prru_cli_units(const char *cmd, const char *units, int *motor, int *current);
 /* prru_limits_for_run with the options: 0, or 2 after the message naming
  * the option (also when --force-max and its alias are both given). */
 int prru_cli_limits(const char *cmd, const char *alias_name, const prru_cli_limit_args *a, prru_limits *out);
@@ -195,6 +199,11 @@ typedef struct {
   long rows;
   double flushed_at;  /* CLOCK_MONOTONIC seconds of the last flush */
 } prru_cli_out;
+/* The columns of motor units after a row's others: ",tau1..,i1.." names
+ * and the values for rail forces fd (prru_model_motor_units); nothing
+ * when !motor. */
+void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current);
+void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current);
 /* Opens (checks that it can be written: the directory exists and takes a
  * new file); 0, or 1 after a message with the reason. */
 int prru_cli_out_open(prru_cli_out *o, const char *cmd, const char *path);

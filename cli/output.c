@@ -6,6 +6,7 @@
 #define _POSIX_C_SOURCE 200809L /* mkstemp, fchmod, fsync */
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -107,6 +108,23 @@ void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n)
   if (o->err || reserve(o, n)) return;
   memcpy(o->buf + o->len, data, n);
   o->len += n;
+}
+
+void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current)
+{
+  char names[256];
+  if (motor) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "tau", PRRU_NACT, ","));
+  if (motor && current) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "i", PRRU_NACT, ","));
+}
+
+void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current)
+{
+  double tau[PRRU_NACT], cur[PRRU_NACT];
+  if (!motor) return;
+  if (prru_model_motor_units(m, fd, tau, cur) != PRRU_OK) /* checked by prru_cli_units */
+    for (int i = 0; i < PRRU_NACT; i++) tau[i] = cur[i] = NAN;
+  prru_cli_out_numbers(o, tau, PRRU_NACT);
+  if (current) prru_cli_out_numbers(o, cur, PRRU_NACT);
 }
 
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)

@@ -187,6 +187,35 @@ if [ "$nact" -eq 3 ]; then
     -- --model "$D" simulate --scenario "$tmp/fall.scn" --out "$tmp/fall.csv"
   grep -qF "is out_of_stroke: slider 1 at d = -0.05" "$tmp/err" && ok || bad "simulate: $(cat "$tmp/err")"
   [ "$(tail -n 1 "$tmp/fall.csv" | cut -d, -f1)" = 0.12 ] && ok || bad "simulate: samples up to the stroke end kept"
+  # --units motor: tau = fd lead / (2 pi gear), i = tau / k_t (lead 0.02 m,
+  # gear 1, k_t 0.11 N m/A). Tolerance: each side a few correctly rounded
+  # operations on the same doubles (the CLI's fd / (2 pi gear / lead), the
+  # check's fd lead / (2 pi gear), both from the printed 17 digits): 8 u.
+  "$PRRU" --model "$D" traj --waypoints "0,0,0;0.1,0,0.02" --durations 1 --dt 0.01 --out "$tmp/mt.csv" 2>/dev/null \
+    || bad "traj for --units motor"
+  "$PRRU" --model "$D" id --traj "$tmp/mt.csv" --units motor --out "$tmp/mid.csv" 2>"$tmp/mid.err" \
+    || bad "id --units motor: $(cat "$tmp/mid.err")"
+  python3 - "$tmp/mid.csv" <<'PY' && ok || bad "id --units motor: tau or i columns wrong"
+import csv, math, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+assert h == ["t", "fd1", "fd2", "fd3", "tau1", "tau2", "tau3", "i1", "i2", "i3"], h
+tol = 8 * 2.0 ** -52
+for r in rows[1:]:
+    v = dict(zip(h, map(float, r)))
+    for k in "123":
+        tau = v["fd" + k] * 0.02 / (2 * math.pi * 1)
+        assert abs(v["tau" + k] - tau) <= tol * abs(tau), (v, k)
+        assert abs(v["i" + k] - tau / 0.11) <= tol * abs(tau / 0.11), (v, k)
+PY
+  model_edit "$D" "$tmp/nokt.json" "del d['actuators']['torque_constant']"
+  "$PRRU" --model "$tmp/nokt.json" id --traj "$tmp/mt.csv" --units motor --out - 2>/dev/null | grep -v '^#' | head -n 1 \
+    | grep -qx "t,fd1,fd2,fd3,tau1,tau2,tau3" && ok || bad "id --units motor without torque_constant: no current columns"
+  rm -f "$tmp/x.csv"
+  expect 2 "--units motor: model proto has no screw lead (actuators.lead" \
+    -- --model "$E" id --traj "$tmp/mt.csv" --units motor --out "$tmp/x.csv"
+  [ ! -e "$tmp/x.csv" ] && ok || bad "id --units motor without a lead wrote its output"
+  expect 2 "--units 'amps': one of rail, motor" -- --model "$D" id --traj "$tmp/mt.csv" --units amps
 fi
 
 finish test_cli_model
