@@ -876,13 +876,16 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
   const char *akeys[3] = {"armature", "damping", "coulomb"};
   const double *avals[3] = {p->armature, p->damping, p->coulomb};
   int has_vs = p->coulomb_velocity > 0;
-  for (int g = 0; g < 3; g++) {
-    prru_cli_out_printf(o, "    \"%s\": [", akeys[g]);
+  /* where the file gives rotor_inertia, the armature goes back there */
+  for (int g = prru_cli_writes_armature() ? 0 : 1; g < 3; g++) {
+    prru_cli_out_printf(o, "%s    \"%s\": [", g > 0 && prru_cli_writes_armature() ? ",\n" : g > 1 ? ",\n" : "",
+                        akeys[g]);
     for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", avals[g][i]);
-    prru_cli_out_printf(o, "]%s\n", g < 2 || has_vs ? "," : "");
+    prru_cli_out_printf(o, "]");
   }
-  if (has_vs) prru_cli_out_printf(o, "    \"coulomb_velocity\": %.17g\n", p->coulomb_velocity);
-  prru_cli_out_printf(o, "  }\n}\n");
+  if (has_vs) prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
+  prru_cli_out_drive_keys(o, p->armature);
+  prru_cli_out_printf(o, "\n  }\n}\n");
   prru_cli_out_line(o);
 }
 

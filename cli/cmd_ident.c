@@ -662,13 +662,19 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
     json_list(o, p->inertia[b], 6);
     prru_cli_out_printf(o, "}%s\n", b + 1 < PRRU_NBODY ? "," : "");
   }
-  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n    \"armature\": ");
-  json_list(o, p->armature, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"damping\": ");
+  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n");
+  if (prru_cli_writes_armature()) { /* else rotor_inertia, below */
+    prru_cli_out_printf(o, "    \"armature\": ");
+    json_list(o, p->armature, PRRU_NACT);
+    prru_cli_out_printf(o, ",\n");
+  }
+  prru_cli_out_printf(o, "    \"damping\": ");
   json_list(o, p->damping, PRRU_NACT);
   prru_cli_out_printf(o, ",\n    \"coulomb\": ");
   json_list(o, p->coulomb, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g\n  }\n}\n", p->coulomb_velocity);
+  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
+  prru_cli_out_drive_keys(o, p->armature);
+  prru_cli_out_printf(o, "\n  }\n}\n");
   prru_cli_out_line(o);
 }
 

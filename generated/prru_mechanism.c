@@ -97,5 +97,9 @@ const prru_mechanism prru_mech = {
   /* .force_max = */ {INFINITY, INFINITY, INFINITY},
   /* .speed_max = */ {INFINITY, INFINITY, INFINITY},
   /* .d_min = */ {-INFINITY, -INFINITY, -INFINITY},
-  /* .d_max = */ {INFINITY, INFINITY, INFINITY}
+  /* .d_max = */ {INFINITY, INFINITY, INFINITY},
+  /* .drive_keys = */ 0u,
+  /* .rotor_inertia = */ {0.0, 0.0, 0.0},
+  /* .torque_max = */ {0.0, 0.0, 0.0},
+  /* .motor_speed_max = */ {0.0, 0.0, 0.0}
 };

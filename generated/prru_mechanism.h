@@ -63,6 +63,12 @@ typedef struct {
    * d_max m; INFINITY (-INFINITY for d_min) when the model sets none */
   double force_max[PRRU_NACT], speed_max[PRRU_NACT];
   double d_min[PRRU_NACT], d_max[PRRU_NACT];
+  /* the forms the model file gives (for writers that keep them): bit k
+   * for its k-th key of lead, gear, rotor_inertia, torque_constant,
+   * stroke, force_max, torque_max, speed_max, motor_speed_max; and those
+   * values as written (0 where not given): kg m^2, N m, rev/min */
+  unsigned int drive_keys;
+  double rotor_inertia[PRRU_NACT], torque_max[PRRU_NACT], motor_speed_max[PRRU_NACT];
 } prru_mechanism;
 
 #ifdef __cplusplus

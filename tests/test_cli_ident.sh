@@ -301,6 +301,52 @@ if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(ope
     -- excite --force-max 1 --fd-max 1 --out "$tmp/c.csv"
   expect 2 "--speed-max: '-1' is not a positive number" -- excite --speed-max -1 --out "$tmp/c.csv"
   expect 2 "--stroke: '1,2,3': give LO,HI for all sliders or 6 numbers" -- excite --stroke 1,2,3 --out "$tmp/c.csv"
+  # The writer keeps the drive keys as the file gives them (spec 13): the
+  # identified armature goes back into rotor_inertia (no "armature" beside
+  # it), every other key as written. Data: the paper's motion with the
+  # forces of the model with drives (armature J (2 pi gear / lead)^2).
+  python3 - "$tmp/lim.json" "$tmp/drv.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["actuators"] = {"lead": 0.02, "gear": 2, "rotor_inertia": [5e-6, 6e-6, 7e-6], "torque_constant": 0.11,
+                  "stroke": [0.1, 0.35], "torque_max": 0.64, "motor_speed_max": 3000}
+json.dump(d, open(sys.argv[2], "w"), indent=1)
+PY
+  "$PRRU" --model "$tmp/drv.json" id --traj "$tmp/ex.csv" --out "$tmp/drvfd.csv" 2>/dev/null || bad "id with drives"
+  python3 - "$tmp/ex.csv" "$tmp/drvfd.csv" "$tmp/drvdata.csv" <<'PY'
+import csv, sys
+def rows(p): return [r for r in csv.reader(l for l in open(p) if not l.startswith('#'))]
+a, b = rows(sys.argv[1]), rows(sys.argv[2])
+out = [a[0]] + [[y[b[0].index(h)] if h in b[0][1:] else x for h, x in zip(a[0], r)] for r, y in zip(a[1:], b[1:])]
+csv.writer(open(sys.argv[3], "w")).writerows(out)
+PY
+  "$PRRU" --model "$tmp/drv.json" identify --data "$tmp/drvdata.csv" --out "$tmp/drvid.json" \
+    --report "$tmp/drvrep.csv" 2>"$tmp/drvid.err" || bad "identify with drives: $(cat "$tmp/drvid.err")"
+  # Written back: J = k / w^2 (w = 2 pi gear / lead), reread: J w w, four
+  # roundings of the same doubles (4 u of k, 8 u allowed); the report's
+  # model column is the written model's base parameter to the estimate's
+  # own rounding rule (16 eps cond max(|prior|, resolution), as above).
+  python3 - "$tmp/drvid.json" "$tmp/drvrep.csv" "$PRRU_SOURCE_DIR/gen" <<'PY' && ok || bad "identify's model: drive keys not kept: $(tr -d '\n' <"$tmp/drvid.json" | grep -o '"actuators.*')"
+import csv, json, sys
+sys.path.insert(0, sys.argv[3])
+from prrugen import model
+a = json.load(open(sys.argv[1]))["actuators"]
+assert "armature" not in a, a
+want = {"lead": 0.02, "gear": 2, "torque_constant": 0.11, "stroke": [0.1, 0.35], "torque_max": 0.64,
+        "motor_speed_max": 3000}
+assert {k: a[k] for k in want} == want, a
+m = model.load(sys.argv[1])
+import re
+text = open(sys.argv[2]).read()
+cond = float(re.search(r"condition number ([0-9.e+-]+)", text).group(1))
+rows = {r["parameter"]: r for r in csv.DictReader(l for l in text.splitlines() if not l.startswith("#"))}
+u = 2.0 ** -53
+for i in range(3):
+    r = rows["armature%d" % (i + 1)]
+    k = float(r["model"])
+    tol = 16 * 2 * u * cond * max(abs(float(r["prior"])), float(r["resolution"])) + 8 * u * k
+    assert abs(float(m.armature[i]) - k) <= tol, (i, float(m.armature[i]), k, tol)
+PY
 fi
 
 finish test_cli_ident

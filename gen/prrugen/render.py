@@ -8,7 +8,7 @@ from string import Template
 from . import batch, cgen, params, regressor
 from .ctext import c_comment, c_string
 from .kernels import kernels, lambda_labels
-from .model import c_double
+from .model import ACTUATOR_KEYS, c_double
 
 GENERATOR = "gen/prru_gen.py"
 
@@ -132,6 +132,11 @@ def _descriptor(model, mech, prefix, labels):
         ("speed_max", _block([_limit(dr.speed_limit(i)) for i in range(nl)])),
         ("d_min", _block([_limit(dr.stroke_limits(i)[0]) for i in range(nl)])),
         ("d_max", _block([_limit(dr.stroke_limits(i)[1]) for i in range(nl)])),
+        ("drive_keys", "%du" % sum(1 << k for k, key in enumerate(
+            ACTUATOR_KEYS[4:]) if key in dr.keys)),
+        ("rotor_inertia", _block([num(x or 0) for x in dr.rotor_inertia])),
+        ("torque_max", _block([num(x or 0) for x in dr.torque_max])),
+        ("motor_speed_max", _block([num(x or 0) for x in dr.motor_speed_max])),
     ]
     return ",\n".join("  /* .%s = */ %s" % f for f in fields)
 

@@ -188,12 +188,30 @@ typedef struct {
   double speed_max[PRRU_NACT];
   double d_min[PRRU_NACT], d_max[PRRU_NACT];
 } prru_limits;
+/* The section 13 keys a model file gives, as bits (prru_mechanism.drive_keys,
+ * prru_model_spec.keys): bit k for the k-th key of this list. */
+enum {
+  PRRU_DRIVE_LEAD = 1 << 0,
+  PRRU_DRIVE_GEAR = 1 << 1,
+  PRRU_DRIVE_ROTOR_INERTIA = 1 << 2,
+  PRRU_DRIVE_TORQUE_CONSTANT = 1 << 3,
+  PRRU_DRIVE_STROKE = 1 << 4,
+  PRRU_DRIVE_FORCE_MAX = 1 << 5,
+  PRRU_DRIVE_TORQUE_MAX = 1 << 6,
+  PRRU_DRIVE_SPEED_MAX = 1 << 7,
+  PRRU_DRIVE_MOTOR_SPEED_MAX = 1 << 8
+};
+
 /* Every limit off. */
 void prru_limits_none(prru_limits *l);
 /* The model's own limits (its file's actuators keys, spec 13, in rail
  * units: torque_max and motor_speed_max converted through the lead and
  * gear); none where the file sets none. */
 void prru_model_limits(const prru_model *m, prru_limits *out);
+/* Motor radians per metre of slider i's travel, 2 pi gear_i / lead_i
+ * (rad/m; the reflected armature of a rotor inertia J_r is J_r times its
+ * square), NaN without a lead or for i outside 0..PRRU_NACT-1. */
+double prru_model_drive_ratio(const prru_model *m, int i);
 /* Whether every actuator has a screw lead (the file's actuators.lead):
  * only then do rail quantities convert to the motor. */
 int prru_model_has_lead(const prru_model *m);

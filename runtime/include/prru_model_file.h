@@ -23,19 +23,6 @@ typedef struct {
   double b, l1, l2, a; /* m; a = 0 for limbs 3 and 4 */
 } prru_model_limb;
 
-/* prru_model_spec.keys: the section 13 keys a file gives. */
-enum {
-  PRRU_DRIVE_LEAD = 1 << 0,
-  PRRU_DRIVE_GEAR = 1 << 1,
-  PRRU_DRIVE_ROTOR_INERTIA = 1 << 2,
-  PRRU_DRIVE_TORQUE_CONSTANT = 1 << 3,
-  PRRU_DRIVE_STROKE = 1 << 4,
-  PRRU_DRIVE_FORCE_MAX = 1 << 5,
-  PRRU_DRIVE_TORQUE_MAX = 1 << 6,
-  PRRU_DRIVE_SPEED_MAX = 1 << 7,
-  PRRU_DRIVE_MOTOR_SPEED_MAX = 1 << 8
-};
-
 typedef struct {
   char name[PRRU_MODEL_NAME_MAX + 1];
   char description[4 * PRRU_MODEL_DESCRIPTION_MAX + 1];

@@ -36,6 +36,12 @@ void prru_model_limits(const prru_model *m, prru_limits *out)
   }
 }
 
+double prru_model_drive_ratio(const prru_model *m, int i)
+{
+  if (i < 0 || i >= PRRU_NACT || !(m->mech->lead[i] > 0)) return NAN;
+  return prru_drive_ratio(m->mech->lead[i], m->mech->gear[i]);
+}
+
 int prru_model_has_lead(const prru_model *m)
 {
   for (int i = 0; i < PRRU_NACT; i++)
@@ -249,7 +255,10 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
     me->torque_constant[i] = s->torque_constant[i];
     me->force_max[i] = s->force_max[i], me->speed_max[i] = s->speed_max[i];
     me->d_min[i] = s->d_min[i], me->d_max[i] = s->d_max[i];
+    me->rotor_inertia[i] = s->rotor_inertia[i], me->torque_max[i] = s->torque_max[i];
+    me->motor_speed_max[i] = s->motor_speed_max[i];
   }
+  me->drive_keys = s->keys;
 }
 
 void prru_model_params(const prru_model *m, prru_params *p)
