@@ -4,7 +4,7 @@
  * 3-PRRU 1T2R parallel manipulator, geometry and inertia of Chen, Yu, Li, Wang, Nonlinear Dynamics 90 (2017), Table 1
  * Edit the model file or the generator and regenerate instead.
  */
-#include <math.h> /* INFINITY: a limit the model does not set */
+#include <math.h> /* HUGE_VAL (an infinity, C99 Annex F): a limit the model does not set */
 
 #include "prru_mechanism.h"
 
@@ -94,10 +94,10 @@ const prru_mechanism prru_mech = {
   /* .lead = */ {0.0, 0.0, 0.0},
   /* .gear = */ {1.0, 1.0, 1.0},
   /* .torque_constant = */ {0.0, 0.0, 0.0},
-  /* .force_max = */ {INFINITY, INFINITY, INFINITY},
-  /* .speed_max = */ {INFINITY, INFINITY, INFINITY},
-  /* .d_min = */ {-INFINITY, -INFINITY, -INFINITY},
-  /* .d_max = */ {INFINITY, INFINITY, INFINITY},
+  /* .force_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+  /* .speed_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+  /* .d_min = */ {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL},
+  /* .d_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
   /* .drive_keys = */ 0u,
   /* .rotor_inertia = */ {0.0, 0.0, 0.0},
   /* .torque_max = */ {0.0, 0.0, 0.0},

@@ -66,8 +66,10 @@ def _block(values, indent="    "):
 
 
 def _limit(x):
-    """A limit in rail units as C: INFINITY where the model sets none."""
-    return ("INFINITY" if x > 0 else "-INFINITY") if math.isinf(x) \
+    """A limit in rail units as C: an infinity where the model sets none
+    (HUGE_VAL, a double; INFINITY is a float, which -Wdouble-promotion
+    refuses to widen)."""
+    return ("HUGE_VAL" if x > 0 else "-HUGE_VAL") if math.isinf(x) \
         else c_double(x)
 
 
