@@ -297,6 +297,20 @@ if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(ope
     --out "$tmp/ovr.csv" 2>/dev/null \
     && grep -qx "# limits: force_max 400 N, speed_max 2 m/s, stroke \[0.1, 0.3\] m" "$tmp/ovr.csv" && ok \
     || bad "excite --fd-max (alias) --stroke LO:HI --speed-max: $(grep limits "$tmp/ovr.csv")"
+  # --speed-max: the slider speeds keep it at the excitation's dense check
+  # points (period 8 s / 2000: every 4 ms, so every row at a multiple of
+  # 0.02 s); the unlimited excitation reaches 0.136 m/s. Tolerance: the
+  # same J_d qd from a time that may differ in its last bit: 1e-12.
+  "$PRRU" excite $EX --speed-max 0.01 --out "$tmp/spd.csv" 2>/dev/null || bad "excite --speed-max"
+  "$PRRU" id --traj "$tmp/spd.csv" --rates --out "$tmp/spdid.csv" 2>/dev/null || bad "id --rates of excite --speed-max"
+  python3 - "$tmp/spdid.csv" "$nact" <<'PY' && ok || bad "excite --speed-max 0.01: a slider faster at a checked time"
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+top = max(abs(float(r[h.index("dd%d" % (i + 1))])) for k, r in enumerate(rows[1:]) if k % 2 == 0
+          for i in range(int(sys.argv[2])))
+assert 0.005 < top <= 0.01 * (1 + 1e-12), top
+PY
   expect 2 "--force-max and --fd-max are the same limit: give one" \
     -- excite --force-max 1 --fd-max 1 --out "$tmp/c.csv"
   expect 2 "--speed-max: '-1' is not a positive number" -- excite --speed-max -1 --out "$tmp/c.csv"
