@@ -480,8 +480,11 @@ def _actuators(path, value, nlimb):
                          "velocity v_s (m/s)")
     _drives(path, value, nlimb, drives)
     if drives.rotor_inertia[0] is not None:
-        lists[0] = tuple(Fraction(reflected_armature(
-            drives.rotor_inertia[i], drives.lead[i], drives.gear[i]))
+        # The double's shortest decimal, as the user would write the
+        # armature (the same double: the loader agrees bit for bit), so
+        # that a rotor inertia and its armature written out fold alike.
+        lists[0] = tuple(Fraction(repr(reflected_armature(
+            drives.rotor_inertia[i], drives.lead[i], drives.gear[i])))
             for i in range(nlimb))
     return lists[0], lists[1], lists[2], vs if any(lists[2]) else None, drives
 
