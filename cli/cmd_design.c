@@ -22,7 +22,10 @@
 /* ---- Options shared by optimize and sensitivity ---- */
 
 typedef struct {
-  const char *q1, *q2, *q3, *rcond, *stroke, *objective, *set;
+  const char *q1, *q2, *q3, *rcond, *objective, *set;
+  int limits;              /* the drives' limits act (optimize) */
+  prru_cli_limit_args lim; /* their overrides */
+  prru_limits run;         /* out: the run's limits (when limits) */
 } problem_text;
 
 /* "LO:HI" with finite LO < HI; 0 or 2. */
@@ -80,7 +83,25 @@ static int parse_set(const char *cmd, const char *text, prru_params *p)
   return 0;
 }
 
-static int parse_problem(const char *cmd, const problem_text *t, prru_design_problem *pr,
+/* The design's stroke: every slider of a candidate within the run's
+ * stroke, one interval for all (the design problem's): the
+ * intersection of the sliders' strokes. 0 or 2. */
+static int design_stroke(const char *cmd, const prru_limits *l, prru_design_problem *pr)
+{
+  double lo = -INFINITY, hi = INFINITY;
+  for (int i = 0; i < PRRU_NACT; i++) lo = fmax(lo, l->d_min[i]), hi = fmin(hi, l->d_max[i]);
+  if (isinf(lo) && isinf(hi)) return 0;
+  if (!(lo < hi)) {
+    prru_cli_error(cmd, "the sliders' strokes have no common interval ([%g, %g]): the design's stroke is one "
+                   "interval for all; give --stroke LO,HI", lo, hi);
+    return 2;
+  }
+  pr->stroke = 1;
+  pr->stroke_lo = lo, pr->stroke_hi = hi;
+  return 0;
+}
+
+static int parse_problem(const char *cmd, problem_text *t, prru_design_problem *pr,
                          prru_params *start)
 {
   prru_map_grid g = {0, 0, 0, 0, 0.0, 0, 0};
@@ -99,10 +120,8 @@ static int parse_problem(const char *cmd, const problem_text *t, prru_design_pro
       return 2;
     }
   }
-  if (t->stroke) {
-    if (parse_pair(cmd, "stroke", t->stroke, &pr->stroke_lo, &pr->stroke_hi)) return 2;
-    pr->stroke = 1;
-  }
+  if (t->limits && (prru_cli_limits(cmd, "force-max", &t->lim, &t->run) || design_stroke(cmd, &t->run, pr)))
+    return 2;
   if (t->objective && prru_objective_parse(t->objective, &pr->objective) != PRRU_OK) {
     prru_cli_error(cmd, "--objective '%s': one of mean, max, log", t->objective);
     return 2;
@@ -733,7 +752,8 @@ static const char opt_help[] =
     "usage: prru optimize --vars SPEC[,SPEC...] --q1 START:STOP:COUNT\n"
     "                     --q2 START:STOP:COUNT [--q3 Z] --out MODEL.json\n"
     "                     --report DIR [--range PCT] [--objective mean|max|log]\n"
-    "                     [--rcond-min R] [--stroke LO:HI] [--set NAME=VALUE,...]\n"
+    "                     [--rcond-min R] [--stroke LO,HI|LO1,HI1,..] [--no-limits]\n"
+    "                     [--force-max F] [--speed-max V] [--set NAME=VALUE,...]\n"
     "                     [--max-iter N] [--penalty W] [--name NAME] [--threads N]\n"
     "                     [--progress] [--clip W]\n"
     "Chooses the design variables within their bounds so that the rotational\n"
@@ -744,8 +764,13 @@ static const char opt_help[] =
     "Constraints: every grid point reachable and regular (J_d's scaled\n"
     "1/(|J|_1 |J^-1|_1) >= R, default 4e-3, i.e. cond_1 <= 250, the test of\n"
     "'prru map --rcond-min'; a pose of the other assembly mode counts as\n"
-    "singular, as there), and with --stroke every slider height d_i within\n"
-    "[LO, HI] (m) on the grid. They enter as a penalty W x violation (default W\n"
+    "singular, as there), and every slider height d_i within the stroke (m) on\n"
+    "the grid: the model's (actuators.stroke) unless --stroke replaces it (LO,HI\n"
+    "or LO:HI for all sliders, or a pair each) or --no-limits drops it; one\n"
+    "interval binds all sliders (their strokes' common part). --force-max and\n"
+    "--speed-max are accepted (the limits options of every command) but w_R has\n"
+    "no forces or speeds. The report names the limits. They enter as a penalty\n"
+    "W x violation (default W\n"
     "1000), continuous so that an infeasible start (singular points in the\n"
     "rectangle) can move into feasibility; the result is accepted only when it\n"
     "is feasible.\n"
@@ -851,13 +876,16 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
   const char *akeys[3] = {"armature", "damping", "coulomb"};
   const double *avals[3] = {p->armature, p->damping, p->coulomb};
   int has_vs = p->coulomb_velocity > 0;
-  for (int g = 0; g < 3; g++) {
-    prru_cli_out_printf(o, "    \"%s\": [", akeys[g]);
+  /* where the file gives rotor_inertia, the armature goes back there */
+  for (int g = prru_cli_writes_armature() ? 0 : 1; g < 3; g++) {
+    prru_cli_out_printf(o, "%s    \"%s\": [", g > 0 && prru_cli_writes_armature() ? ",\n" : g > 1 ? ",\n" : "",
+                        akeys[g]);
     for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", avals[g][i]);
-    prru_cli_out_printf(o, "]%s\n", g < 2 || has_vs ? "," : "");
+    prru_cli_out_printf(o, "]");
   }
-  if (has_vs) prru_cli_out_printf(o, "    \"coulomb_velocity\": %.17g\n", p->coulomb_velocity);
-  prru_cli_out_printf(o, "  }\n}\n");
+  if (has_vs) prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
+  prru_cli_out_drive_keys(o, p->armature);
+  prru_cli_out_printf(o, "\n  }\n}\n");
   prru_cli_out_line(o);
 }
 
@@ -932,6 +960,7 @@ typedef struct {
   const char *out, *name;
   const char *set;
   double clip; /* the maps' colour clip, NaN: the percentile */
+  const prru_limits *limits; /* the run's (optimize keeps the stroke) */
 } opt_report;
 
 static int write_report(const char *path, const opt_report *rp)
@@ -949,6 +978,11 @@ static int write_report(const char *path, const opt_report *rp)
   fprintf(f, "regular: J_d's scaled rcond >= %g (cond_1 <= %g) at every grid point", pr->rcond_min,
           1 / pr->rcond_min);
   if (pr->stroke) fprintf(f, "; sliders within [%.17g, %.17g] m", pr->stroke_lo, pr->stroke_hi);
+  {
+    char lt[400];
+    prru_limits_describe(rp->limits, lt, sizeof lt);
+    fprintf(f, "\nlimits: %s (w_R has no forces or speeds: only the stroke acts)", lt);
+  }
   fprintf(f, "\nobjective: %s (%s), penalty weight %g\n", prru_objective_name(pr->objective),
           objective_text(pr->objective), pr->penalty_weight);
   fprintf(f, "optimiser: GSL nmsimplex2 on sine-transformed bounds, %d iterations, %d evaluations, "
@@ -1128,7 +1162,7 @@ int prru_cmd_optimize(int argc, char **argv)
       {"vars", 1, &vars_s, NULL},      {"q1", 1, &t.q1, NULL},       {"q2", 1, &t.q2, NULL},
       {"q3", 1, &t.q3, NULL},          {"out", 1, &out, NULL},       {"report", 1, &report, NULL},
       {"range", 1, &range, NULL},      {"objective", 1, &t.objective, NULL},
-      {"rcond-min", 1, &t.rcond, NULL}, {"stroke", 1, &t.stroke, NULL}, {"set", 1, &t.set, NULL},
+      {"rcond-min", 1, &t.rcond, NULL}, PRRU_CLI_LIMIT_OPTIONS(t.lim), {"set", 1, &t.set, NULL},
       {"max-iter", 1, &iters, NULL},   {"penalty", 1, &pen, NULL},   {"name", 1, &name_s, NULL},
       {"threads", 1, &ths, NULL},      {"progress", 0, NULL, &progress}, {"clip", 1, &clip_s, NULL},
       {"help", 0, NULL, &help}};
@@ -1147,6 +1181,7 @@ int prru_cmd_optimize(int argc, char **argv)
   }
   prru_design_problem pr;
   prru_params start;
+  t.limits = 1;
   if (parse_problem(cmd, &t, &pr, &start)) return 2;
   double pct = 20;
   if (range && (prru_cli_number(cmd, "range", range, &pct) || !(pct > 0 && pct < 100))) {
@@ -1248,7 +1283,7 @@ int prru_cmd_optimize(int argc, char **argv)
   if (!rc) {
     describe(desc, sizeof desc, &pr, vars, nvar);
     write_model(&jo, &r->best, name, desc);
-    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip};
+    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip, &t.run};
     rc = stage_report(cmd, stage, report, &rp);
   }
   if (prru_cli_out_close(&jo, rc == 0 && !jo.err) && !rc) rc = 1;

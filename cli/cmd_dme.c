@@ -20,8 +20,8 @@ static const char dme_help[] =
     "w_R = sigma_1/sigma_2 (>= 1). The translational segment runs along z with\n"
     "half-length 1/sigma_T (m/s^2 per N).\n"
     "%s"
-    "Prints JSON: model (name, file, sha256, ...), q, status (\"ok\", \"singular\" or\n"
-    "\"unreachable\"), w_R, Jd_rcond,\n"
+    "Prints JSON: model (name, file, sha256, ...), q, status (\"ok\", \"singular\",\n"
+    "\"unreachable\" or \"out_of_stroke\"), w_R, Jd_rcond,\n"
     "sigma, semi_axes (minor, major), axis_directions, sigma_T,\n"
     "translational_half_length, translational_direction, Mt (%dx%d), JtR and\n"
     "JtT (3x%d). At a singular or unreachable pose the status says so and\n"
@@ -89,7 +89,7 @@ int prru_cmd_dme(int argc, char **argv)
   fprintf(f, ", \"status\": \"%s\", \"w_R\": ", prru_dme_status_name(st));
   prru_cli_json_number(f, r.w_R);
   fputs(", \"Jd_rcond\": ", f);
-  prru_cli_json_number(f, st == PRRU_EUNREACHABLE ? NAN : r.jd_rcond);
+  prru_cli_json_number(f, st == PRRU_EUNREACHABLE || st == PRRU_ESTROKE ? NAN : r.jd_rcond);
   fputs(", \"sigma\": ", f);
   json_vec(f, r.sigma, 2);
   fputs(", \"semi_axes\": ", f);

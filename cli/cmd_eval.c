@@ -19,7 +19,8 @@ static const char eval_help[] =
     "J_R,P^T mp + passive) and lambda (the %d joint reaction coordinates: force\n"
     "(N) and moment (N m) components of what each joint's proximal body exerts\n"
     "on the distal one, named in lambda_labels as JOINT_COMPONENT, e.g. %s).\n"
-    "Velocities and loads default to 0. Exit 1 when q is unreachable, J_d is\n"
+    "Velocities and loads default to 0. Exit 1 when q is unreachable or\n"
+    "out_of_stroke (a slider beyond the model's actuators.stroke), J_d is\n"
     "singular there, or q is too near the workspace boundary to trust the\n"
     "dynamics (the mass matrix's rcond below 1e-6), 2 on bad arguments.\n"
     "%s";
@@ -98,9 +99,12 @@ int prru_cmd_eval(int argc, char **argv)
   char qtext[128];
   int st = prru_check_regular(&m, d, q, &rcond);
   if (st != PRRU_OK) {
+    char why[200];
     if (st == PRRU_ESINGULAR)
       prru_cli_error("eval", "q = %s: J_d is singular there (rcond %.3g below jd_rcond_min %.3g)",
                      prru_cli_vec(qtext, sizeof qtext, q, 3), rcond, m.jd_rcond_min);
+    else if (st == PRRU_ESTROKE && prru_stroke_why(&m, d->d, why, sizeof why) == PRRU_ESTROKE)
+      prru_cli_error("eval", "q = %s: out_of_stroke: %s", prru_cli_vec(qtext, sizeof qtext, q, 3), why);
     else
       prru_cli_error("eval", "q = %s: %s", prru_cli_vec(qtext, sizeof qtext, q, 3), prru_strerror(st));
     free(d);

@@ -53,9 +53,10 @@ static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_ba
 
 static const char excite_help[] =
     "usage: prru excite [--out FILE.csv|-] [--period T] [--harmonics L] [--periods N]\n"
-    "         [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3] [--fd-max F|F1,..]\n"
-    "         [--rcond-min R] [--evals N] [--samples N] [--seed S]\n"
-    "         [--stroke LO,HI|LO1,HI1,..] [--coulomb-velocity VS]\n"
+    "         [--dt DT] [--centre q1,q2,q3] [--amplitude A1,A2,A3]\n"
+    "         [--force-max F|F1,..] [--speed-max V|V1,..] [--stroke LO,HI|LO1,HI1,..]\n"
+    "         [--no-limits] [--rcond-min R] [--evals N] [--samples N] [--seed S]\n"
+    "         [--coulomb-velocity VS]\n"
     "An excitation trajectory for identification: each coordinate a Fourier\n"
     "series q_k(t) = c_k + sum_l (a_kl sin(l w t) + b_kl cos(l w t)), w = 2 pi / T\n"
     "(default T = 10 s, L = 5 harmonics, centre c = 0), whose coefficients are\n"
@@ -66,9 +67,13 @@ static const char excite_help[] =
     "(rcond >= --rcond-min, default 1e-2, prru ik's Jd_rcond) in the centre's\n"
     "assembly mode, |q_k - c_k| <= A_k (default 0.25 rad, 0.25 rad, 0.1 L with L\n"
     "the mean upper-link length), and the actuator forces of this model's\n"
-    "inverse dynamics (no platform loads) within --fd-max (N, one value for all\n"
-    "or one per actuator, default 500), the sliders within --stroke (m, for all\n"
-    "or per slider; default none). The result is then checked at 20 times\n"
+    "inverse dynamics (no platform loads), the slider speeds and the sliders\n"
+    "within the drives' limits. The limits are the model's (its actuators keys:\n"
+    "force_max or torque_max, speed_max or motor_speed_max, stroke) unless\n"
+    "--force-max (N; alias --fd-max), --speed-max (m/s) or --stroke (m) replace\n"
+    "them, one value (pair) for all or one per actuator, or --no-limits drops\n"
+    "them; without a force limit, 500 N. A comment line names the limits\n"
+    "applied. The result is then checked at 20 times\n"
     "as many points, and shrunk about the centre until it passes.\n"
     "Writes the model line, comment lines with the coefficients and the\n"
     "condition number, then the columns\n"
@@ -81,8 +86,8 @@ static const char excite_help[] =
     "when no feasible trajectory is found (nothing written).\n";
 
 typedef struct {
-  const char *out, *period, *harm, *periods, *dt, *centre, *amp, *fdmax, *rcond, *evals, *samples,
-      *seed, *vs, *stroke;
+  const char *out, *period, *harm, *periods, *dt, *centre, *amp, *rcond, *evals, *samples, *seed, *vs;
+  prru_cli_limit_args lim;
   int help;
 } excite_args;
 
@@ -108,49 +113,8 @@ static int parse_positive(const char *cmd, const char *name, const char *text, d
   return 0;
 }
 
-static int parse_fd_max(const char *text, double fd_max[PRRU_NACT])
-{
-  double one;
-  if (!strchr(text, ',')) {
-    if (parse_positive("excite", "fd-max", text, &one)) return 2;
-    for (int i = 0; i < PRRU_NACT; i++) fd_max[i] = one;
-    return 0;
-  }
-  if (prru_cli_numbers("excite", "fd-max", text, fd_max, PRRU_NACT)) return 2;
-  for (int i = 0; i < PRRU_NACT; i++)
-    if (!(fd_max[i] > 0)) {
-      prru_cli_error("excite", "--fd-max: the limit of actuator %d must be positive", i + 1);
-      return 2;
-    }
-  return 0;
-}
-
-/* --stroke LO,HI (all sliders) or LO1,HI1,..: 0 or 2. */
-static int parse_stroke(const char *text, prru_excite_options *o)
-{
-  int n = 1;
-  for (const char *c = text; *c; c++) n += *c == ',';
-  double v[2 * PRRU_NACT];
-  if (n != 2 && n != 2 * PRRU_NACT) {
-    prru_cli_error("excite", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per slider), not %d",
-                   2 * PRRU_NACT, n);
-    return 2;
-  }
-  if (prru_cli_numbers("excite", "stroke", text, v, n)) return 2;
-  for (int i = 0; i < PRRU_NACT; i++) {
-    o->d_min[i] = v[n == 2 ? 0 : 2 * i];
-    o->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
-    if (!(o->d_min[i] < o->d_max[i])) {
-      prru_cli_error("excite", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)", i + 1,
-                     o->d_min[i], o->d_max[i]);
-      return 2;
-    }
-  }
-  return 0;
-}
-
 static int excite_options(const excite_args *a, prru_excite_options *o, prru_fourier *f, int *periods,
-                          double *dt)
+                          double *dt, prru_limits *lim)
 {
   const char *c = "excite";
   prru_excite_options_default(o);
@@ -170,8 +134,15 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
         return 2;
       }
   }
-  if (a->fdmax && parse_fd_max(a->fdmax, o->fd_max)) return 2;
-  if (a->stroke && parse_stroke(a->stroke, o)) return 2;
+  /* The run's limits (the model's unless overridden; excite_model makes
+   * the stroke the reach of the run's model too). Excitation needs a
+   * force bound: 500 N (the default) where the run has none. */
+  if (prru_cli_limits(c, "fd-max", &a->lim, lim)) return 2;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    if (isfinite(lim->force_max[i])) o->fd_max[i] = lim->force_max[i];
+    o->speed_max[i] = lim->speed_max[i];
+    o->d_min[i] = lim->d_min[i], o->d_max[i] = lim->d_max[i];
+  }
   if (a->rcond && prru_cli_number(c, "rcond-min", a->rcond, &o->rcond_min)) return 2;
   if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
     prru_cli_error(c, "--rcond-min: %s must lie between 0 and 1", a->rcond);
@@ -188,6 +159,21 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
     return 2;
   }
   return 0;
+}
+
+/* The limits the excitation kept: the run's, with the default force
+ * bound where the run has none. */
+static void excite_limits_comment(prru_cli_out *out, const prru_limits *run, const prru_excite_options *o)
+{
+  prru_limits applied = *run;
+  int dflt = 0;
+  char text[400];
+  for (int i = 0; i < PRRU_NACT; i++) {
+    dflt |= !isfinite(run->force_max[i]);
+    applied.force_max[i] = o->fd_max[i];
+  }
+  prru_limits_describe(&applied, text, sizeof text);
+  prru_cli_out_comment_line(out, "limits: %s%s", text, dflt ? " (force: excite's default where the run has none)" : "");
 }
 
 /* The starting condition number, or why there is none. */
@@ -257,9 +243,9 @@ int prru_cmd_excite(int argc, char **argv)
   prru_cli_option opts[] = {
       {"out", 1, &a.out, NULL},         {"period", 1, &a.period, NULL},   {"harmonics", 1, &a.harm, NULL},
       {"periods", 1, &a.periods, NULL}, {"dt", 1, &a.dt, NULL},           {"centre", 1, &a.centre, NULL},
-      {"amplitude", 1, &a.amp, NULL},   {"fd-max", 1, &a.fdmax, NULL},    {"rcond-min", 1, &a.rcond, NULL},
+      {"amplitude", 1, &a.amp, NULL},   {"fd-max", 1, &a.lim.alias, NULL}, {"rcond-min", 1, &a.rcond, NULL},
       {"evals", 1, &a.evals, NULL},     {"samples", 1, &a.samples, NULL}, {"seed", 1, &a.seed, NULL},
-      {"coulomb-velocity", 1, &a.vs, NULL}, {"stroke", 1, &a.stroke, NULL}, {"help", 0, NULL, &a.help}};
+      {"coulomb-velocity", 1, &a.vs, NULL}, PRRU_CLI_LIMIT_OPTIONS(a.lim), {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("excite", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (a.help) {
     char dn[256], fn[256];
@@ -272,11 +258,15 @@ int prru_cmd_excite(int argc, char **argv)
   prru_fourier f;
   int periods;
   double dt, vs;
-  if (excite_options(&a, &o, &f, &periods, &dt) || coulomb_velocity("excite", a.vs, &vs)) return 2;
-  prru_model m = *prru_cli_model();
+  prru_limits lim;
+  if (excite_options(&a, &o, &f, &periods, &dt, &lim) || coulomb_velocity("excite", a.vs, &vs)) return 2;
+  /* the run's model: the run's stroke bounds its reach */
+  prru_model m;
+  if (prru_model_with_limits(&m, prru_cli_model(), &lim) != PRRU_OK) return 1;
   prru_base *b;
   if (base_or_fail("excite", &m, vs, &b)) {
     free(b);
+    prru_model_free(&m);
     return 1;
   }
   prru_cli_catch_signals();
@@ -285,6 +275,7 @@ int prru_cmd_excite(int argc, char **argv)
   int st = prru_excite(&m, b, &o, &prru_cli_interrupted, &f, &r, msg, sizeof msg);
   if (st != PRRU_OK) {
     free(b);
+    prru_model_free(&m);
     if (st == PRRU_EINTERRUPTED) {
       prru_cli_error("excite", "interrupted (%s); nothing written", prru_cli_signal_name());
       return prru_cli_exit_interrupted();
@@ -295,18 +286,22 @@ int prru_cmd_excite(int argc, char **argv)
   prru_cli_out out;
   if (prru_cli_out_open(&out, "excite", a.out)) {
     free(b);
+    prru_model_free(&m);
     return 1;
   }
   prru_cli_out_comment(&out);
+  excite_limits_comment(&out, &lim, &o);
   excite_comments(&out, &f, &r, b);
   st = excite_rows(&out, &m, &f, periods, dt);
   int io = out.err != 0;
   if (prru_cli_out_close(&out, !io && st == PRRU_OK)) {
     free(b);
+    prru_model_free(&m);
     return 1;
   }
   if (st != PRRU_OK) {
     free(b);
+    prru_model_free(&m);
     prru_cli_error("excite", "%s; nothing written", prru_strerror(st));
     return st == PRRU_EINTERRUPTED ? prru_cli_exit_interrupted() : 1;
   }
@@ -318,6 +313,7 @@ int prru_cmd_excite(int argc, char **argv)
   for (int i = 0; i < PRRU_NACT; i++) fprintf(stderr, " %.4g", r.fd_peak[i]);
   fprintf(stderr, " N\n");
   free(b);
+  prru_model_free(&m);
   return 0;
 }
 
@@ -692,13 +688,19 @@ static void write_model(prru_cli_out *o, const prru_params *p, const char *name,
     json_list(o, p->inertia[b], 6);
     prru_cli_out_printf(o, "}%s\n", b + 1 < PRRU_NBODY ? "," : "");
   }
-  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n    \"armature\": ");
-  json_list(o, p->armature, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"damping\": ");
+  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n");
+  if (prru_cli_writes_armature()) { /* else rotor_inertia, below */
+    prru_cli_out_printf(o, "    \"armature\": ");
+    json_list(o, p->armature, PRRU_NACT);
+    prru_cli_out_printf(o, ",\n");
+  }
+  prru_cli_out_printf(o, "    \"damping\": ");
   json_list(o, p->damping, PRRU_NACT);
   prru_cli_out_printf(o, ",\n    \"coulomb\": ");
   json_list(o, p->coulomb, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g\n  }\n}\n", p->coulomb_velocity);
+  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
+  prru_cli_out_drive_keys(o, p->armature);
+  prru_cli_out_printf(o, "\n  }\n}\n");
   prru_cli_out_line(o);
 }
 

@@ -193,7 +193,7 @@ int prru_cmd_fk(int argc, char **argv)
 static const char id_help[] =
     "usage: prru id --traj FILE.csv [--out FILE.csv|-] [--preload T] [--null-vector]\n"
     "               [--differentiate] [--window M] [--degree P] [--derivatives]\n"
-    "               [--rates] [--reactions]\n"
+    "               [--rates] [--reactions] [--units rail|motor]\n"
     "Inverse dynamics along a trajectory: FILE has a header row and columns\n"
     "t, q1..q3, qd1..qd3, qdd1..qdd3 (any order, other columns ignored) and\n"
     "optionally fp1..fp3, mp1..mp3 (platform loads, default 0); lines starting\n"
@@ -217,8 +217,11 @@ static const char id_help[] =
     "--derivatives adds the columns qd1..3, qdd1..3 used; --rates the slider\n"
     "velocities %s (m/s) and the actuator powers\n"
     "%s = fd dd (W);\n"
-    "--reactions the joint reactions (columns as in 'prru simulate'). With any\n"
-    "of them the output is no longer a load table.\n"
+    "--reactions the joint reactions (columns as in 'prru simulate'); --units\n"
+    "motor the motor torques tau1.. (N m, fd lead / (2 pi gear)) and, where the\n"
+    "model gives torque_constant, the currents i1.. (A): the model file's\n"
+    "actuators.lead is required (exit 2 without). With any of them the output\n"
+    "is no longer a load table.\n"
     "%s"
     "A row where the pose is unreachable or J_d singular, or where det J_d has\n"
     "changed sign since the row before (the motion crossed a singular pose in\n"
@@ -318,7 +321,7 @@ static int id_diff_options(const char *wins, const char *degs, prru_diff_options
 
 int prru_cmd_id(int argc, char **argv)
 {
-  const char *traj = NULL, *out = NULL, *pre = NULL, *wins = NULL, *degs = NULL;
+  const char *traj = NULL, *out = NULL, *pre = NULL, *wins = NULL, *degs = NULL, *units = NULL;
   int help = 0, null_vector = 0, force_diff = 0, derivs = 0, rates = 0, reactions = 0;
   prru_cli_option opts[] = {{"traj", 1, &traj, NULL},
                             {"out", 1, &out, NULL},
@@ -330,8 +333,9 @@ int prru_cmd_id(int argc, char **argv)
                             {"derivatives", 0, NULL, &derivs},
                             {"rates", 0, NULL, &rates},
                             {"reactions", 0, NULL, &reactions},
+                            {"units", 1, &units, NULL},
                             {"help", 0, NULL, &help}};
-  if (prru_cli_parse("id", argc, argv, opts, 11)) return 2;
+  if (prru_cli_parse("id", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   char fd_names[256], n_names[256], dd_names[256], pow_names[256];
   prru_cli_names(fd_names, sizeof fd_names, "fd", PRRU_NACT, ",");
   prru_cli_names(n_names, sizeof n_names, "n", PRRU_NACT, ",");
@@ -351,6 +355,8 @@ int prru_cmd_id(int argc, char **argv)
     return 2;
   }
   if (prru_cli_refuse_same_file("id", "traj", traj, "out", out)) return 2;
+  int motor = 0, current = 0;
+  if (prru_cli_units("id", units, &motor, &current)) return 2;
   double preload = 0.0;
   if (pre && prru_cli_number("id", "preload", pre, &preload)) return 2;
   if ((pre || null_vector) && PRRU_NPRELOAD == 0) {
@@ -441,6 +447,7 @@ int prru_cmd_id(int argc, char **argv)
   if (rates) prru_cli_out_printf(&o, ",%s,%s", dd_names, pow_names);
   for (int k = 0; reactions && k < PRRU_NLAMBDA; k++)
     prru_cli_out_printf(&o, ",%s", prru_cli_model()->mech->lambda_labels[k]);
+  prru_cli_out_motor_names(&o, motor, current);
   prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
   char why[700] = "";
@@ -502,6 +509,7 @@ int prru_cmd_id(int argc, char **argv)
       prru_cli_out_numbers(&o, pw, PRRU_NACT);
     }
     if (reactions) prru_cli_out_numbers(&o, lambda, PRRU_NLAMBDA);
+    prru_cli_out_motor(&o, &m, fd, motor, current);
     prru_cli_out_printf(&o, "\n");
     prru_cli_out_row(&o);
   }

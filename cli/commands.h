@@ -123,6 +123,28 @@ int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_o
 /* Exactly n comma-separated finite numbers for option `name`: 0, else 2
  * after printing what was wrong. */
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n);
+
+/* The drives' limits of a run (spec 13): the model's unless overridden.
+ * One set of options for every command that plans, tracks, excites or
+ * optimises: --no-limits, --force-max F|F1,..., --speed-max V|V1,...,
+ * --stroke LO,HI|LO1,HI1,...; alias: the command's older name of
+ * --force-max (--fd-max, --fmax; NULL: none). */
+typedef struct {
+  const char *force_max, *alias, *speed_max, *stroke;
+  int none;
+} prru_cli_limit_args;
+/* The entries of a command's option table (the alias's, {NAME, 1,
+ * &a.alias, NULL}, beside them where the command has one). */
+#define PRRU_CLI_LIMIT_OPTIONS(a)                                                                              \
+  {"force-max", 1, &(a).force_max, NULL}, {"speed-max", 1, &(a).speed_max, NULL},                             \
+      {"stroke", 1, &(a).stroke, NULL}, {"no-limits", 0, NULL, &(a).none}
+/* --units rail|motor (NULL: rail): *motor = 1 for motor units, *current
+ * = 1 when the model also gives torque_constant. 0, or 2 after the
+ * message (an unknown unit; motor units without the model's lead). */
+int prru_cli_units(const char *cmd, const char *units, int *motor, int *current);
+/* prru_limits_for_run with the options: 0, or 2 after the message naming
+ * the option (also when --force-max and its alias are both given). */
+int prru_cli_limits(const char *cmd, const char *alias_name, const prru_cli_limit_args *a, prru_limits *out);
 /* 1 when paths a and b name the same existing file, compared by device
  * and inode (so "f", "./f", a hard or symbolic link to f alike); 0 when
  * either is NULL, "-" (stdout) or does not exist. */
@@ -178,6 +200,20 @@ typedef struct {
   long rows;
   double flushed_at;  /* CLOCK_MONOTONIC seconds of the last flush */
 } prru_cli_out;
+/* The columns of motor units after a row's others: ",tau1..,i1.." names
+ * and the values for rail forces fd (prru_model_motor_units); nothing
+ * when !motor. */
+void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current);
+/* A model writer's actuators keys after coulomb_velocity: the current
+ * model's section-13 keys in the forms its file gives them, each
+ * ",\n    \"key\": value" (one number, or a list where the actuators
+ * differ). armature: the written model's (identified, optimised); where
+ * the file gives rotor_inertia it goes back there (k / (2 pi gear /
+ * lead)^2; the file's own value where k is unchanged) and the writer
+ * writes no "armature" (prru_cli_writes_armature). */
+void prru_cli_out_drive_keys(prru_cli_out *o, const double armature[PRRU_NACT]);
+int prru_cli_writes_armature(void);
+void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current);
 /* Opens (checks that it can be written: the directory exists and takes a
  * new file); 0, or 1 after a message with the reason. */
 int prru_cli_out_open(prru_cli_out *o, const char *cmd, const char *path);

@@ -116,7 +116,7 @@ const char *prru_cli_map_parse_row(char *line, double q[3], double *w, int *stat
   static const char expected[] = "expected q1,q2,q3,w_R,status with finite numbers, a status of "
                                  "prru map, w_R >= 1 where ok and NaN elsewhere";
   static const int codes[] = {PRRU_OK, PRRU_ESINGULAR, PRRU_EUNREACHABLE, PRRU_DME_OTHER_MODE,
-                              PRRU_EINPUT};
+                              PRRU_EINPUT, PRRU_ESTROKE};
   char *field[5];
   int n = 0;
   for (char *c = line; n < 5; c++) { /* empty fields are fields */
@@ -147,7 +147,7 @@ void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond
           s->n_points, s->n_ok, s->n_singular - s->n_other_mode, s->n_unreachable, s->n_other_mode,
           rcond_min);
   fprintf(f, "global_index: %.10g (mean of w_R - 1 over the ok points)\n", s->index);
-  fprintf(f, "singular_fraction: %.10g (share of the grid that is singular, unreachable or in the "
+  fprintf(f, "singular_fraction: %.10g (share of the grid that is singular, unreachable, out of stroke or in the "
              "other assembly mode)\n", s->singular_fraction);
   fprintf(f, "index_log: %.10g (mean of ln w_R over the ok points)\n", s->index_log);
   if (s->n_ok)

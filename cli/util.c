@@ -141,6 +141,43 @@ int prru_cli_parse_file(const char *cmd, int argc, char **argv, const prru_cli_o
   return parse_args(cmd, argc, argv, opts, nopts, file);
 }
 
+int prru_cli_units(const char *cmd, const char *units, int *motor, int *current)
+{
+  const prru_model *m = prru_cli_model();
+  *motor = *current = 0;
+  if (!units || strcmp(units, "rail") == 0) return 0;
+  if (strcmp(units, "motor") != 0) {
+    prru_cli_error(cmd, "--units '%s': one of rail, motor", units);
+    return 2;
+  }
+  if (!prru_model_has_lead(m)) {
+    prru_cli_error(cmd, "--units motor: model %s has no screw lead (actuators.lead in its model file, "
+                   "spec 13): rail forces cannot be converted to motor torques", m->mech->name);
+    return 2;
+  }
+  *motor = 1;
+  *current = 1;
+  for (int i = 0; i < PRRU_NACT; i++) *current &= m->mech->torque_constant[i] > 0;
+  return 0;
+}
+
+int prru_cli_limits(const char *cmd, const char *alias_name, const prru_cli_limit_args *a, prru_limits *out)
+{
+  if (a->force_max && a->alias) {
+    prru_cli_error(cmd, "--force-max and --%s are the same limit: give one", alias_name);
+    return 2;
+  }
+  const prru_limit_args la = {a->none, a->force_max ? a->force_max : a->alias, a->speed_max, a->stroke};
+  char msg[600];
+  if (prru_limits_for_run(prru_cli_model(), &la, out, msg, sizeof msg) == PRRU_OK) return 0;
+  /* the library names --force-max; the user may have typed the alias */
+  if (a->alias && strncmp(msg, "--force-max", 11) == 0)
+    prru_cli_error(cmd, "--%s%s", alias_name, msg + 11);
+  else
+    prru_cli_error(cmd, "%s", msg);
+  return 2;
+}
+
 int prru_cli_numbers(const char *cmd, const char *name, const char *text, double *out, int n)
 {
   if (prru_parse_values(text, out, n) == PRRU_OK) return 0;

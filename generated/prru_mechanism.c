@@ -4,6 +4,8 @@
  * 3-PRRU 1T2R parallel manipulator, geometry and inertia of Chen, Yu, Li, Wang, Nonlinear Dynamics 90 (2017), Table 1
  * Edit the model file or the generator and regenerate instead.
  */
+#include <math.h> /* HUGE_VAL (an infinity, C99 Annex F): a limit the model does not set */
+
 #include "prru_mechanism.h"
 
 const prru_mechanism prru_mech = {
@@ -88,5 +90,16 @@ const prru_mechanism prru_mech = {
     "A1_fz", "A1_my", "A1_mz", "A2_fx", "A2_fy", "A2_fz", "A2_my",
     "A2_mz", "A3_fx", "A3_fy", "A3_fz", "A3_mx", "A3_mz", "P1_fx",
     "P1_fy", "P1_mx", "P1_my", "P1_mz", "P2_fx", "P2_fy", "P2_mx",
-    "P2_my", "P2_mz", "P3_fx", "P3_fy", "P3_mx", "P3_my", "P3_mz"}
+    "P2_my", "P2_mz", "P3_fx", "P3_fy", "P3_mx", "P3_my", "P3_mz"},
+  /* .lead = */ {0.0, 0.0, 0.0},
+  /* .gear = */ {1.0, 1.0, 1.0},
+  /* .torque_constant = */ {0.0, 0.0, 0.0},
+  /* .force_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+  /* .speed_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+  /* .d_min = */ {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL},
+  /* .d_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+  /* .drive_keys = */ 0u,
+  /* .rotor_inertia = */ {0.0, 0.0, 0.0},
+  /* .torque_max = */ {0.0, 0.0, 0.0},
+  /* .motor_speed_max = */ {0.0, 0.0, 0.0}
 };

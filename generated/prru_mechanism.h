@@ -54,6 +54,21 @@ typedef struct {
   double coulomb_velocity;
   prru_joint_info joint[PRRU_NJOINT]; /* lambda order */
   const char *lambda_labels[PRRU_NLAMBDA];
+  /* screw drives per actuator (spec 13): lead m of slider travel per screw
+   * revolution (0: no lead given), gear motor revolutions per screw
+   * revolution (1 unless given), torque constant N m / A (0: none) */
+  double lead[PRRU_NACT], gear[PRRU_NACT], torque_constant[PRRU_NACT];
+  /* limits per actuator in rail units (torque_max and motor_speed_max
+   * converted): |f| <= force_max N, |dd| <= speed_max m/s, d_min <= d <=
+   * d_max m; INFINITY (-INFINITY for d_min) when the model sets none */
+  double force_max[PRRU_NACT], speed_max[PRRU_NACT];
+  double d_min[PRRU_NACT], d_max[PRRU_NACT];
+  /* the forms the model file gives (for writers that keep them): bit k
+   * for its k-th key of lead, gear, rotor_inertia, torque_constant,
+   * stroke, force_max, torque_max, speed_max, motor_speed_max; and those
+   * values as written (0 where not given): kg m^2, N m, rev/min */
+  unsigned int drive_keys;
+  double rotor_inertia[PRRU_NACT], torque_max[PRRU_NACT], motor_speed_max[PRRU_NACT];
 } prru_mechanism;
 
 #ifdef __cplusplus

@@ -28,6 +28,7 @@ def python_side(model, path):
     except model.ModelError as exc:
         return {"ok": False, "message": str(exc)}
     f = float
+    dr = m.drives
     return {"ok": True, "name": m.name, "description": m.description,
             "format": m.format, "nlimb": m.nlimb,
             "gravity": [f(x) for x in m.gravity],
@@ -39,6 +40,17 @@ def python_side(model, path):
             "damping": [f(x) for x in m.damping],
             "coulomb": [f(x) for x in m.coulomb],
             "coulomb_velocity": f(m.coulomb_velocity or 0),
+            "drive_keys": list(dr.keys),
+            "lead": [f(x or 0) for x in dr.lead],
+            "gear": [f(x) for x in dr.gear],
+            "rotor_inertia": [f(x or 0) for x in dr.rotor_inertia],
+            "torque_constant": [f(x or 0) for x in dr.torque_constant],
+            "d_min": [dr.stroke_limits(i)[0] for i in range(m.nlimb)],
+            "d_max": [dr.stroke_limits(i)[1] for i in range(m.nlimb)],
+            "torque_max": [f(x or 0) for x in dr.torque_max],
+            "motor_speed_max": [f(x or 0) for x in dr.motor_speed_max],
+            "force_max": [dr.force_limit(i) for i in range(m.nlimb)],
+            "speed_max": [dr.speed_limit(i) for i in range(m.nlimb)],
             "sha256": m.sha256, "canonical_sha256": model.canonical_sha256(m)}
 
 
@@ -70,7 +82,7 @@ def compare(py, c, path):
     for key in py:
         if key == "ok":
             continue
-        if key in ("format", "nlimb"):
+        if key in ("format", "nlimb", "drive_keys"):
             same = py[key] == c[key]
         else:
             same = bits(py[key]) == bits(c[key])

@@ -4,6 +4,7 @@
  * "status": s, "message": m}. tests/model_conformance.py compares it with
  * the generator's reading (gen/prrugen/model.py). With --time N, prints
  * the median wall time of N loads instead. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,12 +27,21 @@ static void string(const char *s)
   putchar('"');
 }
 
+/* %.17g, or Python json's Infinity tokens (the limits' "none"). */
+static void number(double x)
+{
+  if (isinf(x))
+    printf("%sInfinity", x < 0 ? "-" : "");
+  else
+    printf("%.17g", x);
+}
+
 static void list(const char *key, const double *v, int n)
 {
   int i;
   printf(", \"%s\": [", key);
   for (i = 0; i < n; i++)
-    printf("%s%.17g", i ? ", " : "", v[i]);
+    printf("%s", i ? ", " : ""), number(v[i]);
   putchar(']');
 }
 
@@ -99,6 +109,27 @@ int main(int argc, char **argv)
   list("armature", m.armature, m.nlimb);
   list("damping", m.damping, m.nlimb);
   list("coulomb", m.coulomb, m.nlimb);
+  {
+    static const char *const names[] = {"lead", "gear", "rotor_inertia", "torque_constant",
+                                        "stroke", "force_max", "torque_max", "speed_max",
+                                        "motor_speed_max"};
+    int first = 1;
+    printf(", \"drive_keys\": [");
+    for (i = 0; i < 9; i++)
+      if (m.keys & (1u << i))
+        printf("%s\"%s\"", first ? "" : ", ", names[i]), first = 0;
+    putchar(']');
+  }
+  list("lead", m.lead, m.nlimb);
+  list("gear", m.gear, m.nlimb);
+  list("rotor_inertia", m.rotor_inertia, m.nlimb);
+  list("torque_constant", m.torque_constant, m.nlimb);
+  list("d_min", m.d_min, m.nlimb);
+  list("d_max", m.d_max, m.nlimb);
+  list("torque_max", m.torque_max, m.nlimb);
+  list("motor_speed_max", m.motor_speed_max, m.nlimb);
+  list("force_max", m.force_max, m.nlimb);
+  list("speed_max", m.speed_max, m.nlimb);
   printf(", \"coulomb_velocity\": %.17g, \"sha256\": \"%s\", \"canonical_sha256\": \"%s\"}\n",
          m.coulomb_velocity, m.sha256, m.canonical_sha256);
   return 0;

@@ -107,7 +107,7 @@ expect 2 "outside the bounds" -- optimize --vars l2=1e-3:2e-3 "${B[@]}"
 expect 2 "cannot be assembled" -- optimize --vars l2 --set b3=10 "${B[@]}"
 expect 2 "I_P: the inertia tensor is not positive definite" -- optimize --vars l2 --set I_P_xy=1 "${B[@]}"
 expect 2 "--objective 'median'" -- optimize --vars l2 --objective median "${B[@]}"
-expect 2 "--stroke '1:0'" -- optimize --vars l2 --stroke 1:0 "${B[@]}"
+expect 2 "--stroke: slider 1's range [1, 0] is empty" -- optimize --vars l2 --stroke 1:0 "${B[@]}"
 expect 2 "--range '0'" -- optimize --vars l2 --range 0 "${B[@]}"
 expect 2 "--rcond-min '0'" -- optimize --vars l2 --rcond-min 0 "${B[@]}"
 expect 2 "--name 'Bad-Name'" -- optimize --vars l2 --name Bad-Name "${B[@]}"
@@ -123,6 +123,31 @@ expect 1 "no feasible design found" -- optimize --vars l2 --range 0.1 --max-iter
   --q2 -1.5:1.5:9 --out "$tmp/bad/m.json" --report "$tmp/bad/rep"
 # A stroke no slider can keep is infeasible too.
 expect 1 "no feasible design found" -- optimize --vars l2 --range 0.1 --max-iter 5 --stroke 50:51 "${B[@]}"
+# The model's own stroke (spec 13) acts by default: the same stroke in the
+# model file is infeasible; --no-limits drops it (the report says so).
+python3 - "$PRRU_MODEL" "$tmp/stroke.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+if d.get("format", 1) == 1:
+    g = d["geometry"]
+    d["geometry"] = {"b": [g["b12"], g["b12"], g["b3"]], "l1": g["l1"], "l2": g["l2"], "a": g["a"]}
+    d["format"] = 2
+d.setdefault("actuators", {})["stroke"] = [50, 51]
+json.dump(d, open(sys.argv[2], "w"), indent=1)
+PY
+expect 1 "no feasible design found" -- --model "$tmp/stroke.json" optimize --vars l2 --range 0.1 --max-iter 5 "${B[@]}"
+mkdir "$tmp/nolim"
+"$PRRU" --model "$tmp/stroke.json" optimize --vars l2 --range 0.1 --max-iter 5 --q1 "$Q1" --q2 "$Q2" --no-limits \
+  --out "$tmp/nolim/m.json" --report "$tmp/nolim/rep" >/dev/null 2>"$tmp/nolim/err" \
+  || bad "optimize --no-limits: $(head -c 300 "$tmp/nolim/err")"
+grep -qx "limits: force_max none, speed_max none, stroke none (w_R has no forces or speeds: only the stroke acts)" \
+  "$tmp/nolim/rep/report.txt" && ! grep -q "sliders within" "$tmp/nolim/rep/report.txt" && ok \
+  || bad "optimize --no-limits report: $(grep -E "limits|sliders" "$tmp/nolim/rep/report.txt")"
+"$PRRU" --model "$tmp/stroke.json" optimize --vars l2 --range 0.1 --max-iter 5 --q1 "$Q1" --q2 "$Q2" \
+  --stroke -1,1 --out "$tmp/nolim/m2.json" --report "$tmp/nolim/rep2" >/dev/null 2>&1 \
+  && grep -qx "limits: force_max none, speed_max none, stroke \[-1, 1\] m (w_R has no forces or speeds: only the stroke acts)" \
+    "$tmp/nolim/rep2/report.txt" && grep -q "sliders within \[-1, 1\] m" "$tmp/nolim/rep2/report.txt" && ok \
+  || bad "optimize --stroke over the model's: $(grep -E "limits|sliders" "$tmp/nolim/rep2/report.txt")"
 echo x >"$tmp/bad/file"
 expect 2 "exists and is not a directory" -- optimize --vars l2 --q1 "$Q1" --q2 "$Q2" --out "$tmp/bad/m.json" --report "$tmp/bad/file"
 rm "$tmp/bad/file"

@@ -297,7 +297,8 @@ echo old >"$tmp/keep.json"
 expect 2 "--data and --out are required" -- identify --data "$tmp/ex.csv"
 cut -d, -f1-13 "$tmp/ex.csv" >"$tmp/nofd.csv"
 expect 2 "missing column 'fd1'" -- identify --data "$tmp/nofd.csv" --out "$tmp/keep.json"
-awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$2=2.5} {print}' "$tmp/ex.csv" >"$tmp/far.csv"
+# (ex.csv: the model line, the limits line, 4 comment lines, the header, then data rows)
+awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==10 {$2=2.5} {print}' "$tmp/ex.csv" >"$tmp/far.csv"
 expect 1 "data row 3" -- identify --data "$tmp/far.csv" --out "$tmp/keep.json"
 grep -q "not reachable" "$tmp/err" && ok || bad "unreachable row: reason missing: $(cat "$tmp/err")"
 awk -F, 'BEGIN{OFS=","} /^#/ {print; next} NR==9 {$1=0} {print}' "$tmp/ex.csv" >"$tmp/time.csv"
@@ -348,5 +349,113 @@ expect 2 "outside its stroke" -- excite --stroke 0.5,0.6 --out "$tmp/c.csv"
 expect 1 "no feasible excitation" -- excite --fd-max 1 --evals 50 --out "$tmp/c.csv"
 [ ! -e "$tmp/c.csv" ] && ok || bad "a refused excite wrote its output"
 [ ! -e "$tmp/x.json" ] && ok || bad "a refused identify wrote its output"
+
+# ---- the drives' limits (spec 13) act by default; options override ----
+# The build's model with a stroke and a force limit (format 2 keeps the
+# build's geometry, so excite accepts it). The default 30-evaluation
+# excitation ($EX) leaves [0.19, 0.235] m (paper model): that stroke
+# of [0.19, 0.235] m must shrink it; --no-limits must not.
+python3 - "$PRRU_MODEL" "$tmp/lim.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+if d.get("format", 1) == 1:
+    g = d["geometry"]
+    n = 3
+    d["geometry"] = {"b": [g["b12"], g["b12"], g["b3"]], "l1": g["l1"], "l2": g["l2"], "a": g["a"]}
+    d["format"] = 2
+d.setdefault("actuators", {})
+d["actuators"].update({"stroke": [0.19, 0.235], "force_max": 60})
+json.dump(d, open(sys.argv[2], "w"), indent=1)
+PY
+slider_range() { python3 -c '
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+v = [float(r[h.index(sys.argv[2])]) for r in rows[1:]]
+print(min(v), max(v))' "$1" "$2"; }
+if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1])).get("name") == "prru" else 1)' "$PRRU_MODEL"; then
+  EX="--evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --out "$tmp/lim.csv" 2>"$tmp/lim.err" \
+    || bad "excite with the model's limits: $(cat "$tmp/lim.err")"
+  grep -qx "# limits: force_max 60 N, speed_max none, stroke \[0.19, 0.235\] m" "$tmp/lim.csv" && ok \
+    || bad "excite: limits line: $(grep limits "$tmp/lim.csv")"
+  read -r lo hi <<<"$(slider_range "$tmp/lim.csv" d1)"
+  python3 -c "import sys; sys.exit(0 if 0.19 <= $lo and $hi <= 0.235 else 1)" && ok \
+    || bad "excite: slider 1 over [$lo, $hi] m, outside the model's stroke [0.19, 0.235]"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --no-limits --out "$tmp/nolim.csv" 2>/dev/null \
+    && grep -qx "# limits: force_max 500 N, speed_max none, stroke none (force: excite's default where the run has none)" \
+      "$tmp/nolim.csv" && ok || bad "excite --no-limits: $(grep limits "$tmp/nolim.csv")"
+  read -r lo hi <<<"$(slider_range "$tmp/nolim.csv" d1)"
+  python3 -c "import sys; sys.exit(0 if $lo < 0.19 else 1)" && ok \
+    || bad "excite --no-limits: slider 1 kept within the dropped stroke ([$lo, $hi] m)"
+  "$PRRU" --model "$tmp/lim.json" excite $EX --fd-max 400 --stroke 0.1:0.3 --speed-max 2 \
+    --out "$tmp/ovr.csv" 2>/dev/null \
+    && grep -qx "# limits: force_max 400 N, speed_max 2 m/s, stroke \[0.1, 0.3\] m" "$tmp/ovr.csv" && ok \
+    || bad "excite --fd-max (alias) --stroke LO:HI --speed-max: $(grep limits "$tmp/ovr.csv")"
+  # --speed-max: the slider speeds keep it at the excitation's dense check
+  # points (period 8 s / 2000: every 4 ms, so every row at a multiple of
+  # 0.02 s); the unlimited excitation reaches 0.136 m/s. Tolerance: the
+  # same J_d qd from a time that may differ in its last bit: 1e-12.
+  "$PRRU" excite $EX --speed-max 0.01 --out "$tmp/spd.csv" 2>/dev/null || bad "excite --speed-max"
+  "$PRRU" id --traj "$tmp/spd.csv" --rates --out "$tmp/spdid.csv" 2>/dev/null || bad "id --rates of excite --speed-max"
+  python3 - "$tmp/spdid.csv" "$nact" <<'PY' && ok || bad "excite --speed-max 0.01: a slider faster at a checked time"
+import csv, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+top = max(abs(float(r[h.index("dd%d" % (i + 1))])) for k, r in enumerate(rows[1:]) if k % 2 == 0
+          for i in range(int(sys.argv[2])))
+assert 0.005 < top <= 0.01 * (1 + 1e-12), top
+PY
+  expect 2 "--force-max and --fd-max are the same limit: give one" \
+    -- excite --force-max 1 --fd-max 1 --out "$tmp/c.csv"
+  expect 2 "--speed-max: '-1' is not a positive number" -- excite --speed-max -1 --out "$tmp/c.csv"
+  expect 2 "--stroke: '1,2,3': give LO,HI for all sliders or 6 numbers" -- excite --stroke 1,2,3 --out "$tmp/c.csv"
+  # The writer keeps the drive keys as the file gives them (spec 13): the
+  # identified armature goes back into rotor_inertia (no "armature" beside
+  # it), every other key as written. Data: the paper's motion with the
+  # forces of the model with drives (armature J (2 pi gear / lead)^2).
+  python3 - "$tmp/lim.json" "$tmp/drv.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["actuators"] = {"lead": 0.02, "gear": 2, "rotor_inertia": [5e-6, 6e-6, 7e-6], "torque_constant": 0.11,
+                  "stroke": [0.1, 0.35], "torque_max": 0.64, "motor_speed_max": 3000}
+json.dump(d, open(sys.argv[2], "w"), indent=1)
+PY
+  "$PRRU" --model "$tmp/drv.json" id --traj "$tmp/ex.csv" --out "$tmp/drvfd.csv" 2>/dev/null || bad "id with drives"
+  python3 - "$tmp/ex.csv" "$tmp/drvfd.csv" "$tmp/drvdata.csv" <<'PY'
+import csv, sys
+def rows(p): return [r for r in csv.reader(l for l in open(p) if not l.startswith('#'))]
+a, b = rows(sys.argv[1]), rows(sys.argv[2])
+out = [a[0]] + [[y[b[0].index(h)] if h in b[0][1:] else x for h, x in zip(a[0], r)] for r, y in zip(a[1:], b[1:])]
+csv.writer(open(sys.argv[3], "w")).writerows(out)
+PY
+  "$PRRU" --model "$tmp/drv.json" identify --data "$tmp/drvdata.csv" --out "$tmp/drvid.json" \
+    --report "$tmp/drvrep.csv" 2>"$tmp/drvid.err" || bad "identify with drives: $(cat "$tmp/drvid.err")"
+  # Written back: J = k / w^2 (w = 2 pi gear / lead), reread: J w w, four
+  # roundings of the same doubles (4 u of k, 8 u allowed); the report's
+  # model column is the written model's base parameter to the estimate's
+  # own rounding rule (16 eps cond max(|prior|, resolution), as above).
+  python3 - "$tmp/drvid.json" "$tmp/drvrep.csv" "$PRRU_SOURCE_DIR/gen" <<'PY' && ok || bad "identify's model: drive keys not kept: $(tr -d '\n' <"$tmp/drvid.json" | grep -o '"actuators.*')"
+import csv, json, sys
+sys.path.insert(0, sys.argv[3])
+from prrugen import model
+a = json.load(open(sys.argv[1]))["actuators"]
+assert "armature" not in a, a
+want = {"lead": 0.02, "gear": 2, "torque_constant": 0.11, "stroke": [0.1, 0.35], "torque_max": 0.64,
+        "motor_speed_max": 3000}
+assert {k: a[k] for k in want} == want, a
+m = model.load(sys.argv[1])
+import re
+text = open(sys.argv[2]).read()
+cond = float(re.search(r"condition number ([0-9.e+-]+)", text).group(1))
+rows = {r["parameter"]: r for r in csv.DictReader(l for l in text.splitlines() if not l.startswith("#"))}
+u = 2.0 ** -53
+for i in range(3):
+    r = rows["armature%d" % (i + 1)]
+    k = float(r["model"])
+    tol = 16 * 2 * u * cond * max(abs(float(r["prior"])), float(r["resolution"])) + 8 * u * k
+    assert abs(float(m.armature[i]) - k) <= tol, (i, float(m.armature[i]), k, tol)
+PY
+fi
 
 finish test_cli_ident

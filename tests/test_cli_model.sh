@@ -164,4 +164,58 @@ expect 2 "its geometry or gravity differs" -- excite --model "$tmp/geo.json" --o
 "$PRRU" --model "$F" excite --evals 20 --period 4 --out "$tmp/hex.csv" 2>/dev/null && ok \
   || bad "excite with the build's geometry and another mass refused"
 
+# ---- drives and limits (spec 13): the stroke bounds the workspace ----
+# models/prototype_drives.json: stroke [-0.05, 0.45] m, sliders near
+# d = 0.21 m at q = 0; q3 = 0.3 puts slider 1 at 0.512 m (beyond d_max),
+# q3 = -0.2 falls under gravity to d_min within 0.13 s.
+if [ "$nact" -eq 3 ]; then
+  D="$PRRU_SOURCE_DIR/models/prototype_drives.json"
+  E="$PRRU_SOURCE_DIR/models/prototype_example.json"
+  expect 1 "q = (0, 0, 0.3): out_of_stroke: slider 1 at d = 0.512424928 m is outside its stroke [-0.05, 0.45] m" \
+    -- --model "$D" eval --q 0,0,0.3
+  "$PRRU" --model "$E" eval --q 0,0,0.3 >/dev/null 2>&1 && ok || bad "eval beyond the stroke of a model without one"
+  "$PRRU" --model "$D" eval --q 0,0,0.2 >/dev/null 2>&1 && ok || bad "eval inside the stroke refused"
+  "$PRRU" --model "$D" map --q1 -0.2:0.2:5 --q2 -0.2:0.2:5 --q3 0.235 --out "$tmp/smap.csv" >"$tmp/smap.txt" 2>&1 \
+    || bad "map across the stroke end: $(cat "$tmp/smap.txt")"
+  [ "$(grep -c ',NaN,out_of_stroke$' "$tmp/smap.csv")" -eq 22 ] && [ "$(grep -c ',ok$' "$tmp/smap.csv")" -eq 3 ] \
+    && ok || bad "map: 22 points out_of_stroke, 3 ok expected: $(cut -d, -f5 "$tmp/smap.csv" | sort | uniq -c)"
+  grep -qF "unreachable 22" "$tmp/smap.txt" && ok || bad "map summary: $(cat "$tmp/smap.txt")"
+  "$PRRU" --model "$E" map --q1 -0.2:0.2:5 --q2 -0.2:0.2:5 --q3 0.235 --out "$tmp/emap.csv" >/dev/null 2>&1 \
+    && ! grep -q out_of_stroke "$tmp/emap.csv" && ok || bad "map without a stroke reports out_of_stroke"
+  printf 'q0 = 0, 0, -0.2\nt_end = 0.5\ndt = 0.01\n' >"$tmp/fall.scn"
+  expect 1 "the motion reached the workspace boundary at t = " \
+    -- --model "$D" simulate --scenario "$tmp/fall.scn" --out "$tmp/fall.csv"
+  grep -qF "is out_of_stroke: slider 1 at d = -0.05" "$tmp/err" && ok || bad "simulate: $(cat "$tmp/err")"
+  [ "$(tail -n 1 "$tmp/fall.csv" | cut -d, -f1)" = 0.12 ] && ok || bad "simulate: samples up to the stroke end kept"
+  # --units motor: tau = fd lead / (2 pi gear), i = tau / k_t (lead 0.02 m,
+  # gear 1, k_t 0.11 N m/A). Tolerance: each side a few correctly rounded
+  # operations on the same doubles (the CLI's fd / (2 pi gear / lead), the
+  # check's fd lead / (2 pi gear), both from the printed 17 digits): 8 u.
+  "$PRRU" --model "$D" traj --waypoints "0,0,0;0.1,0,0.02" --durations 1 --dt 0.01 --out "$tmp/mt.csv" 2>/dev/null \
+    || bad "traj for --units motor"
+  "$PRRU" --model "$D" id --traj "$tmp/mt.csv" --units motor --out "$tmp/mid.csv" 2>"$tmp/mid.err" \
+    || bad "id --units motor: $(cat "$tmp/mid.err")"
+  python3 - "$tmp/mid.csv" <<'PY' && ok || bad "id --units motor: tau or i columns wrong"
+import csv, math, sys
+rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("#"))]
+h = rows[0]
+assert h == ["t", "fd1", "fd2", "fd3", "tau1", "tau2", "tau3", "i1", "i2", "i3"], h
+tol = 8 * 2.0 ** -52
+for r in rows[1:]:
+    v = dict(zip(h, map(float, r)))
+    for k in "123":
+        tau = v["fd" + k] * 0.02 / (2 * math.pi * 1)
+        assert abs(v["tau" + k] - tau) <= tol * abs(tau), (v, k)
+        assert abs(v["i" + k] - tau / 0.11) <= tol * abs(tau / 0.11), (v, k)
+PY
+  model_edit "$D" "$tmp/nokt.json" "del d['actuators']['torque_constant']"
+  "$PRRU" --model "$tmp/nokt.json" id --traj "$tmp/mt.csv" --units motor --out - 2>/dev/null | grep -v '^#' | head -n 1 \
+    | grep -qx "t,fd1,fd2,fd3,tau1,tau2,tau3" && ok || bad "id --units motor without torque_constant: no current columns"
+  rm -f "$tmp/x.csv"
+  expect 2 "--units motor: model proto has no screw lead (actuators.lead" \
+    -- --model "$E" id --traj "$tmp/mt.csv" --units motor --out "$tmp/x.csv"
+  [ ! -e "$tmp/x.csv" ] && ok || bad "id --units motor without a lead wrote its output"
+  expect 2 "--units 'amps': one of rail, motor" -- --model "$D" id --traj "$tmp/mt.csv" --units amps
+fi
+
 finish test_cli_model

@@ -366,6 +366,83 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   TU_TRUE(m.own == NULL && m.mech == &prru_mech, "prru_model_free leaves the default model");
 }
 
+/* The drives (spec 13) of a loaded model: the descriptor and the accessor
+ * hold the loader's numbers; prru_model_motor_units inverts the file's
+ * torque_max and reproduces the spec's conversions written another way.
+ * Tolerance: each side is a few correctly rounded operations on the same
+ * doubles (tau = f / (2 pi gear / lead) against f lead / (2 pi gear):
+ * 3 roundings each, plus the 1 of 2 pi and the file's torque_max -> f
+ * conversion), so they agree to 8 u of the result. */
+static void check_drives(const char *src)
+{
+  const double tol = 8 * DBL_EPSILON, twopi = 2 * 3.14159265358979323846;
+  char path[2100], msg[1024], what[2300];
+  const char *files[2] = {"models/prototype_drives.json",
+                          "tests/models/conformance/valid/f2_drives_motor_forms.json"};
+  for (int k = 0; k < 2; k++) {
+    prru_model_spec s;
+    prru_model m;
+    prru_limits lim;
+    prru_model_default(&m);
+    snprintf(path, sizeof path, "%s/%s", src, files[k]);
+    if (!TU_TRUE(prru_model_file_read(path, &s, msg, sizeof msg) == PRRU_OK &&
+                     prru_model_load(&m, path, msg, sizeof msg) == PRRU_OK,
+                 path))
+      continue;
+    prru_model_limits(&m, &lim);
+    int same = 1, conv = 1;
+    double f[PRRU_NACT], tau[PRRU_NACT], cur[PRRU_NACT];
+    for (int i = 0; i < PRRU_NACT; i++) {
+      same &= lim.force_max[i] == s.force_max[i] && lim.speed_max[i] == s.speed_max[i] &&
+              lim.d_min[i] == s.d_min[i] && lim.d_max[i] == s.d_max[i] && m.mech->lead[i] == s.lead[i] &&
+              m.mech->gear[i] == s.gear[i] && m.mech->torque_constant[i] == s.torque_constant[i];
+      const double lead = s.lead[i], gear = s.gear[i], w = twopi * gear / lead;
+      /* the file's forms: torque_max, motor_speed_max (rev/min), rotor_inertia */
+      conv &= fabs(lim.force_max[i] - s.torque_max[i] * twopi * gear / lead) <= tol * lim.force_max[i];
+      conv &= fabs(lim.speed_max[i] - s.motor_speed_max[i] * lead / (60 * gear)) <= tol * lim.speed_max[i];
+      conv &= fabs(m.mech->armature[i] - s.rotor_inertia[i] * w * w) <= tol * m.mech->armature[i];
+      f[i] = lim.force_max[i];
+    }
+    snprintf(what, sizeof what, "%s: descriptor and prru_model_limits hold the loader's drives", path);
+    TU_TRUE(same && prru_model_has_lead(&m), what);
+    snprintf(what, sizeof what, "%s: rail limits and armature from torque_max, motor_speed_max, rotor_inertia",
+             path);
+    TU_TRUE(conv, what);
+    int back = prru_model_motor_units(&m, f, tau, cur) == PRRU_OK;
+    for (int i = 0; i < PRRU_NACT; i++)
+      back &= fabs(tau[i] - s.torque_max[i]) <= tol * s.torque_max[i] &&
+              fabs(cur[i] - s.torque_max[i] / s.torque_constant[i]) <= tol * cur[i];
+    snprintf(what, sizeof what, "%s: motor units of force_max give torque_max and its current", path);
+    TU_TRUE(back, what);
+    prru_model_free(&m);
+  }
+  /* No drive keys: no limits, no lead, motor units refused. */
+  prru_model m;
+  prru_limits lim;
+  prru_model_default(&m);
+  snprintf(path, sizeof path, "%s/models/prototype_example.json", src);
+  if (TU_TRUE(prru_model_load(&m, path, msg, sizeof msg) == PRRU_OK, path)) {
+    prru_model_limits(&m, &lim);
+    int none = 1;
+    double f[PRRU_NACT] = {0}, tau[PRRU_NACT], cur[PRRU_NACT];
+    for (int i = 0; i < PRRU_NACT; i++) {
+      none &= isinf(lim.force_max[i]) && lim.force_max[i] > 0 && isinf(lim.speed_max[i]) &&
+              lim.speed_max[i] > 0 && isinf(lim.d_min[i]) && lim.d_min[i] < 0 && isinf(lim.d_max[i]) &&
+              lim.d_max[i] > 0 && m.mech->gear[i] == 1 && m.mech->lead[i] == 0;
+      tau[i] = cur[i] = 7;
+    }
+    TU_TRUE(none, "a model without drive keys: every limit none, gear 1, no lead");
+    TU_TRUE(!prru_model_has_lead(&m) && prru_model_motor_units(&m, f, tau, cur) == PRRU_EINPUT && tau[0] == 7 &&
+                cur[0] == 7,
+            "motor units without a lead: PRRU_EINPUT, outputs untouched");
+    prru_model_free(&m);
+  }
+  prru_model_default(&m);
+  prru_model_limits(&m, &lim);
+  TU_TRUE(isinf(lim.force_max[0]) && isinf(lim.d_min[PRRU_NACT - 1]) && lim.d_min[PRRU_NACT - 1] < 0,
+          "the build's paper model (generated descriptor): no limits");
+}
+
 static int by_name(const struct dirent **a, const struct dirent **b) { return strcmp((*a)->d_name, (*b)->d_name); }
 static int json_file(const struct dirent *e)
 {
@@ -460,6 +537,7 @@ int main(int argc, char **argv)
   if (n > 0) free(list);
   printf("%d of %d invalid files refused with their name\n", refused, n);
   TU_TRUE(n > 20 && refused == n, "every invalid file refused (PRRU_EPARSE, named, model untouched)");
+  if (PRRU_NLIMB == 3) check_drives(src);
   prru_ref_free(W);
   return tu_finish("test_model_load");
 }

@@ -39,7 +39,13 @@ TOP_KEYS = ("name", "description", "gravity", "geometry", "bodies")
 TOP2_KEYS = ("format",) + TOP_KEYS + ("actuators",)
 BODY_KEYS = ("mass", "inertia")
 BODY2_KEYS = ("mass", "inertia", "com")
-ACTUATOR_KEYS = ("armature", "damping", "coulomb", "coulomb_velocity")
+ACTUATOR_KEYS = ("armature", "damping", "coulomb", "coulomb_velocity",
+                 "lead", "gear", "rotor_inertia", "torque_constant", "stroke",
+                 "force_max", "torque_max", "speed_max", "motor_speed_max")
+# Spec 13's keys that convert between the rail and the motor through the
+# lead, in the order their missing lead is reported.
+NEEDS_LEAD = ("rotor_inertia", "torque_max", "motor_speed_max",
+              "torque_constant")
 MAX_BYTES = 1 << 20
 # Bounds the C loader (runtime/src/model_file.c) shares, so that it decides
 # every file as this module does with fixed-size exact arithmetic: at most
@@ -72,6 +78,70 @@ class Limb:
         self.b, self.l1, self.l2, self.a = b, l1, l2, a
 
 
+class Drives:
+    """Spec 13's screw drives and limits, per actuator: the values as the
+    file gives them (None: key absent) and, as floats, the limits in rail
+    units (drive_ratio and the limits' conversions below). The armature a
+    rotor_inertia reflects is in Model.armature already."""
+
+    def __init__(self, n):
+        none = (None,) * n
+        self.lead = self.rotor_inertia = self.torque_constant = none
+        self.gear = (Fraction(1),) * n
+        self.stroke = none                   # (d_min, d_max) or None
+        self.force_max = self.torque_max = none
+        self.speed_max = self.motor_speed_max = none
+        self.keys = ()                       # the section 13 keys given
+
+    @property
+    def given(self):
+        """Whether the file gives any spec-13 key."""
+        return bool(self.keys)
+
+    def ratio(self, i):
+        """Motor radians per metre of slider travel, 2 pi gear / lead, as a
+        double (None without a lead)."""
+        lead = self.lead[i]
+        return None if lead is None else drive_ratio(lead, self.gear[i])
+
+    def force_limit(self, i):
+        """|f_i| bound in N (rail force), inf when none."""
+        if self.torque_max[i] is not None:
+            return float(self.torque_max[i]) * self.ratio(i)
+        return math.inf if self.force_max[i] is None else float(self.force_max[i])
+
+    def speed_limit(self, i):
+        """|d_i'| bound in m/s, inf when none."""
+        if self.motor_speed_max[i] is not None:
+            return motor_speed_to_rail(self.motor_speed_max[i], self.lead[i],
+                                       self.gear[i])
+        return math.inf if self.speed_max[i] is None else float(self.speed_max[i])
+
+    def stroke_limits(self, i):
+        """(d_min, d_max) in m, (-inf, inf) when none."""
+        if self.stroke[i] is None:
+            return -math.inf, math.inf
+        return float(self.stroke[i][0]), float(self.stroke[i][1])
+
+
+# The conversions are defined as these double operations, in this order,
+# so that the C loader (runtime/src/model_file.c) computes the same bits.
+def drive_ratio(lead, gear):
+    """2 pi gear / lead (rad/m): ((2 pi) gear) / lead in doubles."""
+    return 2.0 * math.pi * float(gear) / float(lead)
+
+
+def reflected_armature(rotor_inertia, lead, gear):
+    """k = J_r (2 pi gear / lead)^2 (kg): (J_r w) w in doubles."""
+    w = drive_ratio(lead, gear)
+    return float(rotor_inertia) * w * w
+
+
+def motor_speed_to_rail(rpm, lead, gear):
+    """rev/min at the motor to m/s on the rail: ((n / 60) lead) / gear."""
+    return float(rpm) / 60.0 * float(lead) / float(gear)
+
+
 class Model:
     """A validated model: exact Fractions, plus the file's SHA-256.
 
@@ -98,6 +168,7 @@ class Model:
         self.coulomb_velocity = coulomb_velocity
         self.sha256 = sha256
         self.path = path
+        self.drives = Drives(len(limbs))
 
     @property
     def nlimb(self):
@@ -389,9 +460,12 @@ def _gravity(path, value, fmt):
 
 
 def _actuators(path, value, nlimb):
+    """Section 11's drive terms and section 13's drives and limits: the
+    armature, damping and Coulomb lists, v_s, and the Drives."""
     zero = (Fraction(0),) * nlimb
+    drives = Drives(nlimb)
     if value is None:
-        return zero, zero, zero, None
+        return zero, zero, zero, None, drives
     value = _object(path, "actuators", value, ACTUATOR_KEYS, ())
     lists = [_per_limb(path, "actuators." + k, value[k], nlimb, _nonnegative,
                        "one per actuator") if k in value else zero
@@ -404,7 +478,75 @@ def _actuators(path, value, nlimb):
         raise ModelError(path, "actuators.coulomb_velocity", "missing: the "
                          "Coulomb force -f tanh(dd / v_s) needs the smoothing "
                          "velocity v_s (m/s)")
-    return lists[0], lists[1], lists[2], vs if any(lists[2]) else None
+    _drives(path, value, nlimb, drives)
+    if drives.rotor_inertia[0] is not None:
+        # The double's shortest decimal, as the user would write the
+        # armature (the same double: the loader agrees bit for bit), so
+        # that a rotor inertia and its armature written out fold alike.
+        lists[0] = tuple(Fraction(repr(reflected_armature(
+            drives.rotor_inertia[i], drives.lead[i], drives.gear[i])))
+            for i in range(nlimb))
+    return lists[0], lists[1], lists[2], vs if any(lists[2]) else None, drives
+
+
+def _stroke(path, value, n):
+    """[d_min, d_max] for every actuator, or a list of n such pairs."""
+    key = "actuators.stroke"
+    if isinstance(value, list) and any(isinstance(v, list) for v in value):
+        if len(value) != n:
+            raise ModelError(path, key, "must be one pair [d_min, d_max] (m) "
+                             "or a list of %d pairs (one per actuator), got "
+                             "%d entries" % (n, len(value)))
+        items = [("%s[%d]" % (key, i), v) for i, v in enumerate(value)]
+    elif isinstance(value, list) and len(value) == 2:
+        items = [(key, value)]
+    else:
+        raise ModelError(path, key, "must be one pair [d_min, d_max] (m) or a "
+                         "list of %d pairs (one per actuator)" % n)
+    pairs = []
+    for k, pair in items:
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise ModelError(path, k, "must be a pair [d_min, d_max] (m)")
+        lo = _number(path, k + "[0]", pair[0])
+        hi = _number(path, k + "[1]", pair[1])
+        if lo >= hi:
+            raise ModelError(path, k, "d_min = %s m must be below d_max = %s m"
+                             % (_fmt(lo), _fmt(hi)))
+        pairs.append((lo, hi))
+    return tuple(pairs) if len(pairs) == n else (pairs[0],) * n
+
+
+def _drives(path, value, n, drives):
+    """Section 13, checked in key order, then the keys' relations."""
+    def per(key, check):
+        if key not in value:
+            return None
+        return _per_limb(path, "actuators." + key, value[key], n, check,
+                         "one per actuator")
+    got = {k: per(k, _nonnegative if k == "rotor_inertia" else _positive)
+           for k in ("lead", "gear", "rotor_inertia", "torque_constant")}
+    if "stroke" in value:
+        drives.stroke = _stroke(path, value["stroke"], n)
+    for k in ("force_max", "torque_max", "speed_max", "motor_speed_max"):
+        got[k] = per(k, _positive)
+    for a, b, what in (("armature", "rotor_inertia", "drive inertia"),
+                       ("force_max", "torque_max", "force limit"),
+                       ("speed_max", "motor_speed_max", "speed limit")):
+        if a in value and b in value:
+            raise ModelError(path, "actuators." + b, "given with actuators.%s:"
+                             " both set the %s of every actuator (ambiguous);"
+                             " give one" % (a, what))
+    if "lead" not in value:
+        for k in NEEDS_LEAD:
+            if k in value:
+                raise ModelError(path, "actuators." + k, "needs actuators."
+                                 "lead (m of slider travel per screw "
+                                 "revolution) to convert between motor and "
+                                 "rail")
+    for k, v in got.items():
+        if v is not None:
+            setattr(drives, k, v)
+    drives.keys = tuple(k for k in ACTUATOR_KEYS[4:] if k in value)
 
 
 _TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]', re.S)
@@ -518,10 +660,12 @@ def parse(text, path="<model>"):
         coms.append(_vector3(path, key + ".com", body["com"], "centre of mass "
                              "in the body frame, m") if "com" in body
                     else (Fraction(0),) * 3)
-    drives = _actuators(path, data.get("actuators"), len(limbs))
+    *terms, drives = _actuators(path, data.get("actuators"), len(limbs))
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    return Model(name, description, fmt, gravity, limbs, tuple(masses),
-                 tuple(coms), tuple(inertias), *drives, sha256=sha, path=path)
+    m = Model(name, description, fmt, gravity, limbs, tuple(masses),
+              tuple(coms), tuple(inertias), *terms, sha256=sha, path=path)
+    m.drives = drives
+    return m
 
 
 def load(path):
@@ -550,8 +694,11 @@ def canonical_bytes(model):
     IEEE-754 binary64 little-endian of float() of each exact value: gravity
     (3); per limb b, l1, l2, a; per body (body_names order) mass, com (3),
     inertia (Ixx, Iyy, Izz, Ixy, Ixz, Iyz); per actuator armature, damping,
-    coulomb; coulomb_velocity (0 when none). Name and description are not
-    numbers of the dynamics and are left out. runtime/src/model_file.c
+    coulomb; coulomb_velocity (0 when none); then, only for a file with
+    section 13's keys (so that other files keep their hash), per actuator
+    lead (0 when none), gear, torque_constant (0 when none), d_min, d_max,
+    the force and the speed limit in rail units (infinities when none; a
+    rotor_inertia is in the armature). Name and description are left out. runtime/src/model_file.c
     writes the same bytes (docs/model-files.md)."""
     numbers = list(model.gravity)
     for limb in model.limbs:
@@ -562,6 +709,12 @@ def canonical_bytes(model):
     for i in range(model.nlimb):
         numbers += [model.armature[i], model.damping[i], model.coulomb[i]]
     numbers.append(model.coulomb_velocity or 0)
+    dr = model.drives
+    if dr.given:
+        for i in range(model.nlimb):
+            numbers += [dr.lead[i] or 0, dr.gear[i], dr.torque_constant[i] or 0,
+                        *dr.stroke_limits(i), dr.force_limit(i),
+                        dr.speed_limit(i)]
     return CANONICAL_MAGIC + bytes((model.format, model.nlimb)) + b"".join(
         struct.pack("<d", float(x)) for x in numbers)
 

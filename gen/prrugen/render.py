@@ -1,5 +1,6 @@
 """Filling the C templates: file headers, kernels, mechanism descriptor."""
 
+import math
 import os
 import re
 from string import Template
@@ -7,7 +8,7 @@ from string import Template
 from . import batch, cgen, params, regressor
 from .ctext import c_comment, c_string
 from .kernels import kernels, lambda_labels
-from .model import c_double
+from .model import ACTUATOR_KEYS, c_double
 
 GENERATOR = "gen/prru_gen.py"
 
@@ -64,6 +65,14 @@ def _block(values, indent="    "):
     return "\n".join(lines)
 
 
+def _limit(x):
+    """A limit in rail units as C: an infinity where the model sets none
+    (HUGE_VAL, a double; INFINITY is a float, which -Wdouble-promotion
+    refuses to widen)."""
+    return ("HUGE_VAL" if x > 0 else "-HUGE_VAL") if math.isinf(x) \
+        else c_double(x)
+
+
 def _descriptor(model, mech, prefix, labels):
     """Initializer fields of the mechanism descriptor, in struct order."""
     nb, nl = len(mech.bodies), len(mech.limbs)
@@ -80,6 +89,7 @@ def _descriptor(model, mech, prefix, labels):
         offset += n
     inertia = [_tensor3(i) for i in model.inertias]
     num = lambda v: c_double(v)  # noqa: E731
+    dr = model.drives
     fields = [
         ("name", c_string(model.name)),
         ("description", c_string(model.description)),
@@ -117,6 +127,18 @@ def _descriptor(model, mech, prefix, labels):
         ("coulomb_velocity", num(model.coulomb_velocity or 0)),
         ("joint", "{\n      " + ",\n      ".join(joints) + "}"),
         ("lambda_labels", _block([c_string(l) for l in labels])),
+        ("lead", _block([num(x or 0) for x in dr.lead])),
+        ("gear", _block([num(x) for x in dr.gear])),
+        ("torque_constant", _block([num(x or 0) for x in dr.torque_constant])),
+        ("force_max", _block([_limit(dr.force_limit(i)) for i in range(nl)])),
+        ("speed_max", _block([_limit(dr.speed_limit(i)) for i in range(nl)])),
+        ("d_min", _block([_limit(dr.stroke_limits(i)[0]) for i in range(nl)])),
+        ("d_max", _block([_limit(dr.stroke_limits(i)[1]) for i in range(nl)])),
+        ("drive_keys", "%du" % sum(1 << k for k, key in enumerate(
+            ACTUATOR_KEYS[4:]) if key in dr.keys)),
+        ("rotor_inertia", _block([num(x or 0) for x in dr.rotor_inertia])),
+        ("torque_max", _block([num(x or 0) for x in dr.torque_max])),
+        ("motor_speed_max", _block([num(x or 0) for x in dr.motor_speed_max])),
     ]
     return ",\n".join("  /* .%s = */ %s" % f for f in fields)
 

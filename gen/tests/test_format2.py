@@ -271,6 +271,58 @@ class FormatTranscription(unittest.TestCase):
             self.assertEqual(a, b, name)
 
 
+DRIVES = os.path.join(ROOT, "models", "prototype_drives.json")
+
+
+class Drives(unittest.TestCase):
+    """Spec 13 (models/prototype_drives.json): the rotor inertia enters the
+    kernels as the armature J_r (2 pi gear / lead)^2 would, and the
+    descriptor carries the drives and the limits in rail units. Tolerance
+    of the conversions: the generator's and these formulas are each a few
+    correctly rounded operations on the same doubles: 8 u."""
+
+    def test_rotor_inertia_is_the_reflected_armature(self):
+        m = model.load(DRIVES)
+        spec = json.load(open(DRIVES))
+        acts = spec["actuators"]
+        u = 2.0 ** -53
+        k = []
+        for i, J in enumerate(acts["rotor_inertia"]):
+            k.append(float(m.armature[i]))
+            want = J * (2 * math.pi * acts["gear"] / acts["lead"]) ** 2
+            self.assertLessEqual(abs(k[-1] - want), 8 * u * want)
+        del acts["rotor_inertia"], acts["lead"], acts["gear"], acts["torque_constant"]
+        del acts["torque_max"], acts["motor_speed_max"]
+        acts["armature"] = k
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "proto_drives.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            one, _ = prru_gen.generate(DRIVES)
+            two, _ = prru_gen.generate(path)
+        for name in one:
+            if not name.endswith("mechanism.c"):
+                self.assertEqual(one[name].split(" */\n", 1)[1], two[name].split(" */\n", 1)[1], name)
+        text = one["proto_drives_mechanism.c"]
+
+        def field(key):
+            line = next(l for l in text.splitlines() if "/* .%s = */" % key in l)
+            return line.split("*/", 1)[1].strip().rstrip(",")
+
+        force = [float(x) for x in field("force_max").strip("{}").split(",")]
+        for f in force:
+            want = 0.64 * 2 * math.pi / 0.02
+            self.assertLessEqual(abs(f - want), 8 * u * want)
+        self.assertEqual(field("speed_max"), "{1.0, 1.0, 1.0}")
+        self.assertEqual(field("d_min"), "{-0.05, -0.05, -0.05}")
+        self.assertEqual(field("d_max"), "{0.45, 0.45, 0.45}")
+        self.assertEqual(field("lead"), "{0.02, 0.02, 0.02}")
+        self.assertEqual(field("drive_keys"), "%du" % (1 | 2 | 4 | 8 | 16 | 64 | 256))
+        none = two["proto_drives_mechanism.c"]
+        self.assertIn("/* .force_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL}", none)
+        self.assertIn("/* .lead = */ {0.0, 0.0, 0.0}", none)
+
+
 class Determinism(unittest.TestCase):
     def test_output_does_not_depend_on_what_the_process_built_before(self):
         first, _ = prru_gen.generate(PROTO)

@@ -19,7 +19,8 @@ one the library was built from: Model.name, .nact, .body_names,
 .lambda_labels, ...; a library built for the 4-PRRU gives four actuators.
 
 Failures raise PrruError subclasses with the library's message:
-InputError (also ValueError), Unreachable, Singular, NoConvergence,
+InputError (also ValueError), Unreachable (OutOfStroke: a slider outside
+its stroke), Singular, NoConvergence,
 Interrupted, PrruIOError, ParseError; wrong argument lengths and NaN raise
 ValueError naming the argument, and a vector given as anything but an
 ordered sequence of numbers (a dict, set, string, iterator, ...) TypeError
@@ -30,8 +31,8 @@ simulate at once, also inside a long sample interval (KeyboardInterrupt).
 """
 
 from .errors import (InputError, Interrupted, LayoutError, LibraryNotFound, NoConvergence,
-                     ParseError, PrruError, PrruIOError, PrruMemoryError, Singular,
-                     Unreachable)
+                     OutOfStroke, ParseError, PrruError, PrruIOError, PrruMemoryError,
+                     Singular, Unreachable)
 from ._lib import Library, load_library
 from .model import Dme, Joint, Model
 from .simulation import Sample, Scenario, Trajectory
@@ -41,6 +42,6 @@ from .measurements import Measurement
 __version__ = "0.2.0"
 
 __all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult",
-           "Library", "load_library", "PrruError", "InputError", "Unreachable", "Singular",
+           "Library", "load_library", "PrruError", "InputError", "Unreachable", "OutOfStroke", "Singular",
            "NoConvergence", "Interrupted", "PrruIOError", "PrruMemoryError", "ParseError",
            "LibraryNotFound", "LayoutError"]

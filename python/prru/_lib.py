@@ -142,7 +142,12 @@ class Types:
             ("a", _arr(d, nlimb)),
             ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
             ("coulomb_velocity", d), ("joint", _arr(_JointInfo, njoint)),
-            ("lambda_labels", _arr(ctypes.c_char_p, nlambda))]})
+            ("lambda_labels", _arr(ctypes.c_char_p, nlambda)),
+            ("lead", _arr(d, nact)), ("gear", _arr(d, nact)), ("torque_constant", _arr(d, nact)),
+            ("force_max", _arr(d, nact)), ("speed_max", _arr(d, nact)),
+            ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)),
+            ("drive_keys", ctypes.c_uint), ("rotor_inertia", _arr(d, nact)),
+            ("torque_max", _arr(d, nact)), ("motor_speed_max", _arr(d, nact))]})
         self.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": [
             ("fd", _arr(d, nact)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
         self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [

@@ -15,6 +15,7 @@ EINTERRUPTED = 5
 EIO = 6
 ENOMEM = 7
 EPARSE = 8
+ESTROKE = 9
 
 
 class PrruError(Exception):
@@ -44,6 +45,14 @@ class Unreachable(PrruError):
     """PRRU_EUNREACHABLE: the pose has no inverse kinematics."""
 
     status = EUNREACHABLE
+
+
+class OutOfStroke(Unreachable):
+    """PRRU_ESTROKE: a slider lies outside its stroke (the model's
+    actuators.stroke): the stroke ends bound the workspace as the reach does,
+    so this is an Unreachable."""
+
+    status = ESTROKE
 
 
 class Singular(PrruError):
@@ -101,6 +110,7 @@ _BY_STATUS = {
     EIO: PrruIOError,
     ENOMEM: PrruMemoryError,
     EPARSE: ParseError,
+    ESTROKE: OutOfStroke,
 }
 
 

@@ -116,6 +116,12 @@ class Model:
                                             out.vec(me.a))
         self.armature, self.damping = out.vec(me.armature), out.vec(me.damping)
         self.coulomb, self.coulomb_velocity = out.vec(me.coulomb), me.coulomb_velocity
+        # spec 13: lead 0 and torque_constant 0 mean none; limits in rail
+        # units, inf (-inf for d_min) where the model sets none
+        self.lead, self.gear = out.vec(me.lead), out.vec(me.gear)
+        self.torque_constant = out.vec(me.torque_constant)
+        self.force_max, self.speed_max = out.vec(me.force_max), out.vec(me.speed_max)
+        self.d_min, self.d_max = out.vec(me.d_min), out.vec(me.d_max)
         self.joints = tuple(Joint(s(j.name), s(j.type), j.limb, j.proximal, j.distal,
                                   j.lambda_offset, j.lambda_count) for j in me.joint)
         self.lambda_labels = tuple(s(me.lambda_labels[i]) for i in range(me.nlambda))

@@ -215,6 +215,26 @@ class TestModelFile(unittest.TestCase):
             checked += 1
         self.assertGreater(checked, 0)
 
+    def test_drives_and_stroke(self):
+        """models/prototype_drives.json (spec 13): the descriptor's drives in
+        rail units (torque_max 0.64 N m through lead 0.02 m: 0.64 2 pi / 0.02
+        N; 3000 rev/min: 1 m/s, to the rounding of those few operations),
+        and a slider beyond its stroke is OutOfStroke, an Unreachable."""
+        if MODEL.nlimb != 3:
+            self.skipTest("a 3-limb model file")
+        m = prru.Model(model=os.path.join(SOURCE_DIR, "models", "prototype_drives.json"), lib=MODEL.lib)
+        self.assertEqual(list(m.lead), [0.02] * 3)
+        self.assertEqual(list(m.torque_constant), [0.11] * 3)
+        self.assertEqual((list(m.d_min), list(m.d_max)), ([-0.05] * 3, [0.45] * 3))
+        for f, v in zip(m.force_max, m.speed_max):
+            self.assertLessEqual(abs(f - 0.64 * 2 * math.pi / 0.02), 8 * 2.2e-16 * f)
+            self.assertLessEqual(abs(v - 1.0), 8 * 2.2e-16)
+        m.check([0.0, 0.0, 0.2])
+        with self.assertRaises(prru.OutOfStroke) as e:
+            m.check([0.0, 0.0, 0.3])
+        self.assertIsInstance(e.exception, prru.Unreachable)
+        self.assertEqual(e.exception.status, 9)
+
     def test_refusals(self):
         with self.assertRaises(prru.PrruIOError) as e:
             prru.Model(model=os.path.join(self.tmp, "missing.json"), lib=MODEL.lib)

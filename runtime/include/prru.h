@@ -51,7 +51,10 @@ typedef enum {
   PRRU_EINTERRUPTED = 5, /* stopped on request (SIGINT) */
   PRRU_EIO = 6,          /* a file could not be read or written */
   PRRU_ENOMEM = 7,
-  PRRU_EPARSE = 8        /* malformed number, list, CSV or scenario */
+  PRRU_EPARSE = 8,       /* malformed number, list, CSV or scenario */
+  PRRU_ESTROKE = 9       /* a slider outside its stroke (the model's
+                            actuators.stroke, spec 13): the stroke ends
+                            bound the workspace like the reach does */
 } prru_status;
 
 /* A short, stable description of a status code. */
@@ -191,8 +194,64 @@ typedef struct {
   double speed_max[PRRU_NACT];
   double d_min[PRRU_NACT], d_max[PRRU_NACT];
 } prru_limits;
+/* The section 13 keys a model file gives, as bits (prru_mechanism.drive_keys,
+ * prru_model_spec.keys): bit k for the k-th key of this list. */
+enum {
+  PRRU_DRIVE_LEAD = 1 << 0,
+  PRRU_DRIVE_GEAR = 1 << 1,
+  PRRU_DRIVE_ROTOR_INERTIA = 1 << 2,
+  PRRU_DRIVE_TORQUE_CONSTANT = 1 << 3,
+  PRRU_DRIVE_STROKE = 1 << 4,
+  PRRU_DRIVE_FORCE_MAX = 1 << 5,
+  PRRU_DRIVE_TORQUE_MAX = 1 << 6,
+  PRRU_DRIVE_SPEED_MAX = 1 << 7,
+  PRRU_DRIVE_MOTOR_SPEED_MAX = 1 << 8
+};
+
 /* Every limit off. */
 void prru_limits_none(prru_limits *l);
+/* The model's own limits (its file's actuators keys, spec 13, in rail
+ * units: torque_max and motor_speed_max converted through the lead and
+ * gear); none where the file sets none. */
+void prru_model_limits(const prru_model *m, prru_limits *out);
+/* Motor radians per metre of slider i's travel, 2 pi gear_i / lead_i
+ * (rad/m; the reflected armature of a rotor inertia J_r is J_r times its
+ * square), NaN without a lead or for i outside 0..PRRU_NACT-1. */
+double prru_model_drive_ratio(const prru_model *m, int i);
+/* Whether every actuator has a screw lead (the file's actuators.lead):
+ * only then do rail quantities convert to the motor. */
+int prru_model_has_lead(const prru_model *m);
+/* Rail forces f (N) to the ideal motor torques tau_i = f_i lead_i /
+ * (2 pi gear_i) (N m) and, where current is non-NULL, the motor currents
+ * tau_i / k_t,i (A; NaN for an actuator without torque_constant). tau
+ * may be NULL. PRRU_EINPUT (outputs untouched) when an actuator has no
+ * lead (prru_model_has_lead); else PRRU_OK. */
+int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
+                           double current[PRRU_NACT]);
+/* A run's overrides of the model's limits, as given on a command line
+ * (--no-limits, --force-max, --speed-max, --stroke); NULL text: not given. */
+typedef struct {
+  int none;              /* drop every limit of the model first (--no-limits) */
+  const char *force_max; /* "F" for every actuator or "F1,..,FN" (N, > 0) */
+  const char *speed_max; /* likewise, m/s */
+  const char *stroke;    /* "LO,HI" (or "LO:HI") for every slider, or
+                            "LO1,HI1,..,LON,HIN" (m, LO < HI) */
+} prru_limit_args;
+/* The limits a run applies: the model's (prru_model_limits), all none if
+ * a->none, then each limit given in a replaces that kind for every
+ * actuator. PRRU_OK; PRRU_EINPUT with msg naming the option
+ * ("--force-max: ...") and out untouched. a may be NULL (the model's). */
+int prru_limits_for_run(const prru_model *m, const prru_limit_args *a, prru_limits *out, char *msg,
+                        int msglen);
+/* One line for a run's header: "force_max F N, speed_max V m/s, stroke
+ * [LO, HI] m" (one value when every actuator has the same, else a list
+ * per actuator; "none" for a kind that is off), into buf (len bytes). */
+void prru_limits_describe(const prru_limits *l, char *buf, size_t len);
+/* out: src with l's limits in a descriptor of its own (the stroke then
+ * bounds every reachability test of out, prru_stroke_actuator); src's
+ * numbers, kernels and settings otherwise. Allocates: prru_model_free(out)
+ * (src may be freed first). PRRU_OK or PRRU_ENOMEM (out untouched). */
+int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_limits *l);
 
 typedef struct {
   double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */
@@ -214,13 +273,26 @@ typedef struct {
   double lambda_null[PRRU_NLAMBDA];
 } prru_data;
 
-/* PRRU_OK, PRRU_EINPUT (non-finite q) or PRRU_EUNREACHABLE; fills d->d. */
+/* PRRU_OK, PRRU_EINPUT (non-finite q), PRRU_EUNREACHABLE or PRRU_ESTROKE
+ * (a slider outside its stroke, prru_stroke_actuator); fills d->d. */
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3]);
+/* The first actuator (0-based) whose displacement d_i lies outside the
+ * model's stroke [d_min_i, d_max_i] (m->mech, ends included), -1 when
+ * none does (NaN d_i: none; unreachability is tested apart). Every
+ * reachability test of the library applies it: prru_check_reachable,
+ * prru_check_regular, the dynamics, prru_simulate, the maps. */
+int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT]);
+/* At a q whose sliders are at d: PRRU_ESTROKE and msg "slider I at d = X m
+ * is outside its stroke [D_MIN, D_MAX] m" (I 1-based), else PRRU_OK and
+ * msg "". */
+int prru_stroke_why(const prru_model *m, const double d[PRRU_NACT], char *msg, int msglen);
 /* Reachable and J_d regular (full column rank 3); fills d->d, d->Jd,
  * d->Jdpinv (when regular); *rcond if non-NULL: 1 / (|J|_1 |J^+|_1) for
  * J = J_d diag(1/L, 1/L, 1) (see prru_model), which for three actuators is
  * 1 / (|J|_1 |J^-1|_1). J^+ comes from a Householder QR of J for four. */
 int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
+/* (prru_check_regular: PRRU_ESTROKE before the regularity test, as
+ * prru_check_reachable.) */
 /* The regularity test of prru_check_regular on a given J_d (finite), for a
  * mechanism of length scale L (m) and tolerance rcond_min: PRRU_OK and
  * Jdpinv = J_d^+, or PRRU_ESINGULAR; *rcond as there. prru_check_regular is

@@ -99,8 +99,9 @@ typedef struct {
  * with three actuators (a square J_d; with more, J_d has no sign). */
 #define PRRU_DME_OTHER_MODE 0xFE
 
-/* "ok", "singular", "unreachable", "other_mode" (PRRU_DME_OTHER_MODE) or
- * "invalid" (PRRU_EINPUT and any other code). */
+/* "ok", "singular", "unreachable", "out_of_stroke" (PRRU_ESTROKE),
+ * "other_mode" (PRRU_DME_OTHER_MODE) or "invalid" (PRRU_EINPUT and any
+ * other code). */
 const char *prru_dme_status_name(int status);
 
 /* The assembly mode of a pose from its slider positions d and J_d: the
@@ -207,9 +208,13 @@ int prru_map_check(const prru_map_grid *g);
 int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
 
 /* Evaluates w_R at every grid point: index k = i n2 + j for (q1_i, q2_j)
- * (q1 outer). status[k] is PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESINGULAR or
+ * (q1 outer). status[k] is PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESTROKE (a
+ * slider outside the model's stroke: prru_stroke_actuator, tested before
+ * the regularity as prru_check_regular does), PRRU_ESINGULAR or
  * PRRU_DME_OTHER_MODE (the regular poses whose assembly mode is not
- * prru_map_home_mode's); w_R[k] is NaN where status[k] != PRRU_OK.
+ * prru_map_home_mode's); w_R[k] is NaN where status[k] != PRRU_OK. The
+ * summary counts PRRU_ESTROKE in n_unreachable (the stroke ends bound the
+ * workspace).
  * Allocates one batch workspace per thread (not per point). status may be
  * NULL if not needed; sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
  * PRRU_ENOMEM, or PRRU_EINTERRUPTED (outputs partly filled, sum not set). */

@@ -232,9 +232,10 @@ typedef struct {
   int check_samples;         /* points per period of the final feasibility check */
   int max_evals;             /* Nelder-Mead budget */
   unsigned long seed;
+  double speed_max[PRRU_NACT]; /* |d_i'| limit (m/s), INFINITY: none */
 } prru_excite_options;
 
-/* fd_max 500 N each, no stroke limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
+/* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, 2000 check samples, 3000 evaluations, seed 1. */
 void prru_excite_options_default(prru_excite_options *o);
 
@@ -261,8 +262,8 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
 
 /* The excitation's feasibility at n points per period: 0 and the peak
  * forces and worst rcond, or the first failing point's status
- * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, or PRRU_EINPUT for a force or
- * stroke limit)
+ * (PRRU_EUNREACHABLE, PRRU_ESTROKE beyond the model's stroke,
+ * PRRU_ESINGULAR, or PRRU_EINPUT for a force, speed or stroke limit)
  * with *t_bad its time. */
 int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
                       int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad);

@@ -39,6 +39,21 @@ typedef struct {
   double damping[PRRU_MAX_LIMB];          /* N s/m */
   double coulomb[PRRU_MAX_LIMB];          /* N */
   double coulomb_velocity;                /* m/s; 0 when no Coulomb force */
+  /* Section 13, per actuator. keys: which of its keys the file gives
+   * (PRRU_DRIVE_* bits; each key covers every actuator). The values as
+   * written, and the limits in rail units: force_max from torque_max,
+   * speed_max from motor_speed_max (docs/model-files.md gives the
+   * conversions); armature above holds what rotor_inertia reflects. */
+  unsigned keys;
+  double lead[PRRU_MAX_LIMB];            /* m per screw revolution; 0: none */
+  double gear[PRRU_MAX_LIMB];            /* motor rev per screw rev; 1 */
+  double rotor_inertia[PRRU_MAX_LIMB];   /* kg m^2; 0 unless given */
+  double torque_constant[PRRU_MAX_LIMB]; /* N m / A; 0: none */
+  double d_min[PRRU_MAX_LIMB], d_max[PRRU_MAX_LIMB]; /* m; -inf, inf: none */
+  double torque_max[PRRU_MAX_LIMB];      /* N m at the motor, as written */
+  double motor_speed_max[PRRU_MAX_LIMB]; /* rev/min at the motor, as written */
+  double force_max[PRRU_MAX_LIMB];       /* N on the rail; inf: none */
+  double speed_max[PRRU_MAX_LIMB];       /* m/s on the rail; inf: none */
   char sha256[65];           /* of the file's bytes, as generated/ headers print it */
   char canonical_sha256[65]; /* of the parsed numbers (model.canonical_sha256) */
 } prru_model_spec;

@@ -24,6 +24,7 @@ const char *prru_strerror(int status)
   case PRRU_EIO: return "input/output error";
   case PRRU_ENOMEM: return "out of memory";
   case PRRU_EPARSE: return "malformed input";
+  case PRRU_ESTROKE: return "out_of_stroke: a slider outside its stroke (actuators.stroke)";
   default: return "unknown status";
   }
 }
@@ -36,12 +37,38 @@ void prru_gsl_init(void) { pthread_once(&gsl_once, gsl_handler_off); }
 
 static int finite3(const double v[3]) { return prru_finite_n(v, 3); }
 
+int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT])
+{
+  const prru_mechanism *me = m->mech;
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (d[i] < me->d_min[i] || d[i] > me->d_max[i]) return i;
+  return -1;
+}
+
+int prru_stroke_why(const prru_model *m, const double d[PRRU_NACT], char *msg, int msglen)
+{
+  const int i = prru_stroke_actuator(m, d);
+  if (i < 0) return prru_fail(msg, msglen, PRRU_OK, "%s", "");
+  return prru_fail(msg, msglen, PRRU_ESTROKE, "slider %d at d = %.9g m is outside its stroke [%.9g, %.9g] m",
+                   i + 1, d[i], m->mech->d_min[i], m->mech->d_max[i]);
+}
+
+/* Whether the model limits any slider's travel (else the stroke test is
+ * skipped where it would cost a kernel call). */
+static int has_stroke(const prru_model *m)
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (m->mech->d_min[i] > -INFINITY || m->mech->d_max[i] < INFINITY) return 1;
+  return 0;
+}
+
 int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
 {
   if (!finite3(q)) return PRRU_EINPUT;
   KERNEL(m, ik)(m->kernel_params, q, d->d);
   /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
-  return prru_finite_n(d->d, PRRU_NACT) ? PRRU_OK : PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  return prru_stroke_actuator(m, d->d) < 0 ? PRRU_OK : PRRU_ESTROKE;
 }
 
 double prru_rcond3(const double a[9], double inv[9])
@@ -233,6 +260,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   if (!finite3(q)) return PRRU_EINPUT;
   KERNEL(m, ik_jd)(m->kernel_params, q, d->d, d->Jd);
   if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (prru_stroke_actuator(m, d->d) >= 0) return PRRU_ESTROKE;
   return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
 
@@ -299,6 +327,11 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
   if (!mass_norms(d->M, 1.0 / prru_length_scale(m->mech), &na, &ni, &det) ||
       !(na * ni * m->mass_rcond_min <= det))
     return PRRU_ESINGULAR;
+  if (has_stroke(m)) { /* the kernel leaves no d: one more for the stroke */
+    double act[PRRU_NACT];
+    KERNEL(m, ik)(m->kernel_params, q, act);
+    if (prru_stroke_actuator(m, act) >= 0) return PRRU_ESTROKE;
+  }
   memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }
@@ -316,6 +349,13 @@ int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[
     return prru_fail(msg, msglen, st, "%s", "");
   case PRRU_EUNREACHABLE:
     return prru_fail(msg, msglen, st, "q = %s is outside the workspace (no inverse kinematics)", qs);
+  case PRRU_ESTROKE: {
+    char why[160];
+    double act[PRRU_NACT];
+    KERNEL(m, ik)(m->kernel_params, q, act);
+    prru_stroke_why(m, act, why, sizeof why);
+    return prru_fail(msg, msglen, st, "q = %s is out_of_stroke: %s", qs, why);
+  }
   case PRRU_ESINGULAR: {
     if (!finite3(d->b))
       return prru_fail(msg, msglen, st,
@@ -391,6 +431,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   double f[3];
   KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
   else if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
     st = PRRU_ESINGULAR;
   else if (!near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
@@ -401,6 +442,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
   double tau[3], f[PRRU_NACT];
   KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau);
   if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
   else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
   if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
   if (st == PRRU_OK) {

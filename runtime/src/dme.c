@@ -12,6 +12,7 @@ const char *prru_dme_status_name(int status)
   case PRRU_OK: return "ok";
   case PRRU_ESINGULAR: return "singular";
   case PRRU_EUNREACHABLE: return "unreachable";
+  case PRRU_ESTROKE: return "out_of_stroke";
   case PRRU_DME_OTHER_MODE: return "other_mode";
   default: return "invalid";
   }

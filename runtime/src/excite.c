@@ -16,7 +16,8 @@
 void prru_excite_options_default(prru_excite_options *o)
 {
   memset(o, 0, sizeof *o);
-  for (int i = 0; i < PRRU_NACT; i++) o->fd_max[i] = 500.0, o->d_min[i] = -HUGE_VAL, o->d_max[i] = HUGE_VAL;
+  for (int i = 0; i < PRRU_NACT; i++)
+    o->fd_max[i] = 500.0, o->d_min[i] = -HUGE_VAL, o->d_max[i] = HUGE_VAL, o->speed_max[i] = HUGE_VAL;
   o->rcond_min = 1e-2;
   o->amplitude_max[0] = o->amplitude_max[1] = 0.25;
   o->amplitude_max[2] = -0.1; /* negative: that many length scales L */
@@ -76,6 +77,17 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
   memset(&l, 0, sizeof l);
   *excess = 0;
   int st = prru_check_regular(m, d, q, rcond);
+  if (st == PRRU_ESTROKE) {
+    /* Beyond the model's own stroke: measured like the options' stroke
+     * below (check_regular left d), so the penalty stays continuous. */
+    for (int i = 0; i < PRRU_NACT; i++) {
+      const double range = m->mech->d_max[i] - m->mech->d_min[i];
+      if (d->d[i] < m->mech->d_min[i]) *excess += (m->mech->d_min[i] - d->d[i]) / range;
+      if (d->d[i] > m->mech->d_max[i]) *excess += (d->d[i] - m->mech->d_max[i]) / range;
+    }
+    if (!(*excess > 0)) *excess = 10; /* an infinite end: no distance to measure */
+    return st;
+  }
   if (st == PRRU_ESINGULAR || (st == PRRU_OK && (*rcond < o->rcond_min || pose_mode(d) != mode))) {
     /* Continuous through the mode change: the other mode counts as
      * negative rcond. */
@@ -87,11 +99,14 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
     *excess = 10;
     return st;
   }
-  /* Stroke violations relative to the stroke (d holds the sliders). */
+  /* Stroke violations relative to the stroke (d holds the sliders), and
+   * slider speeds d' = J_d qd beyond speed_max (J_d from check_regular). */
   for (int i = 0; i < PRRU_NACT; i++) {
     const double range = o->d_max[i] - o->d_min[i];
     if (d->d[i] < o->d_min[i]) *excess += (o->d_min[i] - d->d[i]) / range;
     if (d->d[i] > o->d_max[i]) *excess += (d->d[i] - o->d_max[i]) / range;
+    const double v = d->Jd[3 * i] * qd[0] + d->Jd[3 * i + 1] * qd[1] + d->Jd[3 * i + 2] * qd[2];
+    if (fabs(v) > o->speed_max[i]) *excess += fabs(v) / o->speed_max[i] - 1;
   }
   st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
   if (st != PRRU_OK) {
@@ -226,6 +241,11 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
       return PRRU_EINPUT;
     }
   for (int i = 0; i < PRRU_NACT; i++)
+    if (!(o->speed_max[i] > 0)) {
+      snprintf(msg, (size_t)msglen, "speed limit of actuator %d must be positive", i + 1);
+      return PRRU_EINPUT;
+    }
+  for (int i = 0; i < PRRU_NACT; i++)
     if (!(o->d_min[i] < o->d_max[i])) {
       snprintf(msg, (size_t)msglen, "stroke of slider %d is empty", i + 1);
       return PRRU_EINPUT;
@@ -247,6 +267,12 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
   prru_data d;
   double rc;
   int st = prru_check_regular(m, &d, f->centre, &rc);
+  if (st == PRRU_ESTROKE) {
+    const int i = prru_stroke_actuator(m, d.d);
+    snprintf(msg, (size_t)msglen, "centre (%g, %g, %g) puts slider %d at %g m, outside its stroke [%g, %g] m",
+             f->centre[0], f->centre[1], f->centre[2], i + 1, d.d[i], m->mech->d_min[i], m->mech->d_max[i]);
+    return PRRU_EINPUT;
+  }
   if (st != PRRU_OK || rc < o->rcond_min) {
     snprintf(msg, (size_t)msglen, "centre (%g, %g, %g) is %s", f->centre[0], f->centre[1], f->centre[2],
              st == PRRU_OK ? "too close to a singularity (rcond below the limit)" : prru_strerror(st));

@@ -194,7 +194,16 @@ int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long
   b->vs = vs;
   b->nstates = nstates;
   b->seed = seed;
-  int st = stack_states(m, vs, nstates, seed, W);
+  /* the base is the model's structure: the stroke has no part in it */
+  prru_mechanism *me = malloc(sizeof *me);
+  prru_model um;
+  if (!me) {
+    gsl_matrix_free(W);
+    return PRRU_ENOMEM;
+  }
+  prru_model_unbounded(m, &um, me);
+  int st = stack_states(&um, vs, nstates, seed, W);
+  free(me);
   if (st == PRRU_OK) st = reduce(W, b);
   gsl_matrix_free(W);
   return st;

@@ -14,6 +14,26 @@ extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter;
 /* C99 has no M_PI. */
 #define PRRU_PI 3.14159265358979323846
 
+/* m without a stroke, in out (with its descriptor copied into *mech): for
+ * what depends on the model's numbers alone (the base parameters), never
+ * on how far the sliders may travel. */
+static inline void prru_model_unbounded(const prru_model *m, prru_model *out, prru_mechanism *mech)
+{
+  *mech = *m->mech;
+  for (int i = 0; i < PRRU_NACT; i++) mech->d_min[i] = -INFINITY, mech->d_max[i] = INFINITY;
+  *out = *m;
+  out->mech = mech;
+}
+
+/* A screw drive's motor radians per metre of slider travel, 2 pi gear /
+ * lead, as these double operations in this order: the generator
+ * (model.drive_ratio) computes the same bits, and so every conversion
+ * between the rail and the motor agrees with it. */
+static inline double prru_drive_ratio(double lead, double gear)
+{
+  return 2.0 * PRRU_PI * gear / lead;
+}
+
 /* Whether v[0..n) are all finite. */
 static inline int prru_finite_n(const double *v, int n)
 {

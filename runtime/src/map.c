@@ -88,8 +88,17 @@ static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
   }
   KERNEL(j->m, batch_dme_terms)(j->m->kernel_params, n, b->q, b->d, b->Jd, b->M, b->JP);
   const long k = (long)(row - j->row_begin) * g->n2 + c0;
-  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, j->w + k,
-                 j->st ? j->st + k : b->st, NULL, NULL);
+  unsigned char *st = j->st ? j->st + k : b->st;
+  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, j->w + k, st, NULL,
+                 NULL);
+  /* The stroke ends bound the workspace as the reach does (the scalar
+   * path's prru_check_regular tests it in the same place). */
+  for (int c = 0; c < n; c++) {
+    if (st[c] == PRRU_EUNREACHABLE) continue;
+    double dc[PRRU_NACT];
+    for (int i = 0; i < PRRU_NACT; i++) dc[i] = b->d[(long)i * n + c];
+    if (prru_stroke_actuator(j->m, dc) >= 0) st[c] = PRRU_ESTROKE, j->w[k + c] = NAN;
+  }
 }
 
 /* The next row to do, or -1 when there is none or the map was stopped. */
@@ -230,7 +239,7 @@ void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigne
       acc += w - 1.0;
       acc_log += log(w);
       sum->n_ok++;
-    } else if (status[k] == PRRU_EUNREACHABLE) {
+    } else if (status[k] == PRRU_EUNREACHABLE || status[k] == PRRU_ESTROKE) {
       sum->n_unreachable++;
     } else {
       sum->n_other_mode += status[k] == PRRU_DME_OTHER_MODE;

@@ -27,6 +27,167 @@ void prru_limits_none(prru_limits *l)
   }
 }
 
+void prru_model_limits(const prru_model *m, prru_limits *out)
+{
+  const prru_mechanism *me = m->mech;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    out->force_max[i] = me->force_max[i], out->speed_max[i] = me->speed_max[i];
+    out->d_min[i] = me->d_min[i], out->d_max[i] = me->d_max[i];
+  }
+}
+
+double prru_model_drive_ratio(const prru_model *m, int i)
+{
+  if (i < 0 || i >= PRRU_NACT || !(m->mech->lead[i] > 0)) return NAN;
+  return prru_drive_ratio(m->mech->lead[i], m->mech->gear[i]);
+}
+
+int prru_model_has_lead(const prru_model *m)
+{
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(m->mech->lead[i] > 0)) return 0;
+  return 1;
+}
+
+int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
+                           double current[PRRU_NACT])
+{
+  const prru_mechanism *me = m->mech;
+  if (!prru_model_has_lead(m)) return PRRU_EINPUT;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    /* tau_m = f lead / (2 pi gear): the drive's ideal transmission */
+    double t = f[i] / prru_drive_ratio(me->lead[i], me->gear[i]);
+    if (tau) tau[i] = t;
+    if (current) current[i] = me->torque_constant[i] > 0 ? t / me->torque_constant[i] : NAN;
+  }
+  return PRRU_OK;
+}
+
+/* text as one positive value for every actuator or one each. */
+static int limit_values(const char *name, const char *text, double v[PRRU_NACT], char *msg, int msglen)
+{
+  if (!strchr(text, ',')) {
+    if (prru_parse_double(text, &v[0]) != PRRU_OK || !(v[0] > 0))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: '%s' is not a positive number", name, text);
+    for (int i = 1; i < PRRU_NACT; i++) v[i] = v[0];
+    return PRRU_OK;
+  }
+  if (prru_parse_list(text, v, PRRU_NACT) != PRRU_OK)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: '%s' is not one number or %d comma-separated numbers",
+                     name, text, PRRU_NACT);
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(v[i] > 0))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: the limit of actuator %d must be positive", name, i + 1);
+  return PRRU_OK;
+}
+
+/* "LO,HI" / "LO:HI" for every slider or LO,HI per slider. */
+static int stroke_values(const char *text, double lo[PRRU_NACT], double hi[PRRU_NACT], char *msg, int msglen)
+{
+  char buf[512];
+  double v[2 * PRRU_NACT];
+  int n = 1;
+  if (strlen(text) >= sizeof buf) return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: too long");
+  strcpy(buf, text);
+  char *colon = strchr(buf, ':');
+  if (colon && !strchr(buf, ',') && !strchr(colon + 1, ':')) *colon = ',';
+  for (const char *c = buf; *c; c++) n += *c == ',';
+  if ((n != 2 && n != 2 * PRRU_NACT) || prru_parse_list(buf, v, n) != PRRU_OK)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: '%s': give LO,HI for all sliders or %d numbers "
+                     "(LO,HI per slider)", text, 2 * PRRU_NACT);
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double a = v[n == 2 ? 0 : 2 * i], b = v[n == 2 ? 1 : 2 * i + 1];
+    if (!(a < b))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: slider %d's range [%g, %g] is empty (LO must be "
+                       "below HI)", i + 1, a, b);
+    lo[i] = a, hi[i] = b;
+  }
+  return PRRU_OK;
+}
+
+int prru_limits_for_run(const prru_model *m, const prru_limit_args *a, prru_limits *out, char *msg, int msglen)
+{
+  prru_limits l;
+  if (msg && msglen > 0) msg[0] = 0;
+  if (a && a->none) prru_limits_none(&l);
+  else prru_model_limits(m, &l);
+  int st = PRRU_OK;
+  if (a && a->force_max) st = limit_values("force-max", a->force_max, l.force_max, msg, msglen);
+  if (!st && a && a->speed_max) st = limit_values("speed-max", a->speed_max, l.speed_max, msg, msglen);
+  if (!st && a && a->stroke) st = stroke_values(a->stroke, l.d_min, l.d_max, msg, msglen);
+  if (!st) *out = l;
+  return st;
+}
+
+/* One kind of limit: "none", "X UNIT" or "X1,..,XN UNIT". */
+static void describe_kind(char *buf, size_t len, const char *name, const double *v, const char *unit)
+{
+  int same = 1, any = 0;
+  for (int i = 0; i < PRRU_NACT; i++) same &= v[i] == v[0], any |= isfinite(v[i]);
+  size_t n = strlen(buf);
+  if (!any) {
+    snprintf(buf + n, len - n, "%s none", name);
+    return;
+  }
+  n += (size_t)snprintf(buf + n, len - n, "%s ", name);
+  for (int i = 0; i < (same ? 1 : PRRU_NACT) && n < len; i++)
+    n += (size_t)snprintf(buf + n, len - n, "%s%.9g", i ? "," : "", v[i]);
+  if (n < len) snprintf(buf + n, len - n, " %s", unit);
+}
+
+void prru_limits_describe(const prru_limits *l, char *buf, size_t len)
+{
+  if (len == 0) return;
+  buf[0] = 0;
+  describe_kind(buf, len, "force_max", l->force_max, "N");
+  strncat(buf, ", ", len - strlen(buf) - 1);
+  describe_kind(buf, len, "speed_max", l->speed_max, "m/s");
+  strncat(buf, ", ", len - strlen(buf) - 1);
+  int same = 1, any = 0;
+  for (int i = 0; i < PRRU_NACT; i++)
+    same &= l->d_min[i] == l->d_min[0] && l->d_max[i] == l->d_max[0],
+        any |= isfinite(l->d_min[i]) || isfinite(l->d_max[i]);
+  size_t n = strlen(buf);
+  if (!any) {
+    snprintf(buf + n, len - n, "stroke none");
+    return;
+  }
+  n += (size_t)snprintf(buf + n, len - n, "stroke");
+  for (int i = 0; i < (same ? 1 : PRRU_NACT) && n < len; i++)
+    n += (size_t)snprintf(buf + n, len - n, "%s[%.9g, %.9g]", i ? ", " : " ", l->d_min[i], l->d_max[i]);
+  if (n < len) snprintf(buf + n, len - n, " m");
+}
+
+int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_limits *l)
+{
+  const loaded_model *s = src->own;
+  loaded_model *c = calloc(1, sizeof *c);
+  const char *file = s ? s->path : src->mech->model_file;
+  char *p = malloc(strlen(file) + 1);
+  if (!c || !p) {
+    free(c), free(p);
+    return PRRU_ENOMEM;
+  }
+  strcpy(p, file);
+  if (s) {
+    *c = *s;
+    c->mech.name = c->name, c->mech.description = c->description, c->mech.sha256 = c->sha256;
+  } else {
+    c->mech = *src->mech;
+  }
+  c->path = p;
+  c->mech.model_file = p;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    c->mech.force_max[i] = l->force_max[i], c->mech.speed_max[i] = l->speed_max[i];
+    c->mech.d_min[i] = l->d_min[i], c->mech.d_max[i] = l->d_max[i];
+  }
+  *out = *src;
+  out->mech = &c->mech;
+  out->own = c;
+  if (src->kernel_params) out->kernel_params = &c->params;
+  return PRRU_OK;
+}
+
 void prru_model_default(prru_model *m)
 {
   m->mech = &prru_mech;
@@ -89,6 +250,15 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
     me->coulomb[i] = s->coulomb[i];
   }
   me->coulomb_velocity = s->coulomb_velocity;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    me->lead[i] = s->lead[i], me->gear[i] = s->gear[i];
+    me->torque_constant[i] = s->torque_constant[i];
+    me->force_max[i] = s->force_max[i], me->speed_max[i] = s->speed_max[i];
+    me->d_min[i] = s->d_min[i], me->d_max[i] = s->d_max[i];
+    me->rotor_inertia[i] = s->rotor_inertia[i], me->torque_max[i] = s->torque_max[i];
+    me->motor_speed_max[i] = s->motor_speed_max[i];
+  }
+  me->drive_keys = s->keys;
 }
 
 void prru_model_params(const prru_model *m, prru_params *p)

@@ -30,6 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "sha256.h"
 
 enum {
@@ -878,8 +879,133 @@ static prru_status gravity(ctx *c, const json_t *v, int fmt, double g[3])
   return PRRU_OK;
 }
 
-static const char *const ACTUATOR_KEYS[] = {"armature", "damping", "coulomb",
-                                            "coulomb_velocity"};
+static const char *const ACTUATOR_KEYS[] = {
+    "armature", "damping", "coulomb", "coulomb_velocity", "lead", "gear",
+    "rotor_inertia", "torque_constant", "stroke", "force_max", "torque_max",
+    "speed_max", "motor_speed_max"};
+enum { NACTUATOR_KEYS = sizeof ACTUATOR_KEYS / sizeof *ACTUATOR_KEYS };
+
+/* model._stroke: one pair [d_min, d_max] for every actuator, or n pairs. */
+static prru_status stroke(ctx *c, const json_t *v, prru_model_spec *m)
+{
+  static const char *const key = "actuators.stroke";
+  int n = m->nlimb, nested = 0, npair, i;
+  size_t k;
+  prru_status st;
+  for (k = 0; json_is_array(v) && k < json_array_size(v); k++)
+    nested |= json_is_array(json_array_get(v, k));
+  if (nested && json_array_size(v) != (size_t)n)
+    return fail(c, key, "must be one pair [d_min, d_max] (m) or a list of %d pairs "
+                "(one per actuator), got %d entries", n, (int)json_array_size(v));
+  if (!nested && !(json_is_array(v) && json_array_size(v) == 2))
+    return fail(c, key, "must be one pair [d_min, d_max] (m) or a list of %d pairs "
+                "(one per actuator)", n);
+  npair = nested ? n : 1;
+  for (i = 0; i < npair; i++) {
+    const json_t *pair = nested ? json_array_get(v, (size_t)i) : v;
+    char where[48], kk[56], tl[40], th[40];
+    big lo, hi, diff;
+    if (nested)
+      snprintf(where, sizeof where, "%s[%d]", key, i);
+    else
+      snprintf(where, sizeof where, "%s", key);
+    if (!json_is_array(pair) || json_array_size(pair) != 2)
+      return fail(c, where, "must be a pair [d_min, d_max] (m)");
+    snprintf(kk, sizeof kk, "%s[0]", where);
+    if ((st = number(c, kk, json_array_get(pair, 0), &m->d_min[i])))
+      return st;
+    snprintf(kk, sizeof kk, "%s[1]", where);
+    if ((st = number(c, kk, json_array_get(pair, 1), &m->d_max[i])))
+      return st;
+    big_num(&lo, c, json_array_get(pair, 0)), big_num(&hi, c, json_array_get(pair, 1));
+    big_sub(&diff, &hi, &lo);
+    if (big_sign(&diff) <= 0) {
+      py_repr(m->d_min[i], tl), py_repr(m->d_max[i], th);
+      return fail(c, where, "d_min = %s m must be below d_max = %s m", tl, th);
+    }
+  }
+  for (i = npair; i < n; i++)
+    m->d_min[i] = m->d_min[0], m->d_max[i] = m->d_max[0];
+  return PRRU_OK;
+}
+
+/* Bit of a section 13 key (PRRU_DRIVE_*), 0 for section 11's. */
+static unsigned drive_bit(const char *key)
+{
+  int i;
+  for (i = 4; i < NACTUATOR_KEYS; i++)
+    if (strcmp(key, ACTUATOR_KEYS[i]) == 0)
+      return 1u << (i - 4);
+  return 0;
+}
+
+/* No section 13 key: no lead, gear 1, no limits. */
+static void drives_none(prru_model_spec *m)
+{
+  int i;
+  for (i = 0; i < m->nlimb; i++) {
+    m->lead[i] = m->rotor_inertia[i] = m->torque_constant[i] = 0.0;
+    m->torque_max[i] = m->motor_speed_max[i] = 0.0;
+    m->gear[i] = 1.0;
+    m->d_min[i] = -INFINITY, m->d_max[i] = INFINITY;
+    m->force_max[i] = m->speed_max[i] = INFINITY;
+  }
+  m->keys = 0;
+}
+
+/* model._drives: section 13 in key order, then the keys' relations. */
+static prru_status drives(ctx *c, const json_t *v, prru_model_spec *m)
+{
+  static const char *const pairs[3][3] = {
+      {"armature", "rotor_inertia", "drive inertia"},
+      {"force_max", "torque_max", "force limit"},
+      {"speed_max", "motor_speed_max", "speed limit"}};
+  static const char *const needs_lead[4] = {"rotor_inertia", "torque_max",
+                                            "motor_speed_max", "torque_constant"};
+  double *lists[] = {m->lead, m->gear, m->rotor_inertia, m->torque_constant, NULL,
+                     m->force_max, m->torque_max, m->speed_max, m->motor_speed_max};
+  int i, j, n = m->nlimb;
+  char k[40];
+  prru_status st;
+  drives_none(m);
+  for (j = 4; j < NACTUATOR_KEYS; j++) {
+    const json_t *x = json_object_get(v, ACTUATOR_KEYS[j]);
+    if (!x)
+      continue;
+    m->keys |= drive_bit(ACTUATOR_KEYS[j]);
+    snprintf(k, sizeof k, "actuators.%s", ACTUATOR_KEYS[j]);
+    if (j == 8)
+      st = stroke(c, x, m);
+    else
+      st = per_limb(c, k, x, n, j == 6 ? nonnegative : positive, "one per actuator",
+                    lists[j - 4], NULL);
+    if (st)
+      return st;
+  }
+  for (j = 0; j < 3; j++)
+    if (json_object_get(v, pairs[j][0]) && json_object_get(v, pairs[j][1])) {
+      snprintf(k, sizeof k, "actuators.%s", pairs[j][1]);
+      return fail(c, k, "given with actuators.%s: both set the %s of every actuator "
+                  "(ambiguous); give one", pairs[j][0], pairs[j][2]);
+    }
+  if (!(m->keys & PRRU_DRIVE_LEAD))
+    for (j = 0; j < 4; j++)
+      if (m->keys & drive_bit(needs_lead[j])) {
+        snprintf(k, sizeof k, "actuators.%s", needs_lead[j]);
+        return fail(c, k, "needs actuators.lead (m of slider travel per screw "
+                    "revolution) to convert between motor and rail");
+      }
+  for (i = 0; i < n; i++) {
+    double w = m->lead[i] > 0 ? prru_drive_ratio(m->lead[i], m->gear[i]) : 0.0;
+    if (m->keys & PRRU_DRIVE_ROTOR_INERTIA)
+      m->armature[i] = m->rotor_inertia[i] * w * w; /* model.reflected_armature */
+    if (m->keys & PRRU_DRIVE_TORQUE_MAX)
+      m->force_max[i] = m->torque_max[i] * w;
+    if (m->keys & PRRU_DRIVE_MOTOR_SPEED_MAX) /* model.motor_speed_to_rail */
+      m->speed_max[i] = m->motor_speed_max[i] / 60.0 * m->lead[i] / m->gear[i];
+  }
+  return PRRU_OK;
+}
 
 /* model._actuators: absent or null means no drives. */
 static prru_status actuators(ctx *c, const json_t *v, prru_model_spec *m)
@@ -892,9 +1018,10 @@ static prru_status actuators(ctx *c, const json_t *v, prru_model_spec *m)
   for (i = 0; i < n; i++)
     m->armature[i] = m->damping[i] = m->coulomb[i] = 0.0;
   m->coulomb_velocity = 0.0;
+  drives_none(m);
   if (!v || json_is_null(v))
     return PRRU_OK;
-  if ((st = object(c, "actuators", v, ACTUATOR_KEYS, 4, NULL, 0)))
+  if ((st = object(c, "actuators", v, ACTUATOR_KEYS, NACTUATOR_KEYS, NULL, 0)))
     return st;
   for (i = 0; i < 3; i++) {
     const json_t *x = json_object_get(v, ACTUATOR_KEYS[i]);
@@ -912,7 +1039,7 @@ static prru_status actuators(ctx *c, const json_t *v, prru_model_spec *m)
                 "-f tanh(dd / v_s) needs the smoothing velocity v_s (m/s)");
   if (!any)
     m->coulomb_velocity = 0.0;
-  return PRRU_OK;
+  return drives(c, v, m);
 }
 
 static const char *const TOP_KEYS[] = {"format", "name", "description", "gravity",
@@ -1253,7 +1380,8 @@ static void canonical_hash(prru_model_spec *m)
   prru_sha256_update(&h, head, 2);
 
   {
-    double v[3 + 4 * PRRU_MAX_LIMB + 10 * PRRU_MAX_BODY + 3 * PRRU_MAX_LIMB + 1];
+    double v[3 + 4 * PRRU_MAX_LIMB + 10 * PRRU_MAX_BODY + 3 * PRRU_MAX_LIMB + 1
+             + 7 * PRRU_MAX_LIMB];
     int n = 0, k;
     for (i = 0; i < 3; i++)
       v[n++] = m->gravity[i];
@@ -1270,6 +1398,10 @@ static void canonical_hash(prru_model_spec *m)
     for (i = 0; i < m->nlimb; i++)
       v[n++] = m->armature[i], v[n++] = m->damping[i], v[n++] = m->coulomb[i];
     v[n++] = m->coulomb_velocity;
+    for (i = 0; m->keys && i < m->nlimb; i++) /* only with section 13's keys */
+      v[n++] = m->lead[i], v[n++] = m->gear[i], v[n++] = m->torque_constant[i],
+      v[n++] = m->d_min[i], v[n++] = m->d_max[i], v[n++] = m->force_max[i],
+      v[n++] = m->speed_max[i];
     for (i = 0; i < n; i++) {
       unsigned char le[8];
       uint64_t bits;

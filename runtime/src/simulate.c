@@ -276,7 +276,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
         prru_schedule_eval(ls, c.t_fail, &lf);
         st = prru_forward_dynamics_why(m, d, c.y_fail, c.y_fail + 3, &lf, why, sizeof why);
         if (st == PRRU_OK) st = c.status; /* not reproduced: report the status */
-        const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR;
+        const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR || st == PRRU_ESTROKE;
         prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at t = %.9g s: %s", t,
                   edge ? "the motion reached the workspace boundary"
                        : "the dynamics failed in the step",
@@ -308,7 +308,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                  y[2]);
       /* Only a state whose own dynamics fail is the workspace's edge; a
        * singular J_d there (make_sample's test) is a singularity inside. */
-      const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR;
+      const int edge = st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR || st == PRRU_ESTROKE;
       if (st == PRRU_OK) st = ss;
       prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s%s", tk,
                 edge ? "the motion reached the workspace boundary: " : "", why);

@@ -17,6 +17,18 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PAPER = open(os.path.join(ROOT, "models/3prru_paper.json")).read()
 FOUR = open(os.path.join(ROOT, "models/4prru.json")).read()
 PROTO = open(os.path.join(ROOT, "models/prototype_example.json")).read()
+DRIVES = open(os.path.join(ROOT, "models/prototype_drives.json")).read()
+
+
+def acts(text=PROTO, **keys):
+    """text with its actuators' keys set (None deletes one)."""
+    def fn(d):
+        for k, v in keys.items():
+            if v is None:
+                del d["actuators"][k]
+            else:
+                d["actuators"][k] = v
+    return edit(text, fn)
 
 
 def sub(text, old, new):
@@ -53,6 +65,21 @@ def setk(path, value, text=PAPER):
 DELETE = object()
 VALID = {
     "paper": PAPER, "4prru": FOUR, "prototype": PROTO,
+    # section 13: per-actuator lists and the rail forms of the limits;
+    # armature beside a lead (no rotor_inertia) is allowed
+    "f2_drives_lists": acts(lead=[0.02, 0.01, 0.005], gear=[1, 2, 3.5],
+                            torque_constant=[0.11, 0.12, 0.13],
+                            stroke=[[-0.05, 0.45], [-0.04, 0.44], [0, 0.4]],
+                            force_max=[150, 160, 170], speed_max=0.75),
+    "f2_drives_motor_forms": acts(DRIVES, lead=[0.02, 0.01, 0.005],
+                                  gear=[1, 2, 3.5], torque_max=[0.64, 0.5, 0.3],
+                                  motor_speed_max=[3000, 4500, 6000]),
+    "f2_drives_gear_stroke_only": acts(gear=2, stroke=[-1, 1]),
+    "f2_drives_four_limbs": setk("actuators", {
+        "lead": 0.01, "rotor_inertia": [1e-6, 2e-6, 3e-6, 4e-6],
+        "stroke": [[-0.1, 0.5]] * 4, "force_max": [100, 100, 200, 200],
+        "motor_speed_max": 2000}, FOUR),
+    "f2_drives_rotor_inertia_zero": acts(DRIVES, rotor_inertia=0),
     "paper_format_1_explicit": sub(PAPER, "{", '{"format": 1,'),
     "paper_format_1_real": sub(PAPER, "{", '{"format": 1.0e0,'),
     "paper_reordered": json.dumps(dict(reversed(list(obj(PAPER).items()))),
@@ -155,12 +182,42 @@ INVALID = {
     "f2_not_positive_definite": setk("bodies.P.inertia", [1, 1, 1, 2, 0, 0], PROTO),
     "f2_tensor_triangle": setk("bodies.P.inertia", [1, 0.1, 0.1, 0, 0, 0], PROTO),
     "f2_actuators_list": setk("actuators", [1], PROTO),
-    "f2_actuators_unknown": setk("actuators.gear", 1, PROTO),
+    "f2_actuators_unknown": setk("actuators.gearing", 1, PROTO),
     "f2_damping_negative": setk("actuators.damping", [0.1, -0.1, 0.1], PROTO),
     "f2_armature_count": setk("actuators.armature", [0.1, 0.1], PROTO),
     "f2_coulomb_without_velocity": setk("actuators.coulomb_velocity", DELETE, PROTO),
     "f2_coulomb_velocity_zero": setk("actuators.coulomb_velocity", 0, PROTO),
     "f2_four_limbs_body_missing": setk("bodies.S4", DELETE, FOUR),
+    # section 13
+    "f2_rotor_inertia_with_armature": acts(lead=0.02, rotor_inertia=2e-6),
+    "f2_rotor_inertia_without_lead": acts(DRIVES, lead=None),
+    "f2_torque_max_without_lead": acts(torque_max=0.5),
+    "f2_motor_speed_max_without_lead": acts(motor_speed_max=3000),
+    "f2_torque_constant_without_lead": acts(torque_constant=0.1),
+    "f2_force_max_and_torque_max": acts(DRIVES, force_max=[100, 100, 100]),
+    "f2_speed_max_and_motor_speed_max": acts(DRIVES, speed_max=1),
+    "f2_lead_zero": acts(DRIVES, lead=0),
+    "f2_lead_negative_entry": acts(DRIVES, lead=[0.02, -0.02, 0.02]),
+    "f2_gear_zero": acts(DRIVES, gear=0),
+    "f2_gear_bool": acts(DRIVES, gear=True),
+    "f2_rotor_inertia_negative": acts(DRIVES, rotor_inertia=[2e-6, 2e-6, -2e-6]),
+    "f2_torque_constant_zero": acts(DRIVES, torque_constant=0),
+    "f2_torque_max_negative": acts(DRIVES, torque_max=-0.64),
+    "f2_motor_speed_max_string": acts(DRIVES, motor_speed_max="3000"),
+    "f2_force_max_zero": acts(force_max=0),
+    "f2_speed_max_count": acts(speed_max=[1, 1]),
+    "f2_lead_count": acts(DRIVES, lead=[0.02] * 4),
+    "f2_stroke_reversed": acts(stroke=[0.45, -0.05]),
+    "f2_stroke_empty": acts(stroke=[0.1, 0.1]),
+    "f2_stroke_pair_equal": acts(stroke=[[0, 0.4], [0.2, 0.2], [0, 0.4]]),
+    "f2_stroke_number": acts(stroke=0.4),
+    "f2_stroke_three_numbers": acts(stroke=[0, 0.2, 0.4]),
+    "f2_stroke_pair_count": acts(stroke=[[0, 0.4], [0, 0.4]]),
+    "f2_stroke_pair_three": acts(stroke=[[0, 0.4], [0, 0.2, 0.4], [0, 0.4]]),
+    "f2_stroke_pair_number": acts(stroke=[[0, 0.4], 0.4, [0, 0.4]]),
+    "f2_stroke_entry_string": acts(stroke=[[0, "0.4"], [0, 0.4], [0, 0.4]]),
+    "f2_stroke_entry_huge": acts(stroke=[-0.05, 2e6]),
+    "f2_drives_four_limbs_count": setk("actuators", {"lead": [0.01] * 3}, FOUR),
 }
 INVALID_BYTES = {
     "not_utf8": PAPER.encode().replace(b"Table", b"T\xe4ble", 1),
