@@ -122,16 +122,17 @@ static const char topp_help[] =
     "usage: prru traj --time-optimal --waypoints 'q1,q2,q3;q1,q2,q3;...'\n"
     "                 [--force-max F|F1,..] [--speed-max V|V1,..]\n"
     "                 [--stroke LO,HI|LO1,HI1,..] [--no-limits] [--grid N]\n"
-    "                 [--dt S|grid] [--out FILE.csv|-]\n"
+    "                 [--dt S|grid] [--units rail|motor] [--out FILE.csv|-]\n"
     "The fastest motion along the same path as the quintic trajectory (straight\n"
     "lines in q, at rest at every waypoint) within the drives' limits: each\n"
     "rail force |fd_i| <= --force-max (N; --fmax and --fd-max are the same\n"
     "option), each slider speed |dd_i| <= --speed-max (m/s), each slider within\n"
     "--stroke (m); one value for every actuator or one each. The forces are\n"
     "the model's inverse dynamics without platform loads, drives included.\n%s"
-    "At least one force limit is needed (speed limits alone leave the\n"
-    "accelerations unbounded). --no-limits starts from no limits (the model's\n"
-    "own, once model files carry them) before the options apply.\n"
+    "The model file's limits (spec 13: force_max or torque_max, speed_max or\n"
+    "motor_speed_max, stroke) act unless --no-limits; each option replaces\n"
+    "its kind. At least one force limit is needed (speed limits alone leave\n"
+    "the accelerations unbounded).\n"
     "Method: reachability analysis on a grid of N intervals per segment\n"
     "(default 400), constant path acceleration on each, every interval\n"
     "checked with the exact inverse dynamics at 9 points and tightened where\n"
@@ -142,6 +143,8 @@ static const char topp_help[] =
     "limits) and the columns\n"
     "  t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,\n"
     "  %s,%s,%s\n"
+    "(with --units motor also the motor torques tau1.. in N m, and the\n"
+    "currents i1.. in A where the model gives torque_constant)\n"
     "every dt (default 1 ms; the last row at the end) or, with --dt grid, at\n"
     "the grid points; every row is checked again (a limit exceeded by more\n"
     "than 1e-6 of it is an error, exit 1). Limits that the path cannot meet\n"
@@ -155,62 +158,20 @@ typedef struct {
   int none;
 } topp_limit_args;
 
-/* One positive value for every actuator or one each ("F" or "F1,..,Fn"). */
-static int per_actuator(const char *name, const char *text, double out[PRRU_NACT])
-{
-  double v[PRRU_NACT];
-  int n;
-  if (parse_number_list("traj", name, text, v, PRRU_NACT, &n)) return 2;
-  if (n != 1 && n != PRRU_NACT) {
-    prru_cli_error("traj", "--%s: give 1 limit or %d (one per actuator), not %d", name, PRRU_NACT, n);
-    return 2;
-  }
-  for (int i = 0; i < PRRU_NACT; i++) {
-    out[i] = v[n == 1 ? 0 : i];
-    if (!(out[i] > 0)) {
-      prru_cli_error("traj", "--%s: limit %g of actuator %d is not > 0", name, out[i], i + 1);
-      return 2;
-    }
-  }
-  return 0;
-}
-
-/* The limits from the options: none to start with (until model files
- * carry limits: then the model's, unless --no-limits), then each option
- * given replaces its kind. *given: whether any force or speed limit is
- * set. 0 or 2. */
+/* The run's limits: the model file's (spec 13) unless --no-limits, each
+ * kind given as an option replacing the model's (prru_cli_limits, shared
+ * with excite, optimize and track); --fmax and --fd-max are older names of
+ * --force-max. *forces, *speeds: how many actuators have such a limit.
+ * 0 or 2. */
 static int topp_limits(const topp_limit_args *a, prru_limits *lim, int *forces, int *speeds)
 {
-  static const char *const names[3] = {"force-max", "fmax", "fd-max"};
-  prru_limits_none(lim);
-  int nf = 0, which = 0;
-  for (int k = 0; k < 3; k++)
-    if (a->force[k]) nf++, which = k;
-  if (nf > 1) {
-    prru_cli_error("traj", "--force-max, --fmax and --fd-max are one option: give it once");
+  if (a->force[1] && a->force[2]) {
+    prru_cli_error("traj", "--fmax and --fd-max are the same limit: give one");
     return 2;
   }
-  if (nf && per_actuator(names[which], a->force[which], lim->force_max)) return 2;
-  if (a->speed && per_actuator("speed-max", a->speed, lim->speed_max)) return 2;
-  if (a->stroke) {
-    double v[2 * PRRU_NACT];
-    int n;
-    if (parse_number_list("traj", "stroke", a->stroke, v, 2 * PRRU_NACT, &n)) return 2;
-    if (n != 2 && n != 2 * PRRU_NACT) {
-      prru_cli_error("traj", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per "
-                     "slider), not %d", 2 * PRRU_NACT, n);
-      return 2;
-    }
-    for (int i = 0; i < PRRU_NACT; i++) {
-      lim->d_min[i] = v[n == 2 ? 0 : 2 * i];
-      lim->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
-      if (!(lim->d_min[i] < lim->d_max[i])) {
-        prru_cli_error("traj", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)",
-                       i + 1, lim->d_min[i], lim->d_max[i]);
-        return 2;
-      }
-    }
-  }
+  const int alias = a->force[1] ? 1 : 2;
+  const prru_cli_limit_args la = {a->force[0], a->force[alias], a->speed, a->stroke, a->none};
+  if (prru_cli_limits("traj", alias == 1 ? "fmax" : "fd-max", &la, lim)) return 2;
   *forces = *speeds = 0;
   for (int i = 0; i < PRRU_NACT; i++)
     *forces += isfinite(lim->force_max[i]), *speeds += isfinite(lim->speed_max[i]);
@@ -272,7 +233,8 @@ static double topp_time(const prru_topp *tp, double dt, long k, long n)
 
 /* The rows (out NULL: only the check and the peaks). */
 static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *lim,
-                     const prru_topp *tp, double dt, topp_peaks *pk, char *why, size_t whylen)
+                     const prru_topp *tp, double dt, const int units[2], topp_peaks *pk, char *why,
+                     size_t whylen)
 {
   prru_data *d = malloc(sizeof *d);
   if (!d) {
@@ -299,6 +261,7 @@ static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *li
     prru_cli_out_numbers(o, d->d, PRRU_NACT);
     prru_cli_out_numbers(o, dd, PRRU_NACT);
     prru_cli_out_numbers(o, fd, PRRU_NACT);
+    prru_cli_out_motor(o, m, fd, units[0], units[1]);
     prru_cli_out_printf(o, "\n");
     prru_cli_out_row(o);
   }
@@ -346,7 +309,7 @@ static void topp_summary(prru_cli_out *o, const prru_topp *tp, const prru_limits
 }
 
 typedef struct {
-  const char *wps, *durs, *dts, *out, *grid;
+  const char *wps, *durs, *dts, *out, *grid, *units;
   topp_limit_args lim;
 } topp_args;
 
@@ -381,8 +344,9 @@ static int topp_settings(const topp_args *a, double *q, int *n, prru_limits *lim
       prru_cli_error("traj", "--time-optimal: --speed-max alone leaves the accelerations "
                      "unbounded: give --force-max as well");
     else
-      prru_cli_error("traj", "--time-optimal needs at least one force or speed limit, and none "
-                     "is given: --force-max F (N), with or without --speed-max V (m/s)");
+      prru_cli_error("traj", "--time-optimal needs at least one force or speed limit, and neither "
+                     "the options nor the model file give one: --force-max F (N), with or without "
+                     "--speed-max V (m/s)");
     return 2;
   }
   double g = 0;
@@ -409,7 +373,9 @@ static int traj_time_optimal(const topp_args *a)
   prru_limits lim;
   int n, grid;
   double dt;
-  if (topp_settings(a, q, &n, &lim, &grid, &dt)) return 2;
+  int units[2]; /* --units motor: torques, and currents where the model gives torque_constant */
+  if (topp_settings(a, q, &n, &lim, &grid, &dt) || prru_cli_units("traj", a->units, &units[0], &units[1]))
+    return 2;
   const prru_model *m = prru_cli_model();
   char msg[600], why[600] = "";
   prru_topp tp;
@@ -429,7 +395,7 @@ static int traj_time_optimal(const topp_args *a)
   /* The rows twice: checked first (the summary needs their peaks), then
    * written. */
   topp_peaks pk;
-  st = topp_rows(NULL, m, &lim, &tp, dt, &pk, why, sizeof why);
+  st = topp_rows(NULL, m, &lim, &tp, dt, units, &pk, why, sizeof why);
   if (st != PRRU_OK) {
     prru_topp_free(&tp);
     prru_cli_error("traj", "--time-optimal: %s; nothing written", why);
@@ -447,9 +413,11 @@ static int traj_time_optimal(const topp_args *a)
   prru_cli_out_comment(&o);
   const int to_stdout = !a->out || strcmp(a->out, "-") == 0;
   topp_summary(&o, &tp, &lim, qdur, &pk, to_stdout ? NULL : stderr);
-  prru_cli_out_printf(&o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s,%s\n", dn, ddn, fn);
+  prru_cli_out_printf(&o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s,%s", dn, ddn, fn);
+  prru_cli_out_motor_names(&o, units[0], units[1]);
+  prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
-  st = topp_rows(&o, m, &lim, &tp, dt, &pk, why, sizeof why);
+  st = topp_rows(&o, m, &lim, &tp, dt, units, &pk, why, sizeof why);
   prru_topp_free(&tp);
   return prru_cli_out_finish(&o, st, why);
 }
@@ -532,7 +500,7 @@ int prru_cmd_traj(int argc, char **argv)
 {
   const char *wps = NULL, *durs = NULL, *dts = NULL, *out = NULL;
   int help = 0, quintic = 0, topp = 0;
-  topp_args ta = {NULL, NULL, NULL, NULL, NULL, {{NULL, NULL, NULL}, NULL, NULL, 0}};
+  topp_args ta = {NULL, NULL, NULL, NULL, NULL, NULL, {{NULL, NULL, NULL}, NULL, NULL, 0}};
   prru_cli_option opts[] = {{"quintic", 0, NULL, &quintic},
                             {"waypoints", 1, &wps, NULL},
                             {"durations", 1, &durs, NULL},
@@ -546,7 +514,8 @@ int prru_cmd_traj(int argc, char **argv)
                             {"speed-max", 1, &ta.lim.speed, NULL},
                             {"stroke", 1, &ta.lim.stroke, NULL},
                             {"no-limits", 0, NULL, &ta.lim.none},
-                            {"grid", 1, &ta.grid, NULL}};
+                            {"grid", 1, &ta.grid, NULL},
+                            {"units", 1, &ta.units, NULL}};
   if (prru_cli_parse("traj", argc, argv, opts, (int)(sizeof opts / sizeof *opts))) return 2;
   char dn[256], ddn[256], fn[256];
   prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
@@ -572,8 +541,8 @@ int prru_cmd_traj(int argc, char **argv)
     return traj_time_optimal(&ta);
   }
   if (ta.lim.force[0] || ta.lim.force[1] || ta.lim.force[2] || ta.lim.speed || ta.lim.stroke ||
-      ta.lim.none || ta.grid) {
-    prru_cli_error("traj", "the limits and --grid apply only with --time-optimal");
+      ta.lim.none || ta.grid || ta.units) {
+    prru_cli_error("traj", "the limits, --grid and --units apply only with --time-optimal");
     return 2;
   }
   if (!wps) {
@@ -618,14 +587,15 @@ static const char track_help[] =
     "                  [--bandwidth W | --kp K1,K2,K3 --kd D1,D2,D3] [--period S]\n"
     "                  [--dt S] [--plant MODEL.json] [--mismatch KEY=F[,KEY=F..]]\n"
     "                  [--noise SQ,SQD]\n"
-    "                  [--seed N] [--fmax F|%s] [--stroke LO,HI|LO1,HI1,..]\n"
+    "                  [--seed N] [--force-max F|%s] [--speed-max V|..]\n"
+    "                  [--stroke LO,HI|LO1,HI1,..] [--no-limits] [--units rail|motor]\n"
     "                  [--q0-offset E1,E2,E3] [--atol X] [--rtol X]\n"
     "                  [--out FILE.csv|-] [--summary FILE.json] [--plot FILE.png]\n"
     "Simulates the robot following a reference trajectory under computed-torque\n"
     "control: the model's inverse dynamics at the measured state with the\n"
     "commanded acceleration qdd_c = qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q),\n"
     "  fd = J_d^-T (M qdd_c + h - G - passive)%s,\n"
-    "each force clipped to --fmax (saturation). With the model exact and no\n"
+    "each force clipped to its limit (saturation). With the model exact and no\n"
     "saturation each error e = q_ref - q obeys e'' + Kd e' + Kp e = 0.\n"
     "Reference: --ref, a CSV with t, q1..3 and qd1..3, qdd1..3 (as 'prru traj'\n"
     "writes; interpolated by quintics matching q, qd, qdd at every row), or\n"
@@ -644,8 +614,14 @@ static const char track_help[] =
     "--noise SQ,SQD: Gaussian sensor noise on q and qd (standard deviations,\n"
     "rad or m, and per s; needs --period > 0), from a generator seeded by\n"
     "--seed (default 1): the same seed gives the same run.\n"
-    "Limits: --fmax, one force limit (N) for every actuator or one each;\n"
-    "--stroke, the slider range (m), for all sliders or per slider. The\n"
+    "Limits: the model file's drives (force_max or torque_max, speed_max or\n"
+    "motor_speed_max, stroke) act unless --no-limits; --force-max (N, alias\n"
+    "--fmax), --speed-max (m/s) and --stroke LO,HI (m), one value for every\n"
+    "actuator or one each, replace that kind for this run; a line of the CSV\n"
+    "and the summary say which were active. Forces are clipped to force_max;\n"
+    "computed torque cannot hold a speed, so the summary reports the plant's\n"
+    "largest slider speeds (max_dd) and the fraction of samples above\n"
+    "speed_max (over_speed_fraction). The\n"
     "reference must stay inside the workspace, away from singularities (and\n"
     "not cross one: det J_d keeps its sign) and in the stroke, checked at\n"
     "every row and at least every millisecond (else exit 2, nothing written).\n"
@@ -654,10 +630,13 @@ static const char track_help[] =
     "--q0-offset E starts the plant at q_ref(0) - E (an initial error);\n"
     "--atol, --rtol: the integrator's tolerances (default 1e-12, at least\n"
     "2.2e-14).\n"
-    "Output: the model line, a line with the settings, then\n"
+    "Output: the model line, a line with the settings, one with the limits,\n"
+    "then\n"
     "  t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,\n"
     "  %s,%s,\n"
     "  %s,%s,qdd1,qdd2,qdd3\n"
+    "and with --units motor the motor torques tau1.. (N m; the model's lead\n"
+    "and gear) and, where it gives torque_constant, the currents i1.. (A)\n"
     "(qr the reference, fdc the controller's forces before clipping, sat 1 where\n"
     "clipped, d the slider heights, qdd the plant's accelerations under fd:\n"
     "with q, qd and fd, exact identification data) to --out or stdout; a JSON\n"
@@ -670,6 +649,11 @@ static const char track_help[] =
 
 typedef struct {
   prru_cli_out *out;
+  const prru_model *m;
+  int motor, current;                 /* --units motor columns */
+  double speed_max[PRRU_NACT];        /* the run's speed limits (reported, not enforced) */
+  double max_dd[PRRU_NACT];           /* largest |slider speed| of the plant */
+  long over_speed;                    /* samples with a speed above its limit */
 } track_output;
 
 static int track_row(const prru_track_sample *s, void *ctx)
@@ -686,7 +670,18 @@ static int track_row(const prru_track_sample *s, void *ctx)
   for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, ",%d", s->saturated[i]);
   prru_cli_out_numbers(o, s->d, PRRU_NACT);
   prru_cli_out_numbers(o, s->qdd, 3);
+  prru_cli_out_motor(o, to->m, s->fd, to->motor, to->current);
   prru_cli_out_printf(o, "\n");
+  /* The plant's slider speeds against the speed limits: computed torque
+   * cannot hold a speed, so the run reports them. */
+  double dd[PRRU_NACT], ddb[PRRU_NACT];
+  int over = 0;
+  prru_model_actuator_rates(to->m, s->q, s->qd, dd, ddb);
+  for (int i = 0; i < PRRU_NACT; i++) {
+    to->max_dd[i] = fmax(to->max_dd[i], fabs(dd[i]));
+    over |= fabs(dd[i]) > to->speed_max[i];
+  }
+  to->over_speed += over;
   return prru_cli_out_row(o) == 0 ? PRRU_OK : PRRU_EIO;
 }
 
@@ -803,7 +798,7 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
     for (int i = 0; i < PRRU_NACT && !rc; i++)
       if (d->d[i] < o->d_min[i] || d->d[i] > o->d_max[i]) {
         prru_cli_error("track", "reference at sample %ld (t = %.9g s): slider %d at d = %.9g m is "
-                       "outside its --stroke [%g, %g]; nothing written", k + 1, t, i + 1,
+                       "outside its stroke [%g, %g]; nothing written", k + 1, t, i + 1,
                        d->d[i], o->d_min[i], o->d_max[i]);
         rc = 2;
       }
@@ -817,7 +812,8 @@ static int check_reference(const prru_quintic *tr, const prru_track_options *o, 
 }
 
 static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_options *o,
-                         const char *plant, const char *mismatch, double ff_peak, const char *status)
+                         const char *plant, const char *mismatch, double ff_peak, const char *status,
+                         const char *limits, const track_output *to)
 {
   fputc('{', f);
   prru_cli_json_model(f);
@@ -849,6 +845,12 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   prru_cli_json_array(f, frac, PRRU_NACT);
   fputs(", \"any_saturated_fraction\": ", f);
   prru_cli_json_number(f, s->samples ? (double)s->any_saturated / (double)s->samples : 0.0);
+  fputs(",\n \"limits\": ", f);
+  prru_cli_json_string(f, limits);
+  fputs(", \"max_dd\": ", f);
+  prru_cli_json_array(f, to->max_dd, PRRU_NACT);
+  fprintf(f, ", \"over_speed_fraction\": ");
+  prru_cli_json_number(f, s->samples ? (double)to->over_speed / (double)s->samples : 0.0);
   fputs(",\n \"feedforward_peak\": ", f);
   prru_cli_json_number(f, ff_peak);
   fputs(", \"status\": ", f);
@@ -860,17 +862,18 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
  * stderr when the CSV went to stdout. 0 or 1 after a message. */
 static int write_summary(const char *sums, const char *out, const prru_track_summary *s,
                          const prru_track_options *o, const char *plant, const char *mismatch,
-                         double ff_peak, const char *status)
+                         double ff_peak, const char *status, const char *limits, const track_output *to)
 {
   if (!sums) {
-    json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, plant, mismatch, ff_peak, status);
+    json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, plant, mismatch, ff_peak, status,
+                 limits, to);
     return 0;
   }
   char *buf = NULL;
   size_t len = 0;
   FILE *g = open_memstream(&buf, &len);
   if (!g) return 1;
-  json_summary(g, s, o, plant, mismatch, ff_peak, status);
+  json_summary(g, s, o, plant, mismatch, ff_peak, status, limits, to);
   fclose(g);
   prru_cli_out so;
   int rc = prru_cli_out_open(&so, "track", sums);
@@ -909,45 +912,6 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
   unlink(path);
   rmdir(dir);
   return rc;
-}
-
-/* --fmax and --stroke into o. 0 or 2. */
-static int parse_limits(const char *fmaxs, const char *strokes, prru_track_options *o)
-{
-  double v[2 * PRRU_NACT];
-  int n;
-  if (fmaxs) {
-    if (parse_number_list("track", "fmax", fmaxs, v, PRRU_NACT, &n)) return 2;
-    if (n != 1 && n != PRRU_NACT) {
-      prru_cli_error("track", "--fmax: give 1 limit or %d (one per actuator), not %d", PRRU_NACT, n);
-      return 2;
-    }
-    for (int i = 0; i < PRRU_NACT; i++) {
-      o->f_max[i] = v[n == 1 ? 0 : i];
-      if (!(o->f_max[i] > 0)) {
-        prru_cli_error("track", "--fmax: limit %g of actuator %d is not > 0", o->f_max[i], i + 1);
-        return 2;
-      }
-    }
-  }
-  if (strokes) {
-    if (parse_number_list("track", "stroke", strokes, v, 2 * PRRU_NACT, &n)) return 2;
-    if (n != 2 && n != 2 * PRRU_NACT) {
-      prru_cli_error("track", "--stroke: give LO,HI for all sliders or %d numbers (LO,HI per "
-                     "slider), not %d", 2 * PRRU_NACT, n);
-      return 2;
-    }
-    for (int i = 0; i < PRRU_NACT; i++) {
-      o->d_min[i] = v[n == 2 ? 0 : 2 * i];
-      o->d_max[i] = v[n == 2 ? 1 : 2 * i + 1];
-      if (!(o->d_min[i] < o->d_max[i])) {
-        prru_cli_error("track", "--stroke: slider %d's range [%g, %g] is empty (LO must be below HI)",
-                       i + 1, o->d_min[i], o->d_max[i]);
-        return 2;
-      }
-    }
-  }
-  return 0;
 }
 
 /* Gains, timing, noise and tolerances into o. 0 or 2. */
@@ -1047,18 +1011,20 @@ static int plant_params(const char *plant, prru_params *p)
 
 int prru_cmd_track(int argc, char **argv)
 {
-  const char *refs = NULL, *wps = NULL, *durs = NULL, *mism = NULL, *fmaxs = NULL,
-             *strokes = NULL, *out = NULL, *sums = NULL, *plot = NULL, *plants = NULL;
+  const char *refs = NULL, *wps = NULL, *durs = NULL, *mism = NULL, *units = NULL, *out = NULL, *sums = NULL,
+             *plot = NULL, *plants = NULL;
   const char *a[10] = {NULL};
   int help = 0;
+  prru_cli_limit_args lim = {NULL, NULL, NULL, NULL, 0};
   prru_cli_option opts[] = {
       {"ref", 1, &refs, NULL},        {"waypoints", 1, &wps, NULL},  {"durations", 1, &durs, NULL},
       {"bandwidth", 1, &a[0], NULL},  {"kp", 1, &a[1], NULL},        {"kd", 1, &a[2], NULL},
       {"period", 1, &a[3], NULL},     {"dt", 1, &a[4], NULL},        {"mismatch", 1, &mism, NULL},
-      {"noise", 1, &a[5], NULL},      {"seed", 1, &a[6], NULL},      {"fmax", 1, &fmaxs, NULL},
-      {"stroke", 1, &strokes, NULL},  {"q0-offset", 1, &a[7], NULL}, {"atol", 1, &a[8], NULL},
+      {"noise", 1, &a[5], NULL},      {"seed", 1, &a[6], NULL},      {"fmax", 1, &lim.alias, NULL},
+      PRRU_CLI_LIMIT_OPTIONS(lim),    {"q0-offset", 1, &a[7], NULL}, {"atol", 1, &a[8], NULL},
       {"rtol", 1, &a[9], NULL},       {"out", 1, &out, NULL},        {"summary", 1, &sums, NULL},
-      {"plot", 1, &plot, NULL},       {"plant", 1, &plants, NULL},   {"help", 0, NULL, &help}};
+      {"plot", 1, &plot, NULL},       {"plant", 1, &plants, NULL},   {"units", 1, &units, NULL},
+      {"help", 0, NULL, &help}};
   if (prru_cli_parse("track", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   char fdn[256], fdcn[256], satn[256], dn[256];
   prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
@@ -1092,7 +1058,19 @@ int prru_cmd_track(int argc, char **argv)
   prru_track_options o;
   prru_track_options_default(&o);
   if (plant_params(plants, &o.plant)) return 2;
-  if (parse_track_settings(a, &o) || parse_limits(fmaxs, strokes, &o)) return 2;
+  /* The drives' limits: the model file's unless overridden (spec 13). The
+   * forces are clipped to force_max, the stroke ends the run like an end
+   * stop; a speed cannot be held by computed torque, so the run reports
+   * the plant's speeds against it (summary: max_dd, over_speed_fraction). */
+  prru_limits limits;
+  int motor, current;
+  if (parse_track_settings(a, &o) || prru_cli_limits("track", "fmax", &lim, &limits) ||
+      prru_cli_units("track", units, &motor, &current))
+    return 2;
+  for (int i = 0; i < PRRU_NACT; i++)
+    o.f_max[i] = limits.force_max[i], o.d_min[i] = limits.d_min[i], o.d_max[i] = limits.d_max[i];
+  char limits_text[400];
+  prru_limits_describe(&limits, limits_text, sizeof limits_text);
   if (mism && parse_mismatch(mism, &o.plant)) return 2;
   prru_quintic tr;
   int rc = refs ? csv_reference(refs, &tr) : waypoint_reference("track", wps, durs, &tr);
@@ -1127,16 +1105,20 @@ int prru_cmd_track(int argc, char **argv)
                             step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], plants ? "plant " : "",
                             plants ? plants : "", plants ? ", " : "", mism ? mism : "", o.noise_q, o.noise_qd,
                             o.seed);
-  prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s,qdd1,qdd2,qdd3\n", fdn,
+  prru_cli_out_comment_line(&co, "limits: %s", limits_text);
+  prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s,qdd1,qdd2,qdd3", fdn,
                       fdcn, satn, dn);
+  prru_cli_out_motor_names(&co, motor, current);
+  prru_cli_out_printf(&co, "\n");
   prru_cli_out_line(&co);
-  track_output to = {&co};
+  prru_model m = *prru_cli_model();
+  track_output to = {&co, &m, motor, current, {0}, {0}, 0};
+  memcpy(to.speed_max, limits.speed_max, sizeof to.speed_max);
   o.on_sample = track_row;
   o.ctx = &to;
   o.interrupt = &prru_cli_interrupted;
   prru_track_summary sum;
   char msg[600];
-  prru_model m = *prru_cli_model();
   int st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
   prru_quintic_free(&tr);
   long rows = co.rows;
@@ -1148,7 +1130,8 @@ int prru_cmd_track(int argc, char **argv)
     else
       prru_cli_error("track", "%s; %ld rows written to %s", msg, rows, name);
   }
-  if (write_summary(sums, out, &sum, &o, plants, mism, ff_peak, st == PRRU_OK ? "complete" : msg)) return 1;
+  if (write_summary(sums, out, &sum, &o, plants, mism, ff_peak, st == PRRU_OK ? "complete" : msg, limits_text, &to))
+    return 1;
   if (st != PRRU_OK) return prru_cli_exit_for(st);
   if (plot) return track_plot(out, plot, &o);
   return 0;

@@ -282,11 +282,11 @@ st=$?
 [ $st -eq 2 ] && grep -q -E "reference at sample [0-9]+ \(t = .*(outside the workspace|crosses a singularity).*nothing written" "$tmp/err" \
   && ok || bad "track with an unreachable reference: exit $st, $(cat "$tmp/err")"
 dmax=$(grep -v '^#' "$tmp/t.csv" | sed -n 2p | cut -d, -f11)
-expect 2 "outside its --stroke" -- track --waypoints "$WP" --durations 1,1 --stroke -10,"$dmax" --out "$tmp/x.csv"
+expect 2 "outside its stroke" -- track --waypoints "$WP" --durations 1,1 --stroke -10,"$dmax" --out "$tmp/x.csv"
 expect 2 "needs --period > 0" -- track --waypoints "$WP" --durations 1,1 --noise 1e-5,0 --out "$tmp/x.csv"
 expect 2 "unknown key 'masses'" -- track --waypoints "$WP" --durations 1,1 --mismatch masses=2 --out "$tmp/x.csv"
 expect 2 "is not a number > 0" -- track --waypoints "$WP" --durations 1,1 --mismatch mass=0 --out "$tmp/x.csv"
-expect 2 "--fmax: limit" -- track --waypoints "$WP" --durations 1,1 --fmax 0 --out "$tmp/x.csv"
+expect 2 "--fmax: '0' is not a positive number" -- track --waypoints "$WP" --durations 1,1 --fmax 0 --out "$tmp/x.csv"
 expect 2 "is empty" -- track --waypoints "$WP" --durations 1,1 --stroke 1,0 --out "$tmp/x.csv"
 expect 2 "--plot needs --out" -- track --waypoints "$WP" --durations 1,1 --plot "$tmp/x.png"
 expect 2 "one of them" -- track --ref "$tmp/t.csv" --waypoints "$WP" --durations 1,1
@@ -429,14 +429,63 @@ print(','.join('%r,%r' % (x - 1e-9, x + 1e-9) for x in d))" "$tmp/ik0.json")
 expect 1 "segment 1 (waypoint 1 to 2), s = 0.0025 (grid point 1 of 400): slider" -- traj --time-optimal \
   --waypoints "$WP" --force-max "$FLIM" --stroke "$stroke" --out "$tmp/keep.csv"
 [ "$(cat "$tmp/keep.csv")" = keep ] && ok || bad "a refused time-optimal run changed its output file"
+# The model file's limits (spec 13) act unless --no-limits: a model with
+# torque_max and motor_speed_max plans within their rail equivalents, tau
+# 2 pi gear / lead and rpm / 60 lead / gear, without limit options.
+# The file: the committed format-2 model of the build's number of limbs
+# with those keys added (its own numbers: the parameter kernels).
+python3 - "$PRRU_MODEL" "$PRRU_SOURCE_DIR" "$tmp/lim.json" <<'PY'
+import json, sys
+sys.path.insert(0, sys.argv[2] + '/gen')
+from prrugen import model
+n = model.parse(open(sys.argv[1]).read(), sys.argv[1]).nlimb
+m = json.load(open(sys.argv[2] + ('/models/prototype_example.json' if n == 3 else '/models/4prru.json')))
+m.setdefault('actuators', {}).update({'lead': 0.02, 'gear': 2, 'torque_max': 0.5, 'motor_speed_max': 3000})
+json.dump(m, open(sys.argv[3], 'w'))
+PY
+"$PRRU" --model "$tmp/lim.json" traj --time-optimal --waypoints "$WP" --out "$tmp/lim.csv" 2>"$tmp/err" \
+  && grep -q "^# limits: force_max (N) 314.159.*; speed_max (m/s) 0.5,0.5" "$tmp/lim.csv" && ok \
+  || bad "time-optimal with the model's limits: $(cat "$tmp/err") $(grep '^# limits' "$tmp/lim.csv")"
+expect 2 "neither the options nor the model file give one" -- --model "$tmp/lim.json" traj --time-optimal \
+  --waypoints "$WP" --no-limits
+# track on the same model: its force limit clips (a line and the summary
+# name the limits), --units motor adds tau = f lead / (2 pi gear) per
+# actuator, and the plant's slider speeds are reported against speed_max.
+"$PRRU" --model "$tmp/lim.json" track --waypoints "$WP" --durations 0.3,0.3 --units motor --out "$tmp/limt.csv" \
+  --summary "$tmp/limt.json" 2>"$tmp/err" && python3 - "$tmp/limt.csv" "$tmp/limt.json" "$nact" <<'PY' \
+  && ok || bad "track with the model's limits and --units motor: $(cat "$tmp/err")"
+import csv, json, math, sys
+lines = open(sys.argv[1]).read().splitlines()
+assert any(l.startswith('# limits: force_max 314.159') for l in lines), [l for l in lines if l.startswith('#')]
+rows = list(csv.DictReader(l for l in lines if not l.startswith('#')))
+n = int(sys.argv[3])
+for r in rows:
+    for i in range(1, n + 1):
+        f, tau = float(r['fd%d' % i]), float(r['tau%d' % i])
+        assert abs(f) <= 314.16 and abs(tau - f * 0.02 / (2 * math.pi * 2)) <= 1e-12 * (1 + abs(tau)), (r['t'], i)
+s = json.load(open(sys.argv[2]))
+assert s['limits'].startswith('force_max 314.159') and len(s['max_dd']) == n and 0 <= s['over_speed_fraction'] <= 1, s
+PY
+expect 2 "--units" -- track --waypoints "$WP" --durations 1,1 --units motor --out "$tmp/x.csv"
+"$PRRU" --model "$tmp/lim.json" traj --time-optimal --waypoints "$WP" --units motor --out "$tmp/limm.csv" \
+  2>"$tmp/err" && python3 - "$tmp/limm.csv" "$nact" <<'PY' && ok || bad "traj --time-optimal --units motor: $(cat "$tmp/err")"
+import csv, math, sys
+rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
+for r in rows:
+    for i in range(1, int(sys.argv[2]) + 1):
+        f, tau = float(r['fd%d' % i]), float(r['tau%d' % i])
+        assert abs(tau - f * 0.02 / (2 * math.pi * 2)) <= 1e-12 * (1 + abs(tau)), (r['t'], i)
+        assert abs(tau) <= 0.5 * (1 + 1e-6), (r['t'], i, tau)  # torque_max
+PY
+expect 2 "--units" -- traj --time-optimal --waypoints "$WP" --force-max 100 --units motor
 # Bad options: exit 2.
-expect 2 "needs at least one force or speed limit, and none is given" -- traj --time-optimal --waypoints "$WP"
+expect 2 "needs at least one force or speed limit, and neither the options nor the model file give one" -- traj --time-optimal --waypoints "$WP"
 expect 2 "needs at least one force or speed limit" -- traj --time-optimal --waypoints "$WP" --no-limits
 expect 2 "--speed-max alone leaves the accelerations unbounded" -- traj --time-optimal --waypoints "$WP" --speed-max 1
 expect 2 "--durations does not apply with --time-optimal" -- traj --time-optimal --waypoints "$WP" --durations 1,1 --fmax 100
-expect 2 "--force-max, --fmax and --fd-max are one option" -- traj --time-optimal --waypoints "$WP" --fmax 100 --fd-max 100
-expect 2 "--fmax: limit 0 of actuator 1 is not > 0" -- traj --time-optimal --waypoints "$WP" --fmax 0
-expect 2 "--speed-max: give 1 limit or $nact" -- traj --time-optimal --waypoints "$WP" --fmax 100 --speed-max 1,2
+expect 2 "--fmax and --fd-max are the same limit: give one" -- traj --time-optimal --waypoints "$WP" --fmax 100 --fd-max 100
+expect 2 "--fmax: '0' is not a positive number" -- traj --time-optimal --waypoints "$WP" --fmax 0
+expect 2 "--speed-max: '1,2' is not one number or $nact comma-separated numbers" -- traj --time-optimal --waypoints "$WP" --fmax 100 --speed-max 1,2
 expect 2 "--stroke: slider 1's range" -- traj --time-optimal --waypoints "$WP" --fmax 100 --stroke 0.3,0.2
 expect 2 "--grid: '1' is not a whole number" -- traj --time-optimal --waypoints "$WP" --fmax 100 --grid 1
 expect 2 "--grid: '2.5' is not a whole number" -- traj --time-optimal --waypoints "$WP" --fmax 100 --grid 2.5
