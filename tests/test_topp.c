@@ -124,11 +124,11 @@ static void optimal(const prru_model *m, const prru_limits *lim, const char *wha
     return;
   }
   double active = 0;
-  /* The library checks each interval at 9 points to PRRU_TOPP_CHECK_TOL =
-   * 1e-9; between them the forces follow smooth functions of s over
-   * 1/3200 of a segment, whose curvature term (1/3200)^2 / 8 times a
-   * relative second derivative of order 10 is below 1e-7: rows anywhere
-   * stay within 1e-6 of the limits (the required bound). */
+  /* The library maximises each force near its limit over every interval
+   * to PRRU_TOPP_CHECK_TOL = 1e-9, from samples that resolve the
+   * friction's ramp near rest: rows anywhere stay within 1e-6 of the
+   * limits (the required bound; a random model's Coulomb ramp put rows
+   * 1e-3 over when only 9 points of each interval were checked). */
   double worst = profile_ratio(m, d, lim, &tp, 1e-4, &active);
   snprintf(buf, sizeof buf, "%s: forces and speeds within the limits at every row", what);
   tu_check(worst <= 1 + 1e-6, buf, worst - 1, 1e-6);

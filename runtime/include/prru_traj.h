@@ -167,7 +167,10 @@ int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const
  * than 1e-6 of its largest value. The linearisation is exact at x0, and
  * whatever it leaves is caught by the check: the result is
  * then checked with the exact inverse dynamics at 9 points of every
- * interval, and where a force or speed exceeds its limit by more than
+ * interval (more where a slider's speed passes through its smoothed
+ * Coulomb force's ramp: the points where it crosses +-2^k
+ * coulomb_velocity, k = -4..4), each force near its limit maximised
+ * between the samples by golden sections, and where a force or speed exceeds its limit by more than
  * PRRU_TOPP_CHECK_TOL (relative), that limit is tightened at the
  * interval's ends by the excess and the passes run again (at most
  * PRRU_TOPP_MAX_ITER times, else PRRU_ENOCONV). */

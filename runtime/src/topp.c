@@ -362,45 +362,153 @@ static int forward(topp_ctx *c)
   return PRRU_OK;
 }
 
-/* Exact inverse dynamics at CHECK_POINTS + 1 points of every interval:
- * where a limit is exceeded by more than PRRU_TOPP_CHECK_TOL, tighten it
- * at both ends by the excess. *excess: the largest relative excess;
- * *active: intervals with a limit within ACTIVE_TOL at an end. */
+/* The interval's state at fraction sg of interval j (x linear in s). */
+static int state_at(topp_ctx *c, int j, double sg, double f[PRRU_NACT], double v[PRRU_NACT])
+{
+  const double s = (j + sg) / c->N, x = c->x[j] + sg * (c->x[j + 1] - c->x[j]);
+  double q[3], qd[3], qdd[3];
+  path_pose(c, s, q);
+  for (int i = 0; i < 3; i++) qd[i] = c->dq[i] * sqrt(fmax(x, 0.0)), qdd[i] = c->dq[i] * c->u[j];
+  int st = prru_limits_ratio(c->m, c->d, c->lim, q, qd, qdd, f, v, NULL, NULL, NULL);
+  if (st != PRRU_OK) {
+    char at[160];
+    where(c, j, at, sizeof at);
+    return prru_fail(c->msg, c->msglen, st, "%s: inverse dynamics refuses the pose at s = %.9g (%s)",
+                     at, s, prru_strerror(st));
+  }
+  return PRRU_OK;
+}
+
+/* Slider i's speed over the Coulomb velocity at fraction sg of interval
+ * j, with dd_i/ds interpolated linearly between the grid points: only
+ * where to look, not a checked value. */
+static double coulomb_arg(const topp_ctx *c, int j, int i, double sg)
+{
+  const double w = c->p[j].w[i] + sg * (c->p[j + 1].w[i] - c->p[j].w[i]);
+  const double x = c->x[j] + sg * (c->x[j + 1] - c->x[j]);
+  return w * sqrt(fmax(x, 0.0)) / c->m->mech->coulomb_velocity;
+}
+
+/* The points of interval j checked with the exact inverse dynamics, in
+ * increasing order: CHECK_POINTS + 1 uniform in s, where the forces are
+ * smooth in s, and, where a slider's speed passes through the ramp of
+ * its smoothed Coulomb force (tanh of the speed over coulomb_velocity:
+ * in an interval leaving or reaching rest it rises to its full value
+ * within a small fraction of the interval), the points where the speed
+ * crosses +-2^k coulomb_velocity, k = -4..4, so that the ramp is
+ * resolved too. */
+#define RAMP_POINTS 9
+#define MAX_SAMPLES (CHECK_POINTS + 1 + 2 * RAMP_POINTS * PRRU_NACT)
+static int sample_points(const topp_ctx *c, int j, double *sg)
+{
+  int n = 0;
+  for (int k = 0; k <= CHECK_POINTS; k++) sg[n++] = (double)k / CHECK_POINTS;
+  if (!(c->m->mech->coulomb_velocity > 0)) return n;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    if (c->m->mech->coulomb[i] == 0) continue;
+    const double z0 = coulomb_arg(c, j, i, 0), z1 = coulomb_arg(c, j, i, 1);
+    for (int k = 0; k < 2 * RAMP_POINTS; k++) {
+      const double zt = (k % 2 ? -1 : 1) * ldexp(1.0, k / 2 - RAMP_POINTS / 2);
+      if (!((z0 - zt) * (z1 - zt) < 0)) continue;
+      double lo = 0, hi = 1;
+      for (int b = 0; b < 60; b++) {
+        const double mid = 0.5 * (lo + hi);
+        if ((coulomb_arg(c, j, i, mid) - zt) * (z0 - zt) > 0)
+          lo = mid;
+        else
+          hi = mid;
+      }
+      sg[n++] = 0.5 * (lo + hi);
+    }
+  }
+  for (int a = 1; a < n; a++)
+    for (int b = a; b > 0 && sg[b] < sg[b - 1]; b--) {
+      const double t = sg[b];
+      sg[b] = sg[b - 1], sg[b - 1] = t;
+    }
+  return n;
+}
+
+/* The largest |f_i| on [lo, hi] of interval j near its sample mid, by
+ * golden sections to 1e-12 of the interval: the samples resolve the
+ * forces' shape, so one local maximum lies between a best sample's
+ * neighbours. *sg, *f: where and the signed force there. */
+static int refine_force(topp_ctx *c, int j, int i, double lo, double hi, double *sg, double *f)
+{
+  const double g = 0.5 * (sqrt(5.0) - 1);
+  double fa[PRRU_NACT], fb[PRRU_NACT], v[PRRU_NACT];
+  double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+  int st = state_at(c, j, a, fa, v);
+  if (st == PRRU_OK) st = state_at(c, j, b, fb, v);
+  double ya = fabs(fa[i]), yb = fabs(fb[i]), sa = fa[i], sb = fb[i];
+  while (st == PRRU_OK && hi - lo > 1e-12) {
+    if (ya >= yb) {
+      hi = b, b = a, yb = ya, sb = sa;
+      a = hi - g * (hi - lo);
+      st = state_at(c, j, a, fa, v);
+      ya = fabs(fa[i]), sa = fa[i];
+    } else {
+      lo = a, a = b, ya = yb, sa = sb;
+      b = lo + g * (hi - lo);
+      st = state_at(c, j, b, fb, v);
+      yb = fabs(fb[i]), sb = fb[i];
+    }
+  }
+  if (st != PRRU_OK) return st;
+  if (fabs(sa) > fabs(*f)) *sg = a, *f = sa;
+  if (fabs(sb) > fabs(*f)) *sg = b, *f = sb;
+  return PRRU_OK;
+}
+
+/* Exact inverse dynamics at the sample points of every interval
+ * (sample_points), and each actuator's force maximised between the
+ * neighbours of its largest sample wherever that sample is within
+ * ACTIVE_TOL of the limit (the profile presses against its limits
+ * on nearly every interval, and between samples the force can rise
+ * above both): where a limit is exceeded by more than
+ * PRRU_TOPP_CHECK_TOL, tighten it at both ends by the excess. *excess:
+ * the largest relative excess; *active: intervals with a limit within
+ * ACTIVE_TOL at an end. */
 static int check(topp_ctx *c, double *excess, int *active)
 {
   *excess = 0;
   *active = 0;
-  const double delta = 1.0 / c->N;
   for (int j = 0; j < c->N; j++) {
-    int act = 0;
-    for (int k = 0; k <= CHECK_POINTS; k++) {
-      const double sg = (double)k / CHECK_POINTS, s = (j + sg) * delta;
-      const double x = c->x[j] + sg * (c->x[j + 1] - c->x[j]);
-      double q[3], qd[3], qdd[3], f[PRRU_NACT], v[PRRU_NACT], ratio;
-      path_pose(c, s, q);
-      for (int i = 0; i < 3; i++) qd[i] = c->dq[i] * sqrt(x), qdd[i] = c->dq[i] * c->u[j];
-      int st = prru_limits_ratio(c->m, c->d, c->lim, q, qd, qdd, f, v, &ratio, NULL, NULL);
-      if (st != PRRU_OK) {
-        char at[160];
-        where(c, j, at, sizeof at);
-        return prru_fail(c->msg, c->msglen, st, "%s: inverse dynamics refuses the pose at s = "
-                         "%.9g (%s)", at, s, prru_strerror(st));
-      }
-      if ((k == 0 || k == CHECK_POINTS) && ratio >= 1 - ACTIVE_TOL) act = 1;
+    double sg[MAX_SAMPLES], fbig[PRRU_NACT] = {0}, vbig[PRRU_NACT] = {0};
+    int best[PRRU_NACT] = {0}, act = 0;
+    const int n = sample_points(c, j, sg);
+    for (int k = 0; k < n; k++) {
+      double f[PRRU_NACT], v[PRRU_NACT];
+      int st = state_at(c, j, sg[k], f, v);
+      if (st != PRRU_OK) return st;
       for (int i = 0; i < PRRU_NACT; i++) {
-        const double F = c->lim->force_max[i], V = c->lim->speed_max[i];
-        const double ef = fabs(f[i]) - F, rv = fabs(v[i]) / V;
-        if (ef > PRRU_TOPP_CHECK_TOL * F) {
-          *excess = fmax(*excess, ef / F);
-          for (int e = j; e <= j + 1; e++) {
-            double *mu = f[i] > 0 ? &c->p[e].mu_hi[i] : &c->p[e].mu_lo[i];
-            *mu += ef + PRRU_TOPP_CHECK_TOL * F;
-          }
+        if (fabs(f[i]) > fabs(fbig[i])) fbig[i] = f[i], best[i] = k;
+        vbig[i] = fmax(vbig[i], fabs(v[i]));
+        if ((sg[k] == 0 || sg[k] == 1) &&
+            (fabs(f[i]) >= (1 - ACTIVE_TOL) * c->lim->force_max[i] ||
+             fabs(v[i]) >= (1 - ACTIVE_TOL) * c->lim->speed_max[i]))
+          act = 1;
+      }
+    }
+    for (int i = 0; i < PRRU_NACT; i++) {
+      const double F = c->lim->force_max[i], V = c->lim->speed_max[i];
+      if (fabs(fbig[i]) >= (1 - ACTIVE_TOL) * F) {
+        const int k = best[i];
+        double at = sg[k];
+        int st = refine_force(c, j, i, sg[k > 0 ? k - 1 : 0], sg[k < n - 1 ? k + 1 : n - 1], &at, &fbig[i]);
+        if (st != PRRU_OK) return st;
+      }
+      const double ef = fabs(fbig[i]) - F, rv = vbig[i] / V;
+      if (ef > PRRU_TOPP_CHECK_TOL * F) {
+        *excess = fmax(*excess, ef / F);
+        for (int e = j; e <= j + 1; e++) {
+          double *mu = fbig[i] > 0 ? &c->p[e].mu_hi[i] : &c->p[e].mu_lo[i];
+          *mu += ef + PRRU_TOPP_CHECK_TOL * F;
         }
-        if (rv > 1 + PRRU_TOPP_CHECK_TOL) {
-          *excess = fmax(*excess, rv - 1);
-          for (int e = j; e <= j + 1; e++) c->p[e].rho[i] /= rv * rv * (1 + PRRU_TOPP_CHECK_TOL);
-        }
+      }
+      if (rv > 1 + PRRU_TOPP_CHECK_TOL) {
+        *excess = fmax(*excess, rv - 1);
+        for (int e = j; e <= j + 1; e++) c->p[e].rho[i] /= rv * rv * (1 + PRRU_TOPP_CHECK_TOL);
       }
     }
     *active += act;
