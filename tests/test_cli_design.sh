@@ -143,11 +143,17 @@ mkdir "$tmp/nolim"
 grep -qx "limits: force_max none, speed_max none, stroke none (w_R has no forces or speeds: only the stroke acts)" \
   "$tmp/nolim/rep/report.txt" && ! grep -q "sliders within" "$tmp/nolim/rep/report.txt" && ok \
   || bad "optimize --no-limits report: $(grep -E "limits|sliders" "$tmp/nolim/rep/report.txt")"
+# A stroke every slider keeps: |d| is below the sum of the largest base
+# radius, link lengths and platform size, rounded up to whole metres.
+R=$(python3 -c 'import json, math, sys
+g = json.load(open(sys.argv[1]))["geometry"]
+big = lambda v: max(v) if isinstance(v, list) else v
+print(math.ceil(sum(big(g[k]) for k in ("b", "l1", "l2", "a"))))' "$tmp/stroke.json")
 "$PRRU" --model "$tmp/stroke.json" optimize --vars l2 --range 0.1 --max-iter 5 --q1 "$Q1" --q2 "$Q2" \
-  --stroke -1,1 --out "$tmp/nolim/m2.json" --report "$tmp/nolim/rep2" >/dev/null 2>&1 \
-  && grep -qx "limits: force_max none, speed_max none, stroke \[-1, 1\] m (w_R has no forces or speeds: only the stroke acts)" \
-    "$tmp/nolim/rep2/report.txt" && grep -q "sliders within \[-1, 1\] m" "$tmp/nolim/rep2/report.txt" && ok \
-  || bad "optimize --stroke over the model's: $(grep -E "limits|sliders" "$tmp/nolim/rep2/report.txt")"
+  --stroke "-$R,$R" --out "$tmp/nolim/m2.json" --report "$tmp/nolim/rep2" >/dev/null 2>"$tmp/nolim/err2" \
+  && grep -qx "limits: force_max none, speed_max none, stroke \[-$R, $R\] m (w_R has no forces or speeds: only the stroke acts)" \
+    "$tmp/nolim/rep2/report.txt" && grep -q "sliders within \[-$R, $R\] m" "$tmp/nolim/rep2/report.txt" && ok \
+  || bad "optimize --stroke over the model's: $(head -c 300 "$tmp/nolim/err2"; grep -E "limits|sliders" "$tmp/nolim/rep2/report.txt")"
 echo x >"$tmp/bad/file"
 expect 2 "exists and is not a directory" -- optimize --vars l2 --q1 "$Q1" --q2 "$Q2" --out "$tmp/bad/m.json" --report "$tmp/bad/file"
 rm "$tmp/bad/file"
