@@ -358,7 +358,7 @@ static const char identify_help[] =
     "the value at which it alone would give forces of the data's RMS size;\n"
     "model: the written model's; t: (model - estimate) / se).\n"
     "Model files hold no magnitude below 1e-9 but 0: smaller values are\n"
-    "written as 0 (a principal moment of inertia as 1e-9).\n"
+    "written as 0 (a mass or a principal moment of inertia as 1e-9).\n"
     "Exit 2 for bad options or a malformed FILE, 1 when a row is unreachable or\n"
     "singular (named), the data do not excite every base parameter, or the\n"
     "data contradict physics (no consistent robot within the covariance: a\n"
@@ -598,12 +598,14 @@ static int to_params(const prru_base *b, const double *pi, prru_params *p, char 
       return 1;
     }
     /* A model file holds no magnitude below 1e-9 but 0 (model_number):
-     * a principal moment the fit left smaller (a body on the consistent
-     * set's boundary, a line mass: noisy data can put it there) is raised
-     * to 1e-9 kg m^2, which adds at most 1e-9 kg m^2 of inertia and keeps
-     * the body consistent (its second moments about the centre change by
-     * +-5e-10); the loader's check of the written file (identify_run)
-     * catches anything this misses. */
+     * a mass or principal moment the fit left smaller (a body on the
+     * consistent set's boundary, whose margin is 1e-9 of the prior body:
+     * data that hardly reveal a slider's mass beside its armature can
+     * put it there) is raised to 1e-9 kg or kg m^2, which keeps the body
+     * consistent (the centre of mass stays; the second moments about it
+     * change by +-5e-10); the loader's check of the written file
+     * (identify_run) catches anything this misses. */
+    m = fmax(m, 1e-9);
     for (int d = 0; d < 3; d++) I[d] = fmax(I[d], 1e-9);
     const double m2 = I[0] * I[1] - I[3] * I[3];
     const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
