@@ -82,8 +82,9 @@ optimize-design: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=$(PAPER_BUILD)
 	studies/optimize_paper.sh $(PAPER_BUILD) $(RESULTS)/optimize
 
+# CTEST_ARGS: more ctest options, e.g. -LE independent (tests/CMakeLists.txt).
 test: deps-test build check-generated web-deps
-	cd $(BUILD) && ctest --output-on-failure -j 2
+	cd $(BUILD) && ctest --output-on-failure -j 2 $(CTEST_ARGS)
 
 # The browser test's driver, playwright-core, and three.js (to check that
 # web/vendor/three.module.min.js, which the build embeds, is the npm

@@ -16,7 +16,9 @@
 #   SANITIZE_SKIP_VALGRIND=1   stages 1-2 only
 #   VALGRIND_TIMEOUT seconds (default 600; the run takes ~15 s on one core)
 #
-# Not run under the sanitizers: gen_unittest (Python only), the MuJoCo
+# Not run under the sanitizers: the label independent (gen_unittest, Python
+# only; the package list; the random model generator; the drop-in build,
+# compiled uninstrumented by its own compilers), the MuJoCo
 # validation (MuJoCo's own code, and too slow instrumented) and the docs'
 # checks (paper_doc_commands: the docs' 51 commands, the slow ones excite
 # and paper, which the CLI tests run instrumented already; paper_cli_doc:
@@ -49,7 +51,7 @@ if ! cmake -S "$SRC" -B "$asan" -DCMAKE_BUILD_TYPE=Debug \
   exit 1
 fi
 echo "== ctest under ASan/UBSan"
-if ! (cd "$asan" && ctest --output-on-failure -j "$JOBS" -E '^(gen_unittest|validate_mujoco|paper_doc_commands|paper_cli_doc)$'); then
+if ! (cd "$asan" && ctest --output-on-failure -j "$JOBS" -LE independent -E '^(validate_mujoco|paper_doc_commands|paper_cli_doc)$'); then
   echo "FAIL: ctest under the sanitizers"
   status=1
 fi
