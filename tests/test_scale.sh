@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Tolerances relative to the robot's size: the build's model with its
 # geometry (every kinematic length) multiplied by 1e-7 and by 1e5 is
-# generated and compiled with the runtime; at the same poses (q3 scaled
+# generated and its kernels linked with the build's runtime; at the same poses (q3 scaled
 # too) J_d must be regular exactly where it is for the model itself, with
 # the same condition numbers, and FK(IK(q)) must recover q. Before the
 # tolerances were relative, the 1e-7 robot was "singular" everywhere and
@@ -24,16 +24,43 @@ PY
   # json.dump of Decimal as strings: turn them back into numbers.
   sed -i -E 's/"(-?[0-9.]+(E[-+]?[0-9]+)?)"/\1/g' "$tmp/model_$s.json"
   python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru --quiet || return 1
-  # The topology kernels (any model's numbers at run time) are the
-  # committed ones of every build; $dir comes first for the model's own.
-  gcc -std=c99 -O2 -I"$dir" -I"$SRC/runtime/include" -I"$SRC/runtime/src" -I"$SRC/generated" \
-    "$SRC/tests/scale_main.c" "$SRC"/runtime/src/*.c "$dir/prru_kernels.c" "$dir/prru_mechanism.c" \
-    "$dir/prru_param_kernels.c" "$dir/prru_regressor.c" \
-    "$SRC/generated/prru_p3_kernels.c" "$SRC/generated/prru_p4_kernels.c" \
-    -lgsl -lgslcblas -ljansson -lm -lpthread -o "$tmp/scale_$s"
+  # Only the model's own kernels are compiled: the build's runtime
+  # (compiled against headers that differ from these in their comments
+  # alone, checked) and its topology kernels come from its archives, whose
+  # model-kernel member the objects given first leave unused (a clash
+  # would fail the link, not pass silently).
+  for h in prru_kernels.h prru_mechanism.h prru_param_kernels.h prru_regressor.h; do
+    diff <(sed "1,/\*\//d" "$dir/$h") <(sed "1,/\*\//d" "$BUILD/generated/$h") >/dev/null || {
+      echo "scale $s: $h differs from the build's beyond its comment"; return 1; }
+  done
+  local objs=()
+  for c in prru_kernels prru_mechanism prru_param_kernels prru_regressor; do
+    cc -I"$dir" -c "$dir/$c.c" -o "$dir/$c.o" || return 1
+    objs+=("$dir/$c.o")
+  done
+  link "$tmp/scale_$s" "${objs[@]}"
 }
 
-for s in 1 1e-7 1e5; do
+BUILD=${PRRU_BUILD_DIR:?}
+# The build's compiler and flags (a sanitizer build's archives need them).
+cache() { sed -n "s/^$1:[A-Z]*=//p" "$BUILD/CMakeCache.txt" | head -n 1; }
+CC_BUILD=$(cache CMAKE_C_COMPILER)
+read -r -a C_FLAGS <<<"$(cache CMAKE_C_FLAGS)"
+read -r -a LD_FLAGS <<<"$(cache CMAKE_EXE_LINKER_FLAGS)"
+cc() { "$CC_BUILD" -std=c99 -O2 "${C_FLAGS[@]}" "$@"; }
+scale_main_o="$tmp/scale_main.o"
+cc -I"$BUILD/generated" -I"$SRC/runtime/include" -c "$SRC/tests/scale_main.c" -o "$scale_main_o" ||
+  bad "scale_main.c does not compile"
+link() { # out objects... : scale_main with the objects, then the build's archives
+  local out=$1
+  shift
+  "$CC_BUILD" "${LD_FLAGS[@]}" "${C_FLAGS[@]}" "$scale_main_o" "$@" "$BUILD/runtime/libprru_runtime.a" \
+    "$BUILD/libprru_kernels.a" -lgsl -lgslcblas -ljansson -lm -lpthread -o "$out"
+}
+
+# The model itself: the build's own kernels.
+if link "$tmp/scale_1" && "$tmp/scale_1" 1 >"$tmp/out_1"; then ok; else bad "scale 1: build or FK(IK(q)) failed"; fi
+for s in 1e-7 1e5; do
   if build "$s" && "$tmp/scale_$s" "$s" >"$tmp/out_$s"; then ok; else bad "scale $s: build or FK(IK(q)) failed"; fi
 done
 for s in 1e-7 1e5; do
