@@ -765,54 +765,6 @@ static int csv_reference(const char *path, prru_quintic *tr)
   return 0;
 }
 
-/* Every row time of the run: the reference's pose regular and inside the
- * stroke; *ff_peak the largest feed-forward force. 0, or 2 after a
- * message naming the first bad time. */
-static int check_reference(const prru_quintic *tr, const prru_track_options *o, double step,
-                           double *ff_peak)
-{
-  prru_model m = *prru_cli_model();
-  prru_data *d = malloc(sizeof *d);
-  if (!d) return 1;
-  const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
-  const long n = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9)); /* as traj_rows */
-  int rc = 0, crossed;
-  prru_path_side side;
-  prru_path_side_init(&side);
-  *ff_peak = 0;
-  for (long k = 0; k <= n && !rc; k++) {
-    double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
-    prru_quintic_eval(tr, t, q, qd, qdd);
-    int st = prru_path_sample(&side, &m, d, q, &rcond, &crossed);
-    if (crossed) {
-      prru_cli_error("track", "reference at sample %ld (t = %.9g s): the path crosses a "
-                     "singularity (det J_d changes sign) before q = (%.9g, %.9g, %.9g); nothing "
-                     "written", k + 1, t, q[0], q[1], q[2]);
-      rc = 2;
-      break;
-    }
-    if (st != PRRU_OK) {
-      prru_cli_error("track", "reference at sample %ld (t = %.9g s): q = (%.9g, %.9g, %.9g) is %s; "
-                     "nothing written", k + 1, t, q[0], q[1], q[2], pose_problem(st));
-      rc = 2;
-      break;
-    }
-    for (int i = 0; i < PRRU_NACT && !rc; i++)
-      if (d->d[i] < o->d_min[i] || d->d[i] > o->d_max[i]) {
-        prru_cli_error("track", "reference at sample %ld (t = %.9g s): slider %d at d = %.9g m is "
-                       "outside its stroke [%g, %g]; nothing written", k + 1, t, i + 1,
-                       d->d[i], o->d_min[i], o->d_max[i]);
-        rc = 2;
-      }
-    prru_loads l;
-    memset(&l, 0, sizeof l);
-    if (!rc && prru_inverse_dynamics(&m, d, q, qd, qdd, &l, fd) == PRRU_OK)
-      for (int i = 0; i < PRRU_NACT; i++) *ff_peak = fmax(*ff_peak, fabs(fd[i]));
-  }
-  free(d);
-  return rc;
-}
-
 static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_options *o,
                          const char *plant, const char *mismatch, double ff_peak, const char *status,
                          const char *limits, const track_output *to)
@@ -1078,19 +1030,12 @@ int prru_cmd_track(int argc, char **argv)
   int rc = refs ? csv_reference(refs, &tr) : waypoint_reference("track", wps, durs, &tr);
   if (rc) return rc;
   double step = o.control_period > 0 ? o.control_period : o.dt_out, ff_peak;
-  double span = prru_quintic_t_end(&tr) - prru_quintic_t_begin(&tr);
-  if (!(span / step <= 1e8)) {
-    prru_cli_error("track", "more than 1e8 samples (span %g s, step %g s)", span, step);
+  char msg[600];
+  int st = prru_track_check_reference(prru_cli_model(), &tr, &o, step, &ff_peak, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    prru_cli_error("track", st == PRRU_EINPUT ? "%s; nothing written" : "%s", msg);
     prru_quintic_free(&tr);
-    return 2;
-  }
-  /* The reference is checked every millisecond at least, also between
-   * coarse rows (up to 1e8 checks: a reference of more than 1e5 s is
-   * checked at its rows). */
-  double check_step = span / 1e-3 <= 1e8 ? fmin(step, 1e-3) : step;
-  if ((rc = check_reference(&tr, &o, check_step, &ff_peak)) != 0) {
-    prru_quintic_free(&tr);
-    return rc;
+    return st == PRRU_EINPUT ? 2 : 1;
   }
   prru_cli_catch_signals();
   prru_cli_out co;
@@ -1120,8 +1065,7 @@ int prru_cmd_track(int argc, char **argv)
   o.ctx = &to;
   o.interrupt = &prru_cli_interrupted;
   prru_track_summary sum;
-  char msg[600];
-  int st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
+  st = prru_track(&m, &tr, &o, &sum, msg, sizeof msg);
   prru_quintic_free(&tr);
   long rows = co.rows;
   int io = co.err != 0;

@@ -104,6 +104,18 @@ typedef struct {
 int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
                prru_track_summary *sum, char *msg, int msglen);
 
+/* The reference of a run with rows every step (s): checked at every row
+ * time and at least every millisecond (up to 1e8 checks; a longer
+ * reference at its rows), and at its end: every pose usable (reachable,
+ * J_d regular), det J_d never changing sign (the path does not cross the
+ * singular set), every slider within [o->d_min, o->d_max]. *ff_peak: the
+ * largest feed-forward force |fd_i| (inverse dynamics without loads)
+ * along it. PRRU_EINPUT with msg naming the first bad sample ("reference
+ * at sample K (t = T s): ...") or a step giving more than 1e8 rows;
+ * PRRU_ENOMEM. */
+int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                               double step, double *ff_peak, char *msg, int msglen);
+
 /* One controller evaluation: the clipped forces fd and the unclipped
  * fd_cmd at the measured (q, qd) for the reference (q_ref, qd_ref,
  * qdd_ref); sat[i] set where clipped. prru_inverse_dynamics's statuses. */

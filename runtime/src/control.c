@@ -447,6 +447,58 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   return st;
 }
 
+/* Where a pose is not usable, for the reference's messages. */
+static const char *pose_problem(int st)
+{
+  return st == PRRU_EUNREACHABLE ? "outside the workspace (unreachable)"
+         : st == PRRU_ESINGULAR  ? "at a singularity (J_d singular)"
+                                 : prru_strerror(st);
+}
+
+int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                               double step, double *ff_peak, char *msg, int msglen)
+{
+  *ff_peak = 0;
+  if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
+  const double t0 = prru_quintic_t_begin(ref), t1 = prru_quintic_t_end(ref), span = t1 - t0;
+  if (!(step > 0) || !(span / step <= 1e8))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "more than 1e8 samples (span %g s, step %g s)", span, step);
+  /* Every millisecond at least, also between coarse rows. */
+  if (span / 1e-3 <= 1e8) step = fmin(step, 1e-3);
+  prru_data *d = malloc(sizeof *d);
+  if (!d) return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
+  const long n = (long)fmax(1.0, ceil(span / step - 1e-9));
+  int st = PRRU_OK, crossed;
+  prru_path_side side;
+  prru_path_side_init(&side);
+  static const prru_loads none;
+  for (long k = 0; k <= n && st == PRRU_OK; k++) {
+    double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
+    prru_quintic_eval(ref, t, q, qd, qdd);
+    int ps = prru_path_sample(&side, m, d, q, &rcond, &crossed);
+    if (crossed) {
+      st = prru_fail(msg, msglen, PRRU_EINPUT, "reference at sample %ld (t = %.9g s): the path crosses a "
+                     "singularity (det J_d changes sign) before q = (%.9g, %.9g, %.9g)", k + 1, t, q[0],
+                     q[1], q[2]);
+      break;
+    }
+    if (ps != PRRU_OK) {
+      st = prru_fail(msg, msglen, PRRU_EINPUT, "reference at sample %ld (t = %.9g s): q = (%.9g, %.9g, "
+                     "%.9g) is %s", k + 1, t, q[0], q[1], q[2], pose_problem(ps));
+      break;
+    }
+    for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++)
+      if (d->d[i] < o->d_min[i] || d->d[i] > o->d_max[i])
+        st = prru_fail(msg, msglen, PRRU_EINPUT, "reference at sample %ld (t = %.9g s): slider %d at d = "
+                       "%.9g m is outside its stroke [%g, %g]", k + 1, t, i + 1, d->d[i], o->d_min[i],
+                       o->d_max[i]);
+    if (st == PRRU_OK && prru_inverse_dynamics(m, d, q, qd, qdd, &none, fd) == PRRU_OK)
+      for (int i = 0; i < PRRU_NACT; i++) *ff_peak = fmax(*ff_peak, fabs(fd[i]));
+  }
+  free(d);
+  return st;
+}
+
 static void scale_n(double *v, int n, double f)
 {
   for (int i = 0; i < n; i++) v[i] *= f;
