@@ -38,10 +38,12 @@ from .model import Dme, Joint, Model
 from .simulation import Sample, Scenario, Trajectory
 from .maps import MapResult
 from .measurements import Measurement
+from .motion import Limits, Motion, TimeOptimal, TrackRun
 
 __version__ = "0.2.0"
 
-__all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult",
+__all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult", "Measurement",
+           "Limits", "Motion", "TimeOptimal", "TrackRun",
            "Library", "load_library", "PrruError", "InputError", "Unreachable", "OutOfStroke", "Singular",
            "NoConvergence", "Interrupted", "PrruIOError", "PrruMemoryError", "ParseError",
            "LibraryNotFound", "LayoutError"]

@@ -106,6 +106,20 @@ STEPPERS = ("rk8pd", "rkf45", "rkck", "msbdf")
 LOAD_CONSTANT, LOAD_HARMONIC, LOAD_TABLE = 0, 1, 2
 
 
+class _Quintic(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_int), ("t", c_double_p), ("coef", c_double_p)]
+
+
+class _Topp(ctypes.Structure):
+    _fields_ = [("nseg", ctypes.c_int), ("grid", ctypes.c_int), ("q", c_double_p),
+                ("x", c_double_p), ("u", c_double_p), ("t", c_double_p), ("duration", ctypes.c_double),
+                ("active_fraction", ctypes.c_double), ("iterations", ctypes.c_int)]
+
+
+class _PathSide(ctypes.Structure):
+    _fields_ = [("sign", ctypes.c_int)]
+
+
 def _guarded(struct, guard_bytes):
     """A struct followed by guard bytes: a library whose struct is larger
     than the mirror writes into the guard instead of foreign memory."""
@@ -183,6 +197,36 @@ class Types:
             self.sample_columns[name] = (col, width)
             col += width
         self.sample_width = col
+        # Motion planning and tracking (prru.h, prru_traj.h, prru_control.h,
+        # prru_param_kernels.h).
+        self.Limits = type("prru_limits", (ctypes.Structure,), {"_fields_": [
+            ("force_max", _arr(d, nact)), ("speed_max", _arr(d, nact)),
+            ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact))]})
+        self.Params = type("prru_params", (ctypes.Structure,), {"_fields_": [
+            ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
+            ("a", _arr(d, nlimb)), ("gravity", _arr(d, 3)), ("mass", _arr(d, nbody)),
+            ("com", _arr(_arr(d, 3), nbody)), ("inertia", _arr(_arr(d, 6), nbody)),
+            ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
+            ("coulomb_velocity", d)]})
+        self.TrackSample = type("prru_track_sample", (ctypes.Structure,), {"_fields_": [
+            ("t", d), ("q_ref", _arr(d, 3)), ("qd_ref", _arr(d, 3)), ("qdd_ref", _arr(d, 3)),
+            ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("e", _arr(d, 3)), ("fd", _arr(d, nact)),
+            ("fd_cmd", _arr(d, nact)), ("d", _arr(d, nact)), ("qdd", _arr(d, 3)),
+            ("saturated", _arr(ctypes.c_int, nact))]})
+        self.TrackFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.TrackSample),
+                                        ctypes.c_void_p)
+        self.TrackOptions = type("prru_track_options", (ctypes.Structure,), {"_fields_": [
+            ("kp", _arr(d, 3)), ("kd", _arr(d, 3)), ("control_period", d), ("dt_out", d),
+            ("f_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)),
+            ("noise_q", d), ("noise_qd", d), ("seed", ctypes.c_ulong), ("q0_offset", _arr(d, 3)),
+            ("plant", self.Params), ("abs_tol", d), ("rel_tol", d), ("on_sample", self.TrackFn),
+            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p)]})
+        self.TrackSummary = type("prru_track_summary", (ctypes.Structure,), {"_fields_": [
+            ("samples", ctypes.c_long), ("t_end", d), ("rms_e", _arr(d, 3)), ("max_e", _arr(d, 3)),
+            ("max_fd", _arr(d, nact)), ("saturated", _arr(ctypes.c_long, nact)),
+            ("any_saturated", ctypes.c_long)]})
+        self.GuardedLimits = _guarded(self.Limits, 4096)
+        self.GuardedTrackOptions = _guarded(self.TrackOptions, 4096)
         self.GuardedData = _guarded(self.Data, ctypes.sizeof(self.Data) // 2 + 4096)
         self.GuardedDme = _guarded(self.Dme, 4096)
         self.GuardedScenario = _guarded(self.Scenario, 4096)
@@ -276,6 +320,34 @@ class Library:
         self.measure_apply = _declare(dll, "prru_measure_apply", i, mo, i, i, vp, vp, ctypes.c_char_p, i)
         self.measure_best_diff = _declare(dll, "prru_measure_best_diff", i, mp, i, vp, vp, vp,
                                           ctypes.POINTER(_DiffChoice), ctypes.c_char_p, i)
+        # Motion: limits, quintics, the time-optimal planner, tracking.
+        cp, lmp = ctypes.c_char_p, ctypes.POINTER(t.Limits)
+        qp, tpp = ctypes.POINTER(_Quintic), ctypes.POINTER(_Topp)
+        self.limits_none = _declare(dll, "prru_limits_none", None, lmp)
+        self.model_limits = _declare(dll, "prru_model_limits", None, mp, lmp)
+        self.limits_ratio = _declare(dll, "prru_limits_ratio", i, mp, dp, lmp, vp, vp, vp, vp, vp,
+                                     vp, c_int_p, c_int_p)
+        self.quintic_waypoints = _declare(dll, "prru_quintic_waypoints", i, qp, i, vp, vp, d, cp, i)
+        self.quintic_samples = _declare(dll, "prru_quintic_samples", i, qp, i, vp, vp, vp, vp, cp, i)
+        self.quintic_eval = _declare(dll, "prru_quintic_eval", i, qp, d, vp, vp, vp)
+        self.quintic_t_begin = _declare(dll, "prru_quintic_t_begin", d, qp)
+        self.quintic_t_end = _declare(dll, "prru_quintic_t_end", d, qp)
+        self.quintic_free = _declare(dll, "prru_quintic_free", None, qp)
+        self.quintic_fastest = _declare(dll, "prru_quintic_fastest", i, mp, i, vp, lmp, i, vp, cp, i)
+        self.path_side_init = _declare(dll, "prru_path_side_init", None, ctypes.POINTER(_PathSide))
+        self.path_sample = _declare(dll, "prru_path_sample", i, ctypes.POINTER(_PathSide), mp, dp, vp,
+                                    vp, c_int_p)
+        self.model_actuator_rates = _declare(dll, "prru_model_actuator_rates", None, mp, vp, vp, vp, vp)
+        self.topp_solve = _declare(dll, "prru_topp_solve", i, tpp, mp, i, vp, lmp, i, cp, i)
+        self.topp_eval = _declare(dll, "prru_topp_eval", i, tpp, d, vp, vp, vp)
+        self.topp_free = _declare(dll, "prru_topp_free", None, tpp)
+        top, pp = ctypes.POINTER(t.TrackOptions), ctypes.POINTER(t.Params)
+        self.track_options_default = _declare(dll, "prru_track_options_default", None, top)
+        self.track_check_reference = _declare(dll, "prru_track_check_reference", i, mp, qp, top, d,
+                                              vp, cp, i)
+        self.track = _declare(dll, "prru_track", i, mp, qp, top, ctypes.POINTER(t.TrackSummary), cp, i)
+        self.model_params = _declare(dll, "prru_model_params", None, mp, pp)
+        self.params_scale = _declare(dll, "prru_params_scale", i, pp, cp, d)
 
     def status_text(self, status):
         return self.strerror(status).decode()
@@ -319,6 +391,7 @@ class Library:
         self._check_scenario()
         self._check_data_and_dme()
         self._check_map_summary()
+        self._check_motion()
 
     def _check_mechanism(self):
         me = self.mech
@@ -382,6 +455,30 @@ class Library:
         if (s.n_points != 4 or s.n_ok + n_not_ok != 4 or not 0 <= s.n_other_mode <= s.n_singular
                 or s.singular_fraction != n_not_ok / 4 or not guard_intact(gs)):
             raise self._layout_error("prru_map_summary")
+
+    def _check_motion(self):
+        """prru_track_options_default and prru_model_limits into guarded
+        mirrors: the defaults the header states, the plant the model's own
+        numbers (prru_model_params), and nothing written past the mirror."""
+        t, m = self.types, self.new_model()
+        g = t.GuardedTrackOptions()
+        fill_guard(g)
+        self.track_options_default(ctypes.byref(g.s))
+        o, p = g.s, t.Params()
+        self.model_params(ctypes.byref(m), ctypes.byref(p))
+        if (list(o.kp) != [400.0] * 3 or list(o.kd) != [40.0] * 3 or o.control_period != 0
+                or o.dt_out != 1e-3 or o.seed != 1 or o.abs_tol != 1e-12 or o.rel_tol != 1e-12
+                or any(v != math.inf for v in o.f_max) or any(v != -math.inf for v in o.d_min)
+                or bytes(o.plant) != bytes(p) or p.coulomb_velocity <= 0 or o.on_sample
+                or not guard_intact(g)):
+            raise self._layout_error("prru_track_options")
+        gl = t.GuardedLimits()
+        fill_guard(gl)
+        self.model_limits(ctypes.byref(m), ctypes.byref(gl.s))
+        lim = gl.s
+        if (not guard_intact(gl) or any(not lim.d_min[i] < lim.d_max[i] for i in range(t.nact))
+                or any(not lim.force_max[i] > 0 or not lim.speed_max[i] > 0 for i in range(t.nact))):
+            raise self._layout_error("prru_limits")
 
     def _check_data_and_dme(self):
         """At q = 0 (every valid model assembles there; when J_d happens to

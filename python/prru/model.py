@@ -406,3 +406,4 @@ class Model:
     from .simulation import simulate, paper_scenario, read_scenario  # noqa: E402
     from .maps import map  # noqa: E402
     from .measurements import measure  # noqa: E402
+    from .motion import limits, quintic, time_optimal, track  # noqa: E402

@@ -442,6 +442,155 @@ class TestAgainstCli(unittest.TestCase):
                          [s["n_ok"], s["n_singular"] - n_other, s["n_unreachable"], n_other])
 
 
+def csv_rows(text):
+    """The data rows of a CLI CSV as dicts of floats (comments skipped)."""
+    return [{k: float(v) for k, v in r.items()}
+            for r in csv.DictReader(l for l in text.splitlines() if not l.startswith("#"))]
+
+
+class TestMotion(unittest.TestCase):
+    """limits, quintic, time_optimal and track against prru traj and prru
+    track: the same library calls, so the same rows to the bit."""
+
+    WPS = [[0, 0, -0.8], [0.1, 0.05, -0.78], [0, 0, -0.8]]
+    WPS_TEXT = "0,0,-0.8;0.1,0.05,-0.78;0,0,-0.8"
+
+    def static_load(self):
+        return max(abs(f) for q in self.WPS for f in MODEL.inverse_dynamics(q, [0] * 3, [0] * 3))
+
+    def motion_columns(self, mo, k):
+        n = MODEL.nact
+        row = {"t": mo.t[k]}
+        for name, width in (("q", 3), ("qd", 3), ("qdd", 3), ("d", n), ("dd", n), ("fd", n)):
+            for i in range(width):
+                row["%s%d" % (name, i + 1)] = getattr(mo, name)[k][i]
+        return row
+
+    def same_rows(self, mo, rows):
+        self.assertEqual(len(mo.t), len(rows))
+        for k, r in enumerate(rows):
+            mine = self.motion_columns(mo, k)
+            self.assertEqual(bits([mine[c] for c in r]), bits(list(r.values())), "row %d" % k)
+
+    def test_limits(self):
+        n = MODEL.nact
+        own = MODEL.limits()
+        self.assertEqual(len(own.force_max), n)
+        none = MODEL.limits(model_limits=False)
+        self.assertEqual(none, prru.Limits((math.inf,) * n, (math.inf,) * n, ((-math.inf, math.inf),) * n))
+        lim = MODEL.limits(force_max=100, speed_max=[0.1 * (i + 1) for i in range(n)], stroke=(-1, 1))
+        self.assertEqual(lim.force_max, (100.0,) * n)
+        self.assertEqual(lim.speed_max[-1], 0.1 * n)
+        self.assertEqual(lim.stroke, ((-1.0, 1.0),) * n)
+        # The model file's limits (spec 13) are what the library applies.
+        with tempfile.TemporaryDirectory() as tmp:
+            model = json.loads(read(os.environ.get("PRRU_BUILD_MODEL")
+                                    or os.path.join(SOURCE_DIR, "models", "3prru_paper.json")))
+            model.setdefault("format", 1)
+            if model["format"] == 1:
+                g = model["geometry"]
+                model["geometry"] = {"b": [g["b12"], g["b12"], g["b3"]], "l1": g["l1"], "l2": g["l2"],
+                                     "a": g["a"]}
+                model["format"] = 2
+            model.setdefault("actuators", {}).update(
+                {"force_max": [300 + i for i in range(n)], "speed_max": 0.5, "stroke": [-2, 2]})
+            path = os.path.join(tmp, "lim.json")
+            with open(path, "w") as f:
+                json.dump(model, f)
+            m = prru.Model(LIB, model=path)
+        self.assertEqual(m.limits(), prru.Limits(tuple(300.0 + i for i in range(n)), (0.5,) * n,
+                                                 ((-2.0, 2.0),) * n))
+        self.assertEqual(m.limits(force_max=50).force_max, (50.0,) * n)
+        for kw, pattern in (({"force_max": -1}, r"force_max\[0\] must be > 0"),
+                            ({"speed_max": [1] * (n + 1)}, "speed_max must have %d" % n),
+                            ({"stroke": (1, 0)}, r"stroke\[0\]: slider 1's range \[1.0, 0.0\] is empty"),
+                            ({"force_max": math.nan}, r"force_max\[0\] must be a number")):
+            with self.subTest(kw=kw), self.assertRaisesRegex(ValueError, pattern):
+                MODEL.limits(**kw)
+        with self.assertRaisesRegex(TypeError, "limits must be a prru.Limits"):
+            MODEL.time_optimal(self.WPS, limits={"force_max": 1})
+
+    def test_quintic(self):
+        mo = MODEL.quintic(self.WPS, [0.3, 0.25])
+        rows = csv_rows(cli("traj", "--waypoints", self.WPS_TEXT, "--durations", "0.3,0.25"))
+        self.same_rows(mo, rows)
+        # The forces (not in prru traj's rows) are inverse dynamics.
+        k = len(mo.t) // 3
+        self.assertEqual(bits(mo.fd[k]), bits(MODEL.inverse_dynamics(mo.q[k], mo.qd[k], mo.qdd[k])))
+        with self.assertRaisesRegex(prru.InputError, "duration"):
+            MODEL.quintic(self.WPS, [0.3, -1])
+        with self.assertRaisesRegex(ValueError, "durations must have 2 elements"):
+            MODEL.quintic(self.WPS, [0.3])
+        # Far beyond the links' reach: the first sample outside, named.
+        with self.assertRaisesRegex(prru.Unreachable, r"quintic: sample \d+ \(t = "):
+            MODEL.quintic([[0, 0, -0.8], [1.5, 1.5, -0.8]], [1])
+
+    def test_time_optimal(self):
+        F = 3 * self.static_load()
+        lim = MODEL.limits(model_limits=False, force_max=F, speed_max=0.4)
+        r = MODEL.time_optimal(self.WPS, limits=lim)
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "topp.csv")
+            p = subprocess.run([CLI, "traj", "--time-optimal", "--waypoints", self.WPS_TEXT, "--no-limits",
+                                "--force-max", repr(F), "--speed-max", "0.4", "--out", out],
+                               capture_output=True, text=True)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            text = read(out)
+        self.same_rows(r.motion, csv_rows(text))
+        dur = float(re.search(r"3 waypoints, ([0-9.e+-]+) s", p.stderr).group(1))
+        self.assertEqual("%.9g" % r.duration, "%.9g" % dur)
+        self.assertEqual(r.limits, lim)
+        self.assertEqual(r.grid, 400)
+        self.assertGreaterEqual(r.active_fraction, 0.95)
+        self.assertLess(r.duration, sum(r.quintic_durations))
+        # Every row within the limits (ROW_TOL), and some force at its limit.
+        peak = max(abs(f) for row in r.motion.fd for f in row)
+        self.assertLessEqual(peak, F * (1 + prru.motion.ROW_TOL))
+        self.assertGreaterEqual(peak, F * (1 - 1e-3))
+        with self.assertRaisesRegex(prru.InputError, "force_max of actuator"):
+            MODEL.time_optimal(self.WPS, limits=MODEL.limits(model_limits=False,
+                                                            force_max=0.5 * self.static_load()))
+
+    def test_track(self):
+        ref = MODEL.quintic(self.WPS[:2], [0.3])
+        run = MODEL.track(ref, mismatch={"mass": 1.1}, limits=MODEL.limits(model_limits=False))
+        # prru track --ref on prru traj's rows: the same reference (the C2
+        # quintic through the same rows) as the binding's from ref.
+        with tempfile.TemporaryDirectory() as tmp:
+            tr, out, summ = (os.path.join(tmp, f) for f in ("traj.csv", "tr.csv", "tr.json"))
+            cli("traj", "--waypoints", ";".join(self.WPS_TEXT.split(";")[:2]), "--durations", "0.3",
+                "--out", tr)
+            cli("track", "--ref", tr, "--mismatch", "mass=1.1", "--no-limits", "--out", out, "--summary", summ)
+            rows, s = csv_rows(read(out)), json.loads(read(summ))
+        n = MODEL.nact
+        self.assertEqual(len(run.t), len(rows))
+        for k in (0, len(rows) // 2, len(rows) - 1):
+            r = rows[k]
+            self.assertEqual(bits(run.q[k]), bits([r["q%d" % (i + 1)] for i in range(3)]))
+            self.assertEqual(bits(run.q_ref[k]), bits([r["qr%d" % (i + 1)] for i in range(3)]))
+            self.assertEqual(bits(run.fd[k]), bits([r["fd%d" % (i + 1)] for i in range(n)]))
+            self.assertEqual(bits(run.qdd[k]), bits([r["qdd%d" % (i + 1)] for i in range(3)]))
+        for key in ("rms_error", "max_error", "max_fd", "max_dd", "feedforward_peak", "samples"):
+            self.assertEqual(bits(run.summary[key]), bits(s[key]), key)
+        self.assertEqual(run.summary["status"], "complete")
+        self.assertGreater(max(run.summary["max_error"]), 0)  # the mismatch shows
+        exact = MODEL.track(ref)
+        self.assertLess(max(exact.summary["max_error"]), 1e-6 * max(run.summary["max_error"]) + 1e-9)
+        # A stroke the reference leaves: named, nothing run.
+        d0 = ref.d[0][0]
+        with self.assertRaisesRegex(prru.InputError, r"reference at sample 1 \(t = 0 s\): slider 1"):
+            MODEL.track(ref, limits=MODEL.limits(model_limits=False, stroke=(d0 + 1e-3, d0 + 1)))
+        with self.assertRaisesRegex(ValueError, "mismatch: unknown key 'weight'"):
+            MODEL.track(ref, mismatch={"weight": 2})
+        # A callback-free run keeps the rows it made when the plant fails.
+        with self.assertRaises(prru.Unreachable) as cm:
+            MODEL.track(ref, limits=MODEL.limits(model_limits=False,
+                                                 stroke=(min(min(r) for r in ref.d) - 1e-9,
+                                                         max(max(r) for r in ref.d) + 1e-9)),
+                        mismatch={"mass": 3})
+        self.assertGreater(len(cm.exception.run.t), 0)
+
+
 class TestRoundTrips(unittest.TestCase):
     def test_fk_of_ik(self):
         for q, _, _, _, _ in random_states(20, 3):
@@ -1019,7 +1168,7 @@ class TestLayout(unittest.TestCase):
                          [("lambda" if f == "lambda_" else f) for f, _ in pyfields],
                          "%s: field names" % cname)
         env = self.sizes()
-        csize = {"double": 8, "int": 4, "long": 8, "char": 1, "const char *": 8,
+        csize = {"double": 8, "int": 4, "long": 8, "char": 1, "const char *": 8, "unsigned long": 8,
                  "unsigned char": 1, "prru_stepper": 4, "prru_load_kind": 4}  # enums: int
         for (fname, ctype, dims), (_, pyt) in zip(cfields, pyfields):
             count = 1
@@ -1051,7 +1200,15 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_dme.h", "prru_map_summary", _lib._MapSummary),
                 ("runtime/include/prru_dme.h", "prru_map_options", _lib._MapOptions),
                 ("generated/prru_mechanism.h", "prru_joint_info", _lib._JointInfo),
-                ("generated/prru_mechanism.h", "prru_mechanism", t.Mechanism)):
+                ("generated/prru_mechanism.h", "prru_mechanism", t.Mechanism),
+                ("runtime/include/prru.h", "prru_limits", t.Limits),
+                ("runtime/include/prru_traj.h", "prru_quintic", _lib._Quintic),
+                ("runtime/include/prru_traj.h", "prru_topp", _lib._Topp),
+                ("runtime/include/prru_traj.h", "prru_path_side", _lib._PathSide),
+                ("generated/prru_param_kernels.h", "prru_params", t.Params),
+                ("runtime/include/prru_control.h", "prru_track_sample", t.TrackSample),
+                ("runtime/include/prru_control.h", "prru_track_options", t.TrackOptions),
+                ("runtime/include/prru_control.h", "prru_track_summary", t.TrackSummary)):
             with self.subTest(struct=cname):
                 self.check(header, cname, pytype)
 
