@@ -848,47 +848,6 @@ static int on_iteration(int iter, int evals, const prru_design_eval *best, doubl
   return prru_cli_interrupted != 0;
 }
 
-/* The design as a format-2 model file. */
-static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *desc)
-{
-  char text[PRRU_DESCRIPTION_SIZE];
-  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n  \"description\": ", name);
-  prru_cli_out_json_string(o, prru_description(text, sizeof text, desc));
-  prru_cli_out_printf(o, ",\n");
-  prru_cli_out_printf(o, "  \"gravity\": [%.17g, %.17g, %.17g],\n  \"geometry\": {\n", p->gravity[0],
-                      p->gravity[1], p->gravity[2]);
-  const char *keys[3] = {"b", "l1", "l2"};
-  const double *vals[3] = {p->b, p->l1, p->l2};
-  for (int g = 0; g < 3; g++) {
-    prru_cli_out_printf(o, "    \"%s\": [", keys[g]);
-    for (int i = 0; i < PRRU_NLIMB; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", vals[g][i]);
-    prru_cli_out_printf(o, "],\n");
-  }
-  prru_cli_out_printf(o, "    \"a\": [%.17g, %.17g]\n  },\n  \"bodies\": {\n", p->a[0], p->a[1]);
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": [%.17g, %.17g, %.17g],\n", prru_cli_model()->mech->body_names[b],
-                        p->mass[b], p->com[b][0], p->com[b][1], p->com[b][2]);
-    prru_cli_out_printf(o, "      \"inertia\": [");
-    for (int e = 0; e < 6; e++) prru_cli_out_printf(o, "%s%.17g", e ? ", " : "", p->inertia[b][e]);
-    prru_cli_out_printf(o, "]}%s\n", b + 1 < PRRU_NBODY ? "," : "");
-  }
-  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n");
-  const char *akeys[3] = {"armature", "damping", "coulomb"};
-  const double *avals[3] = {p->armature, p->damping, p->coulomb};
-  int has_vs = p->coulomb_velocity > 0;
-  /* where the file gives rotor_inertia, the armature goes back there */
-  for (int g = prru_cli_writes_armature() ? 0 : 1; g < 3; g++) {
-    prru_cli_out_printf(o, "%s    \"%s\": [", g > 0 && prru_cli_writes_armature() ? ",\n" : g > 1 ? ",\n" : "",
-                        akeys[g]);
-    for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", avals[g][i]);
-    prru_cli_out_printf(o, "]");
-  }
-  if (has_vs) prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
-  prru_cli_out_drive_keys(o, p->armature);
-  prru_cli_out_printf(o, "\n  }\n}\n");
-  prru_cli_out_line(o);
-}
-
 /* A map CSV as prru map writes it (after a second comment line saying
  * which design it is). */
 static int write_map_file(const char *cmd, const char *path, const char *shown, const char *design,
@@ -1282,7 +1241,17 @@ int prru_cmd_optimize(int argc, char **argv)
   char desc[420];
   if (!rc) {
     describe(desc, sizeof desc, &pr, vars, nvar);
-    write_model(&jo, &r->best, name, desc);
+    char *text = NULL, why[800];
+    if (prru_model_file_text(prru_cli_model(), &r->best, name, desc, &text, why, sizeof why) != PRRU_OK) {
+      prru_cli_error(cmd, "internal error: %s; %s not written", why, out);
+      rc = 1;
+    } else {
+      prru_cli_out_write(&jo, text, strlen(text));
+      prru_cli_out_line(&jo);
+    }
+    free(text);
+  }
+  if (!rc) {
     opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip, &t.run};
     rc = stage_report(cmd, stage, report, &rp);
   }

@@ -597,7 +597,7 @@ static int to_params(const prru_base *b, const double *pi, prru_params *p, char 
       snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_cli_model()->mech->body_names[k], pi[PRRU_NBODYPAR * k]);
       return 1;
     }
-    /* A model file holds no magnitude below 1e-9 but 0 (model_number):
+    /* A model file holds no magnitude below 1e-9 but 0 (prru_model_file_text):
      * a mass or principal moment the fit left smaller (a body on the
      * consistent set's boundary, whose margin is 1e-9 of the prior body:
      * data that hardly reveal a slider's mass beside its armature can
@@ -632,78 +632,6 @@ static int to_params(const prru_base *b, const double *pi, prru_params *p, char 
     }
   p->coulomb_velocity = b->vs;
   return 0;
-}
-
-/* Model files hold no magnitude below 1e-9 but 0 (the loader refuses
- * them as typing errors): smaller identified values are written as 0. */
-static double model_number(double v)
-{
-  return fabs(v) < 1e-9 ? 0.0 : v;
-}
-
-static void json_list(prru_cli_out *o, const double *v, int n)
-{
-  prru_cli_out_printf(o, "[");
-  for (int i = 0; i < n; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", model_number(v[i]));
-  prru_cli_out_printf(o, "]");
-}
-
-/* The model file's description names the data file, whatever its path
- * (any bytes, any length): prru_description makes it one the generator
- * accepts. */
-static void write_description(prru_cli_out *o, const char *data)
-{
-  static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
-  const size_t len = sizeof fmt + strlen(data) + strlen(prru_cli_model()->mech->name);
-  char *text = malloc(len), desc[PRRU_DESCRIPTION_SIZE];
-  if (!text) {
-    prru_cli_out_printf(o, "  \"description\": \"Identified by prru identify\",\n");
-    return;
-  }
-  snprintf(text, len, fmt, data, prru_cli_model()->mech->name);
-  prru_cli_out_printf(o, "  \"description\": ");
-  prru_cli_out_json_string(o, prru_description(desc, sizeof desc, text));
-  prru_cli_out_printf(o, ",\n");
-  free(text);
-}
-
-static void write_model(prru_cli_out *o, const prru_params *p, const char *name, const char *data)
-{
-  prru_cli_out_printf(o, "{\n  \"format\": 2,\n  \"name\": \"%s\",\n", name);
-  write_description(o, data);
-  prru_cli_out_printf(o, "  \"gravity\": ");
-  json_list(o, p->gravity, 3);
-  prru_cli_out_printf(o, ",\n  \"geometry\": {\n    \"b\": ");
-  json_list(o, p->b, PRRU_NLIMB);
-  prru_cli_out_printf(o, ",\n    \"l1\": ");
-  json_list(o, p->l1, PRRU_NLIMB);
-  prru_cli_out_printf(o, ",\n    \"l2\": ");
-  json_list(o, p->l2, PRRU_NLIMB);
-  prru_cli_out_printf(o, ",\n    \"a\": ");
-  json_list(o, p->a, 2);
-  prru_cli_out_printf(o, "\n  },\n  \"bodies\": {\n");
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    prru_cli_out_printf(o, "    \"%s\": {\"mass\": %.17g, \"com\": ", prru_cli_model()->mech->body_names[b],
-                        model_number(p->mass[b]));
-    json_list(o, p->com[b], 3);
-    prru_cli_out_printf(o, ",\n      \"inertia\": ");
-    json_list(o, p->inertia[b], 6);
-    prru_cli_out_printf(o, "}%s\n", b + 1 < PRRU_NBODY ? "," : "");
-  }
-  prru_cli_out_printf(o, "  },\n  \"actuators\": {\n");
-  if (prru_cli_writes_armature()) { /* else rotor_inertia, below */
-    prru_cli_out_printf(o, "    \"armature\": ");
-    json_list(o, p->armature, PRRU_NACT);
-    prru_cli_out_printf(o, ",\n");
-  }
-  prru_cli_out_printf(o, "    \"damping\": ");
-  json_list(o, p->damping, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"coulomb\": ");
-  json_list(o, p->coulomb, PRRU_NACT);
-  prru_cli_out_printf(o, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
-  prru_cli_out_drive_keys(o, p->armature);
-  prru_cli_out_printf(o, "\n  }\n}\n");
-  prru_cli_out_line(o);
 }
 
 static int valid_name(const char *s)
@@ -855,26 +783,27 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
     rc = 1;
   }
   prru_cli_out mo;
-  if (!rc && prru_cli_out_open(&mo, "identify", a->out)) rc = 1;
+  char *text = NULL;
   if (!rc) {
-    write_model(&mo, &p, name, a->data);
-    /* The whole file is still in the buffer (prru_cli_out_line flushes
-     * at 64 kB; a model file is a few kB): the loader reads it before it
-     * replaces anything, so identify never writes a model nothing can
-     * load. */
-    prru_model_spec *spec = malloc(sizeof *spec);
-    char lmsg[700] = "out of memory";
-    const int ok = spec && prru_model_file_parse(mo.buf, mo.len, a->out, spec, lmsg, sizeof lmsg) == PRRU_OK;
-    free(spec);
-    if (!ok) {
-      prru_cli_error("identify", "internal error: the identified model does not load: %s; %s not written", lmsg,
-                     a->out);
-      prru_cli_out_close(&mo, 0);
-      rc = 1;
-    } else if (prru_cli_out_close(&mo, !mo.err)) {
+    /* The library reads the text back before it hands it over: identify
+     * never writes a model nothing can load. */
+    static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
+    const size_t len = sizeof fmt + strlen(a->data) + strlen(m.mech->name);
+    char *desc = malloc(len), lmsg[800] = "out of memory";
+    if (desc) snprintf(desc, len, fmt, a->data, m.mech->name);
+    if (!desc || prru_model_file_text(&m, &p, name, desc, &text, lmsg, sizeof lmsg) != PRRU_OK) {
+      prru_cli_error("identify", "internal error: %s; %s not written", lmsg, a->out);
       rc = 1;
     }
+    free(desc);
   }
+  if (!rc && prru_cli_out_open(&mo, "identify", a->out)) rc = 1;
+  if (!rc) {
+    prru_cli_out_write(&mo, text, strlen(text));
+    prru_cli_out_line(&mo);
+    if (prru_cli_out_close(&mo, !mo.err)) rc = 1;
+  }
+  free(text);
   if (!rc)
     fprintf(stderr, "identify: %d base parameters from %d samples, residual sigma %.6g N, condition number "
                     "%.6g; model %s written to %s\n", b->nbase, D->n, r->sigma, r->cond, name, a->out);

@@ -22,6 +22,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "prru_control.h"
 #include "prru_model_file.h"
 #include "testref.h"
 #include "testutil.h"
@@ -288,6 +289,87 @@ static int numbers_are_built(const prru_model_spec *s)
   return s->coulomb_velocity == me->coulomb_velocity;
 }
 
+static int same_bits(const double *a, const double *b, int n)
+{
+  return memcmp(a, b, (size_t)n * sizeof *a) == 0;
+}
+
+/* prru_model_file_text of a loaded model's own numbers reads back as the
+ * same numbers, bit for bit (%.17g round-trips a double), with the
+ * file's drive keys; a description with bytes that are not UTF-8 and
+ * quotes comes back as prru_description made it; numbers that do not
+ * make a model (a mass of 0, a bad name) are refused with the loader's
+ * message and no text. */
+static void check_written(const char *path, const prru_model *m, const prru_model_spec *spec)
+{
+  prru_params p;
+  prru_model_params(m, &p);
+  char *text = NULL, msg[1024], what[1400], desc[PRRU_DESCRIPTION_SIZE];
+  static const char hostile[] = "round trip \"quoted\" \\ \377\376 */ <&>";
+  int st = prru_model_file_text(m, &p, spec->name, hostile, &text, msg, sizeof msg);
+  snprintf(what, sizeof what, "%s: written back (%s)", path, st ? msg : "ok");
+  if (!TU_TRUE(st == PRRU_OK && text, what)) return;
+  prru_model_spec *s2 = malloc(sizeof *s2);
+  st = s2 ? prru_model_file_parse(text, strlen(text), "written", s2, msg, sizeof msg) : PRRU_ENOMEM;
+  snprintf(what, sizeof what, "%s: the written text parses (%s)", path, st ? msg : "ok");
+  if (TU_TRUE(st == PRRU_OK, what)) {
+    int same = same_bits(s2->gravity, spec->gravity, 3) && s2->keys == spec->keys &&
+               strcmp(s2->description, prru_description(desc, sizeof desc, hostile)) == 0;
+    for (int i = 0; i < spec->nlimb; i++)
+      same &= same_bits(&s2->limb[i].b, &spec->limb[i].b, 1) && same_bits(&s2->limb[i].l1, &spec->limb[i].l1, 1) &&
+              same_bits(&s2->limb[i].l2, &spec->limb[i].l2, 1) && same_bits(&s2->limb[i].a, &spec->limb[i].a, 1);
+    same &= same_bits(s2->mass, spec->mass, spec->nbody);
+    for (int k = 0; k < spec->nbody; k++)
+      same &= same_bits(s2->com[k], spec->com[k], 3) && same_bits(s2->inertia[k], spec->inertia[k], 6);
+    same &= same_bits(s2->armature, spec->armature, spec->nlimb) && same_bits(s2->damping, spec->damping, spec->nlimb) &&
+            same_bits(s2->coulomb, spec->coulomb, spec->nlimb) && same_bits(s2->d_min, spec->d_min, spec->nlimb) &&
+            same_bits(s2->d_max, spec->d_max, spec->nlimb) && same_bits(s2->force_max, spec->force_max, spec->nlimb) &&
+            same_bits(s2->speed_max, spec->speed_max, spec->nlimb);
+    /* Without Coulomb friction the file has no coulomb_velocity; the
+     * parameters carry 1 m/s (prru_model_params), which is written. */
+    same &= spec->coulomb_velocity == 0 || s2->coulomb_velocity == spec->coulomb_velocity;
+    snprintf(what, sizeof what, "%s: written and read back: the same numbers, drive keys and description", path);
+    TU_TRUE(same, what);
+  }
+  /* Numbers no short decimal holds (an identified model's): each body's
+   * mass and inertia, and each drive's damping and Coulomb force, times
+   * 1 + 1/3000 (divided by it where that would pass a file's 1e6 bound;
+   * a body's inertia scaled as one keeps it consistent) read back exactly. */
+  prru_params odd = p;
+  const double f = 1 + 1.0 / 3000;
+  for (int k = 0; k < PRRU_NBODY; k++) {
+    double big = odd.mass[k];
+    for (int e = 0; e < 6; e++) big = fmax(big, fabs(odd.inertia[k][e]));
+    const double g = big * f <= 1e6 ? f : 1 / f;
+    odd.mass[k] *= g;
+    for (int e = 0; e < 6; e++) odd.inertia[k][e] *= g;
+  }
+  for (int i = 0; i < PRRU_NACT; i++) {
+    odd.damping[i] *= odd.damping[i] * f <= 1e6 ? f : 1 / f;
+    odd.coulomb[i] *= odd.coulomb[i] * f <= 1e6 ? f : 1 / f;
+  }
+  free(text);
+  st = prru_model_file_text(m, &odd, spec->name, "", &text, msg, sizeof msg);
+  if (st == PRRU_OK) st = prru_model_file_parse(text, strlen(text), "written", s2, msg, sizeof msg);
+  snprintf(what, sizeof what, "%s: numbers of 17 digits written and read back exactly (%s)", path, st ? msg : "ok");
+  if (TU_TRUE(st == PRRU_OK, what)) {
+    int same = same_bits(s2->mass, odd.mass, PRRU_NBODY) && same_bits(s2->damping, odd.damping, PRRU_NACT) &&
+               same_bits(s2->coulomb, odd.coulomb, PRRU_NACT);
+    for (int k = 0; k < PRRU_NBODY; k++) same &= same_bits(s2->inertia[k], odd.inertia[k], 6);
+    TU_TRUE(same, what);
+  }
+  free(s2);
+  free(text);
+  prru_params bad = p;
+  bad.mass[PRRU_NBODY - 1] = 0;
+  st = prru_model_file_text(m, &bad, spec->name, "", &text, msg, sizeof msg);
+  snprintf(what, sizeof what, "%s: a slider of mass 0 is refused with the loader's message (%s)", path, msg);
+  TU_TRUE(st == PRRU_EINPUT && text == NULL && strstr(msg, "mass: must be positive"), what);
+  st = prru_model_file_text(m, &p, "Bad-Name", "", &text, msg, sizeof msg);
+  snprintf(what, sizeof what, "%s: a name that is no identifier is refused (%s)", path, msg);
+  TU_TRUE(st == PRRU_EINPUT && text == NULL && strstr(msg, "Bad-Name"), what);
+}
+
 static void check_file(const char *path, int *loaded, int *other, int *specialised, int reactions)
 {
   prru_model_spec spec;
@@ -316,6 +398,7 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   snprintf(what, sizeof what, "%s: loads", path);
   if (!TU_TRUE(st == PRRU_OK, what)) return;
   (*loaded)++;
+  check_written(path, &m, &spec);
   const int built = numbers_are_built(&spec);
   *specialised += built;
   snprintf(what, sizeof what, "%s: %s kernels", path, built ? "specialised" : "parameter");

@@ -47,6 +47,19 @@ extern "C" {
  * model; coulomb_velocity 1 m/s where the model has no Coulomb force. */
 void prru_model_params(const prru_model *m, prru_params *p);
 
+/* The model file (format 2, spec 11-13) of m's structure, body names and
+ * drive keys (lead, gear, stroke, limits: m's own; a changed armature
+ * goes back into rotor_inertia where m's file gave that) with the numbers
+ * p, named name ([a-z][a-z0-9_]{0,15}) and described by description (any
+ * bytes: made valid by prru_description and JSON-escaped): *text, a
+ * NUL-terminated string to free(). Magnitudes below 1e-9 are written as
+ * 0 (model files hold none). The text is read back by the loader first:
+ * PRRU_EINPUT with its message when p does not make a valid model (a
+ * mass not positive, ...), PRRU_ENOMEM; *text NULL then. What identify
+ * and optimize write. */
+int prru_model_file_text(const prru_model *m, const prru_params *p, const char *name, const char *description,
+                         char **text, char *msg, int msglen);
+
 typedef struct {
   double t;                   /* s */
   double q_ref[3], qd_ref[3], qdd_ref[3];
