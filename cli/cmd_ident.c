@@ -583,57 +583,6 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   }
 }
 
-/* The consistent standard parameters as model numbers in p; 0, or 1 with
- * why naming a body or drive that is not physical (a guard: never for the
- * output of prru_ident_consistent). */
-static int to_params(const prru_base *b, const double *pi, prru_params *p, char *why, size_t len)
-{
-  /* Geometry and gravity: the current model's, which are the build's
-   * (require_built_geometry). */
-  prru_model_params(prru_cli_model(), p);
-  for (int k = 0; k < PRRU_NBODY; k++) {
-    double m, c[3], I[6];
-    if (prru_ident_body(pi + PRRU_NBODYPAR * k, &m, c, I) != PRRU_OK) {
-      snprintf(why, len, "body %s: mass %.6g kg is not positive", prru_cli_model()->mech->body_names[k], pi[PRRU_NBODYPAR * k]);
-      return 1;
-    }
-    /* A model file holds no magnitude below 1e-9 but 0 (prru_model_file_text):
-     * a mass or principal moment the fit left smaller (a body on the
-     * consistent set's boundary, whose margin is 1e-9 of the prior body:
-     * data that hardly reveal a slider's mass beside its armature can
-     * put it there) is raised to 1e-9 kg or kg m^2, which keeps the body
-     * consistent (the centre of mass stays; the second moments about it
-     * change by +-5e-10); the loader's check of the written file
-     * (identify_run) catches anything this misses. */
-    m = fmax(m, 1e-9);
-    for (int d = 0; d < 3; d++) I[d] = fmax(I[d], 1e-9);
-    const double m2 = I[0] * I[1] - I[3] * I[3];
-    const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
-                      I[4] * (I[3] * I[5] - I[1] * I[4]);
-    if (!(I[0] > 0 && m2 > 0 && m3 > 0)) {
-      snprintf(why, len, "body %s: the inertia about the centre of mass is not positive definite",
-               prru_cli_model()->mech->body_names[k]);
-      return 1;
-    }
-    p->mass[k] = m;
-    memcpy(p->com[k], c, sizeof c);
-    memcpy(p->inertia[k], I, sizeof I);
-  }
-  double *dr[3] = {p->armature, p->damping, p->coulomb};
-  static const char *const dn[3] = {"armature", "damping", "coulomb"};
-  for (int g = 0; g < 3; g++)
-    for (int i = 0; i < PRRU_NACT; i++) {
-      const double v = pi[PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i];
-      if (!(v >= 0)) {
-        snprintf(why, len, "%s%d = %.6g is negative", dn[g], i + 1, v);
-        return 1;
-      }
-      dr[g][i] = v;
-    }
-  p->coulomb_velocity = b->vs;
-  return 0;
-}
-
 static int valid_name(const char *s)
 {
   size_t n = strlen(s);
@@ -747,7 +696,7 @@ static int identify_run(const identify_args *a, const char *name, const ident_da
   const int cst = prru_ident_consistent(&m, b, r, pi0, &co, pi, c);
   /* PRRU_ESINGULAR (data against physics) comes with a solution: reported. */
   const int solved = cst == PRRU_OK || cst == PRRU_ESINGULAR;
-  const int unphysical = solved && to_params(b, pi, &p, why, sizeof why);
+  const int unphysical = solved && prru_ident_model_params(&m, b, pi, &p, why, sizeof why) != PRRU_OK;
   prru_cli_out ro;
   if (solved && prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
   if (solved && !rc) {

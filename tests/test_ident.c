@@ -19,11 +19,13 @@
  *    on fd, every base parameter within 4 standard errors, the mean
  *    squared normalised error near 1 and the residual sigma near the
  *    noise's; an unreachable sample is named. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "prru.h"
+#include "prru_control.h"
 #include "prru_ident.h"
 #include "prru_kernels.h"
 #include "prru_param_kernels.h"
@@ -601,6 +603,43 @@ static void check_consistent(const prru_base *b)
   free(q), free(qd), free(qdd), free(fd), free(r), free(c);
 }
 
+/* prru_ident_model_params: the model's own standard parameters give its
+ * numbers back (to the rounding of m c / m and I_O -> I_c: a few u of
+ * each body's scale); a body shrunk to 1e-3 of the file's floor (mass
+ * and moments times 1e-12) comes back raised to the floor and still
+ * consistent, and its model file loads; a negative damping is named. */
+static void check_model_params_of_pi(const prru_base *b)
+{
+  double pi[PRRU_NREG];
+  prru_ident_standard(model.mech, pi);
+  prru_params p, ref;
+  char why[300], *text = NULL;
+  prru_model_params(&model, &ref);
+  int st = prru_ident_model_params(&model, b, pi, &p, why, sizeof why);
+  double err = 0;
+  for (int k = 0; k < PRRU_NBODY; k++) {
+    double scale = ref.mass[k];
+    for (int e = 0; e < 3; e++) scale = fmax(scale, ref.inertia[k][e]);
+    err = fmax(err, fabs(p.mass[k] - ref.mass[k]) / scale);
+    for (int e = 0; e < 6; e++) err = fmax(err, fabs(p.inertia[k][e] - ref.inertia[k][e]) / scale);
+  }
+  tu_check(st == PRRU_OK && err <= 64 * DBL_EPSILON, "prru_ident_model_params of the model's own pi: its numbers",
+           err, 64 * DBL_EPSILON);
+  const int k = PRRU_NBODY - 1;
+  for (int j = 0; j < PRRU_NBODYPAR; j++) pi[PRRU_NBODYPAR * k + j] *= 1e-12;
+  st = prru_ident_model_params(&model, b, pi, &p, why, sizeof why);
+  TU_TRUE(st == PRRU_OK && p.mass[k] == 1e-9 && p.inertia[k][0] == 1e-9 && p.inertia[k][1] == 1e-9 &&
+              p.inertia[k][2] == 1e-9,
+          "a body below the file's floor is raised to 1e-9 kg and 1e-9 kg m^2");
+  st = prru_model_file_text(&model, &p, "floor", "", &text, why, sizeof why);
+  TU_TRUE(st == PRRU_OK, "its model file loads");
+  free(text);
+  prru_ident_standard(model.mech, pi);
+  pi[PRRU_NBODYPAR * PRRU_NBODY + PRRU_NACT] = -1; /* damping1 */
+  st = prru_ident_model_params(&model, b, pi, &p, why, sizeof why);
+  TU_TRUE(st == PRRU_EINPUT && strstr(why, "damping1 = -1 is negative"), "a negative damping is named");
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -613,6 +652,7 @@ int main(void)
   hand_excitation();
   check_excite(b);
   check_identify(b);
+  check_model_params_of_pi(b);
   /* A truth other than the model (the prior): every inertial and drive
    * number perturbed, Coulomb smoothing as in the base parameters. */
   prru_mechanism me;

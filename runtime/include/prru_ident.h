@@ -32,6 +32,7 @@
 #define PRRU_IDENT_H
 
 #include "prru.h"
+#include "prru_param_kernels.h"
 #include "prru_regressor.h"
 
 #ifdef __cplusplus
@@ -208,6 +209,18 @@ typedef struct {
 int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
                           const double pi0[PRRU_NREG], const prru_consistent_options *o,
                           double pi[PRRU_NREG], prru_consistent_result *c);
+
+/* Standard parameters pi (e.g. prru_ident_consistent's) as the numbers of
+ * a model file: m's geometry and gravity (the regressor's), each body's
+ * mass, centre of mass and inertia about it, the drives, b's Coulomb
+ * smoothing velocity. A mass or principal moment below 1e-9 (a body on
+ * the consistent set's margin) is raised to 1e-9 kg or kg m^2, which a
+ * model file can hold and which keeps the body consistent. PRRU_EINPUT
+ * with why naming the body or drive that is not physical (a mass <= 0,
+ * an inertia not positive definite, a negative drive coefficient; never
+ * for prru_ident_consistent's output). prru_model_file_text writes p. */
+int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
+                            char *why, int len);
 
 /* ---- Periodic excitation ----
  * q_k(t) = c_k + sum_{l=1..L} (a_kl sin(l w t) + b_kl cos(l w t)),

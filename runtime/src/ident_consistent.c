@@ -15,6 +15,7 @@
 #include <gsl/gsl_matrix.h>
 
 #include "internal.h"
+#include "prru_control.h"
 #include "prru_ident.h"
 
 #define NP PRRU_NREG
@@ -741,4 +742,49 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
   }
   free(G), free(a.P), free(x), free(Rinv);
   return st;
+}
+
+/* Masses and principal moments below this are written as 0 in a model
+ * file (prru_model_file_text), which the loader refuses. */
+#define FILE_FLOOR 1e-9
+
+int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
+                            char *why, int len)
+{
+  /* Geometry and gravity: the model's (the regressor's, which identification needs). */
+  prru_model_params(m, p);
+  for (int k = 0; k < PRRU_NBODY; k++) {
+    double mass, c[3], I[6];
+    if (prru_ident_body(pi + PRRU_NBODYPAR * k, &mass, c, I) != PRRU_OK)
+      return prru_fail(why, len, PRRU_EINPUT, "body %s: mass %.6g kg is not positive", m->mech->body_names[k],
+                       pi[PRRU_NBODYPAR * k]);
+    /* A mass or principal moment the fit left below the file's floor (a
+     * body on the consistent set's boundary, whose margin is 1e-9 of the
+     * prior body: data that hardly reveal a slider's mass beside its
+     * armature can put it there) is raised to 1e-9 kg or kg m^2, which
+     * keeps the body consistent (the centre of mass stays; the second
+     * moments about it change by +-5e-10); prru_model_file_text's read
+     * back catches anything this misses. */
+    mass = fmax(mass, FILE_FLOOR);
+    for (int d = 0; d < 3; d++) I[d] = fmax(I[d], FILE_FLOOR);
+    const double m2 = I[0] * I[1] - I[3] * I[3];
+    const double m3 = I[0] * (I[1] * I[2] - I[5] * I[5]) - I[3] * (I[3] * I[2] - I[5] * I[4]) +
+                      I[4] * (I[3] * I[5] - I[1] * I[4]);
+    if (!(I[0] > 0 && m2 > 0 && m3 > 0))
+      return prru_fail(why, len, PRRU_EINPUT, "body %s: the inertia about the centre of mass is not positive "
+                       "definite", m->mech->body_names[k]);
+    p->mass[k] = mass;
+    memcpy(p->com[k], c, sizeof c);
+    memcpy(p->inertia[k], I, sizeof I);
+  }
+  double *dr[3] = {p->armature, p->damping, p->coulomb};
+  static const char *const dn[3] = {"armature", "damping", "coulomb"};
+  for (int g = 0; g < 3; g++)
+    for (int i = 0; i < PRRU_NACT; i++) {
+      const double v = pi[PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i];
+      if (!(v >= 0)) return prru_fail(why, len, PRRU_EINPUT, "%s%d = %.6g is negative", dn[g], i + 1, v);
+      dr[g][i] = v;
+    }
+  p->coulomb_velocity = b->vs;
+  return PRRU_OK;
 }
