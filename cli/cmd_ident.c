@@ -16,7 +16,7 @@
  * else the model's, else 1 mm/s. */
 static int coulomb_velocity(const char *cmd, const char *text, double *vs)
 {
-  *vs = prru_cli_model()->mech->coulomb_velocity > 0 ? prru_cli_model()->mech->coulomb_velocity : 1e-3;
+  *vs = prru_ident_default_vs(prru_cli_model());
   if (!text) return 0;
   if (prru_cli_number(cmd, "coulomb-velocity", text, vs)) return 2;
   if (!(*vs > 0)) {
@@ -138,11 +138,7 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
    * the stroke the reach of the run's model too). Excitation needs a
    * force bound: 500 N (the default) where the run has none. */
   if (prru_cli_limits(c, "fd-max", &a->lim, lim)) return 2;
-  for (int i = 0; i < PRRU_NACT; i++) {
-    if (isfinite(lim->force_max[i])) o->fd_max[i] = lim->force_max[i];
-    o->speed_max[i] = lim->speed_max[i];
-    o->d_min[i] = lim->d_min[i], o->d_max[i] = lim->d_max[i];
-  }
+  prru_excite_options_limits(o, lim);
   if (a->rcond && prru_cli_number(c, "rcond-min", a->rcond, &o->rcond_min)) return 2;
   if (!(o->rcond_min > 0 && o->rcond_min < 1)) {
     prru_cli_error(c, "--rcond-min: %s must lie between 0 and 1", a->rcond);

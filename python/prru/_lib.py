@@ -120,6 +120,22 @@ class _PathSide(ctypes.Structure):
     _fields_ = [("sign", ctypes.c_int)]
 
 
+# Identification (prru_ident.h).
+EXCITE_MAX_HARMONICS = 8
+CONSISTENT_EXACT, CONSISTENT_COVARIANCE = 0, 1
+
+
+class _Fourier(ctypes.Structure):
+    _fields_ = [("period", ctypes.c_double), ("harmonics", ctypes.c_int), ("centre", ctypes.c_double * 3),
+                ("a", (ctypes.c_double * EXCITE_MAX_HARMONICS) * 3),
+                ("b", (ctypes.c_double * EXCITE_MAX_HARMONICS) * 3)]
+
+
+class _ConsistentOptions(ctypes.Structure):
+    _fields_ = [("mu", ctypes.c_double), ("alpha", ctypes.c_double), ("sigma_floor", ctypes.c_double),
+                ("eps", ctypes.c_double), ("max_newton", ctypes.c_int)]
+
+
 def _guarded(struct, guard_bytes):
     """A struct followed by guard bytes: a library whose struct is larger
     than the mirror writes into the guard instead of foreign memory."""
@@ -225,6 +241,27 @@ class Types:
             ("samples", ctypes.c_long), ("t_end", d), ("rms_e", _arr(d, 3)), ("max_e", _arr(d, 3)),
             ("max_fd", _arr(d, nact)), ("saturated", _arr(ctypes.c_long, nact)),
             ("any_saturated", ctypes.c_long)]})
+        # Identification: PRRU_NREG standard parameters (10 per body, 3 per
+        # actuator; prru_regressor_names' last is checked at load).
+        self.nreg = nreg = 10 * nbody + 3 * nact
+        i = ctypes.c_int
+        self.Base = type("prru_base", (ctypes.Structure,), {"_fields_": [
+            ("nbase", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
+            ("vs", d), ("last_kept", d), ("first_dropped", d), ("nstates", i), ("seed", ctypes.c_ulong)]})
+        self.IdentResult = type("prru_ident_result", (ctypes.Structure,), {"_fields_": [
+            ("nsamples", i), ("nrows", i), ("dof", i), ("beta", _arr(d, nreg)), ("se", _arr(d, nreg)),
+            ("scale", _arr(d, nreg)), ("sigma", d), ("rms", _arr(d, nact)), ("cond", d), ("yrms", d),
+            ("inflation", d), ("hac_lags", i), ("R", _arr(d, nreg * nreg))]})
+        self.ConsistentResult = type("prru_consistent_result", (ctypes.Structure,), {"_fields_": [
+            ("how", i), ("beta", _arr(d, nreg)), ("t", _arr(d, nreg)), ("w", _arr(d, nreg)), ("d2", d),
+            ("d2_max", d), ("sigma_w", d), ("prior_dist", d), ("margin", d), ("newton", i)]})
+        self.ExciteOptions = type("prru_excite_options", (ctypes.Structure,), {"_fields_": [
+            ("fd_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)), ("rcond_min", d),
+            ("amplitude_max", _arr(d, 3)), ("samples", i), ("check_samples", i), ("max_evals", i),
+            ("seed", ctypes.c_ulong), ("speed_max", _arr(d, nact))]})
+        self.ExciteResult = type("prru_excite_result", (ctypes.Structure,), {"_fields_": [
+            ("cond", d), ("cond_start", d), ("fd_peak", _arr(d, nact)), ("rcond_worst", d), ("evals", i),
+            ("shrunk", i)]})
         self.GuardedLimits = _guarded(self.Limits, 4096)
         self.GuardedTrackOptions = _guarded(self.TrackOptions, 4096)
         self.GuardedData = _guarded(self.Data, ctypes.sizeof(self.Data) // 2 + 4096)
@@ -348,6 +385,32 @@ class Library:
         self.track = _declare(dll, "prru_track", i, mp, qp, top, ctypes.POINTER(t.TrackSummary), cp, i)
         self.model_params = _declare(dll, "prru_model_params", None, mp, pp)
         self.params_scale = _declare(dll, "prru_params_scale", i, pp, cp, d)
+        # Identification.
+        bp, irp = ctypes.POINTER(t.Base), ctypes.POINTER(t.IdentResult)
+        eop, fp = ctypes.POINTER(t.ExciteOptions), ctypes.POINTER(_Fourier)
+        self.model_is_built = _declare(dll, "prru_model_is_built", i, mp, i)
+        self.model_with_limits = _declare(dll, "prru_model_with_limits", i, mp, mp, lmp)
+        self.ident_default_vs = _declare(dll, "prru_ident_default_vs", d, mp)
+        self.base_compute = _declare(dll, "prru_base_compute", i, mp, d, i, ctypes.c_ulong, bp)
+        self.base_params = _declare(dll, "prru_base_params", None, bp, vp, vp)
+        self.ident_standard = _declare(dll, "prru_ident_standard", None, ctypes.c_void_p, vp)
+        self.identify = _declare(dll, "prru_identify", i, mp, bp, i, vp, vp, vp, vp, irp, c_int_p)
+        self.consistent_options_default = _declare(dll, "prru_consistent_options_default", None,
+                                                   ctypes.POINTER(_ConsistentOptions))
+        self.ident_consistent = _declare(dll, "prru_ident_consistent", i, mp, bp, irp, vp,
+                                         ctypes.POINTER(_ConsistentOptions), vp,
+                                         ctypes.POINTER(t.ConsistentResult))
+        self.ident_model_params = _declare(dll, "prru_ident_model_params", i, mp, bp, vp, pp, cp, i)
+        self.model_file_text = _declare(dll, "prru_model_file_text", i, mp, pp, cp, cp,
+                                        ctypes.POINTER(ctypes.c_void_p), cp, i)
+        self.excite_options_default = _declare(dll, "prru_excite_options_default", None, eop)
+        self.excite_options_limits = _declare(dll, "prru_excite_options_limits", None, eop, lmp)
+        self.excite = _declare(dll, "prru_excite", i, mp, bp, eop, c_int_p, fp,
+                               ctypes.POINTER(t.ExciteResult), cp, i)
+        self.fourier_eval = _declare(dll, "prru_fourier_eval", None, fp, d, vp, vp, vp)
+        self.regressor_names = (ctypes.c_char_p * t.nreg).in_dll(dll, "prru_regressor_names")
+        # The C library's free, for the strings the library allocates.
+        self.free = _declare(ctypes.CDLL(None), "free", None, ctypes.c_void_p)
 
     def status_text(self, status):
         return self.strerror(status).decode()
@@ -479,6 +542,9 @@ class Library:
         if (not guard_intact(gl) or any(not lim.d_min[i] < lim.d_max[i] for i in range(t.nact))
                 or any(not lim.force_max[i] > 0 or not lim.speed_max[i] > 0 for i in range(t.nact))):
             raise self._layout_error("prru_limits")
+        last = self.regressor_names[t.nreg - 1]
+        if last != ("coulomb%d" % t.nact).encode():
+            raise self._layout_error("PRRU_NREG (prru_regressor_names' last is %r)" % last)
 
     def _check_data_and_dme(self):
         """At q = 0 (every valid model assembles there; when J_d happens to

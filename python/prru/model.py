@@ -407,3 +407,4 @@ class Model:
     from .maps import map  # noqa: E402
     from .measurements import measure  # noqa: E402
     from .motion import limits, quintic, time_optimal, track  # noqa: E402
+    from .identification import excite, identify  # noqa: E402

@@ -591,6 +591,83 @@ class TestMotion(unittest.TestCase):
         self.assertGreater(len(cm.exception.run.t), 0)
 
 
+class TestIdentification(unittest.TestCase):
+    """excite and identify against prru excite and prru identify: the same
+    library calls, so the same rows and the same model numbers."""
+
+    ARGS = dict(evals=300, period=8.0, harmonics=4, amplitude=(0.2, 0.2, 0.02), dt=0.01)
+
+    @classmethod
+    def setUpClass(cls):
+        cls.ex = MODEL.excite(**cls.ARGS)
+
+    def test_excite(self):
+        ex, n = self.ex, MODEL.nact
+        text = cli("excite", "--evals", "300", "--period", "8", "--harmonics", "4", "--amplitude", "0.2,0.2,0.02",
+                   "--dt", "0.01")
+        rows = csv_rows(text)
+        self.assertEqual(len(rows), len(ex.motion.t))
+        for k in (0, len(rows) // 3, len(rows) - 1):
+            r, mo = rows[k], ex.motion
+            mine = [mo.t[k]] + list(mo.q[k]) + list(mo.qd[k]) + list(mo.qdd[k]) + list(mo.d[k]) + list(mo.fd[k])
+            cols = (["t"] + ["q%d" % i for i in (1, 2, 3)] + ["qd%d" % i for i in (1, 2, 3)]
+                    + ["qdd%d" % i for i in (1, 2, 3)] + ["d%d" % (i + 1) for i in range(n)]
+                    + ["fd%d" % (i + 1) for i in range(n)])
+            self.assertEqual(bits(mine), bits([r[c] for c in cols]), "row %d" % k)
+        cond = float(re.search(r"condition number ([0-9.e+-]+) \(start", text).group(1))
+        self.assertEqual("%.6g" % ex.cond, "%.6g" % cond)
+        a1 = [float(x) for x in re.search(r"# q1: a ([^;]+);", text).group(1).split()]
+        self.assertEqual(bits(list(ex.a[0])), bits(a1))
+        self.assertEqual(ex.harmonics, 4)
+        self.assertEqual(ex.limits, MODEL.limits())
+        with self.assertRaisesRegex(ValueError, "harmonics must be at most 8"):
+            MODEL.excite(harmonics=9)
+        with self.assertRaisesRegex(ValueError, "rcond_min must lie between 0 and 1"):
+            MODEL.excite(rcond_min=2)
+
+    def test_identify(self):
+        mo, n = self.ex.motion, MODEL.nact
+        with tempfile.TemporaryDirectory() as tmp:
+            data, out, rep = (os.path.join(tmp, f) for f in ("ex.csv", "id.json", "rep.csv"))
+            with open(data, "w") as f:
+                f.write("t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s\n" % ",".join("fd%d" % (i + 1) for i in range(n)))
+                for k in range(len(mo.t)):
+                    f.write(",".join(repr(float(x)) for x in [mo.t[k]] + list(mo.q[k]) + list(mo.qd[k])
+                                     + list(mo.qdd[k]) + list(mo.fd[k])) + "\n")
+            cli("identify", "--data", data, "--out", out, "--report", rep)
+            theirs, report = json.loads(read(out)), read(rep)
+            r = MODEL.identify(mo.t, mo.q, mo.qd, mo.qdd, mo.fd)
+            mine = json.loads(r.text)
+            r.write(os.path.join(tmp, "mine.json"))
+            written = prru.Model(LIB, model=os.path.join(tmp, "mine.json"))
+        self.assertEqual(mine["name"], theirs["name"])
+        for key in ("gravity", "geometry", "bodies", "actuators"):
+            self.assertEqual(mine[key], theirs[key], key)
+        self.assertEqual(written.name, theirs["name"])
+        rows = list(csv.DictReader(l for l in report.splitlines() if not l.startswith("#")))
+        self.assertEqual(len(rows), r.nbase)
+        for p, row in zip(r.parameters, rows):
+            self.assertEqual(p.name, row["parameter"])
+            self.assertEqual(bits([p.estimate, p.se, p.prior, p.model]),
+                             bits([float(row[k]) for k in ("estimate", "se", "prior", "model")]))
+        sigma = float(re.search(r"residual sigma ([0-9.e+-]+) N", report).group(1))
+        self.assertEqual("%.6g" % r.sigma, "%.6g" % sigma)
+        # Too few samples; a sample outside the workspace, named.
+        with self.assertRaisesRegex(prru.InputError, "fewer than the"):
+            MODEL.identify(mo.t[:3], mo.q[:3], mo.qd[:3], mo.qdd[:3], mo.fd[:3])
+        q = [list(x) for x in mo.q]
+        q[5] = [1.5, 1.5, q[5][2]]
+        with self.assertRaisesRegex(prru.InputError, r"sample 6 \(t = 0.05\)"):
+            MODEL.identify(mo.t, q, mo.qd, mo.qdd, mo.fd)
+        # Forces of the wrong sign: no physical robot explains them.
+        neg = [[-x for x in row] for row in mo.fd]
+        with self.assertRaisesRegex(prru.Singular, "the data contradict physics") as cm:
+            MODEL.identify(mo.t, mo.q, mo.qd, mo.qdd, neg)
+        self.assertIsNone(cm.exception.result.text)
+        with self.assertRaisesRegex(ValueError, "no model to write"):
+            cm.exception.result.write(os.path.join(HERE, "never.json"))
+
+
 class TestRoundTrips(unittest.TestCase):
     def test_fk_of_ik(self):
         for q, _, _, _, _ in random_states(20, 3):
@@ -1157,6 +1234,7 @@ class TestLayout(unittest.TestCase):
     def sizes(self):
         m = MODEL
         return {"PRRU_NACT": m.nact, "PRRU_NBODY": m.nbody, "PRRU_NLIMB": m.nlimb,
+                "PRRU_NREG": 10 * m.nbody + 3 * m.nact, "PRRU_EXCITE_MAX_HARMONICS": 8,
                 "PRRU_NLAMBDA": m.nlambda, "PRRU_NJOINT": m.njoint, "PRRU_NH": 6 * m.nbody,
                 "PRRU_NQ": 3}
 
@@ -1208,7 +1286,14 @@ class TestLayout(unittest.TestCase):
                 ("generated/prru_param_kernels.h", "prru_params", t.Params),
                 ("runtime/include/prru_control.h", "prru_track_sample", t.TrackSample),
                 ("runtime/include/prru_control.h", "prru_track_options", t.TrackOptions),
-                ("runtime/include/prru_control.h", "prru_track_summary", t.TrackSummary)):
+                ("runtime/include/prru_control.h", "prru_track_summary", t.TrackSummary),
+                ("runtime/include/prru_ident.h", "prru_base", t.Base),
+                ("runtime/include/prru_ident.h", "prru_ident_result", t.IdentResult),
+                ("runtime/include/prru_ident.h", "prru_consistent_options", _lib._ConsistentOptions),
+                ("runtime/include/prru_ident.h", "prru_consistent_result", t.ConsistentResult),
+                ("runtime/include/prru_ident.h", "prru_fourier", _lib._Fourier),
+                ("runtime/include/prru_ident.h", "prru_excite_options", t.ExciteOptions),
+                ("runtime/include/prru_ident.h", "prru_excite_result", t.ExciteResult)):
             with self.subTest(struct=cname):
                 self.check(header, cname, pytype)
 

@@ -74,6 +74,10 @@ typedef struct {
 int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
                             double q[3], double qd[3], double qdd[3]);
 
+/* The Coulomb smoothing velocity identification evaluates the regressor
+ * with unless told otherwise: the model's, else 1 mm/s (m/s). */
+double prru_ident_default_vs(const prru_model *m);
+
 /* Base parameters from nstates random states (PRRU_BASE_STATES when <= 0)
  * drawn with seed; vs > 0 the Coulomb smoothing velocity. Allocates (a
  * set-up call). PRRU_EINPUT for vs <= 0, PRRU_ENOMEM, PRRU_ENOCONV. */
@@ -251,6 +255,10 @@ typedef struct {
 /* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, 2000 check samples, 3000 evaluations, seed 1. */
 void prru_excite_options_default(prru_excite_options *o);
+/* A run's limits (prru_limits_for_run) into o: the force bounds where
+ * finite (an excitation needs one: o's, 500 N by default, where the run
+ * has none), the speed limits and the strokes. */
+void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
 
 typedef struct {
   double cond;          /* condition number of the column-scaled stacked base regressor */

@@ -27,6 +27,15 @@ void prru_excite_options_default(prru_excite_options *o)
   o->seed = 1;
 }
 
+void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim)
+{
+  for (int i = 0; i < PRRU_NACT; i++) {
+    if (isfinite(lim->force_max[i])) o->fd_max[i] = lim->force_max[i];
+    o->speed_max[i] = lim->speed_max[i];
+    o->d_min[i] = lim->d_min[i], o->d_max[i] = lim->d_max[i];
+  }
+}
+
 void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3], double qdd[3])
 {
   const double w = 2 * PRRU_PI / f->period;

@@ -183,6 +183,11 @@ static int reduce(gsl_matrix *W, prru_base *b)
   return st;
 }
 
+double prru_ident_default_vs(const prru_model *m)
+{
+  return m->mech->coulomb_velocity > 0 ? m->mech->coulomb_velocity : 1e-3;
+}
+
 int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed, prru_base *b)
 {
   if (!(vs > 0) || !isfinite(vs)) return PRRU_EINPUT;

@@ -1,0 +1,277 @@
+"""Identification: excitation trajectories and the physically consistent
+model identified from measured motion and forces (prru_ident.h), as
+`prru excite` and `prru identify` compute them. Methods of Model."""
+
+import collections
+import ctypes
+import os
+import tempfile
+
+from . import _convert, _interrupt, _lib, errors
+from .motion import Motion, _c_limits
+
+Excitation = collections.namedtuple(
+    "Excitation", "motion period harmonics centre a b cond cond_start fd_peak rcond_worst evals shrunk "
+                  "nbase limits")
+Excitation.__doc__ = """Model.excite's result: motion (a Motion sampled every
+dt over the periods; its fd is this model's inverse dynamics, to be
+replaced by measured forces), the Fourier series (period s, harmonics L,
+centre, a and b: 3 rows of L sine and cosine amplitudes), cond (the
+condition number of the column-scaled base regressor it was optimised
+for; cond_start the start's, inf if infeasible), fd_peak (N per actuator),
+rcond_worst (J_d along it), evals, shrunk (times scaled by 0.95 to pass
+the dense check), nbase and the limits kept."""
+
+Parameter = collections.namedtuple("Parameter", "name estimate se prior model t")
+Parameter.__doc__ = """One base parameter: its own standard parameter's
+name, the least-squares estimate and standard error, the prior's value
+(the model's numbers), the written model's value, and t = (model -
+estimate) / se."""
+
+
+class Identification:
+    """Model.identify's result.
+
+    Attributes: text (the identified model file, format 2; None when the
+    data contradict physics), name, nsamples, nbase, sigma (residual
+    standard deviation, N), cond (condition number of the column-scaled
+    regressor), inflation (residual variance inflation, Newey-West),
+    consistent ("exact": a consistent robot has the estimate's base
+    parameters; "covariance": the consistent set nearest them), d2 and
+    d2_max (the Mahalanobis distance^2 of the model's base parameters to
+    the estimate and the chi^2 quantile that refuses), parameters (a list
+    of Parameter). write(path) writes the model file.
+    """
+
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+    def write(self, path):
+        """Writes text to path: a temporary file in the same directory,
+        renamed into place (an existing file stays whole on failure)."""
+        if self.text is None:
+            raise ValueError("no model to write: the data contradict physics")
+        d = os.path.dirname(os.path.abspath(path))
+        fd, tmp = tempfile.mkstemp(prefix=".prru-", suffix=".json", dir=d)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(self.text)
+            os.replace(tmp, path)
+        except BaseException:
+            os.unlink(tmp)
+            raise
+
+    def __repr__(self):
+        return "<prru.Identification %s: %d base parameters from %d samples, sigma %.4g N, %s>" % (
+            self.name, self.nbase, self.nsamples, self.sigma, self.consistent)
+
+
+def _base(model, vs):
+    lib, b = model.lib, model.lib.types.Base()
+    if vs is None:
+        vs = lib.ident_default_vs(ctypes.byref(model._m))
+    vs = _convert.scalar("coulomb_velocity", vs, positive=True, allow_zero=False)
+    with model._lock:
+        st = lib.base_compute(ctypes.byref(model._m), vs, 0, 1, ctypes.byref(b))
+    if st != errors.OK:
+        raise errors.make_error(st, "base parameters: %s" % lib.status_text(st))
+    return b
+
+
+def _require_built_geometry(model, what):
+    """The identification regressor is generated for the library's own
+    geometry and gravity (masses, inertias and drives may differ)."""
+    if not model.lib.model_is_built(ctypes.byref(model._m), 1):
+        raise errors.make_error(errors.EINPUT, "%s: model %s has another geometry or gravity than the "
+                                "library's model (%s): the identification regressor exists only for that one; "
+                                "build the library for this model" % (what, model.model_file, model.lib.mech.name
+                                                                       .decode()))
+
+
+def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0.0, 0.0), amplitude=None,
+           limits=None, rcond_min=1e-2, evals=3000, samples=100, seed=1, coulomb_velocity=None):
+    """An excitation trajectory for identification (prru excite): each
+    coordinate a Fourier series of harmonics harmonics about centre with
+    the given period (s), its coefficients chosen (Nelder-Mead, seeded)
+    for the smallest condition number of the base regressor over samples
+    points a period, within amplitude (|q_k - c_k|; default 0.25 rad, 0.25
+    rad, 0.1 L), J_d's rcond >= rcond_min, and the limits (a Limits;
+    default the model's, with 500 N where it has no force limit), then
+    checked at 20 times as many points. Sampled every dt over periods
+    periods. Returns Excitation. Raises InputError for bad options or
+    centre, NoConvergence when no feasible trajectory is found."""
+    _require_built_geometry(self, "excite")
+    lib, t = self.lib, self.lib.types
+    lim, c = _c_limits(self, limits)
+    o = t.ExciteOptions()
+    lib.excite_options_default(ctypes.byref(o))
+    lib.excite_options_limits(ctypes.byref(o), ctypes.byref(c))
+    f = _lib._Fourier()
+    f.period = _convert.scalar("period", period, positive=True, allow_zero=False)
+    f.harmonics = _convert.integer("harmonics", harmonics, 1)
+    if f.harmonics > _lib.EXCITE_MAX_HARMONICS:
+        raise ValueError("harmonics must be at most %d, got %d" % (_lib.EXCITE_MAX_HARMONICS, harmonics))
+    f.centre[:] = list(_convert.vector("centre", centre, 3))
+    if amplitude is not None:
+        amp = list(_convert.vector("amplitude", amplitude, 3))
+        if not all(a > 0 for a in amp):
+            raise ValueError("amplitude must be positive, got %r" % amp)
+        o.amplitude_max[:] = amp
+    o.rcond_min = _convert.scalar("rcond_min", rcond_min, positive=True, allow_zero=False)
+    if not o.rcond_min < 1:
+        raise ValueError("rcond_min must lie between 0 and 1, got %r" % rcond_min)
+    o.max_evals = _convert.integer("evals", evals, 1)
+    o.samples = _convert.integer("samples", samples, 1)
+    o.check_samples = 20 * o.samples  # as prru excite
+    o.seed = _convert.integer("seed", seed, 0)
+    periods = _convert.integer("periods", periods, 1)
+    dt = _convert.scalar("dt", dt, positive=True, allow_zero=False)
+    if dt > f.period * periods:
+        raise ValueError("dt %g s is longer than the run (%g s)" % (dt, f.period * periods))
+    # The run's model: its stroke bounds the reach.
+    m = _lib._Model()
+    if lib.model_with_limits(ctypes.byref(m), ctypes.byref(self._m), ctypes.byref(c)) != errors.OK:
+        raise errors.make_error(errors.ENOMEM, "excite: out of memory")
+    try:
+        b = _base(self, coulomb_velocity)
+        r, msg, stop = t.ExciteResult(), ctypes.create_string_buffer(600), ctypes.c_int(0)
+        with self._lock:
+            st, interrupt = _interrupt.call_in_worker(
+                lambda: lib.excite(ctypes.byref(m), ctypes.byref(b), ctypes.byref(o), ctypes.byref(stop),
+                                   ctypes.byref(f), ctypes.byref(r), msg, len(msg)), stop, "prru excite")
+        if interrupt is not None:
+            raise interrupt
+        if st != errors.OK:
+            raise errors.make_error(st, "excite: " + (msg.value.decode("utf-8", "replace")
+                                                      or lib.status_text(st)))
+        motion = _excite_rows(self, m, f, periods, dt)
+    finally:
+        lib.model_free(ctypes.byref(m))
+    L = f.harmonics
+    return Excitation(motion, f.period, L, tuple(f.centre), tuple(tuple(f.a[k][:L]) for k in range(3)),
+                      tuple(tuple(f.b[k][:L]) for k in range(3)), r.cond, r.cond_start, tuple(r.fd_peak),
+                      r.rcond_worst, r.evals, r.shrunk, b.nbase, lim)
+
+
+def _excite_rows(model, m, f, periods, dt):
+    """Rows every dt to periods periods (the last at or before the end, as
+    prru excite): q, qd, qdd of the series, d, dd and fd of the run's
+    model (inverse dynamics, no loads)."""
+    lib, n = model.lib, model.nact
+    g = model.lib.new_data()
+    t_end = f.period * periods
+    count = int(t_end / dt * (1 + 1e-12))
+    cols = {k: [] for k in Motion._fields}
+    q, qd, qdd = (ctypes.c_double * 3)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+    fd, dd, ddb = (ctypes.c_double * n)(), (ctypes.c_double * n)(), (ctypes.c_double * n)()
+    loads = lib.types.Loads()
+    with model._lock:
+        for i in range(count + 1):
+            t = i * dt
+            lib.fourier_eval(ctypes.byref(f), t, q, qd, qdd)
+            st = lib.inverse_dynamics_preload(ctypes.byref(m), ctypes.byref(g.s), q, qd, qdd, ctypes.byref(loads),
+                                              0.0, fd)
+            if st != errors.OK:
+                raise errors.make_error(st, "excite: t = %.9g s: %s" % (t, lib.status_text(st)))
+            lib.model_actuator_rates(ctypes.byref(m), q, qd, dd, ddb)
+            for key, v in (("t", t), ("q", list(q)), ("qd", list(qd)), ("qdd", list(qdd)),
+                           ("d", list(g.s.d)), ("dd", list(dd)), ("fd", list(fd))):
+                cols[key].append(v)
+    out, rows = model._out, len(cols["t"])
+    return Motion(out.vec(cols["t"]), *(out.mat([x for r in cols[k] for x in r], rows, len(cols[k][0]))
+                                         for k in Motion._fields[1:]))
+
+
+def _rows(name, rows, n, width):
+    rows = _convert.ordered(name, rows, "rows of %d numbers" % width, ndim=2)
+    if len(rows) != n:
+        raise ValueError("%s: %d rows for %d samples" % (name, len(rows), n))
+    a = (ctypes.c_double * (width * max(n, 1)))()
+    for k, r in enumerate(rows):
+        a[width * k:width * k + width] = list(_convert.vector("%s[%d]" % (name, k), r, width))
+    return a
+
+
+def identify(self, t, q, qd, qdd, fd, *, name=None, coulomb_velocity=None):
+    """The physically consistent model identified from n samples of
+    measured motion and actuator forces (prru identify on exact rates): t
+    (s), q, qd, qdd (rows of 3), fd (rows of nact, N). Least squares of
+    the base parameters, then the standard parameters nearest this model's
+    (the prior) among the physically consistent ones with the estimate's
+    base parameters, or, where none has them, the consistent set nearest
+    the estimate within its covariance. name: the model's name (default
+    this model's name + "_id"). Returns Identification. Raises InputError
+    naming the sample that is unreachable or singular, for too few samples
+    or another geometry than the library's; Singular when the motion does
+    not excite every base parameter, or when the data contradict physics
+    (no consistent robot within the covariance: a force sign, a gear
+    ratio, a unit; .result then holds the fit without a model)."""
+    _require_built_geometry(self, "identify")
+    lib, T = self.lib, self.lib.types
+    tt = _convert.ordered("t", t, "a sequence of times")
+    n = len(tt)
+    tv = _convert.vector("t", tt, n)
+    qa, qda, qdda = _rows("q", q, n, 3), _rows("qd", qd, n, 3), _rows("qdd", qdd, n, 3)
+    fda = _rows("fd", fd, n, self.nact)
+    if name is None:
+        name = self.name[:13] + "_id"  # as prru identify
+    b = _base(self, coulomb_velocity)
+    r, bad = T.IdentResult(), ctypes.c_int(-1)
+    with self._lock:
+        st = lib.identify(ctypes.byref(self._m), ctypes.byref(b), n, qa, qda, qdda, fda, ctypes.byref(r),
+                          ctypes.byref(bad))
+    if st != errors.OK:
+        if bad.value >= 0:
+            raise errors.make_error(errors.EINPUT, "identify: sample %d (t = %g): %s"
+                                    % (bad.value + 1, tv[bad.value], lib.status_text(st)))
+        if st == errors.EINPUT:
+            raise errors.make_error(st, "identify: %d samples give %d independent rows, fewer than the %d base "
+                                    "parameters need" % (n, 3 * n, b.nbase + 1))
+        raise errors.make_error(st, "identify: the motion does not excite every base parameter (condition "
+                                "number %.3g of the column-scaled regressor); use an excitation from excite"
+                                % r.cond)
+    nreg = T.nreg
+    pi0, pi, prior = (ctypes.c_double * nreg)(), (ctypes.c_double * nreg)(), (ctypes.c_double * nreg)()
+    lib.ident_standard(self._m.mech, pi0)
+    lib.base_params(ctypes.byref(b), pi0, prior)
+    co, c = _lib._ConsistentOptions(), T.ConsistentResult()
+    lib.consistent_options_default(ctypes.byref(co))
+    with self._lock:
+        cst = lib.ident_consistent(ctypes.byref(self._m), ctypes.byref(b), ctypes.byref(r), pi0, ctypes.byref(co),
+                                   pi, ctypes.byref(c))
+    if cst not in (errors.OK, errors.ESINGULAR):
+        raise errors.make_error(cst, "identify: " + (
+            "the model's own parameters (the prior) are not physical: no prior to start from"
+            if cst == errors.EINPUT else "the physically consistent fit did not converge"))
+    names = lib.regressor_names
+    params = [Parameter(names[b.col[i]].decode(), r.beta[i], r.se[i], prior[i], c.beta[i], c.t[i])
+              for i in range(b.nbase)]
+    result = Identification(text=None, name=name, nsamples=r.nsamples, nbase=b.nbase, sigma=r.sigma, cond=r.cond,
+                            inflation=r.inflation,
+                            consistent="exact" if c.how == _lib.CONSISTENT_EXACT else "covariance",
+                            d2=c.d2, d2_max=c.d2_max, parameters=params)
+    if cst == errors.ESINGULAR:
+        worst = sorted(params, key=lambda p: -abs(p.t))[:5]
+        err = errors.make_error(cst, "identify: the data contradict physics: no physically consistent robot has "
+                                "base parameters within the estimate's covariance (Mahalanobis distance^2 %.4g, "
+                                "above the chi^2 quantile %.4g of %d degrees of freedom at 1 - %g); furthest from "
+                                "the estimate: %s; check the signs and directions of the forces, the gear ratios "
+                                "and the units of fd" % (c.d2, c.d2_max, b.nbase, co.alpha,
+                                                          ", ".join("%s at %.3g se" % (p.name, p.t) for p in worst)))
+        err.result = result
+        raise err
+    p, why = T.Params(), ctypes.create_string_buffer(300)
+    if lib.ident_model_params(ctypes.byref(self._m), ctypes.byref(b), pi, ctypes.byref(p), why, len(why)) != errors.OK:
+        raise errors.make_error(errors.EINPUT, "identify: internal error: the consistent parameters are not "
+                                "physical: " + why.value.decode())
+    desc = "Identified by prru.Model.identify from %d samples (prior: model %s)" % (n, self.name)
+    text, msg = ctypes.c_void_p(), ctypes.create_string_buffer(800)
+    st = lib.model_file_text(ctypes.byref(self._m), ctypes.byref(p), name.encode(), desc.encode(),
+                             ctypes.byref(text), msg, len(msg))
+    if st != errors.OK:
+        raise errors.make_error(st, "identify: " + msg.value.decode("utf-8", "replace"))
+    try:
+        result.text = ctypes.string_at(text).decode("utf-8")
+    finally:
+        lib.free(text)
+    return result
