@@ -83,22 +83,13 @@ static int parse_set(const char *cmd, const char *text, prru_params *p)
   return 0;
 }
 
-/* The design's stroke: every slider of a candidate within the run's
- * stroke, one interval for all (the design problem's): the
- * intersection of the sliders' strokes. 0 or 2. */
+/* The design's stroke (prru_design_problem_stroke). 0 or 2. */
 static int design_stroke(const char *cmd, const prru_limits *l, prru_design_problem *pr)
 {
-  double lo = -INFINITY, hi = INFINITY;
-  for (int i = 0; i < PRRU_NACT; i++) lo = fmax(lo, l->d_min[i]), hi = fmin(hi, l->d_max[i]);
-  if (isinf(lo) && isinf(hi)) return 0;
-  if (!(lo < hi)) {
-    prru_cli_error(cmd, "the sliders' strokes have no common interval ([%g, %g]): the design's stroke is one "
-                   "interval for all; give --stroke LO,HI", lo, hi);
-    return 2;
-  }
-  pr->stroke = 1;
-  pr->stroke_lo = lo, pr->stroke_hi = hi;
-  return 0;
+  char msg[300];
+  if (prru_design_problem_stroke(pr, l, msg, sizeof msg) == PRRU_OK) return 0;
+  prru_cli_error(cmd, "%s; give --stroke LO,HI", msg);
+  return 2;
 }
 
 static int parse_problem(const char *cmd, problem_text *t, prru_design_problem *pr,

@@ -39,12 +39,14 @@ from .simulation import Sample, Scenario, Trajectory
 from .maps import MapResult
 from .measurements import Measurement
 from .motion import Limits, Motion, TimeOptimal, TrackRun
-from .identification import Excitation, Identification, Parameter
+from .identification import Excitation, Identification, Parameter, write_model_text
+from .design import Design
 
 __version__ = "0.2.0"
 
 __all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult", "Measurement",
            "Limits", "Motion", "TimeOptimal", "TrackRun", "Excitation", "Identification", "Parameter",
+           "Design", "write_model_text",
            "Library", "load_library", "PrruError", "InputError", "Unreachable", "OutOfStroke", "Singular",
            "NoConvergence", "Interrupted", "PrruIOError", "PrruMemoryError", "ParseError",
            "LibraryNotFound", "LayoutError"]

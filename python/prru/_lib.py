@@ -120,6 +120,16 @@ class _PathSide(ctypes.Structure):
     _fields_ = [("sign", ctypes.c_int)]
 
 
+# Design optimisation (prru_design.h).
+DESIGN_MAX_VARS = 64
+
+
+class _DesignProblem(ctypes.Structure):
+    _fields_ = [("grid", _MapGrid), ("rcond_min", ctypes.c_double), ("objective", ctypes.c_int),
+                ("stroke", ctypes.c_int), ("stroke_lo", ctypes.c_double), ("stroke_hi", ctypes.c_double),
+                ("penalty_weight", ctypes.c_double)]
+
+
 # Identification (prru_ident.h).
 EXCITE_MAX_HARMONICS = 8
 CONSISTENT_EXACT, CONSISTENT_COVARIANCE = 0, 1
@@ -262,6 +272,22 @@ class Types:
         self.ExciteResult = type("prru_excite_result", (ctypes.Structure,), {"_fields_": [
             ("cond", d), ("cond_start", d), ("fd_peak", _arr(d, nact)), ("rcond_worst", d), ("evals", i),
             ("shrunk", i)]})
+        # Design optimisation (prru_design.h).
+        self.DesignVar = type("prru_design_var", (ctypes.Structure,), {"_fields_": [
+            ("name", _arr(ctypes.c_char, 24)), ("n", i), ("offset", _arr(ctypes.c_size_t, nbody)),
+            ("lo", d), ("hi", d)]})
+        self.DesignEval = type("prru_design_eval", (ctypes.Structure,), {"_fields_": [
+            ("valid", i), ("sum", _MapSummary), ("objective", d), ("n_other_mode", ctypes.c_long),
+            ("reg_violation", d), ("stroke_violation", d), ("d_min", d), ("d_max", d), ("merit", d),
+            ("feasible", i)]})
+        self.DesignProgress = ctypes.CFUNCTYPE(i, i, i, ctypes.POINTER(self.DesignEval), d, ctypes.c_void_p)
+        self.DesignOptions = type("prru_design_options", (ctypes.Structure,), {"_fields_": [
+            ("max_iter", i), ("tol", d), ("restarts", i), ("nthreads", i), ("progress", self.DesignProgress),
+            ("ctx", ctypes.c_void_p)]})
+        self.DesignResult = type("prru_design_result", (ctypes.Structure,), {"_fields_": [
+            ("best", self.Params), ("start_eval", self.DesignEval), ("best_eval", self.DesignEval),
+            ("x0", _arr(d, DESIGN_MAX_VARS)), ("x", _arr(d, DESIGN_MAX_VARS)), ("iterations", i),
+            ("evaluations", i), ("restarts_done", i), ("converged", i)]})
         self.GuardedLimits = _guarded(self.Limits, 4096)
         self.GuardedTrackOptions = _guarded(self.TrackOptions, 4096)
         self.GuardedData = _guarded(self.Data, ctypes.sizeof(self.Data) // 2 + 4096)
@@ -409,6 +435,21 @@ class Library:
                                ctypes.POINTER(t.ExciteResult), cp, i)
         self.fourier_eval = _declare(dll, "prru_fourier_eval", None, fp, d, vp, vp, vp)
         self.regressor_names = (ctypes.c_char_p * t.nreg).in_dll(dll, "prru_regressor_names")
+        # Design optimisation.
+        dpp, dvp = ctypes.POINTER(_DesignProblem), ctypes.POINTER(t.DesignVar)
+        self.design_problem_default = _declare(dll, "prru_design_problem_default", None, dpp,
+                                               ctypes.POINTER(_MapGrid))
+        self.design_problem_check = _declare(dll, "prru_design_problem_check", i, dpp, cp, i)
+        self.design_problem_stroke = _declare(dll, "prru_design_problem_stroke", i, dpp, lmp, cp, i)
+        self.objective_parse = _declare(dll, "prru_objective_parse", i, cp, c_int_p)
+        self.design_var_parse = _declare(dll, "prru_design_var_parse", i, cp, dvp, cp, i)
+        self.design_var_bounds = _declare(dll, "prru_design_var_bounds", i, pp, dvp, d)
+        self.design_get = _declare(dll, "prru_design_get", d, pp, dvp)
+        self.design_check = _declare(dll, "prru_design_check", i, pp, cp, i)
+        self.design_options_default = _declare(dll, "prru_design_options_default", None,
+                                               ctypes.POINTER(t.DesignOptions))
+        self.design_optimize = _declare(dll, "prru_design_optimize", i, dpp, pp, dvp, i,
+                                        ctypes.POINTER(t.DesignOptions), ctypes.POINTER(t.DesignResult), cp, i)
         # The C library's free, for the strings the library allocates.
         self.free = _declare(ctypes.CDLL(None), "free", None, ctypes.c_void_p)
 

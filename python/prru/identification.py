@@ -10,6 +10,21 @@ import tempfile
 from . import _convert, _interrupt, _lib, errors
 from .motion import Motion, _c_limits
 
+def write_model_text(text, path):
+    """A model file's text to path: a temporary file in the same
+    directory, renamed into place (an existing file stays whole on
+    failure)."""
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".prru-", suffix=".json", dir=d)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
 Excitation = collections.namedtuple(
     "Excitation", "motion period harmonics centre a b cond cond_start fd_peak rcond_worst evals shrunk "
                   "nbase limits")
@@ -47,19 +62,10 @@ class Identification:
         self.__dict__.update(kw)
 
     def write(self, path):
-        """Writes text to path: a temporary file in the same directory,
-        renamed into place (an existing file stays whole on failure)."""
+        """Writes the model file to path (write_model_text)."""
         if self.text is None:
             raise ValueError("no model to write: the data contradict physics")
-        d = os.path.dirname(os.path.abspath(path))
-        fd, tmp = tempfile.mkstemp(prefix=".prru-", suffix=".json", dir=d)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(self.text)
-            os.replace(tmp, path)
-        except BaseException:
-            os.unlink(tmp)
-            raise
+        write_model_text(self.text, path)
 
     def __repr__(self):
         return "<prru.Identification %s: %d base parameters from %d samples, sigma %.4g N, %s>" % (

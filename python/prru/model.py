@@ -408,3 +408,4 @@ class Model:
     from .measurements import measure  # noqa: E402
     from .motion import limits, quintic, time_optimal, track  # noqa: E402
     from .identification import excite, identify  # noqa: E402
+    from .design import optimize  # noqa: E402

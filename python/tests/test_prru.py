@@ -668,6 +668,48 @@ class TestIdentification(unittest.TestCase):
             cm.exception.result.write(os.path.join(HERE, "never.json"))
 
 
+class TestDesign(unittest.TestCase):
+    """optimize against prru optimize: the same library optimiser, so the
+    same design to the bit."""
+
+    def test_optimize(self):
+        grid = dict(q1=(-0.2, 0.2, 13), q2=(-0.25, 0.15, 11))
+        d = MODEL.optimize(["l2", "b12"], range=5, max_iter=40, **grid)
+        with tempfile.TemporaryDirectory() as tmp:
+            out, rep = os.path.join(tmp, "o.json"), os.path.join(tmp, "rep")
+            cli("optimize", "--vars", "l2,b12", "--range", "5", "--q1", "-0.2:0.2:13", "--q2", "-0.25:0.15:11",
+                "--max-iter", "40", "--out", out, "--report", rep)
+            theirs, report = json.loads(read(out)), read(os.path.join(rep, "report.txt"))
+            d.write(os.path.join(tmp, "mine.json"))
+            written = prru.Model(LIB, model=os.path.join(tmp, "mine.json"))
+        mine = json.loads(d.text)
+        self.assertEqual(mine["name"], theirs["name"])
+        for key in ("gravity", "geometry", "bodies", "actuators"):
+            self.assertEqual(mine[key], theirs[key], key)
+        self.assertEqual(written.name, theirs["name"])
+        for name, before, after, lo, hi in d.variables:
+            row = re.search(r"^%s +(\S+) +(\S+) +(\S+) +(\S+)" % name, report, re.M)
+            self.assertEqual(bits([before, after, lo, hi]), bits([float(x) for x in row.groups()]))
+        after = float(re.search(r"^after_index: (\S+)", report, re.M).group(1))
+        self.assertEqual(bits(d.best["index"]), bits(after))
+        self.assertTrue(d.best["feasible"])
+        with self.assertRaisesRegex(ValueError, r"vars\[0\]: "):
+            MODEL.optimize(["no_such_thing"], **grid)
+        with self.assertRaisesRegex(ValueError, "outside the bounds"):
+            MODEL.optimize([("l2", 10.0, 11.0)], **grid)
+        with self.assertRaisesRegex(ValueError, "objective must be one of mean, max, log"):
+            MODEL.optimize(["l2"], objective="median", **grid)
+        # Platform tilted by 80 degrees about both axes: beyond reach.
+        with self.assertRaisesRegex(prru.InputError, "no grid point of the workspace is regular"):
+            MODEL.optimize(["l2"], q1=(1.4, 1.5, 5), q2=(1.4, 1.5, 5))
+        # A stroke no slider keeps: no feasible design; the best one comes along.
+        with self.assertRaisesRegex(prru.NoConvergence, "no feasible design found") as cm:
+            MODEL.optimize(["l2"], range=0.1, max_iter=5,
+                           limits=MODEL.limits(model_limits=False, stroke=(50, 51)), **grid)
+        self.assertIsNone(cm.exception.design.text)
+        self.assertFalse(cm.exception.design.best["feasible"])
+
+
 class TestRoundTrips(unittest.TestCase):
     def test_fk_of_ik(self):
         for q, _, _, _, _ in random_states(20, 3):
@@ -1235,6 +1277,7 @@ class TestLayout(unittest.TestCase):
         m = MODEL
         return {"PRRU_NACT": m.nact, "PRRU_NBODY": m.nbody, "PRRU_NLIMB": m.nlimb,
                 "PRRU_NREG": 10 * m.nbody + 3 * m.nact, "PRRU_EXCITE_MAX_HARMONICS": 8,
+                "PRRU_DESIGN_MAX_TIE": m.nbody, "PRRU_DESIGN_MAX_VARS": 64,
                 "PRRU_NLAMBDA": m.nlambda, "PRRU_NJOINT": m.njoint, "PRRU_NH": 6 * m.nbody,
                 "PRRU_NQ": 3}
 
@@ -1247,6 +1290,7 @@ class TestLayout(unittest.TestCase):
                          "%s: field names" % cname)
         env = self.sizes()
         csize = {"double": 8, "int": 4, "long": 8, "char": 1, "const char *": 8, "unsigned long": 8,
+                 "size_t": 8, "prru_objective": 4,
                  "unsigned char": 1, "prru_stepper": 4, "prru_load_kind": 4}  # enums: int
         for (fname, ctype, dims), (_, pyt) in zip(cfields, pyfields):
             count = 1
@@ -1293,7 +1337,12 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_ident.h", "prru_consistent_result", t.ConsistentResult),
                 ("runtime/include/prru_ident.h", "prru_fourier", _lib._Fourier),
                 ("runtime/include/prru_ident.h", "prru_excite_options", t.ExciteOptions),
-                ("runtime/include/prru_ident.h", "prru_excite_result", t.ExciteResult)):
+                ("runtime/include/prru_ident.h", "prru_excite_result", t.ExciteResult),
+                ("runtime/include/prru_design.h", "prru_design_var", t.DesignVar),
+                ("runtime/include/prru_design.h", "prru_design_problem", _lib._DesignProblem),
+                ("runtime/include/prru_design.h", "prru_design_eval", t.DesignEval),
+                ("runtime/include/prru_design.h", "prru_design_options", t.DesignOptions),
+                ("runtime/include/prru_design.h", "prru_design_result", t.DesignResult)):
             with self.subTest(struct=cname):
                 self.check(header, cname, pytype)
 

@@ -128,6 +128,11 @@ typedef struct {
 void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g);
 /* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
 int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
+/* A run's strokes (prru_limits_for_run) as the problem's: one interval
+ * for every slider, the intersection of theirs (none when no slider has
+ * one). PRRU_OK, or PRRU_EINPUT with msg when they have no common
+ * interval (pr untouched). */
+int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen);
 
 /* The status of a regular grid point in the other assembly mode: the
  * map's (PRRU_DME_OTHER_MODE, classified by prru_mode_status);

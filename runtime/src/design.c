@@ -376,6 +376,19 @@ void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g
   pr->penalty_weight = 1000.0;
 }
 
+int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen)
+{
+  double lo = -INFINITY, hi = INFINITY;
+  for (int i = 0; i < PRRU_NACT; i++) lo = fmax(lo, l->d_min[i]), hi = fmin(hi, l->d_max[i]);
+  if (isinf(lo) && isinf(hi)) return PRRU_OK;
+  if (!(lo < hi))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "the sliders' strokes have no common interval ([%g, %g]): the "
+                     "design's stroke is one interval for all", lo, hi);
+  pr->stroke = 1;
+  pr->stroke_lo = lo, pr->stroke_hi = hi;
+  return PRRU_OK;
+}
+
 int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen)
 {
   if (prru_map_check(&pr->grid) != PRRU_OK)
