@@ -26,7 +26,8 @@
  *   reaction_basis     259 arithmetic (33 add, 47 sub, 134 mul, 4 div, 41 neg); calls: cos 2, sin 2, sqrt 4
  *   eom_solve          1000 arithmetic (224 add, 109 sub, 655 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   inverse_terms      1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   joint_reactions    1664 arithmetic (427 add, 294 sub, 923 mul, 11 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   joint_reactions    1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   regressor          1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_P3_KERNELS_H
 #define PRRU_P3_KERNELS_H
@@ -85,7 +86,8 @@
 #define PRRU_P3_ARITH_REACTION_BASIS 259 /* arithmetic operations */
 #define PRRU_P3_ARITH_EOM_SOLVE 1000 /* arithmetic operations */
 #define PRRU_P3_ARITH_INVERSE_TERMS 1030 /* arithmetic operations */
-#define PRRU_P3_ARITH_JOINT_REACTIONS 1664 /* arithmetic operations */
+#define PRRU_P3_ARITH_JOINT_REACTIONS 1679 /* arithmetic operations */
+#define PRRU_P3_ARITH_REGRESSOR 1134 /* arithmetic operations */
 #define PRRU_P3_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
@@ -106,7 +108,8 @@
 #define PRRU_P3_OPS_REACTION_BASIS "259 arithmetic (33 add, 47 sub, 134 mul, 4 div, 41 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_EOM_SOLVE "1000 arithmetic (224 add, 109 sub, 655 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_P3_OPS_INVERSE_TERMS "1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_JOINT_REACTIONS "1664 arithmetic (427 add, 294 sub, 923 mul, 11 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_JOINT_REACTIONS "1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_REGRESSOR "1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 /* Whether the inputs of prru_p3_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -216,6 +219,9 @@ void prru_p3_inverse_terms(const prru_params3 *p, const double q[3], const doubl
 
 /* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. Parameters from *p. */
 void prru_p3_joint_reactions(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);
+
+/* Regressor Y (3x109, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
+void prru_p3_regressor(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], double Y[327]);
 
 /* Batched kernels, prru_p3_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n

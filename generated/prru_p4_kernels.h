@@ -26,8 +26,9 @@
  *   reaction_basis     320 arithmetic (39 add, 57 sub, 167 mul, 5 div, 52 neg); calls: cos 2, sin 2, sqrt 5
  *   eom_solve          1249 arithmetic (272 add, 143 sub, 820 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
  *   inverse_terms      1263 arithmetic (287 add, 132 sub, 830 mul, 10 div, 4 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   joint_reactions    2319 arithmetic (566 add, 429 sub, 1290 mul, 15 div, 19 neg); calls: cos 2, sin 2, sqrt 6, tanh 4
- *   reaction_nullspace 78 arithmetic (8 add, 9 sub, 45 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4
+ *   joint_reactions    2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4
+ *   reaction_nullspace 77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4
+ *   regressor          1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
  */
 #ifndef PRRU_P4_KERNELS_H
 #define PRRU_P4_KERNELS_H
@@ -86,8 +87,9 @@
 #define PRRU_P4_ARITH_REACTION_BASIS 320 /* arithmetic operations */
 #define PRRU_P4_ARITH_EOM_SOLVE 1249 /* arithmetic operations */
 #define PRRU_P4_ARITH_INVERSE_TERMS 1263 /* arithmetic operations */
-#define PRRU_P4_ARITH_JOINT_REACTIONS 2319 /* arithmetic operations */
-#define PRRU_P4_ARITH_REACTION_NULLSPACE 78 /* arithmetic operations */
+#define PRRU_P4_ARITH_JOINT_REACTIONS 2333 /* arithmetic operations */
+#define PRRU_P4_ARITH_REACTION_NULLSPACE 77 /* arithmetic operations */
+#define PRRU_P4_ARITH_REGRESSOR 1540 /* arithmetic operations */
 #define PRRU_P4_OPS_IK "67 arithmetic (8 add, 13 sub, 40 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_JD "108 arithmetic (8 add, 13 sub, 74 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_IK_JD "124 arithmetic (15 add, 16 sub, 80 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
@@ -108,8 +110,9 @@
 #define PRRU_P4_OPS_REACTION_BASIS "320 arithmetic (39 add, 57 sub, 167 mul, 5 div, 52 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_EOM_SOLVE "1249 arithmetic (272 add, 143 sub, 820 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 #define PRRU_P4_OPS_INVERSE_TERMS "1263 arithmetic (287 add, 132 sub, 830 mul, 10 div, 4 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_JOINT_REACTIONS "2319 arithmetic (566 add, 429 sub, 1290 mul, 15 div, 19 neg); calls: cos 2, sin 2, sqrt 6, tanh 4"
-#define PRRU_P4_OPS_REACTION_NULLSPACE "78 arithmetic (8 add, 9 sub, 45 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4"
+#define PRRU_P4_OPS_JOINT_REACTIONS "2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4"
+#define PRRU_P4_OPS_REACTION_NULLSPACE "77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4"
+#define PRRU_P4_OPS_REGRESSOR "1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 /* Whether the inputs of prru_p4_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -222,6 +225,9 @@ void prru_p4_joint_reactions(const prru_params4 *p, const double q[3], const dou
 
 /* z of joint_reactions at q alone. Parameters from *p. */
 void prru_p4_reaction_nullspace(const prru_params4 *p, const double q[3], double z[76]);
+
+/* Regressor Y (3x142, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
+void prru_p4_regressor(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], double Y[426]);
 
 /* Batched kernels, prru_p4_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n

@@ -640,6 +640,91 @@ static void check_model_params_of_pi(const prru_base *b)
   TU_TRUE(st == PRRU_EINPUT && strstr(why, "damping1 = -1 is negative"), "a negative damping is named");
 }
 
+/* A model of another geometry, loaded at run time, is identified without
+ * a build of its own: the topology's regressor (geometry and gravity
+ * read at run time) satisfies Y pi = M qdd + h - G - passive of the loaded
+ * model, and its identification from its own exact inverse dynamics at
+ * random states returns its base parameters. Tolerances: Y pi is a
+ * straight-line program of PRRU_P<n>_ARITH_REGRESSOR operations, so its
+ * forward error is at most that many u times the magnitude of the terms
+ * (|M qdd| + |h| + |G| + |passive|, each a sum of products of the same
+ * parameters); the fit's errors, for exact data, are rounding amplified
+ * by the regressor's conditioning, and the issue's bound is 1e-8 of each
+ * base parameter's resolution (the report's column). */
+#if PRRU_NLIMB == 3
+#include "prru_p3_kernels.h"
+#define ARITH_REGRESSOR PRRU_P3_ARITH_REGRESSOR
+static const char *const other_geometry[] = {"models/prototype_example.json",
+                                             "tests/models/conformance/valid/random_3.json"};
+#else
+#include "prru_p4_kernels.h"
+#define ARITH_REGRESSOR PRRU_P4_ARITH_REGRESSOR
+static const char *const other_geometry[] = {"tests/models/conformance/valid/random_1.json",
+                                             "tests/models/conformance/valid/random_2.json"};
+#endif
+
+static void check_other_geometry(const char *src, const char *file)
+{
+  char path[4096], msg[1024], what[4400];
+  snprintf(path, sizeof path, "%s/%s", src, file);
+  prru_model m;
+  prru_model_default(&m);
+  if (!TU_TRUE(prru_model_load(&m, path, msg, sizeof msg) == PRRU_OK, path)) return;
+  if (prru_model_is_built(&m, 1)) {
+    printf("%s: SKIPPED: its geometry and gravity are the build's\n", file);
+    prru_model_free(&m);
+    return;
+  }
+  prru_data *d = malloc(sizeof *d);
+  double pi[PRRU_NREG], worst = 0;
+  const double vs = prru_ident_default_vs(&m);
+  prru_ident_standard(m.mech, pi);
+  unsigned long long seed = 777;
+  enum { N = 200 };
+  double *q = malloc(sizeof(double) * 3 * N * 3), *qd = q + 3 * N, *qdd = qd + 3 * N;
+  double *fd = malloc(sizeof(double) * PRRU_NACT * N);
+  int n = 0;
+  for (int s = 0; s < N; s++) {
+    double Y[3 * PRRU_NREG], M[9], h[3], G[3], Qp[3], tau[3], yp[3], scale = 0;
+    if (prru_ident_random_state(&m, d, &seed, q + 3 * n, qd + 3 * n, qdd + 3 * n) != PRRU_OK) break;
+    const double *x = q + 3 * n, *v = qd + 3 * n, *a = qdd + 3 * n;
+    prru_model_regressor(&m, x, v, a, vs, Y);
+    prru_model_dynamics(&m, x, v, M, h, G);
+    prru_model_passive(&m, x, v, Qp);
+    for (int i = 0; i < 3; i++) {
+      const double Ma = M[3 * i] * a[0] + M[3 * i + 1] * a[1] + M[3 * i + 2] * a[2];
+      tau[i] = Ma + h[i] - G[i] - Qp[i];
+      scale = fmax(scale, fabs(M[3 * i]) * fabs(a[0]) + fabs(M[3 * i + 1]) * fabs(a[1]) +
+                              fabs(M[3 * i + 2]) * fabs(a[2]) + fabs(h[i]) + fabs(G[i]) + fabs(Qp[i]));
+    }
+    y_times(Y, pi, yp);
+    for (int i = 0; i < 3; i++) worst = fmax(worst, fabs(yp[i] - tau[i]) / scale);
+    static const prru_loads none;
+    if (prru_inverse_dynamics(&m, d, x, v, a, &none, fd + PRRU_NACT * n) == PRRU_OK) n++;
+  }
+  const double bound = ARITH_REGRESSOR * DBL_EPSILON;
+  printf("%s (parameter kernels): Y pi vs its dynamics over %d states: %.2e of the terms (bound %.2e)\n", file, n,
+         worst, bound);
+  snprintf(what, sizeof what, "%s (parameter kernels): Y pi = its dynamics (%d states)", file, n);
+  tu_check(worst <= bound, what, worst, bound);
+  prru_base *b = malloc(sizeof *b);
+  prru_ident_result *r = malloc(sizeof *r);
+  int bad = -1, st = prru_base_compute(&m, vs, 0, 1, b);
+  if (st == PRRU_OK) st = prru_identify(&m, b, n, q, qd, qdd, fd, r, &bad);
+  snprintf(what, sizeof what, "%s: identified without a build of its own (status %d)", file, st);
+  if (TU_TRUE(st == PRRU_OK && n >= N / 2, what)) {
+    double beta_true[PRRU_NREG], err = 0;
+    prru_base_params(b, pi, beta_true);
+    for (int i = 0; i < b->nbase; i++) err = fmax(err, fabs(r->beta[i] - beta_true[i]) / r->scale[i]);
+    snprintf(what, sizeof what, "%s: base parameters within 1e-8 of their resolution (%d of them)", file, b->nbase);
+    printf("%s: %d base parameters identified from its exact forces: %.2e of their resolution\n", file, b->nbase,
+           err);
+    tu_check(err <= 1e-8, what, err, 1e-8);
+  }
+  free(b), free(r), free(q), free(fd), free(d);
+  prru_model_free(&m);
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -653,6 +738,9 @@ int main(void)
   check_excite(b);
   check_identify(b);
   check_model_params_of_pi(b);
+  const char *src = getenv("PRRU_SOURCE_DIR");
+  if (TU_TRUE(src != NULL, "PRRU_SOURCE_DIR set (ctest sets it)"))
+    for (size_t k = 0; k < sizeof other_geometry / sizeof *other_geometry; k++) check_other_geometry(src, other_geometry[k]);
   /* A truth other than the model (the prior): every inertial and drive
    * number perturbed, Coulomb smoothing as in the base parameters. */
   prru_mechanism me;

@@ -130,12 +130,13 @@ def param_kernels(deriv, pmodel, prefix):
             for k in kernels(deriv) if k.name in PARAM_KERNELS]
 
 
-def topology_kernels(deriv, pmodel, ctype):
-    """Every kernel of deriv, the derivation of ParamModel pmodel, each with
-    the leading `const <ctype> *p` argument: the topology kernels."""
+def topology_kernels(deriv, pmodel, ctype, extra=()):
+    """Every kernel of deriv, the derivation of ParamModel pmodel, and the
+    kernels extra of the same derivation, each with the leading `const
+    <ctype> *p` argument: the topology kernels."""
     arg = ParamsArg(ctype, pmodel.order, local_name, _access)
     # p is the parameters: poses' output p (the centres) becomes pos.
     return [Kernel(k.name, k.doc, k.inputs,
                    [("pos" if arr == "p" else arr, x) for arr, x in k.outputs],
                    k.guards, arg, k.witnesses, k.pattern)
-            for k in kernels(deriv)]
+            for k in list(kernels(deriv)) + list(extra)]

@@ -131,6 +131,24 @@ def regressor_kernel(model, deriv, rmodel):
     return Kernel("regressor", doc, inputs, [("Y", y)], deriv.mech.guards)
 
 
+def topology_regressor_kernel(deriv, pmodel):
+    """The Kernel `regressor` of the topology derivation deriv of
+    params.ParamModel pmodel: geometry, gravity and the Coulomb smoothing
+    velocity are its parameters (p->b[i], ..., p->coulomb_velocity), the
+    inertial and drive parameters differentiated away as above, so that a
+    model of any numbers loaded at run time is identified with the same
+    regressor as its own build's (whose numbers are constants there)."""
+    qdd = [sym.sym("qdd%d" % (i + 1)) for i in range(3)]
+    y, npar = _columns(pmodel, deriv, qdd)
+    doc = ("Regressor Y (3x%d, row-major) with J_d^T fd = M qdd + h - G - "
+           "passive = Y pi, pi the standard parameters (prru_regressor.h's "
+           "order); geometry, gravity and the Coulomb smoothing velocity "
+           "from *p, its inertial and drive numbers unused." % npar)
+    inputs = [("q", ["q1", "q2", "q3"]), ("qd", ["qd1", "qd2", "qd3"]),
+              ("qdd", ["qdd1", "qdd2", "qdd3"])]
+    return Kernel("regressor", doc, inputs, [("Y", y)], deriv.mech.guards)
+
+
 def model_standard(model):
     """The model's standard parameters in column order, exact: m, m c and
     the inertia about the body-frame origin, then the drives."""

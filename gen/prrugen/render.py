@@ -235,7 +235,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     n = pmodel.nlimb
     prefix, ctype = topology_prefix(n), topology_ctype(n)
     upper = prefix.upper()
-    kernel_list = params.topology_kernels(deriv, pmodel, ctype)
+    kernel_list = params.topology_kernels(
+        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)])
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
     banner = _banner(_topology_head(n, reference), emitted)
     macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"

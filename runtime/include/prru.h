@@ -104,6 +104,10 @@ typedef struct prru_kernel_table {
   void (*passive)(const void *p, const double q[3], const double qd[3], double Qp[3]);
   void (*batch_dme_terms)(const void *p, int n, const double *q, double *d, double *Jd, double *M,
                           double *JP);
+  /* The identification regressor Y (3 x PRRU_NREG, prru_regressor.h) at
+   * the Coulomb smoothing velocity vs. */
+  void (*regressor)(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
+                    double *Y);
 } prru_kernel_table;
 
 typedef struct {

@@ -74,6 +74,14 @@ typedef struct {
 int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
                             double q[3], double qd[3], double qdd[3]);
 
+/* The regressor Y (3 x PRRU_NREG, row-major; prru_regressor.h's columns)
+ * of model m at (q, qd, qdd) with Coulomb smoothing velocity vs: the
+ * build's specialised kernel for the build's own numbers, the topology's
+ * (geometry and gravity read at run time) for a loaded model, so that a
+ * model of any geometry is identified without a build of its own. */
+void prru_model_regressor(const prru_model *m, const double q[3], const double qd[3], const double qdd[3], double vs,
+                          double *Y);
+
 /* The Coulomb smoothing velocity identification evaluates the regressor
  * with unless told otherwise: the model's, else 1 mm/s (m/s). */
 double prru_ident_default_vs(const prru_model *m);

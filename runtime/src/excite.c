@@ -216,7 +216,7 @@ static double merit(const gsl_vector *x, void *ctx)
       excess += ex;
       continue;
     }
-    prru_regressor(q, qd, qdd, &c->b->vs, Y);
+    prru_model_regressor(c->m, q, qd, qdd, c->b->vs, Y);
     prru_base_regressor(c->b, Y, 3, Yb);
     for (int r = 0; r < 3; r++)
       for (int j = 0; j < p; j++) gsl_matrix_set(c->W, 3 * (size_t)s + (size_t)r, (size_t)j, Yb[r * p + j]);

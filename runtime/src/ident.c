@@ -115,7 +115,7 @@ static int stack_states(const prru_model *m, double vs, int nstates, unsigned lo
     double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG];
     st = prru_ident_random_state(m, d, &s, q, qd, qdd);
     if (st != PRRU_OK) break;
-    prru_regressor(q, qd, qdd, &vs, Y);
+    prru_model_regressor(m, q, qd, qdd, vs, Y);
     for (int r = 0; r < 3; r++)
       for (int j = 0; j < PRRU_NREG; j++) gsl_matrix_set(W, 3 * (size_t)i + r, j, Y[r * PRRU_NREG + j]);
   }
@@ -254,7 +254,7 @@ int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const
   int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
   double Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG], tau[3];
-  prru_regressor(q, qd, qdd, &b->vs, Y);
+  prru_model_regressor(m, q, qd, qdd, b->vs, Y);
   prru_base_regressor(b, Y, 3, Yb);
   for (int k = 0; k < 3; k++) {
     tau[k] = 0;

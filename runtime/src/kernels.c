@@ -10,6 +10,7 @@
 #include "internal.h"
 #include "prru.h"
 #include "prru_param_kernels.h"
+#include "prru_regressor.h"
 
 #if PRRU_NLIMB == 3
 #include "prru_p3_kernels.h"
@@ -116,6 +117,12 @@ static void s_batch_dme_terms(const void *p, int n, const double *q, double *d, 
   (void)p, prru_batch_dme_terms(n, q, d, Jd, M, JP);
 }
 
+static void s_regressor(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
+                        double *Y)
+{
+  (void)p, prru_regressor(q, qd, qdd, &vs, Y);
+}
+
 const prru_kernel_table prru_kernels_specialised = {
   "specialised",  s_ik,      s_jd,
   s_ik_jd,        s_mass,    s_dynamics,
@@ -123,6 +130,7 @@ const prru_kernel_table prru_kernels_specialised = {
   s_inverse_terms, s_unseen_inverse_terms, s_joint_reactions,
   s_platform_jacobian, s_poses, s_energy,
   s_actuator_rates, s_passive, s_batch_dme_terms,
+  s_regressor,
 };
 
 /* ---- parameter: the topology's kernels, p a prru_params ---- */
@@ -208,6 +216,16 @@ static void p_batch_dme_terms(const void *p, int n, const double *q, double *d, 
   P(batch_dme_terms)(TP(p), n, q, d, Jd, M, JP);
 }
 
+/* The topology's regressor reads the smoothing velocity from its
+ * parameters: a copy with vs in it. */
+static void p_regressor(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
+                        double *Y)
+{
+  topo_params c = *TP(p);
+  c.coulomb_velocity = vs;
+  P(regressor)(&c, q, qd, qdd, Y);
+}
+
 const prru_kernel_table prru_kernels_parameter = {
   "parameter",    p_ik,      p_jd,
   p_ik_jd,        p_mass,    p_dynamics,
@@ -215,4 +233,5 @@ const prru_kernel_table prru_kernels_parameter = {
   p_inverse_terms, p_unseen_inverse_terms, p_joint_reactions,
   p_platform_jacobian, p_poses, p_energy,
   p_actuator_rates, p_passive, p_batch_dme_terms,
+  p_regressor,
 };

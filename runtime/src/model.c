@@ -368,6 +368,12 @@ void prru_model_passive(const prru_model *m, const double q[3], const double qd[
   KERNEL(m, passive)(m->kernel_params, q, qd, Qp);
 }
 
+void prru_model_regressor(const prru_model *m, const double q[3], const double qd[3], const double qdd[3], double vs,
+                          double *Y)
+{
+  KERNEL(m, regressor)(m->kernel_params, q, qd, qdd, vs, Y);
+}
+
 void prru_model_platform_jacobian(const prru_model *m, const double q[3], double JP[18])
 {
   KERNEL(m, platform_jacobian)(m->kernel_params, q, JP);
