@@ -26,21 +26,6 @@ static int coulomb_velocity(const char *cmd, const char *text, double *vs)
   return 0;
 }
 
-/* 0, or 2 after the reason when the current model (--model's) has
- * another geometry or gravity than the build's: the identification
- * regressor (prru_regressor.h) is generated for the build's alone; the
- * masses, inertias and drives may differ (they are what is identified). */
-static int require_built_geometry(const char *cmd)
-{
-  const prru_model *m = prru_cli_model();
-  if (prru_model_is_built(m, 1)) return 0;
-  prru_cli_error(cmd, "model %s (--model or PRRU_MODEL): its geometry or gravity differs from the build's "
-                 "model (%s, %s); the identification regressor exists only for the build's geometry and "
-                 "gravity: identification needs a build of that model: make build MODEL=%s",
-                 m->mech->model_file, prru_mech.name, prru_mech.model_file, m->mech->model_file);
-  return 2;
-}
-
 static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_base **b)
 {
   *b = malloc(sizeof **b);
@@ -249,7 +234,6 @@ int prru_cmd_excite(int argc, char **argv)
            prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","));
     return 0;
   }
-  if (require_built_geometry("excite")) return 2;
   prru_excite_options o;
   prru_fourier f;
   int periods;
@@ -772,7 +756,6 @@ int prru_cmd_identify(int argc, char **argv)
            prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","));
     return 0;
   }
-  if (require_built_geometry("identify")) return 2;
   char name[32];
   prru_diff_options dopt;
   double vs;

@@ -84,16 +84,6 @@ def _base(model, vs):
     return b
 
 
-def _require_built_geometry(model, what):
-    """The identification regressor is generated for the library's own
-    geometry and gravity (masses, inertias and drives may differ)."""
-    if not model.lib.model_is_built(ctypes.byref(model._m), 1):
-        raise errors.make_error(errors.EINPUT, "%s: model %s has another geometry or gravity than the "
-                                "library's model (%s): the identification regressor exists only for that one; "
-                                "build the library for this model" % (what, model.model_file, model.lib.mech.name
-                                                                       .decode()))
-
-
 def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0.0, 0.0), amplitude=None,
            limits=None, rcond_min=1e-2, evals=3000, samples=100, seed=1, coulomb_velocity=None):
     """An excitation trajectory for identification (prru excite): each
@@ -106,7 +96,6 @@ def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0
     checked at 20 times as many points. Sampled every dt over periods
     periods. Returns Excitation. Raises InputError for bad options or
     centre, NoConvergence when no feasible trajectory is found."""
-    _require_built_geometry(self, "excite")
     lib, t = self.lib, self.lib.types
     lim, c = _c_limits(self, limits)
     o = t.ExciteOptions()
@@ -207,12 +196,11 @@ def identify(self, t, q, qd, qdd, fd, *, name=None, coulomb_velocity=None):
     base parameters, or, where none has them, the consistent set nearest
     the estimate within its covariance. name: the model's name (default
     this model's name + "_id"). Returns Identification. Raises InputError
-    naming the sample that is unreachable or singular, for too few samples
-    or another geometry than the library's; Singular when the motion does
+    naming the sample that is unreachable or singular or for too few
+    samples; Singular when the motion does
     not excite every base parameter, or when the data contradict physics
     (no consistent robot within the covariance: a force sign, a gear
     ratio, a unit; .result then holds the fit without a model)."""
-    _require_built_geometry(self, "identify")
     lib, T = self.lib, self.lib.types
     tt = _convert.ordered("t", t, "a sequence of times")
     n = len(tt)
