@@ -2,6 +2,7 @@
 """Generate the C dynamics kernels of a 3-PRRU model file.
 
 usage: python3 gen/prru_gen.py MODEL.json --out DIR [--prefix NAME] [--quiet]
+       python3 gen/prru_gen.py MODEL.json --precision float --out DIR [...]
        python3 gen/prru_gen.py --topology {3,4} --out DIR [--quiet]
 
 Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
@@ -13,8 +14,10 @@ identification), where <prefix> is the model's "name" unless
 DIR/prru_pN_kernels.{h,c}: every kernel with every number of the model read
 from a prru_paramsN argument, derived from the structure of the N-limb
 machine alone (the same files whatever model a build uses; the library of
-every build carries both). Nothing in DIR changes unless generation
-succeeds.
+every build carries both). With --precision float instead, writes only
+DIR/<prefix>_f_kernels.{h,c}: the controller kernels (render.CONTROLLER_KERNELS)
+in single precision, named <prefix>_f_*, so that they link beside the double
+set. Nothing in DIR changes unless generation succeeds.
 """
 
 import argparse
@@ -27,7 +30,7 @@ sys.setrecursionlimit(20000)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from prrugen import model as model_mod  # noqa: E402
-from prrugen import mechanism, dynamics, output, params, regressor, \
+from prrugen import cgen, mechanism, dynamics, output, params, regressor, \
     render, sym  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -63,6 +66,41 @@ def generate_model(model, templates_dir=TEMPLATES, prefix=None):
                                                templates_dir, prefix)
     files.update(rfiles)
     return files, emitted + pemitted + remitted
+
+
+def generate_float(model, templates_dir=TEMPLATES, prefix=None):
+    """(files {name: text}, emitted kernels) of the single-precision
+    controller kernels of a loaded model (render.render_float): the same
+    derivation as generate_model's, spelled in float. ModelError naming
+    the model file if a constant of the kernels is finite and nonzero as a
+    double but overflows or underflows a float."""
+    sym.reset()
+    deriv = dynamics.Derivation(mechanism.build(model), model)
+    try:
+        return render.render_float(model, deriv, templates_dir, prefix)
+    except cgen.RangeError as exc:
+        raise _range_error(model, exc) from None
+
+
+def _range_error(model, exc):
+    """The ModelError of a constant out of float's range, naming the key of
+    the file's number most likely to blame: the largest magnitude for an
+    overflow, the smallest nonzero one for an underflow (the kernels'
+    constants are products and quotients of the file's numbers)."""
+    numbers = [(k, abs(v)) for k, v in model.numbers if v != 0]
+    over = abs(exc.value) > 1
+    key = None
+    if numbers:
+        key, value = (max if over else min)(numbers, key=lambda kv: kv[1])
+        blame = "; the file's %s number is this one, %s" % (
+            "largest" if over else "smallest nonzero", repr(float(value)))
+    else:
+        blame = ""
+    return model_mod.ModelError(
+        model.path, key, "cannot be generated in single precision: a constant "
+        "of kernel %s derived from the model's numbers, %r, %s%s (rescale "
+        "the model's units, or use the double kernels)"
+        % (exc.kernel, exc.value, exc.reason, blame))
 
 
 def generate_topology(nlimb, templates_dir=TEMPLATES):
@@ -105,12 +143,22 @@ def main(argv=None):
     parser.add_argument("--prefix", metavar="NAME", type=_prefix,
                         help="C prefix of the generated functions and types "
                         "(default: the model's name)")
+    parser.add_argument("--precision", choices=("double", "float"),
+                        default="double",
+                        help="double (default): every kernel, the descriptor, "
+                        "the runtime-parameter kernels and the regressor; "
+                        "float: only the controller kernels in single "
+                        "precision, named <prefix>_f_* (writes "
+                        "<prefix>_f_kernels.{h,c})")
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
     if (args.model is None) == (args.topology is None):
         parser.error("give a model file or --topology, not %s"
                      % ("both" if args.model else "neither"))
+    if args.topology is not None and args.precision != "double":
+        parser.error("--precision float applies to a model file's kernels "
+                     "only (the topology kernels are double)")
     if args.topology is not None and args.prefix:
         parser.error("--prefix applies to a model file's kernels only "
                      "(the topology kernels are prru_p<N>_*)")
@@ -131,7 +179,14 @@ def _run(args):
         for warning in model.warnings():
             print("prru_gen: warning: %s: %s" % (args.model, warning),
                   file=sys.stderr)
-        files, emitted = generate_model(model, prefix=args.prefix)
+        try:
+            if args.precision == "float":
+                files, emitted = generate_float(model, prefix=args.prefix)
+            else:
+                files, emitted = generate_model(model, prefix=args.prefix)
+        except model_mod.ModelError as exc:
+            print("prru_gen: error: %s" % exc, file=sys.stderr)
+            return 1
     try:
         output.write_files_atomically(args.out, files)
     except OSError as exc:

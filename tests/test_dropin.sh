@@ -7,18 +7,25 @@
 # main.c) into an empty directory, build with nothing but -lm under strict
 # warnings as C99 and C11 with gcc and clang and as C++ with g++, and run
 # each binary against the spec's section 10 reference point.
+# The single-precision controller set (gen/prru_gen.py --precision float,
+# prru_f_*) is generated here from the paper's model (it is not committed)
+# and built the same ways with tests/dropin_float_main.c, linked beside the
+# double set in one program.
 #
 # A missing clang or g++ is reported as SKIPPED (nothing is installed here);
 # set PRRU_DROPIN_REQUIRE_ALL=1 (CI does) to make a skipped compiler a failure.
 set -u
 
 SRC=${PRRU_SOURCE_DIR:-$(cd "$(dirname "$0")/.." && pwd)}
-FLAGS=(-O2 -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wdouble-promotion -Werror)
+FLAGS=(-O2 -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wfloat-conversion -Wdouble-promotion -Werror)
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/prru-dropin.XXXXXX") || exit 1
 trap 'rm -rf "$work"' EXIT
 cp -R "$SRC/generated/." "$work/" || { echo "FAIL: cannot copy $SRC/generated"; exit 1; }
 cp "$SRC/tests/dropin_main.c" "$work/main.c" || exit 1
+cp "$SRC/tests/dropin_float_main.c" "$work/float_main.c" || exit 1
+"${PYTHON:-python3}" "$SRC/gen/prru_gen.py" "$SRC/models/3prru_paper.json" --precision float \
+  --prefix prru --out "$work" --quiet || { echo "FAIL: cannot generate the float set"; exit 1; }
 cd "$work" || exit 1
 
 fail=0
@@ -30,6 +37,8 @@ skipped=()
 for f in ./*.c ./*.h; do
   allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"|"prru_p[34]_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
+  case "$f" in ./prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"prru_f_kernels\.h"' ;; esac
+  [ "$f" = ./float_main.c ] && allowed='<math\.h>|<stdio\.h>|"prru_kernels\.h"|"prru_f_kernels\.h"'
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then
     echo "FAIL: $f includes more than <math.h> and its own header:"
@@ -38,19 +47,36 @@ for f in ./*.c ./*.h; do
   fi
 done
 
+# Single precision throughout: no double in the float set's text at all.
+if grep -nw double prru_f_kernels.c prru_f_kernels.h; then
+  echo "FAIL: the float set names double (above)"
+  fail=1
+fi
+
 kernels=()
-for f in ./*.c; do [ "$f" = ./main.c ] || kernels+=("$f"); done
+for f in ./*.c; do
+  case "$f" in ./main.c | ./float_main.c | ./prru_f_kernels.c) ;; *) kernels+=("$f") ;; esac
+done
 
 build_and_run() { # label compiler args...
-  local label=$1 cc=$2
-  shift 2
+  build_and_run_main main.c "$@"
+  build_and_run_main float_main.c "$1 float" "${@:2}"
+}
+
+build_and_run_main() { # main label compiler args...
+  local main=$1 label=$2 cc=$3
+  shift 3
+  local sources=("${kernels[@]}")
+  # The float program needs only the two controller sets (the rest of
+  # generated/ is built with main.c already).
+  [ "$main" = float_main.c ] && sources=(./prru_kernels.c ./prru_f_kernels.c)
   if ! command -v "$cc" >/dev/null 2>&1; then
     echo "SKIPPED $label: $cc not installed"
     skipped+=("$label")
     return
   fi
   local exe="./dropin_${label//[^a-z0-9]/_}"
-  if ! "$cc" "$@" "${FLAGS[@]}" -I. main.c "${kernels[@]}" -o "$exe" -lm >"$exe.log" 2>&1; then
+  if ! "$cc" "$@" "${FLAGS[@]}" -I. "$main" "${sources[@]}" -o "$exe" -lm >"$exe.log" 2>&1; then
     echo "FAIL $label: compile"
     cat "$exe.log"
     fail=1

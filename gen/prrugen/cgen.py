@@ -10,6 +10,8 @@ reciprocal per denominator, so the only divisions are 1/x.
 """
 
 import heapq
+import math
+import struct
 from fractions import Fraction
 
 from . import sym
@@ -186,13 +188,80 @@ class Graph:
         return self.node("mul", self._ipow(base, p - 1), base)
 
 
-def print_op(n, expr, parent_prec=0, right=False):
+class RangeError(ValueError):
+    """A constant of a kernel that is finite and nonzero as a double but
+    not a normal number in the precision asked for."""
+
+    def __init__(self, value, reason):
+        self.value, self.reason = value, reason
+        super().__init__("constant %r %s" % (value, reason))
+
+
+FLT_MAX = struct.unpack("<f", b"\xff\xff\x7f\x7f")[0]
+FLT_MIN = 2.0 ** -126
+
+
+def _round_float(x):
+    """x rounded to the nearest IEEE binary32, as a Python float (inf when
+    it overflows)."""
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return math.copysign(math.inf, x)
+
+
+def c_float(text):
+    """A C float literal (f suffix) of the binary32 nearest the double
+    constant text (a c_double), the shortest that rounds back to it.
+    RangeError if it overflows or falls below FLT_MIN (a subnormal keeps
+    fewer digits than the kernels' accuracy assumes; 0 loses the term)."""
+    x = float(text)
+    f = _round_float(x)
+    if math.isinf(f):
+        raise RangeError(x, "overflows single precision (above FLT_MAX "
+                         "%.9g)" % FLT_MAX)
+    if x != 0 and abs(f) < FLT_MIN:
+        raise RangeError(x, "underflows single precision (below FLT_MIN "
+                         "%.9g)" % FLT_MIN)
+    for digits in range(1, 10):
+        s = "%.*g" % (digits, f)
+        if _round_float(float(s)) == f:
+            break
+    # The same digits as Python writes a double (100.0, not 1e+02; always
+    # a '.' or an exponent, so the suffix makes a float literal).
+    return repr(float(s)) + "f"
+
+
+class Precision:
+    """How the emitter spells one floating-point type: the C type, the
+    literals, the <math.h> names (sin or sinf), the largest finite value
+    of the finiteness guards and the NaN fill. The symbolic expressions and
+    their lowering (the CSE graph) are the same for every precision."""
+
+    def __init__(self, name, literal, suffix, huge, nan):
+        self.name = self.ctype = name
+        self.literal, self.suffix = literal, suffix
+        self.huge, self.nan = huge, nan
+
+    def call(self, fn):
+        return fn + self.suffix
+
+
+DOUBLE = Precision("double", lambda text: text, "",
+                   "1.7976931348623157e308", "(double)NAN")
+FLOAT = Precision("float", c_float, "f", "FLT_MAX", "NAN")
+PRECISIONS = {"double": DOUBLE, "float": FLOAT}
+
+
+def print_op(n, expr, parent_prec=0, right=False, call=None):
     """C text of operation node n, its operands printed by
     expr(node, precedence, right) (a temporary's name, an input, or the
-    operand inline)."""
+    operand inline); call(name) spells a <math.h> function (default: as
+    named, the double one)."""
     op = n.op
     if op == "call":
-        return "%s(%s)" % (n.args[0], ", ".join(expr(a) for a in n.args[1:]))
+        return "%s(%s)" % (call(n.args[0]) if call else n.args[0],
+                           ", ".join(expr(a) for a in n.args[1:]))
     if op == "neg":
         s = "-" + expr(n.args[0], 3)
     else:
@@ -371,8 +440,12 @@ class Lowered:
                 counts[key] = counts.get(key, 0) + 1
 
 
-def emit(kernel, prefix):
+def emit(kernel, prefix, precision=DOUBLE):
+    """The C function of kernel, named <prefix>_<kernel.name>, in the
+    precision given (DOUBLE or FLOAT): the same graph, spelled for that
+    type. RangeError if a constant does not fit the type."""
     params = kernel.params
+    real, lit = precision.ctype, precision.literal
     low = Lowered(kernel)
     names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
     guard_nodes, finite_nodes, out_nodes = low.guard_nodes, low.finite_nodes, low.out_nodes
@@ -387,23 +460,23 @@ def emit(kernel, prefix):
         if n.op == "in":
             return n.args[0]
         if n.op == "num":
-            return n.args[0]
+            return lit(n.args[0])
         if n.index in temp:
             return temp[n.index]
         return inline(n, parent_prec, right)
 
     def inline(n, parent_prec=0, right=False):
-        return print_op(n, expr, parent_prec, right)
+        return print_op(n, expr, parent_prec, right, precision.call)
 
     # Inputs of the guard first, then the guard, then everything else.
     guard_live = _uses(guard_nodes)[1] if guard_nodes else set()
     lines = []
     for arr, syms in kernel.inputs:
         for i, s in enumerate(syms):
-            lines.append("const double %s%d = %s[%d];" % (arr, i + 1, arr, i))
+            lines.append("const %s %s%d = %s[%d];" % (real, arr, i + 1, arr, i))
     used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
     if params is not None:
-        lines += ["const double %s = %s;" % (params.local(s), params.access(s))
+        lines += ["const %s %s = %s;" % (real, params.local(s), params.access(s))
                   for s in params.order]
     lines = [l for l in lines if l.split()[2] in used_inputs]
 
@@ -413,16 +486,18 @@ def emit(kernel, prefix):
             if i in temp or not materialized(n):
                 continue
             name = "t%d" % len(temp)
-            lines.append("const double %s = %s;" % (name, inline(n)))
+            lines.append("const %s %s = %s;" % (real, name, inline(n)))
             temp[i] = name
 
     if guard_nodes:
         emit_temps(guard_live)
-        conds = ["fabs(%s) <= 1.0" % expr(n) for n in guard_nodes]
-        conds += ["fabs(%s) <= 1.7976931348623157e308" % expr(n)
+        fabs = precision.call("fabs")
+        conds = ["%s(%s) <= %s" % (fabs, expr(n), lit("1.0"))
+                 for n in guard_nodes]
+        conds += ["%s(%s) <= %s" % (fabs, expr(n), precision.huge)
                   for n in finite_nodes]
-        fills = ["for (int i = 0; i < %d; i++) %s[i] = (double)NAN;" % (len(ns), arr)
-                 for arr, ns in out_nodes]
+        fills = ["for (int i = 0; i < %d; i++) %s[i] = %s;"
+                 % (len(ns), arr, precision.nan) for arr, ns in out_nodes]
         lines.append("/* Unreachable or non-finite q: every output is NaN. */")
         lines.append("if (!(%s)) {" % " &&\n      ".join(conds))
         lines += ["  " + f for f in fills]
@@ -445,7 +520,7 @@ def emit(kernel, prefix):
             if done:
                 if materialized(n) and n.index not in temp:
                     temp[n.index] = "t%d" % len(temp)
-                    lines.append("const double %s = %s;" % (temp[n.index], inline(n)))
+                    lines.append("const %s %s = %s;" % (real, temp[n.index], inline(n)))
                 continue
             if not pending(n) or n.index in seen:
                 continue
@@ -466,9 +541,9 @@ def emit(kernel, prefix):
         args.append("const %s *p" % params.ctype)
         if not any(params.local(s) in used_inputs for s in params.order):
             lines.insert(0, "(void)p;")
-    args += ["const double %s[%d]" % (arr, len(syms))
+    args += ["const %s %s[%d]" % (real, arr, len(syms))
              for arr, syms in kernel.inputs]
-    args += ["double %s[%d]" % (arr, len(ns)) for arr, ns in out_nodes]
+    args += ["%s %s[%d]" % (real, arr, len(ns)) for arr, ns in out_nodes]
     signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(args))
     body = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
     return Emitted(kernel.name, signature, body, counts, kernel.doc)

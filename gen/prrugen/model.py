@@ -169,6 +169,7 @@ class Model:
         self.sha256 = sha256
         self.path = path
         self.drives = Drives(len(limbs))
+        self.numbers = ()       # (key, value) of the file's numbers (parse)
 
     @property
     def nlimb(self):
@@ -665,7 +666,21 @@ def parse(text, path="<model>"):
     m = Model(name, description, fmt, gravity, limbs, tuple(masses),
               tuple(coms), tuple(inertias), *terms, sha256=sha, path=path)
     m.drives = drives
+    m.numbers = tuple(_numbers(data))
     return m
+
+
+def _numbers(value, key=""):
+    """(key, value) of every number of parsed JSON, keys as messages name
+    them (bodies.P.mass, geometry.b[2])."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from _numbers(v, (key + "." if key else "") + _key_text(k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from _numbers(v, "%s[%d]" % (key, i))
+    elif isinstance(value, (int, Fraction)) and not isinstance(value, bool):
+        yield key, Fraction(value)
 
 
 def load(path):

@@ -303,6 +303,40 @@ class HostileModels(unittest.TestCase):
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertFalse(os.path.exists(os.path.dirname(fresh)))
 
+    def test_float_refuses_a_constant_beyond_single_precision(self):
+        # Every number in range ([1e-9, 1e6]), but the armature the drives
+        # reflect, rotor_inertia (2 pi gear / lead)^2, is 4e37 kg and M's
+        # constants reach 1.6e42: finite as doubles, inf as floats. The
+        # double kernels generate; the float ones are refused, naming the
+        # file's largest number (gear and rotor_inertia tie; gear first).
+        with open(os.path.join(ROOT, "models", "prototype_drives.json"),
+                  encoding="utf-8") as f:
+            m = json.load(f)
+        m["actuators"] = {"lead": 1e-9, "gear": 1e6, "rotor_inertia": 1e6,
+                          "damping": 18.0, "coulomb": 3.2,
+                          "coulomb_velocity": 0.004}
+        path = os.path.join(self.tmp.name, "float_overflow.json")
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(m, f)
+        r = subprocess.run([sys.executable, ENTRY, path, "--precision",
+                            "float", "--out", self.out],
+                           capture_output=True, text=True, timeout=TIMEOUT)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertEqual(r.stdout, "")
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        self.assertTrue(lines[0].startswith(
+            "prru_gen: error: %s: actuators.gear: cannot be generated in "
+            "single precision: " % path), lines[0])
+        self.assertIn("overflows single precision", lines[0])
+        self.assertEqual(snapshot(self.out), self.before,
+                         "output directory changed")
+        out = os.path.join(self.tmp.name, "float_overflow_double")
+        r = subprocess.run([sys.executable, ENTRY, path, "--out", out,
+                            "--quiet"], capture_output=True, text=True,
+                           timeout=TIMEOUT)
+        self.assertEqual(r.returncode, 0, r.stderr)
+
     def test_largest_accepted_file_still_generates(self):
         # The size limit is inclusive: a valid model padded to exactly
         # MAX_BYTES is accepted, so the limit rejects size, not content.
