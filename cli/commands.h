@@ -204,15 +204,6 @@ typedef struct {
  * and the values for rail forces fd (prru_model_motor_units); nothing
  * when !motor. */
 void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current);
-/* A model writer's actuators keys after coulomb_velocity: the current
- * model's section-13 keys in the forms its file gives them, each
- * ",\n    \"key\": value" (one number, or a list where the actuators
- * differ). armature: the written model's (identified, optimised); where
- * the file gives rotor_inertia it goes back there (k / (2 pi gear /
- * lead)^2; the file's own value where k is unchanged) and the writer
- * writes no "armature" (prru_cli_writes_armature). */
-void prru_cli_out_drive_keys(prru_cli_out *o, const double armature[PRRU_NACT]);
-int prru_cli_writes_armature(void);
 void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current);
 /* Opens (checks that it can be written: the directory exists and takes a
  * new file); 0, or 1 after a message with the reason. */

@@ -127,56 +127,6 @@ void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PR
   if (current) prru_cli_out_numbers(o, cur, PRRU_NACT);
 }
 
-/* Magnitudes below 1e-9 as 0 (model files refuse them: typing errors). */
-static double file_number(double v) { return fabs(v) < 1e-9 ? 0.0 : v; }
-
-/* ",\n    \"key\": " then one number or the list. */
-static void drive_key(prru_cli_out *o, const char *key, const double *v)
-{
-  int same = 1;
-  for (int i = 1; i < PRRU_NACT; i++) same &= v[i] == v[0];
-  prru_cli_out_printf(o, ",\n    \"%s\": ", key);
-  if (same) {
-    prru_cli_out_printf(o, "%.17g", file_number(v[0]));
-    return;
-  }
-  prru_cli_out_printf(o, "[");
-  for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, "%s%.17g", i ? ", " : "", file_number(v[i]));
-  prru_cli_out_printf(o, "]");
-}
-
-int prru_cli_writes_armature(void) { return !(prru_cli_model()->mech->drive_keys & PRRU_DRIVE_ROTOR_INERTIA); }
-
-void prru_cli_out_drive_keys(prru_cli_out *o, const double armature[PRRU_NACT])
-{
-  const prru_model *m = prru_cli_model();
-  const prru_mechanism *me = m->mech;
-  const unsigned k = me->drive_keys;
-  if (k & PRRU_DRIVE_LEAD) drive_key(o, "lead", me->lead);
-  if (k & PRRU_DRIVE_GEAR) drive_key(o, "gear", me->gear);
-  if (k & PRRU_DRIVE_ROTOR_INERTIA) {
-    double J[PRRU_NACT];
-    for (int i = 0; i < PRRU_NACT; i++) {
-      const double w = prru_model_drive_ratio(m, i);
-      J[i] = armature[i] == me->armature[i] ? me->rotor_inertia[i] : armature[i] / (w * w);
-    }
-    drive_key(o, "rotor_inertia", J);
-  }
-  if (k & PRRU_DRIVE_TORQUE_CONSTANT) drive_key(o, "torque_constant", me->torque_constant);
-  if (k & PRRU_DRIVE_STROKE) {
-    int same = 1;
-    for (int i = 1; i < PRRU_NACT; i++) same &= me->d_min[i] == me->d_min[0] && me->d_max[i] == me->d_max[0];
-    prru_cli_out_printf(o, ",\n    \"stroke\": %s", same ? "" : "[");
-    for (int i = 0; i < (same ? 1 : PRRU_NACT); i++)
-      prru_cli_out_printf(o, "%s[%.17g, %.17g]", i ? ", " : "", file_number(me->d_min[i]), file_number(me->d_max[i]));
-    if (!same) prru_cli_out_printf(o, "]");
-  }
-  if (k & PRRU_DRIVE_FORCE_MAX) drive_key(o, "force_max", me->force_max);
-  if (k & PRRU_DRIVE_TORQUE_MAX) drive_key(o, "torque_max", me->torque_max);
-  if (k & PRRU_DRIVE_SPEED_MAX) drive_key(o, "speed_max", me->speed_max);
-  if (k & PRRU_DRIVE_MOTOR_SPEED_MAX) drive_key(o, "motor_speed_max", me->motor_speed_max);
-}
-
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)
 {
   for (int i = 0; i < n; i++) prru_cli_out_printf(o, ",%.17g", v[i]);

@@ -117,18 +117,27 @@ def _columns(rmodel, deriv, qdd):
     return substitute(flat, point), len(unknowns)
 
 
-def regressor_kernel(model, deriv, rmodel):
-    """The Kernel `regressor` of the derivation deriv of
-    RegressorModel(model)."""
+_MOTION = [("q", ["q1", "q2", "q3"]), ("qd", ["qd1", "qd2", "qd3"]),
+           ("qdd", ["qdd1", "qdd2", "qdd3"])]
+
+
+def _kernel(deriv, rmodel, doc_tail, extra_inputs):
+    """The Kernel `regressor` of derivation deriv of rmodel (whose
+    inertial and drive numbers are symbols); doc_tail ends its comment."""
     qdd = [sym.sym("qdd%d" % (i + 1)) for i in range(3)]
     y, npar = _columns(rmodel, deriv, qdd)
     doc = ("Regressor Y (3x%d, row-major) with J_d^T fd = M qdd + h - G - "
-           "passive = Y pi, pi the standard parameters (see "
-           "PRRU_REGRESSOR_NAMES); vs[0] is the Coulomb smoothing velocity "
-           "v_s (m/s, > 0)." % npar)
-    inputs = [("q", ["q1", "q2", "q3"]), ("qd", ["qd1", "qd2", "qd3"]),
-              ("qdd", ["qdd1", "qdd2", "qdd3"]), ("vs", ["vs1"])]
-    return Kernel("regressor", doc, inputs, [("Y", y)], deriv.mech.guards)
+           "passive = Y pi, pi the standard parameters %s" % (npar, doc_tail))
+    return Kernel("regressor", doc, _MOTION + extra_inputs, [("Y", y)],
+                  deriv.mech.guards)
+
+
+def regressor_kernel(model, deriv, rmodel):
+    """The Kernel `regressor` of the derivation deriv of
+    RegressorModel(model)."""
+    return _kernel(deriv, rmodel, "(see PRRU_REGRESSOR_NAMES); vs[0] is the "
+                   "Coulomb smoothing velocity v_s (m/s, > 0).",
+                   [("vs", ["vs1"])])
 
 
 def topology_regressor_kernel(deriv, pmodel):
@@ -138,15 +147,9 @@ def topology_regressor_kernel(deriv, pmodel):
     inertial and drive parameters differentiated away as above, so that a
     model of any numbers loaded at run time is identified with the same
     regressor as its own build's (whose numbers are constants there)."""
-    qdd = [sym.sym("qdd%d" % (i + 1)) for i in range(3)]
-    y, npar = _columns(pmodel, deriv, qdd)
-    doc = ("Regressor Y (3x%d, row-major) with J_d^T fd = M qdd + h - G - "
-           "passive = Y pi, pi the standard parameters (prru_regressor.h's "
-           "order); geometry, gravity and the Coulomb smoothing velocity "
-           "from *p, its inertial and drive numbers unused." % npar)
-    inputs = [("q", ["q1", "q2", "q3"]), ("qd", ["qd1", "qd2", "qd3"]),
-              ("qdd", ["qdd1", "qdd2", "qdd3"])]
-    return Kernel("regressor", doc, inputs, [("Y", y)], deriv.mech.guards)
+    return _kernel(deriv, pmodel, "(prru_regressor.h's order); geometry, "
+                   "gravity and the Coulomb smoothing velocity from *p, its "
+                   "inertial and drive numbers unused.", [])
 
 
 def model_standard(model):
