@@ -136,19 +136,10 @@ void prru_cli_out_json_string(prru_cli_out *o, const char *s)
 {
   prru_cli_out_write(o, "\"", 1);
   while (*s) {
-    const unsigned char c = (unsigned char)*s;
-    const size_t n = prru_utf8_char(s);
-    if (c == '"' || c == '\\')
-      prru_cli_out_printf(o, "\\%c", c);
-    else if (c < 0x20 || c == 0x7f || c == '<' || c == '>' || c == '&')
-      prru_cli_out_printf(o, "\\u%04x", c);
-    else if (n == 0)
-      prru_cli_out_write(o, "\\ufffd", 6);
-    else if (n == 3 && c == 0xe2 && (unsigned char)s[1] == 0x80 && ((unsigned char)s[2] & 0xfe) == 0xa8)
-      prru_cli_out_printf(o, "\\u%04x", 0x2000 + ((unsigned char)s[2] - 0x80));
-    else
-      prru_cli_out_write(o, s, n);
-    s += n ? n : 1;
+    char text[8];
+    size_t used;
+    prru_cli_out_write(o, text, prru_json_char(s, text, &used));
+    s += used;
   }
   prru_cli_out_write(o, "\"", 1);
 }

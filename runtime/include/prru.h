@@ -607,6 +607,13 @@ char *prru_description(char *out, size_t size, const char *text);
  * included, NUL excluded), 0 when s does not start one. For writers of
  * formats that must be UTF-8 (JSON, XML). */
 size_t prru_utf8_char(const char *s);
+/* The JSON string text of the character at s (not its NUL), into out
+ * (at least 7 bytes; not NUL-terminated): quotes and backslashes
+ * escaped, control characters, DEL and, for JSON embedded in HTML, <, >,
+ * & and U+2028/9 as \uXXXX, a byte that starts no well-formed UTF-8
+ * character as \ufffd, any other character as it is. Returns the bytes
+ * written, *used the bytes of s consumed (at least 1). */
+size_t prru_json_char(const char *s, char *out, size_t *used);
 
 #ifdef __cplusplus
 }

@@ -55,26 +55,15 @@ static void put_list(text_buf *b, const double *v, int n)
   put(b, "]");
 }
 
-/* A JSON string of text made a valid description (prru_description):
- * quotes, backslashes, control characters and, for embedding in HTML,
- * <, >, & and U+2028/9 escaped. */
+/* A JSON string of text (prru_json_char's escapes). */
 static void put_string(text_buf *b, const char *text)
 {
   put(b, "\"");
   for (const char *s = text; *s;) {
-    const unsigned char c = (unsigned char)*s;
-    const size_t n = prru_utf8_char(s);
-    if (c == '"' || c == '\\')
-      put(b, "\\%c", c);
-    else if (c < 0x20 || c == 0x7f || c == '<' || c == '>' || c == '&')
-      put(b, "\\u%04x", c);
-    else if (n == 0)
-      put(b, "\\ufffd");
-    else if (n == 3 && c == 0xe2 && (unsigned char)s[1] == 0x80 && ((unsigned char)s[2] & 0xfe) == 0xa8)
-      put(b, "\\u%04x", 0x2000 + ((unsigned char)s[2] - 0x80));
-    else
-      put(b, "%.*s", (int)n, s);
-    s += n ? n : 1;
+    char c[8];
+    size_t used;
+    put(b, "%.*s", (int)prru_json_char(s, c, &used), c);
+    s += used;
   }
   put(b, "\"");
 }

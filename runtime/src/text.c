@@ -1,4 +1,5 @@
 /* User text made fit for the files the runtime's users write. */
+#include <stdio.h>
 #include <string.h>
 
 #include "prru.h"
@@ -31,6 +32,23 @@ size_t prru_utf8_char(const char *text)
 /* Bytes of the code point at s and whether it is a control character
  * (C0, DEL, C1: U+0080..U+009F is 0xc2 0x80..0x9f), 1 byte for a malformed
  * one. */
+size_t prru_json_char(const char *s, char *out, size_t *used)
+{
+  const unsigned char c = (unsigned char)*s;
+  const size_t n = prru_utf8_char(s);
+  *used = n ? n : 1;
+  if (c == '"' || c == '\\') {
+    out[0] = '\\', out[1] = (char)c;
+    return 2;
+  }
+  if (c < 0x20 || c == 0x7f || c == '<' || c == '>' || c == '&') return (size_t)sprintf(out, "\\u%04x", c);
+  if (n == 0) return (size_t)sprintf(out, "\\ufffd");
+  if (n == 3 && c == 0xe2 && (unsigned char)s[1] == 0x80 && ((unsigned char)s[2] & 0xfe) == 0xa8)
+    return (size_t)sprintf(out, "\\u%04x", 0x2000 + ((unsigned char)s[2] - 0x80));
+  memcpy(out, s, n);
+  return n;
+}
+
 static size_t code_point(const unsigned char *s, int *bad)
 {
   size_t n = prru_utf8_char((const char *)s);
