@@ -72,13 +72,17 @@ class Identification:
             self.name, self.nbase, self.nsamples, self.sigma, self.consistent)
 
 
-def _base(model, vs):
+def _base(model, vs, m=None):
+    """The base parameters of model (or of m, a prru_model of its library:
+    excite's, with the run's stroke) as prru identify and excite compute
+    them: random states from seed 1, vs the model's by default."""
     lib, b = model.lib, model.lib.types.Base()
+    m = model._m if m is None else m
     if vs is None:
-        vs = lib.ident_default_vs(ctypes.byref(model._m))
+        vs = lib.ident_default_vs(ctypes.byref(m))
     vs = _convert.scalar("coulomb_velocity", vs, positive=True, allow_zero=False)
     with model._lock:
-        st = lib.base_compute(ctypes.byref(model._m), vs, 0, 1, ctypes.byref(b))
+        st = lib.base_compute(ctypes.byref(m), vs, 0, 1, ctypes.byref(b))
     if st != errors.OK:
         raise errors.make_error(st, "base parameters: %s" % lib.status_text(st))
     return b
@@ -128,7 +132,7 @@ def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0
     if lib.model_with_limits(ctypes.byref(m), ctypes.byref(self._m), ctypes.byref(c)) != errors.OK:
         raise errors.make_error(errors.ENOMEM, "excite: out of memory")
     try:
-        b = _base(self, coulomb_velocity)
+        b = _base(self, coulomb_velocity, m)
         r, msg, stop = t.ExciteResult(), ctypes.create_string_buffer(600), ctypes.c_int(0)
         with self._lock:
             st, interrupt = _interrupt.call_in_worker(

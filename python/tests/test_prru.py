@@ -620,6 +620,16 @@ class TestIdentification(unittest.TestCase):
         self.assertEqual(bits(list(ex.a[0])), bits(a1))
         self.assertEqual(ex.harmonics, 4)
         self.assertEqual(ex.limits, MODEL.limits())
+        # With a stroke that just holds this excitation (the run's model,
+        # which bounds the reach, evaluates everything, the base parameters
+        # included, as in prru excite): the same coefficients.
+        lo = min(min(r) for r in ex.motion.d) - 0.002
+        hi = max(max(r) for r in ex.motion.d) + 0.002
+        ex2 = MODEL.excite(limits=MODEL.limits(stroke=(lo, hi)), **self.ARGS)
+        text2 = cli("excite", "--evals", "300", "--period", "8", "--harmonics", "4", "--amplitude",
+                    "0.2,0.2,0.02", "--dt", "0.01", "--stroke", "%r,%r" % (lo, hi))
+        a2 = [float(x) for x in re.search(r"# q1: a ([^;]+);", text2).group(1).split()]
+        self.assertEqual(bits(list(ex2.a[0])), bits(a2))
         with self.assertRaisesRegex(ValueError, "harmonics must be at most 8"):
             MODEL.excite(harmonics=9)
         with self.assertRaisesRegex(ValueError, "rcond_min must lie between 0 and 1"):
