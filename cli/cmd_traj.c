@@ -180,42 +180,11 @@ static int topp_limits(const topp_limit_args *a, prru_limits *lim, int *forces, 
   return 0;
 }
 
-/* Peak |fd_i| / force_max_i and |dd_i| / speed_max_i over the rows (and
- * the peaks themselves), each row re-checked with the exact inverse
- * dynamics: a row beyond a limit by more than 1e-6 of it is an error. */
+/* Peak |fd_i| and |dd_i| over the rows (each row checked again by
+ * prru_topp_row). */
 typedef struct {
   double f[PRRU_NACT], v[PRRU_NACT];
 } topp_peaks;
-
-static int topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp,
-                    double t, double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT],
-                    double dd[PRRU_NACT], topp_peaks *pk, char *why, size_t whylen)
-{
-  double r;
-  int which, kind;
-  prru_topp_eval(tp, t, q, qd, qdd);
-  int st = prru_limits_ratio(m, d, lim, q, qd, qdd, fd, dd, &r, &which, &kind);
-  if (st != PRRU_OK) {
-    snprintf(why, whylen, "t = %.9g s: inverse dynamics refuses q = (%.9g, %.9g, %.9g) (%s)", t,
-             q[0], q[1], q[2], prru_strerror(st));
-    return st;
-  }
-  if (r > 1 + 1e-6) {
-    snprintf(why, whylen, "t = %.9g s: the %s of actuator %d exceeds its limit by %.3g of it; the "
-             "profile cannot be trusted", t, kind ? "slider speed" : "force", which + 1, r - 1);
-    return PRRU_ENOCONV;
-  }
-  for (int i = 0; i < PRRU_NACT; i++) {
-    if (!(d->d[i] >= lim->d_min[i] && d->d[i] <= lim->d_max[i])) {
-      snprintf(why, whylen, "t = %.9g s: slider %d at d = %.9g m is outside its stroke between "
-               "two grid points", t, i + 1, d->d[i]);
-      return PRRU_ENOCONV;
-    }
-    pk->f[i] = fmax(pk->f[i], fabs(fd[i]));
-    pk->v[i] = fmax(pk->v[i], fabs(dd[i]));
-  }
-  return PRRU_OK;
-}
 
 /* The row times: every dt from 0 and the end, or (dt = 0) the grid's
  * distinct times. */
@@ -254,8 +223,10 @@ static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *li
       snprintf(why, whylen, "interrupted (%s) before row %ld", prru_cli_signal_name(), k + 1);
       break;
     }
-    st = topp_row(m, d, lim, tp, t, q, qd, qdd, fd, dd, pk, why, whylen);
-    if (st != PRRU_OK || !o) continue;
+    st = prru_topp_row(m, d, lim, tp, t, q, qd, qdd, fd, dd, why, (int)whylen);
+    if (st != PRRU_OK) continue;
+    for (int i = 0; i < PRRU_NACT; i++) pk->f[i] = fmax(pk->f[i], fabs(fd[i])), pk->v[i] = fmax(pk->v[i], fabs(dd[i]));
+    if (!o) continue;
     prru_cli_out_printf(o, "%.17g", t);
     prru_cli_out_numbers(o, q, 3);
     prru_cli_out_numbers(o, qd, 3);

@@ -137,6 +137,26 @@ static void optimal(const prru_model *m, const prru_limits *lim, const char *wha
   tu_check(fabs(active - tp.active_fraction) <= 1e-12, "the reported active fraction is the "
            "measured one", fabs(active - tp.active_fraction), 1e-12);
   consistent(&tp, what);
+  /* prru_topp_row: the rows pass under the planner's limits; a force
+   * limit 1 % tighter than the profile's peak is refused, named. */
+  {
+    double q[3], qd[3], qdd[3], f[PRRU_NACT], v[PRRU_NACT], peak = 0;
+    int rows_ok = 1;
+    for (int k = 0; k <= 100 && rows_ok; k++) {
+      rows_ok = prru_topp_row(m, d, lim, &tp, k == 100 ? tp.duration : tp.duration * k / 100, q, qd, qdd, f, v, msg, sizeof msg) == PRRU_OK;
+      for (int i = 0; i < PRRU_NACT; i++) peak = fmax(peak, fabs(f[i]) / lim->force_max[i]);
+    }
+    snprintf(buf, sizeof buf, "%s: prru_topp_row passes the profile's rows (%s)", what, rows_ok ? "ok" : msg);
+    TU_TRUE(rows_ok, buf);
+    prru_limits tight = *lim;
+    for (int i = 0; i < PRRU_NACT; i++) tight.force_max[i] *= 0.99 * peak;
+    int refused = 0;
+    for (int k = 0; k <= 100 && !refused; k++)
+      refused = prru_topp_row(m, d, &tight, &tp, k == 100 ? tp.duration : tp.duration * k / 100, q, qd, qdd, f, v, msg, sizeof msg) ==
+                    PRRU_ENOCONV && strstr(msg, "exceeds its limit");
+    snprintf(buf, sizeof buf, "%s: prru_topp_row refuses a row over a tighter limit", what);
+    TU_TRUE(refused, buf);
+  }
   double dur[2];
   st = prru_quintic_fastest(m, 3, WP, lim, 2000, dur, msg, sizeof msg);
   snprintf(buf, sizeof buf, "%s: fastest scaled quintic (%s)", what, st ? msg : "ok");

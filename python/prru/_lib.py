@@ -404,6 +404,7 @@ class Library:
         self.topp_solve = _declare(dll, "prru_topp_solve", i, tpp, mp, i, vp, lmp, i, cp, i)
         self.topp_eval = _declare(dll, "prru_topp_eval", i, tpp, d, vp, vp, vp)
         self.topp_free = _declare(dll, "prru_topp_free", None, tpp)
+        self.topp_row = _declare(dll, "prru_topp_row", i, mp, dp, lmp, tpp, d, vp, vp, vp, vp, vp, cp, i)
         top, pp = ctypes.POINTER(t.TrackOptions), ctypes.POINTER(t.Params)
         self.track_options_default = _declare(dll, "prru_track_options_default", None, top)
         self.track_check_reference = _declare(dll, "prru_track_check_reference", i, mp, qp, top, d,

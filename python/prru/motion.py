@@ -44,12 +44,6 @@ over_speed_fraction (samples with a slider above its speed_max),
 feedforward_peak (the largest |fd| of inverse dynamics along the
 reference) and limits."""
 
-# Rows of a time-optimal profile beyond a limit by more than this share of
-# it are an error (the planner's own check is at 1e-9 between its
-# samples; prru traj --time-optimal applies the same rule to its rows).
-ROW_TOL = 1e-6
-
-
 def _limit_values(name, value, n, positive=True):
     """A limit for every actuator (one number) or one each (a sequence of
     n): a tuple of n floats, each > 0 with positive (math.inf: none);
@@ -156,9 +150,9 @@ class _Rows:
         self.none = model.lib.types.Limits()
         model.lib.limits_none(ctypes.byref(self.none))
 
-    def add(self, t, q, qd, qdd, lim=None):
-        """One row; with lim (a C prru_limits) the row's largest limit
-        ratio is returned."""
+    def add(self, t, q, qd, qdd):
+        """One row of a time law: the pose checked, the sliders' positions
+        and speeds, the forces of inverse dynamics."""
         m, lib, n = self.model, self.model.lib, self.model.nact
         g, rc, crossed = m._g, ctypes.c_double(), ctypes.c_int()
         st = lib.path_sample(ctypes.byref(self.side), ctypes.byref(m._m), ctypes.byref(g.s), q,
@@ -171,20 +165,19 @@ class _Rows:
         if st != errors.OK:
             raise errors.make_error(st, "%s: %s" % (where, lib.status_text(st)))
         d = list(g.s.d)
-        fd, dd, ratio = (ctypes.c_double * n)(), (ctypes.c_double * n)(), ctypes.c_double()
-        st = lib.limits_ratio(ctypes.byref(m._m), ctypes.byref(g.s),
-                              ctypes.byref(lim if lim is not None else self.none), q, qd, qdd, fd, dd,
-                              ctypes.byref(ratio), None, None)
+        fd, dd = (ctypes.c_double * n)(), (ctypes.c_double * n)()
+        st = lib.limits_ratio(ctypes.byref(m._m), ctypes.byref(g.s), ctypes.byref(self.none), q, qd, qdd, fd, dd,
+                              None, None, None)
         if st != errors.OK:
             raise errors.make_error(st, "%s: inverse dynamics: %s" % (where, lib.status_text(st)))
-        if lim is None:
-            # The kernels' slider rates, as prru traj writes them (the
-            # limits' check uses J_d qd, equal to rounding).
-            lib.model_actuator_rates(ctypes.byref(m._m), q, qd, dd, (ctypes.c_double * n)())
-        for key, v in (("t", t), ("q", list(q)), ("qd", list(qd)), ("qdd", list(qdd)), ("d", d),
+        # The kernels' slider rates, as prru traj writes them.
+        lib.model_actuator_rates(ctypes.byref(m._m), q, qd, dd, (ctypes.c_double * n)())
+        self.record(t, q, qd, qdd, d, dd, fd)
+
+    def record(self, t, q, qd, qdd, d, dd, fd):
+        for key, v in (("t", t), ("q", list(q)), ("qd", list(qd)), ("qdd", list(qdd)), ("d", list(d)),
                        ("dd", list(dd)), ("fd", list(fd))):
             self.cols[key].append(v)
-        return ratio.value
 
     def motion(self):
         out, c = self.model._out, self.cols
@@ -229,8 +222,9 @@ def time_optimal(self, waypoints, *, limits=None, grid=0, dt=1e-3):
     checked again with the exact inverse dynamics. Returns TimeOptimal.
     Raises InputError naming the first infeasible grid point and limit
     (a static load above force_max, a pose outside the stroke or the
-    workspace), NoConvergence if the planner does not settle, InputError
-    if a row exceeds a limit by more than ROW_TOL."""
+    workspace), NoConvergence if the planner does not settle or a row
+    exceeds a limit by more than 1e-6 of it (PRRU_TOPP_ROW_TOL) or leaves
+    the stroke."""
     q, n = _waypoints(waypoints)
     lim, c = _c_limits(self, limits)
     grid = _convert.integer("grid", grid, 0)
@@ -249,16 +243,18 @@ def time_optimal(self, waypoints, *, limits=None, grid=0, dt=1e-3):
                                      len(msg))
         if st != errors.OK:
             raise _fail(self, st, "time_optimal: the fastest scaled quintic", msg)
-        rows = _Rows(self, "time_optimal")
+        rows, n = _Rows(self, "time_optimal"), self.nact
         a, b, cc = (ctypes.c_double * 3)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+        fd, dd, g = (ctypes.c_double * n)(), (ctypes.c_double * n)(), self._g
         with self._lock:
             for t in _row_times(0.0, tp.duration, dt):
-                lib.topp_eval(ctypes.byref(tp), t, a, b, cc)
-                r = rows.add(t, a, b, cc, c)
-                if r > 1 + ROW_TOL:
-                    raise errors.make_error(errors.EINPUT, "time_optimal: t = %.9g s: a force or "
-                                            "speed exceeds its limit by %.3g of it; the profile "
-                                            "cannot be trusted" % (t, r - 1))
+                # Each row checked again with the exact inverse dynamics
+                # (prru_topp_row, as prru traj --time-optimal's).
+                st = lib.topp_row(ctypes.byref(self._m), ctypes.byref(g.s), ctypes.byref(c), ctypes.byref(tp),
+                                  t, a, b, cc, fd, dd, msg, len(msg))
+                if st != errors.OK:
+                    raise _fail(self, st, "time_optimal", msg)
+                rows.record(t, a, b, cc, g.s.d, dd, fd)
         return TimeOptimal(rows.motion(), tp.duration, tp.active_fraction, tp.iterations,
                            tuple(durs), lim, tp.grid)
     finally:

@@ -545,7 +545,7 @@ class TestMotion(unittest.TestCase):
         self.assertLess(r.duration, sum(r.quintic_durations))
         # Every row within the limits (ROW_TOL), and some force at its limit.
         peak = max(abs(f) for row in r.motion.fd for f in row)
-        self.assertLessEqual(peak, F * (1 + prru.motion.ROW_TOL))
+        self.assertLessEqual(peak, F * (1 + 1e-6))  # PRRU_TOPP_ROW_TOL
         self.assertGreaterEqual(peak, F * (1 - 1e-3))
         with self.assertRaisesRegex(prru.InputError, "force_max of actuator"):
             MODEL.time_optimal(self.WPS, limits=MODEL.limits(model_limits=False,

@@ -216,6 +216,17 @@ int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
  * interval that starts at or before t; the last one at t = duration).
  * PRRU_EINPUT outside [0, duration]. */
 int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], double qdd[3]);
+/* A row of the profile at t, checked again with the exact inverse
+ * dynamics (what traj --time-optimal writes and the Python binding
+ * returns): q, qd, qdd, the forces fd and slider speeds dd; d->d holds the
+ * sliders. PRRU_OK; inverse dynamics' status where it refuses the pose;
+ * PRRU_ENOCONV when a force or speed exceeds its limit by more than
+ * PRRU_TOPP_ROW_TOL of it or a slider leaves its stroke (between grid
+ * points: the profile cannot be trusted); msg says which, at t. */
+#define PRRU_TOPP_ROW_TOL 1e-6
+int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
+                  double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
+                  char *msg, int msglen);
 void prru_topp_free(prru_topp *tp);
 
 /* The exact check of one state against lim (no platform loads): fd the

@@ -738,6 +738,28 @@ int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], dou
   return PRRU_OK;
 }
 
+int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
+                  double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
+                  char *msg, int msglen)
+{
+  double r;
+  int which, kind;
+  if (prru_topp_eval(tp, t, q, qd, qdd) != PRRU_OK)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "t = %.9g s is outside the profile [0, %.9g] s", t, tp->duration);
+  int st = prru_limits_ratio(m, d, lim, q, qd, qdd, fd, dd, &r, &which, &kind);
+  if (st != PRRU_OK)
+    return prru_fail(msg, msglen, st, "t = %.9g s: inverse dynamics refuses q = (%.9g, %.9g, %.9g) (%s)", t, q[0],
+                     q[1], q[2], prru_strerror(st));
+  if (r > 1 + PRRU_TOPP_ROW_TOL)
+    return prru_fail(msg, msglen, PRRU_ENOCONV, "t = %.9g s: the %s of actuator %d exceeds its limit by %.3g of "
+                     "it; the profile cannot be trusted", t, kind ? "slider speed" : "force", which + 1, r - 1);
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(d->d[i] >= lim->d_min[i] && d->d[i] <= lim->d_max[i]))
+      return prru_fail(msg, msglen, PRRU_ENOCONV, "t = %.9g s: slider %d at d = %.9g m is outside its stroke "
+                       "between two grid points", t, i + 1, d->d[i]);
+  return PRRU_OK;
+}
+
 /* The largest limit ratio along segment (qa, qb) under the quintic time
  * law of duration T at samples + 1 points; a status on a refused pose. */
 static int quintic_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
