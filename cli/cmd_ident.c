@@ -488,21 +488,6 @@ static void combination(const prru_base *b, int i, char *buf, size_t len)
 }
 
 /* The base parameters furthest from the estimate: "#3 P.m at 5.2 se, ...". */
-static void worst_deviations(const prru_base *b, const prru_consistent_result *c, char *buf, size_t len)
-{
-  int used[PRRU_NREG] = {0};
-  size_t k = 0;
-  buf[0] = 0;
-  for (int n = 0; n < 5 && n < b->nbase && k < len; n++) {
-    int w = -1;
-    for (int i = 0; i < b->nbase; i++)
-      if (!used[i] && (w < 0 || fabs(c->t[i]) > fabs(c->t[w]))) w = i;
-    used[w] = 1;
-    k += (size_t)snprintf(buf + k, len - k, "%s#%d %s at %.3g se", n ? ", " : "", w + 1,
-                          prru_regressor_names[b->col[w]], c->t[w]);
-  }
-}
-
 static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_result *r, const double *prior,
                          const prru_consistent_options *co, const prru_consistent_result *c, const double *pi0,
                          const double *pi)
@@ -534,7 +519,7 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
                       c->newton, r->inflation, r->hac_lags);
   prru_cli_out_line(o);
   char worst[512];
-  worst_deviations(b, c, worst, sizeof worst);
+  prru_consistent_worst(b, c, 5, worst, (int)sizeof worst);
   prru_cli_out_printf(o, "# largest deviations of the model's base parameters from the estimate: %s\n", worst);
   prru_cli_out_line(o);
   prru_cli_out_printf(o, "# standard parameters moved from the prior (relative change):");
@@ -631,112 +616,65 @@ static int d_resolution(const identify_args *a, double *r)
 /* Fit and outputs once the data are read; the exit status. */
 static int identify_run(const identify_args *a, const char *name, const ident_data *D, prru_base *b)
 {
-  prru_model m = *prru_cli_model();
-  prru_ident_result *r = malloc(sizeof *r);
-  double *pi0 = malloc(sizeof(double) * PRRU_NREG * 3), *pi = pi0 + PRRU_NREG, *prior = pi + PRRU_NREG;
-  if (!r || !pi0) {
-    free(r), free(pi0);
+  const prru_model *m = prru_cli_model();
+  prru_identification *r = malloc(sizeof *r);
+  static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
+  const size_t len = sizeof fmt + strlen(a->data) + strlen(m->mech->name);
+  char *desc = malloc(len);
+  if (!r || !desc) {
+    free(r), free(desc);
     prru_cli_error("identify", "out of memory");
     return 1;
   }
-  int bad = -1, rc = 0;
-  int st = prru_identify(&m, b, D->n, D->q, D->qd, D->qdd, D->fd, r, &bad);
+  snprintf(desc, len, fmt, a->data, m->mech->name);
+  const int st = prru_identify_model(m, b, D->n, D->q, D->qd, D->qdd, D->fd, name, desc, r);
+  free(desc);
   if (prru_cli_interrupted) {
     prru_cli_error("identify", "interrupted (%s) during the fit of %s; nothing written",
                    prru_cli_signal_name(), a->data);
-    free(r), free(pi0);
+    free(r->text), free(r);
     return prru_cli_exit_interrupted();
   }
-  if (st != PRRU_OK) {
-    if (bad >= 0)
-      prru_cli_error("identify", "%s: data row %d (t = %g): %s; nothing written", a->data, bad + 1, D->t[bad],
-                     prru_strerror(st));
-    else if (st == PRRU_EINPUT)
-      prru_cli_error("identify", "%s: %d samples give %d independent rows, fewer than the %d base parameters "
-                     "need; nothing written", a->data, D->n, 3 * D->n, b->nbase + 1);
-    else
-      prru_cli_error("identify", "%s: the motion does not excite every base parameter (condition number %.3g "
-                     "of the column-scaled regressor); use an excitation from prru excite; nothing written",
-                     a->data, r->cond);
-    free(r), free(pi0);
-    return 1;
-  }
-  prru_ident_standard(m.mech, pi0); /* the prior: the current model's numbers */
-  prru_base_params(b, pi0, prior);
-  prru_params p;
-  char why[300] = "";
-  prru_consistent_options co;
-  prru_consistent_options_default(&co);
-  prru_consistent_result *c = malloc(sizeof *c);
-  if (!c) {
-    free(r), free(pi0);
-    prru_cli_error("identify", "out of memory");
-    return 1;
-  }
-  const int cst = prru_ident_consistent(&m, b, r, pi0, &co, pi, c);
-  /* PRRU_ESINGULAR (data against physics) comes with a solution: reported. */
-  const int solved = cst == PRRU_OK || cst == PRRU_ESINGULAR;
-  const int unphysical = solved && prru_ident_model_params(&m, b, pi, &p, why, sizeof why) != PRRU_OK;
+  int rc = 0;
   prru_cli_out ro;
-  if (solved && prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
-  if (solved && !rc) {
-    write_report(&ro, b, r, prior, &co, c, pi0, pi);
-    if (prru_cli_out_close(&ro, !ro.err)) rc = 1;
+  /* The report once a consistent fit exists, also when the data contradict physics. */
+  if (r->stage >= PRRU_IDENTIFY_PHYSICS) {
+    if (prru_cli_out_open(&ro, "identify", a->report)) rc = 1;
+    if (!rc) {
+      write_report(&ro, b, &r->fit, r->prior, &r->options, &r->consistent, r->pi0, r->pi);
+      if (prru_cli_out_close(&ro, !ro.err)) rc = 1;
+    }
   }
-  if (!rc && !solved) {
-    prru_cli_error("identify", "%s; %s not written",
-                   cst == PRRU_EINPUT ? "the model's own parameters (the prior) are not physical (a body's pseudo-inertia "
-                                        "not positive definite or a negative drive coefficient): no prior to "
-                                        "start from" :
-                                        "the physically consistent fit did not converge", a->out);
-    rc = 1;
-  } else if (!rc && cst == PRRU_ESINGULAR) {
-    char worst[512], diff[400] = "";
-    worst_deviations(b, c, worst, sizeof worst);
-    /* Differentiated rates carry a truncation error the covariance does
-     * not hold: with quantised encoders a too narrow window alone produces
-     * this refusal (docs/guide.md, measurements), so say so first. */
-    if (D->differentiated)
-      snprintf(diff, sizeof diff, "qd and qdd were differentiated from q (--window %d --degree %d), whose error "
-               "the covariance does not hold: try the window 'prru measure' suggests for a simulated run of "
-               "this motion (a wider window for quantised encoders); else ", D->dopt.half_width, D->dopt.degree);
-    prru_cli_error("identify", "the data contradict physics: no physically consistent robot has base parameters "
-                   "within the estimate's covariance (Mahalanobis distance^2 %.4g, above the chi^2 quantile %.4g "
-                   "of %d degrees of freedom at 1 - %g); furthest from the estimate: %s; %scheck the signs and "
-                   "directions of the forces, the gear ratios and the units of fd; %s not written (see the report)",
-                   c->d2, c->d2_max, b->nbase, co.alpha, worst, diff, a->out);
-    rc = 1;
-  } else if (!rc && unphysical) {
-    prru_cli_error("identify", "internal error: the consistent parameters are not physical: %s; %s not written",
-                   why, a->out);
+  if (!rc && st != PRRU_OK) {
+    if (r->stage == PRRU_IDENTIFY_FIT && r->bad >= 0)
+      prru_cli_error("identify", "%s: data row %d (t = %g): %s; nothing written", a->data, r->bad + 1,
+                     D->t[r->bad], prru_strerror(st));
+    else if (r->stage == PRRU_IDENTIFY_FIT)
+      prru_cli_error("identify", "%s: %s; nothing written", a->data, r->msg);
+    else if (r->stage == PRRU_IDENTIFY_PHYSICS && D->differentiated)
+      /* Differentiated rates carry a truncation error the covariance does
+       * not hold: with quantised encoders a too narrow window alone
+       * produces this refusal (docs/guide.md, measurements). */
+      prru_cli_error("identify", "%s; or else qd and qdd were differentiated from q (--window %d --degree %d), "
+                     "whose error the covariance does not hold: try the window 'prru measure' suggests for a "
+                     "simulated run of this motion (a wider window for quantised encoders); %s not written (see "
+                     "the report)", r->msg, D->dopt.half_width, D->dopt.degree, a->out);
+    else
+      prru_cli_error("identify", "%s; %s not written%s", r->msg, a->out,
+                     r->stage == PRRU_IDENTIFY_PHYSICS ? " (see the report)" : "");
     rc = 1;
   }
   prru_cli_out mo;
-  char *text = NULL;
-  if (!rc) {
-    /* The library reads the text back before it hands it over: identify
-     * never writes a model nothing can load. */
-    static const char fmt[] = "Identified by prru identify from %s (prior: model %s)";
-    const size_t len = sizeof fmt + strlen(a->data) + strlen(m.mech->name);
-    char *desc = malloc(len), lmsg[800] = "out of memory";
-    if (desc) snprintf(desc, len, fmt, a->data, m.mech->name);
-    if (!desc || prru_model_file_text(&m, &p, name, desc, &text, lmsg, sizeof lmsg) != PRRU_OK) {
-      prru_cli_error("identify", "internal error: %s; %s not written", lmsg, a->out);
-      rc = 1;
-    }
-    free(desc);
-  }
   if (!rc && prru_cli_out_open(&mo, "identify", a->out)) rc = 1;
   if (!rc) {
-    prru_cli_out_write(&mo, text, strlen(text));
+    prru_cli_out_write(&mo, r->text, strlen(r->text));
     prru_cli_out_line(&mo);
     if (prru_cli_out_close(&mo, !mo.err)) rc = 1;
   }
-  free(text);
   if (!rc)
     fprintf(stderr, "identify: %d base parameters from %d samples, residual sigma %.6g N, condition number "
-                    "%.6g; model %s written to %s\n", b->nbase, D->n, r->sigma, r->cond, name, a->out);
-  free(r), free(pi0), free(c);
+                    "%.6g; model %s written to %s\n", b->nbase, D->n, r->fit.sigma, r->fit.cond, name, a->out);
+  free(r->text), free(r);
   return rc;
 }
 

@@ -725,6 +725,56 @@ static void check_other_geometry(const char *src, const char *file)
   prru_model_free(&m);
 }
 
+/* prru_identify_model, the procedure identify and the Python binding
+ * share: on the model's own noise-free motion the estimate's base
+ * parameters are the prior's, so the consistent set is the prior itself
+ * (the exact case; nearest the prior) and the written model's masses are
+ * the model's to the 1e-9 the consistent fit's margin allows (relative;
+ * the file's 17 digits add nothing); each failing stage stops with its
+ * stage, sample and reason. */
+static void check_identify_model(const prru_base *b)
+{
+  enum { N = 400 };
+  double *q = malloc(sizeof(double) * 3 * N), *qd = malloc(sizeof(double) * 3 * N);
+  double *qdd = malloc(sizeof(double) * 3 * N), *fd = malloc(sizeof(double) * NA * N);
+  prru_identification *r = malloc(sizeof *r);
+  if (!TU_TRUE(q && qd && qdd && fd && r && !make_data(N, 0, q, qd, qdd, fd), "excitation data")) return;
+  int st = prru_identify_model(&model, b, N, q, qd, qdd, fd, "ident_test", "a \"test\"", r);
+  TU_TRUE(st == PRRU_OK && r->stage == PRRU_IDENTIFY_DONE && r->text && r->bad == -1,
+          "identify_model: noise-free data give a model");
+  char path[] = "test_ident_model.json";
+  FILE *f = r->text ? fopen(path, "w") : NULL;
+  if (f) fputs(r->text, f), fclose(f);
+  prru_model m;
+  char msg[512] = "";
+  if (TU_TRUE(f && prru_model_load(&m, path, msg, sizeof msg) == PRRU_OK, "identify_model: its text loads")) {
+    double e = 0;
+    for (int k = 0; k < PRRU_NBODY; k++)
+      e = fmax(e, fabs(m.mech->mass[k] - prru_mech.mass[k]) / prru_mech.mass[k]);
+    tu_check(e <= 1e-6, "identify_model: the prior's masses come back", e, 1e-6);
+    TU_TRUE(strcmp(m.mech->name, "ident_test") == 0, "identify_model: named");
+    prru_model_free(&m);
+  }
+  remove(path);
+  free(r->text);
+
+  q[3 * 17] = 2.5; /* q1 far outside the workspace */
+  st = prru_identify_model(&model, b, N, q, qd, qdd, fd, "x", "", r);
+  TU_TRUE(st == PRRU_EUNREACHABLE && r->stage == PRRU_IDENTIFY_FIT && r->bad == 17 && !r->text &&
+          strncmp(r->msg, "sample 18: ", 11) == 0, "identify_model: an unreachable sample is named");
+  st = prru_identify_model(&model, b, 3, q, qd, qdd, fd, "x", "", r);
+  TU_TRUE(st == PRRU_EINPUT && r->stage == PRRU_IDENTIFY_FIT && strstr(r->msg, "fewer than"),
+          "identify_model: too few samples");
+  make_data(N, 0, q, qd, qdd, fd);
+  for (int i = 0; i < NA * N; i++) fd[i] = -fd[i]; /* a sign convention flipped */
+  st = prru_identify_model(&model, b, N, q, qd, qdd, fd, "x", "", r);
+  TU_TRUE(st == PRRU_ESINGULAR && r->stage == PRRU_IDENTIFY_PHYSICS && !r->text &&
+          r->consistent.d2 > r->consistent.d2_max && strstr(r->msg, "the data contradict physics") == r->msg,
+          "identify_model: flipped forces contradict physics, with the nearest consistent set");
+  printf("flipped forces: %s\n", r->msg);
+  free(q), free(qd), free(qdd), free(fd), free(r);
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -737,6 +787,7 @@ int main(void)
   hand_excitation();
   check_excite(b);
   check_identify(b);
+  check_identify_model(b);
   check_model_params_of_pi(b);
   const char *src = getenv("PRRU_SOURCE_DIR");
   if (TU_TRUE(src != NULL, "PRRU_SOURCE_DIR set (ctest sets it)"))

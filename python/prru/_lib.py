@@ -133,6 +133,8 @@ class _DesignProblem(ctypes.Structure):
 # Identification (prru_ident.h).
 EXCITE_MAX_HARMONICS = 8
 CONSISTENT_EXACT, CONSISTENT_COVARIANCE = 0, 1
+# prru_identification.stage (prru_ident.h)
+IDENTIFY_FIT, IDENTIFY_CONSISTENT, IDENTIFY_PHYSICS, IDENTIFY_MODEL, IDENTIFY_DONE = range(5)
 
 
 class _Fourier(ctypes.Structure):
@@ -205,7 +207,7 @@ class Types:
             ("stepper", ctypes.c_int), ("t_end", d), ("dt_out", d), ("abs_tol", d),
             ("rel_tol", d), ("h0", d), ("reactions", ctypes.c_int),
             ("loads", ctypes.POINTER(self.Schedule)), ("on_sample", self.SampleFn),
-            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("progress", ctypes.c_int),
+            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p),
             ("max_steps", ctypes.c_long)]})
         self.Scenario = type("prru_scenario", (ctypes.Structure,), {"_fields_": [
             ("q0", _arr(d, 3)), ("qd0", _arr(d, 3)), ("loads", self.Schedule),
@@ -265,6 +267,10 @@ class Types:
         self.ConsistentResult = type("prru_consistent_result", (ctypes.Structure,), {"_fields_": [
             ("how", i), ("beta", _arr(d, nreg)), ("t", _arr(d, nreg)), ("w", _arr(d, nreg)), ("d2", d),
             ("d2_max", d), ("sigma_w", d), ("prior_dist", d), ("margin", d), ("newton", i)]})
+        self.Identification = type("prru_identification", (ctypes.Structure,), {"_fields_": [
+            ("stage", i), ("bad", i), ("fit", self.IdentResult), ("options", _ConsistentOptions),
+            ("consistent", self.ConsistentResult), ("pi0", _arr(d, nreg)), ("prior", _arr(d, nreg)),
+            ("pi", _arr(d, nreg)), ("text", ctypes.c_void_p), ("msg", _arr(ctypes.c_char, 1024))]})
         self.ExciteOptions = type("prru_excite_options", (ctypes.Structure,), {"_fields_": [
             ("fd_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)), ("rcond_min", d),
             ("amplitude_max", _arr(d, 3)), ("samples", i), ("check_samples", i), ("max_evals", i),
@@ -427,6 +433,8 @@ class Library:
         self.ident_consistent = _declare(dll, "prru_ident_consistent", i, mp, bp, irp, vp,
                                          ctypes.POINTER(_ConsistentOptions), vp,
                                          ctypes.POINTER(t.ConsistentResult))
+        self.identify_model = _declare(dll, "prru_identify_model", i, mp, bp, i, vp, vp, vp, vp, cp, cp,
+                                       ctypes.POINTER(t.Identification))
         self.ident_model_params = _declare(dll, "prru_ident_model_params", i, mp, bp, vp, pp, cp, i)
         self.model_file_text = _declare(dll, "prru_model_file_text", i, mp, pp, cp, cp,
                                         ctypes.POINTER(ctypes.c_void_p), cp, i)

@@ -214,62 +214,33 @@ def identify(self, t, q, qd, qdd, fd, *, name=None, coulomb_velocity=None):
     if name is None:
         name = self.name[:13] + "_id"  # as prru identify
     b = _base(self, coulomb_velocity)
-    r, bad = T.IdentResult(), ctypes.c_int(-1)
-    with self._lock:
-        st = lib.identify(ctypes.byref(self._m), ctypes.byref(b), n, qa, qda, qdda, fda, ctypes.byref(r),
-                          ctypes.byref(bad))
-    if st != errors.OK:
-        if bad.value >= 0:
-            raise errors.make_error(errors.EINPUT, "identify: sample %d (t = %g): %s"
-                                    % (bad.value + 1, tv[bad.value], lib.status_text(st)))
-        if st == errors.EINPUT:
-            raise errors.make_error(st, "identify: %d samples give %d independent rows, fewer than the %d base "
-                                    "parameters need" % (n, 3 * n, b.nbase + 1))
-        raise errors.make_error(st, "identify: the motion does not excite every base parameter (condition "
-                                "number %.3g of the column-scaled regressor); use an excitation from excite"
-                                % r.cond)
-    nreg = T.nreg
-    pi0, pi, prior = (ctypes.c_double * nreg)(), (ctypes.c_double * nreg)(), (ctypes.c_double * nreg)()
-    lib.ident_standard(self._m.mech, pi0)
-    lib.base_params(ctypes.byref(b), pi0, prior)
-    co, c = _lib._ConsistentOptions(), T.ConsistentResult()
-    lib.consistent_options_default(ctypes.byref(co))
-    with self._lock:
-        cst = lib.ident_consistent(ctypes.byref(self._m), ctypes.byref(b), ctypes.byref(r), pi0, ctypes.byref(co),
-                                   pi, ctypes.byref(c))
-    if cst not in (errors.OK, errors.ESINGULAR):
-        raise errors.make_error(cst, "identify: " + (
-            "the model's own parameters (the prior) are not physical: no prior to start from"
-            if cst == errors.EINPUT else "the physically consistent fit did not converge"))
-    names = lib.regressor_names
-    params = [Parameter(names[b.col[i]].decode(), r.beta[i], r.se[i], prior[i], c.beta[i], c.t[i])
-              for i in range(b.nbase)]
-    result = Identification(text=None, name=name, nsamples=r.nsamples, nbase=b.nbase, sigma=r.sigma, cond=r.cond,
-                            inflation=r.inflation,
-                            consistent="exact" if c.how == _lib.CONSISTENT_EXACT else "covariance",
-                            d2=c.d2, d2_max=c.d2_max, parameters=params)
-    if cst == errors.ESINGULAR:
-        worst = sorted(params, key=lambda p: -abs(p.t))[:5]
-        err = errors.make_error(cst, "identify: the data contradict physics: no physically consistent robot has "
-                                "base parameters within the estimate's covariance (Mahalanobis distance^2 %.4g, "
-                                "above the chi^2 quantile %.4g of %d degrees of freedom at 1 - %g); furthest from "
-                                "the estimate: %s; check the signs and directions of the forces, the gear ratios "
-                                "and the units of fd" % (c.d2, c.d2_max, b.nbase, co.alpha,
-                                                          ", ".join("%s at %.3g se" % (p.name, p.t) for p in worst)))
-        err.result = result
-        raise err
-    p, why = T.Params(), ctypes.create_string_buffer(300)
-    if lib.ident_model_params(ctypes.byref(self._m), ctypes.byref(b), pi, ctypes.byref(p), why, len(why)) != errors.OK:
-        raise errors.make_error(errors.EINPUT, "identify: internal error: the consistent parameters are not "
-                                "physical: " + why.value.decode())
+    out = T.Identification()
     desc = "Identified by prru.Model.identify from %d samples (prior: model %s)" % (n, self.name)
-    text, msg = ctypes.c_void_p(), ctypes.create_string_buffer(800)
-    st = lib.model_file_text(ctypes.byref(self._m), ctypes.byref(p), name.encode(), desc.encode(),
-                             ctypes.byref(text), msg, len(msg))
-    if st != errors.OK:
-        raise errors.make_error(st, "identify: " + msg.value.decode("utf-8", "replace"))
+    with self._lock:
+        st = lib.identify_model(ctypes.byref(self._m), ctypes.byref(b), n, qa, qda, qdda, fda, name.encode(),
+                                desc.encode(), ctypes.byref(out))
     try:
-        result.text = ctypes.string_at(text).decode("utf-8")
+        msg = "identify: " + out.msg.decode("utf-8", "replace")
+        if st != errors.OK and out.stage == _lib.IDENTIFY_FIT:
+            if out.bad >= 0:  # the time, which the library does not know
+                msg = "identify: sample %d (t = %g): %s" % (out.bad + 1, tv[out.bad], lib.status_text(st))
+            raise errors.make_error(errors.EINPUT if out.bad >= 0 else st, msg)
+        if st != errors.OK and out.stage == _lib.IDENTIFY_CONSISTENT:
+            raise errors.make_error(st, msg)
+        r, c = out.fit, out.consistent
+        names = lib.regressor_names
+        params = [Parameter(names[b.col[i]].decode(), r.beta[i], r.se[i], out.prior[i], c.beta[i], c.t[i])
+                  for i in range(b.nbase)]
+        result = Identification(text=None, name=name, nsamples=r.nsamples, nbase=b.nbase, sigma=r.sigma,
+                                cond=r.cond, inflation=r.inflation,
+                                consistent="exact" if c.how == _lib.CONSISTENT_EXACT else "covariance",
+                                d2=c.d2, d2_max=c.d2_max, parameters=params)
+        if st != errors.OK:
+            err = errors.make_error(st, msg)
+            if out.stage == _lib.IDENTIFY_PHYSICS:
+                err.result = result
+            raise err
+        result.text = ctypes.string_at(out.text).decode("utf-8")
     finally:
-        lib.free(text)
+        lib.free(out.text)
     return result

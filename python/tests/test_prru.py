@@ -1345,6 +1345,7 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_ident.h", "prru_ident_result", t.IdentResult),
                 ("runtime/include/prru_ident.h", "prru_consistent_options", _lib._ConsistentOptions),
                 ("runtime/include/prru_ident.h", "prru_consistent_result", t.ConsistentResult),
+                ("runtime/include/prru_ident.h", "prru_identification", t.Identification),
                 ("runtime/include/prru_ident.h", "prru_fourier", _lib._Fourier),
                 ("runtime/include/prru_ident.h", "prru_excite_options", t.ExciteOptions),
                 ("runtime/include/prru_ident.h", "prru_excite_result", t.ExciteResult),

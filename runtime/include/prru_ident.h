@@ -234,6 +234,54 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
 int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
                             char *why, int len);
 
+/* ---- The whole identification ----
+ * What prru identify and prru.Model.identify do, in one call: the least
+ * squares of the base parameters (prru_identify), the physically
+ * consistent standard parameters nearest the model's own (the prior,
+ * prru_ident_consistent with the default options), those as a model's
+ * numbers (prru_ident_model_params) and the identified model file's text
+ * (prru_model_file_text, read back by the loader before it is returned:
+ * nothing is handed over that cannot be loaded). Large (two nreg x nreg
+ * matrices): allocate it. */
+enum {
+  PRRU_IDENTIFY_FIT = 0,        /* stopped at the least squares (bad, fit.cond) */
+  PRRU_IDENTIFY_CONSISTENT = 1, /* no consistent fit: a prior not physical, no convergence */
+  PRRU_IDENTIFY_PHYSICS = 2,    /* the data contradict physics (consistent: the nearest set) */
+  PRRU_IDENTIFY_MODEL = 3,      /* the parameters make no model file (an internal error) */
+  PRRU_IDENTIFY_DONE = 4
+};
+
+typedef struct {
+  int stage;                         /* how far it got: PRRU_IDENTIFY_* */
+  int bad;                           /* the 0-based sample that gave no rows, else -1 */
+  prru_ident_result fit;             /* from stage PRRU_IDENTIFY_CONSISTENT on */
+  prru_consistent_options options;   /* prru_consistent_options_default */
+  prru_consistent_result consistent; /* from stage PRRU_IDENTIFY_PHYSICS on */
+  double pi0[PRRU_NREG];             /* the prior: the model's standard parameters */
+  double prior[PRRU_NREG];           /* its base parameters, nbase values */
+  double pi[PRRU_NREG];              /* the consistent standard parameters */
+  char *text;                        /* the model file on PRRU_OK, to free(); else NULL */
+  char msg[1024];                    /* why it stopped, without the data's name */
+} prru_identification;
+
+/* Identifies m's parameters from n samples (as prru_identify) and writes
+ * the model named name, described by description (prru_model_file_text's
+ * rules). PRRU_OK with stage PRRU_IDENTIFY_DONE and out->text; otherwise
+ * the first failing step's status with out->stage and out->msg:
+ * prru_identify's (with out->bad for a sample that gives no rows),
+ * prru_ident_consistent's PRRU_EINPUT or PRRU_ENOCONV, PRRU_ESINGULAR when
+ * the data contradict physics (the consistent result is filled: a report
+ * can show it), PRRU_EINPUT when the parameters make no model file (never
+ * for a consistent result), PRRU_ENOMEM. Allocates. */
+int prru_identify_model(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
+                        const double *qdd, const double *fd, const char *name, const char *description,
+                        prru_identification *out);
+
+/* The k base parameters whose consistent value is furthest from the
+ * estimate, in standard errors: "#3 m_P at 4.1 se, ..." (1-based index,
+ * its regressor column's name). */
+void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len);
+
 /* ---- Periodic excitation ----
  * q_k(t) = c_k + sum_{l=1..L} (a_kl sin(l w t) + b_kl cos(l w t)),
  * w = 2 pi / period: q, qd and qdd are analytic and periodic. */
