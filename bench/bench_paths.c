@@ -44,7 +44,6 @@ void bench_simulated_second(const prru_model *m, int reps, sim_result *res)
   o.loads = &sched;
   o.on_sample = capture_sample;
   o.interrupt = NULL;
-  o.progress = 0;
   bench_refsim_options ro = {o.h0, o.abs_tol, o.rel_tol, o.t_end};
   double q0[3], qd0[3], y[6], pg[MAXREPS], pr[MAXREPS];
   bench_refsim_initial(q0, qd0);

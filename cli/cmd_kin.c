@@ -98,7 +98,7 @@ static const char fk_method_redundant[] =
  * prru_forward_kinematics). */
 static double fk_tolerance(const double act[PRRU_NACT])
 {
-  double scale = prru_cli_length_scale();
+  double scale = prru_length_scale(prru_cli_model()->mech);
   for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
   return 10 * 100 * DBL_EPSILON * scale;
 }

@@ -175,36 +175,16 @@ int prru_cmd_simulate(int argc, char **argv)
     prru_cli_error("simulate", "--stepper: '%s' is not one of rk8pd, rkf45, rkck, msbdf", stepper);
     bad = 2;
   }
-  if (!bad && !(s.opt.t_end > 0)) {
-    prru_cli_error("simulate", "--t-end: %g is not a positive time (s)", s.opt.t_end);
-    bad = 2;
-  }
-  if (!bad && !(s.opt.dt_out > 0 && s.opt.dt_out <= s.opt.t_end)) {
-    prru_cli_error("simulate", "--dt: %g must be positive and at most t-end (%g s)", s.opt.dt_out, s.opt.t_end);
-    bad = 2;
-  }
-  if (!bad && !(s.opt.t_end / s.opt.dt_out <= 1e8)) {
-    prru_cli_error("simulate", "--t-end/--dt: more than 1e8 samples");
-    bad = 2;
-  }
-  if (!bad && !(s.opt.abs_tol >= 0 && s.opt.rel_tol >= 0 && s.opt.abs_tol + s.opt.rel_tol > 0)) {
-    prru_cli_error("simulate", "--atol/--rtol: must be non-negative and not both zero");
-    bad = 2;
-  }
-  const double tols[2] = {s.opt.abs_tol, s.opt.rel_tol};
-  for (int i = 0; i < 2 && !bad; i++)
-    if (tols[i] != 0 && !(tols[i] >= PRRU_TOL_MIN)) {
-      prru_cli_error("simulate", "--%s: %g is below %.2g (100 times the rounding unit of a double), which no "
-                     "double-precision step can resolve: use 0 (off) or at least %.2g", i ? "rtol" : "atol", tols[i],
-                     PRRU_TOL_MIN, PRRU_TOL_MIN);
-      bad = 2;
-    }
-  if (!bad && s.opt.stepper == PRRU_MSBDF && s.opt.abs_tol == 0) {
-    prru_cli_error("simulate", "--atol: msbdf needs a positive absolute tolerance");
-    bad = 2;
-  }
-  if (!bad && !(s.opt.h0 > 0)) {
-    prru_cli_error("simulate", "--h0: must be a positive step (s)");
+  /* The library's checks, with its member names turned into the options. */
+  static const char *const option_of[][2] = {{"t_end", "t-end"}, {"dt_out", "dt"}, {"abs_tol", "atol"},
+                                             {"rel_tol", "rtol"}, {"h0", "h0"}, {"max_steps", "max-steps"},
+                                             {"stepper", "stepper"}};
+  const char *field = NULL;
+  if (!bad && prru_sim_options_check(&s.opt, &field, msg, sizeof msg) != PRRU_OK) {
+    const char *opt = "scenario";
+    for (size_t k = 0; field && k < sizeof option_of / sizeof *option_of; k++)
+      if (strcmp(field, option_of[k][0]) == 0) opt = option_of[k][1];
+    prru_cli_error("simulate", "--%s: %s", opt, msg);
     bad = 2;
   }
   if (harm && loads) {
@@ -292,7 +272,6 @@ int prru_cmd_simulate(int argc, char **argv)
   s.opt.on_sample = on_sample;
   s.opt.ctx = &so;
   s.opt.loads = &s.loads;
-  s.opt.progress = 0;
   s.opt.interrupt = &prru_cli_interrupted;
   prru_cli_csv_header(&so.csv);
   double t_stop;

@@ -498,7 +498,7 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
   } else {
     o->err = ENOMEM;
   }
-  prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_cli_length_scale() / fref : 0.0);
+  prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_length_scale(prru_cli_model()->mech) / fref : 0.0);
   for (int i = 0; i < PRRU_NLIMB; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
     prru_cli_out_json_string(o, prru_cli_model()->mech->joint[u_joint(i)].name);
@@ -567,9 +567,9 @@ static void out_data(prru_cli_out *o, const prru_table *t, const frames *f, cons
   prru_cli_out_printf(o, "},\n\"source\":{");
   out_source(o, run);
   prru_cli_out_printf(o, ",\"rows\":%d},\n", t->nrows);
-  prru_cli_out_printf(o, "\"length_scale\":%.17g,\"plate_half\":%.17g,", prru_cli_length_scale(), plate_half());
+  prru_cli_out_printf(o, "\"length_scale\":%.17g,\"plate_half\":%.17g,", prru_length_scale(prru_cli_model()->mech), plate_half());
   /* Rails: vertical at the sliders' (x, y), a little beyond their travel. */
-  double margin = 0.1 * (f->hi[2] - f->lo[2]) + 0.25 * prru_cli_length_scale();
+  double margin = 0.1 * (f->hi[2] - f->lo[2]) + 0.25 * prru_length_scale(prru_cli_model()->mech);
   double lo[3] = {f->lo[0], f->lo[1], f->lo[2] - margin}, hi[3] = {f->hi[0], f->hi[1], f->hi[2] + margin};
   prru_cli_out_printf(o, "\"extent\":{\"lo\":");
   out_array(o, lo, 3);

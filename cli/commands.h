@@ -68,7 +68,6 @@ int prru_cli_is_paper_model(void);
 const char *prru_cli_paper_fd_text(void);
 /* The model's length scale L, the mean upper-link length (m), as the
  * runtime uses it for its tolerances (prru_model). */
-double prru_cli_length_scale(void);
 /* Model identity in outputs. JSON: the member
  * "model": {"name": .., "file": .., "sha256": .., "kernels": ..} (no
  * separator around it); CSV: the first line

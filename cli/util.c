@@ -330,14 +330,6 @@ const char *prru_cli_paper_fd_text(void)
   return text;
 }
 
-double prru_cli_length_scale(void)
-{
-  const prru_mechanism *me = prru_cli_model()->mech;
-  double s = 0;
-  for (int i = 0; i < PRRU_NLIMB; i++) s += me->l1[i];
-  return s / PRRU_NLIMB;
-}
-
 int prru_cli_is_paper_model(void) { return strcmp(prru_cli_model()->mech->sha256, PRRU_PAPER_SHA256) == 0; }
 
 void prru_cli_print_version(FILE *f)

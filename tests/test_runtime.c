@@ -667,6 +667,24 @@ static void test_tolerances(void)
   o.max_steps = -1;
   TU_TRUE(prru_simulate(&model, q_mid, qd0, &o, &t_stop, msg, 300) == PRRU_EINPUT &&
               strstr(msg, "max_steps"), "negative max_steps refused");
+  /* prru_sim_options_check names the member at fault (the CLI turns it
+   * into its option) and starts its message with it. */
+  const struct { double *v; double bad; const char *name; } cases[] = {
+      {&o.t_end, -1, "t_end"}, {&o.dt_out, 0, "dt_out"}, {&o.abs_tol, NAN, "abs_tol"},
+      {&o.rel_tol, -1e-3, "rel_tol"}, {&o.h0, INFINITY, "h0"}};
+  for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+    prru_sim_options_default(&o);
+    *cases[c].v = cases[c].bad;
+    const char *field = "none";
+    const int st = prru_sim_options_check(&o, &field, msg, 300);
+    TU_TRUE(st == PRRU_EINPUT && field && strcmp(field, cases[c].name) == 0 &&
+                strncmp(msg, cases[c].name, strlen(cases[c].name)) == 0,
+            "prru_sim_options_check names the member");
+  }
+  prru_sim_options_default(&o);
+  const char *field = "none";
+  TU_TRUE(prru_sim_options_check(&o, &field, NULL, 0) == PRRU_OK && field == NULL,
+          "prru_sim_options_check: the defaults pass");
 }
 
 /* Item 4: the step budget ends a run that needs too many steps between two

@@ -166,6 +166,10 @@ int prru_model_use_parameter_kernels(prru_model *m);
 /* Frees a loaded model's storage (nothing for prru_model_default's);
  * then m is prru_model_default's. */
 void prru_model_free(prru_model *m);
+/* A mechanism's length scale (m): the mean upper-link length. Tolerances
+ * on lengths, the conditioning of J_d and of M, and the drawings' sizes
+ * are relative to it, so that they mean the same for a robot of any size. */
+double prru_length_scale(const prru_mechanism *me);
 /* Whether m's numbers are the build's model's: the kernels that exist only
  * for it (the identification regressor, prru_regressor.h) apply. The
  * inertial and drive numbers may differ when only_geometry is non-zero
@@ -502,11 +506,12 @@ typedef struct {
                                     least PRRU_TOL_MIN), first step */
   int reactions;                 /* compute lambda for each sample */
   const prru_load_schedule *loads;
+  /* Every sample, as it is reached: the caller's output and progress
+   * report (the library draws nothing). */
   prru_sample_fn on_sample; void *ctx;
   /* Non-zero stops the run: polled between samples and inside every
    * evaluation of the right-hand side, so a long integrator step stops too. */
   volatile sig_atomic_t *interrupt;
-  int progress;                  /* progress bar on stderr */
   /* Step budget: the run stops (PRRU_ENOCONV) once the integrator needs
    * more than this many accepted steps between two samples (GSL's driver
    * takes nmax + 2 before it gives up; gsl_odeiv2_driver_set_nmax), so no
@@ -516,6 +521,12 @@ typedef struct {
 } prru_sim_options;
 
 void prru_sim_options_default(prru_sim_options *o);
+/* Checks o as prru_simulate does before it starts: PRRU_OK, or
+ * PRRU_EINPUT with msg (may be NULL) naming the member of
+ * prru_sim_options at fault and why ("abs_tol = 1e-20 is below ..."), and
+ * *field (when field is non-NULL) that member's name, so that a front end
+ * can name its own option. */
+int prru_sim_options_check(const prru_sim_options *o, const char **field, char *msg, int msglen);
 /* Integrates from (q0, qd0); calls on_sample for every sample it reached.
  * Stops with PRRU_EUNREACHABLE / PRRU_ESINGULAR (state left the workspace),
  * PRRU_ENOCONV (step failure, or the step budget max_steps exhausted:

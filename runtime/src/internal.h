@@ -82,9 +82,6 @@ char *prru_read_file(const char *path, size_t *len, char *msg, int msglen);
  * determinant is 0 or not finite. Fills inv = A^-1 when non-NULL and the
  * determinant is usable. */
 double prru_rcond3(const double a[9], double inv[9]);
-/* The model's length scale (m): the mean upper-link length. Tolerances on
- * lengths and the conditioning of J_d are relative to it. */
-double prru_length_scale(const prru_mechanism *me);
 /* Turns GSL's abort-on-error handler off, once per process: every runtime
  * call checks GSL's status codes itself. Thread-safe. */
 void prru_gsl_init(void);

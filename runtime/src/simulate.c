@@ -5,6 +5,7 @@
  * Tolerances below PRRU_TOL_MIN are refused up front: they cannot be met
  * and used to make the step size collapse for ever. */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -165,46 +166,59 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
 }
 
-static void progress(double t, double t_end)
+static int bad_option(const char *f, const char **field, char *msg, int msglen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+static int bad_option(const char *f, const char **field, char *msg, int msglen, const char *fmt, ...)
 {
-  int w = 40, n = (int)(w * t / t_end + 0.5);
-  fprintf(stderr, "\rsimulating [%.*s%*s] %5.1f%% t = %.3f s", n,
-          "########################################", w - n, "", 100.0 * t / t_end, t);
-  fflush(stderr);
+  if (field) *field = f;
+  if (msg && msglen > 0) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, (size_t)msglen, fmt, ap);
+    va_end(ap);
+  }
+  return PRRU_EINPUT;
 }
 
-static int check_options(const prru_sim_options *o, char *msg, int msglen)
+int prru_sim_options_check(const prru_sim_options *o, const char **field, char *msg, int msglen)
 {
+  if (field) *field = NULL;
   if (!(isfinite(o->t_end) && o->t_end > 0))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "t_end must be a positive number of seconds");
+    return bad_option("t_end", field, msg, msglen, "t_end = %g: must be a positive number of seconds", o->t_end);
   if (!(isfinite(o->dt_out) && o->dt_out > 0 && o->dt_out <= o->t_end))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "dt must be positive and at most t_end");
+    return bad_option("dt_out", field, msg, msglen, "dt_out = %g: must be positive and at most t_end (%g s)",
+                      o->dt_out, o->t_end);
   if (o->t_end / o->dt_out > 1e8)
-    return prru_fail(msg, msglen, PRRU_EINPUT, "t_end/dt above 1e8 samples");
-  if ((unsigned)o->stepper > PRRU_MSBDF) return prru_fail(msg, msglen, PRRU_EINPUT, "unknown stepper");
-  if (!(o->abs_tol >= 0 && o->rel_tol >= 0 && o->abs_tol + o->rel_tol > 0 &&
-        isfinite(o->abs_tol) && isfinite(o->rel_tol)))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "tolerances must be non-negative, not both zero");
+    return bad_option("dt_out", field, msg, msglen, "dt_out = %g: more than 1e8 samples up to t_end = %g s",
+                      o->dt_out, o->t_end);
+  if ((unsigned)o->stepper > PRRU_MSBDF)
+    return bad_option("stepper", field, msg, msglen, "stepper = %d: not a prru_stepper", (int)o->stepper);
+  const struct { const char *name; double v; } tol[2] = {{"rel_tol", o->rel_tol}, {"abs_tol", o->abs_tol}};
+  for (int i = 0; i < 2; i++)
+    if (!(tol[i].v >= 0 && isfinite(tol[i].v)))
+      return bad_option(tol[i].name, field, msg, msglen, "%s = %g: must be a non-negative number", tol[i].name,
+                        tol[i].v);
+  if (o->abs_tol + o->rel_tol == 0)
+    return bad_option("abs_tol", field, msg, msglen, "abs_tol and rel_tol are both 0: give at least one");
   /* Below PRRU_TOL_MIN a tolerance is rounding noise (see prru.h). */
-  const struct { const char *name; double v; } tol[2] = {{"rel_tol", o->rel_tol},
-                                                         {"abs_tol", o->abs_tol}};
   for (int i = 0; i < 2; i++)
     if (tol[i].v > 0 && tol[i].v < PRRU_TOL_MIN)
-      return prru_fail(msg, msglen, PRRU_EINPUT,
-                       "%s = %g is below %.2g (100 x DBL_EPSILON), which no double-precision "
-                       "step can resolve: use 0 (off) or at least %.2g",
-                       tol[i].name, tol[i].v, PRRU_TOL_MIN, PRRU_TOL_MIN);
+      return bad_option(tol[i].name, field, msg, msglen,
+                        "%s = %g is below %.2g (100 x DBL_EPSILON), which no double-precision step can "
+                        "resolve: use 0 (off) or at least %.2g", tol[i].name, tol[i].v, PRRU_TOL_MIN, PRRU_TOL_MIN);
   if (o->stepper == PRRU_MSBDF && o->abs_tol == 0)
-    return prru_fail(msg, msglen, PRRU_EINPUT,
-                     "abs_tol = 0 (relative control only) does not work with msbdf, which "
-                     "divides by each component's error level (0 wherever the component is 0): "
-                     "give abs_tol > 0");
+    return bad_option("abs_tol", field, msg, msglen,
+                      "abs_tol = 0 (relative control only) does not work with msbdf, which divides by each "
+                      "component's error level (0 wherever the component is 0): give abs_tol > 0");
   if (o->max_steps < 0)
-    return prru_fail(msg, msglen, PRRU_EINPUT,
-                     "max_steps = %ld: give a positive number of steps per output interval, or 0 "
-                     "for the default (%ld)", o->max_steps, PRRU_MAX_STEPS_DEFAULT);
+    return bad_option("max_steps", field, msg, msglen,
+                      "max_steps = %ld: give a positive number of steps per output interval, or 0 for the "
+                      "default (%ld)", o->max_steps, PRRU_MAX_STEPS_DEFAULT);
   if (!(isfinite(o->h0) && o->h0 > 0))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "first step h0 must be positive");
+    return bad_option("h0", field, msg, msglen, "h0 = %g: the first step must be positive (s)", o->h0);
   return PRRU_OK;
 }
 
@@ -212,7 +226,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
                   const prru_sim_options *o, double *t_stop, char *msg, int msglen)
 {
   if (t_stop) *t_stop = NAN;
-  int st = check_options(o, msg, msglen);
+  int st = prru_sim_options_check(o, NULL, msg, msglen);
   if (st != PRRU_OK) return st;
   for (int i = 0; i < 3; i++)
     if (!isfinite(q0[i]) || !isfinite(qd0[i]))
@@ -326,9 +340,7 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
       prru_fail(msg, msglen, st, "interrupted at t = %.9g s", tk);
       break;
     }
-    if (o->progress && (k % 50 == 0 || k == nsamp)) progress(tk, o->t_end);
   }
-  if (o->progress) fputc('\n', stderr);
   if (drv) gsl_odeiv2_driver_free(drv);
   free(d); free(drhs); free(s);
   if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
