@@ -147,7 +147,7 @@ PATH="$tmp/keepbin0:$PATH" "$PRRU" plot "$tmp/topp.csv" 2>"$tmp/err" && [ "$(png
   && ok || bad "plot of a time-optimal trajectory: $(png_size "$tmp/topp.png") $(head -c 300 "$tmp/err")"
 # identify's report (its format, rows written here): one tick per base
 # parameter, 1000 x 650 for a few.
-{ echo "# prru 0.2.0 model prru (x.json, sha256 $(printf '0%.0s' $(seq 64)), parameter kernels)"
+{ echo "# prru $prru_version model prru (x.json, sha256 $(printf '0%.0s' $(seq 64)), parameter kernels)"
   echo "index,parameter,estimate,se,prior,resolution,model,t,combination"
   echo "1,P.m,1.86,0.01,1.77,0.5,1.859,-0.1,P.m + 1 L1.m - 0.25 S1.m"
   echo "2,armature1,0.001,0.002,0,0.01,0.0009,-0.05,armature1"; } >"$tmp/ident.csv"

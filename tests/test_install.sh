@@ -209,12 +209,16 @@ PY
 # ---- 2a. find_package(prru) ----
 mkdir -p "$tmp/fp"
 cp "$tmp/consumer.c" "$tmp/fp/consumer.c"
+# The version the consumer asks for: this source's major.minor (before
+# 1.0 the package accepts the same minor version only: SameMinorVersion).
+abi_version=$(sed -n 's/^project(prru VERSION \([0-9]*\.[0-9]*\).*/\1/p' "$PRRU_SOURCE_DIR/CMakeLists.txt")
+[ -n "$abi_version" ] || die "no project version in $PRRU_SOURCE_DIR/CMakeLists.txt"
 cat >"$tmp/fp/CMakeLists.txt" <<'EOF'
 cmake_minimum_required(VERSION 3.16)
 project(prru_consumer C)
 set(CMAKE_C_STANDARD 99)
 set(CMAKE_C_EXTENSIONS OFF)
-find_package(prru 0.2 REQUIRED)
+find_package(prru ABI_VERSION REQUIRED)
 if(NOT prru_MODEL_SHA256 STREQUAL EXPECTED_SHA256)
   message(FATAL_ERROR "prru_MODEL_SHA256 ${prru_MODEL_SHA256}, expected ${EXPECTED_SHA256}")
 endif()
@@ -227,6 +231,7 @@ add_executable(use_kernels consumer.c)
 target_compile_definitions(use_kernels PRIVATE KERNELS_ONLY)
 target_link_libraries(use_kernels PRIVATE prru::kernels)
 EOF
+sed -i "s/ABI_VERSION/$abi_version/" "$tmp/fp/CMakeLists.txt"
 # No package registry, no system prru: only the temporary prefix.
 if cmake -S "$tmp/fp" -B "$tmp/fp/build" "${consumer_cmake[@]}" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" \
      -DCMAKE_PREFIX_PATH="$prefix" \

@@ -1,6 +1,6 @@
 """Finding and loading libprru.so, and the ctypes mirror of its headers.
 
-The C structs (runtime/include/prru.h, prru_dme.h, the generated
+The C structs (runtime/include/prru_dynamics.h, prru_sim.h, prru_dme.h, the generated
 prru_mechanism.h) have arrays sized by the model: PRRU_NACT actuators,
 PRRU_NBODY bodies, PRRU_NLAMBDA reaction coordinates. Their sizes are read
 from the library's own descriptor prru_mech, whose leading fields (four

@@ -5,7 +5,7 @@ non-zero code into the matching exception, whose message is the library's
 own description (prru_strerror) preceded by what was being computed.
 """
 
-# prru_status codes of runtime/include/prru.h.
+# prru_status codes of runtime/include/prru_dynamics.h.
 OK = 0
 EINPUT = 1
 EUNREACHABLE = 2

@@ -45,7 +45,7 @@ extern "C" {
 /* A model's numbers in the layout the parameter kernels read (the plant of
  * prru_track, a design's starting point): prru_params_model for the built
  * model; coulomb_velocity 1 m/s where the model has no Coulomb force. */
-void prru_model_params(const prru_model *m, prru_params *p);
+PRRU_API void prru_model_params(const prru_model *m, prru_params *p);
 
 /* The model file (format 2, spec 11-13) of m's structure, body names and
  * drive keys (lead, gear, stroke, limits: m's own; a changed armature
@@ -57,8 +57,8 @@ void prru_model_params(const prru_model *m, prru_params *p);
  * PRRU_EINPUT with its message when p does not make a valid model (a
  * mass not positive, ...), PRRU_ENOMEM; *text NULL then. What identify
  * and optimize write. */
-int prru_model_file_text(const prru_model *m, const prru_params *p, const char *name, const char *description,
-                         char **text, char *msg, int msglen);
+PRRU_API int prru_model_file_text(const prru_model *m, const prru_params *p, const char *name, const char *description,
+                                  char **text, char *msg, int msglen);
 
 typedef struct {
   double t;                   /* s */
@@ -97,7 +97,7 @@ typedef struct {
 /* Gains kp = w^2, kd = 2 w with w = 20 rad/s, continuous, dt_out 1 ms, no
  * limits, no noise, seed 1, the exact plant (prru_params_model), rk8pd at
  * 1e-12. */
-void prru_track_options_default(prru_track_options *o);
+PRRU_API void prru_track_options_default(prru_track_options *o);
 
 typedef struct {
   long samples;
@@ -114,8 +114,8 @@ typedef struct {
  * the workspace or its stroke PRRU_EUNREACHABLE, the controller meeting a
  * singular J_d PRRU_ESINGULAR, integrator failure PRRU_ENOCONV,
  * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why. */
-int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
-               prru_track_summary *sum, char *msg, int msglen);
+PRRU_API int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                        prru_track_summary *sum, char *msg, int msglen);
 
 /* The reference of a run with rows every step (s): checked at every row
  * time and at least every millisecond (up to 1e8 checks; a longer
@@ -126,23 +126,23 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
  * along it. PRRU_EINPUT with msg naming the first bad sample ("reference
  * at sample K (t = T s): ...") or a step giving more than 1e8 rows;
  * PRRU_ENOMEM. */
-int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
-                               double step, double *ff_peak, char *msg, int msglen);
+PRRU_API int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                                        double step, double *ff_peak, char *msg, int msglen);
 
 /* One controller evaluation: the clipped forces fd and the unclipped
  * fd_cmd at the measured (q, qd) for the reference (q_ref, qd_ref,
  * qdd_ref); sat[i] set where clipped. prru_inverse_dynamics's statuses. */
-int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
-                         const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
-                         const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
-                         double fd[PRRU_NACT], int sat[PRRU_NACT]);
+PRRU_API int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
+                                  const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
+                                  const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
+                                  double fd[PRRU_NACT], int sat[PRRU_NACT]);
 
 /* The plant's accelerations under fd (no platform loads): M qdd = b from
  * prru_param_eom with o->plant, solved by Cholesky. PRRU_EUNREACHABLE
  * where the plant's q is unreachable (NaN), PRRU_ESINGULAR when M is not
  * positive definite. */
-int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
-                     const double fd[PRRU_NACT], double qdd[3]);
+PRRU_API int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
+                              const double fd[PRRU_NACT], double qdd[3]);
 
 /* Model mismatch: multiplies one group of *p's parameters by factor
  * (finite, > 0): "mass" every body's mass and inertia tensor (the same
@@ -150,7 +150,7 @@ int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3]
  * the inertia tensors alone, "armature", "damping", "coulomb" the drives'
  * numbers, "gravity" the gravity vector. PRRU_EINPUT for another key or
  * factor. */
-int prru_params_scale(prru_params *p, const char *key, double factor);
+PRRU_API int prru_params_scale(prru_params *p, const char *key, double factor);
 
 #ifdef __cplusplus
 }

@@ -65,32 +65,32 @@ typedef struct {
 
 /* Parses a parameter or variable name (grammar above) into v (bounds not
  * set): PRRU_OK, or PRRU_EINPUT with msg saying why. */
-int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen);
+PRRU_API int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen);
 /* The number of single parameters, and the k-th (0-based, order of the
  * list above: geometry by limb, then every body's m, com, I, then the
  * armatures) as a one-parameter variable named canonically ("b_1"). */
-int prru_design_param_count(void);
-int prru_design_param(int k, prru_design_var *v);
+PRRU_API int prru_design_param_count(void);
+PRRU_API int prru_design_param(int k, prru_design_var *v);
 /* The variable's value in p (its first parameter's). */
-double prru_design_get(const prru_params *p, const prru_design_var *v);
+PRRU_API double prru_design_get(const prru_params *p, const prru_design_var *v);
 /* Sets the variable to x: every tied parameter moves by x minus the
  * first one's value in base (p and base may be the same). */
-void prru_design_set(prru_params *p, const prru_params *base, const prru_design_var *v, double x);
+PRRU_API void prru_design_set(prru_params *p, const prru_params *base, const prru_design_var *v, double x);
 /* A natural scale of the variable at p, for difference steps and scaled
  * sensitivities: |value|, or where the value may be 0, the body's mean
  * principal moment (products of inertia), the design's length scale
  * (centres of mass), the mean slider mass (armature). */
-double prru_design_scale(const prru_params *p, const prru_design_var *v);
+PRRU_API double prru_design_scale(const prru_params *p, const prru_design_var *v);
 
 /* Bounds of v: -+ pct % (0 < pct < 100) of the value of every parameter v
  * ties (of its prru_design_scale where it is 0). Tied parameters move by
  * one shift (prru_design_set), so the bounds of the value are the
  * intersection of every parameter's: no tied parameter leaves its own
  * -+ pct %, whatever the limbs' values. PRRU_OK, or PRRU_EINPUT (pct). */
-int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct);
+PRRU_API int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct);
 
 /* The design's length scale: the mean upper link (prru_length_scale). */
-double prru_design_length_scale(const prru_params *p);
+PRRU_API double prru_design_length_scale(const prru_params *p);
 
 /* Is p a buildable robot, by the rules a model file must follow: lengths
  * and masses positive, armature not negative, every number 0 or of
@@ -98,7 +98,7 @@ double prru_design_length_scale(const prru_params *p);
  * principal moments obeying the triangle inequality, and every limb
  * assembled at q = 0 (horizontal gap |b - a - l2| shorter than l1).
  * PRRU_OK, or PRRU_EINPUT with msg naming the parameter and the rule. */
-int prru_design_check(const prru_params *p, char *msg, int msglen);
+PRRU_API int prru_design_check(const prru_params *p, char *msg, int msglen);
 
 typedef enum {
   PRRU_OBJ_MEAN = 0, /* global index: mean of w_R - 1 over the regular grid points */
@@ -107,8 +107,8 @@ typedef enum {
 } prru_objective;
 
 /* "mean", "max", "log"; PRRU_OK or PRRU_EINPUT. */
-int prru_objective_parse(const char *s, prru_objective *o);
-const char *prru_objective_name(prru_objective o);
+PRRU_API int prru_objective_parse(const char *s, prru_objective *o);
+PRRU_API const char *prru_objective_name(prru_objective o);
 
 /* The optimisation problem: where and how a design is judged. */
 typedef struct {
@@ -125,14 +125,14 @@ typedef struct {
 
 /* Fig. 7-like defaults for a grid: rcond_min 4e-3 (cond_1 <= 250), mean,
  * no stroke limits, weight 1000. */
-void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g);
+PRRU_API void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g);
 /* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
-int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
+PRRU_API int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
 /* A run's strokes (prru_limits_for_run) as the problem's: one interval
  * for every slider, the intersection of theirs (none when no slider has
  * one). PRRU_OK, or PRRU_EINPUT with msg when they have no common
  * interval (pr untouched). */
-int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen);
+PRRU_API int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen);
 
 /* The status of a regular grid point in the other assembly mode: the
  * map's (PRRU_DME_OTHER_MODE, classified by prru_mode_status);
@@ -151,8 +151,8 @@ typedef struct {
 } prru_design_data;
 
 /* PRRU_OK or PRRU_ENOMEM; nthreads 2. */
-int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g);
-void prru_design_data_free(prru_design_data *dd);
+PRRU_API int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g);
+PRRU_API void prru_design_data_free(prru_design_data *dd);
 
 typedef struct {
   int valid;                 /* prru_design_check passed (otherwise only merit is set) */
@@ -178,8 +178,8 @@ typedef struct {
 /* Evaluates p on the problem's grid into dd and ev. The design is checked
  * first (prru_design_check); an invalid one gets merit = 1e30 and
  * ev->valid = 0. Returns PRRU_OK, or PRRU_EINPUT for an invalid design. */
-int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
-                         prru_design_data *dd, prru_design_eval *ev);
+PRRU_API int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
+                                  prru_design_data *dd, prru_design_eval *ev);
 
 /* ---- Optimisation ---- */
 
@@ -195,7 +195,7 @@ typedef struct {
   prru_design_progress_fn progress; void *ctx;
 } prru_design_options;
 
-void prru_design_options_default(prru_design_options *o);
+PRRU_API void prru_design_options_default(prru_design_options *o);
 
 typedef struct {
   prru_params best;      /* the best design found */
@@ -218,9 +218,9 @@ typedef struct {
  * PRRU_OK; PRRU_EINPUT (bad bounds: lo >= hi, a start outside them, more
  * than PRRU_DESIGN_MAX_VARS, msg says which); PRRU_EINTERRUPTED (the
  * progress callback stopped it; r holds the best so far); PRRU_ENOMEM. */
-int prru_design_optimize(const prru_design_problem *pr, const prru_params *start,
-                         const prru_design_var *vars, int nvar, const prru_design_options *o,
-                         prru_design_result *r, char *msg, int msglen);
+PRRU_API int prru_design_optimize(const prru_design_problem *pr, const prru_params *start,
+                                  const prru_design_var *vars, int nvar, const prru_design_options *o,
+                                  prru_design_result *r, char *msg, int msglen);
 
 /* ---- Sensitivity ---- */
 
@@ -240,17 +240,17 @@ typedef struct {
  * step h = rel_step * scale not lost to rounding (value +- h, for every
  * tied parameter, must differ by 2 h to within 1 %). PRRU_OK, or
  * PRRU_EINPUT with msg giving the smallest step that is. */
-int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
-                           int msglen);
+PRRU_API int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
+                                    int msglen);
 /* Central difference of the objective with respect to v at p. Perturbed
  * designs are evaluated without prru_design_check (a parameter at 0, such
  * as an armature, is differentiated through 0); p itself must be valid.
  * PRRU_OK, PRRU_EINPUT (p invalid, rel_step refused by
  * prru_design_step_check) or PRRU_ESINGULAR (no regular grid point at
  * value +- h). */
-int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
-                            const prru_design_var *v, double rel_step, prru_design_data *dd,
-                            prru_design_sens *s);
+PRRU_API int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
+                                     const prru_design_var *v, double rel_step, prru_design_data *dd,
+                                     prru_design_sens *s);
 
 #ifdef __cplusplus
 }

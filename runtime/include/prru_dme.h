@@ -102,26 +102,26 @@ typedef struct {
 /* "ok", "singular", "unreachable", "out_of_stroke" (PRRU_ESTROKE),
  * "other_mode" (PRRU_DME_OTHER_MODE) or "invalid" (PRRU_EINPUT and any
  * other code). */
-const char *prru_dme_status_name(int status);
+PRRU_API const char *prru_dme_status_name(int status);
 
 /* The assembly mode of a pose from its slider positions d and J_d: the
  * sign of det J_d (prru_jd_det_sign), or 0 when it cannot be told (a
  * slider unreachable, det J_d = 0, more than three actuators); with home
  * 0 no pose is in "the other" mode. */
-int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3]);
+PRRU_API int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3]);
 /* 1 when home != 0 and det J_d's sign is not home (a pose beyond the
  * singular locus, or on it), else 0. */
-int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home);
+PRRU_API int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home);
 /* A reachable pose's status from its regularity status (prru_jd_regular):
  * PRRU_DME_OTHER_MODE when it is PRRU_OK but prru_jd_other_mode, else
  * regular_status. The one classification of the map and the design
  * optimiser. */
-int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home);
+PRRU_API int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home);
 
 /* Fills out at q (uses d->d, d->Jd, d->M as workspace) and returns
  * out->status. At a non-OK status every double of out except jd_rcond is
  * NaN. */
-int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme *out);
+PRRU_API int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme *out);
 
 /* The one computation of the DME behind prru_dme_eval, from its
  * ingredients at a pose already found regular: M (3x3), J_d^+ (3 x N, as
@@ -132,8 +132,8 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
  * operations in the same order, its branches as selects), so w_R has one
  * definition. Returns out->status (PRRU_ESINGULAR when a result is not
  * finite); out->jd_rcond is left as it is. */
-int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
-                  prru_dme *out);
+PRRU_API int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
+                           prru_dme *out);
 
 /* ---- Maps over a rectangle of (q1, q2) at fixed q3 ---- */
 
@@ -148,7 +148,7 @@ typedef struct {
 } prru_map_grid;
 
 /* Grid point i of an axis. */
-double prru_map_axis(double lo, double hi, int n, int i);
+PRRU_API double prru_map_axis(double lo, double hi, int n, int i);
 
 /* The global index (the paper's "overall distance between the w_R surface
  * and the plane w_R = 1"), defined over the grid points:
@@ -197,15 +197,15 @@ typedef struct {
 } prru_map_options;
 
 /* nthreads = 2, no progress, no interrupt. */
-void prru_map_options_default(prru_map_options *o);
+PRRU_API void prru_map_options_default(prru_map_options *o);
 
 /* PRRU_OK, or PRRU_EINPUT when the grid is invalid (see prru_map_grid). */
-int prru_map_check(const prru_map_grid *g);
+PRRU_API int prru_map_check(const prru_map_grid *g);
 
 /* The model's assembly mode at the grid's home pose (0, 0, q3):
  * prru_assembly_mode there, 0 when not told (no point of the map is then
  * in the other mode). */
-int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
+PRRU_API int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
 
 /* Evaluates w_R at every grid point: index k = i n2 + j for (q1_i, q2_j)
  * (q1 outer). status[k] is PRRU_OK, PRRU_EUNREACHABLE, PRRU_ESTROKE (a
@@ -218,8 +218,8 @@ int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
  * Allocates one batch workspace per thread (not per point). status may be
  * NULL if not needed; sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
  * PRRU_ENOMEM, or PRRU_EINTERRUPTED (outputs partly filled, sum not set). */
-int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
-                  double *w_R, unsigned char *status, prru_map_summary *sum);
+PRRU_API int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
+                           double *w_R, unsigned char *status, prru_map_summary *sum);
 
 /* Only the q1 rows row_begin .. row_end - 1 of the grid (a shard of a map
  * split across processes): w_R[k] and status[k] for k = (i - row_begin) n2
@@ -227,13 +227,13 @@ int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_op
  * needs the whole grid: prru_map_summarize on the joined rows). PRRU_OK,
  * PRRU_EINPUT (bad grid, options or rows), PRRU_ENOMEM,
  * PRRU_EINTERRUPTED. prru_map_eval is this for every row. */
-int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begin, int row_end,
-                       const prru_map_options *o, double *w_R, unsigned char *status);
+PRRU_API int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begin, int row_end,
+                                const prru_map_options *o, double *w_R, unsigned char *status);
 
 /* The summary of an already computed map (used by prru_map_eval):
  * PRRU_DME_OTHER_MODE counts in n_singular and in n_other_mode. */
-void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
-                        prru_map_summary *sum);
+PRRU_API void prru_map_summarize(const prru_map_grid *g, const double *w_R, const unsigned char *status,
+                                 prru_map_summary *sum);
 
 #ifdef __cplusplus
 }

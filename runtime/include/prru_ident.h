@@ -45,12 +45,12 @@ extern "C" {
 
 /* The standard parameters of a mechanism descriptor: pi from its mass,
  * com, inertia (about the centre) and drives. */
-void prru_ident_standard(const prru_mechanism *me, double pi[PRRU_NREG]);
+PRRU_API void prru_ident_standard(const prru_mechanism *me, double pi[PRRU_NREG]);
 /* One body's mass, centre of mass and inertia about the centre (Ixx Iyy
  * Izz Ixy Ixz Iyz, as in model files) from its 10 standard parameters:
  * PRRU_EINPUT when m <= 0 or a value is not finite. */
-int prru_ident_body(const double pib[PRRU_NBODYPAR], double *mass, double com[3],
-                    double inertia[6]);
+PRRU_API int prru_ident_body(const double pib[PRRU_NBODYPAR], double *mass, double com[3],
+                             double inertia[6]);
 
 /* The role of a standard parameter in the base parameters. */
 enum { PRRU_PAR_BASE = 0, PRRU_PAR_COMBINED = 1, PRRU_PAR_NONE = 2 };
@@ -71,42 +71,42 @@ typedef struct {
  * +-1 rad/s, +-L/s and +-4 rad/s^2, +-4 L/s^2) from the generator state
  * *s (xorshift64*, deterministic). PRRU_ENOCONV when 1000 draws found no
  * regular pose. */
-int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
-                            double q[3], double qd[3], double qdd[3]);
+PRRU_API int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
+                                     double q[3], double qd[3], double qdd[3]);
 
 /* The regressor Y (3 x PRRU_NREG, row-major; prru_regressor.h's columns)
  * of model m at (q, qd, qdd) with Coulomb smoothing velocity vs: the
  * build's specialised kernel for the build's own numbers, the topology's
  * (geometry and gravity read at run time) for a loaded model, so that a
  * model of any geometry is identified without a build of its own. */
-void prru_model_regressor(const prru_model *m, const double q[3], const double qd[3], const double qdd[3], double vs,
-                          double *Y);
+PRRU_API void prru_model_regressor(const prru_model *m, const double q[3], const double qd[3], const double qdd[3], double vs,
+                                   double *Y);
 
 /* The Coulomb smoothing velocity identification evaluates the regressor
  * with unless told otherwise: the model's, else 1 mm/s (m/s). */
-double prru_ident_default_vs(const prru_model *m);
+PRRU_API double prru_ident_default_vs(const prru_model *m);
 
 /* Base parameters from nstates random states (PRRU_BASE_STATES when <= 0)
  * drawn with seed; vs > 0 the Coulomb smoothing velocity. Allocates (a
  * set-up call). PRRU_EINPUT for vs <= 0, PRRU_ENOMEM, PRRU_ENOCONV. */
-int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed,
-                      prru_base *b);
+PRRU_API int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed,
+                               prru_base *b);
 /* beta = B pi (nbase values). */
-void prru_base_params(const prru_base *b, const double pi[PRRU_NREG], double beta[PRRU_NREG]);
+PRRU_API void prru_base_params(const prru_base *b, const double pi[PRRU_NREG], double beta[PRRU_NREG]);
 /* The base columns of rows x PRRU_NREG Y: Yb (rows x nbase). */
-void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *Yb);
+PRRU_API void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *Yb);
 /* A standard parameter vector with B pi = beta: pi0 (a prior, e.g. the
  * model's) with each base parameter's own standard parameter replaced so
  * that the combination equals beta (the others keep pi0's values). */
-void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
-                           const double pi0[PRRU_NREG], double pi[PRRU_NREG]);
+PRRU_API void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
+                                    const double pi0[PRRU_NREG], double pi[PRRU_NREG]);
 
 /* Observation rows of one sample: A (PRRU_NACT x nbase) = J_d^+T Y_base
  * and y (PRRU_NACT) = J_d^+T J_d^T fd. The status of prru_check_regular
  * (unreachable or singular poses give no rows). */
-int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
-                    const double qd[3], const double qdd[3], const double fd[PRRU_NACT],
-                    double *A, double y[PRRU_NACT]);
+PRRU_API int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
+                             const double qd[3], const double qdd[3], const double fd[PRRU_NACT],
+                             double *A, double y[PRRU_NACT]);
 
 typedef struct {
   int nsamples, nrows, dof;   /* dof = 3 nsamples - nbase */
@@ -141,8 +141,8 @@ typedef struct {
  * when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
  * is rank deficient (the motion does not excite every base parameter);
  * PRRU_ENOMEM. Allocates. */
-int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
-                  const double *qdd, const double *fd, prru_ident_result *r, int *bad);
+PRRU_API int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
+                           const double *qdd, const double *fd, prru_ident_result *r, int *bad);
 
 /* ---- Physically consistent parameters ----
  * The least-squares estimate beta^ may belong to no physical robot: a
@@ -195,7 +195,7 @@ typedef struct {
 } prru_consistent_options;
 
 /* mu 1e-6, alpha 1e-3, sigma_floor 1e-8, eps 1e-9, 5000 Newton steps. */
-void prru_consistent_options_default(prru_consistent_options *o);
+PRRU_API void prru_consistent_options_default(prru_consistent_options *o);
 
 enum { PRRU_CONSISTENT_EXACT = 0, PRRU_CONSISTENT_COVARIANCE = 1 };
 
@@ -218,9 +218,9 @@ typedef struct {
  * for bad options or a prior with a mass <= 0, a non-finite value or a
  * negative drive coefficient; PRRU_ENOCONV when the Newton budget runs
  * out; PRRU_ENOMEM. Allocates. */
-int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
-                          const double pi0[PRRU_NREG], const prru_consistent_options *o,
-                          double pi[PRRU_NREG], prru_consistent_result *c);
+PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
+                                   const double pi0[PRRU_NREG], const prru_consistent_options *o,
+                                   double pi[PRRU_NREG], prru_consistent_result *c);
 
 /* Standard parameters pi (e.g. prru_ident_consistent's) as the numbers of
  * a model file: m's geometry and gravity (the regressor's), each body's
@@ -231,8 +231,8 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
  * with why naming the body or drive that is not physical (a mass <= 0,
  * an inertia not positive definite, a negative drive coefficient; never
  * for prru_ident_consistent's output). prru_model_file_text writes p. */
-int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
-                            char *why, int len);
+PRRU_API int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
+                                     char *why, int len);
 
 /* ---- The whole identification ----
  * What prru identify and prru.Model.identify do, in one call: the least
@@ -273,14 +273,14 @@ typedef struct {
  * the data contradict physics (the consistent result is filled: a report
  * can show it), PRRU_EINPUT when the parameters make no model file (never
  * for a consistent result), PRRU_ENOMEM. Allocates. */
-int prru_identify_model(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
-                        const double *qdd, const double *fd, const char *name, const char *description,
-                        prru_identification *out);
+PRRU_API int prru_identify_model(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
+                                 const double *qdd, const double *fd, const char *name, const char *description,
+                                 prru_identification *out);
 
 /* The k base parameters whose consistent value is furthest from the
  * estimate, in standard errors: "#3 m_P at 4.1 se, ..." (1-based index,
  * its regressor column's name). */
-void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len);
+PRRU_API void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len);
 
 /* ---- Periodic excitation ----
  * q_k(t) = c_k + sum_{l=1..L} (a_kl sin(l w t) + b_kl cos(l w t)),
@@ -294,7 +294,7 @@ typedef struct {
   double a[3][PRRU_EXCITE_MAX_HARMONICS], b[3][PRRU_EXCITE_MAX_HARMONICS];
 } prru_fourier;
 
-void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3], double qdd[3]);
+PRRU_API void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3], double qdd[3]);
 
 typedef struct {
   double fd_max[PRRU_NACT];  /* |fd_i| limit (N), > 0 */
@@ -310,11 +310,11 @@ typedef struct {
 
 /* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, 2000 check samples, 3000 evaluations, seed 1. */
-void prru_excite_options_default(prru_excite_options *o);
+PRRU_API void prru_excite_options_default(prru_excite_options *o);
 /* A run's limits (prru_limits_for_run) into o: the force bounds where
  * finite (an excitation needs one: o's, 500 N by default, where the run
  * has none), the speed limits and the strokes. */
-void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
+PRRU_API void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
 
 typedef struct {
   double cond;          /* condition number of the column-scaled stacked base regressor */
@@ -333,17 +333,17 @@ typedef struct {
  * (seeded start, GSL nmsimplex2). PRRU_EINPUT for bad options or centre
  * (msg says which), PRRU_ENOCONV when no feasible trajectory was found,
  * PRRU_EINTERRUPTED when *stop became non-zero. Allocates. */
-int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_options *o,
-                volatile sig_atomic_t *stop, prru_fourier *f, prru_excite_result *r, char *msg,
-                int msglen);
+PRRU_API int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_options *o,
+                         volatile sig_atomic_t *stop, prru_fourier *f, prru_excite_result *r, char *msg,
+                         int msglen);
 
 /* The excitation's feasibility at n points per period: 0 and the peak
  * forces and worst rcond, or the first failing point's status
  * (PRRU_EUNREACHABLE, PRRU_ESTROKE beyond the model's stroke,
  * PRRU_ESINGULAR, or PRRU_EINPUT for a force, speed or stroke limit)
  * with *t_bad its time. */
-int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
-                      int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad);
+PRRU_API int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
+                               int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad);
 
 #ifdef __cplusplus
 }

@@ -38,7 +38,7 @@ typedef struct {
 } prru_measure_options;
 
 /* Every row, exact sensors, seed 1. */
-void prru_measure_options_default(prru_measure_options *o);
+PRRU_API void prru_measure_options_default(prru_measure_options *o);
 
 /* The rows of a run (times t, n rows, strictly increasing) a sensor
  * sampling at o->rate sees: idx[0..*nout) with t[idx[k]] = t[0] + k / rate
@@ -46,14 +46,14 @@ void prru_measure_options_default(prru_measure_options *o);
  * option (negative, not finite) or when a sample time has no row (msg
  * names the time: the run's rows must fall on the sensor's clock). idx
  * holds n entries. */
-int prru_measure_rows(const double *t, int n, const prru_measure_options *o, int *idx, int *nout,
-                      char *msg, int msglen);
+PRRU_API int prru_measure_rows(const double *t, int n, const prru_measure_options *o, int *idx, int *nout,
+                               char *msg, int msglen);
 
 /* The sensors' readings in place: d (n x nact, row-major) quantised,
  * fd (n x nact) with noise, drawn row by row. PRRU_EINPUT for bad options
  * (msg names the option), PRRU_ENOMEM. */
-int prru_measure_apply(const prru_measure_options *o, int n, int nact, double *d, double *fd, char *msg,
-                       int msglen);
+PRRU_API int prru_measure_apply(const prru_measure_options *o, int n, int nact, double *d, double *fd, char *msg,
+                                int msglen);
 
 /* How well a differentiation setting recovers qdd from measured sliders:
  * the poses by forward kinematics (least squares from the previous row's
@@ -75,8 +75,8 @@ typedef struct {
  * than 3 rows or exact qdd of zero RMS in every coordinate, the statuses of
  * prru_forward_kinematics_lsq for a row no pose reproduces (msg names the
  * row), PRRU_ENOMEM. */
-int prru_measure_best_diff(const prru_model *m, int n, const double *t, const double *d, const double *qdd,
-                           prru_diff_choice *c, char *msg, int msglen);
+PRRU_API int prru_measure_best_diff(const prru_model *m, int n, const double *t, const double *d, const double *qdd,
+                                    prru_diff_choice *c, char *msg, int msglen);
 
 #ifdef __cplusplus
 }

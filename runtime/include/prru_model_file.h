@@ -62,14 +62,14 @@ typedef struct {
  * PRRU_EIO (unreadable) or PRRU_EPARSE (refused) write the generator's
  * message "path: key: reason" into msg (msglen bytes, may be NULL/0) and
  * leave *out untouched; PRRU_ENOMEM likewise. */
-prru_status prru_model_file_read(const char *path, prru_model_spec *out,
-                                 char *msg, int msglen);
+PRRU_API prru_status prru_model_file_read(const char *path, prru_model_spec *out,
+                                          char *msg, int msglen);
 
 /* The same for len bytes of text; name stands for the path in messages
  * (NULL: "<model>"). */
-prru_status prru_model_file_parse(const char *text, size_t len,
-                                  const char *name, prru_model_spec *out,
-                                  char *msg, int msglen);
+PRRU_API prru_status prru_model_file_parse(const char *text, size_t len,
+                                           const char *name, prru_model_spec *out,
+                                           char *msg, int msglen);
 
 #ifdef __cplusplus
 }

@@ -47,7 +47,7 @@ typedef struct {
 } prru_diff_options;
 
 /* m = 4, p = 4. */
-void prru_diff_options_default(prru_diff_options *o);
+PRRU_API void prru_diff_options_default(prru_diff_options *o);
 
 /* The weights of sample i of n (times t, strictly increasing, finite):
  * *first is the window's first sample, w[k][j] the weight of sample
@@ -55,8 +55,8 @@ void prru_diff_options_default(prru_diff_options *o);
  * j < 2m + 1. PRRU_EINPUT for bad options, n < 2m + 1 or i out of range,
  * PRRU_ESINGULAR when the window's times are too close to fit (never for
  * distinct times in double precision). */
-int prru_diff_weights(const double *t, int n, int i, const prru_diff_options *o, int *first,
-                      double w[3][PRRU_DIFF_MAX_WINDOW]);
+PRRU_API int prru_diff_weights(const double *t, int n, int i, const prru_diff_options *o, int *first,
+                               double w[3][PRRU_DIFF_MAX_WINDOW]);
 
 /* The smoothed values ys, first derivatives yd and second derivatives ydd
  * of dim signals y sampled at t (n rows, row-major n x dim, any of the
@@ -65,9 +65,9 @@ int prru_diff_weights(const double *t, int n, int i, const prru_diff_options *o,
  * gain[3 i + k] (see above; NULL if not wanted). PRRU_EINPUT with msg
  * (naming the row, 1-based) for non-finite data, times not strictly
  * increasing, too few rows or bad options. */
-int prru_diff_signal(const double *t, int n, const double *y, int dim,
-                     const prru_diff_options *o, double *ys, double *yd, double *ydd,
-                     double *trunc, double *gain, char *msg, int msglen);
+PRRU_API int prru_diff_signal(const double *t, int n, const double *y, int dim,
+                              const prru_diff_options *o, double *ys, double *yd, double *ydd,
+                              double *trunc, double *gain, char *msg, int msglen);
 
 /* ---- Piecewise-quintic trajectories of q ----
  * Knots t_0 < ... < t_{n-1} with q, qd, qdd at each; between two knots
@@ -93,24 +93,24 @@ typedef struct {
  * one that leaves its knot time unchanged, shorter than sqrt(DBL_MIN) =
  * 1.5e-154 s (its square underflows), or whose peak acceleration
  * overflows. */
-int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const double *durations,
-                           double t0, char *msg, int msglen);
+PRRU_API int prru_quintic_waypoints(prru_quintic *tr, int n, const double *q, const double *durations,
+                                    double t0, char *msg, int msglen);
 /* From n samples of t, q, qd, qdd (each n x 3 row-major, t strictly
  * increasing): the C2 interpolation described above. */
-int prru_quintic_samples(prru_quintic *tr, int n, const double *t, const double *q,
-                         const double *qd, const double *qdd, char *msg, int msglen);
+PRRU_API int prru_quintic_samples(prru_quintic *tr, int n, const double *t, const double *q,
+                                  const double *qd, const double *qdd, char *msg, int msglen);
 /* q, qd, qdd at time t in [t_0, t_{n-1}] (any output may be NULL);
  * PRRU_EINPUT outside that interval or for a non-finite t. */
-int prru_quintic_eval(const prru_quintic *tr, double t, double q[3], double qd[3],
-                      double qdd[3]);
-double prru_quintic_t_begin(const prru_quintic *tr);
-double prru_quintic_t_end(const prru_quintic *tr);
-void prru_quintic_free(prru_quintic *tr);
+PRRU_API int prru_quintic_eval(const prru_quintic *tr, double t, double q[3], double qd[3],
+                               double qdd[3]);
+PRRU_API double prru_quintic_t_begin(const prru_quintic *tr);
+PRRU_API double prru_quintic_t_end(const prru_quintic *tr);
+PRRU_API void prru_quintic_free(prru_quintic *tr);
 
 /* A pose on a trajectory is usable when it is reachable and J_d regular:
  * prru_check_regular's status (PRRU_OK, PRRU_EINPUT, PRRU_EUNREACHABLE,
  * PRRU_ESINGULAR), with *rcond as there. */
-int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], double *rcond);
+PRRU_API int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], double *rcond);
 /* Samples of a path are regular one by one even where the path crosses
  * the singular set between two of them; two regular samples with opposite
  * signs of det J_d (prru_jd_det_sign, prru.h) show that crossing whatever
@@ -122,16 +122,16 @@ typedef struct {
   int sign; /* det J_d's sign at the regular samples so far, 0 before */
 } prru_path_side;
 /* Before the first sample. */
-void prru_path_side_init(prru_path_side *s);
+PRRU_API void prru_path_side_init(prru_path_side *s);
 /* 1 when the regular sample's J_d has the opposite sign to the samples
  * before (the path crossed the singular set since the last one; the sign
  * kept), else 0 (the sign recorded). */
-int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3]);
+PRRU_API int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3]);
 /* The next sample q of a path: prru_traj_pose_ok's status (d filled as
  * there), or PRRU_ESINGULAR with *crossed = 1 when the pose is regular but
  * on the other side of the singular set (crossed may be NULL). */
-int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const double q[3], double *rcond,
-                     int *crossed);
+PRRU_API int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const double q[3], double *rcond,
+                              int *crossed);
 
 /* ---- Time-optimal path parameterisation (TOPP-RA) ----
  * The path of prru_quintic_waypoints (straight lines in q from waypoint to
@@ -209,13 +209,13 @@ typedef struct {
  * PRRU_ENOCONV when the check does not pass after PRRU_TOPP_MAX_ITER
  * tightenings, PRRU_ENOMEM. Allocates: prru_topp_free (also after a
  * failure, which leaves tp empty). */
-int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
-                    const prru_limits *lim, int grid, char *msg, int msglen);
+PRRU_API int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
+                             const prru_limits *lim, int grid, char *msg, int msglen);
 /* q, qd, qdd at time t in [0, duration] (any output NULL if not wanted):
  * s(t) integrated exactly with the constant s'' of t's interval (the
  * interval that starts at or before t; the last one at t = duration).
  * PRRU_EINPUT outside [0, duration]. */
-int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], double qdd[3]);
+PRRU_API int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], double qdd[3]);
 /* A row of the profile at t, checked again with the exact inverse
  * dynamics (what traj --time-optimal writes and the Python binding
  * returns): q, qd, qdd, the forces fd and slider speeds dd; d->d holds the
@@ -224,10 +224,10 @@ int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], dou
  * PRRU_TOPP_ROW_TOL of it or a slider leaves its stroke (between grid
  * points: the profile cannot be trusted); msg says which, at t. */
 #define PRRU_TOPP_ROW_TOL 1e-6
-int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
-                  double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
-                  char *msg, int msglen);
-void prru_topp_free(prru_topp *tp);
+PRRU_API int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
+                           double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
+                           char *msg, int msglen);
+PRRU_API void prru_topp_free(prru_topp *tp);
 
 /* The exact check of one state against lim (no platform loads): fd the
  * inverse dynamics' forces (minimum norm with four actuators), dd the
@@ -237,10 +237,10 @@ void prru_topp_free(prru_topp *tp);
  * The stroke is not part of it (prru_topp_solve checks it at the grid);
  * d->d and d->Jd hold the pose's sliders and J_d afterwards. The statuses
  * of prru_inverse_dynamics. */
-int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
-                      const double q[3], const double qd[3], const double qdd[3],
-                      double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
-                      int *kind);
+PRRU_API int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
+                               const double q[3], const double qd[3], const double qdd[3],
+                               double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
+                               int *kind);
 
 /* The fastest point-to-point quintic (prru_quintic_waypoints' time law)
  * through the same waypoints whose every segment is uniformly time-scaled
@@ -251,8 +251,8 @@ int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
  * no duration up to 2^60 s meets the limits (the static loads exceed
  * them), and with inverse dynamics' status where it refuses a pose. The
  * stroke is not checked here (the path's poses are prru_topp_solve's). */
-int prru_quintic_fastest(const prru_model *m, int n, const double *q, const prru_limits *lim,
-                         int samples, double *durations, char *msg, int msglen);
+PRRU_API int prru_quintic_fastest(const prru_model *m, int n, const double *q, const prru_limits *lim,
+                                  int samples, double *durations, char *msg, int msglen);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,7 @@
 
 #include "internal.h"
 #include "prru.h"
+#include "prru_ident.h"
 #include "prru_control.h"
 #include "prru_model_file.h"
 
