@@ -161,7 +161,7 @@ void prru_p3_ik(const prru_params3 *p, const double q[3], double d[3]);
 /* Actuator Jacobian J_d = dd/dq (3x3). Parameters from *p. */
 void prru_p3_jd(const prru_params3 *p, const double q[3], double Jd[9]);
 
-/* prru_ik and prru_jd fused. Parameters from *p. */
+/* ik and jd fused (one shared evaluation). Parameters from *p. */
 void prru_p3_ik_jd(const prru_params3 *p, const double q[3], double d[3], double Jd[9]);
 
 /* H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3. Parameters from *p. */
@@ -214,7 +214,7 @@ extern const int prru_p3_reaction_basis_index[PRRU_P3_REACTION_BASIS_NNZ];
 /* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Parameters from *p. */
 void prru_p3_eom_solve(const prru_params3 *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
 
-/* d, J_d (as prru_ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. Parameters from *p. */
+/* d, J_d (as ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. Parameters from *p. */
 void prru_p3_inverse_terms(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3]);
 
 /* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. Parameters from *p. */
@@ -237,7 +237,7 @@ void prru_p3_regressor(const prru_params3 *p, const double q[3], const double qd
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
 
-/* prru_ik and prru_jd fused. */
+/* ik and jd fused (one shared evaluation). */
 void prru_p3_batch_ik_jd(const prru_params3 *p, int n, const double *q, double *d, double *Jd);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */

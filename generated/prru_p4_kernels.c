@@ -34,19 +34,27 @@
 
 #include "prru_p4_kernels.h"
 
+/* Designated initializers (C99; C++20 in member order); positional in
+ * older C++, which has none: the order is the struct's either way. */
+#if defined(__cplusplus) && __cplusplus < 202002L
+#define PRRU_DESIGNATE(member)
+#else
+#define PRRU_DESIGNATE(member) .member =
+#endif
+
 const prru_params4 prru_p4_params_reference = {
-  /* .b = */ {0.36, 0.36, 0.315, 0.315},
-  /* .l1 = */ {0.23, 0.23, 0.23, 0.23},
-  /* .l2 = */ {0.225, 0.225, 0.225, 0.225},
-  /* .a = */ {0.045, 0.045, 0.0, 0.0},
-  /* .gravity = */ {0.0, 0.0, -9.81},
-  /* .mass = */ {1.77, 0.64, 0.64, 0.64, 0.64, 1.31, 1.31, 1.31, 1.31, 1.59, 1.59, 1.59,
+  PRRU_DESIGNATE(b) {0.36, 0.36, 0.315, 0.315},
+  PRRU_DESIGNATE(l1) {0.23, 0.23, 0.23, 0.23},
+  PRRU_DESIGNATE(l2) {0.225, 0.225, 0.225, 0.225},
+  PRRU_DESIGNATE(a) {0.045, 0.045, 0.0, 0.0},
+  PRRU_DESIGNATE(gravity) {0.0, 0.0, -9.81},
+  PRRU_DESIGNATE(mass) {1.77, 0.64, 0.64, 0.64, 0.64, 1.31, 1.31, 1.31, 1.31, 1.59, 1.59, 1.59,
     1.59},
-  /* .com = */ {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0},
+  PRRU_DESIGNATE(com) {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0},
     {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0},
     {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0},
     {0.0, 0.0, 0.0}},
-  /* .inertia = */ {{0.0024, 0.0028, 0.0032, 0.0, 0.0, 0.0},
+  PRRU_DESIGNATE(inertia) {{0.0024, 0.0028, 0.0032, 0.0, 0.0, 0.0},
     {0.0025, 0.0003, 0.0027, 0.0, 0.0, 0.0},
     {0.0025, 0.0003, 0.0027, 0.0, 0.0, 0.0},
     {0.0003, 0.0025, 0.0027, 0.0, 0.0, 0.0},
@@ -59,11 +67,12 @@ const prru_params4 prru_p4_params_reference = {
     {0.0036, 0.0032, 0.0015, 0.0, 0.0, 0.0},
     {0.0036, 0.0032, 0.0015, 0.0, 0.0, 0.0},
     {0.0036, 0.0032, 0.0015, 0.0, 0.0, 0.0}},
-  /* .armature = */ {0.0, 0.0, 0.0, 0.0},
-  /* .damping = */ {0.0, 0.0, 0.0, 0.0},
-  /* .coulomb = */ {0.0, 0.0, 0.0, 0.0},
-  /* .coulomb_velocity = */ 1.0
+  PRRU_DESIGNATE(armature) {0.0, 0.0, 0.0, 0.0},
+  PRRU_DESIGNATE(damping) {0.0, 0.0, 0.0, 0.0},
+  PRRU_DESIGNATE(coulomb) {0.0, 0.0, 0.0, 0.0},
+  PRRU_DESIGNATE(coulomb_velocity) 1.0
 };
+#undef PRRU_DESIGNATE
 
 const char *const prru_p4_lambda_labels[PRRU_P4_NLAMBDA] = {"C1_fx", "C1_fy", "C1_fz", "C1_mu", "C2_fx", "C2_fy", "C2_fz", "C2_mu",
     "C3_fx", "C3_fy", "C3_fz", "C3_mn", "C4_fx", "C4_fy", "C4_fz",

@@ -164,7 +164,7 @@ void prru_p4_ik(const prru_params4 *p, const double q[3], double d[4]);
 /* Actuator Jacobian J_d = dd/dq (4x3). Parameters from *p. */
 void prru_p4_jd(const prru_params4 *p, const double q[3], double Jd[12]);
 
-/* prru_ik and prru_jd fused. Parameters from *p. */
+/* ik and jd fused (one shared evaluation). Parameters from *p. */
 void prru_p4_ik_jd(const prru_params4 *p, const double q[3], double d[4], double Jd[12]);
 
 /* H (78x3) = [J_R,P; ..; J_R,S4; J_T,P; ..; J_T,S4], world frame, body order P L1 L2 L3 L4 U1 U2 U3 U4 S1 S2 S3 S4. Parameters from *p. */
@@ -217,7 +217,7 @@ extern const int prru_p4_reaction_basis_index[PRRU_P4_REACTION_BASIS_NNZ];
 /* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Parameters from *p. */
 void prru_p4_eom_solve(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
 
-/* d, J_d (as prru_ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. Parameters from *p. */
+/* d, J_d (as ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. Parameters from *p. */
 void prru_p4_inverse_terms(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3]);
 
 /* The joint reaction coordinates lambda (76, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb: the solution of least norm, lambda . z = 0, and z, the unit null direction of Q (C3's force along e2 positive). Parameters from *p. */
@@ -243,7 +243,7 @@ void prru_p4_regressor(const prru_params4 *p, const double q[3], const double qd
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
 
-/* prru_ik and prru_jd fused. */
+/* ik and jd fused (one shared evaluation). */
 void prru_p4_batch_ik_jd(const prru_params4 *p, int n, const double *q, double *d, double *Jd);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */

@@ -98,7 +98,7 @@ void prru_param_ik(const prru_params *p, const double q[3], double d[3]);
 /* Actuator Jacobian J_d = dd/dq (3x3). Parameters from *p. */
 void prru_param_jd(const prru_params *p, const double q[3], double Jd[9]);
 
-/* prru_ik and prru_jd fused. Parameters from *p. */
+/* ik and jd fused (one shared evaluation). Parameters from *p. */
 void prru_param_ik_jd(const prru_params *p, const double q[3], double d[3], double Jd[9]);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Parameters from *p. */
@@ -142,7 +142,7 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
 
-/* prru_ik and prru_jd fused. */
+/* ik and jd fused (one shared evaluation). */
 void prru_param_batch_ik_jd(const prru_params *p, int n, const double *q, double *d, double *Jd);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */

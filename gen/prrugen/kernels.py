@@ -32,7 +32,7 @@ def kernels(deriv):
          [Q], [("d", d)]),
         ("jd", "Actuator Jacobian J_d = dd/dq (%dx3)." % nact, [Q],
          [("Jd", jd)]),
-        ("ik_jd", "prru_ik and prru_jd fused.", [Q], [("d", d), ("Jd", jd)]),
+        ("ik_jd", "ik and jd fused (one shared evaluation).", [Q], [("d", d), ("Jd", jd)]),
         ("jacobians", "H (%dx3) = [J_R,P; ..; J_R,%s; J_T,P; ..; J_T,%s], "
          "world frame, body order %s." % (nh, last, last, " ".join(names)),
          [Q], [("H", deriv.jacobians())]),
@@ -207,7 +207,7 @@ def _inverse_terms(deriv, d, jd, fp, mp):
     tau = deriv.drive_force(qdd, fp, mp)
     ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
     if len(d) != 3:
-        return ("inverse_terms", "d, J_d (as prru_ik_jd) and tau = M qdd + h "
+        return ("inverse_terms", "d, J_d (as ik_jd) and tau = M qdd + h "
                 "- G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized "
                 "force the drives supply: J_d^T fd = tau.", ins,
                 [("d", d), ("Jd", jd), ("tau", tau)], ("d", "tau"))
@@ -228,7 +228,7 @@ def _inverse_terms(deriv, d, jd, fp, mp):
     # fd = J_d^-T tau: fd_i = sum_k (J_d^-1)_ki tau_k = sum_k cof_ik tau_k / det.
     fd = [sym.mul(sym.add(*[sym.mul(cof[i][k], tau[k]) for k in range(3)]),
                   inv_det) for i in range(3)]
-    return ("inverse_terms", "d, J_d (as prru_ik_jd), J_d^-1 (by the "
+    return ("inverse_terms", "d, J_d (as ik_jd), J_d^-1 (by the "
             "adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T "
             "tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: "
             "the actuator forces of the motion.", ins,

@@ -73,6 +73,25 @@ def _limit(x):
         else c_double(x)
 
 
+def _designated(fields):
+    """A struct initializer from (member, C text) pairs in member order,
+    each designated through PRRU_DESIGNATE (DESIGNATE_MACRO): C99 and
+    C++20 check every name; older C++ has no designators and reads the
+    same list by position."""
+    return ",\n".join("  PRRU_DESIGNATE(%s) %s" % f for f in fields)
+
+
+# Defined and undefined around each initializer by the templates (the
+# name is the same for every model: it never leaves its .c file).
+DESIGNATE_MACRO = """/* Designated initializers (C99; C++20 in member order); positional in
+ * older C++, which has none: the order is the struct's either way. */
+#if defined(__cplusplus) && __cplusplus < 202002L
+#define PRRU_DESIGNATE(member)
+#else
+#define PRRU_DESIGNATE(member) .member =
+#endif"""
+
+
 def _descriptor(model, mech, prefix, labels):
     """Initializer fields of the mechanism descriptor, in struct order."""
     nb, nl = len(mech.bodies), len(mech.limbs)
@@ -140,7 +159,7 @@ def _descriptor(model, mech, prefix, labels):
         ("torque_max", _block([num(x or 0) for x in dr.torque_max])),
         ("motor_speed_max", _block([num(x or 0) for x in dr.motor_speed_max])),
     ]
-    return ",\n".join("  /* .%s = */ %s" % f for f in fields)
+    return _designated(fields)
 
 
 def _head(model, precision=None):
@@ -173,8 +192,8 @@ def _initializer(model):
             text = _block([_block(v, "      ") for v in value])
         else:
             text = _block(value)
-        rows.append("  /* .%s = */ %s" % (name, text))
-    return ",\n".join(rows)
+        rows.append((name, text))
+    return _designated(rows)
 
 
 def render_params(model, pmodel, deriv, templates_dir, prefix=None):
@@ -201,7 +220,8 @@ def render_params(model, pmodel, deriv, templates_dir, prefix=None):
     bodies += "\n\n" + bbodies
     values = dict(banner=banner, prefix=prefix, PREFIX=upper,
                   macros="\n".join(macros), declarations=decls,
-                  functions=bodies, initializer=_initializer(model))
+                  functions=bodies, designate=DESIGNATE_MACRO,
+                  initializer=_initializer(model))
     files = {}
     for tmpl, out in (("param_kernels.h.in", "%s_param_kernels.h" % prefix),
                       ("param_kernels.c.in", "%s_param_kernels.c" % prefix)):
@@ -260,7 +280,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
                   reference_file=c_comment(_safe_name(os.path.basename(
                       reference.path))),
                   macros="\n".join(macros), declarations=decls,
-                  functions=bodies, initializer=_initializer(reference),
+                  functions=bodies, designate=DESIGNATE_MACRO,
+                  initializer=_initializer(reference),
                   labels=_block([c_string(l) for l in labels]))
     files = {}
     for tmpl, out in (("topology_kernels.h.in", "%s_kernels.h" % prefix),
@@ -410,6 +431,7 @@ def render(model, deriv, templates_dir, prefix=None):
     values = dict(banner=banner, head=head + " */", prefix=prefix,
                   PREFIX=upper, macros="\n".join(macros),
                   declarations=decls, functions=bodies,
+                  designate=DESIGNATE_MACRO,
                   descriptor=_descriptor(model, mech, prefix, labels))
     files = {}
     for tmpl, out in (("kernels.h.in", "%s_kernels.h" % prefix),

@@ -266,8 +266,8 @@ class FormatTranscription(unittest.TestCase):
             b = two[name].split(" */\n", 1)[1]
             if name.endswith("mechanism.c"):
                 for key in ("model_file", "sha256", "format"):
-                    a = "\n".join(l for l in a.splitlines() if "." + key not in l)
-                    b = "\n".join(l for l in b.splitlines() if "." + key not in l)
+                    a = "\n".join(l for l in a.splitlines() if "PRRU_DESIGNATE(%s)" % key not in l)
+                    b = "\n".join(l for l in b.splitlines() if "PRRU_DESIGNATE(%s)" % key not in l)
             self.assertEqual(a, b, name)
 
 
@@ -306,8 +306,8 @@ class Drives(unittest.TestCase):
         text = one["proto_drives_mechanism.c"]
 
         def field(key):
-            line = next(l for l in text.splitlines() if "/* .%s = */" % key in l)
-            return line.split("*/", 1)[1].strip().rstrip(",")
+            line = next(l for l in text.splitlines() if "PRRU_DESIGNATE(%s)" % key in l)
+            return line.split(")", 1)[1].strip().rstrip(",")
 
         force = [float(x) for x in field("force_max").strip("{}").split(",")]
         for f in force:
@@ -319,8 +319,8 @@ class Drives(unittest.TestCase):
         self.assertEqual(field("lead"), "{0.02, 0.02, 0.02}")
         self.assertEqual(field("drive_keys"), "%du" % (1 | 2 | 4 | 8 | 16 | 64 | 256))
         none = two["proto_drives_mechanism.c"]
-        self.assertIn("/* .force_max = */ {HUGE_VAL, HUGE_VAL, HUGE_VAL}", none)
-        self.assertIn("/* .lead = */ {0.0, 0.0, 0.0}", none)
+        self.assertIn("PRRU_DESIGNATE(force_max) {HUGE_VAL, HUGE_VAL, HUGE_VAL}", none)
+        self.assertIn("PRRU_DESIGNATE(lead) {0.0, 0.0, 0.0}", none)
 
 
 class Determinism(unittest.TestCase):
@@ -336,7 +336,7 @@ class Determinism(unittest.TestCase):
     def test_prefix_option(self):
         files, _ = prru_gen.generate(PROTO, prefix="prru")
         self.assertEqual(sorted(files), OUTPUT_FILES)
-        self.assertIn('/* .name = */ "proto"', files["prru_mechanism.c"])
+        self.assertIn('PRRU_DESIGNATE(name) "proto"', files["prru_mechanism.c"])
         own, _ = prru_gen.generate(PROTO)
         self.assertIn("void proto_dynamics(", own["proto_kernels.c"])
 

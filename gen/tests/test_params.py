@@ -178,7 +178,7 @@ class GeneratedParameterKernels(unittest.TestCase):
         c = self.proto["prru_param_kernels.c"]
         init = re.search(r"prru_params_model = \{(.*?)\n\};", c, re.S).group(1)
         numbers = [float(x) for x in re.findall(
-            r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?", re.sub(r"/\*.*?\*/", "", init))]
+            r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?", re.sub(r"/\*.*?\*/|PRRU_DESIGNATE\(\w+\)", "", init))]
         want = [l.b for l in m.limbs] + [l.l1 for l in m.limbs] + \
             [l.l2 for l in m.limbs] + [l.a for l in m.limbs] + \
             list(m.gravity) + list(m.masses) + \
@@ -187,7 +187,7 @@ class GeneratedParameterKernels(unittest.TestCase):
             list(m.damping) + list(m.coulomb) + [m.coulomb_velocity]
         self.assertEqual(numbers, [float(Fraction(w)) for w in want])
         paper = self.paper["prru_param_kernels.c"]
-        self.assertIn("/* .coulomb_velocity = */ 1.0", paper)
+        self.assertIn("PRRU_DESIGNATE(coulomb_velocity) 1.0", paper)
 
     def test_c_shape(self):
         c = self.paper["prru_param_kernels.c"]
