@@ -58,16 +58,16 @@
  *     differences in ulp over the firmware's sweep. */
 #include <float.h>
 #include <limits.h>
-#include <stddef.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "mcu_ctl.h"
 #include "prru.h"
 #include "prru_f_kernels.h"
-#include "mcu_ctl.h"
 #include "prru_mechanism.h"
 #include "testutil.h"
 
