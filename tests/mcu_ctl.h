@@ -33,7 +33,7 @@ typedef struct {
 #define MCU_IN_WORDS (sizeof(mcu_in) / sizeof(float))
 #define MCU_OUT_WORDS (sizeof(mcu_out) / sizeof(float))
 
-static void mcu_eval(const mcu_in *x, mcu_out *y)
+static inline void mcu_eval(const mcu_in *x, mcu_out *y)
 {
   prru_f_ik_jd(x->q, y->ikjd_d, y->ikjd_J);
   prru_f_dynamics(x->q, x->qd, y->dyn_M, y->dyn_h, y->dyn_G);

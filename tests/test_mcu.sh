@@ -12,7 +12,9 @@
 #     routine (__aeabi_d*, __aeabi_f2d, __adddf3, ...): on an M4 each would
 #     be a silent emulation costing some 100 cycles per operation. The
 #     pattern is shown to catch a firmware that does use one;
-#  3. the M4 firmware runs under QEMU (mps2-an386) on states drawn as
+#  3. the M7 firmware runs under QEMU (mps2-an500) on the first state
+#     (every output finite: the double set runs on its FPU); the M4
+#     firmware under QEMU (mps2-an386) on states drawn as
 #     test_float_kernels draws them (every fourth at rest, the others
 #     moving, accelerating and loaded) and prints every output's bit
 #     pattern; test_float_kernels --mcu holds them to that test's bound
@@ -133,6 +135,16 @@ if [ $qrc -ne 0 ]; then
   bad "qemu-system-arm -M mps2-an386 exited $qrc (124: timeout)"
   head -c 2000 "$work/qemu.err"
   tail -n 3 "$work/m4.out"
+fi
+qrc=0
+timeout 60 qemu-system-arm -M mps2-an500 -nographic -chardev file,id=sh,path="$work/m7.out" \
+  -semihosting-config enable=on,target=native,chardev=sh -kernel "$work/m7.elf" \
+  </dev/null >"$work/qemu7.err" 2>&1 || qrc=$?
+if [ $qrc -ne 0 ]; then
+  bad "qemu-system-arm -M mps2-an500 (the M7 double firmware) exited $qrc (124: timeout)"
+  head -c 2000 "$work/qemu7.err" "$work/m7.out"
+else
+  echo "ok   QEMU mps2-an500 (Cortex-M7): $(cat "$work/m7.out")"
 fi
 echo "QEMU mps2-an386 (Cortex-M4F), $(grep -c '^S ' "$work/m4.out") states:"
 "$CHECK" --mcu "$work/m4.out" || fail=1
