@@ -23,7 +23,9 @@ FUZZ_SECONDS ?= 60
 #         Debian's nodejs lacks it, NodeSource's has it and conflicts with
 #         Debian's npm package), slurm-wlm and munge (a single-node Slurm
 #         cluster that runs the docs' job-array example, tests/test_slurm.sh;
-#         the test starts and stops its own daemons, not the system's);
+#         the test starts and stops its own daemons, not the system's),
+#         the Arm cross compiler, newlib and QEMU (the controller kernels
+#         built for and run on an emulated Cortex-M4, tests/test_mcu.sh);
 #   test-asan: + valgrind (gcc's own sanitizers need nothing more);
 #   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
@@ -31,7 +33,8 @@ FUZZ_SECONDS ?= 60
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.
 DEPS_DEMO = cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox help2man
 DEPS_TEST = $(strip $(DEPS_DEMO) g++ clang libmujoco-dev python3-numpy python3-sympy \
-            chromium nodejs $(if $(shell command -v npm),,npm) slurm-wlm munge)
+            chromium nodejs $(if $(shell command -v npm),,npm) slurm-wlm munge \
+            gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)
 DEPS_ASAN = $(DEPS_TEST) valgrind
 DEPS_FUZZ = clang clang-runtime libgsl-dev libjansson-dev pkg-config
 DEPS_DRY_RUN ?=

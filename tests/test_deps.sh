@@ -188,11 +188,12 @@ deps_of() { # TARGET: the distinct package lists make -n TARGET passes
     sed -n 's/.*debian_deps.sh [a-z-]* //p' | sort -u
 }
 # help2man: the man pages; npm only where no npm command is found
-# (NodeSource's nodejs has one); slurm-wlm and munge: tests/test_slurm.sh.
+# (NodeSource's nodejs has one); slurm-wlm and munge: tests/test_slurm.sh;
+# the Arm cross compiler, newlib and QEMU: tests/test_mcu.sh.
 demo_list="cmake gcc make python3 libgsl-dev libjansson-dev pkg-config gnuplot-nox help2man"
 test_list="$demo_list g++ clang libmujoco-dev python3-numpy python3-sympy chromium nodejs"
 command -v npm >/dev/null 2>&1 || test_list="$test_list npm"
-test_list="$test_list slurm-wlm munge"
+test_list="$test_list slurm-wlm munge gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm"
 for case in "demo|$demo_list" "deps|$demo_list" "bench|$demo_list" \
             "test|$demo_list
 $test_list" "test-asan|$demo_list

@@ -43,11 +43,29 @@
  * Near hover qdd is a small difference of large forces: it is held
  * relative to its terms, never to |qdd|. The printed table (worst error
  * relative to the output's largest entry, to S_y, and over K's unit u c
- * S_y) is the one of docs/performance.md, section "Single precision". */
+ * S_y) is the one of docs/performance.md, section "Single precision".
+ *
+ * The same check on a microcontroller (tests/test_mcu.sh):
+ *   test_float_kernels --states N FILE  writes N states drawn as below
+ *     (every fourth at rest: qd = qdd = 0) as a C header for the firmware;
+ *   test_float_kernels --mcu FILE  reads the firmware's output (the
+ *     controller set's outputs on those states as bit patterns,
+ *     tests/mcu_ctl.h) and holds them to the same bound against the double
+ *     kernels, and, with the same bound, against this host's float kernels
+ *     (which differ from the firmware's only through the C library's sinf,
+ *     cosf, sqrtf, tanhf: the kernels are built without contraction on
+ *     both); it prints the bitwise agreement and the C libraries'
+ *     differences in ulp over the firmware's sweep. */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
+#include "mcu_ctl.h"
 #include "prru.h"
 #include "prru_f_kernels.h"
 #include "prru_mechanism.h"
@@ -82,7 +100,10 @@ static const char *names[O_COUNT] = {
   "inverse_terms tau",
 #endif
 };
-static double worst_rel[O_COUNT], worst_terms[O_COUNT], worst_ratio[O_COUNT];
+/* Table 0: the float outputs against the double kernels; table 1 (--mcu):
+ * the firmware's against this host's float kernels. */
+static double worst_rel[2][O_COUNT], worst_terms[2][O_COUNT], worst_ratio[2][O_COUNT];
+static int seen[O_COUNT], table;
 static double L, Lgeo, W;
 
 static double maxabs(const double *v, int n)
@@ -133,10 +154,54 @@ static void record(int o, const float *yf, const double *yd, int rows, int cols,
     if (!(e <= err)) err = e; /* NaN: fails below */
   }
   double norm = maxabs(d, n), ratio = err / (FLT_EPSILON * c * S);
-  if (norm > 0 && !(err / norm <= worst_rel[o])) worst_rel[o] = err / norm;
-  if (!(err / S <= worst_terms[o])) worst_terms[o] = err / S;
-  if (!(ratio <= worst_ratio[o])) worst_ratio[o] = ratio;
+  seen[o] = 1;
+  if (norm > 0 && !(err / norm <= worst_rel[table][o])) worst_rel[table][o] = err / norm;
+  if (!(err / S <= worst_terms[table][o])) worst_terms[table][o] = err / S;
+  if (!(ratio <= worst_ratio[table][o])) worst_ratio[table][o] = ratio;
 }
+
+/* The distance of two floats in units in the last place (0 for two NaNs). */
+static long long ulp_distance(float a, float b)
+{
+  if (isnan(a) || isnan(b)) return isnan(a) && isnan(b) ? 0 : LLONG_MAX;
+  uint32_t ua, ub;
+  memcpy(&ua, &a, sizeof ua);
+  memcpy(&ub, &b, sizeof ub);
+  long long ia = (ua & 0x80000000u) ? -(long long)(ua & 0x7fffffffu) : (long long)ua;
+  long long ib = (ub & 0x80000000u) ? -(long long)(ub & 0x7fffffffu) : (long long)ub;
+  return ia > ib ? ia - ib : ib - ia;
+}
+
+static const mcu_out *mcu; /* --mcu: the firmware's outputs of this state */
+static mcu_out host;       /* this host's float kernels on the same state */
+static long long mcu_ulp_max, mcu_words, mcu_equal;
+
+/* A controller-set output (a field of mcu_out): the firmware's if there is
+ * one, else this host's, against the double kernels; with the firmware's,
+ * also against the host's, under the same bound. */
+static void record_ctl(int o, size_t field, const double *yd, int rows, int cols,
+                       const double *row, const double *col, double S, double c)
+{
+  const float *yh = (const float *)((const char *)&host + field);
+  if (!mcu) {
+    record(o, yh, yd, rows, cols, row, col, S, c);
+    return;
+  }
+  const float *ym = (const float *)((const char *)mcu + field);
+  double h[64];
+  to_double(yh, h, rows * cols);
+  record(o, ym, yd, rows, cols, row, col, S, c);
+  table = 1;
+  record(o, ym, h, rows, cols, row, col, S, c);
+  table = 0;
+  for (int i = 0; i < rows * cols; i++) {
+    long long u = ulp_distance(ym[i], yh[i]);
+    if (u > mcu_ulp_max) mcu_ulp_max = u;
+    mcu_words++;
+    mcu_equal += u == 0;
+  }
+}
+#define FIELD(name) offsetof(mcu_out, name)
 
 /* The largest permanent of |M| over the principal index sets of size k. */
 static double principal_permanent(const double M[9], int k)
@@ -155,47 +220,55 @@ static double principal_permanent(const double M[9], int k)
   return best;
 }
 
-static void round_to_float(const double *x, float *f, double *d, int n)
+/* One state drawn into x; 0 if no pose with rcond(J_d) >= RCOND_MIN was
+ * found. rest: qd = qdd = 0 (the draws are made all the same, so the
+ * sequence of poses does not depend on it). */
+static int draw_state(const prru_model *m, prru_data *dat, mcu_in *x, int rest, double *rcond_out)
 {
-  for (int i = 0; i < n; i++) {
-    f[i] = (float)x[i];
-    d[i] = (double)f[i];
-  }
-}
-
-/* One state; 0 if no pose with rcond(J_d) >= RCOND_MIN was found. */
-static int one_state(const prru_model *m, prru_data *dat)
-{
-  double x[3], rcond;
+  double p[3], rcond;
   /* A reachable pose with rcond(J_d) >= RCOND_MIN (as ts_random_state,
    * the range halved whenever a model rejects too many draws; by 3000
    * draws it is within 1e-9 rad of q1 = q2 = 0). */
   double span = 1.0;
   for (int tries = 1;; tries++) {
-    x[0] = span * tu_uniform(-0.4, 0.4);
-    x[1] = span * tu_uniform(-0.5, 0.4);
-    x[2] = tu_uniform(-1.0, -0.5);
+    p[0] = span * tu_uniform(-0.4, 0.4);
+    p[1] = span * tu_uniform(-0.5, 0.4);
+    p[2] = tu_uniform(-1.0, -0.5);
     double xr[3];
-    for (int i = 0; i < 3; i++) xr[i] = (double)(float)x[i];
+    for (int i = 0; i < 3; i++) xr[i] = (double)(float)p[i];
     if (prru_check_regular(m, dat, xr, &rcond) == PRRU_OK && rcond >= RCOND_MIN) break;
     if (tries % 100 == 0) span *= 0.5;
     if (tries == 3000) return 0;
   }
-  const double c = 1.0 / rcond;
+  const double D[3] = {L, L, 1.0};
+  for (int i = 0; i < 3; i++) x->q[i] = (float)p[i];
+  for (int i = 0; i < 3; i++) x->qd[i] = (float)(tu_uniform(-1, 1) * D[i]); /* 1/s, m/s */
+  for (int i = 0; i < 3; i++) x->qdd[i] = (float)(tu_uniform(-10, 10) * D[i]); /* 1/s^2, m/s^2 */
+  for (int i = 0; i < NA; i++) x->fd[i] = (float)(tu_uniform(-1, 1) * W); /* loads of the machine's weight */
+  for (int i = 0; i < 3; i++) x->fp[i] = (float)(tu_uniform(-1, 1) * W);
+  for (int i = 0; i < 3; i++) x->mp[i] = (float)(tu_uniform(-1, 1) * W * L);
+  if (rest)
+    for (int i = 0; i < 3; i++) x->qd[i] = x->qdd[i] = 0.0f;
+  *rcond_out = rcond;
+  return 1;
+}
+
+/* The float kernels on state x, rcond(J_d) there, against the double ones
+ * (the controller set's outputs from the firmware when mcu is set, the
+ * others only without it). */
+static void check_state(const mcu_in *x, double rcond)
+{
   const double D[3] = {L, L, 1.0}, Dinv[3] = {1.0 / L, 1.0 / L, 1.0};
-  float qf[3], qdf[3], qddf[3], fdf[NA], fpf[3], mpf[3];
-  double q[3], qd[3], qdd[3], fd[NA], fp[3], mp[3], in[NA > 3 ? NA : 3];
-  round_to_float(x, qf, q, 3);
-  for (int i = 0; i < 3; i++) in[i] = tu_uniform(-1, 1) * D[i]; /* 1/s, m/s */
-  round_to_float(in, qdf, qd, 3);
-  for (int i = 0; i < 3; i++) in[i] = tu_uniform(-10, 10) * D[i]; /* 1/s^2, m/s^2 */
-  round_to_float(in, qddf, qdd, 3);
-  for (int i = 0; i < NA; i++) in[i] = tu_uniform(-1, 1) * W; /* loads of the machine's weight */
-  round_to_float(in, fdf, fd, NA);
-  for (int i = 0; i < 3; i++) in[i] = tu_uniform(-1, 1) * W;
-  round_to_float(in, fpf, fp, 3);
-  for (int i = 0; i < 3; i++) in[i] = tu_uniform(-1, 1) * W * L;
-  round_to_float(in, mpf, mp, 3);
+  const float *qf = x->q, *qdf = x->qd, *fdf = x->fd, *fpf = x->fp, *mpf = x->mp;
+  double q[3], qd[3], qdd[3], fd[NA], fp[3], mp[3];
+  to_double(x->q, q, 3);
+  to_double(x->qd, qd, 3);
+  to_double(x->qdd, qdd, 3);
+  to_double(x->fd, fd, NA);
+  to_double(x->fp, fp, 3);
+  to_double(x->mp, mp, 3);
+  const double c = 1.0 / rcond;
+  mcu_eval(x, &host);
 
   /* Double: the reference values and the scales of the terms. */
   double d[NA], Jd[NA * 3], M[9], h[3], G[3], b[3], qdds[3], minors[3], JP[18], Qp[3];
@@ -227,70 +300,65 @@ static int one_state(const prru_model *m, prru_data *dat)
   const double S_G = maxabs(Gs, 3) + W;
   const double S_load = 3.0 * (maxabs(JPs + 9, 9) * maxabs(fp, 3) + maxabs(JPs, 9) * maxabs(mp, 3));
   const double S_pass = maxabs(Qps, 3);
-
-  float df[NA], Jdf[NA * 3], Mf[9], hf[3], Gf[3], bf[3], qddof[3], minf[3];
-  prru_ik(q, d);
-  prru_f_ik(qf, df);
-  record(O_IK, df, d, NA, 1, NULL, NULL, S_d, 1.0);
-  prru_jd(q, Jd);
-  prru_f_jd(qf, Jdf);
-  record(O_JD, Jdf, Jd, NA, 3, NULL, Dinv, nJ, 1.0);
-  prru_f_ik_jd(qf, df, Jdf);
-  record(O_IKJD_D, df, d, NA, 1, NULL, NULL, S_d, 1.0);
-  record(O_IKJD_J, Jdf, Jd, NA, 3, NULL, Dinv, nJ, 1.0);
-  prru_f_mass(qf, Mf);
-  record(O_MASS, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
-  prru_f_bias(qf, qdf, hf);
-  record(O_BIAS, hf, h, 3, 1, Dinv, NULL, S_h, 1.0);
-  prru_f_gravity(qf, Gf);
-  record(O_GRAV, Gf, G, 3, 1, Dinv, NULL, S_G, 1.0);
-  prru_f_dynamics(qf, qdf, Mf, hf, Gf);
-  record(O_DYN_M, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
-  record(O_DYN_H, hf, h, 3, 1, Dinv, NULL, S_h, 1.0);
-  record(O_DYN_G, Gf, G, 3, 1, Dinv, NULL, S_G, 1.0);
   const double S_b = S_G + S_h + NA * nJ * maxabs(fd, NA) + S_load + S_pass;
-  prru_eom(q, qd, fd, fp, mp, M, b);
-  prru_f_eom(qf, qdf, fdf, fpf, mpf, Mf, bf);
-  record(O_EOM_M, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
-  record(O_EOM_B, bf, b, 3, 1, Dinv, NULL, S_b, 1.0);
+
+  record_ctl(O_IKJD_D, FIELD(ikjd_d), d, NA, 1, NULL, NULL, S_d, 1.0);
+  record_ctl(O_IKJD_J, FIELD(ikjd_J), Jd, NA, 3, NULL, Dinv, nJ, 1.0);
+  record_ctl(O_DYN_M, FIELD(dyn_M), M, 3, 3, Dinv, Dinv, nM, 1.0);
+  record_ctl(O_DYN_H, FIELD(dyn_h), h, 3, 1, Dinv, NULL, S_h, 1.0);
+  record_ctl(O_DYN_G, FIELD(dyn_G), G, 3, 1, Dinv, NULL, S_G, 1.0);
+  if (!mcu) { /* the kernels outside the controller set: host only */
+    float df[NA], Jdf[NA * 3], Mf[9], hf[3], Gf[3], bf[3];
+    prru_ik(q, d);
+    prru_f_ik(qf, df);
+    record(O_IK, df, d, NA, 1, NULL, NULL, S_d, 1.0);
+    prru_jd(q, Jd);
+    prru_f_jd(qf, Jdf);
+    record(O_JD, Jdf, Jd, NA, 3, NULL, Dinv, nJ, 1.0);
+    prru_f_mass(qf, Mf);
+    record(O_MASS, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
+    prru_f_bias(qf, qdf, hf);
+    record(O_BIAS, hf, h, 3, 1, Dinv, NULL, S_h, 1.0);
+    prru_f_gravity(qf, Gf);
+    record(O_GRAV, Gf, G, 3, 1, Dinv, NULL, S_G, 1.0);
+    prru_eom(q, qd, fd, fp, mp, M, b);
+    prru_f_eom(qf, qdf, fdf, fpf, mpf, Mf, bf);
+    record(O_EOM_M, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
+    record(O_EOM_B, bf, b, 3, 1, Dinv, NULL, S_b, 1.0);
+  }
   prru_eom_solve(q, qd, fd, fp, mp, M, b, qdds, minors);
-  prru_f_eom_solve(qf, qdf, fdf, fpf, mpf, Mf, bf, qddof, minf);
-  record(O_ES_M, Mf, M, 3, 3, Dinv, Dinv, nM, 1.0);
-  record(O_ES_B, bf, b, 3, 1, Dinv, NULL, S_b, 1.0);
+  record_ctl(O_ES_M, FIELD(es_M), M, 3, 3, Dinv, Dinv, nM, 1.0);
+  record_ctl(O_ES_B, FIELD(es_b), b, 3, 1, Dinv, NULL, S_b, 1.0);
   {
     double Minv[9], x_s[3];
     tu_inverse3(Ms, Minv);
     for (int i = 0; i < 3; i++) x_s[i] = qdds[i] * D[i];
-    record(O_ES_QDD, qddof, qdds, 3, 1, D, NULL,
-           norm_inf(Minv, 3) * (S_b + norm_inf(Ms, 3) * maxabs(x_s, 3)), 1.0);
+    record_ctl(O_ES_QDD, FIELD(es_qdd), qdds, 3, 1, D, NULL,
+               norm_inf(Minv, 3) * (S_b + norm_inf(Ms, 3) * maxabs(x_s, 3)), 1.0);
     for (int k = 0; k < 3; k++)
-      record(O_ES_MIN, minf + k, minors + k, 1, 1, NULL, NULL, principal_permanent(M, k + 1), 1.0);
+      record_ctl(O_ES_MIN, FIELD(es_min) + (size_t)k * sizeof(float), minors + k, 1, 1, NULL, NULL,
+                 principal_permanent(M, k + 1), 1.0);
   }
   const double S_tau = 3.0 * nM * maxabs(qdd_s, 3) + S_h + S_G + S_load + S_pass;
 #if NA == 3
   double Jdinv[9], fdo[3];
-  float Jdinvf[9], fdof[3];
   prru_inverse_terms(q, qd, qdd, fp, mp, d, Jd, Jdinv, fdo);
-  prru_f_inverse_terms(qf, qdf, qddf, fpf, mpf, df, Jdf, Jdinvf, fdof);
   double Jinv_s[9];
   for (int i = 0; i < 9; i++) Jinv_s[i] = Jdinv[i];
   scale(Jinv_s, 3, 3, D, NULL);
-  record(O_IT_JINV, Jdinvf, Jdinv, 3, 3, D, NULL, maxabs(Jinv_s, 9), c);
+  record_ctl(O_IT_JINV, FIELD(it_Jinv), Jdinv, 3, 3, D, NULL, maxabs(Jinv_s, 9), c);
   double JinvT_s[9];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) JinvT_s[3 * i + j] = Jinv_s[3 * j + i];
-  record(O_IT_FD, fdof, fdo, 3, 1, NULL, NULL, norm_inf(JinvT_s, 3) * S_tau, 1.0 + c);
+  record_ctl(O_IT_FD, FIELD(it_fd), fdo, 3, 1, NULL, NULL, norm_inf(JinvT_s, 3) * S_tau, 1.0 + c);
 #else
   (void)c; /* J_d is not inverted: tau is M qdd + h - G - loads - passive */
   double tau[3];
-  float tauf[3];
   prru_inverse_terms(q, qd, qdd, fp, mp, d, Jd, tau);
-  prru_f_inverse_terms(qf, qdf, qddf, fpf, mpf, df, Jdf, tauf);
-  record(O_IT_TAU, tauf, tau, 3, 1, Dinv, NULL, S_tau, 1.0);
+  record_ctl(O_IT_TAU, FIELD(it_tau), tau, 3, 1, Dinv, NULL, S_tau, 1.0);
 #endif
-  record(O_IT_D, df, d, NA, 1, NULL, NULL, S_d, 1.0);
-  record(O_IT_J, Jdf, Jd, NA, 3, NULL, Dinv, nJ, 1.0);
-  return 1;
+  record_ctl(O_IT_D, FIELD(it_d), d, NA, 1, NULL, NULL, S_d, 1.0);
+  record_ctl(O_IT_J, FIELD(it_J), Jd, NA, 3, NULL, Dinv, nJ, 1.0);
 }
 
 /* Where the double kernels make every output NaN (q unreachable or not
@@ -324,7 +392,165 @@ static void check_nan(void)
   }
 }
 
-int main(void)
+/* The table of worst errors; each row held to K. */
+static void report(int t, int nstate, const char *what)
+{
+  printf("model %s: %d states with rcond(J_d) >= %g; worst error of %s\n", prru_mech.name,
+         nstate, RCOND_MIN, what);
+  printf("%-20s %12s %12s %12s\n", "output", "rel. |y|", "rel. terms", "/(u c S)");
+  for (int o = 0; o < O_COUNT; o++) {
+    if (!seen[o]) continue;
+    printf("%-20s %12.2e %12.2e %12.2f\n", names[o], worst_rel[t][o], worst_terms[t][o],
+           worst_ratio[t][o]);
+    tu_check(worst_ratio[t][o] <= K, names[o], worst_ratio[t][o], K);
+  }
+}
+
+/* --states N FILE: N states as the C header tests/mcu/fw_float.c includes. */
+static int write_states(const prru_model *m, prru_data *dat, int n, const char *path)
+{
+  FILE *f = fopen(path, "w");
+  if (!f) {
+    fprintf(stderr, "test_float_kernels: cannot write %s\n", path);
+    return 2;
+  }
+  fprintf(f, "/* %d states of model %s (test_float_kernels --states) */\n", n, prru_mech.name);
+  fprintf(f, "static const uint32_t mcu_states[%d][%u] = {\n", n, (unsigned)MCU_IN_WORDS);
+  for (int s = 0; s < n; s++) {
+    mcu_in x;
+    double rcond;
+    if (!draw_state(m, dat, &x, s % 4 == 0, &rcond)) {
+      fprintf(stderr, "test_float_kernels: no pose with rcond(J_d) >= 1e-2 in 3000 draws\n");
+      fclose(f);
+      return 1;
+    }
+    fputs("  {", f);
+    for (unsigned i = 0; i < MCU_IN_WORDS; i++) {
+      uint32_t w;
+      memcpy(&w, (const float *)&x + i, sizeof w);
+      fprintf(f, "0x%08lxu%s", (unsigned long)w, i + 1 < MCU_IN_WORDS ? ", " : "");
+    }
+    fputs("},\n", f);
+  }
+  fputs("};\n", f);
+  return fclose(f) == 0 ? 0 : 2;
+}
+
+/* Reads n words of hex bit patterns from *p into v; 0 on a short line. */
+static int read_words(char **p, float *v, unsigned n)
+{
+  for (unsigned i = 0; i < n; i++) {
+    char *end;
+    unsigned long w = strtoul(*p, &end, 16);
+    if (end == *p) return 0;
+    uint32_t u = (uint32_t)w;
+    memcpy(v + i, &u, sizeof u);
+    *p = end;
+  }
+  return 1;
+}
+
+/* The C libraries' float functions: the firmware's (newlib) against this
+ * host's and both against the double function rounded to float. */
+enum { LIBM_COUNT = 6 };
+static const char *libm_names[LIBM_COUNT] = {"sinf", "cosf", "sqrtf", "tanhf", "acosf", "atan2f"};
+static long long libm_n[LIBM_COUNT], libm_differ[LIBM_COUNT], libm_mg[LIBM_COUNT],
+  libm_mr[LIBM_COUNT], libm_gr[LIBM_COUNT];
+
+static void libm_point(const char *name, float x, float y)
+{
+  for (int k = 0; k < LIBM_COUNT; k++) {
+    if (strcmp(name, libm_names[k]) != 0) continue;
+    float g, r;
+    switch (k) {
+    case 0: g = sinf(x), r = (float)sin((double)x); break;
+    case 1: g = cosf(x), r = (float)cos((double)x); break;
+    case 2: g = sqrtf(x), r = (float)sqrt((double)x); break;
+    case 3: g = tanhf(x), r = (float)tanh((double)x); break;
+    case 4: g = acosf(x), r = (float)acos((double)x); break;
+    default: g = atan2f(x, 0.75f), r = (float)atan2((double)x, 0.75); break;
+    }
+    long long mg = ulp_distance(y, g), mr = ulp_distance(y, r), gr = ulp_distance(g, r);
+    libm_n[k]++;
+    libm_differ[k] += mg != 0;
+    if (mg > libm_mg[k]) libm_mg[k] = mg;
+    if (mr > libm_mr[k]) libm_mr[k] = mr;
+    if (gr > libm_gr[k]) libm_gr[k] = gr;
+    return;
+  }
+  tu_check(0, "a float function the check knows", 0, 0);
+}
+
+/* --mcu FILE: the firmware's output (tests/mcu/fw_float.c). */
+static int check_mcu(const prru_model *m, prru_data *dat, const char *path)
+{
+  FILE *f = fopen(path, "r");
+  if (!f) {
+    fprintf(stderr, "test_float_kernels: cannot read %s\n", path);
+    return 2;
+  }
+  static char line[16384];
+  int nstate = 0, model_ok = 0, ended = 0;
+  while (fgets(line, sizeof line, f)) {
+    char *p = line + 2;
+    if (strncmp(line, "M ", 2) == 0) {
+      char name[256], sha[128];
+      model_ok = sscanf(p, "%255s %127s", name, sha) == 2 && strcmp(name, prru_mech.name) == 0 &&
+                 strcmp(sha, prru_mech.sha256) == 0;
+    } else if (strncmp(line, "S ", 2) == 0) {
+      mcu_in x;
+      mcu_out y;
+      char *colon;
+      if (!read_words(&p, (float *)&x, MCU_IN_WORDS) || !(colon = strchr(p, ':')) ||
+          (p = colon + 1, !read_words(&p, (float *)&y, MCU_OUT_WORDS))) {
+        tu_check(0, "a complete state line from the firmware, state", nstate, 0);
+        break;
+      }
+      double q[3], rcond;
+      to_double(x.q, q, 3);
+      if (!tu_check(prru_check_regular(m, dat, q, &rcond) == PRRU_OK && rcond >= RCOND_MIN,
+                    "the firmware's state is a pose with rcond(J_d) >= 1e-2, state", nstate, 0))
+        break;
+      mcu = &y;
+      check_state(&x, rcond);
+      mcu = NULL;
+      nstate++;
+    } else if (strncmp(line, "F ", 2) == 0) {
+      char name[16];
+      float v[2];
+      int at;
+      if (sscanf(p, "%15s %n", name, &at) != 1 || (p += at, !read_words(&p, v, 2))) {
+        tu_check(0, "a complete float-function line from the firmware", 0, 0);
+        break;
+      }
+      libm_point(name, v[0], v[1]);
+    } else if (strncmp(line, "E", 1) == 0) {
+      ended = 1;
+    }
+  }
+  fclose(f);
+  tu_check(model_ok, "the firmware's descriptor is the build's model (name and sha256)", 0, 0);
+  tu_check(ended && nstate > 0, "the firmware ran to its end, states", nstate, 0);
+  report(0, nstate, "the firmware's float kernels against the double kernels");
+  report(1, nstate, "the firmware's float kernels against this host's");
+  printf("bitwise: %lld of %lld output words equal the host's, the others within %lld ulp\n",
+         mcu_equal, mcu_words, mcu_ulp_max);
+#if NA == 4
+  printf("four limbs: the controller set gives tau and J_d (fd = J_d^+ tau needs the runtime's QR)\n");
+#endif
+  printf("C libraries: the firmware's newlib against this host's, over the firmware's sweep (ulp)\n");
+  printf("%-8s %7s %9s %14s %14s %14s\n", "function", "points", "differ", "newlib-host",
+         "newlib-double", "host-double");
+  for (int k = 0; k < LIBM_COUNT; k++) {
+    printf("%-8s %7lld %9lld %14lld %14lld %14lld\n", libm_names[k], libm_n[k], libm_differ[k],
+           libm_mg[k], libm_mr[k], libm_gr[k]);
+    if (libm_n[k] == 0) fprintf(stderr, "the firmware's sweep has no %s\n", libm_names[k]);
+    tu_check(libm_n[k] > 0, "every float function swept", (double)k, 0);
+  }
+  return tu_finish("float_kernels --mcu");
+}
+
+int main(int argc, char **argv)
 {
   prru_model model;
   static prru_data dat;
@@ -337,18 +563,29 @@ int main(void)
   W = prru_mech.total_mass * sqrt(prru_mech.gravity[0] * prru_mech.gravity[0] +
                                   prru_mech.gravity[1] * prru_mech.gravity[1] +
                                   prru_mech.gravity[2] * prru_mech.gravity[2]);
-  for (int s = 0; s < NSTATE; s++)
-    if (!one_state(&model, &dat)) {
+  if (argc == 4 && strcmp(argv[1], "--states") == 0) {
+    int n = atoi(argv[2]);
+    if (n < 1) {
+      fprintf(stderr, "test_float_kernels: --states: N must be a positive count, not '%s'\n", argv[2]);
+      return 2;
+    }
+    return write_states(&model, &dat, n, argv[3]);
+  }
+  if (argc == 3 && strcmp(argv[1], "--mcu") == 0) return check_mcu(&model, &dat, argv[2]);
+  if (argc != 1) {
+    fprintf(stderr, "usage: test_float_kernels [--states N FILE | --mcu FILE]\n");
+    return 2;
+  }
+  for (int s = 0; s < NSTATE; s++) {
+    mcu_in x;
+    double rcond;
+    if (!draw_state(&model, &dat, &x, 0, &rcond)) {
       tu_check(0, "a pose with rcond(J_d) >= 1e-2 in 3000 draws, state", s, 0);
       return tu_finish("float_kernels");
     }
-  printf("model %s: %d states with rcond(J_d) >= %g; worst error of the float kernels\n",
-         prru_mech.name, NSTATE, RCOND_MIN);
-  printf("%-20s %12s %12s %12s\n", "output", "rel. |y|", "rel. terms", "/(u c S)");
-  for (int o = 0; o < O_COUNT; o++) {
-    printf("%-20s %12.2e %12.2e %12.2f\n", names[o], worst_rel[o], worst_terms[o], worst_ratio[o]);
-    tu_check(worst_ratio[o] <= K, names[o], worst_ratio[o], K);
+    check_state(&x, rcond);
   }
+  report(0, NSTATE, "the float kernels");
   check_nan();
   return tu_finish("float_kernels");
 }
