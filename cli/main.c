@@ -29,6 +29,7 @@ static const struct {
     {"optimize", prru_cmd_optimize, "choose geometry/inertia so w_R is nearest 1 over a workspace"},
     {"sensitivity", prru_cmd_sensitivity, "d(global index)/d(parameter) for every parameter, CSV"},
     {"merge", prru_cmd_merge, "join the --shard K/N outputs of map or sensitivity"},
+    {"gen", prru_cmd_gen, "a model file's dynamics as C99 for your controller"},
     {"paper", prru_cmd_paper, "reproduce the paper's simulation study and fig. 7 into a directory"},
 };
 

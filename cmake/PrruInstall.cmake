@@ -55,6 +55,14 @@ install(DIRECTORY "${PROJECT_SOURCE_DIR}/runtime/include/"
 install(DIRECTORY "${PRRU_GEN_DIR}/"
         DESTINATION "${PRRU_INSTALL_INCLUDEDIR}" FILES_MATCHING PATTERN "*.h")
 install(FILES "${PRRU_MODEL}" DESTINATION "${CMAKE_INSTALL_DATADIR}/prru")
+# The generator and its templates, for `prru gen` (Python 3 standard library
+# only): share/prru/gen/prru_gen.py finds share/prru/templates as in the
+# source tree. Its unit tests stay behind.
+install(FILES "${PROJECT_SOURCE_DIR}/gen/prru_gen.py" "${PROJECT_SOURCE_DIR}/gen/prru_mjcf.py"
+        DESTINATION "${CMAKE_INSTALL_DATADIR}/prru/gen")
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/gen/prrugen/" DESTINATION "${CMAKE_INSTALL_DATADIR}/prru/gen/prrugen"
+        FILES_MATCHING PATTERN "*.py")
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/templates/" DESTINATION "${CMAKE_INSTALL_DATADIR}/prru/templates")
 
 install(EXPORT prruTargets NAMESPACE prru:: FILE prruTargets.cmake
         DESTINATION "${PRRU_INSTALL_CMAKEDIR}")

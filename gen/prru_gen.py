@@ -35,6 +35,9 @@ from prrugen import cgen, mechanism, dynamics, output, params, regressor, \
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TEMPLATES = os.path.join(ROOT, "templates")
+# The program's name in messages: main's prog ("prru gen" when `prru gen`
+# runs it, cli/cmd_gen.c).
+_NAME = "prru_gen"
 
 
 def generate(model_path, templates_dir=TEMPLATES, prefix=None):
@@ -127,9 +130,11 @@ def _prefix(text):
     return text
 
 
-def main(argv=None):
+def main(argv=None, prog="prru_gen.py"):
+    global _NAME
+    _NAME = prog[:-3] if prog.endswith(".py") else prog
     parser = argparse.ArgumentParser(
-        prog="prru_gen.py",
+        prog=prog,
         description="Generate C dynamics kernels (prefix = the model's name) "
                     "from a 3-PRRU model file.")
     parser.add_argument("model", nargs="?", help="model file (JSON), e.g. "
@@ -173,11 +178,11 @@ def _run(args):
         else:
             model = model_mod.load(args.model)
     except model_mod.ModelError as exc:
-        print("prru_gen: error: %s" % exc, file=sys.stderr)
+        print("%s: error: %s" % (_NAME, exc), file=sys.stderr)
         return 1
     if args.topology is None:
         for warning in model.warnings():
-            print("prru_gen: warning: %s: %s" % (args.model, warning),
+            print("%s: warning: %s: %s" % (_NAME, args.model, warning),
                   file=sys.stderr)
         try:
             if args.precision == "float":
@@ -185,13 +190,13 @@ def _run(args):
             else:
                 files, emitted = generate_model(model, prefix=args.prefix)
         except model_mod.ModelError as exc:
-            print("prru_gen: error: %s" % exc, file=sys.stderr)
+            print("%s: error: %s" % (_NAME, exc), file=sys.stderr)
             return 1
     try:
         output.write_files_atomically(args.out, files)
     except OSError as exc:
-        print("prru_gen: error: %s: cannot write: %s"
-              % (args.out, exc.strerror), file=sys.stderr)
+        print("%s: error: %s: cannot write: %s"
+              % (_NAME, args.out, exc.strerror), file=sys.stderr)
         return 1
     if not args.quiet:
         width = max(18, max(len(e.name) for e in emitted))

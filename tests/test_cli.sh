@@ -52,7 +52,8 @@ done
 # The words of the model identity (KERNELS kernels, the JSON member
 # "kernels") and the environment variable PRRU_MODEL are the user's.
 user_words='s/PRRU_MODEL//g; s/KERNELS kernels//g; s/^KERNELS: //; s/sha256, kernels/sha256/g'
-for f in "$tmp"/help_*.txt "$tmp/h.txt"; do
+# (gen's help is the generator's: C kernels and their prefix are its subject.)
+for f in $(ls "$tmp"/help_*.txt | grep -v '/help_gen\.txt$') "$tmp/h.txt"; do
   sed "$user_words" "$f" | grep -n -i -E "gsl|odeiv|hybridsj|kernel|descriptor|(^|[^a-z0-9])prru_[a-z]|runtime|generated" | sed "s|^|$f:|"
   sed "$user_words" "$f" | grep -n -E "PRRU_|DBL_" | sed "s|^|$f:|"
 done >"$tmp/jargon.txt"
@@ -357,5 +358,16 @@ jcheck "$tmp/f.json" "d['Jd'] == json.load(open('$tmp/ikq.json'))['Jd']" "eval a
 # ---- --out - means stdout; a command that writes a directory refuses it ----
 expect 2 "--out -: the study is a directory of files" -- paper --out -
 [ ! -e ./- ] && ok || bad "paper --out - created a directory named -"
+
+# ---- prru gen: the generator behind the tool, byte for byte ----
+"$PRRU" gen "$PRRU_SOURCE_DIR/models/prototype_example.json" --out "$tmp/gen_cli" --quiet &&
+  python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$PRRU_SOURCE_DIR/models/prototype_example.json" --out "$tmp/gen_py" \
+    --quiet && diff -r "$tmp/gen_cli" "$tmp/gen_py" >/dev/null && [ -s "$tmp/gen_cli/proto_kernels.c" ] &&
+  ok || bad "prru gen differs from gen/prru_gen.py"
+"$PRRU" gen --help | grep -q -- "--precision" && ok || bad "prru gen --help is the generator's"
+expect 1 "cannot read" -- gen "$tmp/no such model.json" --out "$tmp/gen_none"
+[ ! -e "$tmp/gen_none" ] && ok || bad "prru gen wrote for a missing model"
+PRRU_GENERATOR="$tmp/missing gen.py" "$PRRU" gen --help >/dev/null 2>"$tmp/err"
+[ $? = 2 ] && grep -q "PRRU_GENERATOR=$tmp/missing gen.py" "$tmp/err" && ok || bad "PRRU_GENERATOR missing: $(cat "$tmp/err")"
 
 finish test_cli

@@ -73,6 +73,21 @@ if "$PRRU" --version >"$tmp/v.build" 2>&1 && "$prefix/bin/prru" --version >"$tmp
 else
   fail "installed prru --version differs:"; diff "$tmp/v.build" "$tmp/v.inst" | head
 fi
+# The generator installed for `prru gen` runs on its own (its templates
+# beside it, in share/prru) and writes what the source tree's writes;
+# the installed prru gen (which takes the generator installed beside it)
+# too.
+gen_model="$PRRU_SOURCE_DIR/models/prototype_example.json"
+if env -i PATH="$PATH" python3 "$prefix/share/prru/gen/prru_gen.py" "$gen_model" --out "$tmp/gen_inst" --quiet &&
+   "$prefix/bin/prru" gen "$gen_model" --out "$tmp/gen_inst_cli" --quiet &&
+   python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$gen_model" --out "$tmp/gen_src" --quiet &&
+   diff -r "$tmp/gen_inst" "$tmp/gen_src" >/dev/null && diff -r "$tmp/gen_inst_cli" "$tmp/gen_src" >/dev/null; then
+  ok "install: the generator (share/prru/gen) and prru gen write the source tree's kernels"
+else
+  fail "install: the installed generator or prru gen differs from the source tree's"
+fi
+[ ! -e "$prefix/share/prru/gen/tests" ] && ok "install: the generator's tests stay behind" ||
+  fail "install: share/prru/gen/tests installed"
 # ---- 1b. the Python package, importable from the prefix alone ----
 # A clean environment (env -i): only PATH and PYTHONPATH, the installed
 # package's directory; the binding must load the installed libprru.so
