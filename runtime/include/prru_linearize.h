@@ -22,6 +22,8 @@
 extern "C" {
 #endif
 
+/* The derivative blocks are contiguous, in this order (one finiteness
+ * test covers them). */
 typedef struct {
   double qdd[3];
   double dqdd_dq[9], dqdd_dqd[9];  /* 3x3 */
@@ -47,8 +49,8 @@ int prru_linearize_available(const prru_model *m);
  * criterion, mass_rcond_min included; PRRU_EINPUT for non-finite input),
  * and PRRU_EINPUT for dt < 0 or not finite, for a model without the
  * derivative kernels (prru_linearize_available), or where the exponential
- * overflows (dt far beyond the dynamics' time scales). out is filled only
- * on PRRU_OK. */
+ * overflows (dt far beyond the dynamics' time scales). On failure out is
+ * all zeros: no number of it is a result. */
 int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                    const prru_loads *l, double dt, prru_linearization *out);
 
