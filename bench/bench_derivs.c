@@ -160,10 +160,10 @@ void bench_derivs_print_json(const bench_derivs *r)
     printf(", \"derivs\": null");
     return;
   }
-  printf(", \"derivs\": {\"forward_ns\": %.4g, \"fused_kernel_ns\": %.4g, \"linearize_ns\": %.4g, "
+  printf(", \"derivs\": {\"nact\": %d, \"forward_ns\": %.4g, \"fused_kernel_ns\": %.4g, \"linearize_ns\": %.4g, "
          "\"central_differences_ns\": %.4g, \"fused_over_forward\": %.4g, "
          "\"linearize_over_forward\": %.4g, \"central_over_linearize\": %.4g",
-         r->forward_ns.median, r->fused_kernel_ns.median, r->linearize_ns.median,
+         PRRU_NACT, r->forward_ns.median, r->fused_kernel_ns.median, r->linearize_ns.median,
          r->central_ns.median, r->fused_over_forward.median, r->linearize_over_forward.median,
          r->central_over_linearize.median);
   if (r->inverse_available)

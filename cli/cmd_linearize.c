@@ -23,11 +23,9 @@ static const char linearize_help[] =
     "[0; dqdd_dfd]. With --dt DT (s, > 0): dt, and Ad, Bd of the zero-order\n"
     "hold x_{k+1} = Ad x_k + Bd u_k ([Ad Bd; 0 I] = exp([A B; 0 0] DT)).\n"
     "fp (N) acts at O' and mp (N m) on the platform, in {S}; fp and mp default\n"
-    "to 0. The derivatives exist for the built-in model's numbers only: a\n"
-    "--model of other numbers is refused (exit 2). Exit 1 where forward\n"
-    "dynamics is not trusted (q unreachable, out_of_stroke, on or too near the\n"
-    "workspace boundary: the same test as eval and simulate), 2 on bad\n"
-    "arguments.\n";
+    "to 0. Exit 1 where forward dynamics is not trusted (q unreachable,\n"
+    "out_of_stroke, on or too near the workspace boundary: the same test as\n"
+    "eval and simulate), 2 on bad arguments.\n";
 
 static void member_matrix(const char *sep, const char *name, const double *v, int rows, int cols)
 {

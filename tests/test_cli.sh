@@ -319,9 +319,16 @@ expect 2 "--dt" -- linearize --q "$Q" --qd "$QD" --fd "$FD" --dt -0.001
 expect 2 "--dt" -- linearize --q "$Q" --qd "$QD" --fd "$FD" --dt nan
 expect 2 "are required" -- linearize --q "$Q" --fd "$FD"
 expect 1 "outside the workspace" -- linearize --q 3,0,-0.8 --qd 0,0,0 --fd "$FD"
-# A model of other numbers: the derivatives are the build's only.
+# A model of other numbers loaded at run time (the topology's kernels):
+# its own qdd, eval's.
 if [ "$nact" = 3 ] && [ "$(basename "$PRRU_MODEL")" != prototype_drives.json ]; then
-  expect 2 "build's model only" -- --model "$PRRU_SOURCE_DIR/models/prototype_drives.json" linearize --q 0,0,0 --qd 0,0,0 --fd 1,2,3
+  other=$PRRU_SOURCE_DIR/models/prototype_drives.json
+  "$PRRU" --model "$other" linearize --q 0,0,0.1 --qd 0.1,0.2,0.3 --fd 1,2,3 >"$tmp/lin_other.json" &&
+    "$PRRU" --model "$other" eval --q 0,0,0.1 --qd 0.1,0.2,0.3 --fd 1,2,3 >"$tmp/lin_other_eval.json" ||
+    bad "linearize or eval with --model $other failed"
+  jcheck "$tmp/lin_other.json" "d['model']['kernels'] == 'parameter'" "linearize --model: the parameter kernels"
+  r=$(python3 -c "import json, sys; a, b = (json.load(open(f))['qdd'] for f in sys.argv[1:]); print(max(abs(x - y) / (1 + abs(y)) for x, y in zip(a, b)))" "$tmp/lin_other.json" "$tmp/lin_other_eval.json")
+  below "$r" 1e-12 "linearize --model: qdd against eval's"
 fi
 
 # Bad arguments: exit 2 and a message naming the argument.

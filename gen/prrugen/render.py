@@ -240,7 +240,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     prefix, ctype = topology_prefix(n), topology_ctype(n)
     upper = prefix.upper()
     kernel_list = params.topology_kernels(
-        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)])
+        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)]
+        + derivative_kernels(deriv))
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
     banner = _banner(_topology_head(n, reference), emitted)
     macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
@@ -387,8 +388,8 @@ def render(model, deriv, templates_dir, prefix=None):
     prefix = prefix or model.name
     upper = prefix.upper()
     mech = deriv.mech
-    # The derivative kernels are the specialised set's only (the parameter
-    # and topology sets do not have them yet).
+    # The derivative kernels: this set's and the topology set's (not the
+    # model's parameter set, prru_param_kernels.h).
     kernel_list = kernels(deriv) + derivative_kernels(deriv)
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
     labels = lambda_labels(mech)

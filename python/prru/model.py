@@ -327,8 +327,7 @@ class Model:
         fp, mp (fp, mp default to 0) and the state-space pair, with dt (s,
         > 0) the zero-order-hold discrete pair: a Linearization, the numbers
         `prru linearize` prints. Raises as forward_dynamics where qdd is not
-        trusted; InputError for a model of other numbers than the library's
-        build (the derivatives are generated for the build's model only)."""
+        trusted."""
         q, qd = vector("q", q, 3), vector("qd", qd, 3)
         vector("fd", fd, self.nact)  # required, unlike forward_dynamics's
         l = self._loads(fd, fp, mp)

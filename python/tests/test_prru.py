@@ -317,11 +317,16 @@ class TestAgainstCli(unittest.TestCase):
         with self.assertRaises(prru.Unreachable):
             MODEL.linearize([3.0, 0.0, 0.0], qd, fd)
         if MODEL.nlimb == 3 and MODEL.model_file != "prototype_drives.json":
-            other = prru.Model(model=os.path.join(SOURCE_DIR, "models", "prototype_drives.json"),
-                               lib=MODEL.lib)
-            with self.assertRaises(prru.InputError) as e:
-                other.linearize([0.0, 0.0, 0.0], qd, fd)
-            self.assertIn("build's model only", str(e.exception))
+            # A model loaded at run time: the topology's kernels, the CLI's numbers.
+            path = os.path.join(SOURCE_DIR, "models", "prototype_drives.json")
+            other = prru.Model(model=path, lib=MODEL.lib)
+            q, qd, fd = [0.0, 0.0, 0.1], [0.1, 0.2, 0.3], [1.0, 2.0, 3.0]
+            lin = other.linearize(q, qd, fd, dt=0.01)
+            out = parse(cli("--model", path, "linearize", "--q", arg(q), "--qd", arg(qd),
+                            "--fd", arg(fd), "--dt", "0.01"))
+            self.assertEqual(out["model"]["kernels"], "parameter")
+            for key in keys + ("Ad", "Bd"):
+                self.assertEqual(bits(flat(getattr(lin, key))), bits(flat(out[key])), key)
 
     def test_ik_fk_dme(self):
         for q, _, _, _, _ in random_states(4, 2):

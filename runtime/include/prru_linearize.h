@@ -8,11 +8,9 @@
  * Every matrix is row-major; row i of a derivative block is qdd_i (fd_i),
  * column k the k-th variable.
  *
- * The derivative kernels exist in the specialised set only (constant-
- * folded from the build's model file): a model whose numbers differ from
- * the build's (prru_model_load of another file, or after
- * prru_model_use_parameter_kernels) is refused with PRRU_EINPUT, never
- * evaluated by other means. */
+ * Both kernel sets have them: the specialised one (constant-folded from
+ * the build's model file) and the topology's parameter set, for a model
+ * loaded at run time (prru_model_load) with other numbers. */
 #ifndef PRRU_LINEARIZE_H
 #define PRRU_LINEARIZE_H
 
@@ -39,16 +37,16 @@ typedef struct {
   double Bd[6 * PRRU_NACT];
 } prru_linearization;
 
-/* Whether this model evaluates with the kernels the derivatives exist for
- * (the specialised set). */
+/* Whether this model's kernel table has the derivative kernels (every
+ * table of this build has). */
 int prru_linearize_available(const prru_model *m);
 
 /* The linearisation at (q, qd) under the loads l, into out. PRRU_OK; or
  * the status prru_forward_dynamics gives at the same state where qdd is
  * not trusted (PRRU_EUNREACHABLE, PRRU_ESTROKE, PRRU_ESINGULAR: the same
  * criterion, mass_rcond_min included; PRRU_EINPUT for non-finite input),
- * and PRRU_EINPUT for dt < 0 or not finite, for a model without the
- * derivative kernels (prru_linearize_available), or where the exponential
+ * and PRRU_EINPUT for dt < 0 or not finite, for a kernel table without
+ * the derivative kernels (prru_linearize_available), or where the exponential
  * overflows (dt far beyond the dynamics' time scales). On failure out is
  * all zeros: no number of it is a result. */
 int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],

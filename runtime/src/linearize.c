@@ -9,7 +9,6 @@
 
 #include "prru_linearize.h"
 #include "internal.h"
-#include "prru_kernels.h"
 
 /* prru_linearize tests the five derivative blocks as one array. */
 typedef char prru_blocks_contiguous[offsetof(prru_linearization, dqdd_dmp) + sizeof(double[9]) -
@@ -20,7 +19,7 @@ typedef char prru_blocks_contiguous[offsetof(prru_linearization, dqdd_dmp) + siz
 
 int prru_linearize_available(const prru_model *m)
 {
-  return m->kernels == &prru_kernels_specialised;
+  return m->kernels->eom_solve_derivs != NULL;
 }
 
 /* A = [0 I; Dq Dqd], B = [0; Dfd]. */
@@ -68,10 +67,11 @@ int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const d
   /* Straight into out (a copy of its 1.4 kB costs a tenth of the call). */
   prru_linearization *o = out;
   double minors[3];
-  prru_eom_solve_derivs(q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors, o->dqdd_dq,
-                        o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp, o->dqdd_dmp);
+  KERNEL(m, eom_solve_derivs)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd,
+                               minors, o->dqdd_dq, o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp,
+                               o->dqdd_dmp);
   int st = prru_forward_verdict(m, d, q, qd, l, minors,
-                                PRRU_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, l->fd, l->fp, l->mp));
+                                KERNEL(m, unseen_finite_eom_solve_derivs)(q, qd, l->fd, l->fp, l->mp));
   /* Trusted qdd from finite inputs: the derivatives are products of the
    * same finite terms and one division by det M, which the test bounds;
    * they overflow only where qdd nearly does. */
@@ -96,11 +96,7 @@ int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], con
   const int st = prru_linearize(m, d, q, qd, l, dt, out);
   if (st == PRRU_OK) return prru_fail(msg, msglen, st, "%s", "");
   if (!prru_linearize_available(m))
-    return prru_fail(msg, msglen, st,
-                     "the closed-form derivatives are generated for the build's model only "
-                     "(%s, sha256 %.12s...); this model (%s) evaluates with the %s kernels: "
-                     "build with PRRU_MODEL set to its file to linearize it",
-                     prru_mech.model_file, prru_mech.sha256, m->mech->model_file,
+    return prru_fail(msg, msglen, st, "the %s kernels of this model have no derivatives",
                      m->kernels->path);
   if (!(dt >= 0) || !isfinite(dt))
     return prru_fail(msg, msglen, st, "dt = %g: the hold period must be finite and >= 0", dt);
@@ -118,11 +114,12 @@ int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double
                                  double dfd_dqdd[9])
 {
 #if PRRU_NACT == 3
-  if (!prru_linearize_available(m)) return PRRU_EINPUT;
+  if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
   double f[3], Dq[9], Dqd[9], Dqdd[9];
-  prru_inverse_derivs(q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, Dq, Dqd, Dqdd);
+  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, Dq,
+                            Dqd, Dqdd);
   int st = prru_inverse3_status(m, d, f);
-  if (st != PRRU_OK || !PRRU_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, l->fp, l->mp))
+  if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_derivs)(q, qd, qdd, l->fp, l->mp))
     return prru_inverse_failure(st, q, qd, qdd, l);
   if (!prru_finite_n(Dq, 9) || !prru_finite_n(Dqd, 9) || !prru_finite_n(Dqdd, 9))
     return PRRU_EINPUT;
