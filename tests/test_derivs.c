@@ -139,7 +139,9 @@ static int ref_block(int inverse, const state *s, int v, int n, double h0, doubl
 
 static double worst[2][3 + 3], worst_est, worst_identity;
 static const char *const fwd_names[] = {"dqdd_dq", "dqdd_dqd", "dqdd_dfd", "dqdd_dfp", "dqdd_dmp"};
+#if NA == 3
 static const char *const inv_names[] = {"dfd_dq", "dfd_dqd", "dfd_dqdd"};
+#endif
 
 static void compare(int inverse, int b, const char *name, const double *kernel, const double *ref,
                     int n, double est)
