@@ -191,6 +191,20 @@ void bench_bound_run(const bench_ctx *c, int reps, int quick, bench_bound *b);
 void bench_bound_print_table(const bench_bound *b);
 void bench_bound_print_json(const bench_bound *b);
 
+/* bench_derivs.c: the closed-form derivatives against the forward step,
+ * its central differences and inverse dynamics. */
+typedef struct {
+  int available, inverse_available; /* specialised kernels; three actuators */
+  bench_stats forward_ns, fused_kernel_ns, linearize_ns, central_ns;
+  bench_stats inverse_ns, inverse_kernel_ns, inverse_derivs_ns;
+  bench_stats fused_over_forward, linearize_over_forward, central_over_linearize;
+  bench_stats inverse_derivs_over_inverse;
+} bench_derivs;
+extern bench_derivs bench_derivs_result;
+void bench_derivs_run(bench_ctx *c, int reps, double target_ns, bench_derivs *r);
+void bench_derivs_print_table(const bench_derivs *r);
+void bench_derivs_print_json(const bench_derivs *r);
+
 /* bench_regen.c */
 int bench_time_regeneration(int reps, bench_stats *out);
 

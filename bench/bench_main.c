@@ -159,6 +159,12 @@ int main(int argc, char **argv)
   if (!op.json) fprintf(stderr, "dynamics against the SymPy peer...\n");
   bench_peer_run(&c, op.reps, op.quick, &bench_peer_result);
   bench_bound_run(&c, op.reps, op.quick, &bench_bound_result);
+  if (!op.json) fprintf(stderr, "derivatives...\n");
+  bench_derivs_run(&c, op.reps, op.batch_ms * 1e6, &bench_derivs_result);
+  if (c.failures) {
+    fprintf(stderr, "prru_bench: %ld calls failed in the derivative runs\n", c.failures);
+    return 1;
+  }
   bench_modes_done = 1;
   if (!op.json) fprintf(stderr, "regenerating...\n");
   bench_stats regen = {0, 0, 0};

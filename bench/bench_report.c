@@ -122,6 +122,7 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
     bench_modes_print_json(&bench_modes_result);
     bench_peer_print_json(&bench_peer_result);
     bench_bound_print_json(&bench_bound_result);
+    bench_derivs_print_json(&bench_derivs_result);
   }
   printf("}\n");
 }
@@ -203,6 +204,7 @@ void bench_print_table(const bench_options *op, const char *cpu, const sim_resul
     bench_modes_print_table(&bench_modes_result);
     bench_peer_print_table(&bench_peer_result);
     bench_bound_print_table(&bench_bound_result);
+    bench_derivs_print_table(&bench_derivs_result);
   }
   if (regen_ok)
     printf("regeneration of every kernel from %s: %.3f s [%.3f-%.3f] (target < 2 s)\n",

@@ -134,6 +134,18 @@ def main():
             if not (isinstance(r["muls"], int) and r["muls"] > 0 and
                     positive(r["measured_ns"]) and r["bound_ns"] >= want * (1 - 2e-3)):
                 fail("bound %r: %r" % (name, r))
+    # The closed-form derivatives (the bench runs on the build's model,
+    # whose specialised kernels have them): every time and ratio positive.
+    derivs = doc.get("derivs")
+    keys = ["forward_ns", "fused_kernel_ns", "linearize_ns", "central_differences_ns",
+            "fused_over_forward", "linearize_over_forward", "central_over_linearize"]
+    if not isinstance(derivs, dict) or derivs.get("nact") not in (3, 4):
+        fail("'derivs' missing or without nact: %r" % (derivs,))
+    if derivs["nact"] == 3:
+        keys += ["inverse_ns", "inverse_kernel_ns", "inverse_derivs_ns",
+                 "inverse_derivs_over_inverse"]
+    if not all(positive(derivs.get(k)) for k in keys):
+        fail("'derivs' incomplete: %r" % (derivs,))
     if not positive(doc.get("regeneration_s")):
         fail("regeneration_s missing")
     print("bench_smoke: JSON complete, %d kernels" % len(names))

@@ -23,6 +23,7 @@ typedef char prru_cli_nq_is_3[PRRU_NQ == 3 ? 1 : -1];
 
 int prru_cmd_eval(int argc, char **argv);
 int prru_cmd_gen(int argc, char **argv);
+int prru_cmd_linearize(int argc, char **argv);
 int prru_cmd_simulate(int argc, char **argv);
 int prru_cmd_ik(int argc, char **argv);
 int prru_cmd_fk(int argc, char **argv);

@@ -12,6 +12,7 @@ static const struct {
   const char *help;
 } commands[] = {
     {"eval", prru_cmd_eval, "M, h, G, d, J_d, qdd and the joint reactions at one state (JSON)"},
+    {"linearize", prru_cmd_linearize, "qdd and its derivatives, A, B (and Ad, Bd) at one state (JSON)"},
     {"simulate", prru_cmd_simulate, "integrate the equations of motion, CSV of the samples"},
     {"ik", prru_cmd_ik, "actuator displacements d and J_d for a pose q (JSON)"},
     {"fk", prru_cmd_fk, "pose q for actuator displacements d (JSON; --lsq: least squares)"},

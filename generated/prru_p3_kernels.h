@@ -28,6 +28,8 @@
  *   inverse_terms      1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   joint_reactions    1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   regressor          1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   eom_solve_derivs   3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   inverse_derivs     3723 arithmetic (788 add, 451 sub, 2453 mul, 12 div, 19 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_P3_KERNELS_H
 #define PRRU_P3_KERNELS_H
@@ -88,6 +90,8 @@
 #define PRRU_P3_ARITH_INVERSE_TERMS 1030 /* arithmetic operations */
 #define PRRU_P3_ARITH_JOINT_REACTIONS 1679 /* arithmetic operations */
 #define PRRU_P3_ARITH_REGRESSOR 1134 /* arithmetic operations */
+#define PRRU_P3_ARITH_EOM_SOLVE_DERIVS 3690 /* arithmetic operations */
+#define PRRU_P3_ARITH_INVERSE_DERIVS 3723 /* arithmetic operations */
 #define PRRU_P3_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
@@ -110,6 +114,8 @@
 #define PRRU_P3_OPS_INVERSE_TERMS "1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_P3_OPS_JOINT_REACTIONS "1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_P3_OPS_REGRESSOR "1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_EOM_SOLVE_DERIVS "3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_INVERSE_DERIVS "3723 arithmetic (788 add, 451 sub, 2453 mul, 12 div, 19 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 /* Whether the inputs of prru_p3_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -121,6 +127,18 @@
    infinite (the inputs tested here do not reach them, or reach them only through
    tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
 #define PRRU_P3_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp) \
+  (isfinite((fp)[0]) && isfinite((fp)[1]))
+/* Whether the inputs of prru_p3_eom_solve_derivs that may not show in its b and qdd are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_P3_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp) \
+  (isfinite((fp)[0]) && isfinite((fp)[1]))
+/* Whether the inputs of prru_p3_inverse_derivs that may not show in its d and fd are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_P3_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, fp, mp) \
   (isfinite((fp)[0]) && isfinite((fp)[1]))
 #define PRRU_P3_REACTION_BASIS_NNZ 231 /* entries of prru_p3_reaction_basis's Q */
 
@@ -222,6 +240,12 @@ void prru_p3_joint_reactions(const prru_params3 *p, const double q[3], const dou
 
 /* Regressor Y (3x109, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
 void prru_p3_regressor(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], double Y[327]);
+
+/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Parameters from *p. */
+void prru_p3_eom_solve_derivs(const prru_params3 *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[9], double Dfp[9], double Dmp[9]);
+
+/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). Parameters from *p. */
+void prru_p3_inverse_derivs(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3], double Dq[9], double Dqd[9], double Dqdd[9]);
 
 /* Batched kernels, prru_p3_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n

@@ -29,6 +29,7 @@
  *   joint_reactions    2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4
  *   reaction_nullspace 77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4
  *   regressor          1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   eom_solve_derivs   5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
  */
 #ifndef PRRU_P4_KERNELS_H
 #define PRRU_P4_KERNELS_H
@@ -90,6 +91,7 @@
 #define PRRU_P4_ARITH_JOINT_REACTIONS 2333 /* arithmetic operations */
 #define PRRU_P4_ARITH_REACTION_NULLSPACE 77 /* arithmetic operations */
 #define PRRU_P4_ARITH_REGRESSOR 1540 /* arithmetic operations */
+#define PRRU_P4_ARITH_EOM_SOLVE_DERIVS 5194 /* arithmetic operations */
 #define PRRU_P4_OPS_IK "67 arithmetic (8 add, 13 sub, 40 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_JD "108 arithmetic (8 add, 13 sub, 74 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_IK_JD "124 arithmetic (15 add, 16 sub, 80 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
@@ -113,6 +115,7 @@
 #define PRRU_P4_OPS_JOINT_REACTIONS "2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4"
 #define PRRU_P4_OPS_REACTION_NULLSPACE "77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4"
 #define PRRU_P4_OPS_REGRESSOR "1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_EOM_SOLVE_DERIVS "5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 /* Whether the inputs of prru_p4_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -124,6 +127,12 @@
    infinite (the inputs tested here do not reach them, or reach them only through
    tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
 #define PRRU_P4_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp) \
+  (isfinite((fp)[0]) && isfinite((fp)[1]))
+/* Whether the inputs of prru_p4_eom_solve_derivs that may not show in its b and qdd are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_P4_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp) \
   (isfinite((fp)[0]) && isfinite((fp)[1]))
 #define PRRU_P4_REACTION_BASIS_NNZ 308 /* entries of prru_p4_reaction_basis's Q */
 
@@ -228,6 +237,9 @@ void prru_p4_reaction_nullspace(const prru_params4 *p, const double q[3], double
 
 /* Regressor Y (3x142, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
 void prru_p4_regressor(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], double Y[426]);
+
+/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Parameters from *p. */
+void prru_p4_eom_solve_derivs(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[12], double Dfp[9], double Dmp[9]);
 
 /* Batched kernels, prru_p4_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n

@@ -303,6 +303,35 @@ else
   grep -qF "J_d^-1" "$tmp/help_dme.txt" && ! grep -qF "J_d^+" "$tmp/help_dme.txt" && ok || bad "dme --help of a 3-actuator model: J_d^-1"
 fi
 
+# ---- linearize: the closed-form derivatives and the state-space pairs ----
+"$PRRU" linearize --q "$Q" --qd "$QD" --fd "$FD" --dt 0.001 >"$tmp/lin.json" || bad "linearize failed"
+jcheck "$tmp/lin.json" "d['model'] == model and d['dt'] == 0.001" "linearize: model object and dt"
+jcheck "$tmp/lin.json" "[(len(d[k]), len(d[k][0])) for k in ('dqdd_dq', 'dqdd_dqd', 'dqdd_dfd', 'dqdd_dfp', 'dqdd_dmp', 'A', 'B', 'Ad', 'Bd')] == [(3, 3), (3, 3), (3, $nact), (3, 3), (3, 3), (6, 6), (6, $nact), (6, 6), (6, $nact)]" "linearize: sizes"
+jcheck "$tmp/lin.json" "all(d['A'][i][k] == (1 if k == i + 3 else 0) for i in range(3) for k in range(6)) and all(d['A'][3 + i] == d['dqdd_dq'][i] + d['dqdd_dqd'][i] and d['B'][3 + i] == d['dqdd_dfd'][i] and d['B'][i] == [0] * $nact for i in range(3))" "linearize: A = [0 I; dqdd_dq dqdd_dqd], B = [0; dqdd_dfd]"
+# qdd is eval's (the same expressions in another kernel: rounding apart,
+# a few ulps of the terms, which are at most 1e3 times qdd here).
+"$PRRU" eval --q "$Q" --qd "$QD" --fd "$FD" >"$tmp/lin_eval.json" || bad "eval for linearize failed"
+r=$(python3 -c "import json, sys; a, b = (json.load(open(f))['qdd'] for f in sys.argv[1:]); print(max(abs(x - y) / (1 + abs(y)) for x, y in zip(a, b)))" "$tmp/lin.json" "$tmp/lin_eval.json")
+below "$r" 1e-12 "linearize: qdd against eval's"
+"$PRRU" linearize --q "$Q" --qd "$QD" --fd "$FD" >"$tmp/lin0.json" || bad "linearize without --dt failed"
+jcheck "$tmp/lin0.json" "'Ad' not in d and 'Bd' not in d and 'dt' not in d" "linearize without --dt: no discrete pair"
+expect 2 "--dt" -- linearize --q "$Q" --qd "$QD" --fd "$FD" --dt 0
+expect 2 "--dt" -- linearize --q "$Q" --qd "$QD" --fd "$FD" --dt -0.001
+expect 2 "--dt" -- linearize --q "$Q" --qd "$QD" --fd "$FD" --dt nan
+expect 2 "are required" -- linearize --q "$Q" --fd "$FD"
+expect 1 "outside the workspace" -- linearize --q 3,0,-0.8 --qd 0,0,0 --fd "$FD"
+# A model of other numbers loaded at run time (the topology's kernels):
+# its own qdd, eval's.
+if [ "$nact" = 3 ] && [ "$(basename "$PRRU_MODEL")" != prototype_drives.json ]; then
+  other=$PRRU_SOURCE_DIR/models/prototype_drives.json
+  "$PRRU" --model "$other" linearize --q 0,0,0.1 --qd 0.1,0.2,0.3 --fd 1,2,3 >"$tmp/lin_other.json" &&
+    "$PRRU" --model "$other" eval --q 0,0,0.1 --qd 0.1,0.2,0.3 --fd 1,2,3 >"$tmp/lin_other_eval.json" ||
+    bad "linearize or eval with --model $other failed"
+  jcheck "$tmp/lin_other.json" "d['model']['kernels'] == 'parameter'" "linearize --model: the parameter kernels"
+  r=$(python3 -c "import json, sys; a, b = (json.load(open(f))['qdd'] for f in sys.argv[1:]); print(max(abs(x - y) / (1 + abs(y)) for x, y in zip(a, b)))" "$tmp/lin_other.json" "$tmp/lin_other_eval.json")
+  below "$r" 1e-12 "linearize --model: qdd against eval's"
+fi
+
 # Bad arguments: exit 2 and a message naming the argument.
 expect 2 "--q" -- eval --q 0.1,0.2
 expect 2 "--q" -- eval --q 0.1,abc,0

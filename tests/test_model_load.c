@@ -35,21 +35,6 @@ static prru_data data;
 static prru_ref_ws *W;
 static int energy_checked; /* files whose work-energy balance was checked */
 
-static void ref_params_of(const prru_mechanism *me, prru_ref_params *p)
-{
-  memset(p, 0, sizeof *p);
-  for (int i = 0; i < 3; i++) p->g[i] = me->gravity[i];
-  for (int l = 0; l < PRRU_NLIMB; l++) p->b[l] = me->b[l], p->l1[l] = me->l1[l], p->l2[l] = me->l2[l], p->a[l] = me->a[l];
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    p->mass[b] = me->mass[b];
-    memcpy(p->com[b], me->com[b], sizeof p->com[b]);
-    memcpy(p->inertia[b], me->inertia[b], sizeof p->inertia[b]);
-  }
-  for (int i = 0; i < PRRU_NACT; i++)
-    p->armature[i] = me->armature[i], p->damping[i] = me->damping[i], p->coulomb[i] = me->coulomb[i];
-  p->coulomb_velocity = me->coulomb_velocity;
-}
-
 /* The most regular height of q = (0, 0, q3) on a grid down to 4 lengths
  * below the rails' top (every valid model assembles at q1 = q2 = 0);
  * 0 where none is regular. */

@@ -5,7 +5,8 @@
 # each pass test_model_load's checks on the parameter kernels: forward and
 # inverse dynamics and the reactions against the GSL reference built from
 # the loaded numbers, ID(FD) = the applied forces, and the work-energy
-# balance. Then one of them through the CLI (`prru --model`): eval at the
+# balance; test_derivs's checks of the closed-form derivatives. Then one
+# of them through the CLI (`prru --model`): eval at the
 # home pose and a short simulate. Every seed is printed; a failing model is
 # kept in $PRRU_RANDOM_KEEP (default random-models/ in the build directory)
 # with the command that reproduces it. tests/random_models.sh builds a model
@@ -46,6 +47,11 @@ else
   done
   bad "test_model_load on random models (seeds above; FAILED lines name the files)"
 fi
+
+# The closed-form derivatives (prru_linearize, the topology kernels) on
+# the same models against the reference's Richardson differences.
+"$PRRU_BUILD_DIR/tests/test_derivs" "${files[@]}" >"$tmp/derivs" 2>&1 && ok ||
+  bad "test_derivs on random models: $(grep -E 'FAIL' "$tmp/derivs" | head -c 600)"
 
 # The CLI on the first random model (`--model`, no rebuild): eval at the
 # most regular home pose test_model_load found names the parameter kernels

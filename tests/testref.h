@@ -2,6 +2,7 @@
 #ifndef PRRU_TESTREF_H
 #define PRRU_TESTREF_H
 #include <math.h>
+#include <string.h>
 
 #include <gsl/gsl_errno.h>
 
@@ -24,5 +25,21 @@ static inline double ref_margin(const prru_ref_params *P, const double q[3])
   }
   const double sp = sin(q[0]) * cos(q[1]);
   return fmin(m, sqrt(1.0 - sp * sp));
+}
+/* The reference's parameters of a model's descriptor (a model loaded at
+ * run time: its own numbers). */
+static inline void ref_params_of(const prru_mechanism *me, prru_ref_params *p)
+{
+  memset(p, 0, sizeof *p);
+  for (int i = 0; i < 3; i++) p->g[i] = me->gravity[i];
+  for (int l = 0; l < PRRU_NLIMB; l++) p->b[l] = me->b[l], p->l1[l] = me->l1[l], p->l2[l] = me->l2[l], p->a[l] = me->a[l];
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    p->mass[b] = me->mass[b];
+    memcpy(p->com[b], me->com[b], sizeof p->com[b]);
+    memcpy(p->inertia[b], me->inertia[b], sizeof p->inertia[b]);
+  }
+  for (int i = 0; i < PRRU_NACT; i++)
+    p->armature[i] = me->armature[i], p->damping[i] = me->damping[i], p->coulomb[i] = me->coulomb[i];
+  p->coulomb_velocity = me->coulomb_velocity;
 }
 #endif

@@ -116,16 +116,16 @@ def _atom(name, x):
     return x if x.op == "const" else sym.define("_" + name, x)
 
 
-def _eom_solve(deriv, m, fd, fp, mp):
-    """eom with M qdd = b solved in the same evaluation, by eliminating a
-    constant diagonal entry of M first where there is one (_pivot_solve),
-    else by the adjugate (_adjugate_solve)."""
-    b = deriv.eom_rhs(fd, fp, mp)
-    # The solve works on M's and b's values as atoms, so that it is the
-    # plain arithmetic on them instead of being folded into their
-    # expressions (the sums' scale factors would multiply through it).
+def _mass_solver(deriv, m):
+    """solve(b) -> (x, minors, how_sets) with M x = b, M's values as atoms:
+    a constant diagonal entry of M eliminated first where there is one
+    (_pivot_solve), else the adjugate (_adjugate_solve). Every call shares
+    the factorization's nodes (hash-consing), so several right-hand sides
+    cost only their own arithmetic."""
+    # The solve works on M's values as atoms, so that it is the plain
+    # arithmetic on them instead of being folded into their expressions
+    # (the sums' scale factors would multiply through it).
     ma = [_atom("M%d" % k, x) for k, x in enumerate(m)]
-    ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
     e = [[ma[3 * i + j] for j in range(3)] for i in range(3)]
     # A diagonal entry that is the same at every state: a number in a
     # model's kernels; in the runtime-parameter kernels an expression of
@@ -136,9 +136,17 @@ def _eom_solve(deriv, m, fd, fp, mp):
     pivots = [k for k in range(3)
               if e[k][k].op == "const" or not sym.free_symbols(m[4 * k]) & state]
     if pivots:
-        qdd, minors, how_sets = _pivot_solve(e, ba, pivots[-1])
-    else:
-        qdd, minors, how_sets = _adjugate_solve(e, ba)
+        return lambda rhs, tag="": _pivot_solve(e, rhs, pivots[-1], tag)
+    return lambda rhs, tag="": _adjugate_solve(e, rhs, tag)
+
+
+def _eom_solve(deriv, m, fd, fp, mp):
+    """eom with M qdd = b solved in the same evaluation, by eliminating a
+    constant diagonal entry of M first where there is one (_pivot_solve),
+    else by the adjugate (_adjugate_solve)."""
+    b = deriv.eom_rhs(fd, fp, mp)
+    ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
+    qdd, minors, how_sets = _mass_solver(deriv, m)(ba)
     return ("eom_solve", "eom's M and b, qdd = M^-1 b (%s), and three "
             "principal minors of M on nested index sets (%s): M is positive "
             "definite exactly when all three are positive (Sylvester), and "
@@ -147,7 +155,7 @@ def _eom_solve(deriv, m, fd, fp, mp):
             [("M", m), ("b", b), ("qdd", qdd), ("minors", minors)], ("b", "qdd"))
 
 
-def _pivot_solve(e, b, k):
+def _pivot_solve(e, b, k, tag=""):
     """M x = b with M_kk a constant: x_k eliminated first (a Cholesky step
     with no square root and no division, 1/M_kk being a constant), then
     the 2x2 Schur complement S by its adjugate. About 18 multiplies and one
@@ -165,11 +173,11 @@ def _pivot_solve(e, b, k):
     det = sii * sjj - sij * sij
     inv = sym.power(det, -1)
     x = [None] * 3
-    x[i] = _atom("x%d" % i, (sjj * ci - sij * cj) * inv)
-    x[j] = _atom("x%d" % j, (sii * cj - sij * ci) * inv)
+    x[i] = _atom("x%s%d" % (tag, i), (sjj * ci - sij * cj) * inv)
+    x[j] = _atom("x%s%d" % (tag, j), (sii * cj - sij * ci) * inv)
     # b_k / M_kk as an atom: otherwise the sum is normalised to
     # (b_k - M_kk (u_i x_i + u_j x_j)) / M_kk, a multiply more.
-    x[k] = _atom("y%d" % k, b[k] * r) - ui * x[i] - uj * x[j]
+    x[k] = _atom("y%s%d" % (tag, k), b[k] * r) - ui * x[i] - uj * x[j]
     minors = [e[k][k], e[k][k] * sii, e[k][k] * det]
     what = "a constant" if e[k][k].op == "const" else \
         "constant in q and qd for any parameters (one division by it)"
@@ -178,7 +186,7 @@ def _pivot_solve(e, b, k):
                        "{%d}, {%d, %d}, {0, 1, 2}" % (k, k, i))
 
 
-def _adjugate_solve(e, b):
+def _adjugate_solve(e, b, tag=""):
     """M x = b by M's adjugate: the cofactors are products of M's entries,
     independent of each other, so only one division is serial."""
     cof = [[sym.add(sym.mul(e[(j + 1) % 3][(i + 1) % 3],
@@ -280,3 +288,110 @@ def lambda_labels(mech):
             fi += kind == "f"
             mi += kind == "m"
     return labels
+
+
+def _frozen(name, value, over):
+    """value as a symbol whose partial derivatives with respect to every
+    symbol of over are zero: a number computed once in the kernel (qdd
+    after the solve) that the derivative of an expression holding it
+    treats as an input. Lowered, it is value's own node (shared by CSE)."""
+    return sym.define(name, value, partials={s: sym.ZERO for s in over})
+
+
+def _columns(r, xs, tag):
+    """d r / d x for each symbol x of xs: one column (as atoms) each."""
+    return [[_atom("%s%d_%d" % (tag, c, i), sym.diff(ri, x))
+             for i, ri in enumerate(r)] for c, x in enumerate(xs)]
+
+
+def _row_major(cols):
+    """Columns (one list per variable) as a row-major matrix's entries."""
+    return [cols[k][i] for i in range(len(cols[0])) for k in range(len(cols))]
+
+
+def derivative_kernels(deriv):
+    """The closed-form derivatives of forward and inverse dynamics
+    (specialised set only): eom_solve_derivs and, with three actuators,
+    inverse_derivs."""
+    guards = deriv.mech.guards
+    nact = len(deriv.actuators())
+    fd, fp, mp = _vec("fd", nact), _vec("fp"), _vec("mp")
+    q, qd = list(deriv.mech.q), list(deriv.mech.qd)
+    spec = [_eom_solve_derivs(deriv, q, qd, fd, fp, mp)]
+    if nact == 3:
+        spec.append(_inverse_derivs(deriv, q, qd, fp, mp))
+    return [Kernel(k[0], k[1], k[2], k[3], guards, witnesses=k[4])
+            for k in spec]
+
+
+def _eom_solve_derivs(deriv, q, qd, fd, fp, mp):
+    """qdd = M^-1 b and its derivatives, d qdd/dx = M^-1 (db/dx - (dM/dx)
+    qdd): the residual r = b - M qdd with qdd frozen (its value after the
+    solve, a number to the derivative) differentiated symbolically, then
+    every column solved by eom_solve's factorization of M."""
+    m = deriv.mass()
+    b = deriv.eom_rhs(fd, fp, mp)
+    solve = _mass_solver(deriv, m)
+    ba = [_atom("b%d" % k, x) for k, x in enumerate(b)]
+    qdd, minors, _ = solve(ba)
+    xs = q + qd + fd + fp + mp
+    qv = [_frozen("_qddv%d" % i, qdd[i], xs) for i in range(3)]
+    r = [b[i] - sym.add(*[m[3 * i + j] * qv[j] for j in range(3)])
+         for i in range(3)]
+    blocks = []
+    for tag, vs in (("rq", q), ("rqd", qd), ("rfd", fd), ("rfp", fp),
+                    ("rmp", mp)):
+        blocks.append(_row_major([solve(col, "%s%d_" % (tag, c))[0]
+                                  for c, col in enumerate(_columns(r, vs, tag))]))
+    nact = len(fd)
+    return ("eom_solve_derivs", "eom_solve's M, b, qdd and minors, and the "
+            "derivatives of qdd, each row-major with row i = qdd_i and "
+            "column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = "
+            "dqdd/dqd (3x3), Dfd = dqdd/dfd (3x%d), Dfp = dqdd/dfp (3x3), "
+            "Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), "
+            "the solves by eom_solve's factorization of M." % nact,
+            [Q, QD, _arg("fd", nact), _arg("fp", 3), _arg("mp", 3)],
+            [("M", m), ("b", b), ("qdd", qdd), ("minors", minors),
+             ("Dq", blocks[0]), ("Dqd", blocks[1]), ("Dfd", blocks[2]),
+             ("Dfp", blocks[3]), ("Dmp", blocks[4])], ("b", "qdd"))
+
+
+def _inverse_derivs(deriv, q, qd, fp, mp):
+    """inverse_terms (three actuators) and the derivatives of fd = J_d^-T
+    tau: dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd), from the residual
+    r = tau - J_d^T fd with fd frozen, each column by J_d's adjugate."""
+    d, jd = deriv.actuators(), deriv.actuator_jacobian()
+    qdd = _vec("qdd")
+    tau = deriv.drive_force(qdd, fp, mp)
+    ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
+    e = [[ja[3 * i + j] for j in range(3)] for i in range(3)]
+    cof = [[sym.add(sym.mul(e[(i + 1) % 3][(j + 1) % 3],
+                            e[(i + 2) % 3][(j + 2) % 3]),
+                    -sym.mul(e[(i + 1) % 3][(j + 2) % 3],
+                             e[(i + 2) % 3][(j + 1) % 3]))
+            for j in range(3)] for i in range(3)]
+    inv_det = sym.power(sym.add(*[sym.mul(e[0][k], cof[0][k])
+                                  for k in range(3)]), -1)
+    inv = [sym.mul(cof[j][i], inv_det) for i in range(3) for j in range(3)]
+
+    def solve_t(rhs):
+        """J_d^T x = rhs: x_i = sum_k cof_ik rhs_k / det."""
+        return [sym.mul(sym.add(*[sym.mul(cof[i][k], rhs[k])
+                                  for k in range(3)]), inv_det)
+                for i in range(3)]
+    fd = solve_t([_atom("tau%d" % k, x) for k, x in enumerate(tau)])
+    xs = q + qd + qdd + fp + mp
+    fv = [_frozen("_fdv%d" % i, fd[i], xs) for i in range(3)]
+    r = [tau[i] - sym.add(*[jd[3 * j + i] * fv[j] for j in range(3)])
+         for i in range(3)]
+    blocks = [_row_major([solve_t(col) for col in _columns(r, vs, tag)])
+              for tag, vs in (("sq", q), ("sqd", qd), ("sqdd", qdd))]
+    ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
+    return ("inverse_derivs", "inverse_terms (d, J_d, J_d^-1, fd) and the "
+            "derivatives of fd, row-major with row i = fd_i and column k = "
+            "the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd "
+            "(= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T "
+            "fd).", ins,
+            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd),
+             ("Dq", blocks[0]), ("Dqd", blocks[1]), ("Dqdd", blocks[2])],
+            ("d", "fd"))

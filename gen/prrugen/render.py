@@ -7,7 +7,7 @@ from string import Template
 
 from . import batch, cgen, params, regressor
 from .ctext import c_comment, c_string
-from .kernels import kernels, lambda_labels
+from .kernels import derivative_kernels, kernels, lambda_labels
 from .model import ACTUATOR_KEYS, c_double
 
 GENERATOR = "gen/prru_gen.py"
@@ -260,7 +260,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     prefix, ctype = topology_prefix(n), topology_ctype(n)
     upper = prefix.upper()
     kernel_list = params.topology_kernels(
-        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)])
+        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)]
+        + derivative_kernels(deriv))
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
     banner = _banner(_topology_head(n, reference), emitted)
     macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
@@ -408,7 +409,10 @@ def render(model, deriv, templates_dir, prefix=None):
     prefix = prefix or model.name
     upper = prefix.upper()
     mech = deriv.mech
-    emitted = [cgen.emit(k, prefix) for k in kernels(deriv)]
+    # The derivative kernels: this set's and the topology set's (not the
+    # model's parameter set, prru_param_kernels.h).
+    kernel_list = kernels(deriv) + derivative_kernels(deriv)
+    emitted = [cgen.emit(k, prefix) for k in kernel_list]
     labels = lambda_labels(mech)
     head = _head(model)
     banner = _banner(head, emitted)
@@ -426,7 +430,6 @@ def render(model, deriv, templates_dir, prefix=None):
     macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
                                           c_string(e.summary()))
                for e in emitted]
-    kernel_list = kernels(deriv)
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros, "")
     values = dict(banner=banner, head=head + " */", prefix=prefix,
                   PREFIX=upper, macros="\n".join(macros),

@@ -34,7 +34,7 @@ from .errors import (InputError, Interrupted, LayoutError, LibraryNotFound, NoCo
                      OutOfStroke, ParseError, PrruError, PrruIOError, PrruMemoryError,
                      Singular, Unreachable)
 from ._lib import Library, load_library
-from .model import Dme, Joint, Model
+from .model import Dme, Joint, Linearization, Model
 from .simulation import Sample, Scenario, Trajectory
 from .maps import MapResult
 from .measurements import Measurement
@@ -44,8 +44,8 @@ from .design import Design
 
 __version__ = "0.3.0"
 
-__all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "MapResult", "Measurement",
-           "Limits", "Motion", "TimeOptimal", "TrackRun", "Excitation", "Identification", "Parameter",
+__all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "Linearization", "MapResult",
+           "Measurement", "Limits", "Motion", "TimeOptimal", "TrackRun", "Excitation", "Identification", "Parameter",
            "Design", "write_model_text",
            "Library", "load_library", "PrruError", "InputError", "Unreachable", "OutOfStroke", "Singular",
            "NoConvergence", "Interrupted", "PrruIOError", "PrruMemoryError", "ParseError",

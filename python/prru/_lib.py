@@ -196,6 +196,11 @@ class Types:
             ("d", _arr(d, nact)), ("Jd", _arr(d, nact * 3)), ("Jdpinv", _arr(d, 3 * nact)),
             ("M", _arr(d, 9)), ("b", _arr(d, 3)), ("qdd", _arr(d, 3)),
             ("r", _arr(d, nlambda)), ("lambda_null", _arr(d, nlambda))]})
+        self.Linearization = type("prru_linearization", (ctypes.Structure,), {"_fields_": [
+            ("qdd", _arr(d, 3)), ("dqdd_dq", _arr(d, 9)), ("dqdd_dqd", _arr(d, 9)),
+            ("dqdd_dfd", _arr(d, 3 * nact)), ("dqdd_dfp", _arr(d, 9)),
+            ("dqdd_dmp", _arr(d, 9)), ("A", _arr(d, 36)), ("B", _arr(d, 6 * nact)),
+            ("dt", d), ("Ad", _arr(d, 36)), ("Bd", _arr(d, 6 * nact))]})
         self.Schedule = type("prru_load_schedule", (ctypes.Structure,), {"_fields_": [
             ("kind", ctypes.c_int), ("base", self.Loads), ("amp", d), ("omega", d),
             ("nrows", ctypes.c_int), ("rows", c_double_p)]})
@@ -344,6 +349,8 @@ class Library:
         self.forward_kinematics_lsq = _declare(dll, "prru_forward_kinematics_lsq", i,
                                                mp, dp, vp, vp, vp, vp)
         self.forward_dynamics = _declare(dll, "prru_forward_dynamics", i, mp, dp, vp, vp, lp, vp)
+        self.linearize_why = _declare(dll, "prru_linearize_why", i, mp, dp, vp, vp, lp, d,
+                                      ctypes.POINTER(t.Linearization), ctypes.c_char_p, i)
         self.inverse_dynamics_preload = _declare(dll, "prru_inverse_dynamics_preload", i,
                                                  mp, dp, vp, vp, vp, lp, d, vp)
         self.actuator_null = _declare(dll, "prru_actuator_null", i, mp, dp, vp, vp)

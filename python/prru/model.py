@@ -23,6 +23,14 @@ w_R = sigma[0] / sigma[1] >= 1; sigma (N s^2/rad) and semi_axis = 1/sigma
 axis directions in {S}; sigma_T, half_length_T and dir_T of the
 translational segment; Mt (nact x nact), JtR and JtT (3 x nact)."""
 
+Linearization = collections.namedtuple(
+    "Linearization", "qdd dqdd_dq dqdd_dqd dqdd_dfd dqdd_dfp dqdd_dmp A B dt Ad Bd")
+Linearization.__doc__ = """The dynamics linearised at one state (prru_linearize.h):
+qdd; dqdd_dq, dqdd_dqd (3x3), dqdd_dfd (3 x nact), dqdd_dfp, dqdd_dmp (3x3),
+row i = qdd_i, column k = the k-th variable; A (6x6), B (6 x nact) of
+x' = A x + B u, x = (q, qd), u = fd; with dt, the zero-order-hold pair
+Ad, Bd (None without)."""
+
 
 def _fmt(v):
     return "(" + ", ".join("%.17g" % x for x in v) + ")"
@@ -313,6 +321,31 @@ class Model:
                    q, qd, ctypes.byref(l), qdd, rates=rates)
         self._require_finite("forward_dynamics", q, (qdd,), rates)
         return self._out.vec(qdd)
+
+    def linearize(self, q, qd, fd, fp=None, mp=None, dt=None):
+        """The closed-form derivatives of forward dynamics at (q, qd) under fd,
+        fp, mp (fp, mp default to 0) and the state-space pair, with dt (s,
+        > 0) the zero-order-hold discrete pair: a Linearization, the numbers
+        `prru linearize` prints. Raises as forward_dynamics where qdd is not
+        trusted."""
+        q, qd = vector("q", q, 3), vector("qd", qd, 3)
+        vector("fd", fd, self.nact)  # required, unlike forward_dynamics's
+        l = self._loads(fd, fp, mp)
+        if dt is not None:
+            dt = _convert.scalar("dt", dt, positive=True, allow_zero=False)
+        o, msg = self.lib.types.Linearization(), ctypes.create_string_buffer(600)
+        with self._lock:
+            st = self.lib.linearize_why(ctypes.byref(self._m), ctypes.byref(self._g.s), q, qd,
+                                        ctypes.byref(l), dt or 0.0, ctypes.byref(o), msg,
+                                        len(msg))
+        if st != errors.OK:
+            raise errors.make_error(st, "linearize: %s" % msg.value.decode("utf-8", "replace"))
+        n, mat = self.nact, self._out.mat
+        return Linearization(self._out.vec(o.qdd), mat(o.dqdd_dq, 3, 3), mat(o.dqdd_dqd, 3, 3),
+                             mat(o.dqdd_dfd, 3, n), mat(o.dqdd_dfp, 3, 3),
+                             mat(o.dqdd_dmp, 3, 3), mat(o.A, 6, 6), mat(o.B, 6, n),
+                             dt, mat(o.Ad, 6, 6) if dt else None,
+                             mat(o.Bd, 6, n) if dt else None)
 
     def inverse_dynamics(self, q, qd, qdd, fp=None, mp=None, preload=0.0):
         """Actuator forces fd (N, nact) producing qdd under fp, mp: the

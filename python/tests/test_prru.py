@@ -296,6 +296,38 @@ class TestAgainstCli(unittest.TestCase):
             if MODEL.nreaction_null:
                 self.assertEqual(bits(MODEL.reaction_null(q)), bits(out["reaction_null"]))
 
+    def test_linearize(self):
+        """Model.linearize equals `prru linearize` to the bit, with and
+        without --dt; the CLI's refusals are the binding's."""
+        keys = ("qdd", "dqdd_dq", "dqdd_dqd", "dqdd_dfd", "dqdd_dfp", "dqdd_dmp", "A", "B")
+        for k, (q, qd, fd, fp, mp) in enumerate(random_states(4, 7)):
+            dt = 0.002 if k % 2 else None
+            args = ["linearize", "--q", arg(q), "--qd", arg(qd), "--fd", arg(fd),
+                    "--fp", arg(fp), "--mp", arg(mp)] + (["--dt", repr(dt)] if dt else [])
+            out = parse(cli(*args))
+            lin = MODEL.linearize(q, qd, fd, fp, mp, dt=dt)
+            for key in keys + (("Ad", "Bd") if dt else ()):
+                self.assertEqual(bits(flat(getattr(lin, key))), bits(flat(out[key])), key)
+            self.assertEqual(bits(lin.qdd), bits(MODEL.forward_dynamics(q, qd, fd, fp, mp)))
+            if not dt:
+                self.assertIsNone(lin.Ad)
+                self.assertNotIn("Ad", out)
+        with self.assertRaises(ValueError):
+            MODEL.linearize(q, qd, fd, dt=0.0)
+        with self.assertRaises(prru.Unreachable):
+            MODEL.linearize([3.0, 0.0, 0.0], qd, fd)
+        if MODEL.nlimb == 3 and MODEL.model_file != "prototype_drives.json":
+            # A model loaded at run time: the topology's kernels, the CLI's numbers.
+            path = os.path.join(SOURCE_DIR, "models", "prototype_drives.json")
+            other = prru.Model(model=path, lib=MODEL.lib)
+            q, qd, fd = [0.0, 0.0, 0.1], [0.1, 0.2, 0.3], [1.0, 2.0, 3.0]
+            lin = other.linearize(q, qd, fd, dt=0.01)
+            out = parse(cli("--model", path, "linearize", "--q", arg(q), "--qd", arg(qd),
+                            "--fd", arg(fd), "--dt", "0.01"))
+            self.assertEqual(out["model"]["kernels"], "parameter")
+            for key in keys + ("Ad", "Bd"):
+                self.assertEqual(bits(flat(getattr(lin, key))), bits(flat(out[key])), key)
+
     def test_ik_fk_dme(self):
         for q, _, _, _, _ in random_states(4, 2):
             out = parse(cli("ik", "--q", arg(q)))

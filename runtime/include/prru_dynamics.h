@@ -121,6 +121,24 @@ typedef struct prru_kernel_table {
    * the Coulomb smoothing velocity vs. */
   void (*regressor)(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
                     double *Y);
+  /* The closed-form derivatives (prru_linearize.h): eom_solve's outputs,
+   * then dqdd/dq, dqdd/dqd (3x3), dqdd/dfd (3 x PRRU_NACT), dqdd/dfp,
+   * dqdd/dmp (3x3), row-major, row i = qdd_i. */
+  void (*eom_solve_derivs)(const void *p, const double q[3], const double qd[3],
+                           const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                           double M[9], double b[3], double qdd[3], double minors[3], double Dq[9],
+                           double Dqd[9], double Dfd[3 * PRRU_NACT], double Dfp[9], double Dmp[9]);
+  int (*unseen_finite_eom_solve_derivs)(const double q[3], const double qd[3],
+                                        const double fd[PRRU_NACT], const double fp[3],
+                                        const double mp[3]);
+  /* Three actuators: inverse_terms's outputs, then dfd/dq, dfd/dqd,
+   * dfd/dqdd (3x3 each); NULL (both) with four. */
+  void (*inverse_derivs)(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                         const double fp[3], const double mp[3], double d[PRRU_NACT],
+                         double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
+                         double Dq[9], double Dqd[9], double Dqdd[9]);
+  int (*unseen_finite_inverse_derivs)(const double q[3], const double qd[3], const double qdd[3],
+                                      const double fp[3], const double mp[3]);
 } prru_kernel_table;
 
 typedef struct {

@@ -312,6 +312,15 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * minors the kernel returns: otherwise qdd is not used. */
   double minors[3];
   KERNEL(m, eom_solve)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd, minors);
+  const int st = prru_forward_verdict(m, d, q, qd, l, minors,
+                                      KERNEL(m, unseen_finite_eom_solve)(q, qd, l->fd, l->fp, l->mp));
+  if (st == PRRU_OK) memcpy(qdd, d->qdd, sizeof d->qdd);
+  return st;
+}
+
+int prru_forward_verdict(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                         const prru_loads *l, const double minors[3], int unseen_finite)
+{
   /* The inputs are tested through the outputs, not one by one before the
    * call: the generator proves that a NaN or an infinity in any input but
    * the few PRRU_UNSEEN_FINITE_EOM_SOLVE tests makes b or qdd non-finite
@@ -319,7 +328,7 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * them examined, to name the cause: the statuses are those of testing
    * every input first. */
   if (!finite3(d->b) || !(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0) ||
-      !finite3(d->qdd) || !KERNEL(m, unseen_finite_eom_solve)(q, qd, l->fd, l->fp, l->mp))
+      !finite3(d->qdd) || !unseen_finite)
     return forward_failure(m, d, q, qd, l, minors);
   /* The trust criterion (prru_model.mass_rcond_min): prru_mass_rcond's
    * test without its division. */
@@ -332,7 +341,6 @@ int prru_forward_dynamics(const prru_model *m, prru_data *d, const double q[3],
     KERNEL(m, ik)(m->kernel_params, q, act);
     if (prru_stroke_actuator(m, act) >= 0) return PRRU_ESTROKE;
   }
-  memcpy(qdd, d->qdd, sizeof d->qdd);
   return PRRU_OK;
 }
 
@@ -420,6 +428,24 @@ PRRU_COLD static int inverse_failure(int st, const double q[3], const double qd[
   return st;
 }
 
+#if PRRU_NACT == 3
+int prru_inverse3_status(const prru_model *m, const prru_data *d, const double fd[3])
+{
+  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (prru_stroke_actuator(m, d->d) >= 0) return PRRU_ESTROKE;
+  if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
+    return PRRU_ESINGULAR;
+  if (!near_boundary_ok(m, d->Jd)) return PRRU_ESINGULAR;
+  return prru_finite_n(fd, 3) ? PRRU_OK : PRRU_EINPUT;
+}
+
+int prru_inverse_failure(int st, const double q[3], const double qd[3], const double qdd[3],
+                         const prru_loads *l)
+{
+  return inverse_failure(st, q, qd, qdd, l);
+}
+#endif
+
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
                           double fd[PRRU_NACT])
@@ -430,12 +456,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * prru_check_regular's test, on that J_d and J_d^-1. */
   double f[3];
   KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
-  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
-  else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
-  else if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
-    st = PRRU_ESINGULAR;
-  else if (!near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
-  else st = prru_finite_n(f, 3) ? PRRU_OK : PRRU_EINPUT;
+  st = prru_inverse3_status(m, d, f);
 #else
   /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
    * J_R,P^T mp - h): prru_check_regular's test on that J_d. */

@@ -11,6 +11,22 @@ extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter;
 /* A model's kernel K with its parameters: K(m, ik)(m->kernel_params, ...). */
 #define KERNEL(m, k) ((m)->kernels->k)
 
+/* prru_forward_dynamics's trust test on eom_solve's outputs, left in d
+ * (M, b, qdd) with minors: PRRU_OK where qdd is trusted, else the status
+ * the forward step returns. unseen_finite: the kernel's
+ * PRRU_UNSEEN_FINITE_* test of the inputs its outputs do not witness. */
+int prru_forward_verdict(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                         const prru_loads *l, const double minors[3], int unseen_finite);
+#if PRRU_NACT == 3
+/* prru_inverse_dynamics's test (three actuators) of inverse_terms's
+ * outputs: d, J_d and J_d^-1 in d (d->d, d->Jd, d->Jdpinv), fd. */
+int prru_inverse3_status(const prru_model *m, const prru_data *d, const double fd[3]);
+/* The status of a failed inverse test st once the inputs are examined:
+ * PRRU_EINPUT where one is not finite, else st. */
+int prru_inverse_failure(int st, const double q[3], const double qd[3], const double qdd[3],
+                         const prru_loads *l);
+#endif
+
 /* C99 has no M_PI. */
 #define PRRU_PI 3.14159265358979323846
 

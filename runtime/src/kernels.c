@@ -123,6 +123,39 @@ static void s_regressor(const void *p, const double q[3], const double qd[3], co
   (void)p, prru_regressor(q, qd, qdd, &vs, Y);
 }
 
+static void s_eom_solve_derivs(const void *p, const double q[3], const double qd[3],
+                               const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                               double M[9], double b[3], double qdd[3], double minors[3],
+                               double Dq[9], double Dqd[9], double Dfd[3 * PRRU_NACT], double Dfp[9],
+                               double Dmp[9])
+{
+  (void)p, prru_eom_solve_derivs(q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
+}
+static int s_unseen_eom_solve_derivs(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                                     const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
+  return PRRU_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp);
+}
+#if PRRU_NACT == 3
+static void s_inverse_derivs(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                             const double fp[3], const double mp[3], double d[PRRU_NACT],
+                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
+                             double Dq[9], double Dqd[9], double Dqdd[9])
+{
+  (void)p, prru_inverse_derivs(q, qd, qdd, fp, mp, d, Jd, Jdinv, fd, Dq, Dqd, Dqdd);
+}
+static int s_unseen_inverse_derivs(const double q[3], const double qd[3], const double qdd[3],
+                                   const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
+  return PRRU_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, fp, mp);
+}
+#else
+#define s_inverse_derivs NULL
+#define s_unseen_inverse_derivs NULL
+#endif
+
 const prru_kernel_table prru_kernels_specialised = {
   "specialised",  s_ik,      s_jd,
   s_ik_jd,        s_mass,    s_dynamics,
@@ -130,7 +163,8 @@ const prru_kernel_table prru_kernels_specialised = {
   s_inverse_terms, s_unseen_inverse_terms, s_joint_reactions,
   s_platform_jacobian, s_poses, s_energy,
   s_actuator_rates, s_passive, s_batch_dme_terms,
-  s_regressor,
+  s_regressor,    s_eom_solve_derivs, s_unseen_eom_solve_derivs,
+  s_inverse_derivs, s_unseen_inverse_derivs,
 };
 
 /* ---- parameter: the topology's kernels, p a prru_params ---- */
@@ -226,6 +260,39 @@ static void p_regressor(const void *p, const double q[3], const double qd[3], co
   P(regressor)(&c, q, qd, qdd, Y);
 }
 
+static void p_eom_solve_derivs(const void *p, const double q[3], const double qd[3],
+                               const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                               double M[9], double b[3], double qdd[3], double minors[3],
+                               double Dq[9], double Dqd[9], double Dfd[3 * PRRU_NACT], double Dfp[9],
+                               double Dmp[9])
+{
+  P(eom_solve_derivs)(TP(p), q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
+}
+static int p_unseen_eom_solve_derivs(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+                                     const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
+  return UNSEEN_P(EOM_SOLVE_DERIVS)(q, qd, fd, fp, mp);
+}
+#if PRRU_NACT == 3
+static void p_inverse_derivs(const void *p, const double q[3], const double qd[3], const double qdd[3],
+                             const double fp[3], const double mp[3], double d[PRRU_NACT],
+                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
+                             double Dq[9], double Dqd[9], double Dqdd[9])
+{
+  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, fd, Dq, Dqd, Dqdd);
+}
+static int p_unseen_inverse_derivs(const double q[3], const double qd[3], const double qdd[3],
+                                   const double fp[3], const double mp[3])
+{
+  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
+  return UNSEEN_P(INVERSE_DERIVS)(q, qd, qdd, fp, mp);
+}
+#else
+#define p_inverse_derivs NULL
+#define p_unseen_inverse_derivs NULL
+#endif
+
 const prru_kernel_table prru_kernels_parameter = {
   "parameter",    p_ik,      p_jd,
   p_ik_jd,        p_mass,    p_dynamics,
@@ -233,5 +300,6 @@ const prru_kernel_table prru_kernels_parameter = {
   p_inverse_terms, p_unseen_inverse_terms, p_joint_reactions,
   p_platform_jacobian, p_poses, p_energy,
   p_actuator_rates, p_passive, p_batch_dme_terms,
-  p_regressor,
+  p_regressor,    p_eom_solve_derivs, p_unseen_eom_solve_derivs,
+  p_inverse_derivs, p_unseen_inverse_derivs,
 };

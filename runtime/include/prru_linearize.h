@@ -1,0 +1,75 @@
+/* Linearisation of the dynamics, for LQR and MPC: the closed-form
+ * derivatives of forward dynamics (the generated prru_eom_solve_derivs,
+ * one evaluation with qdd) and of inverse dynamics (prru_inverse_derivs).
+ *
+ * State x = (q, qd) (6), input u = fd (PRRU_NACT), x' = f(x, u) =
+ * (qd, qdd(q, qd, fd, fp, mp)):
+ *     A = df/dx = [0 I; dqdd/dq dqdd/dqd],  B = df/du = [0; dqdd/dfd].
+ * Every matrix is row-major; row i of a derivative block is qdd_i (fd_i),
+ * column k the k-th variable.
+ *
+ * Both kernel sets have them: the specialised one (constant-folded from
+ * the build's model file) and the topology's parameter set, for a model
+ * loaded at run time (prru_model_load) with other numbers. */
+#ifndef PRRU_LINEARIZE_H
+#define PRRU_LINEARIZE_H
+
+#include "prru.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The derivative blocks are contiguous, in this order (one finiteness
+ * test covers them). */
+typedef struct {
+  double qdd[3];
+  double dqdd_dq[9], dqdd_dqd[9];  /* 3x3 */
+  double dqdd_dfd[3 * PRRU_NACT];  /* 3 x PRRU_NACT */
+  double dqdd_dfp[9], dqdd_dmp[9]; /* 3x3: the platform force and moment */
+  double A[36];                    /* 6x6 */
+  double B[6 * PRRU_NACT];         /* 6 x PRRU_NACT */
+  /* With dt > 0: the zero-order-hold discrete pair x_{k+1} = Ad x_k + Bd
+   * u_k, [Ad Bd; 0 I] = exp([A B; 0 0] dt) (gsl_linalg_exponential_ss,
+   * GSL_PREC_DOUBLE); with dt = 0 they are not computed (left 0). */
+  double dt;
+  double Ad[36];
+  double Bd[6 * PRRU_NACT];
+} prru_linearization;
+
+/* Whether this model's kernel table has the derivative kernels (every
+ * table of this build has). */
+PRRU_API int prru_linearize_available(const prru_model *m);
+
+/* The linearisation at (q, qd) under the loads l, into out. PRRU_OK; or
+ * the status prru_forward_dynamics gives at the same state where qdd is
+ * not trusted (PRRU_EUNREACHABLE, PRRU_ESTROKE, PRRU_ESINGULAR: the same
+ * criterion, mass_rcond_min included; PRRU_EINPUT for non-finite input),
+ * and PRRU_EINPUT for dt < 0 or not finite, for a kernel table without
+ * the derivative kernels (prru_linearize_available), or where the exponential
+ * overflows (dt far beyond the dynamics' time scales). On failure out is
+ * all zeros: no number of it is a result. */
+PRRU_API int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                            const prru_loads *l, double dt, prru_linearization *out);
+
+/* prru_linearize with the reason of a failure in msg (as
+ * prru_forward_dynamics_why). */
+PRRU_API int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                                const prru_loads *l, double dt, prru_linearization *out, char *msg,
+                                int msglen);
+
+/* Three actuators: inverse dynamics fd (as prru_inverse_dynamics, the same
+ * statuses and trust test) and its derivatives dfd/dq, dfd/dqd, dfd/dqdd
+ * (3x3 each; dfd/dqdd = J_d^-T M), any of them NULL if not wanted. Four
+ * actuators: PRRU_EINPUT (the minimum-norm solution's derivatives are not
+ * generated). */
+PRRU_API int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
+                                          const double qd[3], const double qdd[3], const prru_loads *l,
+                                          double fd[PRRU_NACT], double dfd_dq[9], double dfd_dqd[9],
+                                          double dfd_dqdd[9]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,136 @@
+/* prru_linearize.h: the closed-form derivatives of the dynamics. */
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_matrix.h>
+
+#include "prru_linearize.h"
+#include "internal.h"
+
+/* prru_linearize tests the five derivative blocks as one array. */
+typedef char prru_blocks_contiguous[offsetof(prru_linearization, dqdd_dmp) + sizeof(double[9]) -
+                                            offsetof(prru_linearization, dqdd_dq) ==
+                                        sizeof(double[9 + 9 + 3 * PRRU_NACT + 9 + 9])
+                                    ? 1
+                                    : -1];
+
+int prru_linearize_available(const prru_model *m)
+{
+  return m->kernels->eom_solve_derivs != NULL;
+}
+
+/* A = [0 I; Dq Dqd], B = [0; Dfd]. */
+static void state_space(prru_linearization *o)
+{
+  enum { N = PRRU_NACT };
+  memset(o->A, 0, sizeof o->A);
+  memset(o->B, 0, sizeof o->B);
+  for (int i = 0; i < 3; i++) {
+    o->A[6 * i + 3 + i] = 1.0;
+    for (int k = 0; k < 3; k++) {
+      o->A[6 * (3 + i) + k] = o->dqdd_dq[3 * i + k];
+      o->A[6 * (3 + i) + 3 + k] = o->dqdd_dqd[3 * i + k];
+    }
+    for (int k = 0; k < N; k++) o->B[N * (3 + i) + k] = o->dqdd_dfd[N * i + k];
+  }
+}
+
+/* Ad, Bd from exp([A B; 0 0] dt): PRRU_OK, or PRRU_EINPUT where GSL fails
+ * or the exponential is not finite. */
+static int zero_order_hold(prru_linearization *o, double dt)
+{
+  enum { N = PRRU_NACT, S = 6 + PRRU_NACT };
+  double aug[S * S] = {0}, ex[S * S];
+  for (int i = 0; i < 6; i++) {
+    for (int k = 0; k < 6; k++) aug[S * i + k] = o->A[6 * i + k] * dt;
+    for (int k = 0; k < N; k++) aug[S * i + 6 + k] = o->B[N * i + k] * dt;
+  }
+  gsl_matrix_view a = gsl_matrix_view_array(aug, S, S), e = gsl_matrix_view_array(ex, S, S);
+  prru_gsl_init();
+  if (gsl_linalg_exponential_ss(&a.matrix, &e.matrix, GSL_PREC_DOUBLE) != GSL_SUCCESS ||
+      !prru_finite_n(ex, S * S))
+    return PRRU_EINPUT;
+  for (int i = 0; i < 6; i++) {
+    for (int k = 0; k < 6; k++) o->Ad[6 * i + k] = ex[S * i + k];
+    for (int k = 0; k < N; k++) o->Bd[N * i + k] = ex[S * i + 6 + k];
+  }
+  return PRRU_OK;
+}
+
+int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                   const prru_loads *l, double dt, prru_linearization *out)
+{
+  if (!prru_linearize_available(m) || !(dt >= 0) || !isfinite(dt)) return PRRU_EINPUT;
+  /* Straight into out (a copy of its 1.4 kB costs a tenth of the call). */
+  prru_linearization *o = out;
+  double minors[3];
+  KERNEL(m, eom_solve_derivs)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd,
+                               minors, o->dqdd_dq, o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp,
+                               o->dqdd_dmp);
+  int st = prru_forward_verdict(m, d, q, qd, l, minors,
+                                KERNEL(m, unseen_finite_eom_solve_derivs)(q, qd, l->fd, l->fp, l->mp));
+  /* Trusted qdd from finite inputs: the derivatives are products of the
+   * same finite terms and one division by det M, which the test bounds;
+   * they overflow only where qdd nearly does. */
+  if (st == PRRU_OK && !prru_finite_n(o->dqdd_dq, 9 + 9 + 3 * PRRU_NACT + 9 + 9)) st = PRRU_EINPUT;
+  if (st == PRRU_OK) {
+    memcpy(o->qdd, d->qdd, sizeof o->qdd);
+    state_space(o);
+    o->dt = dt;
+    if (dt > 0)
+      st = zero_order_hold(o, dt);
+    else
+      memset(o->Ad, 0, sizeof o->Ad), memset(o->Bd, 0, sizeof o->Bd);
+  }
+  if (st != PRRU_OK) memset(out, 0, sizeof *out);
+  return st;
+}
+
+int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                       const prru_loads *l, double dt, prru_linearization *out, char *msg,
+                       int msglen)
+{
+  const int st = prru_linearize(m, d, q, qd, l, dt, out);
+  if (st == PRRU_OK) return prru_fail(msg, msglen, st, "%s", "");
+  if (!prru_linearize_available(m))
+    return prru_fail(msg, msglen, st, "the %s kernels of this model have no derivatives",
+                     m->kernels->path);
+  if (!(dt >= 0) || !isfinite(dt))
+    return prru_fail(msg, msglen, st, "dt = %g: the hold period must be finite and >= 0", dt);
+  /* The forward step's own diagnosis: the same kernel terms and test. */
+  if (prru_forward_dynamics_why(m, d, q, qd, l, msg, msglen) != PRRU_OK) return st;
+  return prru_fail(msg, msglen, st,
+                   "the derivatives of qdd or their exponential over dt = %g overflow at this "
+                   "state",
+                   dt);
+}
+
+int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
+                                 const double qd[3], const double qdd[3], const prru_loads *l,
+                                 double fd[PRRU_NACT], double dfd_dq[9], double dfd_dqd[9],
+                                 double dfd_dqdd[9])
+{
+#if PRRU_NACT == 3
+  if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
+  double f[3], Dq[9], Dqd[9], Dqdd[9];
+  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, Dq,
+                            Dqd, Dqdd);
+  int st = prru_inverse3_status(m, d, f);
+  if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_derivs)(q, qd, qdd, l->fp, l->mp))
+    return prru_inverse_failure(st, q, qd, qdd, l);
+  if (!prru_finite_n(Dq, 9) || !prru_finite_n(Dqd, 9) || !prru_finite_n(Dqdd, 9))
+    return PRRU_EINPUT;
+  memcpy(fd, f, sizeof f);
+  if (dfd_dq) memcpy(dfd_dq, Dq, sizeof Dq);
+  if (dfd_dqd) memcpy(dfd_dqd, Dqd, sizeof Dqd);
+  if (dfd_dqdd) memcpy(dfd_dqdd, Dqdd, sizeof Dqdd);
+  return PRRU_OK;
+#else
+  (void)m, (void)d, (void)q, (void)qd, (void)qdd, (void)l, (void)fd, (void)dfd_dq, (void)dfd_dqd,
+      (void)dfd_dqdd;
+  return PRRU_EINPUT;
+#endif
+}

@@ -1,0 +1,454 @@
+/* The closed-form derivatives of the dynamics (prru_linearize.h: the
+ * generated prru_eom_solve_derivs and prru_inverse_derivs) against an
+ * evaluation that shares no code with them: Richardson-extrapolated
+ * central differences of the hand-written GSL reference (reference/,
+ * prru_ref_forward_dynamics and prru_ref_inverse_dynamics), for the
+ * build's model at a state at rest and at random states with velocities
+ * and loads. Then identities that hold exactly: the inverse of forward
+ * dynamics (dqdd/dfd dfd/dqdd = I, dfd/dq + dfd/dqdd dqdd/dq = 0, the same
+ * for qd), A and B's structure, and the zero-order hold (Ad, Bd) against
+ * the exponential's Taylor series summed here.
+ *
+ * The bound, relative to each matrix's largest entry (tu_relerr):
+ * 1e-9. The two sides' errors:
+ *   - the reference's differences: central differences at h, h/2, h/4,
+ *     h/8 extrapolated three times (Richardson), truncation O(h^8), with
+ *     h = 0.005 m^2 rad for the angles (m the state's margin from the
+ *     workspace boundary, ref_margin, at least MARGIN here: the functions
+ *     vary on a length that shrinks like m^2 near it; 0.02 m^2 and more
+ *     left truncation errors of 1e-9 and above on the paper model) and L
+ *     times that for q3; the rounding of the reference (a few ulps of its
+ *     terms) divided by h/8 and amplified ~3 by the extrapolation. The
+ *     tableau's last correction (the error of the previous, less
+ *     accurate extrapolant, so an over-estimate) is checked below 1e-9 of
+ *     the block: the tableau converged (measured on the paper model: 4e-10
+ *     at worst, while the two sides agree to 1.2e-11 at worst, which an
+ *     error of either would not allow);
+ *   - the kernel's: qdd's rounding (2e-10 relative at the trust limit
+ *     mass_rcond_min = 1e-6, prru.h; ~1e-14 at these margins) times the
+ *     few extra operations of a derivative: ~1e-13.
+ * So 1e-9 leaves two orders of magnitude over the sum while a wrong term
+ * (of order the block) fails by nine. The identities hold to rounding:
+ * 1e-11 of the terms' magnitudes (products of two derivative blocks, each
+ * accurate to ~1e-13 relative). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+
+#include "prru.h"
+#include "prru_linearize.h"
+#include "prru_model_file.h"
+#include "prru_mechanism.h"
+#include "prru_ref.h"
+#include "testref.h"
+#include "testutil.h"
+
+#define PI 3.14159265358979323846
+#define NA PRRU_NACT
+#define LEVELS 4
+#define MARGIN 0.3
+#define BOUND 1e-9
+#define REF_ACCURACY 1e-9
+#define IDENTITY_BOUND 1e-11
+
+static prru_ref_params P;
+static prru_ref_ws *W;
+static prru_model model;
+static prru_data data;
+static double length; /* the machine's scale (m): the mean link length */
+
+typedef struct {
+  double q[3], qd[3], fd[NA], fp[3], mp[3], qdd[3];
+} state;
+
+enum { V_Q, V_QD, V_FD, V_FP, V_MP, V_QDD };
+
+static double *slot(state *s, int v)
+{
+  double *const slots[] = {s->q, s->qd, s->fd, s->fp, s->mp, s->qdd};
+  return slots[v];
+}
+
+/* Forward dynamics' qdd (3), or inverse dynamics' fd (NA), by the reference. */
+static int ref_eval(int inverse, const state *s, double *out)
+{
+  return inverse ? prru_ref_inverse_dynamics(&P, W, s->q, s->qd, s->qdd, s->fp, s->mp, out)
+                 : prru_ref_forward_dynamics(&P, W, s->q, s->qd, s->fd, s->fp, s->mp, out);
+}
+
+/* d out / d (variable v, component k) by Richardson extrapolation of
+ * central differences with steps h0 / 2^j; *est: the last correction's
+ * size (its error estimate). */
+static int richardson(int inverse, const state *s, int v, int k, double h0, int nout,
+                      double *deriv, double *est)
+{
+  double T[LEVELS][LEVELS][NA];
+  for (int lev = 0; lev < LEVELS; lev++) {
+    const double h = ldexp(h0, -lev);
+    state up = *s, dn = *s;
+    slot(&up, v)[k] += h;
+    slot(&dn, v)[k] -= h;
+    double fu[NA], fdn[NA];
+    if (ref_eval(inverse, &up, fu) || ref_eval(inverse, &dn, fdn)) return 1;
+    for (int i = 0; i < nout; i++) T[lev][0][i] = (fu[i] - fdn[i]) / (2 * h);
+    for (int j = 1; j <= lev; j++) {
+      const double f = ldexp(1.0, 2 * j) - 1;
+      for (int i = 0; i < nout; i++)
+        T[lev][j][i] = T[lev][j - 1][i] + (T[lev][j - 1][i] - T[lev - 1][j - 1][i]) / f;
+    }
+  }
+  *est = 0;
+  for (int i = 0; i < nout; i++) {
+    deriv[i] = T[LEVELS - 1][LEVELS - 1][i];
+    *est = fmax(*est, fabs(deriv[i] - T[LEVELS - 2][LEVELS - 2][i]));
+  }
+  return 0;
+}
+
+/* The reference's block d out / d v (nout x n, row-major); *est relative
+ * to its largest entry. */
+static int ref_block(int inverse, const state *s, int v, int n, double h0, double *block,
+                     double *est)
+{
+  const int nout = inverse ? NA : 3;
+  double big = 1e-300, e = 0;
+  for (int k = 0; k < n; k++) {
+    double col[NA], ek;
+    const double h = (v == V_Q || v == V_QD || v == V_QDD) && k == 2 ? h0 * length : h0;
+    if (richardson(inverse, s, v, k, h, nout, col, &ek)) return 1;
+    /* Where the tableau has not converged (a function that bends on a
+     * shorter length than the step assumes), the step a quarter, twice at
+     * most, keeping the better column. */
+    for (int shrink = 1; shrink <= 2 && ek > REF_ACCURACY * tu_norm_inf(col, nout); shrink++) {
+      double c2[NA], e2;
+      if (richardson(inverse, s, v, k, ldexp(h, -2 * shrink), nout, c2, &e2)) return 1;
+      if (e2 < ek) memcpy(col, c2, sizeof col), ek = e2;
+    }
+    e = fmax(e, ek);
+    for (int i = 0; i < nout; i++) {
+      block[n * i + k] = col[i];
+      big = fmax(big, fabs(col[i]));
+    }
+  }
+  *est = e / big;
+  return 0;
+}
+
+static double worst[2][3 + 3], worst_est, worst_identity;
+static const char *const fwd_names[] = {"dqdd_dq", "dqdd_dqd", "dqdd_dfd", "dqdd_dfp", "dqdd_dmp"};
+#if NA == 3
+static const char *const inv_names[] = {"dfd_dq", "dfd_dqd", "dfd_dqdd"};
+#endif
+
+static void compare(int inverse, int b, const char *name, const double *kernel, const double *ref,
+                    int n, double est)
+{
+  const double e = tu_relerr(kernel, ref, n, 1e-300);
+  char what[96];
+  snprintf(what, sizeof what, "%s against the reference's Richardson differences", name);
+  tu_check(e <= BOUND, what, e, BOUND);
+  snprintf(what, sizeof what, "%s: the reference differences' own error estimate", name);
+  tu_check(est <= REF_ACCURACY, what, est, REF_ACCURACY);
+  worst[inverse][b] = fmax(worst[inverse][b], e);
+  worst_est = fmax(worst_est, est);
+}
+
+/* Steps: angles h = 0.005 m^2 (m the margin), q3 that times L; the rates
+ * 0.05 (rad/s, L m/s); with Coulomb friction both shrink with the width
+ * of its tanh, the rates' to 0.2 v_s / L (on random models a quarter of
+ * that lost to rounding, the Coulomb terms f / v_s being large, and 1e-9
+ * was exceeded; 0.2 left 2.6e-10 at worst over 20 of them); the loads
+ * enter linearly (1 N, 1 N m). */
+static double step_for(int v, double m)
+{
+  /* tanh(dd / v_s) bends on dd ~ v_s: in qd on v_s / L, in q (dd = J_d qd)
+   * on v_s / (L |qd|), |qd| <= 1 here. */
+  double coulomb = 1.0;
+  for (int i = 0; i < NA; i++)
+    if (P.coulomb[i] != 0) coulomb = fmin(coulomb, P.coulomb_velocity / length);
+  if (v == V_Q) return 0.005 * m * m * fmin(1.0, 10 * coulomb);
+  if (v == V_QD) return fmin(0.05, 0.2 * coulomb);
+  return 1.0;
+}
+
+static void check_forward(state *s, double m)
+{
+  prru_loads l;
+  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  prru_linearization o;
+  const int st = prru_linearize(&model, &data, s->q, s->qd, &l, 0.0, &o);
+  if (!TU_TRUE(st == PRRU_OK, "prru_linearize at a trusted state")) return;
+  const double *blocks[] = {o.dqdd_dq, o.dqdd_dqd, o.dqdd_dfd, o.dqdd_dfp, o.dqdd_dmp};
+  const int vars[] = {V_Q, V_QD, V_FD, V_FP, V_MP}, widths[] = {3, 3, NA, 3, 3};
+  for (int b = 0; b < 5; b++) {
+    double ref[3 * NA], est;
+    if (!TU_TRUE(!ref_block(0, s, vars[b], widths[b], step_for(vars[b], m), ref, &est),
+                 "reference forward dynamics near the state"))
+      return;
+    compare(0, b, fwd_names[b], blocks[b], ref, 3 * widths[b], est);
+  }
+  /* A = [0 I; Dq Dqd], B = [0; Dfd], exactly. */
+  int structure = 1;
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++) {
+      structure &= o.A[6 * i + k] == 0 && o.A[6 * i + 3 + k] == (i == k);
+      structure &= o.A[6 * (3 + i) + k] == o.dqdd_dq[3 * i + k];
+      structure &= o.A[6 * (3 + i) + 3 + k] == o.dqdd_dqd[3 * i + k];
+    }
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < NA; k++)
+      structure &= o.B[NA * i + k] == 0 && o.B[NA * (3 + i) + k] == o.dqdd_dfd[NA * i + k];
+  TU_TRUE(structure, "A = [0 I; dqdd_dq dqdd_dqd], B = [0; dqdd_dfd]");
+  memcpy(s->qdd, o.qdd, sizeof o.qdd);
+}
+
+#if NA == 3
+/* max |X Y - I| (X, Y 3x3) relative to max (|X| |Y|)_ij. */
+static double identity_error(const double X[9], const double Y[9], const double *add, int sign)
+{
+  double e = 0, scale = 1e-300;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double s = add ? add[3 * i + j] : -(i == j), t = add ? fabs(add[3 * i + j]) : 1;
+      for (int k = 0; k < 3; k++) {
+        s += sign * X[3 * i + k] * Y[3 * k + j];
+        t += fabs(X[3 * i + k] * Y[3 * k + j]);
+      }
+      e = fmax(e, fabs(s));
+      scale = fmax(scale, t);
+    }
+  return e / scale;
+}
+
+/* Inverse dynamics' derivatives at qdd = FD(q, qd, fd) (s->qdd), against
+ * the reference, and the identities of ID(FD) = fd. */
+static void check_inverse(state *s, double m)
+{
+  prru_loads l;
+  memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  double fd[NA], Dq[9], Dqd[9], Dqdd[9];
+  int st = prru_inverse_dynamics_derivs(&model, &data, s->q, s->qd, s->qdd, &l, fd, Dq, Dqd, Dqdd);
+  if (!TU_TRUE(st == PRRU_OK, "prru_inverse_dynamics_derivs at a trusted state")) return;
+  /* Relative to the forces' size, at least the platform's weight. */
+  const double floor = prru_mech.total_mass * 9.81;
+  const double e_id = tu_relerr(fd, s->fd, NA, floor);
+  tu_check(e_id <= 1e-11, "ID(FD(fd)) = fd", e_id, 1e-11);
+  const double *blocks[] = {Dq, Dqd, Dqdd};
+  const int vars[] = {V_Q, V_QD, V_QDD};
+  for (int b = 0; b < 3; b++) {
+    double ref[9], est;
+    if (!TU_TRUE(!ref_block(1, s, vars[b], 3, step_for(vars[b], m), ref, &est),
+                 "reference inverse dynamics near the state"))
+      return;
+    compare(1, b, inv_names[b], blocks[b], ref, 9, est);
+  }
+  memcpy(l.fd, s->fd, sizeof l.fd);
+  prru_linearization o;
+  if (!TU_TRUE(prru_linearize(&model, &data, s->q, s->qd, &l, 0.0, &o) == PRRU_OK, "linearize"))
+    return;
+  /* fd(q, qd, qdd(q, qd, fd)) = fd: dfd/dqdd dqdd/dfd = I, and
+   * dfd/dq + dfd/dqdd dqdd/dq = 0 (the same for qd). */
+  const double e[3] = {identity_error(Dqdd, o.dqdd_dfd, NULL, 1),
+                       identity_error(Dqdd, o.dqdd_dq, Dq, 1),
+                       identity_error(Dqdd, o.dqdd_dqd, Dqd, 1)};
+  static const char *const what[3] = {"dfd/dqdd dqdd/dfd = I", "dfd/dq + dfd/dqdd dqdd/dq = 0",
+                                      "dfd/dqd + dfd/dqdd dqdd/dqd = 0"};
+  for (int i = 0; i < 3; i++) {
+    tu_check(e[i] <= IDENTITY_BOUND, what[i], e[i], IDENTITY_BOUND);
+    worst_identity = fmax(worst_identity, e[i]);
+  }
+}
+#endif
+
+/* [Ad Bd; 0 I] = exp(Z), Z = [A B; 0 0] dt, against its Taylor series
+ * summed here: of Z / 2^k with |Z / 2^k|_inf <= 1/2 (30 terms leave
+ * 2^-30 / 30! ~ 1e-42), then squared k times. */
+static void check_hold(const state *s)
+{
+  enum { S = 6 + NA };
+  prru_loads l;
+  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  const double dts[] = {1e-3, 2e-2, 0.5};
+  for (int t = 0; t < 3; t++) {
+    prru_linearization o;
+    if (!TU_TRUE(prru_linearize(&model, &data, s->q, s->qd, &l, dts[t], &o) == PRRU_OK,
+                 "linearize with dt"))
+      return;
+    double Z[S * S] = {0}, term[S * S] = {0}, sum[S * S] = {0}, next[S * S], zn = 0;
+    for (int i = 0; i < 6; i++) {
+      for (int k = 0; k < 6; k++) Z[S * i + k] = o.A[6 * i + k] * dts[t];
+      for (int k = 0; k < NA; k++) Z[S * i + 6 + k] = o.B[NA * i + k] * dts[t];
+    }
+    for (int i = 0; i < S; i++) {
+      double r = 0;
+      for (int k = 0; k < S; k++) r += fabs(Z[S * i + k]);
+      zn = fmax(zn, r);
+    }
+    int squarings = 0, sq0;
+    for (; zn > 0.5; zn /= 2) squarings++;
+    sq0 = squarings;
+    for (int i = 0; i < S * S; i++) Z[i] = ldexp(Z[i], -squarings);
+    for (int i = 0; i < S; i++) term[S * i + i] = sum[S * i + i] = 1;
+    for (int n = 1; n <= 30; n++) {
+      for (int i = 0; i < S; i++)
+        for (int j = 0; j < S; j++) {
+          double x = 0;
+          for (int k = 0; k < S; k++) x += term[S * i + k] * Z[S * k + j];
+          next[S * i + j] = x / n;
+        }
+      memcpy(term, next, sizeof term);
+      for (int i = 0; i < S * S; i++) sum[i] += term[i];
+    }
+    for (; squarings > 0; squarings--) {
+      for (int i = 0; i < S; i++)
+        for (int j = 0; j < S; j++) {
+          double x = 0;
+          for (int k = 0; k < S; k++) x += sum[S * i + k] * sum[S * k + j];
+          next[S * i + j] = x;
+        }
+      memcpy(sum, next, sizeof sum);
+    }
+    double Ad[36], Bd[6 * NA];
+    for (int i = 0; i < 6; i++) {
+      for (int k = 0; k < 6; k++) Ad[6 * i + k] = sum[S * i + k];
+      for (int k = 0; k < NA; k++) Bd[NA * i + k] = sum[S * i + 6 + k];
+    }
+    /* GSL_PREC_DOUBLE and the series: a few ulps of the exponential's
+     * largest entry (Ad's, at least 1: Bd, of order B dt, is relative to
+     * it too), the rounding of each squaring doubling it on either side
+     * (measured 1e-15 without squaring, 4e-13 after ten): 1e-14 2^k. */
+    const double tol = ldexp(1e-14, sq0), big = fmax(1.0, tu_norm_inf(Ad, 36));
+    double e = tu_relerr(o.Ad, Ad, 36, big);
+    tu_check(e <= tol, "Ad against the exponential's Taylor series", e, tol);
+    e = tu_relerr(o.Bd, Bd, 6 * NA, big);
+    tu_check(e <= tol, "Bd against the exponential's Taylor series", e, tol);
+  }
+}
+
+static int trusted_state(state *s, double *m)
+{
+  prru_loads l;
+  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  double qdd[3];
+  *m = ref_margin(&P, s->q);
+  return *m >= MARGIN && prru_forward_dynamics(&model, &data, s->q, s->qd, &l, qdd) == PRRU_OK;
+}
+
+static int random_state(state *s, double *m)
+{
+  for (long tries = 0; tries < 100000; tries++) {
+    memset(s, 0, sizeof *s);
+    s->q[0] = tu_uniform(-PI / 4, PI / 4);
+    s->q[1] = tu_uniform(-PI / 4, PI / 4);
+    s->q[2] = tu_uniform(-2 * length, 2 * length);
+    for (int i = 0; i < 3; i++) {
+      s->qd[i] = tu_uniform(-1, 1) * (i == 2 ? length : 1);
+      s->fp[i] = tu_uniform(-30, 30);
+      s->mp[i] = tu_uniform(-3, 3);
+    }
+    for (int i = 0; i < NA; i++) s->fd[i] = tu_uniform(-60, 60);
+    if (trusted_state(s, m)) return 1;
+  }
+  return 0;
+}
+
+/* Hovering (at rest, the drives holding the robot against gravity:
+ * unloaded it falls as one rigid body and every derivative is 0), then
+ * random states with rates and loads, on model (P its numbers). */
+static void check_model(const char *name, int nstates)
+{
+  memset(worst, 0, sizeof worst);
+  worst_est = worst_identity = 0;
+  length = 0;
+  for (int i = 0; i < PRRU_NLIMB; i++) length += (P.l1[i] + P.l2[i]) / (2 * PRRU_NLIMB);
+  state s;
+  double m = 0;
+  int n = 0, hover = 0;
+  memset(&s, 0, sizeof s);
+  prru_loads none = {{0}, {0, 0, 0}, {0, 0, 0}};
+  for (int tries = 0; tries < 2000 && !hover; tries++) {
+    s.q[2] = tu_uniform(-2 * length, 2 * length);
+    hover = prru_inverse_dynamics(&model, &data, s.q, s.qd, s.qdd, &none, s.fd) == PRRU_OK &&
+            trusted_state(&s, &m);
+  }
+  char what[300];
+  snprintf(what, sizeof what, "%s: a hovering state with margin >= %g", name, MARGIN);
+  TU_TRUE(hover, what);
+  for (int k = 0; k < nstates; k++) {
+    if (k > 0 || !hover) {
+      snprintf(what, sizeof what, "%s: a random trusted state with margin >= %g", name, MARGIN);
+      if (!TU_TRUE(random_state(&s, &m), what)) break;
+    }
+    check_forward(&s, m);
+#if NA == 3
+    check_inverse(&s, m);
+#endif
+    if (k < 3) check_hold(&s);
+    n++;
+  }
+  printf("%s (%s kernels), %d states:\n", name, model.kernels->path, n);
+  for (int b = 0; b < 5; b++) printf("  %-9s worst relative error %.2e\n", fwd_names[b], worst[0][b]);
+#if NA == 3
+  for (int b = 0; b < 3; b++) printf("  %-9s worst relative error %.2e\n", inv_names[b], worst[1][b]);
+  printf("  identities worst %.2e\n", worst_identity);
+#else
+  /* Four actuators: the minimum-norm solution's derivatives are not generated. */
+  double fd[NA];
+  TU_TRUE(prru_inverse_dynamics_derivs(&model, &data, s.q, s.qd, s.qdd, &none, fd, NULL, NULL, NULL) ==
+              PRRU_EINPUT,
+          "four actuators: inverse derivatives refused");
+#endif
+  printf("  reference differences' worst error estimate %.2e\n", worst_est);
+}
+
+/* A model file loaded at run time: 0 when it is of the other topology
+ * (refused by the build: not this test's business). */
+static int check_file(const char *path, int nstates, int must_load)
+{
+  char msg[1024];
+  const int st = prru_model_load(&model, path, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    if (must_load) tu_check(0, msg, 0, 0);
+    return 0;
+  }
+  ref_params_of(model.mech, &P);
+  check_model(path, nstates);
+  prru_model_free(&model);
+  return 1;
+}
+
+/* No arguments: the build's model (specialised kernels), then every
+ * committed model file of the build's number of limbs loaded at run time
+ * (the parameter kernels where its numbers differ). Arguments: those
+ * model files (test_random_loaded.sh: random valid models). */
+int main(int argc, char **argv)
+{
+  gsl_set_error_handler_off();
+  W = prru_ref_alloc();
+  if (argc > 1) {
+    for (int i = 1; i < argc; i++) {
+      const int before = tu_failures;
+      check_file(argv[i], 6, 1);
+      if (tu_failures != before) printf("FAILED: %s\n", argv[i]);
+    }
+  } else {
+    prru_ref_params_default(&P);
+    prru_model_default(&model);
+    check_model("the build's model", 21);
+    const char *src = getenv("PRRU_SOURCE_DIR");
+    static const char *const files[] = {"3prru_paper.json", "prototype_drives.json",
+                                        "prototype_example.json", "4prru.json"};
+    int loaded = 0;
+    for (int i = 0; src && i < 4; i++) {
+      char path[2048];
+      snprintf(path, sizeof path, "%s/models/%s", src, files[i]);
+      loaded += check_file(path, 8, 0);
+    }
+    TU_TRUE(loaded >= (PRRU_NLIMB == 3 ? 3 : 1), "the committed models of the build's limbs (PRRU_SOURCE_DIR)");
+  }
+  prru_ref_free(W);
+  return tu_finish("test_derivs");
+}
