@@ -586,7 +586,8 @@ static int merge_map(shard_file *sh, char **paths, int n, const char *out)
     if (prru_cli_out_close(&o, ws == PRRU_OK && !o.err)) rc = 1;
     else if (ws != PRRU_OK) rc = prru_cli_exit_for(ws);
   }
-  if (!rc) prru_cli_map_print_summary(strcmp(out, "-") == 0 ? stderr : stdout, &sum, rcond);
+  const int precision = strstr(sh[0].kind_line, " precision=float") ? PRRU_PRECISION_FLOAT : PRRU_PRECISION_DOUBLE;
+  if (!rc) prru_cli_map_print_summary(strcmp(out, "-") == 0 ? stderr : stdout, &sum, rcond, precision);
   free(w);
   free(st);
   return rc;

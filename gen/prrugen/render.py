@@ -469,4 +469,44 @@ def render_float(model, deriv, templates_dir, prefix=None):
     for tmpl, out in (("float_kernels.h.in", "%s_kernels.h" % prefix),
                       ("float_kernels.c.in", "%s_kernels.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
+    files.update(_float_batch_files(model, kernels(deriv), templates_dir,
+                                    prefix, model_prefix))
     return files, emitted
+
+
+def float_batch(kernel_list, prefix, file_prefix=None):
+    """The emitted single-precision batched kernels (batch.FLOAT_FUSED: the
+    fused dme_terms) of kernel_list, named <prefix>_batch_<name>, their
+    macros carrying file_prefix (default prefix)."""
+    upper = (file_prefix or prefix).upper()
+    out = []
+    for k in batch.batch_kernels(kernel_list, (), batch.FLOAT_FUSED):
+        try:
+            out.append(batch.emit_batch(k, prefix, "%s_BATCH_LOOP" % upper,
+                                        "%s_BATCH_%%s" % upper, cgen.FLOAT))
+        except cgen.RangeError as exc:
+            exc.kernel = k.name
+            raise
+    return out
+
+
+def _float_batch_files(model, kernel_list, templates_dir, prefix,
+                       model_prefix):
+    """{name: text} of <prefix>_batch.{h,c}: the float batched kernels, in
+    files of their own so that a controller's build of <prefix>_kernels.c
+    carries none of them."""
+    emitted = float_batch(kernel_list, prefix)
+    upper = prefix.upper()
+    values = dict(banner=_banner(_head(model, "float"), emitted),
+                  prefix=prefix, PREFIX=upper, model_prefix=model_prefix,
+                  declarations="\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
+                                            for e in emitted),
+                  prologue=batch.float_prologue(prefix),
+                  functions="\n\n".join("%s_BATCH_TARGETS %s\n{\n%s\n}"
+                                         % (upper, e.signature, e.body)
+                                         for e in emitted))
+    files = {}
+    for tmpl, out in (("float_batch.h.in", "%s_batch.h" % prefix),
+                      ("float_batch.c.in", "%s_batch.c" % prefix)):
+        files[out] = _template(templates_dir, tmpl).substitute(values)
+    return files
