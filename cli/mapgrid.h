@@ -26,8 +26,8 @@
 
 /* The summary's line for --precision float (after the model's). */
 #define PRRU_CLI_PRECISION_FLOAT_LINE                                                           \
-  "precision: float (w_R from the single-precision batched kernels, within 1e-5 relative of "   \
-  "double where rcond(J_d) >= 1e-2; statuses decided in double)"
+  "precision: float (w_R from the single-precision batched kernels, relative error below "     \
+  "64 FLT_EPSILON w_R / rcond(J_d); statuses decided in double)"
 
 /* --NAME "START:STOP:COUNT": finite START < STOP, an integer 2 <= COUNT <=
  * 1e6. 0, or 2 after a message naming cmd and the option. */

@@ -49,6 +49,7 @@
 #include <stdio.h>
 
 #include "prru.h"
+#include "prru_f_batch.h"
 #include "prru_f_kernels.h"
 #include "prru_mechanism.h"
 #include "testutil.h"
@@ -70,6 +71,7 @@ enum {
 #else
   O_IT_TAU,
 #endif
+  O_B_D, O_B_J, O_B_M, O_B_JP,
   O_COUNT
 };
 static const char *names[O_COUNT] = {
@@ -81,6 +83,7 @@ static const char *names[O_COUNT] = {
 #else
   "inverse_terms tau",
 #endif
+  "batch d - scalar", "batch Jd - scalar", "batch M - scalar", "batch J_P",
 };
 static double worst_rel[O_COUNT], worst_terms[O_COUNT], worst_ratio[O_COUNT];
 static double L, Lgeo, W;
@@ -161,6 +164,40 @@ static void round_to_float(const double *x, float *f, double *d, int n)
     f[i] = (float)x[i];
     d[i] = (double)f[i];
   }
+}
+
+/* The float batched dme_terms (prru_f_batch_dme_terms, the maps'
+ * --precision float) at qf in every lane of a block of BL, so that the
+ * vector loops (and libmvec's vector sinf, cosf) run: d, J_d and M against
+ * the float scalar kernels (prru_f_ik_jd, prru_f_mass; both within K u S of
+ * double, so their difference is too: only sin and cos differ, by an ulp
+ * or so), J_P against double (no scalar float J_P), to the same bound.
+ * Lane 5's outputs (any lane: all are the same inputs). */
+#define BL 24
+static void check_batch(const float qf[3], const double JP[18], double nM, double nJ, double S_d,
+                        double nJP)
+{
+  static float q[3 * BL], d[NA * BL], J[3 * NA * BL], M[9 * BL], P[18 * BL];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < BL; k++) q[i * BL + k] = qf[i];
+  prru_f_batch_dme_terms(BL, q, d, J, M, P);
+  float db[NA], Jb[3 * NA], Mb[9], Pb[18], ds[NA], Js[3 * NA], Ms[9];
+  double dd[NA], Jdd[3 * NA], Md[9];
+  const int k = 5;
+  for (int i = 0; i < NA; i++) db[i] = d[i * BL + k];
+  for (int i = 0; i < 3 * NA; i++) Jb[i] = J[i * BL + k];
+  for (int i = 0; i < 9; i++) Mb[i] = M[i * BL + k];
+  for (int i = 0; i < 18; i++) Pb[i] = P[i * BL + k];
+  prru_f_ik_jd(qf, ds, Js);
+  prru_f_mass(qf, Ms);
+  to_double(ds, dd, NA);
+  to_double(Js, Jdd, 3 * NA);
+  to_double(Ms, Md, 9);
+  const double Dinv[3] = {1.0 / L, 1.0 / L, 1.0};
+  record(O_B_D, db, dd, NA, 1, NULL, NULL, S_d, 1.0);
+  record(O_B_J, Jb, Jdd, NA, 3, NULL, Dinv, nJ, 1.0);
+  record(O_B_M, Mb, Md, 3, 3, Dinv, Dinv, nM, 1.0);
+  record(O_B_JP, Pb, JP, 6, 3, NULL, Dinv, nJP, 1.0);
 }
 
 /* One state; 0 if no pose with rcond(J_d) >= RCOND_MIN was found. */
@@ -290,6 +327,7 @@ static int one_state(const prru_model *m, prru_data *dat)
 #endif
   record(O_IT_D, df, d, NA, 1, NULL, NULL, S_d, 1.0);
   record(O_IT_J, Jdf, Jd, NA, 3, NULL, Dinv, nJ, 1.0);
+  check_batch(qf, JP, nM, nJ, S_d, maxabs(JPs, 18));
   return 1;
 }
 

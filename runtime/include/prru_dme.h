@@ -192,8 +192,10 @@ typedef int (*prru_map_progress_fn)(long done, long total, void *ctx);
 
 /* The arithmetic of w_R in the maps and the optimiser. PRRU_PRECISION_FLOAT
  * runs the single-precision batched kernels (prru_f_batch_dme_terms, 8
- * poses a vector with AVX2) and the w_R stage in float: w_R within 1e-5
- * relative of double's where rcond(J_d) >= 1e-2, and every status (ok,
+ * poses a vector with AVX2) and the w_R stage in float: w_R within
+ * 64 FLT_EPSILON w_R / rcond(J_d) relative of double's (where rcond >=
+ * 1e-2, within 1e-5 but where w_R is large: up to 7e-5 measured at w_R
+ * 20; tests/test_map_batch.c), and every status (ok,
  * singular, unreachable, out of stroke, other mode) the double path's: a
  * pose whose float result is not clearly ok (docs/performance.md, "Single
  * precision") is evaluated again in double. Only the build's model has

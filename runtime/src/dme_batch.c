@@ -89,11 +89,12 @@ void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, c
  * norms in float add a few u more. RC_MARGIN = 1024 u (1.2e-4) covers
  * 3 x 16 u x a term sum up to 20 |J| with room to spare. The same margin
  * covers the mode (det J_d's sign): flipping it takes a perturbation
- * that makes J singular, i.e. of relative size rcond, and the reach: at
+ * that makes J singular, i.e. of relative size rcond; and the reach: at
  * the reach boundary an IK acos argument reaches +-1, where its
- * derivative, and so J_d, is unbounded (rcond -> 0). GAP_MARGIN: det S
- * and sb, computed from J_d^-1 (conditioning 1/rcond >= ... ) in float,
- * are trusted positive when they exceed 1024 u / rcond of their scale. */
+ * derivative, and so J_d, is unbounded (rcond -> 0). The DME's own tests
+ * (det S > 0, sb > 0, tests/test_map_batch.c's bound) take J_d^-1, whose
+ * relative error is kappa = 1/rcond times J_d's: their relative margins
+ * (ws->gap) must exceed RC_MARGIN / rcond. */
 #define RC_MARGIN (1024.0 * FLT_EPSILON)
 
 PRRU_BATCH_TARGETS

@@ -125,8 +125,8 @@ void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, c
                     double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
                     unsigned char *status, double *rcond, unsigned char *other);
 /* prru_dme_batch on float kernel outputs (prru_f_batch_dme_terms), in
- * float: w_R (within 1e-5 relative of the double path's where rcond(J_d) >=
- * 1e-2: tests/test_map_batch.c) and the status as float sees it; sure[k]
+ * float: w_R (within 64 FLT_EPSILON w_R / rcond(J_d) relative of the
+ * double path's: tests/test_map_batch.c) and the status as float sees it; sure[k]
  * is 1 where that status is certain to be the double path's: PRRU_OK with
  * rcond and the DME's tests clear of their thresholds by more than float's
  * error (dme_batch.c). Elsewhere the caller decides the status in double
