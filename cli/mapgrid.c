@@ -149,7 +149,7 @@ int prru_cli_parse_precision(const char *cmd, const char *text, const prru_model
     return 2;
   }
   if (prru_precision_available(m, p) != PRRU_OK) {
-    prru_cli_error(cmd, "--precision float: the model (%s) has no single-precision kernels: only the "
+    prru_cli_error(cmd, "--precision float: model %s has no single-precision kernels: only the "
                         "build's own model (PRRU_MODEL) is generated in float; a model file of other "
                         "numbers runs the run-time parameter kernels, in double (use --precision double, "
                         "or build prru with PRRU_MODEL set to this file)", prru_cli_model_id());
