@@ -26,8 +26,8 @@
 
 /* The summary's line for --precision float (after the model's). */
 #define PRRU_CLI_PRECISION_FLOAT_LINE                                                           \
-  "precision: float (w_R from the single-precision batched kernels, relative error below "     \
-  "64 FLT_EPSILON w_R / rcond(J_d); statuses decided in double)"
+  "precision: float (w_R computed in single precision, relative error below 64 x 2^-23 x w_R / " \
+  "rcond; statuses decided in double)"
 
 /* --NAME "START:STOP:COUNT": finite START < STOP, an integer 2 <= COUNT <=
  * 1e6. 0, or 2 after a message naming cmd and the option. */

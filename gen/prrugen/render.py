@@ -199,6 +199,12 @@ def render_params(model, pmodel, deriv, templates_dir, prefix=None):
                                prefix + "_param", prefix)
     decls += "\n\n" + bdecls
     bodies += "\n\n" + bbodies
+    # The optimiser's --precision float: the fused dme_terms in float,
+    # <prefix>_param_f_batch_dme_terms (the parameters converted once).
+    fdecls, fbodies = _float_param_batch(
+        params.param_kernels(deriv, pmodel, prefix), prefix)
+    decls += "\n\n" + fdecls
+    bodies += "\n\n" + fbodies
     values = dict(banner=banner, prefix=prefix, PREFIX=upper,
                   macros="\n".join(macros), declarations=decls,
                   functions=bodies, initializer=_initializer(model))
@@ -488,6 +494,21 @@ def float_batch(kernel_list, prefix, file_prefix=None):
             exc.kernel = k.name
             raise
     return out
+
+
+def _float_param_batch(kernel_list, prefix):
+    """(declarations, definitions) of the float batched kernels of the
+    parameter kernels, named <prefix>_param_f_batch_<name>, their macros
+    PREFIX_BATCH_* (the file's)."""
+    emitted = float_batch(kernel_list, prefix + "_param_f", prefix)
+    upper = prefix.upper()
+    decls = "\n\n".join("/* %s In single precision: %s_f_batch.h's "
+                         "conventions, parameters from *p (rounded to float "
+                         "once). */\n%s;" % (e.doc, prefix, e.signature)
+                         for e in emitted)
+    bodies = "\n\n".join("%s_BATCH_TARGETS %s\n{\n%s\n}"
+                          % (upper, e.signature, e.body) for e in emitted)
+    return decls, batch.float_prologue(prefix) + "\n\n" + bodies
 
 
 def _float_batch_files(model, kernel_list, templates_dir, prefix,

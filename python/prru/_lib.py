@@ -283,7 +283,7 @@ class Types:
         self.DesignProgress = ctypes.CFUNCTYPE(i, i, i, ctypes.POINTER(self.DesignEval), d, ctypes.c_void_p)
         self.DesignOptions = type("prru_design_options", (ctypes.Structure,), {"_fields_": [
             ("max_iter", i), ("tol", d), ("restarts", i), ("nthreads", i), ("progress", self.DesignProgress),
-            ("ctx", ctypes.c_void_p)]})
+            ("ctx", ctypes.c_void_p), ("precision", i)]})
         self.DesignResult = type("prru_design_result", (ctypes.Structure,), {"_fields_": [
             ("best", self.Params), ("start_eval", self.DesignEval), ("best_eval", self.DesignEval),
             ("x0", _arr(d, DESIGN_MAX_VARS)), ("x", _arr(d, DESIGN_MAX_VARS)), ("iterations", i),

@@ -729,6 +729,18 @@ class TestDesign(unittest.TestCase):
         after = float(re.search(r"^after_index: (\S+)", report, re.M).group(1))
         self.assertEqual(bits(d.best["index"]), bits(after))
         self.assertTrue(d.best["feasible"])
+        # precision="float" is prru optimize --precision float, bit for bit.
+        f = MODEL.optimize(["l2", "b12"], range=5, max_iter=40, precision="float", **grid)
+        with tempfile.TemporaryDirectory() as tmp:
+            rep = os.path.join(tmp, "rep")
+            cli("optimize", "--vars", "l2,b12", "--range", "5", "--q1", "-0.2:0.2:13", "--q2", "-0.25:0.15:11",
+                "--max-iter", "40", "--precision", "float", "--out", os.path.join(tmp, "o.json"), "--report", rep)
+            report = read(os.path.join(rep, "report.txt"))
+        self.assertIn("precision: float (", report)
+        after = float(re.search(r"^after_index: (\S+)", report, re.M).group(1))
+        self.assertEqual(bits(f.best["index"]), bits(after))
+        with self.assertRaisesRegex(ValueError, "precision must be 'double' or 'float', got 'single'"):
+            MODEL.optimize(["l2"], precision="single", **grid)
         with self.assertRaisesRegex(ValueError, r"vars\[0\]: "):
             MODEL.optimize(["no_such_thing"], **grid)
         with self.assertRaisesRegex(ValueError, "outside the bounds"):
