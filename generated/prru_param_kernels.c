@@ -18,7 +18,6 @@
  *   actuator_rates     198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
  *   passive            134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
-#include <float.h> /* FLT_MAX: the float batch's finiteness test */
 #include <math.h>
 
 #include "prru_param_kernels.h"
@@ -3385,9 +3384,9 @@ PRRU_BATCH_TARGETS void prru_param_f_batch_dme_terms(const prru_params *p, int n
       const int ok = islessequal(fabsf(t4 * t7), 1.0f) &
           islessequal(fabsf(t8 * t11), 1.0f) &
           islessequal(fabsf(-(t12 * t21)), 1.0f) &
-          islessequal(fabsf(q1), FLT_MAX) &
-          islessequal(fabsf(q2), FLT_MAX) &
-          islessequal(fabsf(q3), FLT_MAX);
+          islessequal(fabsf(q1), 3.4028235e+38f) &
+          islessequal(fabsf(q2), 3.4028235e+38f) &
+          islessequal(fabsf(q3), 3.4028235e+38f);
       d[i] = ok ? p_l1_0 * t26 + (q3 - t22 - t23) : NAN;
       d[s + i] = ok ? p_l1_1 * t31 + (t28 + (q3 + t27)) : NAN;
       d[2 * s + i] = ok ? p_l1_2 * t36 + (q3 - t33) : NAN;

@@ -135,7 +135,7 @@ static void threads_same_bits(void)
  * 4 L), as the runtime's margin). */
 static void float_evaluation(void)
 {
-  const prru_map_grid g = {-1.2, 1.2, -1.3, 1.3, 0.0, 47, 53};
+  const prru_map_grid g = {-1.55, 1.55, -1.55, 1.55, 0.0, 47, 53}; /* as test_map_batch's: every status */
   prru_design_problem pr;
   prru_design_problem_default(&pr, &g);
   prru_design_data a, b;

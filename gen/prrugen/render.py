@@ -480,7 +480,13 @@ def render_float(model, deriv, templates_dir, prefix=None):
     return files, emitted
 
 
-def float_batch(kernel_list, prefix, file_prefix=None):
+# FLOAT with FLT_MAX spelled as its value, for a file whose promise is to
+# depend on <math.h> alone (the parameter kernels').
+FLOAT_NO_FLOAT_H = cgen.Precision("float", cgen.c_float, "f",
+                                  cgen.c_float(repr(cgen.FLT_MAX)), "NAN")
+
+
+def float_batch(kernel_list, prefix, file_prefix=None, precision=cgen.FLOAT):
     """The emitted single-precision batched kernels (batch.FLOAT_FUSED: the
     fused dme_terms) of kernel_list, named <prefix>_batch_<name>, their
     macros carrying file_prefix (default prefix)."""
@@ -489,7 +495,7 @@ def float_batch(kernel_list, prefix, file_prefix=None):
     for k in batch.batch_kernels(kernel_list, (), batch.FLOAT_FUSED):
         try:
             out.append(batch.emit_batch(k, prefix, "%s_BATCH_LOOP" % upper,
-                                        "%s_BATCH_%%s" % upper, cgen.FLOAT))
+                                        "%s_BATCH_%%s" % upper, precision))
         except cgen.RangeError as exc:
             exc.kernel = k.name
             raise
@@ -500,7 +506,7 @@ def _float_param_batch(kernel_list, prefix):
     """(declarations, definitions) of the float batched kernels of the
     parameter kernels, named <prefix>_param_f_batch_<name>, their macros
     PREFIX_BATCH_* (the file's)."""
-    emitted = float_batch(kernel_list, prefix + "_param_f", prefix)
+    emitted = float_batch(kernel_list, prefix + "_param_f", prefix, FLOAT_NO_FLOAT_H)
     upper = prefix.upper()
     decls = "\n\n".join("/* %s In single precision: %s_f_batch.h's "
                          "conventions, parameters from *p (rounded to float "

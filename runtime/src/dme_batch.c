@@ -15,7 +15,12 @@
  * (GCC turns them into per-lane arrays it does not vectorise), so the
  * stages keep per-lane values in scalars or in the workspace's rows, and
  * small loops over matrix entries are unrolled inside the loop over
- * poses. */
+ * poses.
+ *
+ * The stages are written once over the type (dme_batch_stages.h) and
+ * instantiated in double (prru_dme_batch, as above) and float
+ * (prru_dme_batch_f, the maps' --precision float: not bit for bit, it
+ * says which statuses it is sure of). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
