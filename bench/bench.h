@@ -144,11 +144,17 @@ typedef struct {
 typedef struct {
   bench_stats specialised_ns, parameter_ns, ratio;
 } bench_path_row;
+/* Single against double precision (--precision float): ns per state of
+ * each, and per repetition double / float. */
+typedef struct {
+  bench_stats double_ns, float_ns, ratio;
+} bench_precision_row;
 typedef struct {
   bench_mode_row dynamics, forward, inverse;
   int paths_measured;             /* the model file loaded */
   bench_path_row path_forward, path_inverse;
   bench_batch_row batch_dynamics, batch_eom_solve, batch_dme_terms, batch_w_r;
+  bench_precision_row float_dme_terms, float_w_r;
   int ncpu, scaling_measured;
   double idle_second_core; /* of the second most idle CPU, just before */
   bench_stats scaling;     /* map: 1-thread time / 2-thread time */

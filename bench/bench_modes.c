@@ -21,6 +21,7 @@
 
 #include "bench.h"
 #include "prru_dme.h"
+#include "prru_f_batch.h"
 
 #define NB 1024   /* states per batched call */
 #define MAP_N 64  /* w_R grid: MAP_N x MAP_N */
@@ -256,6 +257,83 @@ static double run_map(bench_ctx *c, int threads, double *w, unsigned char *st)
   return run_map_n(c, MAP_N, threads, w, st);
 }
 
+/* ---- single against double precision ---- */
+
+#if defined(__GNUC__)
+static float soa_qf[3 * NB] __attribute__((aligned(64))), soa_outf[48 * NB] __attribute__((aligned(64)));
+#else
+static float soa_qf[3 * NB], soa_outf[48 * NB];
+#endif
+
+/* The batched dme_terms over the NB states, in float or double (the same
+ * target_clones: AVX2 on an AVX2 machine). ns per state; every output
+ * feeds the sink after the clock stops. */
+static double run_dme_terms(int single)
+{
+  const int nout = batch_nout[2];
+  double t0 = bench_now_ns();
+  if (single)
+    prru_f_batch_dme_terms(NB, soa_qf, soa_outf, soa_outf + PRRU_NACT * NB, soa_outf + 4 * PRRU_NACT * NB,
+                           soa_outf + (4 * PRRU_NACT + 9) * NB);
+  else
+    prru_batch_dme_terms(NB, soa.q, soa.out, soa.out + PRRU_NACT * NB, soa.out + 4 * PRRU_NACT * NB,
+                         soa.out + (4 * PRRU_NACT + 9) * NB);
+  double t = bench_now_ns() - t0;
+  double acc = 0.0;
+  if (single)
+    for (int i = 0; i < nout * NB; i++) acc += soa_outf[i];
+  else
+    acc = sum_out(nout * NB);
+  bench_sink = bench_sink + acc;
+  return t / NB;
+}
+
+/* w_R over an n x n grid, one thread, in the precision given: repetition
+ * `rep` picks one of three grids (fig. 7's rectangle, a wider one reaching
+ * the other assembly mode and the singular band, a higher q3), so that the
+ * inputs vary; the float run includes its points redone in double. ns per
+ * point. */
+static double run_map_precision(bench_ctx *c, int rep, int precision, double *w, unsigned char *st)
+{
+  static const double grids[3][5] = {{-PRRU_BENCH_PI / 6, PRRU_BENCH_PI / 6, -PRRU_BENCH_PI / 4,
+                                      PRRU_BENCH_PI / 4, 0.0},
+                                     {-0.9, 0.9, -0.9, 0.9, 0.0},
+                                     {-0.6, 0.6, -0.7, 0.5, 0.05}};
+  const double *r = grids[rep % 3];
+  const prru_map_grid g = {r[0], r[1], r[2], r[3], r[4], SCALE_N / 2, SCALE_N / 2};
+  prru_map_options o;
+  prru_map_options_default(&o);
+  o.nthreads = 1;
+  o.precision = precision;
+  double t0 = bench_now_ns(), acc = 0.0;
+  c->failures += prru_map_eval(&c->m, &g, &o, w, st, NULL) != PRRU_OK;
+  double t = bench_now_ns() - t0;
+  for (long k = 0; k < (long)g.n1 * g.n2; k++) acc += st[k] == PRRU_OK ? w[k] : (double)st[k];
+  bench_sink = bench_sink + acc;
+  return t / ((double)g.n1 * g.n2);
+}
+
+/* kind 0: the dme_terms kernels; 1: the map. Interleaved, medians. */
+static void time_precision(bench_ctx *c, int kind, int reps, bench_precision_row *r)
+{
+  double dn[MAXREPS], fn[MAXREPS], ratio[MAXREPS];
+  static double w[(SCALE_N / 2) * (SCALE_N / 2)];
+  static unsigned char st[(SCALE_N / 2) * (SCALE_N / 2)];
+  for (int i = 0; i < 3 * NB; i++) soa_qf[i] = (float)soa.q[i];
+  for (int i = -2; i < reps; i++) { /* two warm-up rounds */
+    const int rep = i < 0 ? 0 : i;
+    const double td = kind == 0 ? run_dme_terms(0) : run_map_precision(c, rep, PRRU_PRECISION_DOUBLE, w, st);
+    const double tf = kind == 0 ? run_dme_terms(1) : run_map_precision(c, rep, PRRU_PRECISION_FLOAT, w, st);
+    if (i < 0) continue;
+    dn[i] = td;
+    fn[i] = tf;
+    ratio[i] = td / tf;
+  }
+  r->double_ns = bench_stats_of(dn, reps);
+  r->float_ns = bench_stats_of(fn, reps);
+  r->ratio = bench_stats_of(ratio, reps);
+}
+
 static void time_batched(bench_ctx *c, int kind, int reps, bench_batch_row *r)
 {
   double b[MAXREPS], s[MAXREPS], ratio[MAXREPS];
@@ -347,6 +425,8 @@ void bench_modes_run(bench_ctx *c, int reps, int quick, bench_modes *m)
   time_batched(c, 1, reps, &m->batch_eom_solve);
   time_batched(c, 2, reps, &m->batch_dme_terms);
   time_batched(c, 3, reps, &m->batch_w_r);
+  time_precision(c, 0, reps, &m->float_dme_terms);
+  time_precision(c, 1, reps, &m->float_w_r);
   /* Thread scaling only with a second core idle (>= 90 %) just before. */
   m->idle_second_core = second_core_idle(quick ? 0.05 : 0.5, &m->ncpu);
   m->scaling_measured = m->ncpu > 1 && m->idle_second_core >= 0.9;
@@ -375,6 +455,13 @@ static void batch_row(const char *name, const bench_batch_row *r)
          r->speedup.max);
 }
 
+static void precision_row(const char *name, const bench_precision_row *r)
+{
+  printf("  %-17s %7.1f ns/state double, %7.1f float: %.2fx [%.2f-%.2f] (%.3g vs %.3g Mposes/s)\n", name,
+         r->double_ns.median, r->float_ns.median, r->ratio.median, r->ratio.min, r->ratio.max,
+         1e3 / r->double_ns.median, 1e3 / r->float_ns.median);
+}
+
 static void path_row(const char *name, const bench_path_row *r)
 {
   printf("  %-17s %7.1f ns specialised, %7.1f parameter: %.2fx [%.2f-%.2f]\n", name, r->specialised_ns.median,
@@ -399,6 +486,9 @@ void bench_modes_print_table(const bench_modes *m)
   batch_row("eom_solve", &m->batch_eom_solve);
   batch_row("dme_terms", &m->batch_dme_terms);
   batch_row("w_R (64x64 map)", &m->batch_w_r);
+  printf("single precision (--precision float) against double, one thread, the same clones:\n");
+  precision_row("dme_terms", &m->float_dme_terms);
+  precision_row("w_R (256x256 map)", &m->float_w_r);
   if (m->scaling_measured)
     printf("thread scaling (%dx%d map, 2 threads vs 1; a second core was %.0f %% idle): "
            "%.2fx [%.2f-%.2f]\n\n",
@@ -431,6 +521,14 @@ static void json_batch(const char *name, const bench_batch_row *r, int last)
   printf("}%s", last ? "" : ", ");
 }
 
+static void json_precision(const char *name, const bench_precision_row *r, int last)
+{
+  printf("\"%s\": {\"double_ns\": %.4g, \"float_ns\": %.4g, ", name, r->double_ns.median,
+         r->float_ns.median);
+  json_stats("double_over_float", &r->ratio);
+  printf("}%s", last ? "" : ", ");
+}
+
 static void json_path(const char *name, const bench_path_row *r, int last)
 {
   printf("\"%s\": {\"specialised_ns\": %.4g, \"parameter_ns\": %.4g, ", name, r->specialised_ns.median,
@@ -459,6 +557,9 @@ void bench_modes_print_json(const bench_modes *m)
   json_batch("eom_solve", &m->batch_eom_solve, 0);
   json_batch("dme_terms", &m->batch_dme_terms, 0);
   json_batch("w_r", &m->batch_w_r, 1);
+  printf("}, \"single_precision\": {");
+  json_precision("dme_terms", &m->float_dme_terms, 0);
+  json_precision("w_r", &m->float_w_r, 1);
   printf("}, \"thread_scaling\": ");
   if (m->scaling_measured) {
     printf("{\"second_core_idle\": %.3f, \"map_points\": %d, ", m->idle_second_core,

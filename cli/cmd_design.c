@@ -586,7 +586,8 @@ static int merge_map(shard_file *sh, char **paths, int n, const char *out)
     if (prru_cli_out_close(&o, ws == PRRU_OK && !o.err)) rc = 1;
     else if (ws != PRRU_OK) rc = prru_cli_exit_for(ws);
   }
-  if (!rc) prru_cli_map_print_summary(strcmp(out, "-") == 0 ? stderr : stdout, &sum, rcond);
+  const int precision = strstr(sh[0].kind_line, " precision=float") ? PRRU_PRECISION_FLOAT : PRRU_PRECISION_DOUBLE;
+  if (!rc) prru_cli_map_print_summary(strcmp(out, "-") == 0 ? stderr : stdout, &sum, rcond, precision);
   free(w);
   free(st);
   return rc;
@@ -746,7 +747,7 @@ static const char opt_help[] =
     "                     [--rcond-min R] [--stroke LO,HI|LO1,HI1,..] [--no-limits]\n"
     "                     [--force-max F] [--speed-max V] [--set NAME=VALUE,...]\n"
     "                     [--max-iter N] [--penalty W] [--name NAME] [--threads N]\n"
-    "                     [--progress] [--clip W]\n"
+    "                     [--progress] [--clip W] [--precision double|float]\n"
     "Chooses the design variables within their bounds so that the rotational\n"
     "dynamic manipulability w_R comes as close to 1 (isotropy) as it can over the\n"
     "workspace rectangle (grid as in 'prru map'), the paper's purpose for w_R.\n"
@@ -776,6 +777,10 @@ static const char opt_help[] =
     "at most N iterations in all (default 600); deterministic: the same command\n"
     "gives the same bits, whatever --threads (per evaluation, default 2).\n"
     "Progress on stderr (--progress, or a terminal).\n"
+    "--precision float: each evaluation's w_R and slider range computed in\n"
+    "single precision (as 'prru map --precision float': every point's status,\n"
+    "and the conditioning where it is penalised, are double's); the report and\n"
+    "the summary say so. Default double.\n"
     "Writes MODEL.json, the optimised design as a format-2 model file (name NAME,\n"
     "default the model's name + _opt), ready to build the tool and the dynamics\n"
     "code from ('make test MODEL=MODEL.json'), and DIR/ with report.txt (before\n"
@@ -910,6 +915,7 @@ typedef struct {
   const char *out, *name;
   const char *set;
   double clip; /* the maps' colour clip, NaN: the percentile */
+  int precision; /* of the evaluations (prru_design_options.precision) */
   const prru_limits *limits; /* the run's (optimize keeps the stroke) */
 } opt_report;
 
@@ -923,6 +929,7 @@ static int write_report(const char *path, const opt_report *rp)
   fprintf(f, "prru optimize: design optimisation of the rotational dynamic manipulability w_R\n");
   fprintf(f, "model: %s%s%s\n", prru_cli_model_id(), rp->set ? ", start changed by --set " : "",
           rp->set ? rp->set : "");
+  if (rp->precision == PRRU_PRECISION_FLOAT) fprintf(f, "%s\n", PRRU_CLI_PRECISION_FLOAT_LINE);
   fprintf(f, "workspace: q1 in [%.17g, %.17g] (%d points), q2 in [%.17g, %.17g] (%d points), q3 = %.17g m\n",
           g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3);
   fprintf(f, "regular: J_d's scaled rcond >= %g (cond_1 <= %g) at every grid point", pr->rcond_min,
@@ -1106,7 +1113,7 @@ int prru_cmd_optimize(int argc, char **argv)
   const char *cmd = "optimize";
   problem_text t = {0};
   const char *vars_s = NULL, *out = NULL, *report = NULL, *range = NULL, *iters = NULL, *pen = NULL,
-             *name_s = NULL, *ths = NULL, *clip_s = NULL;
+             *name_s = NULL, *ths = NULL, *clip_s = NULL, *prs = NULL;
   int help = 0, progress = 0;
   prru_cli_option opts[] = {
       {"vars", 1, &vars_s, NULL},      {"q1", 1, &t.q1, NULL},       {"q2", 1, &t.q2, NULL},
@@ -1115,7 +1122,7 @@ int prru_cmd_optimize(int argc, char **argv)
       {"rcond-min", 1, &t.rcond, NULL}, PRRU_CLI_LIMIT_OPTIONS(t.lim), {"set", 1, &t.set, NULL},
       {"max-iter", 1, &iters, NULL},   {"penalty", 1, &pen, NULL},   {"name", 1, &name_s, NULL},
       {"threads", 1, &ths, NULL},      {"progress", 0, NULL, &progress}, {"clip", 1, &clip_s, NULL},
-      {"help", 0, NULL, &help}};
+      {"help", 0, NULL, &help},        {"precision", 1, &prs, NULL}};
   if (prru_cli_parse(cmd, argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (help) {
     printf(opt_help);
@@ -1142,6 +1149,12 @@ int prru_cmd_optimize(int argc, char **argv)
   prru_design_options o;
   prru_design_options_default(&o);
   if (parse_threads(cmd, ths, &o.nthreads)) return 2;
+  /* Every model's design runs on the parameter kernels, which have a float
+   * batch: any precision named is available. */
+  if (prs && (o.precision = prru_precision_parse(prs)) < 0) {
+    prru_cli_error(cmd, "--precision '%s': must be double or float", prs);
+    return 2;
+  }
   if (iters) {
     char *end;
     long v = strtol(iters, &end, 10);
@@ -1243,7 +1256,7 @@ int prru_cmd_optimize(int argc, char **argv)
     free(text);
   }
   if (!rc) {
-    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip, &t.run};
+    opt_report rp = {&pr, vars, nvar, r, &start, out, name, t.set, clip, o.precision, &t.run};
     rc = stage_report(cmd, stage, report, &rp);
   }
   if (prru_cli_out_close(&jo, rc == 0 && !jo.err) && !rc) rc = 1;
@@ -1251,6 +1264,7 @@ int prru_cmd_optimize(int argc, char **argv)
   if (rc) remove_stage(stage);
   if (!rc) {
     printf("model: %s\n", prru_cli_model_id());
+    if (o.precision == PRRU_PRECISION_FLOAT) printf("%s\n", PRRU_CLI_PRECISION_FLOAT_LINE);
     report_eval_rows(stdout, &r->start_eval, &r->best_eval);
     for (int i = 0; i < nvar; i++)
       printf("%-12s %.10g -> %.10g  [%.10g, %.10g]\n", vars[i].name, r->x0[i], r->x[i], vars[i].lo, vars[i].hi);

@@ -13,7 +13,7 @@
 static const char map_help[] =
     "usage: prru map --q1 START:STOP:COUNT --q2 START:STOP:COUNT [--q3 Z]\n"
     "                --out FILE.csv|- [--rcond-min R] [--threads N] [--progress]\n"
-    "                [--shard K/N]\n"
+    "                [--shard K/N] [--precision double|float]\n"
     "w_R (see 'prru dme --help') at every grid point q1 = START..STOP (COUNT\n"
     "equally spaced values, rad, COUNT >= 2, START < STOP; START and STOP may be\n"
     "multiples of pi: -pi/6:pi/6:201), q2 likewise, q3 = Z (m, default 0).\n"
@@ -45,6 +45,13 @@ static const char map_help[] =
     "q1 rows computed so far are then written (a second signal stops that too,\n"
     "at a row boundary) and no summary is printed. A write error exits 1 with\n"
     "the reason and leaves FILE unchanged.\n"
+    "--precision float: w_R computed in single precision, 8 points a vector\n"
+    "with AVX2 (relative error below 64 x 2^-23 x w_R / rcond: 1e-5 at most\n"
+    "points with rcond >= 1e-2, up to 7e-5 where w_R ~ 20); every status is\n"
+    "still double's (a point single precision cannot decide surely is\n"
+    "evaluated again in double); the summary says so. Only the build's own\n"
+    "model has single-precision code: with --model FILE of other numbers it\n"
+    "exits 2. Default double.\n"
     "--shard K/N: only the K-th of N contiguous blocks of q1 rows (a cluster job\n"
     "array runs one block per task), with a second comment line naming the\n"
     "shard and the settings and no summary; 'prru merge' joins the N files into\n"
@@ -54,14 +61,14 @@ static const char map_help[] =
 int prru_cmd_map(int argc, char **argv)
 {
   const char *q1s = NULL, *q2s = NULL, *q3s = NULL, *out = NULL, *rcs = NULL, *ths = NULL;
-  const char *shs = NULL;
+  const char *shs = NULL, *prs = NULL;
   int help = 0, progress = 0;
   prru_cli_option opts[] = {{"q1", 1, &q1s, NULL},        {"q2", 1, &q2s, NULL},
                             {"q3", 1, &q3s, NULL},        {"out", 1, &out, NULL},
                             {"rcond-min", 1, &rcs, NULL}, {"threads", 1, &ths, NULL},
                             {"progress", 0, NULL, &progress}, {"help", 0, NULL, &help},
-                            {"shard", 1, &shs, NULL}};
-  if (prru_cli_parse("map", argc, argv, opts, 9)) return 2;
+                            {"shard", 1, &shs, NULL},     {"precision", 1, &prs, NULL}};
+  if (prru_cli_parse("map", argc, argv, opts, 10)) return 2;
   if (help) {
     printf(map_help, PRRU_NACT > 3 ? "(The test needs a square J_d: with more actuators than coordinates no\n"
                                    "point is other_mode.)\n" : "",
@@ -94,10 +101,12 @@ int prru_cmd_map(int argc, char **argv)
   prru_model m = *prru_cli_model();
   m.jd_rcond_min = PRRU_CLI_MAP_RCOND_MIN;
   if (prru_cli_parse_rcond("map", rcs, &m)) return 2;
+  int precision;
+  if (prru_cli_parse_precision("map", prs, &m, &precision)) return 2;
   if (shs) {
     int k, n;
     if (prru_cli_parse_shard("map", shs, &k, &n)) return 2;
-    return prru_cli_map_shard(&m, &g, nthreads, k, n, out);
+    return prru_cli_map_shard(&m, &g, nthreads, precision, k, n, out);
   }
   /* With the CSV on stdout the summary goes to stderr. */
   FILE *summary = strcmp(out, "-") == 0 ? stderr : stdout;
@@ -111,7 +120,7 @@ int prru_cmd_map(int argc, char **argv)
   double *w = NULL;
   unsigned char *st = NULL;
   prru_map_summary sum;
-  int rc = prru_cli_map_run("map", &m, &g, nthreads, &bar, &w, &st, &sum);
+  int rc = prru_cli_map_run("map", &m, &g, nthreads, precision, &bar, &w, &st, &sum);
   int nrows = rc == PRRU_OK ? g.n1 : rc == PRRU_EINTERRUPTED ? prru_cli_map_rows_done(&g, st) : 0;
   /* After a first signal the rows computed are still written; a later
    * one stops that too. */
@@ -132,7 +141,7 @@ int prru_cmd_map(int argc, char **argv)
   } else if (rc != PRRU_OK) {
     status = 1;
   } else {
-    prru_cli_map_print_summary(summary, &sum, m.jd_rcond_min);
+    prru_cli_map_print_summary(summary, &sum, m.jd_rcond_min, precision);
     status = 0;
   }
   free(w);

@@ -139,9 +139,30 @@ const char *prru_cli_map_parse_row(char *line, double q[3], double *w, int *stat
   return prru_parse_double(field[3], w) == PRRU_OK && *w >= 1.0 ? NULL : expected;
 }
 
-void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min)
+int prru_cli_parse_precision(const char *cmd, const char *text, const prru_model *m, int *precision)
+{
+  *precision = PRRU_PRECISION_DOUBLE;
+  if (!text) return 0;
+  const int p = prru_precision_parse(text);
+  if (p < 0) {
+    prru_cli_error(cmd, "--precision '%s': must be double or float", text);
+    return 2;
+  }
+  if (prru_precision_available(m, p) != PRRU_OK) {
+    prru_cli_error(cmd, "--precision float: model %s has no single-precision kernels: only the "
+                        "build's own model (PRRU_MODEL) is generated in float; a model file of other "
+                        "numbers runs the run-time parameter kernels, in double (use --precision double, "
+                        "or build prru with PRRU_MODEL set to this file)", prru_cli_model_id());
+    return 2;
+  }
+  *precision = p;
+  return 0;
+}
+
+void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min, int precision)
 {
   fprintf(f, "model: %s\n", prru_cli_model_id());
+  if (precision == PRRU_PRECISION_FLOAT) fprintf(f, "%s\n", PRRU_CLI_PRECISION_FLOAT_LINE);
   fprintf(f, "points: %ld (ok %ld, singular %ld, unreachable %ld, other assembly mode %ld; J_d "
              "singular below rcond %g)\n",
           s->n_points, s->n_ok, s->n_singular - s->n_other_mode, s->n_unreachable, s->n_other_mode,
@@ -156,7 +177,8 @@ void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond
 }
 
 int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
-                          int nthreads, prru_cli_progress *progress, double **w, unsigned char **st)
+                          int nthreads, int precision, prru_cli_progress *progress, double **w,
+                          unsigned char **st)
 {
   size_t n = (size_t)(r1 - r0) * (size_t)g->n2;
   *w = malloc(n * sizeof **w);
@@ -169,6 +191,7 @@ int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_g
   prru_map_options o;
   prru_map_options_default(&o);
   o.nthreads = nthreads;
+  o.precision = precision;
   if (progress && progress->mode != PRRU_PROGRESS_OFF) {
     o.progress = report_progress;
     o.ctx = progress;
@@ -186,10 +209,10 @@ int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_g
  * get to): PRRU_OK, PRRU_EINTERRUPTED (a signal: the rows done so far are
  * in w and st) or another status after a message. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
-                   prru_cli_progress *progress, double **w, unsigned char **st,
+                   int precision, prru_cli_progress *progress, double **w, unsigned char **st,
                    prru_map_summary *sum)
 {
-  int rc = prru_cli_map_run_rows(cmd, m, g, 0, g->n1, nthreads, progress, w, st);
+  int rc = prru_cli_map_run_rows(cmd, m, g, 0, g->n1, nthreads, precision, progress, w, st);
   if (rc == PRRU_OK) prru_map_summarize(g, *w, *st, sum);
   return rc;
 }

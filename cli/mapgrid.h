@@ -24,6 +24,11 @@
  * and the index converges. */
 #define PRRU_CLI_MAP_RCOND_MIN 4e-3
 
+/* The summary's line for --precision float (after the model's). */
+#define PRRU_CLI_PRECISION_FLOAT_LINE                                                           \
+  "precision: float (w_R computed in single precision, relative error below 64 x 2^-23 x w_R / " \
+  "rcond; statuses decided in double)"
+
 /* --NAME "START:STOP:COUNT": finite START < STOP, an integer 2 <= COUNT <=
  * 1e6. 0, or 2 after a message naming cmd and the option. */
 int prru_cli_parse_range(const char *cmd, const char *name, const char *text, double *lo, double *hi,
@@ -39,14 +44,20 @@ int prru_cli_parse_rcond(const char *cmd, const char *text, prru_model *m);
  * PRRU_EINTERRUPTED (the rows done so far are in w and st) or another
  * status after a message. The caller frees *w and *st. */
 int prru_cli_map_run(const char *cmd, const prru_model *m, const prru_map_grid *g, int nthreads,
-                     prru_cli_progress *progress, double **w, unsigned char **st,
+                     int precision, prru_cli_progress *progress, double **w, unsigned char **st,
                      prru_map_summary *sum);
 /* Only the q1 rows r0 .. r1 - 1 (a shard: `prru map --shard K/N`): *w and
  * *st hold (r1 - r0) n2 points from row r0's first, the values
  * prru_cli_map_run gives them; no summary (prru_map_summarize on the
- * joined shards: `prru merge`). Statuses as prru_cli_map_run. */
+ * joined shards: `prru merge`). Statuses as prru_cli_map_run. precision:
+ * prru_map_options.precision. */
 int prru_cli_map_run_rows(const char *cmd, const prru_model *m, const prru_map_grid *g, int r0, int r1,
-                          int nthreads, prru_cli_progress *progress, double **w, unsigned char **st);
+                          int nthreads, int precision, prru_cli_progress *progress, double **w,
+                          unsigned char **st);
+/* --precision double|float (text NULL: double) into *precision, checked
+ * against m (prru_precision_available). 0, or 2 after a message naming cmd,
+ * the option and the reason. */
+int prru_cli_parse_precision(const char *cmd, const char *text, const prru_model *m, int *precision);
 /* The number of complete q1 rows of an interrupted map (prru_map_eval
  * hands rows out in order and finishes every row it started). */
 int prru_cli_map_rows_done(const prru_map_grid *g, const unsigned char *st);
@@ -70,7 +81,8 @@ int prru_cli_map_write_rows(prru_cli_out *o, const prru_map_grid *g, const doubl
  * The one check of the rows that prru plot and prru merge read. */
 const char *prru_cli_map_parse_row(char *line, double q[3], double *w, int *status);
 /* The summary `prru map` prints: model, point counts, global index,
- * singular fraction, mean ln w_R, range (key: value lines). */
-void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min);
+ * singular fraction, mean ln w_R, range (key: value lines); with
+ * PRRU_PRECISION_FLOAT a precision line after the model's. */
+void prru_cli_map_print_summary(FILE *f, const prru_map_summary *s, double rcond_min, int precision);
 
 #endif

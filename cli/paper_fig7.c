@@ -113,14 +113,14 @@ int prru_paper_fig7(const char *stage, const char *outdir, FILE *summary, double
   double *w = NULL;
   unsigned char *st = NULL;
   prru_map_summary csum, csum_numeric;
-  int rc = fig7_status(prru_cli_map_run("paper", &m, &g, 2, NULL, &w, &st, &csum));
+  int rc = fig7_status(prru_cli_map_run("paper", &m, &g, 2, PRRU_PRECISION_DOUBLE, NULL, &w, &st, &csum));
   if (rc == 0) {
     /* The same grid at the numerical tolerance, for the summary only. */
     prru_model mn = m;
     mn.jd_rcond_min = rcond_numeric;
     double *w2 = NULL;
     unsigned char *st2 = NULL;
-    rc = fig7_status(prru_cli_map_run("paper", &mn, &g, 2, NULL, &w2, &st2, &csum_numeric));
+    rc = fig7_status(prru_cli_map_run("paper", &mn, &g, 2, PRRU_PRECISION_DOUBLE, NULL, &w2, &st2, &csum_numeric));
     free(w2);
     free(st2);
   }

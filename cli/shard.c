@@ -35,8 +35,8 @@ void prru_cli_shard_range(long count, int k, int n, long *begin, long *end)
   *end = count * k / n;
 }
 
-int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads, int k, int n,
-                       const char *out)
+int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads, int precision, int k,
+                       int n, const char *out)
 {
   long r0, r1;
   prru_cli_shard_range(g->n1, k, n, &r0, &r1);
@@ -47,11 +47,13 @@ int prru_cli_map_shard(const prru_model *m, const prru_map_grid *g, int nthreads
   unsigned char *st = NULL;
   /* More shards than rows leaves some empty: they still write their
    * header, so that every task of a job array succeeds alike. */
-  int rc = r0 < r1 ? prru_cli_map_run_rows("map", m, g, (int)r0, (int)r1, nthreads, NULL, &w, &st) : PRRU_OK;
+  int rc = r0 < r1 ? prru_cli_map_run_rows("map", m, g, (int)r0, (int)r1, nthreads, precision, NULL, &w, &st) : PRRU_OK;
   if (rc == PRRU_OK) {
     prru_cli_out_comment(&o);
-    prru_cli_out_printf(&o, "# shard %d/%d map q1=%.17g:%.17g:%d q2=%.17g:%.17g:%d q3=%.17g rcond_min=%.17g\n",
-                        k, n, g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3, m->jd_rcond_min);
+    /* The precision only where float (the double shards' line as before). */
+    prru_cli_out_printf(&o, "# shard %d/%d map q1=%.17g:%.17g:%d q2=%.17g:%.17g:%d q3=%.17g rcond_min=%.17g%s\n",
+                        k, n, g->q1_lo, g->q1_hi, g->n1, g->q2_lo, g->q2_hi, g->n2, g->q3, m->jd_rcond_min,
+                        precision == PRRU_PRECISION_FLOAT ? " precision=float" : "");
     prru_cli_out_line(&o);
     prru_cli_out_printf(&o, "q1,q2,q3,w_R,status\n");
     prru_cli_out_line(&o);

@@ -160,6 +160,9 @@ void prru_param_batch_eom(const prru_params *p, int n, const double *q, const do
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void prru_param_batch_dme_terms(const prru_params *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
 
+/* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. In single precision: prru_f_batch.h's conventions, parameters from *p (rounded to float once). */
+void prru_param_f_batch_dme_terms(const prru_params *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
+
 #ifdef __cplusplus
 }
 #endif

@@ -38,6 +38,16 @@ cmp -s <(sed 's|/o[12]/|/oX/|g' "$tmp/o1/stdout") <(sed 's|/o[12]/|/oX/|g' "$tmp
 [ -f "$tmp/o1/rep/optimize_maps.png" ] || ! command -v gnuplot >/dev/null && ok \
   || bad "optimize_maps.png missing although gnuplot is installed"
 ls "$tmp/o1" | grep -q partial && bad "a partial file or directory is left" || ok
+# --precision float: the report and stdout say so, the result is feasible;
+# another value exits 2.
+mkdir "$tmp/of"
+opt --precision float --out "$tmp/of/m.json" --report "$tmp/of/rep" >"$tmp/of/stdout" 2>"$tmp/of/stderr" \
+  || bad "optimize --precision float failed: $(head -c 400 "$tmp/of/stderr")"
+grep -q '^precision: float (' "$tmp/of/rep/report.txt" && grep -q '^precision: float (' "$tmp/of/stdout" \
+  && [ -f "$tmp/of/m.json" ] && ok || bad "optimize --precision float: no precision line or no model"
+! grep -q '^precision:' "$tmp/o1/rep/report.txt" && ok || bad "optimize (double): a precision line"
+expect 2 "--precision 'half': must be double or float" -- optimize --vars l2 --q1 "$Q1" --q2 "$Q2" \
+  --precision half --out "$tmp/of/x.json" --report "$tmp/of/xrep"
 # The model file: format 2, every key, what the generator accepts.
 jcheck "$tmp/o1/m.json" "d['format'] == 2 and d['name'] == '${model_name:0:12}_opt' and set(d) == {'format', 'name', 'description', 'gravity', 'geometry', 'bodies', 'actuators'} and len(d['geometry']['b']) == $nact and len(d['bodies']) == 1 + 3 * $nact and all(len(b['inertia']) == 6 and len(b['com']) == 3 for b in d['bodies'].values())" \
   "optimize: a complete format-2 model"

@@ -150,6 +150,47 @@ expect 2 "--q1 'pi/0:1:5': START 'pi/0' is not a finite number" -- map --q1 pi/0
 cmp -s "$tmp/p.csv" "$tmp/dash.csv" && cmp -s "$tmp/p.txt" "$tmp/dash.txt" && ok \
   || bad "map --out -: stdout is not the CSV or stderr not the summary: $(head -c 200 "$tmp/dash.txt")"
 
+# --precision float: every status the double map's (decided in double),
+# w_R within the derived bound 64 FLT_EPSILON w_R / rcond(J_d) relative
+# (test_map_batch.c), rcond >= the map's 4e-3 at every ok point: so
+# |w_f - w| / w <= 64 * 1.19e-7 * w / 4e-3 = 1.9e-3 w. The grid reaches
+# the singular band, the other mode and out of reach.
+"$PRRU" map --q1 -1.2:1.2:41 --q2 -1.3:1.3:37 --out "$tmp/md.csv" >"$tmp/md.txt" 2>&1 || bad "map (double) failed"
+"$PRRU" map --q1 -1.2:1.2:41 --q2 -1.3:1.3:37 --precision float --out "$tmp/mf.csv" >"$tmp/mf.txt" 2>&1 \
+  || bad "map --precision float failed: $(cat "$tmp/mf.txt")"
+r=$(python3 - "$tmp/md.csv" "$tmp/mf.csv" <<'PY'
+import sys
+rows = [[l.strip().split(",") for l in open(p) if not l.startswith("#")][1:] for p in sys.argv[1:3]]
+kinds = {r[4] for r in rows[0]}
+if not {"ok", "singular", "unreachable", "other_mode"} <= kinds:
+    print("the grid lacks a status: %s" % sorted(kinds)); sys.exit()
+for a, b in zip(*rows):
+    if a[:3] != b[:3] or a[4] != b[4]:
+        print("status differs at %s: %s vs %s" % (a[:2], a[4], b[4])); sys.exit()
+    if a[4] == "ok":
+        w, wf = float(a[3]), float(b[3])
+        if not abs(wf - w) / w <= 64 * 1.1920929e-07 * w / 4e-3:
+            print("w_R at %s: %r vs %r" % (a[:2], w, wf)); sys.exit()
+print("ok")
+PY
+)
+[ "$r" = ok ] && ok || bad "map --precision float against double: $r"
+grep -q '^precision: float (' "$tmp/mf.txt" && ok || bad "map --precision float: the summary does not say so: $(head -3 "$tmp/mf.txt")"
+! grep -q '^precision:' "$tmp/md.txt" && ok || bad "map (double): a precision line"
+"$PRRU" map --q1 -1.2:1.2:41 --q2 -1.3:1.3:37 --precision double --out "$tmp/mdd.csv" >/dev/null 2>&1 \
+  && cmp -s "$tmp/md.csv" "$tmp/mdd.csv" && ok || bad "map --precision double is not the default"
+# Shards in float: the settings line says so, and prru merge's summary too.
+for k in 1 2; do
+  "$PRRU" map --q1 -1.2:1.2:41 --q2 -1.3:1.3:37 --precision float --shard $k/2 --out "$tmp/fs$k.csv" \
+    >/dev/null 2>&1 || bad "map --precision float --shard $k/2 failed"
+done
+grep -q '^# shard 1/2 map .* precision=float$' "$tmp/fs1.csv" && ok || bad "float shard: settings line $(sed -n 2p "$tmp/fs1.csv")"
+"$PRRU" merge --in "$tmp/fs1.csv,$tmp/fs2.csv" --out "$tmp/fm.csv" >"$tmp/fm.txt" 2>&1 || bad "merge of float shards: $(cat "$tmp/fm.txt")"
+cmp -s "$tmp/fm.csv" "$tmp/mf.csv" && grep -q '^precision: float (' "$tmp/fm.txt" && ok \
+  || bad "merge of float shards: not the float map or no precision line: $(head -3 "$tmp/fm.txt")"
+expect 2 "--precision 'half': must be double or float" -- map --q1 0:1:5 --q2 0:1:5 --precision half --out "$tmp/x.csv"
+expect 2 "--precision '': must be double or float" -- map --q1 0:1:5 --q2 0:1:5 --precision "" --out "$tmp/x.csv"
+
 # Bad grids and arguments: exit 2, message naming the argument.
 q2ok="--q2 -0.5:0.5:11"
 expect 2 "--q1 '0:1:1': COUNT" -- map --q1 0:1:1 $q2ok --out "$tmp/x.csv"

@@ -57,6 +57,13 @@ PRRU_MODEL="$F" "$PRRU" eval --q "$q" --qd "$qd" --fd "$fd" >"$tmp/h4.json" || b
 cmp -s "$tmp/h1.json" "$tmp/h2.json" && cmp -s "$tmp/h1.json" "$tmp/h3.json" && cmp -s "$tmp/h1.json" "$tmp/h4.json" \
   && ok || bad "prru --model F eval, prru eval --model F, --model=F and PRRU_MODEL=F differ"
 # The option wins over the environment; an empty PRRU_MODEL is no model.
+# --precision float needs the float batched kernels, which only the
+# build's own numbers have: refused (exit 2, the reason) on the parameter
+# kernels, accepted on the whitespace copy (the specialised kernels).
+expect 2 "--precision float: model $model_name ($F, sha256 $heavy_sha, parameter kernels) has no single-precision kernels" \
+  -- --model "$F" map --q1 0:0.2:3 --q2 0:0.2:3 --precision float --out "$tmp/pf.csv"
+[ ! -e "$tmp/pf.csv" ] && ok || bad "a refused --precision float map wrote its output"
+expect 0 "" -- --model "$tmp/ws.json" map --q1 0:0.2:3 --q2 0:0.2:3 --precision float --out "$tmp/pf.csv"
 PRRU_MODEL="$tmp/ws.json" "$PRRU" --model "$F" eval --q "$q" --qd "$qd" --fd "$fd" >"$tmp/h5.json" \
   && cmp -s "$tmp/h1.json" "$tmp/h5.json" && ok || bad "--model does not win over PRRU_MODEL"
 PRRU_MODEL= "$PRRU" eval --q "$q" --qd "$qd" --fd "$fd" >"$tmp/e2.json" && cmp -s "$tmp/e0.json" "$tmp/e2.json" \

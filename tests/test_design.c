@@ -125,6 +125,53 @@ static void threads_same_bits(void)
   prru_design_data_free(&b);
 }
 
+/* prru_design_data.precision float (prru optimize --precision float): on
+ * a grid with every status and a stroke that cuts it, every status and the
+ * violations are the double evaluation's bit for bit (statuses decided in
+ * double, rcond and d double's wherever they are penalised: elsewhere both
+ * penalties are 0), w_R within test_map_batch.c's derived bound 64
+ * FLT_EPSILON w_R / rcond (rcond >= rcond_min at every ok point), the
+ * slider range within the float kernels' d error (256 FLT_EPSILON (|d| +
+ * 4 L), as the runtime's margin). */
+static void float_evaluation(void)
+{
+  const prru_map_grid g = {-1.55, 1.55, -1.55, 1.55, 0.0, 47, 53}; /* as test_map_batch's: every status */
+  prru_design_problem pr;
+  prru_design_problem_default(&pr, &g);
+  prru_design_data a, b;
+  prru_design_data_alloc(&a, &g);
+  prru_design_data_alloc(&b, &g);
+  prru_design_eval ea, eb;
+  prru_design_evaluate(&pr, &prru_params_model, &a, &ea);
+  pr.stroke = 1;
+  pr.stroke_lo = ea.d_min + 0.1 * (ea.d_max - ea.d_min);
+  pr.stroke_hi = ea.d_max - 0.1 * (ea.d_max - ea.d_min);
+  prru_design_evaluate(&pr, &prru_params_model, &a, &ea);
+  b.precision = PRRU_PRECISION_FLOAT;
+  prru_design_evaluate(&pr, &prru_params_model, &b, &eb);
+  int kinds[256] = {0}, w_ok = 1;
+  for (long k = 0; k < a.n; k++) {
+    kinds[a.status[k]] = 1;
+    if (a.status[k] == PRRU_OK &&
+        !(fabs(b.w_R[k] - a.w_R[k]) <= 64 * FLT_EPSILON * a.w_R[k] * a.w_R[k] / pr.rcond_min))
+      w_ok = 0;
+  }
+  TU_TRUE(kinds[PRRU_OK] && kinds[PRRU_ESINGULAR] && kinds[PRRU_EUNREACHABLE] &&
+              (PRRU_NACT != 3 || kinds[PRRU_DESIGN_OTHER_MODE]),
+          "float evaluation: the grid has every status");
+  TU_TRUE(memcmp(a.status, b.status, (size_t)a.n) == 0, "float evaluation: the statuses are double's");
+  TU_TRUE(ea.reg_violation == eb.reg_violation && ea.stroke_violation > 0 &&
+              ea.stroke_violation == eb.stroke_violation && ea.feasible == eb.feasible,
+          "float evaluation: the violations are double's, bit for bit");
+  TU_TRUE(w_ok, "float evaluation: w_R within 64 FLT_EPSILON w_R / rcond of double's");
+  const double L = prru_design_length_scale(&prru_params_model);
+  TU_TRUE(fabs(eb.d_min - ea.d_min) <= 256 * FLT_EPSILON * (fabs(ea.d_min) + 4 * L) &&
+              fabs(eb.d_max - ea.d_max) <= 256 * FLT_EPSILON * (fabs(ea.d_max) + 4 * L),
+          "float evaluation: the slider range within float's error");
+  prru_design_data_free(&a);
+  prru_design_data_free(&b);
+}
+
 static void stroke_limits(void)
 {
   prru_design_problem pr;
@@ -440,6 +487,7 @@ int main(void)
 {
   objective_equals_map();
   threads_same_bits();
+  float_evaluation();
   stroke_limits();
   sensitivity_two_steps();
   variables();

@@ -10,7 +10,7 @@
 # The single-precision controller set (gen/prru_gen.py --precision float,
 # prru_f_*) is generated here from the paper's model (it is not committed)
 # and built the same ways with tests/dropin_float_main.c, linked beside the
-# double set in one program.
+# double set in one program, with the float batches (prru_f_batch.c).
 #
 # A missing clang or g++ is reported as SKIPPED (nothing is installed here);
 # set PRRU_DROPIN_REQUIRE_ALL=1 (CI does) to make a skipped compiler a failure.
@@ -38,6 +38,7 @@ for f in ./*.c ./*.h; do
   allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"|"prru_p[34]_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   case "$f" in ./prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"prru_f_kernels\.h"' ;; esac
+  case "$f" in ./prru_f_batch.*) allowed='<math\.h>|<float\.h>|"prru_f_batch\.h"' ;; esac
   [ "$f" = ./float_main.c ] && allowed='<math\.h>|<stdio\.h>|"prru_kernels\.h"|"prru_f_kernels\.h"'
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then
@@ -48,14 +49,14 @@ for f in ./*.c ./*.h; do
 done
 
 # Single precision throughout: no double in the float set's text at all.
-if grep -nw double prru_f_kernels.c prru_f_kernels.h; then
+if grep -nw double prru_f_kernels.c prru_f_kernels.h prru_f_batch.c prru_f_batch.h; then
   echo "FAIL: the float set names double (above)"
   fail=1
 fi
 
 kernels=()
 for f in ./*.c; do
-  case "$f" in ./main.c | ./float_main.c | ./prru_f_kernels.c) ;; *) kernels+=("$f") ;; esac
+  case "$f" in ./main.c | ./float_main.c | ./prru_f_kernels.c | ./prru_f_batch.c) ;; *) kernels+=("$f") ;; esac
 done
 
 build_and_run() { # label compiler args...
@@ -68,8 +69,9 @@ build_and_run_main() { # main label compiler args...
   shift 3
   local sources=("${kernels[@]}")
   # The float program needs only the two controller sets (the rest of
-  # generated/ is built with main.c already).
-  [ "$main" = float_main.c ] && sources=(./prru_kernels.c ./prru_f_kernels.c)
+  # generated/ is built with main.c already), and the float batches (the
+  # maps' --precision float) are built with it under the same flags.
+  [ "$main" = float_main.c ] && sources=(./prru_kernels.c ./prru_f_kernels.c ./prru_f_batch.c)
   if ! command -v "$cc" >/dev/null 2>&1; then
     echo "SKIPPED $label: $cc not installed"
     skipped+=("$label")

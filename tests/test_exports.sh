@@ -37,6 +37,14 @@ if [ -n "$missing" ]; then
   echo "FAIL: declared PRRU_API (or generated) but not exported:"; echo "$missing" | sed 's/^/  /'
   fails=1
 fi
+# A declaration of the API without PRRU_API would be hidden from the
+# shared library: every function a public header declares at the start of
+# a line carries it.
+bare=$(grep -n '^[a-z][a-z0-9_ ]*[ *]prru_[a-z0-9_]*(' "$PRRU_SOURCE_DIR"/runtime/include/*.h | grep -v ':typedef ')
+if [ -n "$bare" ]; then
+  echo "FAIL: public declarations without PRRU_API:"; echo "$bare" | sed 's/^/  /'
+  fails=1
+fi
 # The check itself must see something: the API and the hidden helpers.
 napi=$(wc -l <"$tmp/api")
 if [ "$napi" -lt 100 ]; then echo "FAIL: only $napi PRRU_API declarations found"; fails=1; fi

@@ -67,6 +67,7 @@
 
 #include "mcu_ctl.h"
 #include "prru.h"
+#include "prru_f_batch.h"
 #include "prru_f_kernels.h"
 #include "prru_mechanism.h"
 #include "testutil.h"
@@ -88,6 +89,7 @@ enum {
 #else
   O_IT_TAU,
 #endif
+  O_B_D, O_B_J, O_B_M, O_B_JP,
   O_COUNT
 };
 static const char *names[O_COUNT] = {
@@ -99,6 +101,7 @@ static const char *names[O_COUNT] = {
 #else
   "inverse_terms tau",
 #endif
+  "batch d - scalar", "batch Jd - scalar", "batch M - scalar", "batch J_P",
 };
 /* Table 0: the float outputs against the double kernels; table 1 (--mcu):
  * the firmware's against this host's float kernels. */
@@ -218,6 +221,40 @@ static double principal_permanent(const double M[9], int k)
     for (int s = 0; s < 6; s++) best += fabs(M[p[s][0]]) * fabs(M[3 + p[s][1]]) * fabs(M[6 + p[s][2]]);
   }
   return best;
+}
+
+/* The float batched dme_terms (prru_f_batch_dme_terms, the maps'
+ * --precision float) at qf in every lane of a block of BL, so that the
+ * vector loops (and libmvec's vector sinf, cosf) run: d, J_d and M against
+ * the float scalar kernels (prru_f_ik_jd, prru_f_mass; both within K u S of
+ * double, so their difference is too: only sin and cos differ, by an ulp
+ * or so), J_P against double (no scalar float J_P), to the same bound.
+ * Lane 5's outputs (any lane: all are the same inputs). */
+#define BL 24
+static void check_batch(const float qf[3], const double JP[18], double nM, double nJ, double S_d,
+                        double nJP)
+{
+  static float q[3 * BL], d[NA * BL], J[3 * NA * BL], M[9 * BL], P[18 * BL];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < BL; k++) q[i * BL + k] = qf[i];
+  prru_f_batch_dme_terms(BL, q, d, J, M, P);
+  float db[NA], Jb[3 * NA], Mb[9], Pb[18], ds[NA], Js[3 * NA], Ms[9];
+  double dd[NA], Jdd[3 * NA], Md[9];
+  const int k = 5;
+  for (int i = 0; i < NA; i++) db[i] = d[i * BL + k];
+  for (int i = 0; i < 3 * NA; i++) Jb[i] = J[i * BL + k];
+  for (int i = 0; i < 9; i++) Mb[i] = M[i * BL + k];
+  for (int i = 0; i < 18; i++) Pb[i] = P[i * BL + k];
+  prru_f_ik_jd(qf, ds, Js);
+  prru_f_mass(qf, Ms);
+  to_double(ds, dd, NA);
+  to_double(Js, Jdd, 3 * NA);
+  to_double(Ms, Md, 9);
+  const double Dinv[3] = {1.0 / L, 1.0 / L, 1.0};
+  record(O_B_D, db, dd, NA, 1, NULL, NULL, S_d, 1.0);
+  record(O_B_J, Jb, Jdd, NA, 3, NULL, Dinv, nJ, 1.0);
+  record(O_B_M, Mb, Md, 3, 3, Dinv, Dinv, nM, 1.0);
+  record(O_B_JP, Pb, JP, 6, 3, NULL, Dinv, nJP, 1.0);
 }
 
 /* One state drawn into x; 0 if no pose with rcond(J_d) >= RCOND_MIN was
@@ -359,6 +396,7 @@ static void check_state(const mcu_in *x, double rcond)
 #endif
   record_ctl(O_IT_D, FIELD(it_d), d, NA, 1, NULL, NULL, S_d, 1.0);
   record_ctl(O_IT_J, FIELD(it_J), Jd, NA, 3, NULL, Dinv, nJ, 1.0);
+  if (!mcu) check_batch(qf, JP, nM, nJ, S_d, maxabs(JPs, 18));
 }
 
 /* Where the double kernels make every output NaN (q unreachable or not

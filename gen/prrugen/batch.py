@@ -73,13 +73,24 @@ def _is_input_trig(n):
 VECTOR_CALLS = ("tanh",)
 
 
-def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
+def emit_batch(kernel, prefix, loop_macro, vector_trig="%s",
+               precision=cgen.DOUBLE):
     """cgen.Emitted for the batched variant of kernel, named
     <prefix>_batch_<name>. vector_trig % "SIN" is the name of the sin the
     vectorisable kernels call (kernels in EXACT call sin itself), likewise
-    for the VECTOR_CALLS."""
-    trig_name = (lambda fn: fn) if kernel.name in EXACT else \
-        (lambda fn: vector_trig % fn.upper())
+    for the VECTOR_CALLS. precision cgen.FLOAT spells it in float (float
+    literals, sinf, sqrtf, ...; vector_trig % "SINF" for every kernel: the
+    float batches are not held to the scalar kernels bit for bit)."""
+    single = precision is not cgen.DOUBLE
+    if single:
+        trig_name = lambda fn: vector_trig % (fn.upper() + "F")
+    elif kernel.name in EXACT:
+        trig_name = lambda fn: fn
+    else:
+        trig_name = lambda fn: vector_trig % fn.upper()
+    real = precision.ctype
+    lit = precision.literal if single else (lambda text: text)
+    call = precision.call if single else None
     params = kernel.params
     low = cgen.Lowered(kernel)
     names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
@@ -92,8 +103,10 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     temp = {}
 
     def expr(n, parent_prec=0, right=False):
-        if n.op in ("in", "num"):
+        if n.op == "in":
             return n.args[0]
+        if n.op == "num":
+            return lit(n.args[0])
         if n.index in temp:
             return temp[n.index]
         return inline(n, parent_prec, right)
@@ -101,7 +114,7 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     def inline(n, parent_prec=0, right=False):
         if n.op == "call" and n.args[0] in VECTOR_CALLS:
             return "%s(%s)" % (trig_name(n.args[0]), expr(n.args[1]))
-        return cgen.print_op(n, expr, parent_prec, right)
+        return cgen.print_op(n, expr, parent_prec, right, call)
 
     used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
     trig = [g.nodes[i] for i in sorted(live) if _is_input_trig(g.nodes[i])]
@@ -116,11 +129,14 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
         arr, i = row[name]
         at = index if i == 0 else "%d * s + %s" % (i, index) if i > 1 \
             else "s + " + index
-        return "const double %s = %s[%s];" % (name, arr, at)
+        return "const %s %s = %s[%s];" % (real, name, arr, at)
 
     lines = []
     if params is not None:
-        lines += ["const double %s = %s;" % (params.local(s), params.access(s))
+        # A float batch converts each parameter once, explicitly.
+        cast = "(float)" if single else ""
+        lines += ["const %s %s = %s%s;" % (real, params.local(s), cast,
+                                           params.access(s))
                   for s in params.order if params.local(s) in used_inputs]
     lines.append("const long s = n;")
     lines.append("for (long k0 = 0; k0 < s; k0 += %d) {" % BATCH_CHUNK)
@@ -128,8 +144,8 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
                  % (BATCH_CHUNK, BATCH_CHUNK))
     body = []
     if trig:
-        body.append("double %s;" % ", ".join("w%d[%d]" % (j, BATCH_CHUNK)
-                                              for j in range(len(trig))))
+        body.append("%s %s;" % (real, ", ".join("w%d[%d]" % (j, BATCH_CHUNK)
+                                              for j in range(len(trig)))))
         # One loop per function: sin and cos of one argument in one loop
         # would be merged into a sincos call, which has no vector variant.
         for fn in ("cos", "sin"):
@@ -156,12 +172,13 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
         if i in temp or not materialized(n):
             continue
         name = "t%d" % len(temp)
-        inner.append("const double %s = %s;" % (name, inline(n)))
+        inner.append("const %s %s = %s;" % (real, name, inline(n)))
         temp[i] = name
     if guard_nodes:
-        conds = ["islessequal(fabs(%s), 1.0)" % expr(n)
+        fabs = precision.call("fabs")
+        conds = ["islessequal(%s(%s), %s)" % (fabs, expr(n), lit("1.0"))
                  for n in guard_nodes]
-        conds += ["islessequal(fabs(%s), 1.7976931348623157e308)" % expr(n)
+        conds += ["islessequal(%s(%s), %s)" % (fabs, expr(n), precision.huge)
                   for n in finite_nodes]
         inner.append("/* Unreachable or non-finite q: NaN (a select, not a "
                      "branch). */")
@@ -169,7 +186,8 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     calls = any(g.nodes[i].op == "call" and g.nodes[i].args[0] != "sqrt"
                 and not _is_input_trig(g.nodes[i]) for i in live)
     if guard_nodes and calls:
-        inner.append("const double okf = ok ? 1.0 : (double)NAN;")
+        inner.append("const %s okf = ok ? %s : %s;"
+                     % (real, lit("1.0"), precision.nan))
     for arr, ns in out_nodes:
         for j, n in enumerate(ns):
             at = "i" if j == 0 else "s + i" if j == 1 else "%d * s + i" % j
@@ -177,7 +195,7 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
             if guard_nodes and calls:
                 value = "%s * okf" % expr(n, cgen.PREC["mul"])
             elif guard_nodes:
-                value = "ok ? %s : (double)NAN" % value
+                value = "ok ? %s : %s" % (value, precision.nan)
             inner.append("%s[%s] = %s;" % (arr, at, value))
     body += ["  " + l.replace("\n", "\n  ") for l in inner]
     body.append("}")
@@ -187,8 +205,8 @@ def emit_batch(kernel, prefix, loop_macro, vector_trig="%s"):
     if params is not None:
         args.append("const %s *p" % params.ctype)
     args.append("int n")
-    args += ["const double *%s" % arr for arr, _ in kernel.inputs]
-    args += ["double *%s" % arr for arr, _ in out_nodes]
+    args += ["const %s *%s" % (real, arr) for arr, _ in kernel.inputs]
+    args += ["%s *%s" % (real, arr) for arr, _ in out_nodes]
     unused = [arr for arr, syms in kernel.inputs
               if not any(("%s%d" % (arr, i + 1)) in used_inputs
                          for i in range(len(syms)))]
@@ -232,6 +250,42 @@ extern double ${prefix}_batch_vtanh(double) __asm__("tanh") __attribute__((const
 #define ${PREFIX}_BATCH_COS cos
 #define ${PREFIX}_BATCH_TANH tanh
 #endif"""
+
+
+FLOAT_PROLOGUE = """/* Single-precision batched kernels. ${PREFIX}_BATCH_LOOP and
+ * ${PREFIX}_BATCH_TARGETS as for the other batched kernels. With
+ * ${PREFIX}_BATCH_VECTOR_MATH defined (GCC), ${PREFIX}_BATCH_SINF and _COSF
+ * are sinf and cosf declared as having vector variants (glibc's libmvec:
+ * 8 lanes with AVX2, _ZGVdN8v_sinf), within a few units in the last place
+ * of the scalar functions; every float batch calls them, so it agrees with
+ * the scalar float kernels within their accuracy bound, not bit for bit. */
+#ifndef ${PREFIX}_BATCH_LOOP
+#define ${PREFIX}_BATCH_LOOP
+#endif
+#ifndef ${PREFIX}_BATCH_TARGETS
+#define ${PREFIX}_BATCH_TARGETS
+#endif
+#if defined(${PREFIX}_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern float ${prefix}_batch_vsinf(float) __asm__("sinf");
+#pragma omp declare simd notinbranch
+extern float ${prefix}_batch_vcosf(float) __asm__("cosf");
+#define ${PREFIX}_BATCH_SINF ${prefix}_batch_vsinf
+#define ${PREFIX}_BATCH_COSF ${prefix}_batch_vcosf
+#else
+#define ${PREFIX}_BATCH_SINF sinf
+#define ${PREFIX}_BATCH_COSF cosf
+#endif"""
+
+# The kernels of the single-precision batch set: only the fused one the
+# maps and the optimiser need.
+FLOAT_FUSED = FUSED
+
+
+def float_prologue(prefix):
+    """Macros the float batched kernels' definitions need."""
+    return FLOAT_PROLOGUE.replace("${PREFIX}", prefix.upper()).replace(
+        "${prefix}", prefix)
 
 
 def prologue(prefix):

@@ -218,6 +218,12 @@ def render_params(model, pmodel, deriv, templates_dir, prefix=None):
                                prefix + "_param", prefix)
     decls += "\n\n" + bdecls
     bodies += "\n\n" + bbodies
+    # The optimiser's --precision float: the fused dme_terms in float,
+    # <prefix>_param_f_batch_dme_terms (the parameters converted once).
+    fdecls, fbodies = _float_param_batch(
+        params.param_kernels(deriv, pmodel, prefix), prefix)
+    decls += "\n\n" + fdecls
+    bodies += "\n\n" + fbodies
     values = dict(banner=banner, prefix=prefix, PREFIX=upper,
                   macros="\n".join(macros), declarations=decls,
                   functions=bodies, designate=DESIGNATE_MACRO,
@@ -494,4 +500,65 @@ def render_float(model, deriv, templates_dir, prefix=None):
     for tmpl, out in (("float_kernels.h.in", "%s_kernels.h" % prefix),
                       ("float_kernels.c.in", "%s_kernels.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
+    files.update(_float_batch_files(model, kernels(deriv), templates_dir,
+                                    prefix, model_prefix))
     return files, emitted
+
+
+# FLOAT with FLT_MAX spelled as its value, for a file whose promise is to
+# depend on <math.h> alone (the parameter kernels').
+FLOAT_NO_FLOAT_H = cgen.Precision("float", cgen.c_float, "f",
+                                  cgen.c_float(repr(cgen.FLT_MAX)), "NAN")
+
+
+def float_batch(kernel_list, prefix, file_prefix=None, precision=cgen.FLOAT):
+    """The emitted single-precision batched kernels (batch.FLOAT_FUSED: the
+    fused dme_terms) of kernel_list, named <prefix>_batch_<name>, their
+    macros carrying file_prefix (default prefix)."""
+    upper = (file_prefix or prefix).upper()
+    out = []
+    for k in batch.batch_kernels(kernel_list, (), batch.FLOAT_FUSED):
+        try:
+            out.append(batch.emit_batch(k, prefix, "%s_BATCH_LOOP" % upper,
+                                        "%s_BATCH_%%s" % upper, precision))
+        except cgen.RangeError as exc:
+            exc.kernel = k.name
+            raise
+    return out
+
+
+def _float_param_batch(kernel_list, prefix):
+    """(declarations, definitions) of the float batched kernels of the
+    parameter kernels, named <prefix>_param_f_batch_<name>, their macros
+    PREFIX_BATCH_* (the file's)."""
+    emitted = float_batch(kernel_list, prefix + "_param_f", prefix, FLOAT_NO_FLOAT_H)
+    upper = prefix.upper()
+    decls = "\n\n".join("/* %s In single precision: %s_f_batch.h's "
+                         "conventions, parameters from *p (rounded to float "
+                         "once). */\n%s;" % (e.doc, prefix, e.signature)
+                         for e in emitted)
+    bodies = "\n\n".join("%s_BATCH_TARGETS %s\n{\n%s\n}"
+                          % (upper, e.signature, e.body) for e in emitted)
+    return decls, batch.float_prologue(prefix) + "\n\n" + bodies
+
+
+def _float_batch_files(model, kernel_list, templates_dir, prefix,
+                       model_prefix):
+    """{name: text} of <prefix>_batch.{h,c}: the float batched kernels, in
+    files of their own so that a controller's build of <prefix>_kernels.c
+    carries none of them."""
+    emitted = float_batch(kernel_list, prefix)
+    upper = prefix.upper()
+    values = dict(banner=_banner(_head(model, "float"), emitted),
+                  prefix=prefix, PREFIX=upper, model_prefix=model_prefix,
+                  declarations="\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
+                                            for e in emitted),
+                  prologue=batch.float_prologue(prefix),
+                  functions="\n\n".join("%s_BATCH_TARGETS %s\n{\n%s\n}"
+                                         % (upper, e.signature, e.body)
+                                         for e in emitted))
+    files = {}
+    for tmpl, out in (("float_batch.h.in", "%s_batch.h" % prefix),
+                      ("float_batch.c.in", "%s_batch.c" % prefix)):
+        files[out] = _template(templates_dir, tmpl).substitute(values)
+    return files

@@ -9,7 +9,7 @@ import sys
 import tempfile
 import unittest
 
-from prrugen import cgen, dynamics, mechanism, model, render, sym
+from prrugen import batch, cgen, dynamics, mechanism, model, render, sym
 from prrugen.kernels import kernels
 
 GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -78,6 +78,34 @@ class SameGraph(unittest.TestCase):
                 self.assertNotRegex(f.body + f.signature, r"\bdouble\b")
 
 
+class FloatBatch(unittest.TestCase):
+    """The float batched dme_terms is the double one's graph respelled,
+    with the vector sinf and cosf (the double one calls sin and cos
+    themselves, to agree with the scalar kernels bit for bit), and the
+    double batches are spelled as before."""
+
+    @classmethod
+    def setUpClass(cls):
+        sym.reset()
+        m = model.load(MODEL)
+        cls.kernels = kernels(dynamics.Derivation(mechanism.build(m), m))
+
+    def test_float_batch_is_the_double_batch_respelled(self):
+        emitted = render.float_batch(self.kernels, "prru_f")
+        self.assertEqual([e.name for e in emitted], ["dme_terms"])
+        fused = batch.batch_kernels(self.kernels, (), batch.FUSED)[0]
+        d = batch.emit_batch(fused, "prru", "PRRU_BATCH_LOOP", "PRRU_BATCH_%s")
+        f = emitted[0]
+        expected = as_float(d.body).replace("PRRU_BATCH_LOOP", "PRRU_F_BATCH_LOOP")
+        expected = re.sub(r"\b(sin|cos)f\(", lambda x: "PRRU_F_BATCH_%sF(" % x.group(1).upper(),
+                          expected)
+        self.assertEqual(f.body, expected)
+        self.assertEqual(f.signature, as_float(d.signature).replace("prru_", "prru_f_", 1))
+        self.assertEqual(f.counts, d.counts)
+        self.assertNotRegex(f.body + f.signature, r"\bdouble\b")
+        self.assertIn("PRRU_F_BATCH_SINF(", f.body)
+
+
 class FloatFiles(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -85,7 +113,8 @@ class FloatFiles(unittest.TestCase):
         cls.files, cls.emitted = prru_gen.generate_float(cls.model, prefix="prru")
 
     def test_names_and_no_double(self):
-        self.assertEqual(sorted(self.files), ["prru_f_kernels.c", "prru_f_kernels.h"])
+        self.assertEqual(sorted(self.files), ["prru_f_batch.c", "prru_f_batch.h",
+                                              "prru_f_kernels.c", "prru_f_kernels.h"])
         for name, text in self.files.items():
             self.assertNotRegex(text, r"\bdouble\b", name)
             for fn in re.findall(r"^void (\w+)\(", text, re.M):
@@ -127,7 +156,8 @@ class CommandLine(unittest.TestCase):
                                capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertEqual(sorted(os.listdir(tmp)),
-                             ["prru_f_kernels.c", "prru_f_kernels.h"])
+                             ["prru_f_batch.c", "prru_f_batch.h",
+                              "prru_f_kernels.c", "prru_f_kernels.h"])
 
 
 if __name__ == "__main__":

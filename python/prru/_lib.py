@@ -84,7 +84,7 @@ MAP_PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_long, ctypes.c_long, c
 class _MapOptions(ctypes.Structure):
     # volatile sig_atomic_t is int with glibc on every Linux ABI.
     _fields_ = [("nthreads", ctypes.c_int), ("progress", MAP_PROGRESS_FN),
-                ("ctx", ctypes.c_void_p), ("interrupt", c_int_p)]
+                ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("precision", ctypes.c_int)]
 
 
 class _MeasureOptions(ctypes.Structure):
@@ -294,7 +294,7 @@ class Types:
         self.DesignProgress = ctypes.CFUNCTYPE(i, i, i, ctypes.POINTER(self.DesignEval), d, ctypes.c_void_p)
         self.DesignOptions = type("prru_design_options", (ctypes.Structure,), {"_fields_": [
             ("max_iter", i), ("tol", d), ("restarts", i), ("nthreads", i), ("progress", self.DesignProgress),
-            ("ctx", ctypes.c_void_p)]})
+            ("ctx", ctypes.c_void_p), ("precision", i)]})
         self.DesignResult = type("prru_design_result", (ctypes.Structure,), {"_fields_": [
             ("best", self.Params), ("start_eval", self.DesignEval), ("best_eval", self.DesignEval),
             ("x0", _arr(d, DESIGN_MAX_VARS)), ("x", _arr(d, DESIGN_MAX_VARS)), ("iterations", i),
@@ -386,6 +386,7 @@ class Library:
         self.map_check = _declare(dll, "prru_map_check", i, ctypes.POINTER(_MapGrid))
         self.map_options_default = _declare(dll, "prru_map_options_default", None,
                                             ctypes.POINTER(_MapOptions))
+        self.precision_available = _declare(dll, "prru_precision_available", i, mp, i)
         self.map_eval = _declare(dll, "prru_map_eval", i, mp, ctypes.POINTER(_MapGrid),
                                  ctypes.POINTER(_MapOptions), vp,
                                  ctypes.POINTER(ctypes.c_ubyte), ctypes.POINTER(_MapSummary))

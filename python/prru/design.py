@@ -5,7 +5,7 @@ optimize` computes them. A method of Model."""
 import collections
 import ctypes
 
-from . import _convert, _interrupt, _lib, errors
+from . import _convert, _interrupt, _lib, errors, maps
 from .identification import write_model_text
 from .motion import _c_limits
 
@@ -42,7 +42,7 @@ def _range(name, value):
 
 
 def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_min=None, limits=None,
-             penalty=None, max_iter=None, threads=2, name=None):
+             penalty=None, max_iter=None, threads=2, name=None, precision="double"):
     """The design whose variables maximise w_R over the grid q1 = (lo, hi,
     n) x q2 = (lo, hi, n) at q3 (prru optimize): vars, a sequence of
     variable names (prru optimize --help's grammar: "l2", "b12", "m_P",
@@ -54,7 +54,11 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
     writes the model file). Raises
     InputError for bad variables, bounds or options and when no grid point
     is regular at the start; NoConvergence when no feasible design is
-    found (the exception's .design holds the best one)."""
+    found (the exception's .design holds the best one). precision "float":
+    each evaluation's w_R from the single-precision batched kernels (prru
+    optimize --precision float; statuses and penalties still double's)."""
+    if not isinstance(precision, str) or precision not in maps.PRECISIONS:
+        raise ValueError("precision must be 'double' or 'float', got %r" % (precision,))
     lib, T = self.lib, self.lib.types
     grid = _lib._MapGrid()
     grid.q1_lo, grid.q1_hi, grid.n1 = _range("q1", q1)
@@ -110,6 +114,7 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
     if max_iter is not None:
         o.max_iter = _convert.integer("max_iter", max_iter, 1)
     o.nthreads = _convert.integer("threads", threads, 1)
+    o.precision = maps.PRECISIONS[precision]
     stop = ctypes.c_int(0)
     progress = T.DesignProgress(lambda it, ev, best, size, ctx: stop.value)
     o.progress = progress

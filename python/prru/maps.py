@@ -21,7 +21,7 @@ at home; three actuators only); summary: a dict with n_points, n_ok,
 n_singular (counting the other_mode points too), n_unreachable,
 n_other_mode, index (mean of w_R - 1 over the ok points, the paper's global
 index), index_log (mean of ln w_R), singular_fraction, w_min, w_max and
-their (q1, q2) w_min_q, w_max_q. Without an ok point these six are None
+their (q1, q2) w_min_q, w_max_q, and precision ("double" or "float"). Without an ok point these six are None
 (no number: a mean or extreme of nothing is not defined), not NaN."""
 
 
@@ -37,14 +37,36 @@ def _axis(name, value):
     return lo, hi, n
 
 
-def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
+# prru_map_options.precision (prru_dme.h).
+PRECISIONS = {"double": 0, "float": 1}
+
+
+def precision_code(model, precision):
+    """The C code of precision ("double" or "float") for model: ValueError
+    for another value, PrruInputError where model has no float kernels
+    (only the build's model has them, not a model file of other numbers)."""
+    if not isinstance(precision, str) or precision not in PRECISIONS:
+        raise ValueError("precision must be 'double' or 'float', got %r" % (precision,))
+    code = PRECISIONS[precision]
+    if model.lib.precision_available(ctypes.byref(model._m), code) != errors.OK:
+        raise errors.make_error(errors.EINPUT, "precision='float': this model (%s kernels) has no "
+                                "single-precision kernels: only the build's own model is generated "
+                                "in float" % model.kernels)
+    return code
+
+
+def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None, precision="double"):
     """w_R at every point of a grid: q1 = (start, stop, count) gives count
     equally spaced values from start to stop (rad, count >= 2), q2 alike,
     at height q3 (m). jd_rcond_min overrides the model's singularity
     tolerance for this map (e.g. 4e-3 for a practical-singularity band, so
     that the global index converges with the resolution); threads: worker
-    threads (the C library's, outside the GIL). Returns a MapResult.
+    threads (the C library's, outside the GIL); precision "float" computes
+    w_R with the single-precision batched kernels (prru map --precision
+    float: statuses still double's; only the build's model), and the
+    summary's "precision" says which. Returns a MapResult.
     Ctrl-C stops the map between grid rows (KeyboardInterrupt)."""
+    code = precision_code(self, precision)
     lo1, hi1, n1 = _axis("q1", q1)
     lo2, hi2, n2 = _axis("q2", q2)
     g = _lib._MapGrid(lo1, hi1, lo2, hi2, _convert.scalar("q3", q3), n1, n2)
@@ -55,6 +77,7 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
     o = _lib._MapOptions()
     self.lib.map_options_default(ctypes.byref(o))
     o.nthreads = threads
+    o.precision = code
     # The progress report runs Python in the calling thread now and then,
     # which is when a SIGINT handler can run (see _interrupt).
     o.progress = _lib.MAP_PROGRESS_FN(lambda done, total, ctx: 0)
@@ -76,6 +99,7 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None):
                                           "n_other_mode", "index", "index_log",
                                           "singular_fraction", "w_min", "w_max")}
     summary["w_min_q"], summary["w_max_q"] = tuple(s.w_min_q), tuple(s.w_max_q)
+    summary["precision"] = precision
     if s.n_ok == 0:  # the library's NaN: over the ok points, of which there are none
         for k in ("index", "index_log", "w_min", "w_max", "w_min_q", "w_max_q"):
             summary[k] = None

@@ -199,6 +199,8 @@ class TestModelFile(unittest.TestCase):
             models.append(prru.Model(model=self.write("heavier%g.json" % dm, spec), lib=MODEL.lib))
         half, one = models
         self.assertEqual(half.kernels, "parameter")
+        with self.assertRaisesRegex(prru.PrruError, "has no single-precision kernels"):
+            half.map((-0.1, 0.1, 2), (-0.1, 0.1, 2), precision="float")
         self.assertEqual(half.mass[half.platform], MODEL.mass[MODEL.platform] + 0.5)
         checked = 0
         for z in (-0.9, -0.75, -0.6):
@@ -451,6 +453,30 @@ class TestAgainstCli(unittest.TestCase):
             MODEL.measure(t[:-1], [col(r, "d", n) for r in rows], [col(r, "fd", n) for r in rows])
         with self.assertRaisesRegex(ValueError, "force_noise must be non-negative"):
             MODEL.measure(t, [col(r, "d", n) for r in rows], [col(r, "fd", n) for r in rows], force_noise=-1)
+
+    def test_map_precision_float(self):
+        # precision="float" is prru map --precision float: the same
+        # statuses and w_R as the CLI's float map (to its 17 digits), the
+        # statuses those of the double map; another value or a model
+        # without float kernels (the parameter kernels) is refused.
+        args = ("--q1", "-1:1:13", "--q2", "-1:1:11", "--q3", "0.05", "--rcond-min", "4e-3")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "map.csv")
+            text = cli("map", *args, "--precision", "float", "--out", path)
+            lines = [l for l in read(path).splitlines() if not l.startswith("#")]
+        self.assertIn("precision: float (", text)
+        rows = [l.split(",") for l in lines[1:]]
+        r = MODEL.map((-1, 1, 13), (-1, 1, 11), 0.05, jd_rcond_min=4e-3, precision="float")
+        d = MODEL.map((-1, 1, 13), (-1, 1, 11), 0.05, jd_rcond_min=4e-3)
+        flat = [s for row in r.status for s in row]
+        self.assertEqual(flat, [row[4] for row in rows])
+        self.assertEqual(flat, [s for row in d.status for s in row])
+        w = [x for row in r.w_R for x in row]
+        self.assertEqual(["%.17g" % x if x == x else "NaN" for x in w], [row[3] for row in rows])
+        self.assertEqual(r.summary["precision"], "float")
+        self.assertEqual(d.summary["precision"], "double")
+        with self.assertRaisesRegex(ValueError, "precision must be 'double' or 'float', got 'half'"):
+            MODEL.map((-1, 1, 3), (-1, 1, 3), precision="half")
 
     def test_map_other_mode(self):
         # A grid reaching past the singular locus: the binding's statuses
@@ -735,6 +761,18 @@ class TestDesign(unittest.TestCase):
         after = float(re.search(r"^after_index: (\S+)", report, re.M).group(1))
         self.assertEqual(bits(d.best["index"]), bits(after))
         self.assertTrue(d.best["feasible"])
+        # precision="float" is prru optimize --precision float, bit for bit.
+        f = MODEL.optimize(["l2", "b12"], range=5, max_iter=40, precision="float", **grid)
+        with tempfile.TemporaryDirectory() as tmp:
+            rep = os.path.join(tmp, "rep")
+            cli("optimize", "--vars", "l2,b12", "--range", "5", "--q1", "-0.2:0.2:13", "--q2", "-0.25:0.15:11",
+                "--max-iter", "40", "--precision", "float", "--out", os.path.join(tmp, "o.json"), "--report", rep)
+            report = read(os.path.join(rep, "report.txt"))
+        self.assertIn("precision: float (", report)
+        after = float(re.search(r"^after_index: (\S+)", report, re.M).group(1))
+        self.assertEqual(bits(f.best["index"]), bits(after))
+        with self.assertRaisesRegex(ValueError, "precision must be 'double' or 'float', got 'single'"):
+            MODEL.optimize(["l2"], precision="single", **grid)
         with self.assertRaisesRegex(ValueError, r"vars\[0\]: "):
             MODEL.optimize(["no_such_thing"], **grid)
         with self.assertRaisesRegex(ValueError, "outside the bounds"):

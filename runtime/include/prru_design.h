@@ -148,9 +148,12 @@ typedef struct {
   double *w_R;           /* n, NaN where status != PRRU_OK */
   unsigned char *status; /* n, a prru_status per point or PRRU_DESIGN_OTHER_MODE */
   struct prru_design_row *rows; /* per grid row sums (private) */
+  int precision; /* PRRU_PRECISION_DOUBLE (default) or _FLOAT: w_R and the sliders' range in
+                    float (prru_param_f_batch_dme_terms), the statuses double's as in the maps
+                    (prru_dme.h), rcond double's wherever it is penalised */
 } prru_design_data;
 
-/* PRRU_OK or PRRU_ENOMEM; nthreads 2. */
+/* PRRU_OK or PRRU_ENOMEM; nthreads 2, double. */
 PRRU_API int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g);
 PRRU_API void prru_design_data_free(prru_design_data *dd);
 
@@ -193,6 +196,7 @@ typedef struct {
   int restarts;          /* fresh simplices from the best point (default 2) */
   int nthreads;          /* threads per evaluation (default 2; the same result for any) */
   prru_design_progress_fn progress; void *ctx;
+  int precision;         /* of each evaluation: PRRU_PRECISION_DOUBLE (default) or _FLOAT */
 } prru_design_options;
 
 PRRU_API void prru_design_options_default(prru_design_options *o);

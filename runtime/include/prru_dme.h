@@ -190,13 +190,36 @@ typedef struct {
  * far; a non-zero return stops the map (PRRU_EINTERRUPTED). */
 typedef int (*prru_map_progress_fn)(long done, long total, void *ctx);
 
+/* The arithmetic of w_R in the maps and the optimiser. PRRU_PRECISION_FLOAT
+ * runs the single-precision batched kernels (prru_f_batch_dme_terms, 8
+ * poses a vector with AVX2) and the w_R stage in float: w_R within
+ * 64 FLT_EPSILON w_R / rcond(J_d) relative of double's (where rcond >=
+ * 1e-2, within 1e-5 but where w_R is large: up to 7e-5 measured at w_R
+ * 20; tests/test_map_batch.c), and every status (ok,
+ * singular, unreachable, out of stroke, other mode) the double path's: a
+ * pose whose float result is not clearly ok (docs/performance.md, "Single
+ * precision") is evaluated again in double. Only the build's model has
+ * float kernels (prru_precision_available). */
+enum { PRRU_PRECISION_DOUBLE = 0, PRRU_PRECISION_FLOAT = 1 };
+
+/* "double" or "float" (NULL for another value). */
+PRRU_API const char *prru_precision_name(int precision);
+/* The precision named s ("double", "float"), -1 for any other text. */
+PRRU_API int prru_precision_parse(const char *s);
+/* PRRU_OK if m can be evaluated in this precision; PRRU_EINPUT for an
+ * unknown precision or float on a model with the run-time parameter
+ * kernels (a model file of other numbers than the build's: only the
+ * build's model has float batched kernels). */
+PRRU_API int prru_precision_available(const prru_model *m, int precision);
+
 typedef struct {
   int nthreads;                      /* >= 1; the calling thread is one of them */
   prru_map_progress_fn progress; void *ctx; /* may be NULL */
   volatile sig_atomic_t *interrupt;  /* polled per grid row; non-zero stops (may be NULL) */
+  int precision;                     /* PRRU_PRECISION_DOUBLE (default) or _FLOAT */
 } prru_map_options;
 
-/* nthreads = 2, no progress, no interrupt. */
+/* nthreads = 2, no progress, no interrupt, double. */
 PRRU_API void prru_map_options_default(prru_map_options *o);
 
 /* PRRU_OK, or PRRU_EINPUT when the grid is invalid (see prru_map_grid). */
@@ -216,7 +239,8 @@ PRRU_API int prru_map_home_mode(const prru_model *m, const prru_map_grid *g);
  * summary counts PRRU_ESTROKE in n_unreachable (the stroke ends bound the
  * workspace).
  * Allocates one batch workspace per thread (not per point). status may be
- * NULL if not needed; sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options),
+ * NULL if not needed; sum may be NULL. Returns PRRU_OK, PRRU_EINPUT (bad grid or options,
+ * or a precision m does not have: prru_precision_available),
  * PRRU_ENOMEM, or PRRU_EINTERRUPTED (outputs partly filled, sum not set). */
 PRRU_API int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,
                            double *w_R, unsigned char *status, prru_map_summary *sum);

@@ -418,6 +418,7 @@ int prru_design_data_alloc(prru_design_data *dd, const prru_map_grid *g)
 {
   dd->n = (long)g->n1 * g->n2;
   dd->nthreads = 2;
+  dd->precision = PRRU_PRECISION_DOUBLE;
   dd->w_R = malloc((size_t)dd->n * sizeof *dd->w_R);
   dd->status = malloc((size_t)dd->n);
   dd->rows = malloc((size_t)g->n1 * sizeof *dd->rows);
@@ -470,6 +471,69 @@ typedef struct {
   prru_dme_batch_ws ws;
 } grid_block;
 
+/* The float evaluation of a block (prru_design_data.precision): its
+ * kernels' inputs and outputs, and the points redone in double. */
+typedef struct {
+  float q[3 * GRID_BLOCK], d[PRRU_NACT * GRID_BLOCK], Jd[3 * PRRU_NACT * GRID_BLOCK],
+      M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK];
+  unsigned char sure[GRID_BLOCK];
+  int redo[GRID_BLOCK];
+  grid_block x; /* the redone points, compacted */
+  prru_dme_batch_wsf ws;
+} grid_block_f;
+
+/* A float point is taken as it is only where float's status is surely
+ * double's (prru_dme_batch_f's sure: ok with rcond and the DME's tests
+ * clear of their thresholds, so that its violation, 0, is double's too)
+ * and its sliders are clear of the stroke limits by more than their error
+ * (256 FLT_EPSILON (|d| + 4 L), as the map's stroke test). Its d, w_R then
+ * enter in float; every other point is redone in double, rcond with it. */
+static int float_point_clear(const prru_design_problem *pr, const grid_block_f *f, int n, int c,
+                             double L)
+{
+  if (!f->sure[c]) return 0;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double di = f->d[(long)i * n + c], e = 256.0 * FLT_EPSILON * (fabs(di) + 4.0 * L);
+    if (pr->stroke && !(di - e >= pr->stroke_lo && di + e <= pr->stroke_hi)) return 0;
+  }
+  return 1;
+}
+
+/* b (q filled, n points) in float: w_R into w, and b's d, rc, st, other
+ * as the double path gives them (d of the points taken in float: float's
+ * converted; rc: rcond_min there, whose violation is 0 as the true rcond's). */
+static void grid_block_float(const prru_design_problem *pr, const prru_params *p, double L, int home,
+                             grid_block *b, grid_block_f *f, double *w)
+{
+  const int n = b->n;
+  for (int i = 0; i < 3 * n; i++) f->q[i] = (float)b->q[i];
+  prru_param_f_batch_dme_terms(p, n, f->q, f->d, f->Jd, f->M, f->JP);
+  prru_dme_batch_f(n, f->d, f->Jd, f->M, f->JP, L, pr->rcond_min, home, &f->ws, w, b->st, f->sure);
+  int nx = 0;
+  for (int c = 0; c < n; c++) {
+    for (int i = 0; i < PRRU_NACT; i++) b->d[(long)i * n + c] = f->d[(long)i * n + c];
+    b->rc[c] = pr->rcond_min;
+    b->other[c] = 0;
+    if (!float_point_clear(pr, f, n, c, L)) f->redo[nx++] = c;
+  }
+  if (nx == 0) return;
+  grid_block *x = &f->x;
+  x->n = nx;
+  for (int r = 0; r < 3; r++)
+    for (int t = 0; t < nx; t++) x->q[(long)r * nx + t] = b->q[(long)r * n + f->redo[t]];
+  double wx[GRID_BLOCK];
+  prru_param_batch_dme_terms(p, nx, x->q, x->d, x->Jd, x->M, x->JP);
+  prru_dme_batch(nx, x->d, x->Jd, x->M, x->JP, L, pr->rcond_min, home, &x->ws, wx, x->st, x->rc, x->other);
+  for (int t = 0; t < nx; t++) {
+    const int c = f->redo[t];
+    w[c] = wx[t];
+    b->st[c] = x->st[t];
+    b->rc[c] = x->rc[t];
+    b->other[c] = x->other[t];
+    for (int i = 0; i < PRRU_NACT; i++) b->d[(long)i * n + c] = x->d[(long)i * nx + t];
+  }
+}
+
 /* Point c's share of the regularity violation, for the status the map
  * gives it: unreachable, singular (rcond below the tolerance), or regular
  * but in the other assembly mode (det J_d's sign not home's: cut off from
@@ -508,6 +572,13 @@ static void grid_row(grid_job *j, int i)
   struct prru_design_row *r = &j->dd->rows[i];
   const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
   grid_block b PRRU_ALIGN64; /* about 40 KB of this thread's stack: no allocation */
+  /* float: about 70 KB more, allocated (without it, double: slower, the
+   * reference values) */
+  grid_block_f *f = NULL;
+  if (j->dd->precision == PRRU_PRECISION_FLOAT) {
+    void *a = NULL;
+    if (posix_memalign(&a, 64, sizeof *f) == 0) f = a;
+  }
   memset(r, 0, sizeof *r);
   r->dmin = INFINITY;
   r->dmax = -INFINITY;
@@ -519,9 +590,13 @@ static void grid_row(grid_job *j, int i)
       b.q[2 * b.n + t] = g->q3;
     }
     const long k0 = (long)i * g->n2 + c0;
-    prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
-    prru_dme_batch(b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
-                   &j->dd->w_R[k0], b.st, b.rc, b.other);
+    if (f) {
+      grid_block_float(pr, j->p, j->L, j->home, &b, f, &j->dd->w_R[k0]);
+    } else {
+      prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
+      prru_dme_batch(b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
+                     &j->dd->w_R[k0], b.st, b.rc, b.other);
+    }
     for (int c = 0; c < b.n; c++) {
       const long k = k0 + c;
       const int st = b.st[c];
@@ -539,6 +614,7 @@ static void grid_row(grid_job *j, int i)
       if (pr->stroke) r->stroke += stroke_excess(pr, d) / j->L;
     }
   }
+  free(f);
 }
 
 static void *grid_worker(void *arg)
@@ -626,6 +702,7 @@ void prru_design_options_default(prru_design_options *o)
   o->tol = 1e-5;
   o->restarts = 2;
   o->nthreads = 2;
+  o->precision = PRRU_PRECISION_DOUBLE;
   o->progress = NULL;
   o->ctx = NULL;
 }
@@ -762,6 +839,7 @@ int prru_design_optimize(const prru_design_problem *pr, const prru_params *start
   if (prru_design_data_alloc(&dd, &pr->grid) != PRRU_OK)
     return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory for the grid");
   dd.nthreads = o->nthreads;
+  dd.precision = o->precision;
   opt_ctx c = {pr, start, vars, nvar, 0, &dd, *start, {0}, r};
   r->best = *start;
   prru_design_evaluate(pr, start, &dd, &r->start_eval);

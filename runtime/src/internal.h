@@ -104,19 +104,28 @@ void prru_gsl_init(void);
 /* Poses per pass of prru_dme_batch's stages: its workspace (about 16 kB
  * with three actuators) stays in the first-level cache. */
 #define PRRU_DME_BATCH_CHUNK 32
-typedef struct {
-  double inv[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], tmp[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
-      JtR[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], JtT[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
-      Mt[PRRU_NACT * PRRU_NACT][PRRU_DME_BATCH_CHUNK], c0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],
-      c1[PRRU_NACT][PRRU_DME_BATCH_CHUNK], g0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],
-      g1[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
-  double pre[PRRU_DME_BATCH_CHUNK], rcond[PRRU_DME_BATCH_CHUNK], other[PRRU_DME_BATCH_CHUNK],
-      ok[PRRU_DME_BATCH_CHUNK], w[PRRU_DME_BATCH_CHUNK];
+/* The workspace of one type T (double: prru_dme_batch_ws, float:
+ * prru_dme_batch_wsf). */
 #if PRRU_NACT > 3 /* the Householder QR of J_d */
-  double W[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], V[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],
+#define PRRU_DME_BATCH_QR(T)                                                                     \
+  T W[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], V[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],             \
       beta[3][PRRU_DME_BATCH_CHUNK], e[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
+#else
+#define PRRU_DME_BATCH_QR(T)
 #endif
-} prru_dme_batch_ws;
+#define PRRU_DME_BATCH_WS(T)                                                                     \
+  struct {                                                                                       \
+    T inv[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], tmp[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],        \
+        JtR[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], JtT[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],      \
+        Mt[PRRU_NACT * PRRU_NACT][PRRU_DME_BATCH_CHUNK], c0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],    \
+        c1[PRRU_NACT][PRRU_DME_BATCH_CHUNK], g0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],                \
+        g1[PRRU_NACT][PRRU_DME_BATCH_CHUNK];                                                     \
+    T pre[PRRU_DME_BATCH_CHUNK], rcond[PRRU_DME_BATCH_CHUNK], other[PRRU_DME_BATCH_CHUNK],       \
+        ok[PRRU_DME_BATCH_CHUNK], w[PRRU_DME_BATCH_CHUNK], gap[PRRU_DME_BATCH_CHUNK];            \
+    PRRU_DME_BATCH_QR(T)                                                                         \
+  }
+typedef PRRU_DME_BATCH_WS(double) prru_dme_batch_ws;
+typedef PRRU_DME_BATCH_WS(float) prru_dme_batch_wsf;
 /* w_R and the status of n poses from their kernel outputs in SoA layout
  * (entry i of pose k at [i * n + k], as prru_batch_dme_terms gives d, J_d,
  * M and [J_R,P; J_T,P]): at every pose bit for bit what prru_jd_regular
@@ -128,4 +137,14 @@ typedef struct {
 void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, const double *JP,
                     double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
                     unsigned char *status, double *rcond, unsigned char *other);
+/* prru_dme_batch on float kernel outputs (prru_f_batch_dme_terms), in
+ * float: w_R (within 64 FLT_EPSILON w_R / rcond(J_d) relative of the
+ * double path's: tests/test_map_batch.c) and the status as float sees it; sure[k]
+ * is 1 where that status is certain to be the double path's: PRRU_OK with
+ * rcond and the DME's tests clear of their thresholds by more than float's
+ * error (dme_batch.c). Elsewhere the caller decides the status in double
+ * (prru_dme_batch on the double kernels' outputs). */
+void prru_dme_batch_f(int n, const float *d, const float *Jd, const float *M, const float *JP,
+                      double L, double rcond_min, int home, prru_dme_batch_wsf *ws, double *w_R,
+                      unsigned char *status, unsigned char *sure);
 #endif

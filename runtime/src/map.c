@@ -5,12 +5,15 @@
  * evaluated in blocks of points by the batched kernels and prru_dme_batch,
  * which cost the same at every point. */
 #define _POSIX_C_SOURCE 200809L
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "internal.h"
 #include "prru_dme.h"
+#include "prru_f_batch.h"
 
 void prru_map_options_default(prru_map_options *o)
 {
@@ -18,6 +21,25 @@ void prru_map_options_default(prru_map_options *o)
   o->progress = NULL;
   o->ctx = NULL;
   o->interrupt = NULL;
+  o->precision = PRRU_PRECISION_DOUBLE;
+}
+
+const char *prru_precision_name(int precision)
+{
+  return precision == PRRU_PRECISION_DOUBLE ? "double" : precision == PRRU_PRECISION_FLOAT ? "float" : NULL;
+}
+
+int prru_precision_parse(const char *s)
+{
+  return !strcmp(s, "double") ? PRRU_PRECISION_DOUBLE : !strcmp(s, "float") ? PRRU_PRECISION_FLOAT : -1;
+}
+
+int prru_precision_available(const prru_model *m, int precision)
+{
+  if (precision == PRRU_PRECISION_DOUBLE) return PRRU_OK;
+  /* The float batched kernels are the build's model's, with its numbers. */
+  if (precision == PRRU_PRECISION_FLOAT && m->kernels == &prru_kernels_specialised) return PRRU_OK;
+  return PRRU_EINPUT;
 }
 
 double prru_map_axis(double lo, double hi, int n, int i)
@@ -64,6 +86,15 @@ typedef struct {
       M[9 * MAP_BLOCK], JP[18 * MAP_BLOCK];
   unsigned char st[MAP_BLOCK];
   prru_dme_batch_ws ws;
+  /* --precision float: the float kernels' inputs and outputs, and the
+   * points whose status float leaves to double (their index, w_R and
+   * status there). */
+  float qf[3 * MAP_BLOCK], df[PRRU_NACT * MAP_BLOCK], Jdf[3 * PRRU_NACT * MAP_BLOCK],
+      Mf[9 * MAP_BLOCK], JPf[18 * MAP_BLOCK];
+  unsigned char sure[MAP_BLOCK], stx[MAP_BLOCK];
+  int redo[MAP_BLOCK];
+  double wx[MAP_BLOCK];
+  prru_dme_batch_wsf wsf;
 } map_block;
 
 typedef struct {
@@ -77,6 +108,66 @@ typedef struct {
  * kernels' part (prru_ik_jd, prru_mass, prru_platform_jacobian) from the
  * batched dme_terms, the rest from prru_dme_batch, both bit for bit the
  * scalar path. */
+/* The double path for n points of q (rows of n, in b->q): the kernels' part
+ * (prru_ik_jd, prru_mass, prru_platform_jacobian) from the batched
+ * dme_terms, the rest from prru_dme_batch, both bit for bit the scalar
+ * path; w_R and status out. */
+static void map_points_double(map_job *j, map_block *b, int n, double *w, unsigned char *st)
+{
+  KERNEL(j->m, batch_dme_terms)(j->m->kernel_params, n, b->q, b->d, b->Jd, b->M, b->JP);
+  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, w, st, NULL,
+                 NULL);
+  /* The stroke ends bound the workspace as the reach does (the scalar
+   * path's prru_check_regular tests it in the same place). */
+  for (int c = 0; c < n; c++) {
+    if (st[c] == PRRU_EUNREACHABLE) continue;
+    double dc[PRRU_NACT];
+    for (int i = 0; i < PRRU_NACT; i++) dc[i] = b->d[(long)i * n + c];
+    if (prru_stroke_actuator(j->m, dc) >= 0) st[c] = PRRU_ESTROKE, w[c] = NAN;
+  }
+}
+
+/* Whether float's sliders d (rows of n, point c) are inside the stroke by
+ * more than their error: the float kernels' d is within 16 u of the sum of
+ * its terms' magnitudes (tests/test_float_kernels.c), q3 and a few link
+ * lengths, i.e. |d| + 4 L; the margin takes 16 times that. */
+static int stroke_clear(const prru_model *m, const float *d, int n, int c, double L)
+{
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double di = d[(long)i * n + c], e = 256.0 * FLT_EPSILON * (fabs(di) + 4.0 * L);
+    if (!(di - e >= m->mech->d_min[i] && di + e <= m->mech->d_max[i])) return 0;
+  }
+  return 1;
+}
+
+/* The float path: every point through the float kernels and
+ * prru_dme_batch_f; the points whose float status is not surely double's
+ * (sure[c] 0, or a slider within its error of a stroke end) again through
+ * the double path, which then gives their status and w_R. So every status
+ * is the double path's, and only the points near a threshold (and those
+ * not ok) cost a double evaluation too. */
+static void map_points_float(map_job *j, map_block *b, int n, double *w, unsigned char *st)
+{
+  for (int c = 0; c < 3 * n; c++) b->qf[c] = (float)b->q[c];
+  prru_f_batch_dme_terms(n, b->qf, b->df, b->Jdf, b->Mf, b->JPf);
+  prru_dme_batch_f(n, b->df, b->Jdf, b->Mf, b->JPf, j->L, j->m->jd_rcond_min, j->home, &b->wsf, w, st,
+                   b->sure);
+  int nx = 0;
+  for (int c = 0; c < n; c++)
+    if (!b->sure[c] || !stroke_clear(j->m, b->df, n, c, j->L)) b->redo[nx++] = c;
+  if (nx == 0) return;
+  /* The points to redo, compacted into rows of nx (in place: redo[x] >= x). */
+  for (int r = 0; r < 3; r++)
+    for (int x = 0; x < nx; x++) b->q[(long)r * nx + x] = b->q[(long)r * n + b->redo[x]];
+  map_points_double(j, b, nx, b->wx, b->stx);
+  for (int x = 0; x < nx; x++) {
+    w[b->redo[x]] = b->wx[x];
+    st[b->redo[x]] = b->stx[x];
+  }
+}
+
+/* Row `row` of the grid, points c0 .. c0 + n - 1 (n <= MAP_BLOCK), each as
+ * prru_dme_eval evaluates it and classified by prru_mode_status. */
 static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
 {
   const prru_map_grid *g = j->g;
@@ -86,19 +177,12 @@ static void map_block_eval(map_job *j, map_block *b, int row, int c0, int n)
     b->q[n + c] = prru_map_axis(g->q2_lo, g->q2_hi, g->n2, c0 + c);
     b->q[2 * n + c] = g->q3;
   }
-  KERNEL(j->m, batch_dme_terms)(j->m->kernel_params, n, b->q, b->d, b->Jd, b->M, b->JP);
   const long k = (long)(row - j->row_begin) * g->n2 + c0;
   unsigned char *st = j->st ? j->st + k : b->st;
-  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, j->w + k, st, NULL,
-                 NULL);
-  /* The stroke ends bound the workspace as the reach does (the scalar
-   * path's prru_check_regular tests it in the same place). */
-  for (int c = 0; c < n; c++) {
-    if (st[c] == PRRU_EUNREACHABLE) continue;
-    double dc[PRRU_NACT];
-    for (int i = 0; i < PRRU_NACT; i++) dc[i] = b->d[(long)i * n + c];
-    if (prru_stroke_actuator(j->m, dc) >= 0) st[c] = PRRU_ESTROKE, j->w[k + c] = NAN;
-  }
+  if (j->o->precision == PRRU_PRECISION_FLOAT)
+    map_points_float(j, b, n, j->w + k, st);
+  else
+    map_points_double(j, b, n, j->w + k, st);
 }
 
 /* The next row to do, or -1 when there is none or the map was stopped. */
@@ -154,6 +238,7 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
                        const prru_map_options *o, double *w_R, unsigned char *status)
 {
   if (prru_map_check(g) != PRRU_OK || o->nthreads < 1 || o->nthreads > 256) return PRRU_EINPUT;
+  if (prru_precision_available(m, o->precision) != PRRU_OK) return PRRU_EINPUT;
   if (row_begin < 0 || row_end > g->n1 || row_begin >= row_end) return PRRU_EINPUT;
   const int nrows = row_end - row_begin;
   int nt = o->nthreads > nrows ? nrows : o->nthreads;
