@@ -223,16 +223,7 @@ def _inverse_terms(deriv, d, jd, fp, mp):
     # values as atoms.
     ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
     tau = [_atom("tau%d" % k, x) for k, x in enumerate(tau)]
-    e = [[ja[3 * i + j] for j in range(3)] for i in range(3)]
-    # cof[i][j]: the cofactor of e[i][j]; J_d^-1 = cof^T / det.
-    cof = [[sym.add(sym.mul(e[(i + 1) % 3][(j + 1) % 3],
-                            e[(i + 2) % 3][(j + 2) % 3]),
-                    -sym.mul(e[(i + 1) % 3][(j + 2) % 3],
-                             e[(i + 2) % 3][(j + 1) % 3]))
-            for j in range(3)] for i in range(3)]
-    inv_det = sym.power(sym.add(*[sym.mul(e[0][k], cof[0][k])
-                                  for k in range(3)]), -1)
-    inv = [sym.mul(cof[j][i], inv_det) for i in range(3) for j in range(3)]
+    cof, inv_det, inv = _adjugate_inverse(ja)
     # fd = J_d^-T tau: fd_i = sum_k (J_d^-1)_ki tau_k = sum_k cof_ik tau_k / det.
     fd = [sym.mul(sym.add(*[sym.mul(cof[i][k], tau[k]) for k in range(3)]),
                   inv_det) for i in range(3)]
@@ -356,14 +347,10 @@ def _eom_solve_derivs(deriv, q, qd, fd, fp, mp):
              ("Dfp", blocks[3]), ("Dmp", blocks[4])], ("b", "qdd"))
 
 
-def _inverse_derivs(deriv, q, qd, fp, mp):
-    """inverse_terms (three actuators) and the derivatives of fd = J_d^-T
-    tau: dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd), from the residual
-    r = tau - J_d^T fd with fd frozen, each column by J_d's adjugate."""
-    d, jd = deriv.actuators(), deriv.actuator_jacobian()
-    qdd = _vec("qdd")
-    tau = deriv.drive_force(qdd, fp, mp)
-    ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
+def _adjugate_inverse(ja):
+    """J_d (3x3, row-major atoms ja) inverted by its adjugate: the
+    cofactors cof (cof[i][j] of entry (i, j)), 1 / det and J_d^-1 =
+    cof^T / det, row-major (NaN or infinite where J_d is singular)."""
     e = [[ja[3 * i + j] for j in range(3)] for i in range(3)]
     cof = [[sym.add(sym.mul(e[(i + 1) % 3][(j + 1) % 3],
                             e[(i + 2) % 3][(j + 2) % 3]),
@@ -373,6 +360,18 @@ def _inverse_derivs(deriv, q, qd, fp, mp):
     inv_det = sym.power(sym.add(*[sym.mul(e[0][k], cof[0][k])
                                   for k in range(3)]), -1)
     inv = [sym.mul(cof[j][i], inv_det) for i in range(3) for j in range(3)]
+    return cof, inv_det, inv
+
+
+def _inverse_derivs(deriv, q, qd, fp, mp):
+    """inverse_terms (three actuators) and the derivatives of fd = J_d^-T
+    tau: dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd), from the residual
+    r = tau - J_d^T fd with fd frozen, each column by J_d's adjugate."""
+    d, jd = deriv.actuators(), deriv.actuator_jacobian()
+    qdd = _vec("qdd")
+    tau = deriv.drive_force(qdd, fp, mp)
+    ja = [_atom("Jd%d" % k, x) for k, x in enumerate(jd)]
+    cof, inv_det, inv = _adjugate_inverse(ja)
 
     def solve_t(rhs):
         """J_d^T x = rhs: x_i = sum_k cof_ik rhs_k / det."""

@@ -5,7 +5,6 @@
  * Tolerances below PRRU_TOL_MIN are refused up front: they cannot be met
  * and used to make the step size collapse for ever. */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -203,22 +202,9 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
 }
 
-static int bad_option(const char *f, const char **field, char *msg, int msglen, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 5, 6)))
-#endif
-    ;
-static int bad_option(const char *f, const char **field, char *msg, int msglen, const char *fmt, ...)
-{
-  if (field) *field = f;
-  if (msg && msglen > 0) {
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, (size_t)msglen, fmt, ap);
-    va_end(ap);
-  }
-  return PRRU_EINPUT;
-}
+/* PRRU_EINPUT with msg, naming member F in *field (when asked for). */
+#define bad_option(F, field, msg, msglen, ...) \
+  ((field) ? (void)(*(field) = (F)) : (void)0, prru_fail(msg, msglen, PRRU_EINPUT, __VA_ARGS__))
 
 int prru_sim_options_check(const prru_sim_options *o, const char **field, char *msg, int msglen)
 {
