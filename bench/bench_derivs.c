@@ -26,7 +26,7 @@ static void run_side(bench_ctx *c, int side, long n)
   long bad = 0;
   for (long k = 0; k < n; k++) {
     const bench_state *s = &c->st[k & (NSTATES - 1)];
-    double out[3], M[9], b[3], qdd[3], mn[3], D[5][9 + 3 * PRRU_NACT];
+    double out[PRRU_NACT], M[9], b[3], qdd[3], mn[3], D[5][9 + 3 * PRRU_NACT];
     prru_linearization o;
     switch (side) {
     case FWD:
