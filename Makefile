@@ -108,8 +108,8 @@ test-asan: deps-asan build
 	RELEASE_BUILD=$(abspath $(BUILD)) tests/sanitize.sh
 
 # libFuzzer over the number, table, load-schedule and scenario parsers.
-fuzz: deps-fuzz
-	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run.sh
+fuzz: deps-fuzz build
+	FUZZ_SECONDS=$(FUZZ_SECONDS) PRRU_GEN_DIR=$(abspath $(BUILD))/generated fuzz/run.sh
 
 # Fails when the committed generated/ (the paper model's kernels and the
 # topology kernels prru_p3_*, prru_p4_* of every build) is not what the

@@ -61,19 +61,24 @@ if ! "$CC" -fsanitize=fuzzer,address,undefined "$work/probe.c" -o "$work/probe" 
   exit 2
 fi
 
-# The runtime is compiled once into an object list shared by the harnesses;
-# the committed generated/ kernels are enough (no Python needed).
+# The runtime is compiled once into an object list shared by the harnesses,
+# with the kernels a build generated (PRRU_GEN_DIR, `make fuzz` passes its
+# build's: it also holds the single-precision sets the maps call, which
+# the committed generated/ does not).
+gen=${PRRU_GEN_DIR:-$root/build/generated}
+if [ ! -f "$gen/prru_f_batch.c" ]; then
+  echo "fuzz/run.sh: $gen holds no generated kernels: build first ('make build'), or set PRRU_GEN_DIR" >&2
+  exit 2
+fi
 # shellcheck disable=SC2054  # the commas are inside one flag
 sanitize=(-fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
           -fno-omit-frame-pointer)
 cflags=(-std=c99 -O1 -g -Wall -Wextra -Wpedantic -Wshadow
-        -I"$root/generated" -I"$root/runtime/include" -I"$root/runtime/src")
+        -I"$gen" -I"$root/runtime/include" -I"$root/runtime/src")
 build() { # harness
   local name=$1 objs=() src obj
   if [ ! -f "$work/runtime.stamp" ]; then
-    for src in "$root"/runtime/src/*.c "$root/generated/prru_kernels.c" "$root/generated/prru_mechanism.c" \
-        "$root/generated/prru_param_kernels.c" "$root/generated/prru_regressor.c" \
-        "$root/generated/prru_p3_kernels.c" "$root/generated/prru_p4_kernels.c"; do
+    for src in "$root"/runtime/src/*.c "$gen"/*.c; do
       obj="$work/obj_$(basename "$src" .c).o"
       # fuzzer-no-link: coverage instrumentation without a second main()
       "$CC" "${cflags[@]}" -fsanitize=fuzzer-no-link,address,undefined \
