@@ -27,7 +27,8 @@ FUZZ_SECONDS ?= 60
 #         the Arm cross compiler, newlib and QEMU (the controller kernels
 #         built for and run on an emulated Cortex-M4, tests/test_mcu.sh);
 #   test-asan: + valgrind (gcc's own sanitizers need nothing more);
-#   fuzz: clang and its libFuzzer runtime, for the installed clang's version.
+#   fuzz: clang and its libFuzzer runtime, for the installed clang's version
+#         (and the demo's, for the build whose generated kernels it links).
 # cmake/debian_deps.sh installs the missing ones with apt-get as root or
 # through sudo, else lists them with the command to run (exit 2).
 # DEPS_DRY_RUN=1 shows what would be installed; SKIP_DEPS=1 skips the step.

@@ -197,7 +197,8 @@ test_list="$test_list slurm-wlm munge gcc-arm-none-eabi libnewlib-arm-none-eabi 
 for case in "demo|$demo_list" "deps|$demo_list" "bench|$demo_list" \
             "test|$demo_list
 $test_list" "test-asan|$demo_list
-$test_list valgrind" "fuzz|clang clang-runtime libgsl-dev libjansson-dev pkg-config"; do
+$test_list valgrind" "fuzz|clang clang-runtime libgsl-dev libjansson-dev pkg-config
+$demo_list"; do
   target=${case%%|*}
   got=$(deps_of "$target")
   want=$(printf '%s\n' "${case#*|}" | sort -u)
