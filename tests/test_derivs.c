@@ -31,6 +31,7 @@
  * (of order the block) fails by nine. The identities hold to rounding:
  * 1e-11 of the terms' magnitudes (products of two derivative blocks, each
  * accurate to ~1e-13 relative). */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -110,11 +111,13 @@ static int richardson(int inverse, const state *s, int v, int k, double h0, int 
 
 /* The reference's block d out / d v (nout x n, row-major); *est relative
  * to its largest entry. */
+static double ref_hmin; /* the smallest step of the last ref_block */
 static int ref_block(int inverse, const state *s, int v, int n, double h0, double *block,
                      double *est)
 {
   const int nout = inverse ? NA : 3;
   double big = 1e-300, e = 0;
+  ref_hmin = INFINITY;
   for (int k = 0; k < n; k++) {
     double col[NA], ek;
     const double h = (v == V_Q || v == V_QD || v == V_QDD) && k == 2 ? h0 * length : h0;
@@ -125,8 +128,9 @@ static int ref_block(int inverse, const state *s, int v, int n, double h0, doubl
     for (int shrink = 1; shrink <= 2 && ek > REF_ACCURACY * tu_norm_inf(col, nout); shrink++) {
       double c2[NA], e2;
       if (richardson(inverse, s, v, k, ldexp(h, -2 * shrink), nout, c2, &e2)) return 1;
-      if (e2 < ek) memcpy(col, c2, sizeof col), ek = e2;
+      if (e2 < ek) memcpy(col, c2, sizeof col), ek = e2, ref_hmin = fmin(ref_hmin, ldexp(h, -2 * shrink));
     }
+    ref_hmin = fmin(ref_hmin, h);
     e = fmax(e, ek);
     for (int i = 0; i < nout; i++) {
       block[n * i + k] = col[i];
@@ -355,10 +359,160 @@ static int random_state(state *s, double *m)
   return 0;
 }
 
+/* ---- Near the workspace boundary ----
+ * As an upper link turns horizontal, M grows like 1/m^2 in one direction
+ * (m: ref_margin) and the dynamics stop being trusted at prru_mass_rcond(M)
+ * < mass_rcond_min (prru_forward_dynamics). Between MARGIN and that limit
+ * the kernel is checked at states of margins spread log-uniformly down
+ * to BOUNDARY_MIN, wherever forward dynamics is trusted. There the
+ * reference's differences, not the kernel, limit the comparison: the
+ * functions bend on a length ~m^2 (the steps shrink with it) while the
+ * reference's own rounding grows with M's conditioning. So the bound is
+ * the sum of the two sides' errors, each derived at the state:
+ *   - the kernel's: BOUND, as away from the boundary (its rounding, u
+ *     times the conditioning, stays below it: 2e-10 relative for qdd at
+ *     the trust limit, prru.h);
+ *   - the reference's truncation and the part of its rounding that the
+ *     noise below misses (rounding at the steps' own offsets, where the
+ *     state's evaluation differs most): 4 est, est the tableau's last
+ *     correction. With independent rounding per evaluation, est = |T33 -
+ *     T22| is a sample of that rounding about as large as T33's own (rms
+ *     weights 13.9 and 11.7 noise / h); the maximum over a block's
+ *     columns and outputs has not been found below a third of the error
+ *     (measured 1 / 2.5 at worst over the committed models);
+ *   - the reference's rounding: noise (ref_noise, measured at the state)
+ *     enters
+ *     each difference at step h' as noise / h'; the extrapolated entry
+ *     weighs the four levels h, h/2, h/4, h/8 so that its rounding is at
+ *     most sum_j |w_j| 2^j noise / h = 13.5 noise / h (w: the tableau's
+ *     weights, -3.5e-4, 0.030, -0.47, 1.44), doubled because noise is
+ *     sampled rather than bounded: 27 noise / h, relative to the block's
+ *     largest entry.
+ * The bound grows with the conditioning through noise and est: to a few
+ * 1e-6 at the trust limit on the committed models, so a wrong term (of
+ * order the block) fails by five orders. Where sharp Coulomb friction
+ * (a small coulomb_velocity: the steps in q shrink with it, step_for)
+ * meets the boundary the reference resolves less (1e-3 seen on random
+ * models); a bound that grew to the block's size would test nothing, so
+ * at least half of the blocks must be resolved to BOUNDARY_CEILING, and
+ * the count is printed. */
+#define BOUNDARY_MIN 0.003
+#define NOISE_TRIALS 8
+#define BOUNDARY_CEILING 1e-5
+
+/* The reference forward dynamics' rounding noise at s when variable v
+ * moves, as it does in the differences of its block (the other inputs
+ * stay, and so does their rounding): over NOISE_TRIALS random directions
+ * d moving v, the largest |qdd(s + d) + qdd(s - d) - 2 qdd(s)| / 2. The
+ * second difference cancels the outputs' first-order change (their true
+ * dependence, huge near the boundary), so what is left is the rounding
+ * of the three evaluations plus a curvature term of order d^2: for the
+ * forces, on which qdd depends linearly, that term is 0 and d is as long
+ * as the steps (up to h each way: the rounding the differences meet);
+ * for q and qd, d moves each component by up to 4 ulps (angles and rates
+ * of angles about 1, lengths about L where the input is 0) and the
+ * curvature term is negligible. */
+static double ref_noise(const state *s, int v, double h)
+{
+  double base[3], noise = 0;
+  if (ref_eval(0, s, base)) return INFINITY;
+  const int n = v == V_FD ? NA : 3;
+  for (int t = 0; t < NOISE_TRIALS; t++) {
+    state up = *s, dn = *s;
+    for (int k = 0; k < n; k++) {
+      const double x = slot(&up, v)[k];
+      const double unit = (v == V_Q || v == V_QD) && k == 2 ? length : 1.0;
+      const double dx = v == V_FD ? tu_uniform(-h, h) : tu_uniform(-4, 4) * DBL_EPSILON * fmax(fabs(x), unit);
+      slot(&up, v)[k] = x + dx;
+      slot(&dn, v)[k] = x - dx;
+    }
+    double fu[3], fdn[3];
+    if (ref_eval(0, &up, fu) || ref_eval(0, &dn, fdn)) return INFINITY;
+    for (int i = 0; i < 3; i++) noise = fmax(noise, fabs(fu[i] + fdn[i] - 2 * base[i]) / 2);
+  }
+  return noise;
+}
+
+/* A trusted state of margin within a factor 1.25 of target, with rates
+ * and loads as random_state's; 0 when none is found. */
+static int state_at_margin(state *s, double target, double *m)
+{
+  for (long tries = 0; tries < 2000000; tries++) {
+    memset(s, 0, sizeof *s);
+    s->q[0] = tu_uniform(-PI / 2, PI / 2);
+    s->q[1] = tu_uniform(-PI / 2, PI / 2);
+    s->q[2] = tu_uniform(-3 * length, 3 * length);
+    const double mm = ref_margin(&P, s->q);
+    if (mm < target / 1.25 || mm > target * 1.25) continue;
+    for (int i = 0; i < 3; i++) {
+      s->qd[i] = tu_uniform(-1, 1) * (i == 2 ? length : 1);
+      s->fp[i] = tu_uniform(-30, 30);
+      s->mp[i] = tu_uniform(-3, 3);
+    }
+    for (int i = 0; i < NA; i++) s->fd[i] = tu_uniform(-60, 60);
+    prru_loads l;
+    memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+    double qdd[3];
+    if (prru_forward_dynamics(&model, &data, s->q, s->qd, &l, qdd) == PRRU_OK) {
+      *m = mm;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+static void check_boundary(const char *name, int nstates)
+{
+  double worst_ratio = 0, worst_bound = 0, lowest = 1;
+  int n = 0, resolved = 0, blocks_checked = 0;
+  for (int k = 0; k < nstates; k++) {
+    state s;
+    double m;
+    const double target = MARGIN * pow(BOUNDARY_MIN / MARGIN, (k + 1.0) / nstates);
+    if (!state_at_margin(&s, target, &m)) continue;
+    prru_loads l;
+    memcpy(l.fd, s.fd, sizeof l.fd), memcpy(l.fp, s.fp, sizeof l.fp), memcpy(l.mp, s.mp, sizeof l.mp);
+    prru_linearization o;
+    if (!TU_TRUE(prru_linearize(&model, &data, s.q, s.qd, &l, 0.0, &o) == PRRU_OK,
+                 "prru_linearize where forward dynamics is trusted"))
+      continue;
+    const double *blocks[] = {o.dqdd_dq, o.dqdd_dqd, o.dqdd_dfd};
+    const int vars[] = {V_Q, V_QD, V_FD}, widths[] = {3, 3, NA};
+    for (int b = 0; b < 3; b++) {
+      double ref[3 * NA], est;
+      if (!TU_TRUE(!ref_block(0, &s, vars[b], widths[b], step_for(vars[b], m), ref, &est),
+                   "reference forward dynamics near a boundary state"))
+        continue;
+      const double big = fmax(tu_norm_inf(ref, 3 * widths[b]), 1e-300), noise = ref_noise(&s, vars[b], step_for(vars[b], m));
+      const double bound = BOUND + 4 * est + 27 * noise / (ref_hmin * big);
+      const double e = tu_relerr(blocks[b], ref, 3 * widths[b], 1e-300);
+      char what[160];
+      snprintf(what, sizeof what, "%s: %s at margin %.3g against the reference (bound: both sides' errors)",
+               name, fwd_names[b], m);
+      tu_check(e <= bound, what, e, bound);
+      resolved += bound <= BOUNDARY_CEILING;
+      blocks_checked++;
+      worst_ratio = fmax(worst_ratio, e / bound);
+      worst_bound = fmax(worst_bound, bound);
+    }
+    lowest = fmin(lowest, m);
+    n++;
+  }
+  char what[200];
+  snprintf(what, sizeof what, "%s: trusted states near the boundary (margin below %g)", name, MARGIN / 10);
+  TU_TRUE(n >= nstates / 2 && lowest < MARGIN / 10, what);
+  snprintf(what, sizeof what, "%s: blocks near the boundary that the reference resolves to %g", name,
+           BOUNDARY_CEILING);
+  TU_TRUE(2 * resolved >= blocks_checked, what);
+  printf("  near the boundary: %d states down to margin %.2g, worst error / bound %.2f, largest bound %.1e, "
+         "%d of %d blocks resolved to %g\n",
+         n, lowest, worst_ratio, worst_bound, resolved, blocks_checked, BOUNDARY_CEILING);
+}
+
 /* Hovering (at rest, the drives holding the robot against gravity:
  * unloaded it falls as one rigid body and every derivative is 0), then
  * random states with rates and loads, on model (P its numbers). */
-static void check_model(const char *name, int nstates)
+static void check_model(const char *name, int nstates, int nboundary)
 {
   memset(worst, 0, sizeof worst);
   worst_est = worst_identity = 0;
@@ -402,6 +556,7 @@ static void check_model(const char *name, int nstates)
           "four actuators: inverse derivatives refused");
 #endif
   printf("  reference differences' worst error estimate %.2e\n", worst_est);
+  check_boundary(name, nboundary);
 }
 
 /* A model file loaded at run time: 0 when it is of the other topology
@@ -415,7 +570,7 @@ static int check_file(const char *path, int nstates, int must_load)
     return 0;
   }
   ref_params_of(model.mech, &P);
-  check_model(path, nstates);
+  check_model(path, nstates, nstates);
   prru_model_free(&model);
   return 1;
 }
@@ -437,7 +592,7 @@ int main(int argc, char **argv)
   } else {
     prru_ref_params_default(&P);
     prru_model_default(&model);
-    check_model("the build's model", 21);
+    check_model("the build's model", 21, 16);
     const char *src = getenv("PRRU_SOURCE_DIR");
     static const char *const files[] = {"3prru_paper.json", "prototype_drives.json",
                                         "prototype_example.json", "4prru.json"};
