@@ -48,27 +48,23 @@ def generate(model_path, templates_dir=TEMPLATES, prefix=None):
 def generate_model(model, templates_dir=TEMPLATES, prefix=None):
     """(files {name: text}, emitted kernels) for a loaded model: the
     constant kernels, the mechanism descriptor, the runtime-parameter
-    kernels (emitted names param_*) and the regressor."""
+    kernels' names (the topology kernels', render.render_params) and the
+    regressor."""
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
     files, emitted = render.render(model, deriv, templates_dir, prefix)
-    # A fresh start, so the parameter kernels never depend on the constant
-    # ones' creation order (and the constant kernels are as before).
-    sym.reset()
-    pmodel = params.ParamModel(model)
-    pderiv = dynamics.Derivation(mechanism.build(pmodel), pmodel)
-    pfiles, pemitted = render.render_params(model, pmodel, pderiv,
-                                            templates_dir, prefix)
-    files.update(pfiles)
-    for e in pemitted:
-        e.name = "param_" + e.name
+    # The parameter kernels are the topology's (--topology N), named
+    # after the model: nothing to derive.
+    files.update(render.render_params(model, templates_dir, prefix))
+    # A fresh start, so the regressor never depends on the constant
+    # kernels' creation order.
     sym.reset()
     rmodel = regressor.RegressorModel(model)
     rderiv = dynamics.Derivation(mechanism.build(rmodel), rmodel)
     rfiles, remitted = render.render_regressor(model, rmodel, rderiv,
                                                templates_dir, prefix)
     files.update(rfiles)
-    return files, emitted + pemitted + remitted
+    return files, emitted + remitted
 
 
 def generate_float(model, templates_dir=TEMPLATES, prefix=None):

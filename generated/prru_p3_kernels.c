@@ -9354,3 +9354,239 @@ PRRU_P3_BATCH_TARGETS void prru_p3_batch_dme_terms(const prru_params3 *p, int n,
     }
   }
 }
+
+/* Single-precision batched kernels. PRRU_P3_BATCH_LOOP and
+ * PRRU_P3_BATCH_TARGETS as for the other batched kernels. With
+ * PRRU_P3_BATCH_VECTOR_MATH defined (GCC), PRRU_P3_BATCH_SINF and _COSF
+ * are sinf and cosf declared as having vector variants (glibc's libmvec:
+ * 8 lanes with AVX2, _ZGVdN8v_sinf), within a few units in the last place
+ * of the scalar functions; every float batch calls them, so it agrees with
+ * the scalar float kernels within their accuracy bound, not bit for bit. */
+#ifndef PRRU_P3_BATCH_LOOP
+#define PRRU_P3_BATCH_LOOP
+#endif
+#ifndef PRRU_P3_BATCH_TARGETS
+#define PRRU_P3_BATCH_TARGETS
+#endif
+#if defined(PRRU_P3_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern float prru_p3_batch_vsinf(float) __asm__("sinf");
+#pragma omp declare simd notinbranch
+extern float prru_p3_batch_vcosf(float) __asm__("cosf");
+#define PRRU_P3_BATCH_SINF prru_p3_batch_vsinf
+#define PRRU_P3_BATCH_COSF prru_p3_batch_vcosf
+#else
+#define PRRU_P3_BATCH_SINF sinf
+#define PRRU_P3_BATCH_COSF cosf
+#endif
+
+PRRU_P3_BATCH_TARGETS void prru_p3_f_batch_dme_terms(const prru_params3 *p, int n, const float *q, float *d, float *Jd, float *M, float *JP)
+{
+  const float p_b_0 = (float)p->b[0];
+  const float p_b_1 = (float)p->b[1];
+  const float p_b_2 = (float)p->b[2];
+  const float p_l1_0 = (float)p->l1[0];
+  const float p_l1_1 = (float)p->l1[1];
+  const float p_l1_2 = (float)p->l1[2];
+  const float p_l2_0 = (float)p->l2[0];
+  const float p_l2_1 = (float)p->l2[1];
+  const float p_l2_2 = (float)p->l2[2];
+  const float p_a_0 = (float)p->a[0];
+  const float p_a_1 = (float)p->a[1];
+  const float p_mass_0 = (float)p->mass[0];
+  const float p_mass_1 = (float)p->mass[1];
+  const float p_mass_2 = (float)p->mass[2];
+  const float p_mass_3 = (float)p->mass[3];
+  const float p_mass_4 = (float)p->mass[4];
+  const float p_mass_5 = (float)p->mass[5];
+  const float p_mass_6 = (float)p->mass[6];
+  const float p_mass_7 = (float)p->mass[7];
+  const float p_mass_8 = (float)p->mass[8];
+  const float p_mass_9 = (float)p->mass[9];
+  const float p_com_0_0 = (float)p->com[0][0];
+  const float p_com_0_1 = (float)p->com[0][1];
+  const float p_com_0_2 = (float)p->com[0][2];
+  const float p_com_1_1 = (float)p->com[1][1];
+  const float p_com_1_2 = (float)p->com[1][2];
+  const float p_com_2_1 = (float)p->com[2][1];
+  const float p_com_2_2 = (float)p->com[2][2];
+  const float p_com_3_0 = (float)p->com[3][0];
+  const float p_com_3_2 = (float)p->com[3][2];
+  const float p_com_4_1 = (float)p->com[4][1];
+  const float p_com_4_2 = (float)p->com[4][2];
+  const float p_com_5_1 = (float)p->com[5][1];
+  const float p_com_5_2 = (float)p->com[5][2];
+  const float p_com_6_0 = (float)p->com[6][0];
+  const float p_com_6_2 = (float)p->com[6][2];
+  const float p_inertia_0_0 = (float)p->inertia[0][0];
+  const float p_inertia_0_1 = (float)p->inertia[0][1];
+  const float p_inertia_0_2 = (float)p->inertia[0][2];
+  const float p_inertia_0_3 = (float)p->inertia[0][3];
+  const float p_inertia_0_4 = (float)p->inertia[0][4];
+  const float p_inertia_0_5 = (float)p->inertia[0][5];
+  const float p_inertia_1_0 = (float)p->inertia[1][0];
+  const float p_inertia_2_0 = (float)p->inertia[2][0];
+  const float p_inertia_3_1 = (float)p->inertia[3][1];
+  const float p_inertia_4_0 = (float)p->inertia[4][0];
+  const float p_inertia_5_0 = (float)p->inertia[5][0];
+  const float p_inertia_6_1 = (float)p->inertia[6][1];
+  const float p_armature_0 = (float)p->armature[0];
+  const float p_armature_1 = (float)p->armature[1];
+  const float p_armature_2 = (float)p->armature[2];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    float w0[32], w1[32], w2[32], w3[32];
+    PRRU_P3_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const float q1 = q[k0 + k];
+      const float q2 = q[s + k0 + k];
+      w0[k] = PRRU_P3_BATCH_COSF(q1);
+      w1[k] = PRRU_P3_BATCH_COSF(q2);
+    }
+    PRRU_P3_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const float q1 = q[k0 + k];
+      const float q2 = q[s + k0 + k];
+      w2[k] = PRRU_P3_BATCH_SINF(q2);
+      w3[k] = PRRU_P3_BATCH_SINF(q1);
+    }
+    PRRU_P3_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const float q1 = q[i];
+      const float q2 = q[s + i];
+      const float q3 = q[2 * s + i];
+      const float t4 = 1.0f / p_l1_0;
+      const float t5 = p_a_0 * w0[k];
+      const float t6 = w0[k] * p_l2_0;
+      const float t7 = p_b_0 - t5 - t6;
+      const float t8 = 1.0f / p_l1_1;
+      const float t9 = w0[k] * p_a_1;
+      const float t10 = w0[k] * p_l2_1;
+      const float t11 = p_b_1 - t9 - t10;
+      const float t12 = 1.0f / p_l1_2;
+      const float t13 = w1[k] * w1[k];
+      const float t14 = w2[k] * w2[k];
+      const float t15 = w0[k] * w0[k] * t13 + t14;
+      const float t16 = sqrtf(t15);
+      const float t17 = 1.0f / t15;
+      const float t18 = t16 * t17;
+      const float t19 = t18 * (w0[k] * w1[k]);
+      const float t20 = p_l2_2 * t19;
+      const float t21 = p_b_2 - t20;
+      const float t22 = p_a_0 * w3[k];
+      const float t23 = p_l2_0 * w3[k];
+      const float t24 = t4 * t4;
+      const float t25 = 1.0f - t24 * (t7 * t7);
+      const float t26 = sqrtf(t25);
+      const float t27 = p_a_1 * w3[k];
+      const float t28 = p_l2_1 * w3[k];
+      const float t29 = t8 * t8;
+      const float t30 = 1.0f - t29 * (t11 * t11);
+      const float t31 = sqrtf(t30);
+      const float t32 = w2[k] * t18;
+      const float t33 = p_l2_2 * t32;
+      const float t34 = t12 * t12;
+      const float t35 = 1.0f - t34 * (t21 * t21);
+      const float t36 = sqrtf(t35);
+      const float t37 = 1.0f / t25;
+      const float t38 = t26 * t37;
+      const float t39 = t22 + t23;
+      const float t40 = t38 * (t7 * (t4 * t39));
+      const float t41 = t5 + t6;
+      const float t42 = t40 + t41;
+      const float t43 = 1.0f / t30;
+      const float t44 = t31 * t43;
+      const float t45 = t27 + t28;
+      const float t46 = t44 * (t11 * (t8 * t45));
+      const float t47 = t9 + t10;
+      const float t48 = t47 - t46;
+      const float t49 = t17 * (w2[k] * (w1[k] * w3[k]));
+      const float t50 = 1.0f / t35;
+      const float t51 = t36 * t50;
+      const float t52 = t12 * p_l2_2;
+      const float t53 = w0[k] * t17;
+      const float t54 = w0[k] * p_com_0_2;
+      const float t55 = w0[k] * p_com_0_0;
+      const float t56 = w3[k] * p_com_0_1 + w1[k] * t54 - w2[k] * t55;
+      const float t57 = w3[k] * p_com_0_0;
+      const float t58 = w3[k] * p_com_0_2;
+      const float t59 = w2[k] * t57 + w0[k] * p_com_0_1 - w1[k] * t58;
+      const float t60 = t22 - w3[k] * p_com_1_1 + (t23 * 0.5f - w0[k] * p_com_1_2);
+      const float t61 = t5 - w0[k] * p_com_1_1 + (w3[k] * p_com_1_2 + t6 * 0.5f);
+      const float t62 = t27 + w3[k] * p_com_2_1 + (w0[k] * p_com_2_2 + t28 * 0.5f);
+      const float t63 = t9 + w0[k] * p_com_2_1 + (t10 * 0.5f - w3[k] * p_com_2_2);
+      const float t64 = t40 * 0.5f + (t41 - t39 * (t4 * p_com_4_2) - t38 * (t7 * (t39 * (t24 * p_com_4_1))));
+      const float t65 = t39 + (t39 * (t4 * p_com_4_1) - t38 * (t7 * (t39 * (t24 * p_com_4_2)))) * 2.0f;
+      const float t66 = t47 + t45 * (t8 * p_com_5_2) - t44 * (t11 * (t45 * (t29 * p_com_5_1))) - t46 * 0.5f;
+      const float t67 = t45 - 2.0f * (t45 * (t8 * p_com_5_1) + t44 * (t11 * (t45 * (t29 * p_com_5_2))));
+      const float t68 = t42 * t42;
+      const float t69 = t48 * t48;
+      const float t70 = t33 - 2.0f * (t19 * p_com_3_2 - t32 * p_com_3_0);
+      const float t71 = t20 + 2.0f * (t19 * p_com_3_0 + t32 * p_com_3_2);
+      const float t72 = t51 * (t21 * (t32 * t52));
+      const float t73 = p_l2_2 * p_com_6_0;
+      const float t74 = p_l2_2 * p_com_6_2;
+      const float t75 = 0.5f * t72 + (t20 + t32 * (t12 * t74) - t51 * (t21 * (t32 * (t34 * t73))));
+      const float t76 = t33 + 2.0f * (t51 * (t21 * (t32 * (t34 * t74))) + t32 * (t12 * t73));
+      const float t77 = t20 + t72;
+      const float t78 = t77 * t77;
+      const float t79 = (p_mass_6 * (t76 * t76) + (p_mass_3 * (t70 * t70) + p_mass_3 * (t71 * t71))) * 0.25f + (p_mass_9 * t78 + (p_inertia_3_1 + t50 * (t32 * t32 * (t34 * (p_l2_2 * p_l2_2 * p_inertia_6_1)))) + (p_mass_6 * (t75 * t75) + t78 * p_armature_2));
+      const float t80 = w1[k] * t57 + w2[k] * t58;
+      const float t81 = w2[k] * t54 + w1[k] * t55;
+      const float t82 = p_mass_0 * t81;
+      const float t83 = t79 * (t49 * t53) + (w1[k] * p_inertia_0_3 + w2[k] * p_inertia_0_5 - t56 * (p_mass_0 * t80) - t59 * t82);
+      const float t84 = p_mass_3 * t71 + 2.0f * (p_mass_6 * t75 + (p_mass_9 * t77 + t77 * p_armature_2));
+      const float t85 = p_mass_5 * t66 + (p_mass_2 * t63 + (p_mass_0 * t59 - p_mass_1 * t61) - t42 * p_mass_7) + (t48 * p_mass_8 + t48 * p_armature_1 - (p_mass_4 * t64 + t42 * p_armature_0)) - 0.5f * (t49 * t84);
+      const float t86 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const float t87 = -(t82 + 0.5f * (t53 * t84));
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabsf(t4 * t7), 1.0f) &
+          islessequal(fabsf(t8 * t11), 1.0f) &
+          islessequal(fabsf(-(t12 * t21)), 1.0f) &
+          islessequal(fabsf(q1), 3.4028235e+38f) &
+          islessequal(fabsf(q2), 3.4028235e+38f) &
+          islessequal(fabsf(q3), 3.4028235e+38f);
+      d[i] = ok ? p_l1_0 * t26 + (q3 - t22 - t23) : NAN;
+      d[s + i] = ok ? p_l1_1 * t31 + (t28 + (q3 + t27)) : NAN;
+      d[2 * s + i] = ok ? p_l1_2 * t36 + (q3 - t33) : NAN;
+      Jd[i] = ok ? -t42 : NAN;
+      Jd[s + i] = ok ? 0.0f : NAN;
+      Jd[2 * s + i] = ok ? 1.0f : NAN;
+      Jd[3 * s + i] = ok ? t48 : NAN;
+      Jd[4 * s + i] = ok ? 0.0f : NAN;
+      Jd[5 * s + i] = ok ? 1.0f : NAN;
+      Jd[6 * s + i] = ok ? -(t19 * (p_l2_2 * t49) + t51 * (t21 * (t32 * (t49 * t52)))) : NAN;
+      Jd[7 * s + i] = ok ? -(t19 * (p_l2_2 * t53) + t51 * (t21 * (t32 * (t52 * t53)))) : NAN;
+      Jd[8 * s + i] = ok ? 1.0f : NAN;
+      M[i] = ok ? t49 * t49 * t79 + (0.25f * (p_mass_4 * (t65 * t65) + p_mass_5 * (t67 * t67)) + (p_mass_5 * (t66 * t66) + (p_mass_7 * t68 + (t43 * (t45 * t45 * (t29 * p_inertia_5_0)) + (t37 * (t39 * t39 * (t24 * p_inertia_4_0)) + (p_mass_2 * (t63 * t63) + (p_mass_0 * (t56 * t56) + (t13 * p_inertia_0_0 + (p_inertia_1_0 + p_inertia_2_0) + (t14 * p_inertia_0_2 + w2[k] * (w1[k] * p_inertia_0_4) * 2.0f))) + (p_mass_0 * (t59 * t59) + p_mass_1 * (t60 * t60) + (p_mass_1 * (t61 * t61) + p_mass_2 * (t62 * t62))))))) + (p_mass_8 * t69 + t68 * p_armature_0 + (p_mass_4 * (t64 * t64) + t69 * p_armature_1)))) : NAN;
+      M[s + i] = ok ? t83 : NAN;
+      M[2 * s + i] = ok ? t85 : NAN;
+      M[3 * s + i] = ok ? t83 : NAN;
+      M[4 * s + i] = ok ? t79 * (t53 * t53) + (p_inertia_0_1 + p_mass_0 * (t86 * t86) + (p_mass_0 * (t80 * t80) + p_mass_0 * (t81 * t81))) : NAN;
+      M[5 * s + i] = ok ? t87 : NAN;
+      M[6 * s + i] = ok ? t85 : NAN;
+      M[7 * s + i] = ok ? t87 : NAN;
+      M[8 * s + i] = ok ? p_armature_0 + p_armature_1 + (p_armature_2 + (p_mass_0 + p_mass_1)) + (p_mass_2 + p_mass_3 + (p_mass_4 + p_mass_5) + (p_mass_7 + p_mass_6 + (p_mass_8 + p_mass_9))) : NAN;
+      JP[i] = ok ? 1.0f : NAN;
+      JP[s + i] = ok ? 0.0f : NAN;
+      JP[2 * s + i] = ok ? 0.0f : NAN;
+      JP[3 * s + i] = ok ? 0.0f : NAN;
+      JP[4 * s + i] = ok ? w0[k] : NAN;
+      JP[5 * s + i] = ok ? 0.0f : NAN;
+      JP[6 * s + i] = ok ? 0.0f : NAN;
+      JP[7 * s + i] = ok ? w3[k] : NAN;
+      JP[8 * s + i] = ok ? 0.0f : NAN;
+      JP[9 * s + i] = ok ? 0.0f : NAN;
+      JP[10 * s + i] = ok ? 0.0f : NAN;
+      JP[11 * s + i] = ok ? 0.0f : NAN;
+      JP[12 * s + i] = ok ? 0.0f : NAN;
+      JP[13 * s + i] = ok ? 0.0f : NAN;
+      JP[14 * s + i] = ok ? 0.0f : NAN;
+      JP[15 * s + i] = ok ? 0.0f : NAN;
+      JP[16 * s + i] = ok ? 0.0f : NAN;
+      JP[17 * s + i] = ok ? 1.0f : NAN;
+    }
+  }
+}

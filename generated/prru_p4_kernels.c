@@ -10702,3 +10702,277 @@ PRRU_P4_BATCH_TARGETS void prru_p4_batch_dme_terms(const prru_params4 *p, int n,
     }
   }
 }
+
+/* Single-precision batched kernels. PRRU_P4_BATCH_LOOP and
+ * PRRU_P4_BATCH_TARGETS as for the other batched kernels. With
+ * PRRU_P4_BATCH_VECTOR_MATH defined (GCC), PRRU_P4_BATCH_SINF and _COSF
+ * are sinf and cosf declared as having vector variants (glibc's libmvec:
+ * 8 lanes with AVX2, _ZGVdN8v_sinf), within a few units in the last place
+ * of the scalar functions; every float batch calls them, so it agrees with
+ * the scalar float kernels within their accuracy bound, not bit for bit. */
+#ifndef PRRU_P4_BATCH_LOOP
+#define PRRU_P4_BATCH_LOOP
+#endif
+#ifndef PRRU_P4_BATCH_TARGETS
+#define PRRU_P4_BATCH_TARGETS
+#endif
+#if defined(PRRU_P4_BATCH_VECTOR_MATH) && defined(__GNUC__) && !defined(__cplusplus)
+#pragma omp declare simd notinbranch
+extern float prru_p4_batch_vsinf(float) __asm__("sinf");
+#pragma omp declare simd notinbranch
+extern float prru_p4_batch_vcosf(float) __asm__("cosf");
+#define PRRU_P4_BATCH_SINF prru_p4_batch_vsinf
+#define PRRU_P4_BATCH_COSF prru_p4_batch_vcosf
+#else
+#define PRRU_P4_BATCH_SINF sinf
+#define PRRU_P4_BATCH_COSF cosf
+#endif
+
+PRRU_P4_BATCH_TARGETS void prru_p4_f_batch_dme_terms(const prru_params4 *p, int n, const float *q, float *d, float *Jd, float *M, float *JP)
+{
+  const float p_b_0 = (float)p->b[0];
+  const float p_b_1 = (float)p->b[1];
+  const float p_b_2 = (float)p->b[2];
+  const float p_b_3 = (float)p->b[3];
+  const float p_l1_0 = (float)p->l1[0];
+  const float p_l1_1 = (float)p->l1[1];
+  const float p_l1_2 = (float)p->l1[2];
+  const float p_l1_3 = (float)p->l1[3];
+  const float p_l2_0 = (float)p->l2[0];
+  const float p_l2_1 = (float)p->l2[1];
+  const float p_l2_2 = (float)p->l2[2];
+  const float p_l2_3 = (float)p->l2[3];
+  const float p_a_0 = (float)p->a[0];
+  const float p_a_1 = (float)p->a[1];
+  const float p_mass_0 = (float)p->mass[0];
+  const float p_mass_1 = (float)p->mass[1];
+  const float p_mass_2 = (float)p->mass[2];
+  const float p_mass_3 = (float)p->mass[3];
+  const float p_mass_4 = (float)p->mass[4];
+  const float p_mass_5 = (float)p->mass[5];
+  const float p_mass_6 = (float)p->mass[6];
+  const float p_mass_7 = (float)p->mass[7];
+  const float p_mass_8 = (float)p->mass[8];
+  const float p_mass_9 = (float)p->mass[9];
+  const float p_mass_10 = (float)p->mass[10];
+  const float p_mass_11 = (float)p->mass[11];
+  const float p_mass_12 = (float)p->mass[12];
+  const float p_com_0_0 = (float)p->com[0][0];
+  const float p_com_0_1 = (float)p->com[0][1];
+  const float p_com_0_2 = (float)p->com[0][2];
+  const float p_com_1_1 = (float)p->com[1][1];
+  const float p_com_1_2 = (float)p->com[1][2];
+  const float p_com_2_1 = (float)p->com[2][1];
+  const float p_com_2_2 = (float)p->com[2][2];
+  const float p_com_3_0 = (float)p->com[3][0];
+  const float p_com_3_2 = (float)p->com[3][2];
+  const float p_com_4_0 = (float)p->com[4][0];
+  const float p_com_4_2 = (float)p->com[4][2];
+  const float p_com_5_1 = (float)p->com[5][1];
+  const float p_com_5_2 = (float)p->com[5][2];
+  const float p_com_6_1 = (float)p->com[6][1];
+  const float p_com_6_2 = (float)p->com[6][2];
+  const float p_com_7_0 = (float)p->com[7][0];
+  const float p_com_7_2 = (float)p->com[7][2];
+  const float p_com_8_0 = (float)p->com[8][0];
+  const float p_com_8_2 = (float)p->com[8][2];
+  const float p_inertia_0_0 = (float)p->inertia[0][0];
+  const float p_inertia_0_1 = (float)p->inertia[0][1];
+  const float p_inertia_0_2 = (float)p->inertia[0][2];
+  const float p_inertia_0_3 = (float)p->inertia[0][3];
+  const float p_inertia_0_4 = (float)p->inertia[0][4];
+  const float p_inertia_0_5 = (float)p->inertia[0][5];
+  const float p_inertia_1_0 = (float)p->inertia[1][0];
+  const float p_inertia_2_0 = (float)p->inertia[2][0];
+  const float p_inertia_3_1 = (float)p->inertia[3][1];
+  const float p_inertia_4_1 = (float)p->inertia[4][1];
+  const float p_inertia_5_0 = (float)p->inertia[5][0];
+  const float p_inertia_6_0 = (float)p->inertia[6][0];
+  const float p_inertia_7_1 = (float)p->inertia[7][1];
+  const float p_inertia_8_1 = (float)p->inertia[8][1];
+  const float p_armature_0 = (float)p->armature[0];
+  const float p_armature_1 = (float)p->armature[1];
+  const float p_armature_2 = (float)p->armature[2];
+  const float p_armature_3 = (float)p->armature[3];
+  const long s = n;
+  for (long k0 = 0; k0 < s; k0 += 32) {
+    const long m = s - k0 < 32 ? s - k0 : 32;
+    float w0[32], w1[32], w2[32], w3[32];
+    PRRU_P4_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const float q1 = q[k0 + k];
+      const float q2 = q[s + k0 + k];
+      w0[k] = PRRU_P4_BATCH_COSF(q1);
+      w1[k] = PRRU_P4_BATCH_COSF(q2);
+    }
+    PRRU_P4_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const float q1 = q[k0 + k];
+      const float q2 = q[s + k0 + k];
+      w2[k] = PRRU_P4_BATCH_SINF(q2);
+      w3[k] = PRRU_P4_BATCH_SINF(q1);
+    }
+    PRRU_P4_BATCH_LOOP
+    for (long k = 0; k < m; k++) {
+      const long i = k0 + k;
+      const float q1 = q[i];
+      const float q2 = q[s + i];
+      const float q3 = q[2 * s + i];
+      const float t4 = 1.0f / p_l1_0;
+      const float t5 = p_a_0 * w0[k];
+      const float t6 = w0[k] * p_l2_0;
+      const float t7 = p_b_0 - t5 - t6;
+      const float t8 = 1.0f / p_l1_1;
+      const float t9 = w0[k] * p_a_1;
+      const float t10 = w0[k] * p_l2_1;
+      const float t11 = p_b_1 - t9 - t10;
+      const float t12 = 1.0f / p_l1_2;
+      const float t13 = w1[k] * w1[k];
+      const float t14 = w2[k] * w2[k];
+      const float t15 = w0[k] * w0[k] * t13 + t14;
+      const float t16 = sqrtf(t15);
+      const float t17 = 1.0f / t15;
+      const float t18 = t16 * t17;
+      const float t19 = t18 * (w0[k] * w1[k]);
+      const float t20 = p_l2_2 * t19;
+      const float t21 = p_b_2 - t20;
+      const float t22 = 1.0f / p_l1_3;
+      const float t23 = t19 * p_l2_3;
+      const float t24 = p_b_3 - t23;
+      const float t25 = p_a_0 * w3[k];
+      const float t26 = p_l2_0 * w3[k];
+      const float t27 = t4 * t4;
+      const float t28 = 1.0f - t27 * (t7 * t7);
+      const float t29 = sqrtf(t28);
+      const float t30 = p_a_1 * w3[k];
+      const float t31 = p_l2_1 * w3[k];
+      const float t32 = t8 * t8;
+      const float t33 = 1.0f - t32 * (t11 * t11);
+      const float t34 = sqrtf(t33);
+      const float t35 = w2[k] * t18;
+      const float t36 = p_l2_2 * t35;
+      const float t37 = t12 * t12;
+      const float t38 = 1.0f - t37 * (t21 * t21);
+      const float t39 = sqrtf(t38);
+      const float t40 = p_l2_3 * t35;
+      const float t41 = t22 * t22;
+      const float t42 = 1.0f - t41 * (t24 * t24);
+      const float t43 = sqrtf(t42);
+      const float t44 = 1.0f / t28;
+      const float t45 = t29 * t44;
+      const float t46 = t25 + t26;
+      const float t47 = t45 * (t7 * (t4 * t46));
+      const float t48 = t5 + t6;
+      const float t49 = t47 + t48;
+      const float t50 = 1.0f / t33;
+      const float t51 = t34 * t50;
+      const float t52 = t30 + t31;
+      const float t53 = t51 * (t11 * (t8 * t52));
+      const float t54 = t9 + t10;
+      const float t55 = t54 - t53;
+      const float t56 = t17 * (w2[k] * (w1[k] * w3[k]));
+      const float t57 = 1.0f / t38;
+      const float t58 = t39 * t57;
+      const float t59 = t12 * p_l2_2;
+      const float t60 = w0[k] * t17;
+      const float t61 = 1.0f / t42;
+      const float t62 = t43 * t61;
+      const float t63 = t22 * p_l2_3;
+      const float t64 = w0[k] * p_com_0_2;
+      const float t65 = w0[k] * p_com_0_0;
+      const float t66 = w3[k] * p_com_0_1 + w1[k] * t64 - w2[k] * t65;
+      const float t67 = w3[k] * p_com_0_0;
+      const float t68 = w3[k] * p_com_0_2;
+      const float t69 = w2[k] * t67 + w0[k] * p_com_0_1 - w1[k] * t68;
+      const float t70 = t25 - w3[k] * p_com_1_1 + (t26 * 0.5f - w0[k] * p_com_1_2);
+      const float t71 = t5 - w0[k] * p_com_1_1 + (w3[k] * p_com_1_2 + t6 * 0.5f);
+      const float t72 = t30 + w3[k] * p_com_2_1 + (w0[k] * p_com_2_2 + t31 * 0.5f);
+      const float t73 = t9 + w0[k] * p_com_2_1 + (t10 * 0.5f - w3[k] * p_com_2_2);
+      const float t74 = t47 * 0.5f + (t48 - t46 * (t4 * p_com_5_2) - t45 * (t7 * (t46 * (t27 * p_com_5_1))));
+      const float t75 = t46 + (t46 * (t4 * p_com_5_1) - t45 * (t7 * (t46 * (t27 * p_com_5_2)))) * 2.0f;
+      const float t76 = t54 + t52 * (t8 * p_com_6_2) - t51 * (t11 * (t52 * (t32 * p_com_6_1))) - t53 * 0.5f;
+      const float t77 = t52 - 2.0f * (t52 * (t8 * p_com_6_1) + t51 * (t11 * (t52 * (t32 * p_com_6_2))));
+      const float t78 = t49 * t49;
+      const float t79 = t55 * t55;
+      const float t80 = t36 - 2.0f * (t19 * p_com_3_2 - t35 * p_com_3_0);
+      const float t81 = t20 + 2.0f * (t19 * p_com_3_0 + t35 * p_com_3_2);
+      const float t82 = t40 + 2.0f * (t19 * p_com_4_2 - t35 * p_com_4_0);
+      const float t83 = t23 - 2.0f * (t19 * p_com_4_0 + t35 * p_com_4_2);
+      const float t84 = t58 * (t21 * (t35 * t59));
+      const float t85 = p_l2_2 * p_com_7_0;
+      const float t86 = p_l2_2 * p_com_7_2;
+      const float t87 = 0.5f * t84 + (t20 + t35 * (t12 * t86) - t58 * (t21 * (t35 * (t37 * t85))));
+      const float t88 = t36 + 2.0f * (t58 * (t21 * (t35 * (t37 * t86))) + t35 * (t12 * t85));
+      const float t89 = t35 * t35;
+      const float t90 = t62 * (t24 * (t35 * t63));
+      const float t91 = p_l2_3 * p_com_8_2;
+      const float t92 = p_l2_3 * p_com_8_0;
+      const float t93 = t62 * (t24 * (t35 * (t41 * t92))) + (t23 + t35 * (t22 * t91)) - 0.5f * t90;
+      const float t94 = t40 + 2.0f * (t35 * (t22 * t92) - t62 * (t24 * (t35 * (t41 * t91))));
+      const float t95 = t20 + t84;
+      const float t96 = t95 * t95;
+      const float t97 = t23 - t90;
+      const float t98 = t97 * t97;
+      const float t99 = (p_mass_8 * (t94 * t94) + (p_mass_7 * (t88 * t88) + (p_mass_3 * (t80 * t80) + p_mass_3 * (t81 * t81) + (p_mass_4 * (t82 * t82) + p_mass_4 * (t83 * t83))))) * 0.25f + (p_mass_8 * (t93 * t93) + (p_mass_11 * t96 + (t61 * (t89 * (t41 * (p_l2_3 * p_l2_3 * p_inertia_8_1))) + (t57 * (t89 * (t37 * (p_l2_2 * p_l2_2 * p_inertia_7_1))) + (p_inertia_3_1 + p_inertia_4_1)))) + (p_mass_12 * t98 + t96 * p_armature_2 + (p_mass_7 * (t87 * t87) + t98 * p_armature_3)));
+      const float t100 = w1[k] * t67 + w2[k] * t68;
+      const float t101 = w2[k] * t64 + w1[k] * t65;
+      const float t102 = p_mass_0 * t101;
+      const float t103 = t99 * (t56 * t60) + (w1[k] * p_inertia_0_3 + w2[k] * p_inertia_0_5 - t66 * (p_mass_0 * t100) - t69 * t102);
+      const float t104 = 2.0f * (p_mass_7 * t87 - p_mass_8 * t93 + (p_mass_11 * t95 - p_mass_12 * t97 + (t95 * p_armature_2 - t97 * p_armature_3))) + (p_mass_3 * t81 - p_mass_4 * t83);
+      const float t105 = p_mass_6 * t76 + (p_mass_2 * t73 + (p_mass_0 * t69 - p_mass_1 * t71) - t49 * p_mass_9) + (t55 * p_mass_10 + t55 * p_armature_1 - (p_mass_5 * t74 + t49 * p_armature_0)) - 0.5f * (t56 * t104);
+      const float t106 = w2[k] * p_com_0_0 - w1[k] * p_com_0_2;
+      const float t107 = -(t102 + 0.5f * (t60 * t104));
+      /* Unreachable or non-finite q: NaN (a select, not a branch). */
+      const int ok = islessequal(fabsf(t4 * t7), 1.0f) &
+          islessequal(fabsf(t8 * t11), 1.0f) &
+          islessequal(fabsf(-(t12 * t21)), 1.0f) &
+          islessequal(fabsf(t22 * t24), 1.0f) &
+          islessequal(fabsf(q1), 3.4028235e+38f) &
+          islessequal(fabsf(q2), 3.4028235e+38f) &
+          islessequal(fabsf(q3), 3.4028235e+38f);
+      d[i] = ok ? p_l1_0 * t29 + (q3 - t25 - t26) : NAN;
+      d[s + i] = ok ? p_l1_1 * t34 + (t31 + (q3 + t30)) : NAN;
+      d[2 * s + i] = ok ? p_l1_2 * t39 + (q3 - t36) : NAN;
+      d[3 * s + i] = ok ? p_l1_3 * t43 + (q3 + t40) : NAN;
+      Jd[i] = ok ? -t49 : NAN;
+      Jd[s + i] = ok ? 0.0f : NAN;
+      Jd[2 * s + i] = ok ? 1.0f : NAN;
+      Jd[3 * s + i] = ok ? t55 : NAN;
+      Jd[4 * s + i] = ok ? 0.0f : NAN;
+      Jd[5 * s + i] = ok ? 1.0f : NAN;
+      Jd[6 * s + i] = ok ? -(t19 * (p_l2_2 * t56) + t58 * (t21 * (t35 * (t56 * t59)))) : NAN;
+      Jd[7 * s + i] = ok ? -(t19 * (p_l2_2 * t60) + t58 * (t21 * (t35 * (t59 * t60)))) : NAN;
+      Jd[8 * s + i] = ok ? 1.0f : NAN;
+      Jd[9 * s + i] = ok ? t19 * (p_l2_3 * t56) - t62 * (t24 * (t35 * (t56 * t63))) : NAN;
+      Jd[10 * s + i] = ok ? t19 * (p_l2_3 * t60) - t62 * (t24 * (t35 * (t60 * t63))) : NAN;
+      Jd[11 * s + i] = ok ? 1.0f : NAN;
+      M[i] = ok ? t56 * t56 * t99 + (0.25f * (p_mass_5 * (t75 * t75) + p_mass_6 * (t77 * t77)) + (p_mass_6 * (t76 * t76) + (p_mass_9 * t78 + (t50 * (t52 * t52 * (t32 * p_inertia_6_0)) + (t44 * (t46 * t46 * (t27 * p_inertia_5_0)) + (p_mass_2 * (t73 * t73) + (p_mass_0 * (t66 * t66) + (t13 * p_inertia_0_0 + (p_inertia_1_0 + p_inertia_2_0) + (t14 * p_inertia_0_2 + w2[k] * (w1[k] * p_inertia_0_4) * 2.0f))) + (p_mass_0 * (t69 * t69) + p_mass_1 * (t70 * t70) + (p_mass_1 * (t71 * t71) + p_mass_2 * (t72 * t72))))))) + (p_mass_10 * t79 + t78 * p_armature_0 + (p_mass_5 * (t74 * t74) + t79 * p_armature_1)))) : NAN;
+      M[s + i] = ok ? t103 : NAN;
+      M[2 * s + i] = ok ? t105 : NAN;
+      M[3 * s + i] = ok ? t103 : NAN;
+      M[4 * s + i] = ok ? t99 * (t60 * t60) + (p_inertia_0_1 + p_mass_0 * (t106 * t106) + (p_mass_0 * (t100 * t100) + p_mass_0 * (t101 * t101))) : NAN;
+      M[5 * s + i] = ok ? t107 : NAN;
+      M[6 * s + i] = ok ? t105 : NAN;
+      M[7 * s + i] = ok ? t107 : NAN;
+      M[8 * s + i] = ok ? p_mass_2 + p_mass_3 + (p_mass_5 + p_mass_4) + (p_mass_6 + p_mass_7 + (p_mass_9 + p_mass_8)) + (p_mass_10 + p_mass_11 + (p_armature_0 + p_mass_12) + (p_armature_1 + p_armature_2 + (p_armature_3 + (p_mass_0 + p_mass_1)))) : NAN;
+      JP[i] = ok ? 1.0f : NAN;
+      JP[s + i] = ok ? 0.0f : NAN;
+      JP[2 * s + i] = ok ? 0.0f : NAN;
+      JP[3 * s + i] = ok ? 0.0f : NAN;
+      JP[4 * s + i] = ok ? w0[k] : NAN;
+      JP[5 * s + i] = ok ? 0.0f : NAN;
+      JP[6 * s + i] = ok ? 0.0f : NAN;
+      JP[7 * s + i] = ok ? w3[k] : NAN;
+      JP[8 * s + i] = ok ? 0.0f : NAN;
+      JP[9 * s + i] = ok ? 0.0f : NAN;
+      JP[10 * s + i] = ok ? 0.0f : NAN;
+      JP[11 * s + i] = ok ? 0.0f : NAN;
+      JP[12 * s + i] = ok ? 0.0f : NAN;
+      JP[13 * s + i] = ok ? 0.0f : NAN;
+      JP[14 * s + i] = ok ? 0.0f : NAN;
+      JP[15 * s + i] = ok ? 0.0f : NAN;
+      JP[16 * s + i] = ok ? 0.0f : NAN;
+      JP[17 * s + i] = ok ? 1.0f : NAN;
+    }
+  }
+}

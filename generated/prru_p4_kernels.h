@@ -276,6 +276,9 @@ void prru_p4_batch_eom_solve(const prru_params4 *p, int n, const double *q, cons
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void prru_p4_batch_dme_terms(const prru_params4 *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
 
+/* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. In single precision: prru_p4_f_batch.h's conventions, parameters from *p (rounded to float once). */
+void prru_p4_f_batch_dme_terms(const prru_params4 *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
+
 #ifdef __cplusplus
 }
 #endif

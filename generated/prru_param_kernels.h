@@ -3,20 +3,6 @@
  * 3prru_paper.json (sha256 6e4337aa46dd6b6910a47563e2834ac7e42ee1c45a746bc03e121277ef8dfb29):
  * 3-PRRU 1T2R parallel manipulator, geometry and inertia of Chen, Yu, Li, Wang, Nonlinear Dynamics 90 (2017), Table 1
  * Edit the model file or the generator and regenerate instead.
- *
- * Operation counts per kernel:
- *   ik                 55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   jd                 83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   ik_jd              95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   mass               343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   bias               730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   gravity            249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   dynamics           905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   eom                968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   platform_jacobian  26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1
- *   energy             524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   actuator_rates     198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   passive            134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_PARAM_KERNELS_H
 #define PRRU_PARAM_KERNELS_H
@@ -25,10 +11,14 @@
  * name, with the model's geometry, inertia, gravity and drive numbers read
  * from a prru_params argument instead of folded into the code, so that
  * one build can evaluate any design of the same structure (number of limbs)
- * for optimization, sensitivity or calibration. Same arguments after p,
- * same outputs, same conventions (row-major, body order, NaN on every
- * output where q is unreachable or not finite). At prru_params_model
- * they agree with the constant kernels to rounding.
+ * for optimization, sensitivity or calibration. They are the 3-limb
+ * topology kernels, prru_p3_kernels.{h,c} (`prru_gen.py --topology 3`,
+ * generated once per topology, never per model), named here after this
+ * model: prru_param_<kernel> is prru_p3_<kernel> and prru_params
+ * is prru_params3. Compile prru_p3_kernels.c beside this file's .c.
+ * Same arguments after p, same outputs, same conventions (row-major, body
+ * order, NaN on every output where q is unreachable or not finite). At
+ * prru_params_model they agree with the constant kernels to rounding.
  * The parameters are not checked: a design that cannot be built (a link of
  * length <= 0, a non-positive-definite inertia) gives NaN or meaningless
  * numbers, so the caller validates designs. coulomb_velocity must be
@@ -36,132 +26,63 @@
  * Structurally, a link turns about its hinge only, so only its moment about
  * that axis enters any output (Ixx for limbs 1 and 2, Iyy for limbs 3 and
  * 4), a slider's inertia enters none, and a[2], a[3] are ignored: their
- * derivatives are exactly 0.
- * Each kernel reads every member it uses once; no globals are written, no
- * allocation, re-entrant; depends only on <math.h>. */
+ * derivatives are exactly 0. */
 #include "prru_kernels.h"
+#include "prru_p3_kernels.h"
 
-#define PRRU_PARAM_ARITH_IK 55 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_JD 83 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_IK_JD 95 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_MASS 343 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_BIAS 730 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_GRAVITY 249 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_DYNAMICS 905 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_EOM 968 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_PLATFORM_JACOBIAN 26 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ENERGY 524 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_ACTUATOR_RATES 198 /* arithmetic operations */
-#define PRRU_PARAM_ARITH_PASSIVE 134 /* arithmetic operations */
-#define PRRU_PARAM_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_MASS "343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_BIAS "730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_GRAVITY "249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_DYNAMICS "905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_EOM "968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_PARAM_OPS_PLATFORM_JACOBIAN "26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_PARAM_OPS_ENERGY "524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_ACTUATOR_RATES "198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_PARAM_OPS_PASSIVE "134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define prru_param_ik prru_p3_ik
+#define prru_param_jd prru_p3_jd
+#define prru_param_ik_jd prru_p3_ik_jd
+#define prru_param_mass prru_p3_mass
+#define prru_param_bias prru_p3_bias
+#define prru_param_gravity prru_p3_gravity
+#define prru_param_dynamics prru_p3_dynamics
+#define prru_param_eom prru_p3_eom
+#define prru_param_platform_jacobian prru_p3_platform_jacobian
+#define prru_param_energy prru_p3_energy
+#define prru_param_actuator_rates prru_p3_actuator_rates
+#define prru_param_passive prru_p3_passive
+#define prru_param_batch_ik_jd prru_p3_batch_ik_jd
+#define prru_param_batch_mass prru_p3_batch_mass
+#define prru_param_batch_platform_jacobian prru_p3_batch_platform_jacobian
+#define prru_param_batch_dynamics prru_p3_batch_dynamics
+#define prru_param_batch_eom prru_p3_batch_eom
+#define prru_param_batch_dme_terms prru_p3_batch_dme_terms
+#define prru_param_f_batch_dme_terms prru_p3_f_batch_dme_terms
+#define PRRU_PARAM_ARITH_IK PRRU_P3_ARITH_IK
+#define PRRU_PARAM_ARITH_JD PRRU_P3_ARITH_JD
+#define PRRU_PARAM_ARITH_IK_JD PRRU_P3_ARITH_IK_JD
+#define PRRU_PARAM_ARITH_MASS PRRU_P3_ARITH_MASS
+#define PRRU_PARAM_ARITH_BIAS PRRU_P3_ARITH_BIAS
+#define PRRU_PARAM_ARITH_GRAVITY PRRU_P3_ARITH_GRAVITY
+#define PRRU_PARAM_ARITH_DYNAMICS PRRU_P3_ARITH_DYNAMICS
+#define PRRU_PARAM_ARITH_EOM PRRU_P3_ARITH_EOM
+#define PRRU_PARAM_ARITH_PLATFORM_JACOBIAN PRRU_P3_ARITH_PLATFORM_JACOBIAN
+#define PRRU_PARAM_ARITH_ENERGY PRRU_P3_ARITH_ENERGY
+#define PRRU_PARAM_ARITH_ACTUATOR_RATES PRRU_P3_ARITH_ACTUATOR_RATES
+#define PRRU_PARAM_ARITH_PASSIVE PRRU_P3_ARITH_PASSIVE
+#define PRRU_PARAM_OPS_IK PRRU_P3_OPS_IK
+#define PRRU_PARAM_OPS_JD PRRU_P3_OPS_JD
+#define PRRU_PARAM_OPS_IK_JD PRRU_P3_OPS_IK_JD
+#define PRRU_PARAM_OPS_MASS PRRU_P3_OPS_MASS
+#define PRRU_PARAM_OPS_BIAS PRRU_P3_OPS_BIAS
+#define PRRU_PARAM_OPS_GRAVITY PRRU_P3_OPS_GRAVITY
+#define PRRU_PARAM_OPS_DYNAMICS PRRU_P3_OPS_DYNAMICS
+#define PRRU_PARAM_OPS_EOM PRRU_P3_OPS_EOM
+#define PRRU_PARAM_OPS_PLATFORM_JACOBIAN PRRU_P3_OPS_PLATFORM_JACOBIAN
+#define PRRU_PARAM_OPS_ENERGY PRRU_P3_OPS_ENERGY
+#define PRRU_PARAM_OPS_ACTUATOR_RATES PRRU_P3_OPS_ACTUATOR_RATES
+#define PRRU_PARAM_OPS_PASSIVE PRRU_P3_OPS_PASSIVE
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-typedef struct {
-  /* Geometry per limb, m: rail offset b (rails of limbs 1, 2 at y = -b1,
-     +b2, of limb 3 at x = +b3, of a fourth limb at x = -b4), upper link l1
-     (A_i to B_i), lower link l2 (B_i to C_i), U-joint offset a of C_i on the
-     platform (limbs 1 and 2 only: C1 at v = -a[0], C2 at v = +a[1]; the
-     other entries are ignored). */
-  double b[PRRU_NLIMB], l1[PRRU_NLIMB], l2[PRRU_NLIMB], a[PRRU_NLIMB];
-  /* Gravity in {S}, m/s^2. */
-  double gravity[3];
-  /* Per body, in body order: mass (kg), centre of mass in the body frame
-     (m), inertia tensor Ixx Iyy Izz Ixy Ixz Iyz about the centre of mass in
-     body axes (kg m^2). */
-  double mass[PRRU_NBODY], com[PRRU_NBODY][3], inertia[PRRU_NBODY][6];
-  /* Drives: armature (kg), viscous damping (N s/m), Coulomb force (N) per
-     actuator, and the Coulomb smoothing velocity v_s (m/s, > 0). */
-  double armature[PRRU_NACT], damping[PRRU_NACT], coulomb[PRRU_NACT], coulomb_velocity;
-} prru_params;
+typedef prru_params3 prru_params;
 
 /* The model's own numbers (those the constant kernels were generated from;
  * coulomb_velocity is 1 m/s where the model has no Coulomb friction). */
 extern const prru_params prru_params_model;
-
-/* Actuator displacements d_i (height of joint A_i on rail i). Parameters from *p. */
-void prru_param_ik(const prru_params *p, const double q[3], double d[3]);
-
-/* Actuator Jacobian J_d = dd/dq (3x3). Parameters from *p. */
-void prru_param_jd(const prru_params *p, const double q[3], double Jd[9]);
-
-/* ik and jd fused (one shared evaluation). Parameters from *p. */
-void prru_param_ik_jd(const prru_params *p, const double q[3], double d[3], double Jd[9]);
-
-/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Parameters from *p. */
-void prru_param_mass(const prru_params *p, const double q[3], double M[9]);
-
-/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). Parameters from *p. */
-void prru_param_bias(const prru_params *p, const double q[3], const double qd[3], double h[3]);
-
-/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. Parameters from *p. */
-void prru_param_gravity(const prru_params *p, const double q[3], double G[3]);
-
-/* M, h and G fused (one shared evaluation). Parameters from *p. */
-void prru_param_dynamics(const prru_params *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
-
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). Parameters from *p. */
-void prru_param_eom(const prru_params *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3]);
-
-/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). Parameters from *p. */
-void prru_param_platform_jacobian(const prru_params *p, const double q[3], double JP[18]);
-
-/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. Parameters from *p. */
-void prru_param_energy(const prru_params *p, const double q[3], const double qd[3], double E[2]);
-
-/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. Parameters from *p. */
-void prru_param_actuator_rates(const prru_params *p, const double q[3], const double qd[3], double dd[3], double ddb[3]);
-
-/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Parameters from *p. */
-void prru_param_passive(const prru_params *p, const double q[3], const double qd[3], double Qp[3]);
-
-/* Batched kernels, prru_param_batch_<name>(n, inputs..., outputs...): the
- * kernel of the same name (or, for dme_terms, the named ones fused) for n
- * states in one call. Every array holds one row of n per component:
- * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
- * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
- * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
- * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin, cos and tanh (see the source), then within
- * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
- * overlap the inputs. Any alignment works; for speed give every array
- * 64-byte alignment and n a multiple of 8, so that each row starts on a
- * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
-
-/* ik and jd fused (one shared evaluation). */
-void prru_param_batch_ik_jd(const prru_params *p, int n, const double *q, double *d, double *Jd);
-
-/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */
-void prru_param_batch_mass(const prru_params *p, int n, const double *q, double *M);
-
-/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). */
-void prru_param_batch_platform_jacobian(const prru_params *p, int n, const double *q, double *JP);
-
-/* M, h and G fused (one shared evaluation). */
-void prru_param_batch_dynamics(const prru_params *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
-
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
-void prru_param_batch_eom(const prru_params *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
-
-/* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
-void prru_param_batch_dme_terms(const prru_params *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
-
-/* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. In single precision: prru_f_batch.h's conventions, parameters from *p (rounded to float once). */
-void prru_param_f_batch_dme_terms(const prru_params *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
 
 #ifdef __cplusplus
 }

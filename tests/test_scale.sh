@@ -38,7 +38,10 @@ PY
   done
   local objs=()
   for c in prru_kernels prru_mechanism prru_param_kernels prru_regressor; do
-    cc -I"$dir" -c "$dir/$c.c" -o "$dir/$c.o" || return 1
+    # The build's generated/ after the model's own: prru_param_kernels.h
+    # names the topology kernels (prru_p3_kernels.h), which no model's
+    # generation writes.
+    cc -I"$dir" -I"$BUILD/generated" -c "$dir/$c.c" -o "$dir/$c.o" || return 1
     objs+=("$dir/$c.o")
   done
   link "$tmp/scale_$s" "${objs[@]}"

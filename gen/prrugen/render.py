@@ -196,43 +196,44 @@ def _initializer(model):
     return _designated(rows)
 
 
-def render_params(model, pmodel, deriv, templates_dir, prefix=None):
-    """{file name: text} for the runtime-parameter kernels of model, whose
-    derivation deriv was built from pmodel = params.ParamModel(model), and
-    the emitted kernels."""
+def param_kernel_names():
+    """Every runtime-parameter kernel a model's <prefix>_param_kernels.h
+    names (each the topology kernel of the same name): the scalar ones,
+    their batched variants and the float batch."""
+    names = list(params.PARAM_KERNELS)
+    scalar = set(names)
+    names += ["batch_" + n for n in batch.BATCH_KERNELS if n in scalar]
+    names += ["batch_" + f[0] for f in batch.FUSED]
+    names += ["f_batch_" + f[0] for f in batch.FLOAT_FUSED]
+    return names
+
+
+def render_params(model, templates_dir, prefix=None):
+    """{file name: text} for model's runtime-parameter kernels: the
+    topology kernels of its number of limbs (generated once per topology,
+    prru_pN_kernels.h), under the names <prefix>_param_<kernel> and the
+    type <prefix>_params, with <prefix>_params_model, the model's numbers.
+    Nothing is derived: a model's regeneration no longer pays for them."""
     prefix = prefix or model.name
     upper = prefix.upper()
-    emitted = [cgen.emit(k, prefix + "_param")
-               for k in params.param_kernels(deriv, pmodel, prefix)]
-    banner = _banner(_head(model), emitted)
-    macros = ["#define %s_PARAM_ARITH_%s %d /* arithmetic operations */"
-              % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_PARAM_OPS_%s %s' % (upper, e.name.upper(),
-                                                c_string(e.summary()))
-               for e in emitted]
-    decls = "\n\n".join("/* %s Parameters from *p. */\n%s;"
-                         % (e.doc, e.signature) for e in emitted)
-    bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
-                          for e in emitted)
-    bdecls, bbodies = _batched(params.param_kernels(deriv, pmodel, prefix),
-                               prefix + "_param", prefix)
-    decls += "\n\n" + bdecls
-    bodies += "\n\n" + bbodies
-    # The optimiser's --precision float: the fused dme_terms in float,
-    # <prefix>_param_f_batch_dme_terms (the parameters converted once).
-    fdecls, fbodies = _float_param_batch(
-        params.param_kernels(deriv, pmodel, prefix), prefix)
-    decls += "\n\n" + fdecls
-    bodies += "\n\n" + fbodies
-    values = dict(banner=banner, prefix=prefix, PREFIX=upper,
-                  macros="\n".join(macros), declarations=decls,
-                  functions=bodies, designate=DESIGNATE_MACRO,
+    n = len(model.limbs)
+    tprefix = topology_prefix(n)
+    tupper = tprefix.upper()
+    names = param_kernel_names()
+    macros = ["#define %s_param_%s %s_%s" % (prefix, k, tprefix, k) for k in names]
+    macros += ["#define %s_PARAM_ARITH_%s %s_ARITH_%s" % (upper, k.upper(), tupper, k.upper())
+               for k in params.PARAM_KERNELS]
+    macros += ["#define %s_PARAM_OPS_%s %s_OPS_%s" % (upper, k.upper(), tupper, k.upper())
+               for k in params.PARAM_KERNELS]
+    values = dict(banner=_head(model) + " */", prefix=prefix, PREFIX=upper,
+                  tprefix=tprefix, ctype=topology_ctype(n), nlimb=n,
+                  macros="\n".join(macros), designate=DESIGNATE_MACRO,
                   initializer=_initializer(model))
     files = {}
     for tmpl, out in (("param_kernels.h.in", "%s_param_kernels.h" % prefix),
                       ("param_kernels.c.in", "%s_param_kernels.c" % prefix)):
         files[out] = _template(templates_dir, tmpl).substitute(values)
-    return files, emitted
+    return files
 
 
 def _topology_head(nlimb, reference):
@@ -277,6 +278,11 @@ def render_topology(reference, pmodel, deriv, templates_dir):
                for e in emitted]
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros,
                              " Parameters from *p.")
+    # The optimiser's and the maps' --precision float: the fused dme_terms
+    # in float, <prefix>_f_batch_dme_terms (the parameters converted once).
+    fdecls, fbodies = _float_param_batch(kernel_list, prefix, prefix + "_f")
+    decls += "\n\n" + fdecls
+    bodies += "\n\n" + fbodies
     mech = deriv.mech
     labels = lambda_labels(mech)
     values = dict(banner=banner, prefix=prefix, PREFIX=upper, ctype=ctype,
@@ -527,11 +533,11 @@ def float_batch(kernel_list, prefix, file_prefix=None, precision=cgen.FLOAT):
     return out
 
 
-def _float_param_batch(kernel_list, prefix):
+def _float_param_batch(kernel_list, prefix, name_prefix):
     """(declarations, definitions) of the float batched kernels of the
-    parameter kernels, named <prefix>_param_f_batch_<name>, their macros
+    parameter kernels, named <name_prefix>_batch_<name>, their macros
     PREFIX_BATCH_* (the file's)."""
-    emitted = float_batch(kernel_list, prefix + "_param_f", prefix, FLOAT_NO_FLOAT_H)
+    emitted = float_batch(kernel_list, name_prefix, prefix, FLOAT_NO_FLOAT_H)
     upper = prefix.upper()
     decls = "\n\n".join("/* %s In single precision: %s_f_batch.h's "
                          "conventions, parameters from *p (rounded to float "

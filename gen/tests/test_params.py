@@ -161,17 +161,15 @@ class GeneratedParameterKernels(unittest.TestCase):
     def test_no_value_dependent_simplification(self):
         # The paper's model (equal limbs, no centres of mass, no products of
         # inertia, no drives, gravity along -z) and the prototype's give the
-        # same kernels: only the initializer and the banner differ.
+        # same mapping onto the topology kernels: only the initializer and
+        # the banner differ (the topology kernels themselves:
+        # test_topology.TopologyKernels.test_structure_only).
         def body(text):
             text = text.split(" */\n", 1)[1]
             return re.sub(r"params_model = \{.*?\n\};", "", text, flags=re.S)
         for name in ("prru_param_kernels.c", "prru_param_kernels.h"):
             self.assertEqual(body(self.paper[name]), body(self.proto[name]),
                              name)
-        c = self.paper["prru_param_kernels.c"]
-        for member in ("p->com[0][0]", "p->inertia[0][5]", "p->armature[2]",
-                       "p->coulomb_velocity", "p->gravity[0]", "p->b[1]"):
-            self.assertIn(member, c)
 
     def test_model_values_in_the_initializer(self):
         m = model.load(PROTO)
@@ -190,22 +188,28 @@ class GeneratedParameterKernels(unittest.TestCase):
         self.assertIn("PRRU_DESIGNATE(coulomb_velocity) 1.0", paper)
 
     def test_c_shape(self):
+        # Every parameter kernel is the topology kernel of the model's limbs
+        # (generated once per topology), named after the model; the .c holds
+        # the model's numbers alone.
         c = self.paper["prru_param_kernels.c"]
         h = self.paper["prru_param_kernels.h"]
         for k in params.PARAM_KERNELS:
-            self.assertRegex(h, r"void prru_param_%s\(const prru_params \*p, "
-                             r"const double q\[3\]" % k)
-            self.assertRegex(h, r"#define PRRU_PARAM_ARITH_%s \d+" % k.upper())
-        self.assertIn('#include "prru_kernels.h"', h)
-        self.assertEqual(re.findall(r"#include .*", c),
-                         ["#include <math.h>",
-                          '#include "prru_param_kernels.h"'])
-        # Each kernel loads a member at most once, before using it.
-        for fn in re.findall(r"\n(void prru_param_\w+\(.*?\n\}\n)", c + "\n",
-                             re.S):
-            loads = re.findall(r"const double (p_\w+) = p->", fn)
-            self.assertEqual(len(loads), len(set(loads)), fn[:60])
-            self.assertEqual(fn.count("p->"), len(loads), fn[:60])
+            self.assertIn("#define prru_param_%s prru_p3_%s\n" % (k, k), h)
+            self.assertIn("#define PRRU_PARAM_ARITH_%s PRRU_P3_ARITH_%s\n" % (k.upper(), k.upper()), h)
+        for k in render.param_kernel_names():
+            self.assertIn("#define prru_param_%s prru_p3_%s\n" % (k, k), h)
+        self.assertIn("typedef prru_params3 prru_params;", h)
+        self.assertEqual(re.findall(r"#include .*", h),
+                         ['#include "prru_kernels.h"', '#include "prru_p3_kernels.h"'])
+        self.assertEqual(re.findall(r"#include .*", c), ['#include "prru_param_kernels.h"'])
+        self.assertNotIn("(", c.split("params_model = {", 1)[1].replace("PRRU_DESIGNATE(", ""))
+        four, _ = prru_gen.generate(os.path.join(ROOT, "models", "4prru.json"), prefix="m4")
+        self.assertIn("#define m4_param_eom prru_p4_eom\n", four["m4_param_kernels.h"])
+        self.assertIn("typedef prru_params4 m4_params;", four["m4_param_kernels.h"])
+        # Every name the header maps is a kernel the topology file defines.
+        topo = prru_gen.generate_topology(3)[0]["prru_p3_kernels.h"]
+        for k in render.param_kernel_names():
+            self.assertRegex(topo, r"void prru_p3_%s\(" % k)
 
 
 if __name__ == "__main__":

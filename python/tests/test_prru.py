@@ -1407,7 +1407,8 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_traj.h", "prru_quintic", _lib._Quintic),
                 ("runtime/include/prru_traj.h", "prru_topp", _lib._Topp),
                 ("runtime/include/prru_traj.h", "prru_path_side", _lib._PathSide),
-                ("generated/prru_param_kernels.h", "prru_params", t.Params),
+                # prru_params is the topology kernels' struct of the model's limbs.
+                ("generated/prru_p%d_kernels.h" % MODEL.nlimb, "prru_params%d" % MODEL.nlimb, t.Params),
                 ("runtime/include/prru_control.h", "prru_track_sample", t.TrackSample),
                 ("runtime/include/prru_control.h", "prru_track_options", t.TrackOptions),
                 ("runtime/include/prru_control.h", "prru_track_summary", t.TrackSummary),
