@@ -587,7 +587,10 @@ static const char track_help[] =
     "torque's default: R = 1/F^2 (F the feed-forward peak), Q = 1/e^2 with the\n"
     "errors e_q = a/20^2, e_qd = a/(sqrt(2) 20) where a = F |dqdd/dfd| is the\n"
     "acceleration that force scale gives each coordinate (the summary gives\n"
-    "the weights used).\n"
+    "the weights used).\n";
+
+/* The help's second half (one literal stays within C99's 4095 bytes). */
+static const char track_help2[] =
     "Timing: --period 0 (default) evaluates the controller continuously, inside\n"
     "the integrator, with rows every --dt (default 1 ms); --period S > 0 is a\n"
     "digital controller that samples the state every S seconds and holds its\n"
@@ -1050,8 +1053,8 @@ int prru_cmd_track(int argc, char **argv)
     char rl[256];
     printf(track_help, prru_cli_names(rl, sizeof rl, "R", PRRU_NACT, ","),
            prru_cli_names(fl, sizeof fl, "F", PRRU_NACT, ","),
-           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "",
-           fdn, fdcn, satn, dn);
+           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "");
+    printf(track_help2, fdn, fdcn, satn, dn);
     return 0;
   }
   if (!refs == !wps) {

@@ -179,15 +179,19 @@ typedef struct {
 /* Bryson's rule from the model's own scales, matched to computed torque's
  * default bandwidth w = 20 rad/s: a force scale F, the largest |u_ff,i|
  * along the reference at the ticks every period (1 N if that is 0), with
- * R_i = 1 / F^2; a_j = F |row j of dqdd/dfd| (2-norm, the linearisation at
- * the reference's start), the acceleration coordinate j gets from forces
- * of that scale; the acceptable errors e_q,j = a_j / w^2 (the error for
+ * R_i = 1 / F^2; a_j = F / |G^+ e_j|, the acceleration coordinate j alone
+ * gets from forces of that scale (G = dqdd/dfd of the linearisation at the
+ * reference's start, G^+ = G^T (G G^T)^-1, the least-norm forces of an
+ * acceleration); the acceptable errors e_q,j = a_j / w^2 (the error for
  * which computed torque's Kp = w^2 asks for a_j) and e_qd,j = a_j / (sqrt 2
  * w): Q_j = 1 / e_q,j^2, Q_3+j = 1 / e_qd,j^2. For a decoupled double
  * integrator qdd_j = g_j fd_j this makes the continuous LQR's gains
  * exactly Kp = w^2, Kd = 2 w (critically damped at w), whatever F (F
- * only sets the cost's unit). q, r may be NULL. prru_lqr_schedule_build's
- * statuses for a reference the model cannot follow; PRRU_EINPUT for
+ * only sets the cost's unit). A coupled robot's LQR spends force where
+ * it is cheapest instead: its error is shaped differently from computed
+ * torque's (docs/control.md measures both). q, r may be NULL.
+ * prru_lqr_schedule_build's statuses for a reference the model cannot
+ * follow (PRRU_ESINGULAR where G G^T is singular); PRRU_EINPUT for
  * period <= 0. */
 PRRU_API int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period,
                                       double q[6], double r[PRRU_NACT], char *msg, int msglen);

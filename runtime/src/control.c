@@ -163,6 +163,35 @@ static int lqr_linearize_tick(const prru_model *m, prru_data *d, const double x[
   return PRRU_OK;
 }
 
+/* a_j: the acceleration coordinate j alone gets from forces of size F,
+ * F / |G^+ e_j| with G = dqdd/dfd (3 x PRRU_NACT) and G^+ = G^T (G
+ * G^T)^-1 (the least-norm forces for an acceleration): the scale of a
+ * decoupled double integrator, where the largest acceleration of j
+ * (F |row j of G|) would count the other coordinates' motion too. 0, or
+ * -1 when G G^T is singular. */
+static int decoupled_accel(const double G[3 * PRRU_NACT], double F, double a[3])
+{
+  double H[9], Hi[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double h = 0.0;
+      for (int k = 0; k < PRRU_NACT; k++) h += G[i * PRRU_NACT + k] * G[j * PRRU_NACT + k];
+      H[3 * i + j] = h;
+    }
+  if (!(prru_rcond3(H, Hi) > 1e-14)) return -1;
+  for (int j = 0; j < 3; j++) {
+    double n = 0.0;
+    for (int k = 0; k < PRRU_NACT; k++) {
+      double c = 0.0; /* (G^T H^-1)_kj */
+      for (int i = 0; i < 3; i++) c += G[i * PRRU_NACT + k] * Hi[3 * i + j];
+      n = hypot(n, c);
+    }
+    a[j] = F / n;
+    if (!(a[j] > 0.0 && isfinite(a[j]))) return -1;
+  }
+  return 0;
+}
+
 int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period, double q[6],
                              double r[PRRU_NACT], char *msg, int msglen)
 {
@@ -184,21 +213,19 @@ int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, doubl
   if (F == 0.0) F = 1.0;
   if (st == PRRU_OK)
     st = lqr_linearize_tick(m, d, x0, u0, 0.0, prru_quintic_t_begin(ref), 0, lin, msg, msglen);
-  for (int j = 0; j < 3 && st == PRRU_OK; j++) {
-    double g = 0.0;
-    for (int i = 0; i < PRRU_NACT; i++) g = hypot(g, lin->dqdd_dfd[j * PRRU_NACT + i]);
-    const double a = F * g, w = LQR_BANDWIDTH;
-    if (!(a > 0.0 && isfinite(a))) {
-      st = prru_fail(msg, msglen, PRRU_ESINGULAR, "LQR default weights: coordinate %d gets no "
-                     "acceleration from the actuators at the reference's start", j + 1);
-      break;
-    }
-    if (q) q[j] = (w * w / a) * (w * w / a);
-    if (q) q[3 + j] = 2.0 * (w / a) * (w / a);
+  double a[3];
+  if (st == PRRU_OK && decoupled_accel(lin->dqdd_dfd, F, a) != 0)
+    st = prru_fail(msg, msglen, PRRU_ESINGULAR, "LQR default weights: the actuators do not move "
+                   "every coordinate at the reference's start (dqdd/dfd rank-deficient)");
+  for (int j = 0; j < 3 && st == PRRU_OK && q; j++) {
+    const double w = LQR_BANDWIDTH;
+    q[j] = (w * w / a[j]) * (w * w / a[j]);
+    q[3 + j] = 2.0 * (w / a[j]) * (w / a[j]);
   }
   for (int i = 0; i < PRRU_NACT && r && st == PRRU_OK; i++) r[i] = 1.0 / (F * F);
   free(d);
   free(lin);
+  if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
   return st;
 }
 
@@ -320,6 +347,7 @@ int prru_lqr_schedule_build(const prru_model *m, const prru_quintic *ref, const 
   free(d);
   free(lin);
   if (st != PRRU_OK) prru_lqr_schedule_free(s);
+  if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
   return st;
 }
 
