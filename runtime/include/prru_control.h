@@ -124,7 +124,9 @@ typedef struct {
  * PRRU_EINPUT for bad options (msg names the option); the plant leaving
  * the workspace or its stroke PRRU_EUNREACHABLE, the controller meeting a
  * singular J_d PRRU_ESINGULAR, integrator failure PRRU_ENOCONV,
- * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why. */
+ * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why.
+ * With PRRU_TRACK_LQR the gain schedule is built first (once per run):
+ * prru_lqr_schedule_build's statuses, no sample delivered. */
 PRRU_API int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
                         prru_track_summary *sum, char *msg, int msglen);
 
