@@ -1,5 +1,5 @@
 /* prru traj (quintic point-to-point trajectories) and prru track
- * (computed-torque tracking simulated in closed loop). */
+ * (computed-torque or LQR tracking simulated in closed loop). */
 #define _XOPEN_SOURCE 700 /* realpath, open_memstream */
 #include <limits.h>
 #include <math.h>
@@ -558,6 +558,7 @@ int prru_cmd_traj(int argc, char **argv)
 static const char track_help[] =
     "usage: prru track (--ref FILE.csv | --waypoints 'q;q;..' --durations T1,..)\n"
     "                  [--bandwidth W | --kp K1,K2,K3 --kd D1,D2,D3] [--period S]\n"
+    "                  [--controller ct|lqr] [--lqr-q Q1,..,Q6] [--lqr-r %s]\n"
     "                  [--dt S] [--plant MODEL.json] [--mismatch KEY=F[,KEY=F..]]\n"
     "                  [--noise SQ,SQD]\n"
     "                  [--seed N] [--force-max F|%s] [--speed-max V|..]\n"
@@ -575,6 +576,21 @@ static const char track_help[] =
     "--waypoints and --durations as for 'prru traj'.\n"
     "Gains: --bandwidth W (rad/s, default 20) sets Kp = W^2, Kd = 2 W (critically\n"
     "damped); --kp and --kd set them per coordinate (1/s^2, 1/s).\n"
+    "--controller lqr (needs --period > 0) replaces computed torque by a\n"
+    "time-varying discrete LQR: at every control tick the model's inverse\n"
+    "dynamics on the reference (the feed-forward u_ff) and its zero-order-hold\n"
+    "linearisation there (A_k, B_k); gains K_k from the backward Riccati\n"
+    "recursion along the whole reference (terminal cost Q), computed before the\n"
+    "run; fd = u_ff - K_k (x - x_ref) with x = (q, qd), clipped as above.\n"
+    "Weights: --lqr-q on q1..3 then qd1..3 (>= 0, not all 0), --lqr-r per\n"
+    "actuator (1/N^2, > 0); by default Bryson's rule matched to computed\n"
+    "torque's default: R = 1/F^2 (F the feed-forward peak), Q = 1/e^2 with the\n"
+    "errors e_q = a/20^2, e_qd = a/(sqrt(2) 20) where a = F |dqdd/dfd| is the\n"
+    "acceleration that force scale gives each coordinate (the summary gives\n"
+    "the weights used).\n";
+
+/* The help's second half (one literal stays within C99's 4095 bytes). */
+static const char track_help2[] =
     "Timing: --period 0 (default) evaluates the controller continuously, inside\n"
     "the integrator, with rows every --dt (default 1 ms); --period S > 0 is a\n"
     "digital controller that samples the state every S seconds and holds its\n"
@@ -748,6 +764,12 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   prru_cli_json_array(f, o->kp, 3);
   fputs(", \"kd\": ", f);
   prru_cli_json_array(f, o->kd, 3);
+  if (o->controller == PRRU_TRACK_LQR) {
+    fputs(",\n \"controller\": \"lqr\", \"lqr_q\": ", f);
+    prru_cli_json_array(f, o->lqr_q, 6);
+    fputs(", \"lqr_r\": ", f);
+    prru_cli_json_array(f, o->lqr_r, PRRU_NACT);
+  }
   fputs(",\n \"plant\": ", f);
   prru_cli_json_string(f, plant ? plant : "");
   fputs(", \"mismatch\": ", f);
@@ -913,6 +935,75 @@ static int parse_track_settings(const char **a, prru_track_options *o)
   return 0;
 }
 
+/* --controller, --lqr-q, --lqr-r into o (after --period). 0 or 2. */
+static int parse_controller(const char *ctl, const char *q, const char *r, prru_track_options *o)
+{
+  if (ctl && strcmp(ctl, "ct") != 0 && strcmp(ctl, "lqr") != 0) {
+    prru_cli_error("track", "--controller: '%s' is neither ct (computed torque) nor lqr", ctl);
+    return 2;
+  }
+  int lqr = ctl && strcmp(ctl, "lqr") == 0;
+  if (!lqr && (q || r)) {
+    prru_cli_error("track", "--%s belongs to --controller lqr", q ? "lqr-q" : "lqr-r");
+    return 2;
+  }
+  if (!lqr) return 0;
+  if (!(o->control_period > 0)) {
+    prru_cli_error("track", "--controller lqr needs --period S > 0: the LQR's gains are those of a "
+                   "sampled controller");
+    return 2;
+  }
+  o->controller = PRRU_TRACK_LQR;
+  if (q && prru_cli_numbers("track", "lqr-q", q, o->lqr_q, 6)) return 2;
+  int any = 0;
+  for (int i = 0; q && i < 6; i++) {
+    if (!(o->lqr_q[i] >= 0)) {
+      prru_cli_error("track", "--lqr-q: weight %d is %g, not >= 0", i + 1, o->lqr_q[i]);
+      return 2;
+    }
+    any |= o->lqr_q[i] > 0;
+  }
+  if (q && !any) {
+    prru_cli_error("track", "--lqr-q: all weights 0 leave no feedback (omit --lqr-q for the default)");
+    return 2;
+  }
+  if (r && prru_cli_numbers("track", "lqr-r", r, o->lqr_r, PRRU_NACT)) return 2;
+  for (int i = 0; r && i < PRRU_NACT; i++)
+    if (!(o->lqr_r[i] > 0)) {
+      prru_cli_error("track", "--lqr-r: weight %d is %g, not > 0", i + 1, o->lqr_r[i]);
+      return 2;
+    }
+  return 0;
+}
+
+/* The weights of an LQR run that --lqr-q / --lqr-r left out: the
+ * library's defaults, filled in so that the CSV and summary give them. 0,
+ * or 1 after a message. */
+static int lqr_default_weights(const prru_quintic *tr, prru_track_options *o)
+{
+  double q[6], r[PRRU_NACT], zq[6] = {0}, zr[PRRU_NACT] = {0};
+  int dq = memcmp(o->lqr_q, zq, sizeof zq) == 0, dr = memcmp(o->lqr_r, zr, sizeof zr) == 0;
+  if (!dq && !dr) return 0;
+  char msg[600];
+  int st = prru_lqr_default_weights(prru_cli_model(), tr, o->control_period, q, r, msg, sizeof msg);
+  if (st != PRRU_OK) {
+    prru_cli_error("track", "LQR default weights: %s", msg);
+    return 1;
+  }
+  if (dq) memcpy(o->lqr_q, q, sizeof q);
+  if (dr) memcpy(o->lqr_r, r, sizeof r);
+  return 0;
+}
+
+static void lqr_weights_text(const prru_track_options *o, char *buf, size_t len)
+{
+  int n = snprintf(buf, len, "Q");
+  for (int i = 0; i < 6 && n > 0 && (size_t)n < len; i++) n += snprintf(buf + n, len - (size_t)n, " %.6g", o->lqr_q[i]);
+  if (n > 0 && (size_t)n < len) n += snprintf(buf + n, len - (size_t)n, ", R");
+  for (int i = 0; i < PRRU_NACT && n > 0 && (size_t)n < len; i++)
+    n += snprintf(buf + n, len - (size_t)n, " %.6g", o->lqr_r[i]);
+}
+
 /* The plant's numbers before --mismatch: the current model's (built in or
  * --model's), or the model file plant's (--plant). 0, or 2 after the
  * loader's message. */
@@ -938,7 +1029,7 @@ int prru_cmd_track(int argc, char **argv)
 {
   const char *refs = NULL, *wps = NULL, *durs = NULL, *mism = NULL, *units = NULL, *out = NULL, *sums = NULL,
              *plot = NULL, *plants = NULL;
-  const char *a[10] = {NULL};
+  const char *a[10] = {NULL}, *ctl = NULL, *lqr_q = NULL, *lqr_r = NULL;
   int help = 0;
   prru_cli_limit_args lim = {NULL, NULL, NULL, NULL, 0};
   prru_cli_option opts[] = {
@@ -949,6 +1040,7 @@ int prru_cmd_track(int argc, char **argv)
       PRRU_CLI_LIMIT_OPTIONS(lim),    {"q0-offset", 1, &a[7], NULL}, {"atol", 1, &a[8], NULL},
       {"rtol", 1, &a[9], NULL},       {"out", 1, &out, NULL},        {"summary", 1, &sums, NULL},
       {"plot", 1, &plot, NULL},       {"plant", 1, &plants, NULL},   {"units", 1, &units, NULL},
+      {"controller", 1, &ctl, NULL},  {"lqr-q", 1, &lqr_q, NULL},    {"lqr-r", 1, &lqr_r, NULL},
       {"help", 0, NULL, &help}};
   if (prru_cli_parse("track", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   char fdn[256], fdcn[256], satn[256], dn[256];
@@ -958,9 +1050,11 @@ int prru_cmd_track(int argc, char **argv)
   prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
   if (help) {
     char fl[256];
-    printf(track_help, prru_cli_names(fl, sizeof fl, "F", PRRU_NACT, ","),
-           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "",
-           fdn, fdcn, satn, dn);
+    char rl[256];
+    printf(track_help, prru_cli_names(rl, sizeof rl, "R", PRRU_NACT, ","),
+           prru_cli_names(fl, sizeof fl, "F", PRRU_NACT, ","),
+           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "");
+    printf(track_help2, fdn, fdcn, satn, dn);
     return 0;
   }
   if (!refs == !wps) {
@@ -989,8 +1083,8 @@ int prru_cmd_track(int argc, char **argv)
    * the plant's speeds against it (summary: max_dd, over_speed_fraction). */
   prru_limits limits;
   int motor, current;
-  if (parse_track_settings(a, &o) || prru_cli_limits("track", "fmax", &lim, &limits) ||
-      prru_cli_units("track", units, &motor, &current))
+  if (parse_track_settings(a, &o) || parse_controller(ctl, lqr_q, lqr_r, &o) ||
+      prru_cli_limits("track", "fmax", &lim, &limits) || prru_cli_units("track", units, &motor, &current))
     return 2;
   for (int i = 0; i < PRRU_NACT; i++)
     o.f_max[i] = limits.force_max[i], o.d_min[i] = limits.d_min[i], o.d_max[i] = limits.d_max[i];
@@ -1008,6 +1102,10 @@ int prru_cmd_track(int argc, char **argv)
     prru_quintic_free(&tr);
     return st == PRRU_EINPUT ? 2 : 1;
   }
+  if (o.controller == PRRU_TRACK_LQR && lqr_default_weights(&tr, &o)) {
+    prru_quintic_free(&tr);
+    return 1;
+  }
   prru_cli_catch_signals();
   prru_cli_out co;
   if (prru_cli_out_open(&co, "track", out)) {
@@ -1017,12 +1115,21 @@ int prru_cmd_track(int argc, char **argv)
   const char *name = co.name;
   prru_cli_out_comment(&co);
   /* The --plant path (any bytes) stays on the line: comment_line. */
-  prru_cli_out_comment_line(&co, "computed torque, %s%.9g s, kp %g %g %g, kd %g %g %g, %s%s%smismatch '%s', "
-                            "noise %g %g, seed %lu",
-                            o.control_period > 0 ? "zero-order hold every " : "continuous, rows every ",
-                            step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], plants ? "plant " : "",
-                            plants ? plants : "", plants ? ", " : "", mism ? mism : "", o.noise_q, o.noise_qd,
-                            o.seed);
+  if (o.controller == PRRU_TRACK_LQR) {
+    char gains[600];
+    lqr_weights_text(&o, gains, sizeof gains);
+    prru_cli_out_comment_line(&co, "LQR (time-varying, Riccati along the reference), zero-order hold every "
+                              "%.9g s, %s, %s%s%smismatch '%s', noise %g %g, seed %lu", step, gains,
+                              plants ? "plant " : "", plants ? plants : "", plants ? ", " : "",
+                              mism ? mism : "", o.noise_q, o.noise_qd, o.seed);
+  } else {
+    prru_cli_out_comment_line(&co, "computed torque, %s%.9g s, kp %g %g %g, kd %g %g %g, %s%s%smismatch '%s', "
+                              "noise %g %g, seed %lu",
+                              o.control_period > 0 ? "zero-order hold every " : "continuous, rows every ",
+                              step, o.kp[0], o.kp[1], o.kp[2], o.kd[0], o.kd[1], o.kd[2], plants ? "plant " : "",
+                              plants ? plants : "", plants ? ", " : "", mism ? mism : "", o.noise_q, o.noise_qd,
+                              o.seed);
+  }
   prru_cli_out_comment_line(&co, "limits: %s", limits_text);
   prru_cli_out_printf(&co, "t,qr1,qr2,qr3,q1,q2,q3,e1,e2,e3,qd1,qd2,qd3,%s,%s,%s,%s,qdd1,qdd2,qdd3", fdn,
                       fdcn, satn, dn);

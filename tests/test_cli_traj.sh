@@ -7,7 +7,9 @@
 # reactions against prru ik and prru eval; track: exact model to 1e-9,
 # mismatch error falling with the bandwidth, saturation reported and never
 # exceeded, seeded noise reproducible, the CSV reference equal to the
-# waypoints, and every kind of bad input refused with nothing written.
+# waypoints, and every kind of bad input refused with nothing written;
+# track --controller lqr as accurate as computed torque on the exact model,
+# its weights reported, its options' bad values refused (exit 2).
 # traj --time-optimal: every row within the limits by prru id's exact
 # inverse dynamics, faster than the scaled quintic, a limit active on >= 95 %
 # of the grid, on the built model and (three actuators) the prototype's
@@ -275,6 +277,49 @@ done
 cmp -s "$tmp/n1.csv" "$tmp/n1b.csv" && ! cmp -s "$tmp/n1.csv" "$tmp/n2.csv" && ok || bad "track noise not reproducible per seed"
 jcheck "$tmp/n1.json" "d['control'] == 'zero-order hold' and d['samples'] == 1001 and 1e-7 < max(d['max_error']) < 1e-3" \
   "track --period: wrong sampling or error"
+# --controller lqr: the time-varying LQR at the same period as computed
+# torque. Exact plant: both errors are the zero-order hold's, at most
+# jerk Tc / W^2 = 6 rad/s^3 * 2 ms / (20 rad/s)^2 = 3e-5 (the quintic's
+# peak jerk 60 |dq| / T^3 = 6 on this move; the bound's derivation is in
+# test_control.c); the same feed-forward peak forces (0.1 %); the weights
+# used in the summary, the given ones as given.
+"$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --out "$tmp/ct2.csv" --summary "$tmp/ct2.json" \
+  2>"$tmp/err" || bad "track --period 0.002: $(cat "$tmp/err")"
+"$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --out "$tmp/lqr.csv" \
+  --summary "$tmp/lqr.json" 2>"$tmp/err" && ok || bad "track --controller lqr: $(cat "$tmp/err")"
+python3 -c "
+import json, sys
+c, l = (json.load(open(p)) for p in sys.argv[1:3])
+n = int(sys.argv[3])
+assert l['controller'] == 'lqr' and 'controller' not in c, (l.get('controller'), c.get('controller'))
+assert len(l['lqr_q']) == 6 and len(l['lqr_r']) == n and min(l['lqr_q']) > 0 and min(l['lqr_r']) > 0, l
+assert l['samples'] == c['samples'] == 1001 and l['status'] == 'complete', l
+assert max(c['max_error']) <= 3e-5 and max(l['max_error']) <= 3e-5, (c['max_error'], l['max_error'])
+assert abs(max(l['max_fd']) - max(c['max_fd'])) <= 1e-3 * max(c['max_fd']), (l['max_fd'], c['max_fd'])
+print('track 2 ms: max error CT %.3g, LQR %.3g' % (max(c['max_error']), max(l['max_error'])))
+" "$tmp/ct2.json" "$tmp/lqr.json" "$nact" && ok || bad "track --controller lqr: not tracking like computed torque"
+sed -n 2p "$tmp/lqr.csv" | grep -q "^# LQR (time-varying" && ok || bad "track lqr: no controller line"
+[ "$(grep -v '^#' "$tmp/lqr.csv" | head -1)" = "$(grep -v '^#' "$tmp/ct2.csv" | head -1)" ] && ok \
+  || bad "track lqr: columns differ from computed torque's"
+"$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 1e4,1e4,1e4,10,10,10 \
+  --lqr-r "$(nlist 0.001)" --mismatch mass=1.2 --out "$tmp/lqrw.csv" --summary "$tmp/lqrw.json" 2>"$tmp/err" \
+  || bad "track lqr with weights: $(cat "$tmp/err")"
+jcheck "$tmp/lqrw.json" "d['lqr_q'] == [1e4, 1e4, 1e4, 10, 10, 10] and d['lqr_r'] == [0.001] * $nact and d['status'] == 'complete' and max(d['max_error']) > 1e-5" \
+  "track lqr: given weights not used or mismatch not seen"
+rzero=$(nlist 1 | sed 's/[^,]*$/0/')
+expect 2 "--controller lqr needs --period" -- track --waypoints "$WP" --durations 1,1 --controller lqr --out "$tmp/x.csv"
+expect 2 "--controller lqr needs --period" -- track --waypoints "$WP" --durations 1,1 --controller lqr --period 0 --out "$tmp/x.csv"
+expect 2 "--controller: 'pid'" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller pid --out "$tmp/x.csv"
+expect 2 "--lqr-q: '1,1,1,1,1' is not 6" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 1,1,1,1,1 --out "$tmp/x.csv"
+expect 2 "--lqr-q: weight 4 is -1" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 1,1,1,-1,1,1 --out "$tmp/x.csv"
+expect 2 "--lqr-q: all weights 0" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 0,0,0,0,0,0 --out "$tmp/x.csv"
+expect 2 "--lqr-q: 'inf,1,1,1,1,1' is not 6" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q inf,1,1,1,1,1 --out "$tmp/x.csv"
+expect 2 "--lqr-r: weight $nact is 0, not > 0" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-r "$rzero" --out "$tmp/x.csv"
+expect 2 "--lqr-r: '$(nlist 1),1' is not $nact" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-r "$(nlist 1),1" --out "$tmp/x.csv"
+expect 2 "--lqr-r: 'nan" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-r "nan${rzero#1}" --out "$tmp/x.csv"
+expect 2 "--lqr-q belongs to --controller lqr" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --lqr-q 1,1,1,1,1,1 --out "$tmp/x.csv"
+expect 2 "--lqr-r belongs to --controller lqr" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller ct --lqr-r "$(nlist 1)" --out "$tmp/x.csv"
+[ -e "$tmp/x.csv" ] && bad "a refused track --controller lqr wrote its CSV" || ok
 # Bad input: exit 2, nothing written.
 rm -f "$tmp/x.csv"
 "$PRRU" track --waypoints '0,0,0;0.02,0,0;1.5,0,0' --durations 1,1 --dt 1 --out "$tmp/x.csv" 2>"$tmp/err"

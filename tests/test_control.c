@@ -8,13 +8,23 @@
  * falls with the gains (as 1/w^2); a sampled controller with sensor noise
  * is deterministic per seed; force limits are reported as saturation and
  * never exceeded; a stroke limit stops the run; bad options are refused
- * with the option named. */
+ * with the option named. The time-varying LQR: on a pose held at rest its
+ * Riccati recursion reaches the discrete algebraic Riccati equation's
+ * solution to rounding, with a stable closed loop; on the exact plant it
+ * tracks like computed torque at the same period (within the
+ * zero-order-hold error), an initial offset decays, and a wrong gain (sign
+ * or layout) is caught. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_linalg.h>
 
 #include "prru_control.h"
+#include "prru_linearize.h"
 #include "testutil.h"
 
 /* Home (q = 0) to a tilted, raised pose and back: regular for any
@@ -330,6 +340,313 @@ static void refusals(void)
           "unknown mismatch key or bad factor refused");
 }
 
+/* ---- LQR ---- */
+
+static double frob(const double *a, int n)
+{
+  double s = 0;
+  for (int i = 0; i < n; i++) s += a[i] * a[i];
+  return sqrt(s);
+}
+
+/* C = A^T B (A: r x m, B: r x c, row-major), or A B when trans is 0
+ * (A: m x r). */
+static void matmul(int trans, const double *A, const double *B, int m, int r, int c, double *C)
+{
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j < c; j++) {
+      double s = 0;
+      for (int k = 0; k < r; k++) s += (trans ? A[k * m + i] : A[i * r + k]) * B[k * c + j];
+      C[i * c + j] = s;
+    }
+}
+
+/* A reference holding pose q at rest over span seconds. */
+static void hold_reference(prru_quintic *tr, const double q[3], double span)
+{
+  double t[2] = {0, span}, qq[6], z[6] = {0};
+  memcpy(qq, q, 3 * sizeof *q);
+  memcpy(qq + 3, q, 3 * sizeof *q);
+  char msg[256];
+  TU_TRUE(prru_quintic_samples(tr, 2, t, qq, z, z, msg, sizeof msg) == PRRU_OK, msg);
+}
+
+/* The DARE residual at the schedule's P_0 relative to its rounding bound
+ * (see lqr_stationary), and the spectral radius of A - B K_0. */
+static void dare_check(const prru_lqr_schedule *s, const double A[36], const double B[6 * PRRU_NACT],
+                       double *ratio, double *rho)
+{
+  enum { N = PRRU_NACT };
+  const double *P = s->P0, *K = s->K;
+  double PA[36], PB[6 * N], S[N * N], BtPA[N * 6], X[N * 6], AtPA[36], AtPB[6 * N], R[36];
+  matmul(0, P, A, 6, 6, 6, PA);
+  matmul(0, P, B, 6, 6, N, PB);
+  matmul(1, B, PB, N, 6, N, S);
+  for (int i = 0; i < N; i++) S[i * N + i] += s->r[i];
+  matmul(1, B, PA, N, 6, 6, BtPA);
+  matmul(1, A, PA, 6, 6, 6, AtPA);
+  matmul(1, A, PB, 6, 6, N, AtPB);
+  /* The condition of S (2-norm, from its eigenvalues), before the solve
+   * overwrites it. */
+  double Sc[N * N], ev[N];
+  memcpy(Sc, S, sizeof Sc);
+  gsl_matrix_view sc = gsl_matrix_view_array(Sc, N, N);
+  gsl_vector_view evv = gsl_vector_view_array(ev, N);
+  gsl_eigen_symm_workspace *ws = gsl_eigen_symm_alloc(N);
+  gsl_eigen_symm(&sc.matrix, &evv.vector, ws);
+  gsl_eigen_symm_free(ws);
+  double emin = INFINITY, emax = 0;
+  for (int i = 0; i < N; i++) emin = fmin(emin, ev[i]), emax = fmax(emax, ev[i]);
+  gsl_matrix_view sv = gsl_matrix_view_array(S, N, N), bv = gsl_matrix_view_array(BtPA, N, 6),
+                  xv = gsl_matrix_view_array(X, N, 6);
+  gsl_linalg_cholesky_decomp1(&sv.matrix);
+  gsl_linalg_cholesky_solve_mat(&sv.matrix, &bv.matrix, &xv.matrix);
+  double BX[36]; /* A^T P B S^-1 B^T P A */
+  matmul(0, AtPB, X, 6, N, 6, BX);
+  double Q[36] = {0};
+  for (int i = 0; i < 6; i++) Q[i * 6 + i] = s->q[i];
+  for (int i = 0; i < 36; i++) R[i] = Q[i] + AtPA[i] - BX[i] - P[i];
+  double ABK[36], BK[36];
+  matmul(0, B, K, 6, N, 6, BK);
+  for (int i = 0; i < 36; i++) ABK[i] = A[i] - BK[i];
+  double ev_re[6], ev_im[6];
+  gsl_matrix_view abk = gsl_matrix_view_array(ABK, 6, 6);
+  gsl_vector_complex *eval = gsl_vector_complex_alloc(6);
+  gsl_eigen_nonsymm_workspace *wn = gsl_eigen_nonsymm_alloc(6);
+  gsl_eigen_nonsymm(&abk.matrix, eval, wn);
+  *rho = 0;
+  for (int i = 0; i < 6; i++) {
+    ev_re[i] = GSL_REAL(gsl_vector_complex_get(eval, i));
+    ev_im[i] = GSL_IMAG(gsl_vector_complex_get(eval, i));
+    *rho = fmax(*rho, hypot(ev_re[i], ev_im[i]));
+  }
+  gsl_eigen_nonsymm_free(wn);
+  gsl_vector_complex_free(eval);
+  /* Rounding of one Riccati step (6 x 6 and 6 x NACT products, sums of
+   * at most 6 terms, two chained: gamma_12 = 12 u each; the Cholesky
+   * solve's relative error kappa(S) u in K, carried by A^T P B), in the
+   * recursion and again in this evaluation, 32 u for both; a contracting
+   * recursion gathers up to 1 / (1 - rho^2) steps' rounding at its fixed
+   * point (each step multiplies an earlier error by about rho^2). The
+   * residual seen is far below this (1e-5 of it on the paper's model):
+   * this evaluation repeats the recursion's operations on nearly the same
+   * numbers, so most of its rounding repeats too; an unconverged P is
+   * 1e3 and more above it (checked below). */
+  const double u = 0x1p-53;
+  double nA = frob(A, 36), nB = frob(B, 6 * N), nP = frob(P, 36), nK = frob(K, 6 * N);
+  double bound = 32 * u * (frob(Q, 36) + nA * nA * nP + nA * nP * nB * nK * (emax / emin)) /
+                 (1 - *rho * *rho);
+  *ratio = frob(R, 36) / bound;
+}
+
+static void lqr_stationary(void)
+{
+  /* The raised, tilted pose of the move, held 2 s with a 2 ms period: 1000
+   * ticks; the recursion contracts by rho^2 ~ exp(-2 w Tc) = 0.92 per
+   * tick (w 20 rad/s), so P_n = Q is forgotten to exp(-80) at tick 0. */
+  const double q[3] = {0.1, -0.08, 0.02}, period = 2e-3;
+  prru_quintic hold;
+  hold_reference(&hold, q, 2.0);
+  prru_track_options o;
+  prru_track_options_default(&o);
+  o.controller = PRRU_TRACK_LQR;
+  o.control_period = period;
+  prru_lqr_schedule s;
+  char msg[512];
+  TU_TRUE(prru_lqr_schedule_build(&model, &hold, &o, &s, msg, sizeof msg) == PRRU_OK, msg);
+  TU_TRUE(s.n == 1001, "1001 ticks over 2 s at 2 ms");
+  prru_data *d = malloc(sizeof *d);
+  prru_linearization *lin = malloc(sizeof *lin);
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  memcpy(l.fd, s.u_ff, sizeof l.fd);
+  double qd0[3] = {0, 0, 0};
+  TU_TRUE(prru_linearize(&model, d, q, qd0, &l, period, lin) == PRRU_OK, "linearise the held pose");
+  double ratio, rho;
+  dare_check(&s, lin->Ad, lin->Bd, &ratio, &rho);
+  printf("LQR on a held pose: DARE residual at P_0 = %.3g of its rounding bound; spectral radius "
+         "of A - B K_0 = %.6f (exp(-w Tc) = %.6f)\n", ratio, rho, exp(-20 * period));
+  tu_check(ratio <= 1, "Riccati recursion converged to the DARE solution (rounding)", ratio, 1);
+  tu_check(rho < 1, "closed loop A - B K_0 stable", rho, 1);
+  /* The check can fail: 20 ticks before the end the recursion is still
+   * far from the stationary solution. */
+  prru_quintic brief;
+  hold_reference(&brief, q, 19 * period);
+  prru_lqr_schedule b;
+  TU_TRUE(prru_lqr_schedule_build(&model, &brief, &o, &b, msg, sizeof msg) == PRRU_OK, msg);
+  double ratio_b, rho_b;
+  dare_check(&b, lin->Ad, lin->Bd, &ratio_b, &rho_b);
+  tu_check(ratio_b > 1e3, "a 20-tick recursion is detected as not converged", ratio_b, 1e3);
+  prru_lqr_schedule_free(&b);
+  prru_quintic_free(&brief);
+  /* The default weights' gains near the critically damped w = 20 rad/s
+   * of computed torque: eigenvalues near exp(-w Tc). */
+  tu_check(fabs(rho - exp(-20 * period)) < 0.02, "closed loop near exp(-w Tc)", fabs(rho - exp(-20 * period)),
+           0.02);
+  prru_lqr_schedule_free(&s);
+  prru_quintic_free(&hold);
+  free(d);
+  free(lin);
+}
+
+typedef struct {
+  double tmin, worst;
+} late_ctx;
+
+static int late_error(const prru_track_sample *s, void *p)
+{
+  late_ctx *c = p;
+  if (s->t >= c->tmin)
+    for (int i = 0; i < 3; i++) c->worst = fmax(c->worst, fabs(s->e[i]));
+  return 0;
+}
+
+/* The reference's largest jerk per coordinate (differences of qdd over
+ * 0.1 ms; the quintic's jerk varies by 1e-4 of itself over that). */
+static double ref_jerk(void)
+{
+  double j = 0, a0[3], a1[3];
+  for (int k = 0; k < 20000; k++) {
+    prru_quintic_eval(&ref, k * 1e-4, NULL, NULL, a0);
+    prru_quintic_eval(&ref, (k + 1) * 1e-4, NULL, NULL, a1);
+    for (int i = 0; i < 3; i++) j = fmax(j, fabs(a1[i] - a0[i]) / 1e-4);
+  }
+  return j;
+}
+
+static double max3(const double v[3])
+{
+  return fmax(v[0], fmax(v[1], v[2]));
+}
+
+static void lqr_tracking(void)
+{
+  const double period = 1e-3, w = 20;
+  prru_track_options o;
+  prru_track_options_default(&o);
+  o.control_period = period;
+  prru_track_summary ct, lqr;
+  char msg[512];
+  TU_TRUE(prru_track(&model, &ref, &o, &ct, msg, sizeof msg) == PRRU_OK, msg);
+  o.controller = PRRU_TRACK_LQR;
+  TU_TRUE(prru_track(&model, &ref, &o, &lqr, msg, sizeof msg) == PRRU_OK, msg);
+  TU_TRUE(lqr.samples == ct.samples && lqr.samples == 2001, "LQR: one sample per tick");
+  /* Exact plant, started on the reference: the only error is the hold's.
+   * The held force lags the reference's by half a period on average, an
+   * acceleration deficit of about jerk Tc / 2, which a loop critically
+   * damped at w turns into at most jerk Tc / (2 w^2) (the impulse
+   * response t e^(-w t) integrates to 1 / w^2); a factor 2 for the
+   * transient and the LQR's coupled, not exactly critically damped,
+   * gains: jerk Tc / w^2 for either controller. */
+  double j = ref_jerk(), bound = j * period / (w * w);
+  double ect = max3(ct.max_e), elqr = max3(lqr.max_e);
+  printf("exact plant, %g ms hold: max |e| computed torque %.3e, LQR %.3e (bound jerk Tc / w^2 = "
+         "%.3e, jerk %.4g)\n", period * 1e3, ect, elqr, bound, j);
+  tu_check(ect <= bound, "computed torque within the hold's error", ect, bound);
+  tu_check(elqr <= bound, "LQR within the hold's error", elqr, bound);
+  tu_check(fabs(elqr - ect) <= bound, "LQR tracks as computed torque does", fabs(elqr - ect), bound);
+  double fct = 0, flqr = 0;
+  for (int i = 0; i < PRRU_NACT; i++) fct = fmax(fct, ct.max_fd[i]), flqr = fmax(flqr, lqr.max_fd[i]);
+  printf("  peak force: computed torque %.6g N, LQR %.6g N\n", fct, flqr);
+  TU_TRUE(fabs(flqr - fct) <= 1e-3 * fct, "the same feed-forward forces (to 0.1 %)");
+  /* The cost of the schedule (reported, not checked: the machine's). */
+  prru_lqr_schedule sch;
+  clock_t c0 = clock();
+  TU_TRUE(prru_lqr_schedule_build(&model, &ref, &o, &sch, msg, sizeof msg) == PRRU_OK, msg);
+  double per_tick = (double)(clock() - c0) / CLOCKS_PER_SEC / (double)sch.n;
+  printf("  LQR schedule: %ld ticks, %.1f us per tick\n", sch.n, per_tick * 1e6);
+  prru_lqr_schedule_free(&sch);
+  /* Started off the reference: the error decays. By 0.4 s (w t = 8) a
+   * critically damped loop keeps (1 + w t) e^(-w t) = 3e-3 of the offset;
+   * allow 1e-2 (coupling, discrete gains) plus the hold's error. */
+  const double e0[3] = {0.01, -0.008, 0.002};
+  memcpy(o.q0_offset, e0, sizeof e0);
+  late_ctx c = {0.4, 0};
+  o.on_sample = late_error;
+  o.ctx = &c;
+  int st = prru_track(&model, &ref, &o, &lqr, msg, sizeof msg);
+  TU_TRUE(st == PRRU_OK, msg);
+  double late_bound = 1e-2 * max3(e0) + bound;
+  printf("LQR from a %g offset: max |e| after 0.4 s = %.3e (bound %.3e)\n", max3(e0), c.worst,
+         late_bound);
+  tu_check(st == PRRU_OK && c.worst <= late_bound, "LQR: an initial offset decays", c.worst, late_bound);
+  tu_check(lqr.max_e[0] >= 0.99 * e0[0], "the offset was there", lqr.max_e[0], 0.99 * e0[0]);
+}
+
+/* A gain of the wrong sign or layout does not decay an offset: the law
+ * must read K_k as NACT x 6 row-major, with u = u_ff - K dx. */
+static void lqr_wrong_gain(void)
+{
+  const double q[3] = {0.1, -0.08, 0.02};
+  prru_quintic hold;
+  hold_reference(&hold, q, 1.0);
+  prru_track_options o;
+  prru_track_options_default(&o);
+  o.controller = PRRU_TRACK_LQR;
+  o.control_period = 1e-3;
+  prru_lqr_schedule s;
+  char msg[512];
+  TU_TRUE(prru_lqr_schedule_build(&model, &hold, &o, &s, msg, sizeof msg) == PRRU_OK, msg);
+  /* One tick of the law on a state 1 mm / 1 mrad off in q1: the force
+   * change is -K column 1 (row-major NACT x 6). */
+  double x[6], fc[PRRU_NACT], f[PRRU_NACT];
+  int sat[PRRU_NACT];
+  memcpy(x, s.x_ref, sizeof x);
+  x[0] += 1e-3;
+  TU_TRUE(prru_lqr_control(&s, 0, &o, x, fc, f, sat) == PRRU_OK, "LQR law");
+  double worst = 0;
+  for (int i = 0; i < PRRU_NACT; i++)
+    worst = fmax(worst, fabs((fc[i] - s.u_ff[i]) - (-s.K[6 * i] * 1e-3)) / fabs(s.K[6 * i] * 1e-3));
+  tu_check(worst <= 1e-9, "LQR law: u = u_ff - K (x - x_ref)", worst, 1e-9);
+  TU_TRUE(prru_lqr_control(&s, s.n, &o, x, fc, f, sat) == PRRU_EINPUT, "tick out of range refused");
+  prru_lqr_schedule_free(&s);
+  prru_quintic_free(&hold);
+}
+
+static void lqr_refusals(void)
+{
+  prru_track_options o;
+  prru_track_summary s;
+  char msg[512];
+  prru_track_options_default(&o);
+  o.controller = PRRU_TRACK_LQR;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "control period"),
+          "LQR without a control period refused");
+  o.control_period = 1e-3;
+  o.lqr_q[4] = -1;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "lqr_q: weight 5"),
+          "negative Q refused");
+  o.lqr_q[4] = NAN;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "lqr_q"),
+          "NaN Q refused");
+  o.lqr_q[4] = 0;
+  for (int i = 0; i < PRRU_NACT; i++) o.lqr_r[i] = 1e-4;
+  o.lqr_r[PRRU_NACT - 1] = 0;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "lqr_r: weight"),
+          "zero R (not all) refused");
+  o.lqr_r[PRRU_NACT - 1] = INFINITY;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "lqr_r"),
+          "infinite R refused");
+  o.controller = 7;
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "controller"),
+          "unknown controller refused");
+  /* A reference that leaves the workspace: the schedule fails at the
+   * first tick whose pose has no dynamics, naming its time. */
+  prru_track_options_default(&o);
+  o.controller = PRRU_TRACK_LQR;
+  o.control_period = 1e-2;
+  const double wp[6] = {0, 0, 0, 1.5, 0, 0};
+  const double dur[1] = {1};
+  prru_quintic far;
+  TU_TRUE(prru_quintic_waypoints(&far, 2, wp, dur, 0.0, msg, sizeof msg) == PRRU_OK, msg);
+  int st = prru_track(&model, &far, &o, &s, msg, sizeof msg);
+  printf("LQR on a reference out of the workspace: %s\n", msg);
+  TU_TRUE((st == PRRU_EUNREACHABLE || st == PRRU_ESINGULAR) && strstr(msg, "LQR schedule: tick") &&
+              strstr(msg, "t = ") && s.samples == 0,
+          "a tick the model cannot linearise fails the run, named");
+  prru_quintic_free(&far);
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -349,6 +666,10 @@ int main(void)
   stroke();
   stroke_between_samples();
   refusals();
+  lqr_stationary();
+  lqr_tracking();
+  lqr_wrong_gain();
+  lqr_refusals();
   prru_quintic_free(&ref);
   return tu_finish("test_control");
 }

@@ -253,7 +253,8 @@ class Types:
             ("f_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)),
             ("noise_q", d), ("noise_qd", d), ("seed", ctypes.c_ulong), ("q0_offset", _arr(d, 3)),
             ("plant", self.Params), ("abs_tol", d), ("rel_tol", d), ("on_sample", self.TrackFn),
-            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p)]})
+            ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("controller", ctypes.c_int),
+            ("lqr_q", _arr(d, 6)), ("lqr_r", _arr(d, nact))]})
         self.TrackSummary = type("prru_track_summary", (ctypes.Structure,), {"_fields_": [
             ("samples", ctypes.c_long), ("t_end", d), ("rms_e", _arr(d, 3)), ("max_e", _arr(d, 3)),
             ("max_fd", _arr(d, nact)), ("saturated", _arr(ctypes.c_long, nact)),
@@ -424,6 +425,8 @@ class Library:
         self.track_check_reference = _declare(dll, "prru_track_check_reference", i, mp, qp, top, d,
                                               vp, cp, i)
         self.track = _declare(dll, "prru_track", i, mp, qp, top, ctypes.POINTER(t.TrackSummary), cp, i)
+        self.lqr_default_weights = _declare(dll, "prru_lqr_default_weights", i, mp, qp, d,
+                                            ctypes.POINTER(d), ctypes.POINTER(d), cp, i)
         self.model_params = _declare(dll, "prru_model_params", None, mp, pp)
         self.params_scale = _declare(dll, "prru_params_scale", i, pp, cp, d)
         # Identification.
@@ -591,7 +594,7 @@ class Library:
                 or o.dt_out != 1e-3 or o.seed != 1 or o.abs_tol != 1e-12 or o.rel_tol != 1e-12
                 or any(v != math.inf for v in o.f_max) or any(v != -math.inf for v in o.d_min)
                 or bytes(o.plant) != bytes(p) or p.coulomb_velocity <= 0 or o.on_sample
-                or not guard_intact(g)):
+                or o.controller != 0 or any(o.lqr_q) or any(o.lqr_r) or not guard_intact(g)):
             raise self._layout_error("prru_track_options")
         gl = t.GuardedLimits()
         fill_guard(gl)

@@ -291,7 +291,7 @@ def _reference(model, ref):
 
 def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1e-3, limits=None,
           noise=(0.0, 0.0), seed=1, q0_offset=(0.0, 0.0, 0.0), plant=None, mismatch=None,
-          atol=1e-12, rtol=1e-12):
+          atol=1e-12, rtol=1e-12, controller="ct", lqr_q=None, lqr_r=None):
     """Computed-torque tracking of reference (a Motion, e.g. from quintic or
     time_optimal, or (t, q, qd, qdd) rows), simulated in closed loop, as
     prru track: fd = J_d^-T (M qdd_c + h - G - passive) with qdd_c =
@@ -305,7 +305,13 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
     against speed_max. plant: a Model file path or Model with this
     library's limbs (the robot the controller does not know exactly),
     default this model; mismatch: {key: factor} scaling the plant's mass,
-    inertia, armature, damping, coulomb or gravity. Returns TrackRun.
+    inertia, armature, damping, coulomb or gravity. controller "lqr"
+    (needs period > 0) is prru track --controller lqr: a time-varying
+    discrete LQR from the backward Riccati recursion along the reference
+    (prru_control.h), fd = u_ff - K_k (x - x_ref), with the diagonal
+    weights lqr_q (6: q then qd, >= 0, not all 0) and lqr_r (one per
+    actuator, > 0), each by default Bryson's rule (prru_lqr_default_weights;
+    the summary's lqr_q, lqr_r give the weights used). Returns TrackRun.
     Raises InputError for a reference outside the workspace, across a
     singularity or outside the stroke (naming the sample) and for bad
     options; Unreachable when the plant leaves its stroke or the
@@ -338,6 +344,7 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
         plant_model = type(self)(self.lib, model=plant)
     if plant_model.lib is not self.lib:
         raise ValueError("plant must use this model's library (%s)" % self.lib.path)
+    _track_controller(self, o, controller, lqr_q, lqr_r)
     lib.model_params(ctypes.byref(plant_model._m), ctypes.byref(o.plant))
     for key, f in (mismatch or {}).items():
         f = _convert.scalar("mismatch[%r]" % key, f, positive=True, allow_zero=False)
@@ -351,6 +358,46 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
         lib.quintic_free(ctypes.byref(tr))
 
 
+def _track_controller(model, o, controller, lqr_q, lqr_r):
+    """The controller choice and the LQR's weights into o (checked as prru
+    track checks --controller, --lqr-q, --lqr-r)."""
+    if controller not in ("ct", "lqr"):
+        raise ValueError("controller must be 'ct' (computed torque) or 'lqr', got %r" % (controller,))
+    if controller == "ct":
+        if lqr_q is not None or lqr_r is not None:
+            raise ValueError("lqr_q and lqr_r belong to controller='lqr'")
+        return
+    if not o.control_period > 0:
+        raise ValueError("controller 'lqr' needs period > 0 (a sampled controller)")
+    o.controller = 1  # PRRU_TRACK_LQR
+    if lqr_q is not None:
+        q = list(_convert.vector("lqr_q", lqr_q, 6))
+        if any(not v >= 0 for v in q) or not any(v > 0 for v in q):
+            raise ValueError("lqr_q: weights must be >= 0, not all 0, got %r" % (q,))
+        o.lqr_q[:] = q
+    if lqr_r is not None:
+        r = list(_convert.vector("lqr_r", lqr_r, model.nact))
+        if any(not v > 0 for v in r):
+            raise ValueError("lqr_r: weights must be > 0, got %r" % (r,))
+        o.lqr_r[:] = r
+
+
+def _lqr_default_weights(model, tr, o):
+    """The library's default weights into the groups of o left all 0, so
+    that the summary gives the weights used."""
+    lib, n, msg = model.lib, model.nact, ctypes.create_string_buffer(600)
+    q, r = (ctypes.c_double * 6)(), (ctypes.c_double * n)()
+    with model._lock:
+        st = lib.lqr_default_weights(ctypes.byref(model._m), ctypes.byref(tr), o.control_period, q, r, msg,
+                                     len(msg))
+    if st != errors.OK:
+        raise _fail(model, st, "track: LQR default weights", msg)
+    if not any(o.lqr_q):
+        o.lqr_q[:] = list(q)
+    if not any(o.lqr_r):
+        o.lqr_r[:] = list(r)
+
+
 def _track_run(model, tr, o, lim, guard):
     lib, n, msg = model.lib, model.nact, ctypes.create_string_buffer(600)
     step = o.control_period if o.control_period > 0 else o.dt_out
@@ -360,6 +407,8 @@ def _track_run(model, tr, o, lim, guard):
                                        ctypes.byref(ff), msg, len(msg))
     if st != errors.OK:
         raise _fail(model, st, "track", msg)
+    if o.controller == 1:
+        _lqr_default_weights(model, tr, o)
     names = ("t", "q_ref", "q", "e", "qd", "fd", "fd_cmd", "saturated", "d", "qdd", "dd")
     cols = {k: [] for k in names}
     dd, ddb = (ctypes.c_double * n)(), (ctypes.c_double * n)()
@@ -403,6 +452,8 @@ def _track_run(model, tr, o, lim, guard):
             "over_speed_fraction": stats["over"] / samples if samples else 0.0,
             "feedforward_peak": ff.value, "limits": lim,
             "status": "complete" if st == errors.OK else msg.value.decode("utf-8", "replace")}
+    if o.controller == 1:
+        summ.update(controller="lqr", lqr_q=tuple(o.lqr_q), lqr_r=tuple(o.lqr_r))
     run = TrackRun(out.vec(cols["t"]), *(mat[k] for k in names[1:]), summ)
     err = failure[0] if failure else interrupt
     if err is None and st != errors.OK:

@@ -648,6 +648,49 @@ class TestMotion(unittest.TestCase):
                         mismatch={"mass": 3})
         self.assertGreater(len(cm.exception.run.t), 0)
 
+    def test_track_lqr(self):
+        """controller='lqr' is prru track --controller lqr: the same rows
+        and summary to the bit, the default weights reported; bad choices
+        refused as the CLI refuses them."""
+        ref = MODEL.quintic(self.WPS[:2], [0.3])
+        run = MODEL.track(ref, period=0.002, controller="lqr", mismatch={"mass": 1.2},
+                          limits=MODEL.limits(model_limits=False))
+        with tempfile.TemporaryDirectory() as tmp:
+            tr, out, summ = (os.path.join(tmp, f) for f in ("traj.csv", "tr.csv", "tr.json"))
+            cli("traj", "--waypoints", ";".join(self.WPS_TEXT.split(";")[:2]), "--durations", "0.3",
+                "--out", tr)
+            cli("track", "--ref", tr, "--period", "0.002", "--controller", "lqr", "--mismatch", "mass=1.2",
+                "--no-limits", "--out", out, "--summary", summ)
+            rows, s = csv_rows(read(out)), json.loads(read(summ))
+        n = MODEL.nact
+        self.assertEqual(len(run.t), len(rows))
+        for k in (0, len(rows) // 2, len(rows) - 1):
+            r = rows[k]
+            self.assertEqual(bits(run.q[k]), bits([r["q%d" % (i + 1)] for i in range(3)]))
+            self.assertEqual(bits(run.fd[k]), bits([r["fd%d" % (i + 1)] for i in range(n)]))
+        for key in ("rms_error", "max_error", "max_fd", "lqr_q", "lqr_r", "samples"):
+            self.assertEqual(bits(run.summary[key]), bits(s[key]), key)
+        self.assertEqual((run.summary["controller"], len(run.summary["lqr_q"]), len(run.summary["lqr_r"])),
+                         ("lqr", 6, n))
+        self.assertGreater(max(run.summary["max_error"]), 0)  # the mismatch shows
+        # Given weights are used as given; stiffer position weights track
+        # the heavier plant closer.
+        q = [10 * v for v in run.summary["lqr_q"]]
+        stiff = MODEL.track(ref, period=0.002, controller="lqr", lqr_q=q, lqr_r=run.summary["lqr_r"],
+                            mismatch={"mass": 1.2}, limits=MODEL.limits(model_limits=False))
+        self.assertEqual(bits(stiff.summary["lqr_q"]), bits(q))
+        self.assertLess(max(stiff.summary["max_error"]), max(run.summary["max_error"]))
+        for kw, msg in ((dict(controller="lqr"), "needs period > 0"),
+                        (dict(controller="pid", period=0.002), "controller must be"),
+                        (dict(period=0.002, lqr_q=[1] * 6), "belong to controller='lqr'"),
+                        (dict(controller="lqr", period=0.002, lqr_q=[1, 1, 1, -1, 1, 1]), "lqr_q"),
+                        (dict(controller="lqr", period=0.002, lqr_q=[0] * 6), "lqr_q"),
+                        (dict(controller="lqr", period=0.002, lqr_r=[1] * (n - 1) + [0]), "lqr_r"),
+                        (dict(controller="lqr", period=0.002, lqr_r=[1] * (n + 1)), "lqr_r")):
+            with self.subTest(**{k: str(v) for k, v in kw.items()}):
+                with self.assertRaisesRegex(ValueError, msg):
+                    MODEL.track(ref, **kw)
+
 
 class TestIdentification(unittest.TestCase):
     """excite and identify against prru excite and prru identify: the same

@@ -1,4 +1,5 @@
-/* Computed-torque tracking of a joint trajectory, simulated in closed loop.
+/* Computed-torque (or LQR, below) tracking of a joint trajectory,
+ * simulated in closed loop.
  *
  * Controller: the model's own inverse dynamics (the generated kernels) at
  * the measured state with the commanded acceleration
@@ -92,11 +93,21 @@ typedef struct {
   double abs_tol, rel_tol;
   prru_track_fn on_sample; void *ctx;
   volatile sig_atomic_t *interrupt;
+  /* The controller: PRRU_TRACK_CT, computed torque with kp, kd (the
+   * default), or PRRU_TRACK_LQR, the time-varying discrete LQR below
+   * (needs control_period > 0; kp, kd unused) with the diagonal weights
+   * lqr_q (q1..3 then qd1..3, >= 0, finite) and lqr_r (per actuator,
+   * > 0, finite). All of lqr_q zero, or all of lqr_r zero (the default):
+   * that group is prru_lqr_default_weights'. */
+  int controller;
+  double lqr_q[6], lqr_r[PRRU_NACT];
 } prru_track_options;
+
+enum { PRRU_TRACK_CT = 0, PRRU_TRACK_LQR = 1 };
 
 /* Gains kp = w^2, kd = 2 w with w = 20 rad/s, continuous, dt_out 1 ms, no
  * limits, no noise, seed 1, the exact plant (prru_params_model), rk8pd at
- * 1e-12. */
+ * 1e-12; computed torque, the LQR weights 0 (prru_lqr_default_weights). */
 PRRU_API void prru_track_options_default(prru_track_options *o);
 
 typedef struct {
@@ -113,7 +124,9 @@ typedef struct {
  * PRRU_EINPUT for bad options (msg names the option); the plant leaving
  * the workspace or its stroke PRRU_EUNREACHABLE, the controller meeting a
  * singular J_d PRRU_ESINGULAR, integrator failure PRRU_ENOCONV,
- * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why. */
+ * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why.
+ * With PRRU_TRACK_LQR the gain schedule is built first (once per run):
+ * prru_lqr_schedule_build's statuses, no sample delivered. */
 PRRU_API int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
                         prru_track_summary *sum, char *msg, int msglen);
 
@@ -136,6 +149,76 @@ PRRU_API int prru_computed_torque(const prru_model *m, prru_data *d, const prru_
                                   const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
                                   const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
                                   double fd[PRRU_NACT], int sat[PRRU_NACT]);
+
+/* Time-varying discrete LQR tracking (controller PRRU_TRACK_LQR).
+ *
+ * At each control tick t_k of prru_track's run (t_0 + k control_period,
+ * the last one the reference's end) the reference state x_ref,k = (q_ref,
+ * qd_ref), the feed-forward u_ff,k = the controller model's inverse
+ * dynamics at (q_ref, qd_ref, qdd_ref), and the zero-order-hold pair
+ * (A_k, B_k) = prru_linearize at (q_ref, qd_ref) under fd = u_ff,k with
+ * dt = control_period: x_{k+1} - x_ref,k+1 ~ A_k (x_k - x_ref,k) + B_k
+ * (u_k - u_ff,k). The gains minimise sum_k dx_k^T Q dx_k + du_k^T R du_k
+ * (Q = diag lqr_q, R = diag lqr_r) by the backward Riccati recursion
+ *     K_k = (R + B_k^T P_k+1 B_k)^-1 B_k^T P_k+1 A_k   (Cholesky),
+ *     P_k = Q + A_k^T P_k+1 (A_k - B_k K_k), symmetrised,
+ * from the terminal cost P_n = Q: the run ends at the reference's end,
+ * where the state is weighed like at every tick; the recursion forgets
+ * P_n at the closed loop's rate (|eig(A - B K)|^2 per tick), so the gains
+ * are the stationary (infinite-horizon) ones except over the last few
+ * closed-loop time constants. The law at tick k:
+ *     fd = u_ff,k - K_k (x_measured - x_ref,k), then clipped to f_max. */
+typedef struct {
+  long n;              /* ticks */
+  double period;       /* s */
+  double q[6], r[PRRU_NACT]; /* the weights used */
+  double *K;           /* n x PRRU_NACT x 6: K_k at K + 6 PRRU_NACT k, row-major */
+  double *u_ff;        /* n x PRRU_NACT: u_ff,k at u_ff + PRRU_NACT k */
+  double *x_ref;       /* n x 6 */
+  double P0[36];       /* P_0, row-major */
+} prru_lqr_schedule;
+
+/* Bryson's rule from the model's own scales, matched to computed torque's
+ * default bandwidth w = 20 rad/s: a force scale F, the largest |u_ff,i|
+ * along the reference at the ticks every period (1 N if that is 0), with
+ * R_i = 1 / F^2; a_j = F / |G^+ e_j|, the acceleration coordinate j alone
+ * gets from forces of that scale (G = dqdd/dfd of the linearisation at the
+ * reference's start, G^+ = G^T (G G^T)^-1, the least-norm forces of an
+ * acceleration); the acceptable errors e_q,j = a_j / w^2 (the error for
+ * which computed torque's Kp = w^2 asks for a_j) and e_qd,j = a_j / (sqrt 2
+ * w): Q_j = 1 / e_q,j^2, Q_3+j = 1 / e_qd,j^2. For a decoupled double
+ * integrator qdd_j = g_j fd_j this makes the continuous LQR's gains
+ * exactly Kp = w^2, Kd = 2 w (critically damped at w), whatever F (F
+ * only sets the cost's unit). A coupled robot's LQR spends force where
+ * it is cheapest instead: its error is shaped differently from computed
+ * torque's (docs/control.md measures both). q, r may be NULL.
+ * prru_lqr_schedule_build's statuses for a reference the model cannot
+ * follow (PRRU_ESINGULAR where G G^T is singular); PRRU_EINPUT for
+ * period <= 0. */
+PRRU_API int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period,
+                                      double q[6], double r[PRRU_NACT], char *msg, int msglen);
+
+/* The schedule of the run prru_track makes with o (o->controller is not
+ * read; o->control_period > 0 and the weights are), into *s (allocated
+ * once: prru_lqr_schedule_free). PRRU_EINPUT for bad weights or period
+ * (msg names the option: lqr_q, lqr_r, control period); where the
+ * reference's inverse dynamics or linearisation fails at a tick, that
+ * status (PRRU_EUNREACHABLE, PRRU_ESINGULAR, ...) with msg naming the
+ * tick's time; PRRU_ENOCONV where R + B^T P B is not positive definite
+ * (non-finite numbers); PRRU_ENOMEM. On failure *s holds nothing to
+ * free. */
+PRRU_API int prru_lqr_schedule_build(const prru_model *m, const prru_quintic *ref,
+                                     const prru_track_options *o, prru_lqr_schedule *s, char *msg,
+                                     int msglen);
+PRRU_API void prru_lqr_schedule_free(prru_lqr_schedule *s);
+
+/* The LQR law at tick k (0 <= k < s->n) on the measured state x (q then
+ * qd): fd_cmd = u_ff,k - K_k (x - x_ref,k), fd clipped to o->f_max, sat[i]
+ * set where clipped. PRRU_EINPUT where fd_cmd is not finite (k out of
+ * range, x not finite or overflowing). */
+PRRU_API int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_options *o,
+                              const double x[6], double fd_cmd[PRRU_NACT], double fd[PRRU_NACT],
+                              int sat[PRRU_NACT]);
 
 /* The plant's accelerations under fd (no platform loads): M qdd = b from
  * prru_param_eom with o->plant, solved by Cholesky. PRRU_EUNREACHABLE

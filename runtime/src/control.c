@@ -1,14 +1,17 @@
-/* Computed-torque tracking in closed loop (prru_control.h). */
+/* Computed-torque and LQR tracking in closed loop (prru_control.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
 #include "prru_control.h"
+#include "prru_linearize.h"
 #include "internal.h"
 
 void prru_track_options_default(prru_track_options *o)
@@ -93,6 +96,290 @@ int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_opt
   return PRRU_OK;
 }
 
+/* ---- time-varying discrete LQR ---- */
+
+/* The integrator may probe a few ulps past the reference's end. */
+static double clamp_time(const prru_quintic *ref, double t)
+{
+  return fmin(fmax(t, prru_quintic_t_begin(ref)), prru_quintic_t_end(ref));
+}
+
+/* The bandwidth the default weights aim at: computed torque's default. */
+#define LQR_BANDWIDTH 20.0
+
+/* Tick k's time: t_0 + k step, the last one exactly the reference's end. */
+static double tick_time(const prru_quintic *ref, double step, long k, long nticks)
+{
+  return k == nticks ? prru_quintic_t_end(ref) : prru_quintic_t_begin(ref) + (double)k * step;
+}
+
+/* The last tick's index: t_0 is always a tick, and t_1 (a remainder
+ * below 1e-9 step merged into the last tick): at least two, however
+ * short the span. */
+static long last_tick(const prru_quintic *ref, double step)
+{
+  const double t0 = prru_quintic_t_begin(ref), t1 = prru_quintic_t_end(ref);
+  return (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9));
+}
+
+static int all_zero(const double *v, int n)
+{
+  for (int i = 0; i < n; i++)
+    if (v[i] != 0.0) return 0;
+  return 1;
+}
+
+/* The reference at tick k of a run with period step: x = (q, qd), the
+ * feed-forward u (inverse dynamics without loads). */
+static int lqr_reference_tick(const prru_model *m, prru_data *d, const prru_quintic *ref, double step,
+                              long k, long last, double x[6], double u[PRRU_NACT], char *msg, int msglen)
+{
+  static const prru_loads none;
+  double t = tick_time(ref, step, k, last), qdd[3];
+  prru_quintic_eval(ref, clamp_time(ref, t), x, x + 3, qdd);
+  int st = prru_inverse_dynamics(m, d, x, x + 3, qdd, &none, u);
+  if (st == PRRU_OK && !prru_finite_n(u, PRRU_NACT)) st = PRRU_EINPUT;
+  if (st != PRRU_OK)
+    return prru_fail(msg, msglen, st, "LQR schedule: tick %ld (t = %.9g s): the reference's inverse "
+                     "dynamics at q = (%.9g, %.9g, %.9g) failed: %s", k, t, x[0], x[1], x[2],
+                     prru_strerror(st));
+  return PRRU_OK;
+}
+
+/* The zero-order-hold linearisation at tick k's reference (x, u). */
+static int lqr_linearize_tick(const prru_model *m, prru_data *d, const double x[6],
+                              const double u[PRRU_NACT], double step, double t, long k,
+                              prru_linearization *lin, char *msg, int msglen)
+{
+  prru_loads l;
+  memset(&l, 0, sizeof l);
+  memcpy(l.fd, u, sizeof l.fd);
+  char why[300];
+  int st = prru_linearize_why(m, d, x, x + 3, &l, step, lin, why, sizeof why);
+  if (st != PRRU_OK)
+    return prru_fail(msg, msglen, st, "LQR schedule: tick %ld (t = %.9g s): the linearisation at q = "
+                     "(%.9g, %.9g, %.9g) failed: %s%s%s", k, t, x[0], x[1], x[2], prru_strerror(st),
+                     why[0] ? ": " : "", why);
+  return PRRU_OK;
+}
+
+/* a_j: the acceleration coordinate j alone gets from forces of size F,
+ * F / |G^+ e_j| with G = dqdd/dfd (3 x PRRU_NACT) and G^+ = G^T (G
+ * G^T)^-1 (the least-norm forces for an acceleration): the scale of a
+ * decoupled double integrator, where the largest acceleration of j
+ * (F |row j of G|) would count the other coordinates' motion too. 0, or
+ * -1 when G G^T is singular. */
+static int decoupled_accel(const double G[3 * PRRU_NACT], double F, double a[3])
+{
+  double H[9], Hi[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double h = 0.0;
+      for (int k = 0; k < PRRU_NACT; k++) h += G[i * PRRU_NACT + k] * G[j * PRRU_NACT + k];
+      H[3 * i + j] = h;
+    }
+  if (!(prru_rcond3(H, Hi) > 1e-14)) return -1;
+  for (int j = 0; j < 3; j++) {
+    double n = 0.0;
+    for (int k = 0; k < PRRU_NACT; k++) {
+      double c = 0.0; /* (G^T H^-1)_kj */
+      for (int i = 0; i < 3; i++) c += G[i * PRRU_NACT + k] * Hi[3 * i + j];
+      n = hypot(n, c);
+    }
+    a[j] = F / n;
+    if (!(a[j] > 0.0 && isfinite(a[j]))) return -1;
+  }
+  return 0;
+}
+
+int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period, double q[6],
+                             double r[PRRU_NACT], char *msg, int msglen)
+{
+  if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
+  if (!(period > 0.0 && isfinite(period)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "control period: LQR needs a finite period > 0, got %g",
+                     period);
+  prru_gsl_init();
+  prru_data *d = malloc(sizeof *d);
+  prru_linearization *lin = malloc(sizeof *lin);
+  int st = d && lin ? PRRU_OK : prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
+  const long last = last_tick(ref, period);
+  double x[6], u[PRRU_NACT], x0[6], u0[PRRU_NACT], F = 0.0;
+  for (long k = 0; k <= last && st == PRRU_OK; k++) {
+    st = lqr_reference_tick(m, d, ref, period, k, last, x, u, msg, msglen);
+    for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++) F = fmax(F, fabs(u[i]));
+    if (k == 0) memcpy(x0, x, sizeof x0), memcpy(u0, u, sizeof u0);
+  }
+  if (F == 0.0) F = 1.0;
+  if (st == PRRU_OK)
+    st = lqr_linearize_tick(m, d, x0, u0, 0.0, prru_quintic_t_begin(ref), 0, lin, msg, msglen);
+  double a[3];
+  if (st == PRRU_OK && decoupled_accel(lin->dqdd_dfd, F, a) != 0)
+    st = prru_fail(msg, msglen, PRRU_ESINGULAR, "LQR default weights: the actuators do not move "
+                   "every coordinate at the reference's start (dqdd/dfd rank-deficient)");
+  for (int j = 0; j < 3 && st == PRRU_OK && q; j++) {
+    const double w = LQR_BANDWIDTH;
+    q[j] = (w * w / a[j]) * (w * w / a[j]);
+    q[3 + j] = 2.0 * (w / a[j]) * (w / a[j]);
+  }
+  for (int i = 0; i < PRRU_NACT && r && st == PRRU_OK; i++) r[i] = 1.0 / (F * F);
+  free(d);
+  free(lin);
+  if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
+  return st;
+}
+
+static int lqr_weights_check(const prru_track_options *o, char *msg, int msglen)
+{
+  if (!(o->control_period > 0.0))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "control period: the LQR controller needs a sampled "
+                     "controller (control period > 0)");
+  for (int i = 0; i < 6; i++)
+    if (!(o->lqr_q[i] >= 0.0 && isfinite(o->lqr_q[i])))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_q: weight %d must be finite and >= 0, got %g",
+                       i + 1, o->lqr_q[i]);
+  if (all_zero(o->lqr_r, PRRU_NACT)) return PRRU_OK;
+  for (int i = 0; i < PRRU_NACT; i++)
+    if (!(o->lqr_r[i] > 0.0 && isfinite(o->lqr_r[i])))
+      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_r: weight %d must be finite and > 0, got %g",
+                       i + 1, o->lqr_r[i]);
+  return PRRU_OK;
+}
+
+/* One backward Riccati step: K = (R + B^T P B)^-1 B^T P A (Cholesky),
+ * P <- Q + A^T P (A - B K), symmetrised. Works on the caller's arrays: no
+ * allocation. GSL_EDOM where R + B^T P B is not positive definite. */
+static int riccati_step(const double A[36], const double B[6 * PRRU_NACT], const double Q[6],
+                        const double R[PRRU_NACT], double P[36], double K[PRRU_NACT * 6])
+{
+  enum { N = PRRU_NACT };
+  double PA[36], PB[6 * N], S[N * N], BtPA[N * 6], AmBK[36], PAmBK[36];
+  gsl_matrix_const_view a = gsl_matrix_const_view_array(A, 6, 6), b = gsl_matrix_const_view_array(B, 6, N);
+  gsl_matrix_view p = gsl_matrix_view_array(P, 6, 6), pa = gsl_matrix_view_array(PA, 6, 6),
+                  pb = gsl_matrix_view_array(PB, 6, N), s = gsl_matrix_view_array(S, N, N),
+                  btpa = gsl_matrix_view_array(BtPA, N, 6), k = gsl_matrix_view_array(K, N, 6),
+                  ambk = gsl_matrix_view_array(AmBK, 6, 6), pambk = gsl_matrix_view_array(PAmBK, 6, 6);
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &p.matrix, &a.matrix, 0.0, &pa.matrix);
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &p.matrix, &b.matrix, 0.0, &pb.matrix);
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, &b.matrix, &pb.matrix, 0.0, &s.matrix);
+  for (int i = 0; i < N; i++) S[i * N + i] += R[i];
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, &b.matrix, &pa.matrix, 0.0, &btpa.matrix);
+  if (!prru_finite_n(S, N * N) || gsl_linalg_cholesky_decomp1(&s.matrix) != GSL_SUCCESS) return GSL_EDOM;
+  gsl_linalg_cholesky_solve_mat(&s.matrix, &btpa.matrix, &k.matrix);
+  memcpy(AmBK, A, sizeof AmBK);
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, -1.0, &b.matrix, &k.matrix, 1.0, &ambk.matrix);
+  gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &p.matrix, &ambk.matrix, 0.0, &pambk.matrix);
+  gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, &a.matrix, &pambk.matrix, 0.0, &p.matrix);
+  for (int i = 0; i < 6; i++) {
+    P[i * 6 + i] += Q[i];
+    for (int j = 0; j < i; j++) P[i * 6 + j] = P[j * 6 + i] = 0.5 * (P[i * 6 + j] + P[j * 6 + i]);
+  }
+  return prru_finite_n(K, N * 6) && prru_finite_n(P, 36) ? GSL_SUCCESS : GSL_EDOM;
+}
+
+/* The weights of the run: o's, or Bryson's for a group left all zero. */
+static int lqr_weights(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                       prru_lqr_schedule *s, char *msg, int msglen)
+{
+  memcpy(s->q, o->lqr_q, sizeof s->q);
+  memcpy(s->r, o->lqr_r, sizeof s->r);
+  int dq = all_zero(o->lqr_q, 6), dr = all_zero(o->lqr_r, PRRU_NACT);
+  if (!dq && !dr) return PRRU_OK;
+  return prru_lqr_default_weights(m, ref, o->control_period, dq ? s->q : NULL, dr ? s->r : NULL, msg,
+                                  msglen);
+}
+
+/* The reference, feed-forward and the (A_k, B_k) of every tick; then the
+ * gains backwards from P_n = Q (the A_k, B_k kept in the K and a scratch
+ * array: one linearisation per tick). */
+static int lqr_schedule_fill(const prru_model *m, const prru_quintic *ref, prru_lqr_schedule *s,
+                             double *AB, prru_data *d, prru_linearization *lin, char *msg, int msglen)
+{
+  const long last = s->n - 1;
+  enum { NAB = 36 + 6 * PRRU_NACT };
+  for (long k = 0; k < s->n; k++) {
+    double *x = s->x_ref + 6 * k, *u = s->u_ff + PRRU_NACT * k;
+    int st = lqr_reference_tick(m, d, ref, s->period, k, last, x, u, msg, msglen);
+    if (st == PRRU_OK)
+      st = lqr_linearize_tick(m, d, x, u, s->period, tick_time(ref, s->period, k, last), k, lin, msg,
+                              msglen);
+    if (st != PRRU_OK) return st;
+    memcpy(AB + NAB * k, lin->Ad, sizeof lin->Ad);
+    memcpy(AB + NAB * k + 36, lin->Bd, sizeof lin->Bd);
+  }
+  double P[36];
+  memset(P, 0, sizeof P);
+  for (int i = 0; i < 6; i++) P[i * 6 + i] = s->q[i];
+  for (long k = last; k >= 0; k--) {
+    if (riccati_step(AB + NAB * k, AB + NAB * k + 36, s->q, s->r, P, s->K + 6 * PRRU_NACT * k) != GSL_SUCCESS)
+      return prru_fail(msg, msglen, PRRU_ENOCONV, "LQR schedule: tick %ld (t = %.9g s): R + B^T P B is "
+                       "not positive definite (weights or dynamics out of scale)", k,
+                       tick_time(ref, s->period, k, last));
+  }
+  memcpy(s->P0, P, sizeof P);
+  return PRRU_OK;
+}
+
+int prru_lqr_schedule_build(const prru_model *m, const prru_quintic *ref, const prru_track_options *o,
+                            prru_lqr_schedule *s, char *msg, int msglen)
+{
+  memset(s, 0, sizeof *s);
+  if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
+  int st = lqr_weights_check(o, msg, msglen);
+  if (st != PRRU_OK) return st;
+  prru_gsl_init();
+  s->period = o->control_period;
+  s->n = last_tick(ref, s->period) + 1;
+  if (!((double)s->n <= 1e8))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "control period: more than 1e8 ticks");
+  size_t n = (size_t)s->n;
+  s->K = malloc(n * 6 * PRRU_NACT * sizeof *s->K);
+  s->u_ff = malloc(n * PRRU_NACT * sizeof *s->u_ff);
+  s->x_ref = malloc(n * 6 * sizeof *s->x_ref);
+  double *AB = malloc(n * (36 + 6 * PRRU_NACT) * sizeof *AB);
+  prru_data *d = malloc(sizeof *d);
+  prru_linearization *lin = malloc(sizeof *lin);
+  if (!s->K || !s->u_ff || !s->x_ref || !AB || !d || !lin)
+    st = prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
+  if (st == PRRU_OK) st = lqr_weights(m, ref, o, s, msg, msglen);
+  if (st == PRRU_OK) st = lqr_schedule_fill(m, ref, s, AB, d, lin, msg, msglen);
+  free(AB);
+  free(d);
+  free(lin);
+  if (st != PRRU_OK) prru_lqr_schedule_free(s);
+  if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
+  return st;
+}
+
+void prru_lqr_schedule_free(prru_lqr_schedule *s)
+{
+  free(s->K);
+  free(s->u_ff);
+  free(s->x_ref);
+  s->K = s->u_ff = s->x_ref = NULL;
+  s->n = 0;
+}
+
+int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_options *o, const double x[6],
+                     double fd_cmd[PRRU_NACT], double fd[PRRU_NACT], int sat[PRRU_NACT])
+{
+  if (!(k >= 0 && k < s->n)) return PRRU_EINPUT;
+  const double *K = s->K + 6 * PRRU_NACT * k, *xr = s->x_ref + 6 * k, *u = s->u_ff + PRRU_NACT * k;
+  double dx[6];
+  for (int j = 0; j < 6; j++) dx[j] = x[j] - xr[j];
+  for (int i = 0; i < PRRU_NACT; i++) {
+    double f = u[i];
+    for (int j = 0; j < 6; j++) f -= K[6 * i + j] * dx[j];
+    fd_cmd[i] = f;
+  }
+  if (!prru_finite_n(fd_cmd, PRRU_NACT)) return PRRU_EINPUT;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    double lim = o->f_max[i];
+    sat[i] = fabs(fd_cmd[i]) > lim;
+    fd[i] = sat[i] ? copysign(lim, fd_cmd[i]) : fd_cmd[i];
+  }
+  return PRRU_OK;
+}
 
 static int track_options_check(const prru_track_options *o, char *msg, int msglen)
 {
@@ -128,6 +415,10 @@ static int track_options_check(const prru_track_options *o, char *msg, int msgle
       !isfinite(o->rel_tol))
     return prru_fail(msg, msglen, PRRU_EINPUT, "tolerances must be finite and >= %g",
                      PRRU_TOL_MIN);
+  if (o->controller != PRRU_TRACK_CT && o->controller != PRRU_TRACK_LQR)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "controller: %d is neither PRRU_TRACK_CT nor "
+                     "PRRU_TRACK_LQR", o->controller);
+  if (o->controller == PRRU_TRACK_LQR) return lqr_weights_check(o, msg, msglen);
   return PRRU_OK;
 }
 
@@ -136,6 +427,7 @@ typedef struct {
   const prru_quintic *ref;
   const prru_track_options *o;
   prru_data *d;
+  const prru_lqr_schedule *lqr; /* the LQR's gains, NULL for computed torque */
   int continuous;
   double fd_hold[PRRU_NACT];
   int status; /* why the right-hand side last failed */
@@ -145,12 +437,6 @@ typedef struct {
   int in_plant;
   double fail_t, fail_y[6], fd_step_peak;
 } track_ctx;
-
-/* The integrator may probe a few ulps past the reference's end. */
-static double clamp_time(const prru_quintic *ref, double t)
-{
-  return fmin(fmax(t, prru_quintic_t_begin(ref)), prru_quintic_t_end(ref));
-}
 
 /* As in simulate.c: GSL_EBADFUNC makes every stepper return at once. */
 static int track_rhs(double t, const double y[], double f[], void *p)
@@ -227,7 +513,7 @@ static int tick_failure(track_ctx *c, int st, double t, const double y[6], const
                    st == PRRU_ESINGULAR ? " (the controller's inverse dynamics)" : "");
 }
 
-static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
+static int track_tick(track_ctx *c, gsl_rng *rng, long k, double t, const double y[6],
                       prru_track_sample *s, char *msg, int msglen)
 {
   const prru_track_options *o = c->o;
@@ -242,9 +528,18 @@ static int track_tick(track_ctx *c, gsl_rng *rng, double t, const double y[6],
     s->qd[i] = y[3 + i];
     s->e[i] = s->q_ref[i] - y[i];
   }
-  int st = prru_computed_torque(c->m, c->d, o, s->q_ref, s->qd_ref, s->qdd_ref, meas, meas + 3,
-                                s->fd_cmd, s->fd, s->saturated);
-  if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
+  int st;
+  if (c->lqr) {
+    st = prru_lqr_control(c->lqr, k, o, meas, s->fd_cmd, s->fd, s->saturated);
+    if (st != PRRU_OK)
+      return prru_fail(msg, msglen, st, "stopped at t = %.9g s: the LQR's forces overflow at the %s "
+                       "state q = (%.9g, %.9g, %.9g), qd = (%.9g, %.9g, %.9g)", t,
+                       rng ? "measured" : "true", meas[0], meas[1], meas[2], meas[3], meas[4], meas[5]);
+  } else {
+    st = prru_computed_torque(c->m, c->d, o, s->q_ref, s->qd_ref, s->qdd_ref, meas, meas + 3,
+                              s->fd_cmd, s->fd, s->saturated);
+    if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
+  }
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
   st = prru_plant_accel(&o->plant, y, y + 3, s->fd, s->qdd);
   if (st != PRRU_OK)
@@ -279,12 +574,6 @@ static void summary_finish(prru_track_summary *sum)
 {
   for (int i = 0; i < 3; i++)
     sum->rms_e[i] = sum->samples > 0 ? sqrt(sum->rms_e[i] / (double)sum->samples) : 0.0;
-}
-
-/* Tick k's time: t_0 + k step, the last one exactly the reference's end. */
-static double tick_time(const prru_quintic *ref, double step, long k, long nticks)
-{
-  return k == nticks ? prru_quintic_t_end(ref) : prru_quintic_t_begin(ref) + (double)k * step;
 }
 
 /* The first slider outside its stroke, or -1. */
@@ -338,6 +627,12 @@ static int trial_failure(const track_ctx *c, int st, double t, char *msg, int ms
   else
     snprintf(what, sizeof what, "q = (%.9g, %.9g, %.9g) is %s (%s)", y[0], y[1], y[2],
              failure_text(st), where);
+  if (c->lqr)
+    return prru_fail(msg, msglen, st,
+                     "stopped at t = %.9g s: the integrator's trial state at t = %.9g s left the "
+                     "run's regular path: %s; the controller's forces reached %.3g N in this step "
+                     "(LQR): raise the input weights lqr_r or limit the forces", t, c->fail_t, what,
+                     peak);
   return prru_fail(msg, msglen, st,
                    "stopped at t = %.9g s: the integrator's trial state at t = %.9g s left the "
                    "run's regular path: %s; the controller's forces reached %.3g N in this step "
@@ -374,11 +669,9 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
                      prru_track_summary *sum, char *msg, int msglen)
 {
   const prru_track_options *o = c->o;
-  const double t0 = prru_quintic_t_begin(c->ref), t1 = prru_quintic_t_end(c->ref);
+  const double t0 = prru_quintic_t_begin(c->ref);
   const double step = c->continuous ? o->dt_out : o->control_period;
-  /* t_0 is always a tick, and t_1 (a remainder below 1e-9 step merged
-   * into the last tick): at least two, however short the span. */
-  const long nticks = (long)fmax(1.0, ceil((t1 - t0) / step - 1e-9));
+  const long nticks = last_tick(c->ref, step);
   double y[6], t = t0, qd0[3];
   prru_quintic_eval(c->ref, t0, y, qd0, NULL);
   for (int i = 0; i < 3; i++) {
@@ -391,7 +684,7 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
       int st = track_step(drv, c, &t, tk, y, msg, msglen);
       if (st != PRRU_OK) return st;
     }
-    int st = track_tick(c, rng, tk, y, s, msg, msglen);
+    int st = track_tick(c, rng, k, tk, y, s, msg, msglen);
     if (st != PRRU_OK) return st;
     int bad = stroke_violation(o, s->d);
     if (bad >= 0)
@@ -423,6 +716,13 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   c.o = o;
   c.d = malloc(sizeof(prru_data));
   c.continuous = o->control_period == 0.0;
+  prru_lqr_schedule lqr;
+  memset(&lqr, 0, sizeof lqr);
+  if (o->controller == PRRU_TRACK_LQR) {
+    st = prru_lqr_schedule_build(m, ref, o, &lqr, msg, msglen);
+    if (st != PRRU_OK) return st;
+    c.lqr = &lqr;
+  }
   prru_track_sample *s = malloc(sizeof *s);
   gsl_odeiv2_system sys = {track_rhs, NULL, 6, &c};
   double h0 = fmin(1e-4, c.continuous ? o->dt_out : o->control_period);
@@ -443,6 +743,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   if (rng) gsl_rng_free(rng);
   free(c.d);
   free(s);
+  prru_lqr_schedule_free(&lqr);
   if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
   return st;
 }
