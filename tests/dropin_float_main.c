@@ -10,8 +10,8 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "prru_f_kernels.h"
-#include "prru_kernels.h"
+#include "paper3prru_f_kernels.h"
+#include "paper3prru_kernels.h"
 
 static int failures = 0;
 
@@ -62,25 +62,25 @@ int main(void)
     qdr[i] = (double)qdf[i];
     qddr[i] = (double)qddf[i];
   }
-  prru_ik_jd(qr, d, Jd);
-  prru_f_ik_jd(qf, df, Jdf);
+  paper3prru_ik_jd(qr, d, Jd);
+  paper3prru_f_ik_jd(qf, df, Jdf);
   check("ik_jd d", df, d, 3);
   check("ik_jd Jd", Jdf, Jd, 9);
-  prru_dynamics(qr, qdr, M, h, G);
-  prru_f_dynamics(qf, qdf, Mf, hf, Gf);
+  paper3prru_dynamics(qr, qdr, M, h, G);
+  paper3prru_f_dynamics(qf, qdf, Mf, hf, Gf);
   check("dynamics M", Mf, M, 9);
   check("dynamics h", hf, h, 3);
   check("dynamics G", Gf, G, 3);
-  prru_eom_solve(qr, qdr, load, load, load, M, b, x, minors);
-  prru_f_eom_solve(qf, qdf, loadf, loadf, loadf, Mf, bf, xf, minorsf);
+  paper3prru_eom_solve(qr, qdr, load, load, load, M, b, x, minors);
+  paper3prru_f_eom_solve(qf, qdf, loadf, loadf, loadf, Mf, bf, xf, minorsf);
   check("eom_solve b", bf, b, 3);
   check("eom_solve qdd", xf, x, 3);
   check("eom_solve minors", minorsf, minors, 3);
-  prru_inverse_terms(qr, qdr, qddr, load, load, d, Jd, Jdinv, fd);
-  prru_f_inverse_terms(qf, qdf, qddf, loadf, loadf, df, Jdf, Jdinvf, fdf);
+  paper3prru_inverse_terms(qr, qdr, qddr, load, load, d, Jd, Jdinv, fd);
+  paper3prru_f_inverse_terms(qf, qdf, qddf, loadf, loadf, df, Jdf, Jdinvf, fdf);
   check("inverse_terms Jdinv", Jdinvf, Jdinv, 9);
   check("inverse_terms fd", fdf, fd, 3);
-  if (PRRU_F_NQ != PRRU_NQ || PRRU_F_ARITH_INVERSE_TERMS != PRRU_ARITH_INVERSE_TERMS) {
+  if (PAPER3PRRU_F_NQ != PAPER3PRRU_NQ || PAPER3PRRU_F_ARITH_INVERSE_TERMS != PAPER3PRRU_ARITH_INVERSE_TERMS) {
     printf("FAIL the float set's sizes or operation counts differ from the double set's\n");
     failures++;
   }
@@ -89,11 +89,11 @@ int main(void)
     /* Unreachable (limbs 1 and 2 out of reach) and non-finite q. */
     const float bad[3][3] = {{1.5f, 0.0f, 0.0f}, {0.1f, NAN, -0.8f}, {0.1f, 0.2f, INFINITY}};
     for (i = 0; i < 3; i++) {
-      prru_f_inverse_terms(bad[i], qdf, qddf, loadf, loadf, df, Jdf, Jdinvf, fdf);
+      paper3prru_f_inverse_terms(bad[i], qdf, qddf, loadf, loadf, df, Jdf, Jdinvf, fdf);
       check_nan("inverse_terms fd", fdf, 3);
-      prru_f_eom_solve(bad[i], qdf, loadf, loadf, loadf, Mf, bf, xf, minorsf);
+      paper3prru_f_eom_solve(bad[i], qdf, loadf, loadf, loadf, Mf, bf, xf, minorsf);
       check_nan("eom_solve qdd", xf, 3);
-      prru_f_dynamics(bad[i], qdf, Mf, hf, Gf);
+      paper3prru_f_dynamics(bad[i], qdf, Mf, hf, Gf);
       check_nan("dynamics M", Mf, 9);
     }
   }

@@ -1,6 +1,6 @@
 /* Drop-in check of the generated kernels: this file and generated/ are all
  * that test_dropin.sh copies into an empty directory, so it may use nothing
- * but prru_kernels.h, prru_mechanism.h and the C library (no runtime, no
+ * but paper3prru_kernels.h, paper3prru_mechanism.h and the C library (no runtime, no
  * GSL, no testutil.h).
  * It must stay valid C99, C11 and C++ and warning-free under -Wconversion
  * -Wdouble-promotion, because a user's controller build may be any of those.
@@ -11,9 +11,9 @@
 
 #include <string.h>
 
-#include "prru_kernels.h"
-#include "prru_mechanism.h"
-#include "prru_param_kernels.h"
+#include "paper3prru_kernels.h"
+#include "paper3prru_mechanism.h"
+#include "paper3prru_param_kernels.h"
 
 static int failures = 0;
 
@@ -59,7 +59,7 @@ static void check_all_nan(const char *what, const double *got, int n)
  * be NaN: the header promises misuse is visible, never a plausible number. */
 static void check_nan_everywhere(const char *label, const double q[3], const double qd[3])
 {
-  static double H[180], dm[60], JP[18], R[90], p[30], I[90], K[60], Q[PRRU_REACTION_BASIS_NNZ];
+  static double H[180], dm[60], JP[18], R[90], p[30], I[90], K[60], Q[PAPER3PRRU_REACTION_BASIS_NNZ];
   double d[3], Jd[9], M[9], h[3], G[3], b[3], E[2], dd[3], ddb[3], Qp[3];
   const double f[3] = {1.0, 2.0, 3.0};
   char name[96];
@@ -69,34 +69,34 @@ static void check_nan_everywhere(const char *label, const double q[3], const dou
     snprintf(name, sizeof name, "%s %s", label, #arr);      \
     check_all_nan(name, arr, n);                            \
   } while (0)
-  NAN_CHECK(prru_ik(q, d), d, 3);
-  NAN_CHECK(prru_jd(q, Jd), Jd, 9);
-  NAN_CHECK(prru_ik_jd(q, d, Jd), d, 3);
+  NAN_CHECK(paper3prru_ik(q, d), d, 3);
+  NAN_CHECK(paper3prru_jd(q, Jd), Jd, 9);
+  NAN_CHECK(paper3prru_ik_jd(q, d, Jd), d, 3);
   check_all_nan("  ik_jd Jd", Jd, 9);
-  NAN_CHECK(prru_jacobians(q, H), H, 180);
-  NAN_CHECK(prru_bias_terms(q, qd, dm), dm, 60);
-  NAN_CHECK(prru_mass(q, M), M, 9);
-  NAN_CHECK(prru_bias(q, qd, h), h, 3);
-  NAN_CHECK(prru_gravity(q, G), G, 3);
-  NAN_CHECK(prru_eom(q, qd, f, f, f, M, b), b, 3);
+  NAN_CHECK(paper3prru_jacobians(q, H), H, 180);
+  NAN_CHECK(paper3prru_bias_terms(q, qd, dm), dm, 60);
+  NAN_CHECK(paper3prru_mass(q, M), M, 9);
+  NAN_CHECK(paper3prru_bias(q, qd, h), h, 3);
+  NAN_CHECK(paper3prru_gravity(q, G), G, 3);
+  NAN_CHECK(paper3prru_eom(q, qd, f, f, f, M, b), b, 3);
   check_all_nan("  eom M", M, 9);
-  NAN_CHECK(prru_platform_jacobian(q, JP), JP, 18);
-  NAN_CHECK(prru_poses(q, R, p), R, 90);
+  NAN_CHECK(paper3prru_platform_jacobian(q, JP), JP, 18);
+  NAN_CHECK(paper3prru_poses(q, R, p), R, 90);
   check_all_nan("  poses p", p, 30);
-  NAN_CHECK(prru_inertia_world(q, I), I, 90);
-  NAN_CHECK(prru_wrench_bias(q, qd, K), K, 60);
-  NAN_CHECK(prru_energy(q, qd, E), E, 2);
-  NAN_CHECK(prru_reaction_basis(q, Q), Q, PRRU_REACTION_BASIS_NNZ);
-  NAN_CHECK(prru_actuator_rates(q, qd, dd, ddb), dd, 3);
+  NAN_CHECK(paper3prru_inertia_world(q, I), I, 90);
+  NAN_CHECK(paper3prru_wrench_bias(q, qd, K), K, 60);
+  NAN_CHECK(paper3prru_energy(q, qd, E), E, 2);
+  NAN_CHECK(paper3prru_reaction_basis(q, Q), Q, PAPER3PRRU_REACTION_BASIS_NNZ);
+  NAN_CHECK(paper3prru_actuator_rates(q, qd, dd, ddb), dd, 3);
   check_all_nan("  actuator_rates ddb", ddb, 3);
-  NAN_CHECK(prru_passive(q, qd, Qp), Qp, 3);
-  NAN_CHECK(prru_dynamics(q, qd, M, h, G), M, 9);
+  NAN_CHECK(paper3prru_passive(q, qd, Qp), Qp, 3);
+  NAN_CHECK(paper3prru_dynamics(q, qd, M, h, G), M, 9);
   check_all_nan("  dynamics h", h, 3);
   check_all_nan("  dynamics G", G, 3);
-  NAN_CHECK(prru_param_dynamics(&prru_params_model, q, qd, M, h, G), M, 9);
+  NAN_CHECK(paper3prru_param_dynamics(&paper3prru_params_model, q, qd, M, h, G), M, 9);
   check_all_nan("  param_dynamics h", h, 3);
   check_all_nan("  param_dynamics G", G, 3);
-  NAN_CHECK(prru_param_eom(&prru_params_model, q, qd, f, f, f, M, b), b, 3);
+  NAN_CHECK(paper3prru_param_eom(&paper3prru_params_model, q, qd, f, f, f, M, b), b, 3);
   check_all_nan("  param_eom M", M, 9);
 #undef NAN_CHECK
 }
@@ -120,48 +120,48 @@ int main(void)
   double M[9], h[3], G[3], d[3], Jd[9], b[3], b_ref[3];
   int i;
 
-  prru_mass(q, M);
-  check_array("prru_mass M", M, M_ref, 9, 1e-12);
-  prru_bias(q, qd, h);
-  check_array("prru_bias h", h, h_ref, 3, 1e-12);
-  prru_gravity(q, G);
-  check_array("prru_gravity G", G, G_ref, 3, 1e-12);
-  prru_ik(q, d);
-  check_array("prru_ik d", d, d_ref, 3, 1e-12);
-  prru_jd(q, Jd);
-  check_array("prru_jd J_d", Jd, Jd_ref, 9, 1e-12);
-  prru_ik_jd(q, d, Jd);
-  check_array("prru_ik_jd d", d, d_ref, 3, 1e-12);
-  check_array("prru_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
-  prru_dynamics(q, qd, M, h, G);
-  check_array("prru_dynamics M", M, M_ref, 9, 1e-12);
-  check_array("prru_dynamics h", h, h_ref, 3, 1e-12);
-  check_array("prru_dynamics G", G, G_ref, 3, 1e-12);
+  paper3prru_mass(q, M);
+  check_array("paper3prru_mass M", M, M_ref, 9, 1e-12);
+  paper3prru_bias(q, qd, h);
+  check_array("paper3prru_bias h", h, h_ref, 3, 1e-12);
+  paper3prru_gravity(q, G);
+  check_array("paper3prru_gravity G", G, G_ref, 3, 1e-12);
+  paper3prru_ik(q, d);
+  check_array("paper3prru_ik d", d, d_ref, 3, 1e-12);
+  paper3prru_jd(q, Jd);
+  check_array("paper3prru_jd J_d", Jd, Jd_ref, 9, 1e-12);
+  paper3prru_ik_jd(q, d, Jd);
+  check_array("paper3prru_ik_jd d", d, d_ref, 3, 1e-12);
+  check_array("paper3prru_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
+  paper3prru_dynamics(q, qd, M, h, G);
+  check_array("paper3prru_dynamics M", M, M_ref, 9, 1e-12);
+  check_array("paper3prru_dynamics h", h, h_ref, 3, 1e-12);
+  check_array("paper3prru_dynamics G", G, G_ref, 3, 1e-12);
   /* With no loads, M qdd = G - h. */
-  prru_eom(q, qd, zero, zero, zero, M, b);
+  paper3prru_eom(q, qd, zero, zero, zero, M, b);
   for (i = 0; i < 3; i++) b_ref[i] = G_ref[i] - h_ref[i];
-  check_array("prru_eom M", M, M_ref, 9, 1e-12);
-  check_array("prru_eom b (no loads)", b, b_ref, 3, 1e-12);
-  prru_ik(q0, d);
-  check_array("prru_ik d at q = 0", d, d0_ref, 3, 1e-12);
+  check_array("paper3prru_eom M", M, M_ref, 9, 1e-12);
+  check_array("paper3prru_eom b (no loads)", b, b_ref, 3, 1e-12);
+  paper3prru_ik(q0, d);
+  check_array("paper3prru_ik d at q = 0", d, d0_ref, 3, 1e-12);
   /* The runtime-parameter kernels with the model's own numbers. */
-  prru_param_dynamics(&prru_params_model, q, qd, M, h, G);
-  check_array("prru_param_dynamics M", M, M_ref, 9, 1e-12);
-  check_array("prru_param_dynamics h", h, h_ref, 3, 1e-12);
-  check_array("prru_param_dynamics G", G, G_ref, 3, 1e-12);
-  prru_param_ik_jd(&prru_params_model, q, d, Jd);
-  check_array("prru_param_ik_jd d", d, d_ref, 3, 1e-12);
-  check_array("prru_param_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
+  paper3prru_param_dynamics(&paper3prru_params_model, q, qd, M, h, G);
+  check_array("paper3prru_param_dynamics M", M, M_ref, 9, 1e-12);
+  check_array("paper3prru_param_dynamics h", h, h_ref, 3, 1e-12);
+  check_array("paper3prru_param_dynamics G", G, G_ref, 3, 1e-12);
+  paper3prru_param_ik_jd(&paper3prru_params_model, q, d, Jd);
+  check_array("paper3prru_param_ik_jd d", d, d_ref, 3, 1e-12);
+  check_array("paper3prru_param_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
   /* The descriptor describes these kernels: the paper's model, its sizes. */
-  if (!(prru_mech.total_mass == M_ref[8]) || strcmp(prru_mech.name, "prru") != 0 ||
-      prru_mech.nlambda != PRRU_NLAMBDA || prru_mech.nbody != PRRU_NBODY ||
-      prru_mech.joint[PRRU_NJOINT - 1].lambda_offset + prru_mech.joint[PRRU_NJOINT - 1].lambda_count !=
-          PRRU_NLAMBDA) {
+  if (!(paper3prru_mech.total_mass == M_ref[8]) || strcmp(paper3prru_mech.name, "paper3prru") != 0 ||
+      paper3prru_mech.nlambda != PAPER3PRRU_NLAMBDA || paper3prru_mech.nbody != PAPER3PRRU_NBODY ||
+      paper3prru_mech.joint[PAPER3PRRU_NJOINT - 1].lambda_offset + paper3prru_mech.joint[PAPER3PRRU_NJOINT - 1].lambda_count !=
+          PAPER3PRRU_NLAMBDA) {
     printf("FAIL descriptor: total mass %.17g (M33 %.17g), name %s, nlambda %d\n",
-           prru_mech.total_mass, M_ref[8], prru_mech.name, prru_mech.nlambda);
+           paper3prru_mech.total_mass, M_ref[8], paper3prru_mech.name, paper3prru_mech.nlambda);
     failures++;
   } else {
-    printf("ok   descriptor of model %s (sha256 %.12s...)\n", prru_mech.name, prru_mech.sha256);
+    printf("ok   descriptor of model %s (sha256 %.12s...)\n", paper3prru_mech.name, paper3prru_mech.sha256);
   }
 
   {

@@ -14,7 +14,7 @@ r=$(json "$tmp/e.json" "max(abs(a-b)/abs(b) for a,b in [(d['M'][0][0],0.45906598
 below "$r" 1e-12 "eval vs spec point: rel err"
 n=$(json "$tmp/e.json" "len(d['lambda'])"); [ "$n" = 57 ] && ok || bad "lambda has $n entries"
 [ "$(json "$tmp/e.json" "d['lambda_labels'][0]+d['lambda_labels'][56]")" = "C1_fxP3_mz" ] && ok || bad "lambda labels"
-jcheck "$tmp/e.json" "d['model'] == model and d['model']['name'] == 'prru' and d['model']['file'] == '3prru_paper.json'" "eval: the paper's model object"
+jcheck "$tmp/e.json" "d['model'] == model and d['model']['name'] == 'paper3prru' and d['model']['file'] == '3prru_paper.json'" "eval: the paper's model object"
 jcheck "$tmp/e.json" "d['passive'] == [0, 0, 0]" "the paper's model has no drive damping or friction"
 # Help texts count the paper's reactions.
 "$PRRU" eval --help | tr '\n' ' ' | grep -q "the 57 joint reaction coordinates" && ok || bad "eval --help: 57 reactions"
@@ -53,7 +53,7 @@ done
 # prru paper on the paper's model: no warning, the model in the summary.
 "$PRRU" paper --out "$tmp/paper" --skip-map >"$tmp/paper.out" 2>"$tmp/paper.err"
 grep -q "warning" "$tmp/paper.err" && bad "paper warns for the paper's model: $(cat "$tmp/paper.err")" || ok
-grep -qF "Model: prru (3prru_paper.json, sha256 $paper_sha, specialised kernels), the paper's" "$tmp/paper/summary.txt" && ok || bad "summary.txt: model line"
+grep -qF "Model: paper3prru (3prru_paper.json, sha256 $paper_sha, specialised kernels), the paper's" "$tmp/paper/summary.txt" && ok || bad "summary.txt: model line"
 grep -qF "fd = (50, 40, 25) N," "$tmp/paper/summary.txt" && grep -qF "fp = 50 (sin 4 pi t, -cos 4 pi t, 0) N" "$tmp/paper/summary.txt" \
   && ok || bad "summary.txt: the paper's loads"
 

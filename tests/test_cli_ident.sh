@@ -373,7 +373,7 @@ rows = [r for r in csv.reader(l for l in open(sys.argv[1]) if not l.startswith("
 h = rows[0]
 v = [float(r[h.index(sys.argv[2])]) for r in rows[1:]]
 print(min(v), max(v))' "$1" "$2"; }
-if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1])).get("name") == "prru" else 1)' "$PRRU_MODEL"; then
+if [ "$nact" -eq 3 ] && python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1])).get("name") == "paper3prru" else 1)' "$PRRU_MODEL"; then
   EX="--evals 400 --period 8 --harmonics 4 --amplitude 0.2,0.2,0.02"
   "$PRRU" --model "$tmp/lim.json" excite $EX --out "$tmp/lim.csv" 2>"$tmp/lim.err" \
     || bad "excite with the model's limits: $(cat "$tmp/lim.err")"

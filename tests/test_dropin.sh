@@ -7,10 +7,12 @@
 # main.c) into an empty directory, build with nothing but -lm under strict
 # warnings as C99 and C11 with gcc and clang and as C++ with g++, and run
 # each binary against the spec's section 10 reference point.
-# The single-precision controller set (gen/prru_gen.py --precision float,
-# prru_f_*) is generated here from the paper's model (it is not committed)
-# and built the same ways with tests/dropin_float_main.c, linked beside the
-# double set in one program, with the float batches (prru_f_batch.c).
+# The kernels carry the model's name (paper3prru_*): the library's prru_
+# API is never met. The single-precision controller set (gen/prru_gen.py
+# --precision float, paper3prru_f_*) is generated here from the paper's
+# model (it is not committed) and built the same ways with
+# tests/dropin_float_main.c, linked beside the double set in one program,
+# with the float batches (paper3prru_f_batch.c).
 #
 # A missing clang or g++ is reported as SKIPPED (nothing is installed here);
 # set PRRU_DROPIN_REQUIRE_ALL=1 (CI does) to make a skipped compiler a failure.
@@ -25,7 +27,7 @@ cp -R "$SRC/generated/." "$work/" || { echo "FAIL: cannot copy $SRC/generated"; 
 cp "$SRC/tests/dropin_main.c" "$work/main.c" || exit 1
 cp "$SRC/tests/dropin_float_main.c" "$work/float_main.c" || exit 1
 "${PYTHON:-python3}" "$SRC/gen/prru_gen.py" "$SRC/models/3prru_paper.json" --precision float \
-  --prefix prru --out "$work" --quiet || { echo "FAIL: cannot generate the float set"; exit 1; }
+  --out "$work" --quiet || { echo "FAIL: cannot generate the float set"; exit 1; }
 cd "$work" || exit 1
 
 fail=0
@@ -35,11 +37,11 @@ skipped=()
 # runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"prru_kernels\.h"|"prru_mechanism\.h"|"prru_param_kernels\.h"|"prru_regressor\.h"|"prru_p[34]_kernels\.h"'
+  allowed='<math\.h>|"paper3prru_kernels\.h"|"paper3prru_mechanism\.h"|"paper3prru_param_kernels\.h"|"paper3prru_regressor\.h"|"prru_p[34]_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
-  case "$f" in ./prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"prru_f_kernels\.h"' ;; esac
-  case "$f" in ./prru_f_batch.*) allowed='<math\.h>|<float\.h>|"prru_f_batch\.h"' ;; esac
-  [ "$f" = ./float_main.c ] && allowed='<math\.h>|<stdio\.h>|"prru_kernels\.h"|"prru_f_kernels\.h"'
+  case "$f" in ./paper3prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_kernels\.h"' ;; esac
+  case "$f" in ./paper3prru_f_batch.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_batch\.h"' ;; esac
+  [ "$f" = ./float_main.c ] && allowed='<math\.h>|<stdio\.h>|"paper3prru_kernels\.h"|"paper3prru_f_kernels\.h"'
   bad=$(grep -nE '^[[:space:]]*#[[:space:]]*include' "$f" | grep -vE "$allowed" || true)
   if [ -n "$bad" ]; then
     echo "FAIL: $f includes more than <math.h> and its own header:"
@@ -49,14 +51,14 @@ for f in ./*.c ./*.h; do
 done
 
 # Single precision throughout: no double in the float set's text at all.
-if grep -nw double prru_f_kernels.c prru_f_kernels.h prru_f_batch.c prru_f_batch.h; then
+if grep -nw double paper3prru_f_kernels.c paper3prru_f_kernels.h paper3prru_f_batch.c paper3prru_f_batch.h; then
   echo "FAIL: the float set names double (above)"
   fail=1
 fi
 
 kernels=()
 for f in ./*.c; do
-  case "$f" in ./main.c | ./float_main.c | ./prru_f_kernels.c | ./prru_f_batch.c) ;; *) kernels+=("$f") ;; esac
+  case "$f" in ./main.c | ./float_main.c | ./paper3prru_f_kernels.c | ./paper3prru_f_batch.c) ;; *) kernels+=("$f") ;; esac
 done
 
 build_and_run() { # label compiler args...
@@ -71,7 +73,7 @@ build_and_run_main() { # main label compiler args...
   # The float program needs only the two controller sets (the rest of
   # generated/ is built with main.c already), and the float batches (the
   # maps' --precision float) are built with it under the same flags.
-  [ "$main" = float_main.c ] && sources=(./prru_kernels.c ./prru_f_kernels.c ./prru_f_batch.c)
+  [ "$main" = float_main.c ] && sources=(./paper3prru_kernels.c ./paper3prru_f_kernels.c ./paper3prru_f_batch.c)
   if ! command -v "$cc" >/dev/null 2>&1; then
     echo "SKIPPED $label: $cc not installed"
     skipped+=("$label")

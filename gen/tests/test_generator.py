@@ -16,10 +16,11 @@ GEN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROOT = os.path.dirname(GEN_DIR)
 MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
 ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
-# Every file one generation writes (prefix prru), in sorted order.
-OUTPUT_FILES = ["prru_kernels.c", "prru_kernels.h", "prru_mechanism.c",
-                "prru_mechanism.h", "prru_param_kernels.c",
-                "prru_param_kernels.h", "prru_regressor.c", "prru_regressor.h"]
+# Every file one generation of the paper's model writes (its name,
+# paper3prru, the prefix), in sorted order.
+OUTPUT_FILES = ["paper3prru_kernels.c", "paper3prru_kernels.h", "paper3prru_mechanism.c",
+                "paper3prru_mechanism.h", "paper3prru_param_kernels.c",
+                "paper3prru_param_kernels.h", "paper3prru_regressor.c", "paper3prru_regressor.h"]
 
 
 def read_dir(d):

@@ -352,8 +352,8 @@ class HostileModels(unittest.TestCase):
                            timeout=TIMEOUT)
         self.assertEqual(r.returncode, 0, r.stderr)
         # Same kernels as the unpadded model (only the recorded hash differs).
-        got = snapshot(out)["prru_kernels.c"][0].split(b"*/", 1)[1]
-        want = self.before["prru_kernels.c"][0].split(b"*/", 1)[1]
+        got = snapshot(out)["paper3prru_kernels.c"][0].split(b"*/", 1)[1]
+        want = self.before["paper3prru_kernels.c"][0].split(b"*/", 1)[1]
         self.assertEqual(got, want)
 
 
@@ -521,16 +521,16 @@ class HostileDescriptionGenerates(unittest.TestCase):
         from prrugen.render import _safe_name
         main = os.path.join(self.tmp.name, "main.c")
         with open(main, "w") as f:
-            f.write('#include <stdio.h>\n#include "prru_mechanism.h"\n'
+            f.write('#include <stdio.h>\n#include "paper3prru_mechanism.h"\n'
                     "int main(void)\n{\n  printf(\"%s%c%s%c%s%c\", "
-                    "prru_mech.name, 0, prru_mech.description, 0, "
-                    "prru_mech.model_file, 0);\n  return 0;\n}\n")
+                    "paper3prru_mech.name, 0, paper3prru_mech.description, 0, "
+                    "paper3prru_mech.model_file, 0);\n  return 0;\n}\n")
         exe = os.path.join(self.tmp.name, "main")
-        compile_c(self, [main, os.path.join(self.out, "prru_mechanism.c")],
+        compile_c(self, [main, os.path.join(self.out, "paper3prru_mechanism.c")],
                   exe, include=self.out, link=True)
         got = subprocess.run([exe], capture_output=True, timeout=60)
         self.assertEqual(got.stdout.split(b"\0")[:-1],
-                         [b"prru", HOSTILE_DESCRIPTION.encode("utf-8"),
+                         [b"paper3prru", HOSTILE_DESCRIPTION.encode("utf-8"),
                           _safe_name(HOSTILE_FILE).encode("ascii")])
 
 

@@ -156,8 +156,8 @@ class CommandLine(unittest.TestCase):
                                capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertEqual(sorted(os.listdir(tmp)),
-                             ["prru_f_batch.c", "prru_f_batch.h",
-                              "prru_f_kernels.c", "prru_f_kernels.h"])
+                             ["paper3prru_f_batch.c", "paper3prru_f_batch.h",
+                              "paper3prru_f_kernels.c", "paper3prru_f_kernels.h"])
 
 
 if __name__ == "__main__":

@@ -117,11 +117,11 @@ class RegressorTest(unittest.TestCase):
     def test_files(self):
         files, _ = prru_gen.generate(PAPER)
         again, _ = prru_gen.generate(PAPER)
-        for name in ("prru_regressor.h", "prru_regressor.c"):
+        for name in ("paper3prru_regressor.h", "paper3prru_regressor.c"):
             self.assertIn(name, files)
             self.assertEqual(files[name], again[name])
         # The committed generated/ holds the same regressor files.
-        for name in ("prru_regressor.h", "prru_regressor.c"):
+        for name in ("paper3prru_regressor.h", "paper3prru_regressor.c"):
             with open(os.path.join(ROOT, "generated", name),
                       encoding="utf-8") as f:
                 self.assertEqual(f.read(), files[name], name)

@@ -145,7 +145,7 @@ class KilledGenerator(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "out")
             os.makedirs(out)
-            with open(os.path.join(out, "prru_kernels.c"), "w") as f:
+            with open(os.path.join(out, "paper3prru_kernels.c"), "w") as f:
                 f.write("old")
             old = listing(out)
             seen = set()

@@ -1402,7 +1402,11 @@ class TestLayout(unittest.TestCase):
                 "PRRU_NREG": 10 * m.nbody + 3 * m.nact, "PRRU_EXCITE_MAX_HARMONICS": 8,
                 "PRRU_DESIGN_MAX_TIE": m.nbody, "PRRU_DESIGN_MAX_VARS": 64,
                 "PRRU_NLAMBDA": m.nlambda, "PRRU_NJOINT": m.njoint, "PRRU_NH": 6 * m.nbody,
-                "PRRU_NQ": 3}
+                "PRRU_NQ": 3,
+                # generated/'s descriptor carries the paper model's name
+                "PAPER3PRRU_NACT": m.nact, "PAPER3PRRU_NBODY": m.nbody,
+                "PAPER3PRRU_NLIMB": m.nlimb, "PAPER3PRRU_NJOINT": m.njoint,
+                "PAPER3PRRU_NLAMBDA": m.nlambda}
 
     def check(self, header, cname, pytype):
         text = read(os.path.join(SOURCE_DIR, header))
@@ -1444,8 +1448,10 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_dme.h", "prru_map_grid", _lib._MapGrid),
                 ("runtime/include/prru_dme.h", "prru_map_summary", _lib._MapSummary),
                 ("runtime/include/prru_dme.h", "prru_map_options", _lib._MapOptions),
-                ("generated/prru_mechanism.h", "prru_joint_info", _lib._JointInfo),
-                ("generated/prru_mechanism.h", "prru_mechanism", t.Mechanism),
+                # The committed descriptor carries the paper model's name;
+                # the build's (prru_*) has the same layout.
+                ("generated/paper3prru_mechanism.h", "paper3prru_joint_info", _lib._JointInfo),
+                ("generated/paper3prru_mechanism.h", "paper3prru_mechanism", t.Mechanism),
                 ("runtime/include/prru_dynamics.h", "prru_limits", t.Limits),
                 ("runtime/include/prru_traj.h", "prru_quintic", _lib._Quintic),
                 ("runtime/include/prru_traj.h", "prru_topp", _lib._Topp),
