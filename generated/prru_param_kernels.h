@@ -134,10 +134,12 @@ void prru_param_passive(const prru_params *p, const double q[3], const double qd
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
- * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin, cos and tanh (see the source), then within
- * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
+ * platform_jacobian and dme_terms; for dynamics, eom, eom_solve (the
+ * forward-dynamics step's kernel) and the derivative kernels bit for bit
+ * unless the build provides vector sin, cos and tanh (see the source), then
+ * within 1e-14 of each output's largest entry (h, b and qdd: 2e-14; the
+ * derivatives: that plus the output's change under a few ulp of q1, q2,
+ * as tests/test_batch.c checks). Outputs must not
  * overlap the inputs. Any alignment works; for speed give every array
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
