@@ -202,7 +202,8 @@ static const int inv_dims[] = {3, 9, 9, 3, 9, 9, 9};
 #endif
 #define DMAX (FWD_SIZE > INV_SIZE ? FWD_SIZE : INV_SIZE)
 
-static void scalar_derivs(int inverse, const states *s, int k, const double q[3], double *o)
+static void scalar_derivs(int inverse, const states *s, int k, const double q[3], const double qd[3],
+                          double *o)
 {
   double *x[9];
   const int *dims = fwd_dims;
@@ -212,11 +213,11 @@ static void scalar_derivs(int inverse, const states *s, int k, const double q[3]
   x[0] = o;
   for (int a = 1; a < (inverse ? NINV : NFWD); a++) x[a] = x[a - 1] + dims[a - 1];
   if (!inverse)
-    prru_eom_solve_derivs(q, s->qd[k], s->fd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
+    prru_eom_solve_derivs(q, qd, s->fd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
                           x[5], x[6], x[7], x[8]);
 #if PRRU_NACT == 3
   else
-    prru_inverse_derivs(q, s->qd[k], s->qdd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
+    prru_inverse_derivs(q, qd, s->qdd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
                         x[5], x[6]);
 #endif
 }
@@ -235,14 +236,22 @@ static double check_derivs_of(int inverse, const states *s, int n, const double 
   if (inverse) dims = inv_dims, names = inv_arrays;
 #endif
   for (int k = 0; k < n; k++) {
-    scalar_derivs(inverse, s, k, s->q[k], want_d[k]);
+    scalar_derivs(inverse, s, k, s->q[k], s->qd[k], want_d[k]);
     for (int a = 0; a < na; a++) sens_d[a][k] = 0;
     if (!compared[k]) continue;
-    for (int j = 0; j < 2; j++)
+    /* With Coulomb friction the vector tanh differs too: its arguments
+     * are the slider rates J_d qd / v_s, so qd's components are perturbed
+     * as well, by PERTURB_EPS of their own ulps (test_derivs.c's rule for
+     * prru_linearize_batch). */
+    for (int j = 0; j < 5; j++)
       for (int sign = -1; sign <= 1; sign += 2) {
         double qp[3] = {s->q[k][0], s->q[k][1], s->q[k][2]}, o1[DMAX];
-        qp[j] += sign * PERTURB_EPS * DBL_EPSILON * fmax(1.0, fabs(qp[j]));
-        scalar_derivs(inverse, s, k, qp, o1);
+        double qdp[3] = {s->qd[k][0], s->qd[k][1], s->qd[k][2]};
+        if (j < 2)
+          qp[j] += sign * PERTURB_EPS * DBL_EPSILON * fmax(1.0, fabs(qp[j]));
+        else
+          qdp[j - 2] += sign * PERTURB_EPS * DBL_EPSILON * fabs(qdp[j - 2]);
+        scalar_derivs(inverse, s, k, qp, qdp, o1);
         for (int a = 0, at = 0; a < na; at += dims[a], a++)
           sens_d[a][k] = fmax(sens_d[a][k], maxdiff(o1 + at, want_d[k] + at, dims[a]));
       }
