@@ -205,6 +205,10 @@ typedef struct {
   bench_stats inverse_ns, inverse_kernel_ns, inverse_derivs_ns;
   bench_stats fused_over_forward, linearize_over_forward, central_over_linearize;
   bench_stats inverse_derivs_over_inverse;
+  /* Batched (issue 29): prru_batch_eom_solve_derivs against the scalar
+   * kernel's loop, prru_linearize_batch against prru_linearize's, per state. */
+  bench_stats batch_kernel_ns, batch_linearize_ns;
+  bench_stats batch_kernel_speedup, batch_linearize_speedup;
 } bench_derivs;
 extern bench_derivs bench_derivs_result;
 void bench_derivs_run(bench_ctx *c, int reps, double target_ns, bench_derivs *r);

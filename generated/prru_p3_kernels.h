@@ -253,10 +253,12 @@ void prru_p3_inverse_derivs(const prru_params3 *p, const double q[3], const doub
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
- * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin, cos and tanh (see the source), then within
- * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
+ * platform_jacobian and dme_terms; for dynamics, eom, eom_solve (the
+ * forward-dynamics step's kernel) and the derivative kernels bit for bit
+ * unless the build provides vector sin, cos and tanh (see the source), then
+ * within 1e-14 of each output's largest entry (h, b and qdd: 2e-14; the
+ * derivatives: that plus the output's change under a few ulp of q1, q2,
+ * as tests/test_batch.c checks). Outputs must not
  * overlap the inputs. Any alignment works; for speed give every array
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
@@ -278,6 +280,12 @@ void prru_p3_batch_eom(const prru_params3 *p, int n, const double *q, const doub
 
 /* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
 void prru_p3_batch_eom_solve(const prru_params3 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
+
+/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
+void prru_p3_batch_eom_solve_derivs(const prru_params3 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
+
+/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). */
+void prru_p3_batch_inverse_derivs(const prru_params3 *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *Jdinv, double *fd, double *Dq, double *Dqd, double *Dqdd);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void prru_p3_batch_dme_terms(const prru_params3 *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);

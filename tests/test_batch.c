@@ -1,6 +1,8 @@
 /* Batched kernels (prru_batch_*, prru_param_batch_*) against their scalar
  * namesakes, state by state: ik_jd, mass, platform_jacobian and dme_terms
- * bit for bit; dynamics, eom and eom_solve, whose only difference from the
+ * bit for bit; dynamics, eom, eom_solve and the derivative kernels
+ * (eom_solve_derivs, inverse_derivs with three actuators; specialised
+ * only: the model's parameter set has none), whose only difference from the
  * scalar kernels is the vector sin and cos (glibc's libmvec, at most 4 ulp),
  * within 1e-14 of the largest entry of the output array plus twice the
  * output's rounding sensitivity at that state: the largest change of the
@@ -40,10 +42,10 @@ enum { NA = PRRU_NACT };
 /* Inputs, AoS (per state) and SoA (rows of n), at an offset into the
  * buffers so that the batch is not aligned. */
 typedef struct {
-  double q[NMAX][3], qd[NMAX][3], fd[NMAX][NA], fp[NMAX][3], mp[NMAX][3];
+  double q[NMAX][3], qd[NMAX][3], fd[NMAX][NA], fp[NMAX][3], mp[NMAX][3], qdd[NMAX][3];
 } states;
 
-static double soa_buf[5][NA * NMAX + 1];
+static double soa_buf[6][NA * NMAX + 1];
 static int compared[NMAX]; /* margin >= MARGIN */
 static int nreach, nfar;
 
@@ -66,6 +68,7 @@ static void draw(states *s, int n)
       s->qd[k][i] = tu_uniform(-2, 2);
       s->fp[k][i] = tu_uniform(-50, 50);
       s->mp[k][i] = tu_uniform(-5, 5);
+      s->qdd[k][i] = tu_uniform(-10, 10);
     }
     for (int i = 0; i < NA; i++) s->fd[k][i] = tu_uniform(-100, 100);
   }
@@ -178,6 +181,115 @@ static void rounding_sensitivity(const prru_params *p, const states *s, int n, s
   }
 }
 
+/* The derivative kernels (specialised only: the model's parameter set has
+ * none; the topology's are checked through prru_linearize_batch,
+ * test_derivs): every output array against the scalar kernel's under the
+ * vector-trig rule, each with its own sensitivity. One state's outputs,
+ * the arrays in the kernel's argument order. */
+enum { D_NDERIV = 9 + 9 + 3 * NA + 9 + 9 };
+static const char *const fwd_arrays[] = {"M", "b", "qdd", "minors", "Dq", "Dqd", "Dfd", "Dfp", "Dmp"};
+static const int fwd_dims[] = {9, 3, 3, 3, 9, 9, 3 * NA, 9, 9};
+#define NFWD 9
+#define FWD_SIZE (9 + 3 + 3 + 3 + D_NDERIV)
+#if PRRU_NACT == 3
+static const char *const inv_arrays[] = {"d", "Jd", "Jdinv", "fd", "Dq", "Dqd", "Dqdd"};
+static const int inv_dims[] = {3, 9, 9, 3, 9, 9, 9};
+#define NINV 7
+#define INV_SIZE (3 + 9 + 9 + 3 + 27)
+#else
+#define NINV 0
+#define INV_SIZE 0
+#endif
+#define DMAX (FWD_SIZE > INV_SIZE ? FWD_SIZE : INV_SIZE)
+
+static void scalar_derivs(int inverse, const states *s, int k, const double q[3], const double qd[3],
+                          double *o)
+{
+  double *x[9];
+  const int *dims = fwd_dims;
+#if PRRU_NACT == 3
+  if (inverse) dims = inv_dims;
+#endif
+  x[0] = o;
+  for (int a = 1; a < (inverse ? NINV : NFWD); a++) x[a] = x[a - 1] + dims[a - 1];
+  if (!inverse)
+    prru_eom_solve_derivs(q, qd, s->fd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
+                          x[5], x[6], x[7], x[8]);
+#if PRRU_NACT == 3
+  else
+    prru_inverse_derivs(q, qd, s->qdd[k], s->fp[k], s->mp[k], x[0], x[1], x[2], x[3], x[4],
+                        x[5], x[6]);
+#endif
+}
+
+static double want_d[NMAX][DMAX], sens_d[9][NMAX], got_d[DMAX * NMAX];
+
+static double check_derivs_of(int inverse, const states *s, int n, const double *q, const double *qd,
+                              const double *fd, const double *fp, const double *mp, const double *qdd,
+                              int *nan_ok)
+{
+  const int na = inverse ? NINV : NFWD, size = inverse ? INV_SIZE : FWD_SIZE;
+  const int *dims = fwd_dims;
+  const char *const *names = fwd_arrays;
+  const char *kernel = inverse ? "batch_inverse_derivs" : "batch_eom_solve_derivs";
+#if PRRU_NACT == 3
+  if (inverse) dims = inv_dims, names = inv_arrays;
+#endif
+  for (int k = 0; k < n; k++) {
+    scalar_derivs(inverse, s, k, s->q[k], s->qd[k], want_d[k]);
+    for (int a = 0; a < na; a++) sens_d[a][k] = 0;
+    if (!compared[k]) continue;
+    /* With Coulomb friction the vector tanh differs too: its arguments
+     * are the slider rates J_d qd / v_s, so qd's components are perturbed
+     * as well, by PERTURB_EPS of their own ulps (test_derivs.c's rule for
+     * prru_linearize_batch). */
+    for (int j = 0; j < 5; j++)
+      for (int sign = -1; sign <= 1; sign += 2) {
+        double qp[3] = {s->q[k][0], s->q[k][1], s->q[k][2]}, o1[DMAX];
+        double qdp[3] = {s->qd[k][0], s->qd[k][1], s->qd[k][2]};
+        if (j < 2)
+          qp[j] += sign * PERTURB_EPS * DBL_EPSILON * fmax(1.0, fabs(qp[j]));
+        else
+          qdp[j - 2] += sign * PERTURB_EPS * DBL_EPSILON * fabs(qdp[j - 2]);
+        scalar_derivs(inverse, s, k, qp, qdp, o1);
+        for (int a = 0, at = 0; a < na; at += dims[a], a++)
+          sens_d[a][k] = fmax(sens_d[a][k], maxdiff(o1 + at, want_d[k] + at, dims[a]));
+      }
+  }
+  double *x[9];
+  x[0] = got_d;
+  for (int a = 1; a < na; a++) x[a] = x[a - 1] + dims[a - 1] * n;
+  if (!inverse)
+    prru_batch_eom_solve_derivs(n, q, qd, fd, fp, mp, x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7],
+                                x[8]);
+#if PRRU_NACT == 3
+  else
+    prru_batch_inverse_derivs(n, q, qd, qdd, fp, mp, x[0], x[1], x[2], x[3], x[4], x[5], x[6]);
+#else
+  (void)qdd;
+#endif
+  double worst = 0;
+  static double scal[NMAX * DMAX];
+  for (int a = 0, at = 0; a < na; at += dims[a], a++) {
+    for (int k = 0; k < n; k++)
+      for (int i = 0; i < dims[a]; i++) scal[k * dims[a] + i] = want_d[k][at + i];
+    const double e = compare(kernel, names[a], x[a], scal, sens_d[a], dims[a], n, nan_ok);
+    if (e > worst) worst = e;
+  }
+  (void)size;
+  return worst;
+}
+
+static double check_derivs(const states *s, int n, const double *q, const double *qd, const double *fd,
+                           const double *fp, const double *mp, const double *qdd, int *nan_ok)
+{
+  double worst = check_derivs_of(0, s, n, q, qd, fd, fp, mp, qdd, nan_ok);
+#if PRRU_NACT == 3
+  worst = fmax(worst, check_derivs_of(1, s, n, q, qd, fd, fp, mp, qdd, nan_ok));
+#endif
+  return worst;
+}
+
 typedef struct {
   double d[NMAX][NA], Jd[NMAX][NA * 3], M[NMAX][9], h[NMAX][3], G[NMAX][3], b[NMAX][3],
       JP[NMAX][18], qdd[NMAX][3], minors[NMAX][3];
@@ -268,6 +380,10 @@ static double run(const prru_params *p, const states *s, int n, int *nan_ok)
 #undef CMP
 #undef CMP_TRIG
   (void)got_store;
+  if (!p) {
+    e = check_derivs(s, n, q, qd, fd, fp, mp, soa(5, &s->qdd[0][0], 3, n), nan_ok);
+    if (e > worst) worst = e;
+  }
   return worst;
 }
 

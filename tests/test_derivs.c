@@ -35,6 +35,7 @@
  * accurate to ~1e-13 relative). */
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -518,6 +519,208 @@ static void check_boundary(const char *name, int nstates)
          n, lowest, worst_ratio, worst_bound, resolved, blocks_checked, BOUNDARY_CEILING);
 }
 
+/* prru_linearize_batch against prru_linearize, state by state, over
+ * NBATCH states (two of its chunks of 32 and part of a third) drawn over a
+ * box wider than the workspace, with non-finite inputs and states just
+ * inside the reach boundary (PRRU_ESINGULAR: the mass matrix's rcond far
+ * below mass_rcond_min there) mixed in. Statuses must be equal, failures
+ * all zeros. Trusted states: every array of the linearisation (dt > 0: Ad
+ * and Bd too) under test_batch.c's rule for the batched kernels, whose
+ * vector sin and cos (within 4 ulp) are the only difference: within
+ * BATCH_TOL of the array's largest entry plus BATCH_SENS times the largest
+ * change of prru_linearize's array when q1 or q2 moves by BATCH_PERTURB
+ * ulp (more than libmvec's error) either way, or a component of qd by as
+ * many of its ulps: with Coulomb friction the vector tanh differs too, and
+ * its arguments are the slider rates J_d qd / v_s, on which dqdd/dqd
+ * depends through tanh' / v_s, steep where v_s is small (the prototype
+ * models: 4e-14 of dqdd_dqd's largest entry against a bound of 1e-14 plus
+ * q's sensitivity alone). */
+#define NBATCH 75
+#define BATCH_TOL 1e-14
+#define BATCH_PERTURB 8.0
+#define BATCH_SENS 2.0
+#define BATCH_DT 1e-3
+
+static const struct {
+  const char *name;
+  size_t at;
+  int n;
+} lin_arrays[] = {
+  {"qdd", offsetof(prru_linearization, qdd), 3},
+  {"dqdd_dq", offsetof(prru_linearization, dqdd_dq), 9},
+  {"dqdd_dqd", offsetof(prru_linearization, dqdd_dqd), 9},
+  {"dqdd_dfd", offsetof(prru_linearization, dqdd_dfd), 3 * NA},
+  {"dqdd_dfp", offsetof(prru_linearization, dqdd_dfp), 9},
+  {"dqdd_dmp", offsetof(prru_linearization, dqdd_dmp), 9},
+  {"A", offsetof(prru_linearization, A), 36},
+  {"B", offsetof(prru_linearization, B), 6 * NA},
+  {"Ad", offsetof(prru_linearization, Ad), 36},
+  {"Bd", offsetof(prru_linearization, Bd), 6 * NA},
+};
+#define NLIN ((int)(sizeof lin_arrays / sizeof lin_arrays[0]))
+
+static const double *lin_array(const prru_linearization *o, int a)
+{
+  return (const double *)(const void *)((const char *)o + lin_arrays[a].at);
+}
+
+static double bq[NBATCH][3], bqd[NBATCH][3];
+static prru_loads bl[NBATCH];
+static prru_linearization lin_one[NBATCH], lin_many[NBATCH];
+static int st_one[NBATCH], st_many[NBATCH];
+
+/* A state just inside the reach from q (reachable) along q1 towards
+ * +-pi/2: the boundary by bisection, then 1e-10 rad back: PRRU_ESINGULAR
+ * (on the paper model from 1e-8 to 1e-14 rad back, the mass matrix's
+ * rcond below mass_rcond_min; trusted from 1e-6), and 1e-10 rad is a
+ * million ulps of sin and cos from the reach. 0 if no boundary that way. */
+static int near_boundary(double q[3], double to)
+{
+  double lo = q[0], hi = to, x[3] = {to, q[1], q[2]};
+  prru_loads none = {{0}, {0, 0, 0}, {0, 0, 0}};
+  prru_linearization o;
+  const double qd[3] = {0, 0, 0};
+  if (prru_linearize(&model, &data, x, qd, &none, 0.0, &o) != PRRU_EUNREACHABLE) return 0;
+  for (int i = 0; i < 200 && fabs(hi - lo) > 4 * DBL_EPSILON; i++) {
+    x[0] = 0.5 * (lo + hi);
+    if (prru_linearize(&model, &data, x, qd, &none, 0.0, &o) == PRRU_EUNREACHABLE)
+      hi = x[0];
+    else
+      lo = x[0];
+  }
+  q[0] = lo - copysign(1e-10, to);
+  return 1;
+}
+
+static void draw_batch(void)
+{
+  for (int k = 0; k < NBATCH; k++) {
+    bq[k][0] = tu_uniform(-PI / 2, PI / 2);
+    bq[k][1] = tu_uniform(-PI / 2, PI / 2);
+    bq[k][2] = tu_uniform(-2 * length, 2 * length);
+    for (int i = 0; i < 3; i++) {
+      bqd[k][i] = tu_uniform(-1, 1) * (i == 2 ? length : 1);
+      bl[k].fp[i] = tu_uniform(-30, 30);
+      bl[k].mp[i] = tu_uniform(-3, 3);
+    }
+    for (int i = 0; i < NA; i++) bl[k].fd[i] = tu_uniform(-60, 60);
+  }
+  bq[5][0] = NAN, bqd[40][1] = INFINITY, bl[41].fd[0] = NAN;
+  /* Just inside the reach, from reachable states at small angles. */
+  static const int edge[] = {10, 33, 64, 74};
+  for (int e = 0; e < 4; e++) {
+    double *q = bq[edge[e]], mm;
+    state s;
+    memset(&s, 0, sizeof s);
+    for (int tries = 0; tries < 1000; tries++) {
+      s.q[0] = q[0] = tu_uniform(-PI / 8, PI / 8);
+      s.q[1] = q[1] = tu_uniform(-PI / 8, PI / 8);
+      s.q[2] = q[2] = tu_uniform(-length, length);
+      if (trusted_state(&s, &mm) && near_boundary(q, tu_uniform(-1, 1) < 0 ? -PI / 2 : PI / 2)) break;
+    }
+  }
+}
+
+/* The vector tanh's share (drives with Coulomb friction): the friction's
+ * derivative in qd is J_d^T diag(f_i / v_s (1 - t_i^2)) J_d, t_i = tanh(dd_i
+ * / v_s), solved by M; where t_i nears +-1, 1 - t_i^2 cancels, and libmvec's
+ * few ulp in t_i (<= 4) move it by 2 t_i that, absolutely, however small
+ * the term: up to 8 eps max_i f_i / v_s |J_d|^2 |M^-1| in dqdd/dqd
+ * (Frobenius norms, above the 2-norms), 16 eps here for margin. No input
+ * perturbation shows it (t_i's slope vanishes where it cancels). */
+static double tanh_bound(const double q[3])
+{
+  const prru_mechanism *mech = model.mech;
+  double f = 0, Jd[3 * NA], M[9], nj = 0, c[9];
+  for (int i = 0; i < NA; i++) f = fmax(f, mech->coulomb[i]);
+  if (!(f > 0) || !(mech->coulomb_velocity > 0)) return 0;
+  model.kernels->jd(model.kernel_params, q, Jd);
+  model.kernels->mass(model.kernel_params, q, M);
+  for (int i = 0; i < 3 * NA; i++) nj += Jd[i] * Jd[i];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[3 * j + i] = M[3 * ((i + 1) % 3) + (j + 1) % 3] * M[3 * ((i + 2) % 3) + (j + 2) % 3] -
+                     M[3 * ((i + 1) % 3) + (j + 2) % 3] * M[3 * ((i + 2) % 3) + (j + 1) % 3];
+  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
+  double ninv = 0;
+  for (int i = 0; i < 9; i++) ninv += c[i] * c[i];
+  return 16 * DBL_EPSILON * f / mech->coulomb_velocity * nj * sqrt(ninv) / fabs(det);
+}
+
+static void check_batch(const char *name)
+{
+  char what[400];
+  int count[16] = {0};
+  draw_batch();
+  for (int k = 0; k < NBATCH; k++)
+    st_one[k] = prru_linearize(&model, &data, bq[k], bqd[k], &bl[k], BATCH_DT, &lin_one[k]);
+  int first = PRRU_OK;
+  for (int k = 0; k < NBATCH && first == PRRU_OK; k++) first = st_one[k];
+  memset(lin_many, 0x55, sizeof lin_many);
+  const int ret = prru_linearize_batch(&model, NBATCH, &bq[0][0], &bqd[0][0], bl, BATCH_DT, lin_many, st_many);
+  snprintf(what, sizeof what, "%s: prru_linearize_batch returns the first failing state's status", name);
+  TU_TRUE(ret == first, what);
+  int same = 1, zeros = 1;
+  double worst_batch = 0;
+  static const prru_linearization zero;
+  for (int k = 0; k < NBATCH; k++) {
+    same &= st_many[k] == st_one[k];
+    count[st_one[k] & 15]++;
+    if (st_one[k] != PRRU_OK) {
+      zeros &= !memcmp(&lin_many[k], &zero, sizeof zero);
+      continue;
+    }
+    double sens[NLIN] = {0};
+    for (int j = 0; j < 5; j++)
+      for (int sign = -1; sign <= 1; sign += 2) {
+        double q[3] = {bq[k][0], bq[k][1], bq[k][2]}, qd[3] = {bqd[k][0], bqd[k][1], bqd[k][2]};
+        prru_linearization o;
+        if (j < 2)
+          q[j] += sign * BATCH_PERTURB * DBL_EPSILON * fmax(1.0, fabs(q[j]));
+        else
+          qd[j - 2] += sign * BATCH_PERTURB * DBL_EPSILON * fabs(qd[j - 2]);
+        if (prru_linearize(&model, &data, q, qd, &bl[k], BATCH_DT, &o) != PRRU_OK) continue;
+        for (int a = 0; a < NLIN; a++)
+          for (int i = 0; i < lin_arrays[a].n; i++)
+            sens[a] = fmax(sens[a], fabs(lin_array(&o, a)[i] - lin_array(&lin_one[k], a)[i]));
+      }
+    const double tanh_err = tanh_bound(bq[k]);
+    for (int a = 0; a < NLIN; a++) {
+      const double *x = lin_array(&lin_many[k], a), *y = lin_array(&lin_one[k], a);
+      double err = 0, scale = 1e-300;
+      for (int i = 0; i < lin_arrays[a].n; i++) {
+        const double e = fabs(x[i] - y[i]);
+        if (!(e <= err)) err = e;
+        scale = fmax(scale, fabs(y[i]));
+      }
+      snprintf(what, sizeof what, "%s: batched %s of state %d within %.0e + %.0f x its sensitivity to %.0f "
+               "ulp of q1, q2", name, lin_arrays[a].name, k, BATCH_TOL, BATCH_SENS, BATCH_PERTURB);
+      tu_check(err <= BATCH_TOL * scale + BATCH_SENS * sens[a] + tanh_err, what, err / scale, BATCH_TOL);
+      worst_batch = fmax(worst_batch, err / scale);
+    }
+    snprintf(what, sizeof what, "%s: batched dt of state %d", name, k);
+    TU_TRUE(lin_many[k].dt == BATCH_DT, what);
+  }
+  snprintf(what, sizeof what, "%s: prru_linearize_batch's statuses are prru_linearize's", name);
+  TU_TRUE(same, what);
+  snprintf(what, sizeof what, "%s: a failed state's batched linearisation is all zeros", name);
+  TU_TRUE(zeros, what);
+  snprintf(what, sizeof what, "%s: the batch mixes trusted (%d), unreachable (%d), singular (%d), "
+           "out-of-stroke (%d) and non-finite (%d) states", name, count[PRRU_OK], count[PRRU_EUNREACHABLE],
+           count[PRRU_ESINGULAR], count[PRRU_ESTROKE], count[PRRU_EINPUT]);
+  TU_TRUE(count[PRRU_OK] >= NBATCH / 10 && count[PRRU_EUNREACHABLE] > 0 && count[PRRU_ESINGULAR] >= 3 &&
+              count[PRRU_EINPUT] >= 3,
+          what);
+  printf("  batched linearisation: worst difference %.2e of an array's largest entry; %s\n", worst_batch, what);
+  /* Arguments: every state PRRU_EINPUT and zeroed for a bad dt; n = 0. */
+  TU_TRUE(prru_linearize_batch(&model, 3, &bq[0][0], &bqd[0][0], bl, -1.0, lin_many, st_many) == PRRU_EINPUT &&
+              st_many[0] == PRRU_EINPUT && st_many[2] == PRRU_EINPUT &&
+              !memcmp(&lin_many[2], &zero, sizeof zero),
+          "prru_linearize_batch: dt < 0 fails every state");
+  TU_TRUE(prru_linearize_batch(&model, 0, NULL, NULL, NULL, 0.0, NULL, NULL) == PRRU_OK,
+          "prru_linearize_batch: no states, PRRU_OK");
+}
+
 /* Hovering (at rest, the drives holding the robot against gravity:
  * unloaded it falls as one rigid body and every derivative is 0), then
  * random states with rates and loads, on model (P its numbers). */
@@ -571,6 +774,7 @@ static void check_model(const char *name, int nstates, int nboundary)
   snprintf(what, sizeof what, "%s: blocks the reference resolves to %g (at least 95 %%)", name, REF_ACCURACY);
   TU_TRUE(20 * blocks_unresolved <= blocks_total, what);
   check_boundary(name, nboundary);
+  check_batch(name);
 }
 
 /* A model file loaded at run time: 0 when it is of the other topology

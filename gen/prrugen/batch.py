@@ -27,11 +27,13 @@ from .cgen import Node
 
 BATCH_CHUNK = 32
 
-# Which kernels get a batched variant (in header order), and the fused
+# Which kernels get a batched variant (in header order; the derivative
+# kernels only in the sets that have them, kernels.derivative_kernels:
+# prru_linearize_batch's, over the kernel table), and the fused
 # ones that exist only batched: their outputs are those of the named scalar
 # kernels (all with the inputs q, hence the same guards).
 BATCH_KERNELS = ("ik_jd", "mass", "platform_jacobian", "dynamics", "eom",
-                 "eom_solve")
+                 "eom_solve", "eom_solve_derivs", "inverse_derivs")
 FUSED = (("dme_terms", "prru_ik_jd, prru_mass and prru_platform_jacobian "
           "fused: what the manipulability maps need at each q.",
           ("ik_jd", "mass", "platform_jacobian")),)
@@ -300,10 +302,12 @@ HEADER_NOTE = """/* Batched kernels, <prefix>_batch_<name>(n, inputs..., outputs
  * component i of state k is x[i * n + k] (q = q1 of every state, then q2,
  * then q3; M = M[0][0] of every state, then M[0][1], ...). Outputs agree
  * with the scalar kernels state by state: bit for bit for ik_jd, mass,
- * platform_jacobian and dme_terms; for dynamics, eom and eom_solve (the
- * forward-dynamics step's kernel) bit for bit unless
- * the build provides vector sin, cos and tanh (see the source), then within
- * 1e-14 of each output's largest entry (h, b and qdd: 2e-14). Outputs must not
+ * platform_jacobian and dme_terms; for dynamics, eom, eom_solve (the
+ * forward-dynamics step's kernel) and the derivative kernels bit for bit
+ * unless the build provides vector sin, cos and tanh (see the source), then
+ * within 1e-14 of each output's largest entry (h, b and qdd: 2e-14; the
+ * derivatives: that plus the output's change under a few ulp of q1, q2,
+ * as tests/test_batch.c checks). Outputs must not
  * overlap the inputs. Any alignment works; for speed give every array
  * 64-byte alignment and n a multiple of 8, so that each row starts on a
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */"""

@@ -1,7 +1,7 @@
 """The batched kernels (batch.py): their C shape, on the paper model.
 
 - every name of BATCH_KERNELS that the scalar list has gets a batched
-  variant, plus dme_terms with the outputs of ik_jd, mass and
+  variant (the derivative kernels included), plus dme_terms with the outputs of ik_jd, mass and
   platform_jacobian in that order;
 - a batched kernel performs exactly the scalar kernel's operations (the
   operation counts agree: the same lowered graph);
@@ -24,7 +24,7 @@ import re
 import unittest
 
 from prrugen import batch, cgen, dynamics, mechanism, model, sym
-from prrugen.kernels import kernels
+from prrugen.kernels import derivative_kernels, kernels
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))))
@@ -37,7 +37,8 @@ class BatchedKernels(unittest.TestCase):
     def setUpClass(cls):
         sym.reset()
         m = model.load(PAPER)
-        cls.scalar = kernels(dynamics.Derivation(mechanism.build(m), m))
+        deriv = dynamics.Derivation(mechanism.build(m), m)
+        cls.scalar = kernels(deriv) + derivative_kernels(deriv)
         cls.batched = batch.batch_kernels(cls.scalar)
         cls.emitted = {k.name: batch.emit_batch(k, "prru", "PRRU_BATCH_LOOP",
                                                 "PRRU_BATCH_%s")

@@ -335,7 +335,7 @@ class Determinism(unittest.TestCase):
 
     def test_prefix_option(self):
         files, _ = prru_gen.generate(PROTO, prefix="prru")
-        self.assertEqual(sorted(files), OUTPUT_FILES)
+        self.assertEqual(sorted(files), [f.replace("paper3prru_", "prru_") for f in OUTPUT_FILES])
         self.assertIn('PRRU_DESIGNATE(name) "proto"', files["prru_mechanism.c"])
         own, _ = prru_gen.generate(PROTO)
         self.assertIn("void proto_dynamics(", own["proto_kernels.c"])

@@ -139,6 +139,12 @@ typedef struct prru_kernel_table {
                          double Dq[9], double Dqd[9], double Dqdd[9]);
   int (*unseen_finite_inverse_derivs)(const double q[3], const double qd[3], const double qdd[3],
                                       const double fp[3], const double mp[3]);
+  /* eom_solve_derivs batched (prru_batch_eom_solve_derivs in
+   * prru_kernels.h: n states, every array in rows of n). */
+  void (*batch_eom_solve_derivs)(const void *p, int n, const double *q, const double *qd,
+                                 const double *fd, const double *fp, const double *mp, double *M,
+                                 double *b, double *qdd, double *minors, double *Dq, double *Dqd,
+                                 double *Dfd, double *Dfp, double *Dmp);
 } prru_kernel_table;
 
 typedef struct {

@@ -58,6 +58,26 @@ PRRU_API int prru_linearize_why(const prru_model *m, prru_data *d, const double 
                                 const prru_loads *l, double dt, prru_linearization *out, char *msg,
                                 int msglen);
 
+/* prru_linearize at n states in one call, through the batched derivative
+ * kernel (the table's batch_eom_solve_derivs: the loops a build
+ * vectorises). State k is q[3k..3k+2], qd[3k..3k+2] under l[k]; its
+ * linearisation goes to out[k] and its status to status[k] (status may be
+ * NULL): prru_linearize's statuses and zeroed output on failure, by the
+ * same trust test on the batched kernel's outputs. Those equal the scalar
+ * kernel's bit for bit unless the build provides vector sin and cos (the
+ * batched kernels' note in prru_kernels.h), then they agree within a few
+ * ulp of q1 and q2 propagated. A state the test fails is evaluated again
+ * by prru_linearize, whose status it gets; so only a state within those
+ * few ulp of a threshold (the reach, mass_rcond_min) could be trusted here
+ * and not there. Returns PRRU_OK when
+ * every state is PRRU_OK, else the first state's failure status;
+ * PRRU_EINPUT for n < 0 (nothing written), and for dt < 0 or not finite
+ * or a kernel table without the batched kernel (every state PRRU_EINPUT).
+ * The arrays must not overlap. */
+PRRU_API int prru_linearize_batch(const prru_model *m, int n, const double *q, const double *qd,
+                                  const prru_loads *l, double dt, prru_linearization *out,
+                                  int *status);
+
 /* Three actuators: inverse dynamics fd (as prru_inverse_dynamics, the same
  * statuses and trust test) and its derivatives dfd/dq, dfd/dqd, dfd/dqdd
  * (3x3 each; dfd/dqdd = J_d^-T M), any of them NULL if not wanted. Four

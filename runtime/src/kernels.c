@@ -156,6 +156,14 @@ static int s_unseen_inverse_derivs(const double q[3], const double qd[3], const 
 #define s_unseen_inverse_derivs NULL
 #endif
 
+static void s_batch_eom_solve_derivs(const void *p, int n, const double *q, const double *qd,
+                                     const double *fd, const double *fp, const double *mp, double *M,
+                                     double *b, double *qdd, double *minors, double *Dq, double *Dqd,
+                                     double *Dfd, double *Dfp, double *Dmp)
+{
+  (void)p, prru_batch_eom_solve_derivs(n, q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
+}
+
 const prru_kernel_table prru_kernels_specialised = {
   "specialised",  s_ik,      s_jd,
   s_ik_jd,        s_mass,    s_dynamics,
@@ -164,7 +172,7 @@ const prru_kernel_table prru_kernels_specialised = {
   s_platform_jacobian, s_poses, s_energy,
   s_actuator_rates, s_passive, s_batch_dme_terms,
   s_regressor,    s_eom_solve_derivs, s_unseen_eom_solve_derivs,
-  s_inverse_derivs, s_unseen_inverse_derivs,
+  s_inverse_derivs, s_unseen_inverse_derivs, s_batch_eom_solve_derivs,
 };
 
 /* ---- parameter: the topology's kernels, p a prru_params ---- */
@@ -293,6 +301,14 @@ static int p_unseen_inverse_derivs(const double q[3], const double qd[3], const 
 #define p_unseen_inverse_derivs NULL
 #endif
 
+static void p_batch_eom_solve_derivs(const void *p, int n, const double *q, const double *qd,
+                                     const double *fd, const double *fp, const double *mp, double *M,
+                                     double *b, double *qdd, double *minors, double *Dq, double *Dqd,
+                                     double *Dfd, double *Dfp, double *Dmp)
+{
+  P(batch_eom_solve_derivs)(TP(p), n, q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
+}
+
 const prru_kernel_table prru_kernels_parameter = {
   "parameter",    p_ik,      p_jd,
   p_ik_jd,        p_mass,    p_dynamics,
@@ -301,5 +317,5 @@ const prru_kernel_table prru_kernels_parameter = {
   p_platform_jacobian, p_poses, p_energy,
   p_actuator_rates, p_passive, p_batch_dme_terms,
   p_regressor,    p_eom_solve_derivs, p_unseen_eom_solve_derivs,
-  p_inverse_derivs, p_unseen_inverse_derivs,
+  p_inverse_derivs, p_unseen_inverse_derivs, p_batch_eom_solve_derivs,
 };

@@ -60,16 +60,13 @@ static int zero_order_hold(prru_linearization *o, double dt)
   return PRRU_OK;
 }
 
-int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
-                   const prru_loads *l, double dt, prru_linearization *out)
+/* The trust test and the rest of the linearisation once the derivative
+ * kernel has left M, b, qdd in d, minors, and the derivative blocks in o
+ * (prru_linearize and prru_linearize_batch: one test for both). */
+static int linearization_from(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                              const prru_loads *l, const double minors[3], double dt,
+                              prru_linearization *o)
 {
-  if (!prru_linearize_available(m) || !(dt >= 0) || !isfinite(dt)) return PRRU_EINPUT;
-  /* Straight into out (a copy of its 1.4 kB costs a tenth of the call). */
-  prru_linearization *o = out;
-  double minors[3];
-  KERNEL(m, eom_solve_derivs)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd,
-                               minors, o->dqdd_dq, o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp,
-                               o->dqdd_dmp);
   int st = prru_forward_verdict(m, d, q, qd, l, minors,
                                 KERNEL(m, unseen_finite_eom_solve_derivs)(q, qd, l->fd, l->fp, l->mp));
   /* Trusted qdd from finite inputs: the derivatives are products of the
@@ -85,8 +82,97 @@ int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const d
     else
       memset(o->Ad, 0, sizeof o->Ad), memset(o->Bd, 0, sizeof o->Bd);
   }
-  if (st != PRRU_OK) memset(out, 0, sizeof *out);
+  if (st != PRRU_OK) memset(o, 0, sizeof *o);
   return st;
+}
+
+int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                   const prru_loads *l, double dt, prru_linearization *out)
+{
+  if (!prru_linearize_available(m) || !(dt >= 0) || !isfinite(dt)) return PRRU_EINPUT;
+  /* Straight into out (a copy of its 1.4 kB costs a tenth of the call). */
+  prru_linearization *o = out;
+  double minors[3];
+  KERNEL(m, eom_solve_derivs)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd,
+                               minors, o->dqdd_dq, o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp,
+                               o->dqdd_dmp);
+  return linearization_from(m, d, q, qd, l, minors, dt, o);
+}
+
+/* The batched kernel's chunk of states: its inputs and outputs in rows
+ * of CHUNK (component i of state k at [i * CHUNK + k]); the derivative
+ * blocks in prru_linearization's order, one row each. */
+enum { CHUNK = 32, NDERIV = 9 + 9 + 3 * PRRU_NACT + 9 + 9 };
+typedef struct {
+  double q[3 * CHUNK], qd[3 * CHUNK], fd[PRRU_NACT * CHUNK], fp[3 * CHUNK], mp[3 * CHUNK];
+  double M[9 * CHUNK], b[3 * CHUNK], qdd[3 * CHUNK], minors[3 * CHUNK], D[NDERIV * CHUNK];
+} linearize_chunk;
+
+static void to_rows(double *rows, const double *v, int dim, int k, int n)
+{
+  for (int i = 0; i < dim; i++) rows[i * n + k] = v[i];
+}
+
+static void from_rows(double *v, const double *rows, int dim, int k, int n)
+{
+  for (int i = 0; i < dim; i++) v[i] = rows[i * n + k];
+}
+
+/* States o .. o + n - 1 of prru_linearize_batch (n <= CHUNK); the first
+ * status that is not PRRU_OK, else PRRU_OK. */
+static int linearize_chunk_at(const prru_model *m, int o, int n, const double *q, const double *qd,
+                              const prru_loads *l, double dt, prru_linearization *out, int *status,
+                              linearize_chunk *c)
+{
+  enum { N = PRRU_NACT };
+  for (int k = 0; k < n; k++) {
+    to_rows(c->q, q + 3 * (o + k), 3, k, n), to_rows(c->qd, qd + 3 * (o + k), 3, k, n);
+    to_rows(c->fd, l[o + k].fd, N, k, n), to_rows(c->fp, l[o + k].fp, 3, k, n);
+    to_rows(c->mp, l[o + k].mp, 3, k, n);
+  }
+  double *D = c->D;
+  KERNEL(m, batch_eom_solve_derivs)(m->kernel_params, n, c->q, c->qd, c->fd, c->fp, c->mp, c->M, c->b,
+                                    c->qdd, c->minors, D, D + 9 * n, D + 18 * n, D + (18 + 3 * N) * n,
+                                    D + (27 + 3 * N) * n);
+  int first = PRRU_OK;
+  for (int k = 0; k < n; k++) {
+    prru_data d;
+    double minors[3];
+    prru_linearization *x = out + o + k;
+    from_rows(d.M, c->M, 9, k, n), from_rows(d.b, c->b, 3, k, n), from_rows(d.qdd, c->qdd, 3, k, n);
+    from_rows(minors, c->minors, 3, k, n), from_rows(x->dqdd_dq, D, NDERIV, k, n);
+    int st = linearization_from(m, &d, q + 3 * (o + k), qd + 3 * (o + k), l + o + k, minors, dt, x);
+    /* A failure is judged again the scalar way: the batch's vector sin and
+     * cos may move a state within a few ulp of a threshold across it, and
+     * a failure's status is prru_linearize's (failures are rare: the cost
+     * of a second evaluation does not matter). */
+    if (st != PRRU_OK) st = prru_linearize(m, &d, q + 3 * (o + k), qd + 3 * (o + k), l + o + k, dt, x);
+    if (status) status[o + k] = st;
+    if (first == PRRU_OK) first = st;
+  }
+  return first;
+}
+
+int prru_linearize_batch(const prru_model *m, int n, const double *q, const double *qd,
+                         const prru_loads *l, double dt, prru_linearization *out, int *status)
+{
+  const int bad = !m->kernels->batch_eom_solve_derivs || !(dt >= 0) || !isfinite(dt);
+  int first = PRRU_OK;
+  if (n < 0) return PRRU_EINPUT;
+  if (bad) {
+    for (int k = 0; k < n; k++) {
+      memset(out + k, 0, sizeof *out);
+      if (status) status[k] = PRRU_EINPUT;
+    }
+    return PRRU_EINPUT;
+  }
+  /* About 20 kB of this thread's stack (4 actuators: 21): no allocation. */
+  linearize_chunk c PRRU_ALIGN64;
+  for (int o = 0; o < n; o += CHUNK) {
+    const int st = linearize_chunk_at(m, o, n - o < CHUNK ? n - o : CHUNK, q, qd, l, dt, out, status, &c);
+    if (first == PRRU_OK) first = st;
+  }
+  return first;
 }
 
 int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
