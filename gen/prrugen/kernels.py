@@ -385,7 +385,15 @@ def _inverse_derivs(deriv, q, qd, fp, mp):
     fv = [_frozen("_fdv%d" % i, fd[i], xs) for i in range(3)]
     r = [tau[i] - sym.add(*[jd[3 * j + i] * fv[j] for j in range(3)])
          for i in range(3)]
-    blocks = [_row_major([solve_t(col) for col in _columns(r, vs, tag)])
+    # The nine columns by J_d^-T's entries as atoms (the output Jdinv):
+    # 9 multiplies a column, where solve_t's cofactors and 1 / det take 12.
+    ia = [_atom("Ji%d" % k, x) for k, x in enumerate(inv)]
+
+    def map_inv_t(rhs):
+        """J_d^-T rhs: x_i = sum_k (J_d^-1)_ki rhs_k."""
+        return [sym.add(*[sym.mul(ia[3 * k + i], rhs[k]) for k in range(3)])
+                for i in range(3)]
+    blocks = [_row_major([map_inv_t(col) for col in _columns(r, vs, tag)])
               for tag, vs in (("sq", q), ("sqd", qd), ("sqdd", qdd))]
     ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
     return ("inverse_derivs", "inverse_terms (d, J_d, J_d^-1, fd) and the "
@@ -393,7 +401,7 @@ def _inverse_derivs(deriv, q, qd, fp, mp):
             "the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd "
             "(= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T "
             "fd).", ins,
-            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd),
+            [("d", d), ("Jd", jd), ("Jdinv", ia), ("fd", fd),
              ("Dq", blocks[0]), ("Dqd", blocks[1]), ("Dqdd", blocks[2])],
             ("d", "fd"))
 

@@ -114,18 +114,18 @@ static int inverse3_derivs(const prru_model *m, prru_data *d, const double q[3],
                            double dfd_dqd[9], double dfd_dqdd[9])
 {
   if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
-  double f[3], Dq[9], Dqd[9], Dqdd[9];
-  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, Dq,
-                            Dqd, Dqdd, NULL);
+  /* The three blocks in one array: one finiteness test for the 27. */
+  double f[3], D[27];
+  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, D,
+                            D + 9, D + 18, NULL);
   int st = prru_inverse3_status(m, d, f);
   if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_derivs)(q, qd, qdd, l->fp, l->mp))
     return prru_inverse_failure(st, q, qd, qdd, l);
-  if (!prru_finite_n(Dq, 9) || !prru_finite_n(Dqd, 9) || !prru_finite_n(Dqdd, 9))
-    return PRRU_EINPUT;
+  if (!prru_finite_n(D, 27)) return PRRU_EINPUT;
   memcpy(fd, f, sizeof f);
-  if (dfd_dq) memcpy(dfd_dq, Dq, sizeof Dq);
-  if (dfd_dqd) memcpy(dfd_dqd, Dqd, sizeof Dqd);
-  if (dfd_dqdd) memcpy(dfd_dqdd, Dqdd, sizeof Dqdd);
+  if (dfd_dq) memcpy(dfd_dq, D, 9 * sizeof *D);
+  if (dfd_dqd) memcpy(dfd_dqd, D + 9, 9 * sizeof *D);
+  if (dfd_dqdd) memcpy(dfd_dqdd, D + 18, 9 * sizeof *D);
   return PRRU_OK;
 }
 #else
