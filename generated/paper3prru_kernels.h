@@ -27,7 +27,7 @@
  *   inverse_terms      328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3
  *   eom_solve_derivs   1499 arithmetic (215 add, 273 sub, 993 mul, 6 div, 12 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_derivs     1503 arithmetic (236 add, 245 sub, 1001 mul, 6 div, 15 neg); calls: cos 2, sin 2, sqrt 3
+ *   inverse_derivs     1486 arithmetic (256 add, 225 sub, 992 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PAPER3PRRU_KERNELS_H
 #define PAPER3PRRU_KERNELS_H
@@ -70,7 +70,7 @@
 #define PAPER3PRRU_ARITH_INVERSE_TERMS 328 /* arithmetic operations */
 #define PAPER3PRRU_ARITH_JOINT_REACTIONS 686 /* arithmetic operations */
 #define PAPER3PRRU_ARITH_EOM_SOLVE_DERIVS 1499 /* arithmetic operations */
-#define PAPER3PRRU_ARITH_INVERSE_DERIVS 1503 /* arithmetic operations */
+#define PAPER3PRRU_ARITH_INVERSE_DERIVS 1486 /* arithmetic operations */
 #define PAPER3PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_JD "50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_IK_JD "60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -93,7 +93,7 @@
 #define PAPER3PRRU_OPS_INVERSE_TERMS "328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_JOINT_REACTIONS "686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_EOM_SOLVE_DERIVS "1499 arithmetic (215 add, 273 sub, 993 mul, 6 div, 12 neg); calls: cos 2, sin 2, sqrt 3"
-#define PAPER3PRRU_OPS_INVERSE_DERIVS "1503 arithmetic (236 add, 245 sub, 1001 mul, 6 div, 15 neg); calls: cos 2, sin 2, sqrt 3"
+#define PAPER3PRRU_OPS_INVERSE_DERIVS "1486 arithmetic (256 add, 225 sub, 992 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 /* Whether the inputs of paper3prru_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through

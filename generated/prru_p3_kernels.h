@@ -29,7 +29,7 @@
  *   joint_reactions    1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   regressor          1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  *   eom_solve_derivs   3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   inverse_derivs     3723 arithmetic (788 add, 451 sub, 2453 mul, 12 div, 19 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   inverse_derivs     3705 arithmetic (812 add, 427 sub, 2443 mul, 12 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
  */
 #ifndef PRRU_P3_KERNELS_H
 #define PRRU_P3_KERNELS_H
@@ -91,7 +91,7 @@
 #define PRRU_P3_ARITH_JOINT_REACTIONS 1679 /* arithmetic operations */
 #define PRRU_P3_ARITH_REGRESSOR 1134 /* arithmetic operations */
 #define PRRU_P3_ARITH_EOM_SOLVE_DERIVS 3690 /* arithmetic operations */
-#define PRRU_P3_ARITH_INVERSE_DERIVS 3723 /* arithmetic operations */
+#define PRRU_P3_ARITH_INVERSE_DERIVS 3705 /* arithmetic operations */
 #define PRRU_P3_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
 #define PRRU_P3_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
@@ -115,7 +115,7 @@
 #define PRRU_P3_OPS_JOINT_REACTIONS "1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_P3_OPS_REGRESSOR "1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 #define PRRU_P3_OPS_EOM_SOLVE_DERIVS "3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_INVERSE_DERIVS "3723 arithmetic (788 add, 451 sub, 2453 mul, 12 div, 19 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_INVERSE_DERIVS "3705 arithmetic (812 add, 427 sub, 2443 mul, 12 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 /* Whether the inputs of prru_p3_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through

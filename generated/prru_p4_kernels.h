@@ -30,6 +30,7 @@
  *   reaction_nullspace 77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4
  *   regressor          1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
  *   eom_solve_derivs   5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   inverse_derivs     5149 arithmetic (1078 add, 628 sub, 3422 mul, 14 div, 7 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
  */
 #ifndef PRRU_P4_KERNELS_H
 #define PRRU_P4_KERNELS_H
@@ -92,6 +93,7 @@
 #define PRRU_P4_ARITH_REACTION_NULLSPACE 77 /* arithmetic operations */
 #define PRRU_P4_ARITH_REGRESSOR 1540 /* arithmetic operations */
 #define PRRU_P4_ARITH_EOM_SOLVE_DERIVS 5194 /* arithmetic operations */
+#define PRRU_P4_ARITH_INVERSE_DERIVS 5149 /* arithmetic operations */
 #define PRRU_P4_OPS_IK "67 arithmetic (8 add, 13 sub, 40 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_JD "108 arithmetic (8 add, 13 sub, 74 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
 #define PRRU_P4_OPS_IK_JD "124 arithmetic (15 add, 16 sub, 80 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
@@ -116,6 +118,7 @@
 #define PRRU_P4_OPS_REACTION_NULLSPACE "77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4"
 #define PRRU_P4_OPS_REGRESSOR "1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 #define PRRU_P4_OPS_EOM_SOLVE_DERIVS "5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_INVERSE_DERIVS "5149 arithmetic (1078 add, 628 sub, 3422 mul, 14 div, 7 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 /* Whether the inputs of prru_p4_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -133,6 +136,12 @@
    infinite (the inputs tested here do not reach them, or reach them only through
    tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
 #define PRRU_P4_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp) \
+  (isfinite((fp)[0]) && isfinite((fp)[1]))
+/* Whether the inputs of prru_p4_inverse_derivs that may not show in its d and tau are finite:
+   a NaN or an infinity in any other input makes one of those outputs NaN or
+   infinite (the inputs tested here do not reach them, or reach them only through
+   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
+#define PRRU_P4_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, fp, mp) \
   (isfinite((fp)[0]) && isfinite((fp)[1]))
 #define PRRU_P4_REACTION_BASIS_NNZ 308 /* entries of prru_p4_reaction_basis's Q */
 
@@ -241,6 +250,9 @@ void prru_p4_regressor(const prru_params4 *p, const double q[3], const double qd
 /* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Parameters from *p. */
 void prru_p4_eom_solve_derivs(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[12], double Dfp[9], double Dmp[9]);
 
+/* inverse_terms (d, J_d, tau) and the derivatives the runtime composes those of the minimum-norm fd from, row-major with row i = tau_i and column k = the k-th variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), each 3x3; DJd = dJ_d/dq (36: block k, 4x3 row-major, is dJ_d/dq_k). Parameters from *p. */
+void prru_p4_inverse_derivs(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3], double Dq[9], double Dqd[9], double Dqdd[9], double DJd[36]);
+
 /* Batched kernels, prru_p4_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n
  * states in one call. Every array holds one row of n per component:
@@ -277,6 +289,9 @@ void prru_p4_batch_eom_solve(const prru_params4 *p, int n, const double *q, cons
 
 /* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
 void prru_p4_batch_eom_solve_derivs(const prru_params4 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
+
+/* inverse_terms (d, J_d, tau) and the derivatives the runtime composes those of the minimum-norm fd from, row-major with row i = tau_i and column k = the k-th variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), each 3x3; DJd = dJ_d/dq (36: block k, 4x3 row-major, is dJ_d/dq_k). */
+void prru_p4_batch_inverse_derivs(const prru_params4 *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *tau, double *Dq, double *Dqd, double *Dqdd, double *DJd);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void prru_p4_batch_dme_terms(const prru_params4 *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);

@@ -4,10 +4,14 @@
  * central differences of the hand-written GSL reference (reference/,
  * prru_ref_forward_dynamics and prru_ref_inverse_dynamics), for the
  * build's model at a state at rest and at random states with velocities
- * and loads. Then identities that hold exactly: the inverse of forward
- * dynamics (dqdd/dfd dfd/dqdd = I, dfd/dq + dfd/dqdd dqdd/dq = 0, the same
- * for qd), A and B's structure, and the zero-order hold (Ad, Bd) against
- * the exponential's Taylor series summed here.
+ * and loads. With four actuators the minimum-norm fd's derivatives, and
+ * with a fixed preload t those of fd + t n (n by GSL's QR of the
+ * reference's J_d, here). Then identities that hold exactly: the inverse
+ * of forward dynamics (dqdd/dfd dfd/dqdd = I, dqdd/dq + dqdd/dfd dfd/dq =
+ * 0, the same for qd; with three actuators also the other order), J_d^T
+ * dfd/dqdd = M, with four n . fd = t and n^T dfd/dqd = n^T dfd/dqdd = 0,
+ * A and B's structure, and the zero-order hold (Ad, Bd) against the
+ * exponential's Taylor series summed here.
  *
  * The bound, relative to each matrix's largest entry (tu_relerr):
  * 1e-9. The two sides' errors:
@@ -41,6 +45,7 @@
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
 
 #include "prru.h"
 #include "prru_linearize.h"
@@ -76,11 +81,40 @@ static double *slot(state *s, int v)
   return slots[v];
 }
 
-/* Forward dynamics' qdd (3), or inverse dynamics' fd (NA), by the reference. */
+/* The preload t the reference's inverse dynamics adds along n (four
+ * actuators; 0 with three). */
+static double ref_preload;
+
+/* n, the unit vector spanning null(J_d^T) with n_NACT > 0, from the
+ * reference's J_d by GSL's Householder QR (the last column of Q): none of
+ * the runtime's minors. */
+static int ref_null(const double q[3], double n[NA])
+{
+  double jd[NA * 3], qm[NA * NA], rm[NA * 3], tau[3];
+  if (prru_ref_jd(&P, q, jd)) return 1;
+  gsl_matrix_view a = gsl_matrix_view_array(jd, NA, 3), qv = gsl_matrix_view_array(qm, NA, NA),
+                  rv = gsl_matrix_view_array(rm, NA, 3);
+  gsl_vector_view t = gsl_vector_view_array(tau, 3);
+  if (gsl_linalg_QR_decomp(&a.matrix, &t.vector) ||
+      gsl_linalg_QR_unpack(&a.matrix, &t.vector, &qv.matrix, &rv.matrix))
+    return 1;
+  const double sg = qm[NA * NA - 1] < 0 ? -1 : 1;
+  for (int i = 0; i < NA; i++) n[i] = sg * qm[NA * i + NA - 1];
+  return 0;
+}
+
+/* Forward dynamics' qdd (3), or inverse dynamics' fd (NA) plus the
+ * preload's ref_preload n, by the reference. */
 static int ref_eval(int inverse, const state *s, double *out)
 {
-  return inverse ? prru_ref_inverse_dynamics(&P, W, s->q, s->qd, s->qdd, s->fp, s->mp, out)
-                 : prru_ref_forward_dynamics(&P, W, s->q, s->qd, s->fd, s->fp, s->mp, out);
+  if (!inverse) return prru_ref_forward_dynamics(&P, W, s->q, s->qd, s->fd, s->fp, s->mp, out);
+  if (prru_ref_inverse_dynamics(&P, W, s->q, s->qd, s->qdd, s->fp, s->mp, out)) return 1;
+  if (ref_preload != 0) {
+    double n[NA];
+    if (NA == 3 || ref_null(s->q, n)) return 1;
+    for (int i = 0; i < NA; i++) out[i] += ref_preload * n[i];
+  }
+  return 0;
 }
 
 /* d out / d (variable v, component k) by Richardson extrapolation of
@@ -147,9 +181,9 @@ static int ref_block(int inverse, const state *s, int v, int n, double h0, doubl
 static double worst[2][3 + 3], worst_est, worst_identity;
 static int blocks_total, blocks_unresolved; /* of the model being checked */
 static const char *const fwd_names[] = {"dqdd_dq", "dqdd_dqd", "dqdd_dfd", "dqdd_dfp", "dqdd_dmp"};
-#if NA == 3
-static const char *const inv_names[] = {"dfd_dq", "dfd_dqd", "dfd_dqdd"};
-#endif
+/* The last three: with a preload (four actuators). */
+static const char *const inv_names[] = {"dfd_dq", "dfd_dqd", "dfd_dqdd",
+                                        "dfd_dq (t)", "dfd_dqd (t)", "dfd_dqdd (t)"};
 
 static void compare(int inverse, int b, const char *name, const double *kernel, const double *ref,
                     int n, double est)
@@ -219,17 +253,18 @@ static void check_forward(state *s, double m)
   memcpy(s->qdd, o.qdd, sizeof o.qdd);
 }
 
-#if NA == 3
-/* max |X Y - I| (X, Y 3x3) relative to max (|X| |Y|)_ij. */
-static double identity_error(const double X[9], const double Y[9], const double *add, int sign)
+/* max |add + sign X Y| (X r x c, Y c x k; add NULL: -I, r = k) relative
+ * to max (|add| + |X| |Y|)_ij. */
+static double identity_error(const double *X, const double *Y, const double *add, int sign, int r,
+                             int c, int k)
 {
   double e = 0, scale = 1e-300;
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) {
-      double s = add ? add[3 * i + j] : -(i == j), t = add ? fabs(add[3 * i + j]) : 1;
-      for (int k = 0; k < 3; k++) {
-        s += sign * X[3 * i + k] * Y[3 * k + j];
-        t += fabs(X[3 * i + k] * Y[3 * k + j]);
+  for (int i = 0; i < r; i++)
+    for (int j = 0; j < k; j++) {
+      double s = add ? add[k * i + j] : -(i == j), t = add ? fabs(add[k * i + j]) : 1;
+      for (int l = 0; l < c; l++) {
+        s += sign * X[c * i + l] * Y[k * l + j];
+        t += fabs(X[c * i + l] * Y[k * l + j]);
       }
       e = fmax(e, fabs(s));
       scale = fmax(scale, t);
@@ -237,45 +272,106 @@ static double identity_error(const double X[9], const double Y[9], const double 
   return e / scale;
 }
 
-/* Inverse dynamics' derivatives at qdd = FD(q, qd, fd) (s->qdd), against
- * the reference, and the identities of ID(FD) = fd. */
-static void check_inverse(state *s, double m)
+static void check_identity(double e, const char *what)
+{
+  tu_check(e <= IDENTITY_BOUND, what, e, IDENTITY_BOUND);
+  worst_identity = fmax(worst_identity, e);
+}
+
+/* Inverse dynamics' derivatives at qdd = FD(q, qd, fd) (s->qdd) with the
+ * preload t held fixed (four actuators; t = 0 is
+ * prru_inverse_dynamics_derivs), against the reference, and the
+ * identities of FD(ID) = qdd (and with three actuators ID(FD) = fd). */
+static void check_inverse(state *s, double m, double t)
 {
   prru_loads l;
   memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
-  double fd[NA], Dq[9], Dqd[9], Dqdd[9];
-  int st = prru_inverse_dynamics_derivs(&model, &data, s->q, s->qd, s->qdd, &l, fd, Dq, Dqd, Dqdd);
+  double fd[NA], Dq[3 * NA], Dqd[3 * NA], Dqdd[3 * NA], f0[NA];
+  int st = t == 0 ? prru_inverse_dynamics_derivs(&model, &data, s->q, s->qd, s->qdd, &l, fd, Dq, Dqd, Dqdd)
+                  : prru_inverse_dynamics_preload_derivs(&model, &data, s->q, s->qd, s->qdd, &l, t, fd,
+                                                         Dq, Dqd, Dqdd);
   if (!TU_TRUE(st == PRRU_OK, "prru_inverse_dynamics_derivs at a trusted state")) return;
+  /* The same fd as inverse dynamics, to the bit. */
+  TU_TRUE(prru_inverse_dynamics_preload(&model, &data, s->q, s->qd, s->qdd, &l, t, f0) == PRRU_OK &&
+              !memcmp(f0, fd, sizeof fd),
+          "inverse derivatives' fd = prru_inverse_dynamics_preload's");
   /* Relative to the forces' size, at least the platform's weight. */
   const double floor = prru_mech.total_mass * 9.81;
+  ref_preload = t;
+#if NA == 3
   const double e_id = tu_relerr(fd, s->fd, NA, floor);
   tu_check(e_id <= 1e-11, "ID(FD(fd)) = fd", e_id, 1e-11);
+#else
+  /* The reference's minimum-norm forces plus t n: the same solution by
+   * other arithmetic (GSL's QR of J_d^T J_d's system, J_d to ~1e-15 with
+   * rcond >= ~1e-3 at these margins): 1e-11 as above. */
+  double fr[NA], n[NA];
+  if (!TU_TRUE(!ref_eval(1, s, fr) && !ref_null(s->q, n), "reference inverse dynamics")) return;
+  const double e_id = tu_relerr(fd, fr, NA, floor);
+  tu_check(e_id <= 1e-11, "fd = the reference's minimum-norm fd + t n", e_id, 1e-11);
+  /* fd's component along n is the preload's: n . fd = t, to the rounding
+   * of the terms |n_i fd_i|. */
+  double nf = -t, nfs = fabs(t);
+  for (int i = 0; i < NA; i++) nf += n[i] * fd[i], nfs += fabs(n[i] * fd[i]);
+  check_identity(fabs(nf) / fmax(nfs, floor), "n . fd = t");
+  /* And constant in qd and qdd: n^T dfd/dqd = n^T dfd/dqdd = 0. */
+  double nD[6] = {0}, nDs = 1e-300;
+  for (int k = 0; k < 3; k++)
+    for (int i = 0; i < NA; i++) {
+      nD[k] += n[i] * Dqd[3 * i + k], nD[3 + k] += n[i] * Dqdd[3 * i + k];
+      nDs = fmax(nDs, fmax(fabs(n[i] * Dqd[3 * i + k]), fabs(n[i] * Dqdd[3 * i + k])));
+    }
+  check_identity(tu_norm_inf(nD, 6) / nDs, "n^T dfd/dqd = n^T dfd/dqdd = 0");
+#endif
   const double *blocks[] = {Dq, Dqd, Dqdd};
-  const int vars[] = {V_Q, V_QD, V_QDD};
+  const int vars[] = {V_Q, V_QD, V_QDD}, b0 = t == 0 ? 0 : 3;
   for (int b = 0; b < 3; b++) {
-    double ref[9], est;
-    if (!TU_TRUE(!ref_block(1, s, vars[b], 3, step_for(vars[b], m), ref, &est),
+    double ref[3 * NA], est;
+    /* fd is J_d^+T (M qdd - J_T,O'^T fp - J_R,P^T mp) + t n, none of it
+     * depending on qd, plus J_d^+T (h - G - passive): dfd/dqd is that of
+     * the reference at qdd = fp = mp = 0 and t = 0, whose differences
+     * round on the scale of G and h alone (with the large random forces
+     * in, their rounding, ~eps |fd| / h, reached 2e-9 of a small dfd/dqd
+     * on random four-limb models). */
+    state z = *s;
+    if (vars[b] == V_QD) {
+      memset(z.qdd, 0, sizeof z.qdd), memset(z.fp, 0, sizeof z.fp), memset(z.mp, 0, sizeof z.mp);
+      ref_preload = 0;
+    }
+    if (!TU_TRUE(!ref_block(1, &z, vars[b], 3, step_for(vars[b], m), ref, &est),
                  "reference inverse dynamics near the state"))
       return;
-    compare(1, b, inv_names[b], blocks[b], ref, 9, est);
+    ref_preload = t;
+    compare(1, b0 + b, inv_names[b0 + b], blocks[b], ref, 3 * NA, est);
   }
-  memcpy(l.fd, s->fd, sizeof l.fd);
+  ref_preload = 0;
+  /* J_d^T dfd/dqdd = M (J_d^T fd = M qdd - b), J_d and M the reference's. */
+  double jd[3 * NA], jdt[3 * NA], M[9];
+  if (!TU_TRUE(!prru_ref_jd(&P, s->q, jd) && !prru_ref_mass(&P, W, s->q, M), "reference J_d, M"))
+    return;
+  for (int i = 0; i < NA; i++)
+    for (int k = 0; k < 3; k++) jdt[NA * k + i] = jd[3 * i + k];
+  check_identity(identity_error(jdt, Dqdd, M, -1, 3, NA, 3), "J_d^T dfd/dqdd = M");
+  memcpy(l.fd, fd, sizeof l.fd);
   prru_linearization o;
   if (!TU_TRUE(prru_linearize(&model, &data, s->q, s->qd, &l, 0.0, &o) == PRRU_OK, "linearize"))
     return;
+  /* qdd(q, qd, fd(q, qd, qdd)) = qdd: dqdd/dfd dfd/dqdd = I, and
+   * dqdd/dq + dqdd/dfd dfd/dq = 0 (the same for qd). */
+  check_identity(identity_error(o.dqdd_dfd, Dqdd, NULL, 1, 3, NA, 3), "dqdd/dfd dfd/dqdd = I");
+  check_identity(identity_error(o.dqdd_dfd, Dq, o.dqdd_dq, 1, 3, NA, 3),
+                 "dqdd/dq + dqdd/dfd dfd/dq = 0");
+  check_identity(identity_error(o.dqdd_dfd, Dqd, o.dqdd_dqd, 1, 3, NA, 3),
+                 "dqdd/dqd + dqdd/dfd dfd/dqd = 0");
+#if NA == 3
   /* fd(q, qd, qdd(q, qd, fd)) = fd: dfd/dqdd dqdd/dfd = I, and
    * dfd/dq + dfd/dqdd dqdd/dq = 0 (the same for qd). */
-  const double e[3] = {identity_error(Dqdd, o.dqdd_dfd, NULL, 1),
-                       identity_error(Dqdd, o.dqdd_dq, Dq, 1),
-                       identity_error(Dqdd, o.dqdd_dqd, Dqd, 1)};
-  static const char *const what[3] = {"dfd/dqdd dqdd/dfd = I", "dfd/dq + dfd/dqdd dqdd/dq = 0",
-                                      "dfd/dqd + dfd/dqdd dqdd/dqd = 0"};
-  for (int i = 0; i < 3; i++) {
-    tu_check(e[i] <= IDENTITY_BOUND, what[i], e[i], IDENTITY_BOUND);
-    worst_identity = fmax(worst_identity, e[i]);
-  }
-}
+  check_identity(identity_error(Dqdd, o.dqdd_dfd, NULL, 1, 3, 3, 3), "dfd/dqdd dqdd/dfd = I");
+  check_identity(identity_error(Dqdd, o.dqdd_dq, Dq, 1, 3, 3, 3), "dfd/dq + dfd/dqdd dqdd/dq = 0");
+  check_identity(identity_error(Dqdd, o.dqdd_dqd, Dqd, 1, 3, 3, 3),
+                 "dfd/dqd + dfd/dqdd dqdd/dqd = 0");
 #endif
+}
 
 /* [Ad Bd; 0 I] = exp(Z), Z = [A B; 0 0] dt, against its Taylor series
  * summed here: of Z / 2^k with |Z / 2^k|_inf <= 1/2 (30 terms leave
@@ -604,6 +700,14 @@ static void draw_batch(void)
       bl[k].mp[i] = tu_uniform(-3, 3);
     }
     for (int i = 0; i < NA; i++) bl[k].fd[i] = tu_uniform(-60, 60);
+    /* Every fifth state trusted for sure (the box alone gave as few as 6
+     * of 75 on a prototype). */
+    state t;
+    double mt;
+    if (k % 5 == 2 && random_state(&t, &mt)) {
+      memcpy(bq[k], t.q, sizeof t.q), memcpy(bqd[k], t.qd, sizeof t.qd);
+      memcpy(bl[k].fd, t.fd, sizeof t.fd), memcpy(bl[k].fp, t.fp, sizeof t.fp), memcpy(bl[k].mp, t.mp, sizeof t.mp);
+    }
   }
   bq[5][0] = NAN, bqd[40][1] = INFINITY, bl[41].fd[0] = NAN;
   /* Just inside the reach, from reachable states at small angles. */
@@ -750,24 +854,18 @@ static void check_model(const char *name, int nstates, int nboundary)
       if (!TU_TRUE(random_state(&s, &m), what)) break;
     }
     check_forward(&s, m);
-#if NA == 3
-    check_inverse(&s, m);
-#endif
+    check_inverse(&s, m, 0.0);
+    /* A preload of twice the robot's weight: dn/dq of the order of the
+     * minimum-norm part's derivatives. */
+    if (NA == 4) check_inverse(&s, m, 2 * prru_mech.total_mass * 9.81);
     if (k < 3) check_hold(&s);
     n++;
   }
   printf("%s (%s kernels), %d states:\n", name, model.kernels->path, n);
   for (int b = 0; b < 5; b++) printf("  %-9s worst relative error %.2e\n", fwd_names[b], worst[0][b]);
-#if NA == 3
-  for (int b = 0; b < 3; b++) printf("  %-9s worst relative error %.2e\n", inv_names[b], worst[1][b]);
+  for (int b = 0; b < (NA == 3 ? 3 : 6); b++)
+    printf("  %-12s worst relative error %.2e\n", inv_names[b], worst[1][b]);
   printf("  identities worst %.2e\n", worst_identity);
-#else
-  /* Four actuators: the minimum-norm solution's derivatives are not generated. */
-  double fd[NA];
-  TU_TRUE(prru_inverse_dynamics_derivs(&model, &data, s.q, s.qd, s.qdd, &none, fd, NULL, NULL, NULL) ==
-              PRRU_EINPUT,
-          "four actuators: inverse derivatives refused");
-#endif
   printf("  reference differences' worst error estimate %.2e, %d of %d blocks not resolved to %g\n", worst_est,
          blocks_unresolved, blocks_total, REF_ACCURACY);
   /* Nearly every block is checked to 1e-9 (all on the committed models). */

@@ -301,9 +301,9 @@ def _row_major(cols):
 
 
 def derivative_kernels(deriv):
-    """The closed-form derivatives of forward and inverse dynamics
-    (specialised set only): eom_solve_derivs and, with three actuators,
-    inverse_derivs."""
+    """The closed-form derivatives of forward and inverse dynamics:
+    eom_solve_derivs and inverse_derivs (with four actuators the pieces
+    the runtime composes the minimum-norm solution's derivatives from)."""
     guards = deriv.mech.guards
     nact = len(deriv.actuators())
     fd, fp, mp = _vec("fd", nact), _vec("fp"), _vec("mp")
@@ -311,6 +311,8 @@ def derivative_kernels(deriv):
     spec = [_eom_solve_derivs(deriv, q, qd, fd, fp, mp)]
     if nact == 3:
         spec.append(_inverse_derivs(deriv, q, qd, fp, mp))
+    else:
+        spec.append(_inverse_pieces(deriv, q, qd, fp, mp))
     return [Kernel(k[0], k[1], k[2], k[3], guards, witnesses=k[4])
             for k in spec]
 
@@ -383,7 +385,15 @@ def _inverse_derivs(deriv, q, qd, fp, mp):
     fv = [_frozen("_fdv%d" % i, fd[i], xs) for i in range(3)]
     r = [tau[i] - sym.add(*[jd[3 * j + i] * fv[j] for j in range(3)])
          for i in range(3)]
-    blocks = [_row_major([solve_t(col) for col in _columns(r, vs, tag)])
+    # The nine columns by J_d^-T's entries as atoms (the output Jdinv):
+    # 9 multiplies a column, where solve_t's cofactors and 1 / det take 12.
+    ia = [_atom("Ji%d" % k, x) for k, x in enumerate(inv)]
+
+    def map_inv_t(rhs):
+        """J_d^-T rhs: x_i = sum_k (J_d^-1)_ki rhs_k."""
+        return [sym.add(*[sym.mul(ia[3 * k + i], rhs[k]) for k in range(3)])
+                for i in range(3)]
+    blocks = [_row_major([map_inv_t(col) for col in _columns(r, vs, tag)])
               for tag, vs in (("sq", q), ("sqd", qd), ("sqdd", qdd))]
     ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
     return ("inverse_derivs", "inverse_terms (d, J_d, J_d^-1, fd) and the "
@@ -391,6 +401,32 @@ def _inverse_derivs(deriv, q, qd, fp, mp):
             "the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd "
             "(= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T "
             "fd).", ins,
-            [("d", d), ("Jd", jd), ("Jdinv", inv), ("fd", fd),
+            [("d", d), ("Jd", jd), ("Jdinv", ia), ("fd", fd),
              ("Dq", blocks[0]), ("Dqd", blocks[1]), ("Dqdd", blocks[2])],
             ("d", "fd"))
+
+
+def _inverse_pieces(deriv, q, qd, fp, mp):
+    """Four actuators: inverse_terms (d, J_d, tau) and the derivatives of
+    tau and J_d, from which the runtime composes those of the
+    minimum-norm fd = J_d^+T tau (+ t n) with the J_d^+ of its own QR
+    (prru_inverse_dynamics'), not the normal equations a symbolic
+    (J_d^T J_d)^-1 would be: those square J_d's condition number."""
+    d, jd = deriv.actuators(), deriv.actuator_jacobian()
+    qdd = _vec("qdd")
+    tau = deriv.drive_force(qdd, fp, mp)
+    blocks = [_row_major(_columns(tau, vs, tag))
+              for tag, vs in (("tq", q), ("tqd", qd), ("tqdd", qdd))]
+    # dJ_d/dq_k, one NACT x 3 block per k.
+    djd = [x for col in _columns(jd, q, "jq") for x in col]
+    ins = [Q, QD, _arg("qdd", 3), _arg("fp", 3), _arg("mp", 3)]
+    nact = len(d)
+    return ("inverse_derivs", "inverse_terms (d, J_d, tau) and the "
+            "derivatives the runtime composes those of the minimum-norm fd "
+            "from, row-major with row i = tau_i and column k = the k-th "
+            "variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), "
+            "each 3x3; DJd = dJ_d/dq (%d: block k, %dx3 row-major, is "
+            "dJ_d/dq_k)." % (3 * 3 * nact, nact), ins,
+            [("d", d), ("Jd", jd), ("tau", tau), ("Dq", blocks[0]),
+             ("Dqd", blocks[1]), ("Dqdd", blocks[2]), ("DJd", djd)],
+            ("d", "tau"))

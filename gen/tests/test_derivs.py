@@ -6,7 +6,9 @@ eom_solve's qdd and inverse_derivs's those of inverse_terms's fd, on the
 prototype with drives (armature, damping, smoothed Coulomb) and on the
 4-limb model, at a non-hover state with loads; and their values (qdd, fd)
 are eom_solve's and inverse_terms's to the bit (one CSE graph each, the
-same expressions).
+same expressions). With four actuators inverse_derivs gives tau's
+derivatives and dJ_d/dq (the runtime composes the minimum-norm fd's):
+those against differences of inverse_terms's tau and jd's J_d.
 
 Tolerance: a central difference with step h has truncation error
 h^2 |f'''| / 6 and rounding error about eps |f| / h; with h = 1e-6
@@ -82,7 +84,27 @@ class DerivativeKernels(unittest.TestCase):
                                [q, qd, [1.0, 2.0, -3.0], fp, mp], "fd",
                                [(0, "Dq"), (1, "Dqd"), (2, "Dqdd")])
                 else:
-                    self.assertNotIn("inverse_derivs", ks)
+                    args = [q, qd, [1.0, 2.0, -3.0], fp, mp]
+                    self.check(ks, "inverse_terms", "inverse_derivs", args,
+                               "tau", [(0, "Dq"), (1, "Dqd"), (2, "Dqdd")])
+                    self.check_djd(ks, args)
+
+    def check_djd(self, ks, args):
+        """Four actuators: DJd (block k = dJ_d/dq_k) against differences
+        of jd's J_d; J_d to the bit inverse_terms's."""
+        got = _run(ks["inverse_derivs"], args)
+        self.assertEqual(got["Jd"], _run(ks["inverse_terms"], args)["Jd"])
+        n = len(got["Jd"])
+        scale = 1 + max(abs(x) for x in got["DJd"])
+        for k in range(3):
+            up, dn = list(args[0]), list(args[0])
+            up[k] += H
+            dn[k] -= H
+            a, b = _run(ks["jd"], [up])["Jd"], _run(ks["jd"], [dn])["Jd"]
+            for i in range(n):
+                self.assertLess(abs((a[i] - b[i]) / (2 * H)
+                                    - got["DJd"][n * k + i]),
+                                1e-7 * scale, ("DJd", k, i))
 
 
 if __name__ == "__main__":

@@ -131,12 +131,14 @@ typedef struct prru_kernel_table {
   int (*unseen_finite_eom_solve_derivs)(const double q[3], const double qd[3],
                                         const double fd[PRRU_NACT], const double fp[3],
                                         const double mp[3]);
-  /* Three actuators: inverse_terms's outputs, then dfd/dq, dfd/dqd,
-   * dfd/dqdd (3x3 each); NULL (both) with four. */
+  /* inverse_terms's outputs, then three 3x3 blocks, row-major, row i =
+   * out_i: with three actuators dfd/dq, dfd/dqd, dfd/dqdd (DJd unused);
+   * with four dtau/dq, dtau/dqd, dtau/dqdd (= M) and DJd = dJ_d/dq, block
+   * k (PRRU_NACT x 3, row-major) dJ_d/dq_k, Jdinv unused. */
   void (*inverse_derivs)(const void *p, const double q[3], const double qd[3], const double qdd[3],
                          const double fp[3], const double mp[3], double d[PRRU_NACT],
-                         double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
-                         double Dq[9], double Dqd[9], double Dqdd[9]);
+                         double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3],
+                         double Dq[9], double Dqd[9], double Dqdd[9], double DJd[9 * PRRU_NACT]);
   int (*unseen_finite_inverse_derivs)(const double q[3], const double qd[3], const double qdd[3],
                                       const double fp[3], const double mp[3]);
   /* eom_solve_derivs batched (prru_batch_eom_solve_derivs in

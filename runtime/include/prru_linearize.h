@@ -1,6 +1,7 @@
 /* Linearisation of the dynamics, for LQR and MPC: the closed-form
  * derivatives of forward dynamics (the generated prru_eom_solve_derivs,
- * one evaluation with qdd) and of inverse dynamics (prru_inverse_derivs).
+ * one evaluation with qdd) and of inverse dynamics (prru_inverse_derivs;
+ * with four actuators composed from its dtau/dx and dJ_d/dq).
  *
  * State x = (q, qd) (6), input u = fd (PRRU_NACT), x' = f(x, u) =
  * (qd, qdd(q, qd, fd, fp, mp)):
@@ -78,15 +79,28 @@ PRRU_API int prru_linearize_batch(const prru_model *m, int n, const double *q, c
                                   const prru_loads *l, double dt, prru_linearization *out,
                                   int *status);
 
-/* Three actuators: inverse dynamics fd (as prru_inverse_dynamics, the same
- * statuses and trust test) and its derivatives dfd/dq, dfd/dqd, dfd/dqdd
- * (3x3 each; dfd/dqdd = J_d^-T M), any of them NULL if not wanted. Four
- * actuators: PRRU_EINPUT (the minimum-norm solution's derivatives are not
- * generated). */
+/* Inverse dynamics fd (as prru_inverse_dynamics: the same statuses and
+ * trust test, and the same fd) and its derivatives dfd/dq, dfd/dqd,
+ * dfd/dqdd (PRRU_NACT x 3 each), any of them NULL if not wanted. Three
+ * actuators: dfd/dqdd = J_d^-T M, from one generated evaluation. Four: the
+ * minimum-norm fd = J_d^+T tau, dfd/dqdd = J_d^+T M; the derivatives are
+ * composed from the generated dtau/dx and dJ_d/dq with the J_d^+ and n of
+ * prru_inverse_dynamics_preload (see linearize.c). */
 PRRU_API int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
                                           const double qd[3], const double qdd[3], const prru_loads *l,
-                                          double fd[PRRU_NACT], double dfd_dq[9], double dfd_dqd[9],
-                                          double dfd_dqdd[9]);
+                                          double fd[PRRU_NACT], double dfd_dq[3 * PRRU_NACT],
+                                          double dfd_dqd[3 * PRRU_NACT], double dfd_dqdd[3 * PRRU_NACT]);
+
+/* The same for prru_inverse_dynamics_preload's fd = J_d^+T tau + t n with
+ * the preload t held fixed: dfd/dq then also has t dn/dq (n turns with
+ * J_d), dfd/dqd and dfd/dqdd are those of t = 0. PRRU_EINPUT for a
+ * non-finite t and a non-zero t with three actuators, as there. */
+PRRU_API int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, const double q[3],
+                                                  const double qd[3], const double qdd[3],
+                                                  const prru_loads *l, double preload,
+                                                  double fd[PRRU_NACT], double dfd_dq[3 * PRRU_NACT],
+                                                  double dfd_dqd[3 * PRRU_NACT],
+                                                  double dfd_dqdd[3 * PRRU_NACT]);
 
 #ifdef __cplusplus
 }

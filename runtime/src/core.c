@@ -438,13 +438,30 @@ int prru_inverse3_status(const prru_model *m, const prru_data *d, const double f
   if (!near_boundary_ok(m, d->Jd)) return PRRU_ESINGULAR;
   return prru_finite_n(fd, 3) ? PRRU_OK : PRRU_EINPUT;
 }
+#else
+int prru_inverse4_status(const prru_model *m, prru_data *d, const double tau[3],
+                         double f[PRRU_NACT])
+{
+  int st;
+  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
+  else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
+  if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
+  if (st != PRRU_OK) return st;
+  const double *inv = d->Jdpinv;
+  enum { N = PRRU_NACT };
+  /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
+   * solution of J_d^T fd = tau of least norm; non-finite where tau is. */
+  for (int i = 0; i < N; i++) f[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
+  return prru_finite_n(f, N) ? PRRU_OK : PRRU_EINPUT;
+}
+#endif
 
 int prru_inverse_failure(int st, const double q[3], const double qd[3], const double qdd[3],
                          const prru_loads *l)
 {
   return inverse_failure(st, q, qd, qdd, l);
 }
-#endif
 
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
@@ -462,18 +479,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
    * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
   double tau[3], f[PRRU_NACT];
   KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau);
-  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
-  else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
-  else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
-  if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
-  if (st == PRRU_OK) {
-    const double *inv = d->Jdpinv;
-    enum { N = PRRU_NACT };
-    /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
-     * solution of J_d^T fd = tau of least norm; non-finite where tau is. */
-    for (int i = 0; i < N; i++) f[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
-    st = prru_finite_n(f, N) ? PRRU_OK : PRRU_EINPUT;
-  }
+  st = prru_inverse4_status(m, d, tau, f);
 #endif
   /* Inputs tested through the outputs, as in prru_forward_dynamics. */
   if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_terms)(q, qd, qdd, l->fp, l->mp))
@@ -487,7 +493,7 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
  * them. Column scaling (J_d diag(1/L, 1/L, 1)) scales every minor alike,
  * so the scaled J_d is used: no over- or underflow for any robot size. */
 #if PRRU_NPRELOAD == 1
-static int null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], double n[PRRU_NACT])
+int prru_null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], double n[PRRU_NACT])
 {
   enum { N = PRRU_NACT };
   const double L = prru_length_scale(m->mech);
@@ -531,7 +537,7 @@ int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
 #elif PRRU_NPRELOAD == 1
   int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
-  return null_from_jd(m, d->Jd, n);
+  return prru_null_from_jd(m, d->Jd, n);
 #else
 #error "more than one redundant actuator is not implemented"
 #endif
@@ -550,7 +556,7 @@ int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const doubl
   int st = prru_inverse_dynamics(m, d, q, qd, qdd, l, f);
   if (st != PRRU_OK) return st;
   if (preload != 0.0) {
-    st = null_from_jd(m, d->Jd, n);
+    st = prru_null_from_jd(m, d->Jd, n);
     if (st != PRRU_OK) return st;
     for (int i = 0; i < PRRU_NACT; i++) f[i] += preload * n[i];
     if (!prru_finite_n(f, PRRU_NACT)) return PRRU_EINPUT;

@@ -137,13 +137,19 @@ static int s_unseen_eom_solve_derivs(const double q[3], const double qd[3], cons
   (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
   return PRRU_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp);
 }
-#if PRRU_NACT == 3
 static void s_inverse_derivs(const void *p, const double q[3], const double qd[3], const double qdd[3],
                              const double fp[3], const double mp[3], double d[PRRU_NACT],
-                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
-                             double Dq[9], double Dqd[9], double Dqdd[9])
+                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3],
+                             double Dq[9], double Dqd[9], double Dqdd[9], double DJd[9 * PRRU_NACT])
 {
-  (void)p, prru_inverse_derivs(q, qd, qdd, fp, mp, d, Jd, Jdinv, fd, Dq, Dqd, Dqdd);
+  (void)p;
+#if PRRU_NACT == 3
+  (void)DJd;
+  prru_inverse_derivs(q, qd, qdd, fp, mp, d, Jd, Jdinv, out, Dq, Dqd, Dqdd);
+#else
+  (void)Jdinv;
+  prru_inverse_derivs(q, qd, qdd, fp, mp, d, Jd, out, Dq, Dqd, Dqdd, DJd);
+#endif
 }
 static int s_unseen_inverse_derivs(const double q[3], const double qd[3], const double qdd[3],
                                    const double fp[3], const double mp[3])
@@ -151,10 +157,6 @@ static int s_unseen_inverse_derivs(const double q[3], const double qd[3], const 
   (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
   return PRRU_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, fp, mp);
 }
-#else
-#define s_inverse_derivs NULL
-#define s_unseen_inverse_derivs NULL
-#endif
 
 static void s_batch_eom_solve_derivs(const void *p, int n, const double *q, const double *qd,
                                      const double *fd, const double *fp, const double *mp, double *M,
@@ -282,13 +284,18 @@ static int p_unseen_eom_solve_derivs(const double q[3], const double qd[3], cons
   (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
   return UNSEEN_P(EOM_SOLVE_DERIVS)(q, qd, fd, fp, mp);
 }
-#if PRRU_NACT == 3
 static void p_inverse_derivs(const void *p, const double q[3], const double qd[3], const double qdd[3],
                              const double fp[3], const double mp[3], double d[PRRU_NACT],
-                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double fd[3],
-                             double Dq[9], double Dqd[9], double Dqdd[9])
+                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3],
+                             double Dq[9], double Dqd[9], double Dqdd[9], double DJd[9 * PRRU_NACT])
 {
-  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, fd, Dq, Dqd, Dqdd);
+#if PRRU_NACT == 3
+  (void)DJd;
+  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, out, Dq, Dqd, Dqdd);
+#else
+  (void)Jdinv;
+  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, out, Dq, Dqd, Dqdd, DJd);
+#endif
 }
 static int p_unseen_inverse_derivs(const double q[3], const double qd[3], const double qdd[3],
                                    const double fp[3], const double mp[3])
@@ -296,10 +303,6 @@ static int p_unseen_inverse_derivs(const double q[3], const double qd[3], const 
   (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
   return UNSEEN_P(INVERSE_DERIVS)(q, qd, qdd, fp, mp);
 }
-#else
-#define p_inverse_derivs NULL
-#define p_unseen_inverse_derivs NULL
-#endif
 
 static void p_batch_eom_solve_derivs(const void *p, int n, const double *q, const double *qd,
                                      const double *fd, const double *fp, const double *mp, double *M,

@@ -194,29 +194,120 @@ int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], con
                    dt);
 }
 
-int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
-                                 const double qd[3], const double qdd[3], const prru_loads *l,
-                                 double fd[PRRU_NACT], double dfd_dq[9], double dfd_dqd[9],
-                                 double dfd_dqdd[9])
-{
 #if PRRU_NACT == 3
+static int inverse3_derivs(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                           const double qdd[3], const prru_loads *l, double fd[3], double dfd_dq[9],
+                           double dfd_dqd[9], double dfd_dqdd[9])
+{
   if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
-  double f[3], Dq[9], Dqd[9], Dqdd[9];
-  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, Dq,
-                            Dqd, Dqdd);
+  /* The three blocks in one array: one finiteness test for the 27. */
+  double f[3], D[27];
+  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f, D,
+                            D + 9, D + 18, NULL);
   int st = prru_inverse3_status(m, d, f);
   if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_derivs)(q, qd, qdd, l->fp, l->mp))
     return prru_inverse_failure(st, q, qd, qdd, l);
-  if (!prru_finite_n(Dq, 9) || !prru_finite_n(Dqd, 9) || !prru_finite_n(Dqdd, 9))
+  if (!prru_finite_n(D, 27)) return PRRU_EINPUT;
+  memcpy(fd, f, sizeof f);
+  if (dfd_dq) memcpy(dfd_dq, D, 9 * sizeof *D);
+  if (dfd_dqd) memcpy(dfd_dqd, D + 9, 9 * sizeof *D);
+  if (dfd_dqdd) memcpy(dfd_dqdd, D + 18, 9 * sizeof *D);
+  return PRRU_OK;
+}
+#else
+/* rhs (3 x 3, row-major) mapped by J_d^+T (NACT x 3; its row i is column i
+ * of J_d^+, Jp = d->Jdpinv) into out (NACT x 3). */
+static void map_pinv_t(const double *Jp, const double rhs[9], double out[3 * PRRU_NACT])
+{
+  enum { N = PRRU_NACT };
+  for (int i = 0; i < N; i++)
+    for (int k = 0; k < 3; k++)
+      out[3 * i + k] = Jp[i] * rhs[k] + Jp[N + i] * rhs[3 + k] + Jp[2 * N + i] * rhs[6 + k];
+}
+
+/* fd = J_d^+T tau + t n (prru_inverse_dynamics_preload: J_d^+ by the
+ * runtime's QR, n by prru_null_from_jd) and its derivatives, composed from
+ * the kernel's tau, dtau/dx and dJ_d/dq. With y = (J_d^T J_d)^-1 tau
+ * (= J_d^+ fd at t = 0), differentiating J_d^T J_d y = tau gives
+ *   d(J_d y) = (I - J_d J_d^+) dJ_d y + J_d^+T (dtau - dJ_d^T J_d y),
+ * and J_d^T n = 0, |n| = 1 give dn = -J_d^+T dJ_d^T n, so with
+ * I - J_d J_d^+ = n n^T:
+ *   dfd/dx = n n^T (dJ_d/dx) y + J_d^+T (dtau/dx - (dJ_d/dx)^T fd);
+ * dJ_d/dqd = dJ_d/dqdd = 0. Not the symbolic (J_d^T J_d)^-1: the normal
+ * equations square J_d's condition number, up to 1e16 at jd_rcond_min. */
+static int inverse4_derivs(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
+                           const double qdd[3], const prru_loads *l, double t, double fd[PRRU_NACT],
+                           double dfd_dq[3 * PRRU_NACT], double dfd_dqd[3 * PRRU_NACT],
+                           double dfd_dqdd[3 * PRRU_NACT])
+{
+  enum { N = PRRU_NACT };
+  if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
+  double tau[3], Tq[9], Tqd[9], Tqdd[9], DJ[9 * N], f[N], n[N], y[3];
+  KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau, Tq,
+                            Tqd, Tqdd, DJ);
+  int st = prru_inverse4_status(m, d, tau, f);
+  if (st == PRRU_OK) st = prru_null_from_jd(m, d->Jd, n);
+  if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_derivs)(q, qd, qdd, l->fp, l->mp))
+    return prru_inverse_failure(st, q, qd, qdd, l);
+  const double *Jp = d->Jdpinv;
+  for (int k = 0; k < 3; k++) {
+    y[k] = 0;
+    for (int i = 0; i < N; i++) y[k] += Jp[N * k + i] * f[i];
+  }
+  for (int i = 0; i < N; i++) f[i] += t * n[i];
+  double r[9], Dq[3 * N], Dqd[3 * N], Dqdd[3 * N];
+  for (int k = 0; k < 3; k++) {
+    const double *Jk = DJ + 3 * N * k;
+    for (int j = 0; j < 3; j++) {
+      double s = Tq[3 * j + k];
+      for (int i = 0; i < N; i++) s -= Jk[3 * i + j] * f[i];
+      r[3 * j + k] = s;
+    }
+  }
+  map_pinv_t(Jp, r, Dq);
+  for (int k = 0; k < 3; k++) {
+    const double *Jk = DJ + 3 * N * k;
+    double s = 0;
+    for (int i = 0; i < N; i++) s += n[i] * (Jk[3 * i] * y[0] + Jk[3 * i + 1] * y[1] + Jk[3 * i + 2] * y[2]);
+    for (int i = 0; i < N; i++) Dq[3 * i + k] += n[i] * s;
+  }
+  map_pinv_t(Jp, Tqd, Dqd);
+  map_pinv_t(Jp, Tqdd, Dqdd);
+  if (!prru_finite_n(f, N) || !prru_finite_n(Dq, 3 * N) || !prru_finite_n(Dqd, 3 * N) ||
+      !prru_finite_n(Dqdd, 3 * N))
     return PRRU_EINPUT;
   memcpy(fd, f, sizeof f);
   if (dfd_dq) memcpy(dfd_dq, Dq, sizeof Dq);
   if (dfd_dqd) memcpy(dfd_dqd, Dqd, sizeof Dqd);
   if (dfd_dqdd) memcpy(dfd_dqdd, Dqdd, sizeof Dqdd);
   return PRRU_OK;
+}
+#endif
+
+int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, const double q[3],
+                                         const double qd[3], const double qdd[3],
+                                         const prru_loads *l, double preload, double fd[PRRU_NACT],
+                                         double dfd_dq[3 * PRRU_NACT],
+                                         double dfd_dqd[3 * PRRU_NACT],
+                                         double dfd_dqdd[3 * PRRU_NACT])
+{
+  if (!isfinite(preload)) return PRRU_EINPUT;
+#if PRRU_NACT == 3
+  if (preload != 0.0) return PRRU_EINPUT;
+  return inverse3_derivs(m, d, q, qd, qdd, l, fd, dfd_dq, dfd_dqd, dfd_dqdd);
 #else
-  (void)m, (void)d, (void)q, (void)qd, (void)qdd, (void)l, (void)fd, (void)dfd_dq, (void)dfd_dqd,
-      (void)dfd_dqdd;
-  return PRRU_EINPUT;
+  return inverse4_derivs(m, d, q, qd, qdd, l, preload, fd, dfd_dq, dfd_dqd, dfd_dqdd);
+#endif
+}
+
+int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
+                                 const double qd[3], const double qdd[3], const prru_loads *l,
+                                 double fd[PRRU_NACT], double dfd_dq[3 * PRRU_NACT],
+                                 double dfd_dqd[3 * PRRU_NACT], double dfd_dqdd[3 * PRRU_NACT])
+{
+#if PRRU_NACT == 3
+  return inverse3_derivs(m, d, q, qd, qdd, l, fd, dfd_dq, dfd_dqd, dfd_dqdd);
+#else
+  return inverse4_derivs(m, d, q, qd, qdd, l, 0.0, fd, dfd_dq, dfd_dqd, dfd_dqdd);
 #endif
 }
