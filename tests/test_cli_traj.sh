@@ -279,10 +279,16 @@ jcheck "$tmp/n1.json" "d['control'] == 'zero-order hold' and d['samples'] == 100
   "track --period: wrong sampling or error"
 # --controller lqr: the time-varying LQR at the same period as computed
 # torque. Exact plant: both errors are the zero-order hold's, at most
-# jerk Tc / W^2 = 6 rad/s^3 * 2 ms / (20 rad/s)^2 = 3e-5 (the quintic's
-# peak jerk 60 |dq| / T^3 = 6 on this move; the bound's derivation is in
-# test_control.c); the same feed-forward peak forces (0.1 %); the weights
-# used in the summary, the given ones as given.
+# a / W^2 with a the acceleration a held force lacks over a tick
+# (test_control.c derives and checks it for the build's model): without
+# drives a = jerk Tc, so 6 rad/s^3 * 2 ms / (20 rad/s)^2 = 3e-5 (the
+# quintic's peak jerk 60 |dq| / T^3 = 6 on this move). Damping and
+# Coulomb friction add their rate to a (steep for a small smoothing
+# velocity), which only the library's test computes: with drives the LQR
+# is held to 4x computed torque's error here instead (the two share the
+# bound; on the prototype LQR's is the smaller). The same feed-forward
+# peak forces (0.1 %); the weights used in the summary, the given ones as
+# given.
 "$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --out "$tmp/ct2.csv" --summary "$tmp/ct2.json" \
   2>"$tmp/err" || bad "track --period 0.002: $(cat "$tmp/err")"
 "$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --out "$tmp/lqr.csv" \
@@ -291,13 +297,21 @@ python3 -c "
 import json, sys
 c, l = (json.load(open(p)) for p in sys.argv[1:3])
 n = int(sys.argv[3])
+m = json.load(open(sys.argv[4]))
+def drives(k):  # format 2 under actuators, format 1 at the top
+    a = m.get('actuators', {}).get(k, m.get(k, 0))
+    return any(x != 0 for x in (a if isinstance(a, list) else [a]))
+friction = drives('damping') or drives('coulomb')
 assert l['controller'] == 'lqr' and 'controller' not in c, (l.get('controller'), c.get('controller'))
 assert len(l['lqr_q']) == 6 and len(l['lqr_r']) == n and min(l['lqr_q']) > 0 and min(l['lqr_r']) > 0, l
 assert l['samples'] == c['samples'] == 1001 and l['status'] == 'complete', l
-assert max(c['max_error']) <= 3e-5 and max(l['max_error']) <= 3e-5, (c['max_error'], l['max_error'])
+if friction:
+    assert max(l['max_error']) <= 4 * max(c['max_error']) and max(c['max_error']) < 1e-3, (c['max_error'], l['max_error'])
+else:
+    assert max(c['max_error']) <= 3e-5 and max(l['max_error']) <= 3e-5, (c['max_error'], l['max_error'])
 assert abs(max(l['max_fd']) - max(c['max_fd'])) <= 1e-3 * max(c['max_fd']), (l['max_fd'], c['max_fd'])
 print('track 2 ms: max error CT %.3g, LQR %.3g' % (max(c['max_error']), max(l['max_error'])))
-" "$tmp/ct2.json" "$tmp/lqr.json" "$nact" && ok || bad "track --controller lqr: not tracking like computed torque"
+" "$tmp/ct2.json" "$tmp/lqr.json" "$nact" "$PRRU_MODEL" && ok || bad "track --controller lqr: not tracking like computed torque"
 sed -n 2p "$tmp/lqr.csv" | grep -q "^# LQR (time-varying" && ok || bad "track lqr: no controller line"
 [ "$(grep -v '^#' "$tmp/lqr.csv" | head -1)" = "$(grep -v '^#' "$tmp/ct2.csv" | head -1)" ] && ok \
   || bad "track lqr: columns differ from computed torque's"
