@@ -720,7 +720,10 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   memset(&lqr, 0, sizeof lqr);
   if (o->controller == PRRU_TRACK_LQR) {
     st = prru_lqr_schedule_build(m, ref, o, &lqr, msg, msglen);
-    if (st != PRRU_OK) return st;
+    if (st != PRRU_OK) {
+      free(c.d);
+      return st;
+    }
     c.lqr = &lqr;
   }
   prru_track_sample *s = malloc(sizeof *s);
