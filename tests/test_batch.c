@@ -224,31 +224,14 @@ static void scalar_derivs(int inverse, const states *s, int k, const double q[3]
 
 static double want_d[NMAX][DMAX], sens_d[9][NMAX], got_d[DMAX * NMAX];
 
-/* The vector tanh's share in Dqd (drives with Coulomb friction; as
- * test_derivs.c's tanh_bound): the friction's derivative in qd is
- * J_d^T diag(f_i / v_s (1 - t_i^2)) J_d, t_i = tanh(dd_i / v_s); where t_i
- * nears +-1, 1 - t_i^2 cancels and libmvec's few ulp in t_i (<= 4) move it
- * by 2 t_i that, absolutely: up to 8 eps max f_i / v_s |J_d|^2 |M^-1| in
- * dqdd/dqd (Frobenius norms), and 8 eps max f_i / v_s |J_d| in dfd/dqd
- * (inverse dynamics never solves by M, and J_d^-T J_d^T cancels); 16 eps
- * for margin. No input perturbation shows it: t_i's slope vanishes
- * where it cancels. */
+/* The vector tanh's share in Dqd (tu_tanh_share). */
 static double tanh_share(int inverse, const double q[3])
 {
-  double f = 0, Jd[3 * NA], M[9], nj = 0, c[9], ninv = 0;
+  double f = 0, Jd[3 * NA], M[9];
   for (int i = 0; i < NA; i++) f = fmax(f, prru_mech.coulomb[i]);
-  if (!(f > 0) || !(prru_mech.coulomb_velocity > 0)) return 0;
   prru_jd(q, Jd);
-  for (int i = 0; i < 3 * NA; i++) nj += Jd[i] * Jd[i];
-  if (inverse) return 16 * DBL_EPSILON * f / prru_mech.coulomb_velocity * sqrt(nj);
   prru_mass(q, M);
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      c[3 * j + i] = M[3 * ((i + 1) % 3) + (j + 1) % 3] * M[3 * ((i + 2) % 3) + (j + 2) % 3] -
-                     M[3 * ((i + 1) % 3) + (j + 2) % 3] * M[3 * ((i + 2) % 3) + (j + 1) % 3];
-  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
-  for (int i = 0; i < 9; i++) ninv += c[i] * c[i];
-  return 16 * DBL_EPSILON * f / prru_mech.coulomb_velocity * nj * sqrt(ninv) / fabs(det);
+  return tu_tanh_share(Jd, NA, inverse ? NULL : M, f, prru_mech.coulomb_velocity);
 }
 
 static double check_derivs_of(int inverse, const states *s, int n, const double *q, const double *qd,

@@ -737,30 +737,15 @@ static void draw_batch(void)
   }
 }
 
-/* The vector tanh's share (drives with Coulomb friction): the friction's
- * derivative in qd is J_d^T diag(f_i / v_s (1 - t_i^2)) J_d, t_i = tanh(dd_i
- * / v_s), solved by M; where t_i nears +-1, 1 - t_i^2 cancels, and libmvec's
- * few ulp in t_i (<= 4) move it by 2 t_i that, absolutely, however small
- * the term: up to 8 eps max_i f_i / v_s |J_d|^2 |M^-1| in dqdd/dqd
- * (Frobenius norms, above the 2-norms), 16 eps here for margin. No input
- * perturbation shows it (t_i's slope vanishes where it cancels). */
+/* The vector tanh's share in dqdd/dqd (tu_tanh_share, testutil.h). */
 static double tanh_bound(const double q[3])
 {
   const prru_mechanism *mech = model.mech;
-  double f = 0, Jd[3 * NA], M[9], nj = 0, c[9];
+  double f = 0, Jd[3 * NA], M[9];
   for (int i = 0; i < NA; i++) f = fmax(f, mech->coulomb[i]);
-  if (!(f > 0) || !(mech->coulomb_velocity > 0)) return 0;
   model.kernels->jd(model.kernel_params, q, Jd);
   model.kernels->mass(model.kernel_params, q, M);
-  for (int i = 0; i < 3 * NA; i++) nj += Jd[i] * Jd[i];
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      c[3 * j + i] = M[3 * ((i + 1) % 3) + (j + 1) % 3] * M[3 * ((i + 2) % 3) + (j + 2) % 3] -
-                     M[3 * ((i + 1) % 3) + (j + 2) % 3] * M[3 * ((i + 2) % 3) + (j + 1) % 3];
-  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
-  double ninv = 0;
-  for (int i = 0; i < 9; i++) ninv += c[i] * c[i];
-  return 16 * DBL_EPSILON * f / mech->coulomb_velocity * nj * sqrt(ninv) / fabs(det);
+  return tu_tanh_share(Jd, NA, M, f, mech->coulomb_velocity);
 }
 
 static void check_batch(const char *name)

@@ -110,6 +110,32 @@ static inline void tu_reaction_basis_dense(const double q[3], double Q[6 * PRRU_
   tu_reaction_basis_scatter(nz, Q);
 }
 
+/* The vector tanh's share in a derivative in qd (drives with Coulomb
+ * friction f_i, smoothing velocity vs; batched kernels against scalar
+ * ones): the friction's derivative in qd is J_d^T diag(f_i / vs (1 -
+ * t_i^2)) J_d, t_i = tanh(dd_i / vs); where t_i nears +-1, 1 - t_i^2
+ * cancels and libmvec's few ulp in t_i (<= 4) move it by 2 t_i that,
+ * absolutely: up to 8 eps f / vs |J_d|^2 |M^-1| in dqdd/dqd (Frobenius
+ * norms, M given) and 8 eps f / vs |J_d| in dfd/dqd (M NULL: inverse
+ * dynamics never solves by M, and J_d^-T J_d^T cancels); 16 eps for
+ * margin. No input perturbation shows it: t_i's slope vanishes where it
+ * cancels. 0 without friction. */
+static inline double tu_tanh_share(const double *Jd, int nact, const double *M, double f, double vs)
+{
+  if (!(f > 0) || !(vs > 0)) return 0;
+  double nj = 0;
+  for (int i = 0; i < 3 * nact; i++) nj += Jd[i] * Jd[i];
+  if (!M) return 16 * 2.220446049250313e-16 * f / vs * sqrt(nj);
+  double c[9], ninv = 0;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      c[3 * j + i] = M[3 * ((i + 1) % 3) + (j + 1) % 3] * M[3 * ((i + 2) % 3) + (j + 2) % 3] -
+                     M[3 * ((i + 1) % 3) + (j + 2) % 3] * M[3 * ((i + 2) % 3) + (j + 1) % 3];
+  const double det = M[0] * c[0] + M[1] * c[3] + M[2] * c[6];
+  for (int i = 0; i < 9; i++) ninv += c[i] * c[i];
+  return 16 * 2.220446049250313e-16 * f / vs * nj * sqrt(ninv) / fabs(det);
+}
+
 /* Deterministic uniform in [lo, hi] (xorshift64*): tests reproduce exactly. */
 static unsigned long long tu_rng_state = 0x9E3779B97F4A7C15ULL;
 static inline double tu_uniform(double lo, double hi)
