@@ -23,7 +23,6 @@ portable C99 that compiles to a plain scalar loop anywhere.
 """
 
 from . import cgen
-from .cgen import Node
 
 BATCH_CHUNK = 32
 
@@ -65,11 +64,6 @@ def batch_kernels(kernel_list, names=BATCH_KERNELS, fused=FUSED):
     return out
 
 
-def _is_input_trig(n):
-    return n.op == "call" and n.args[0] in ("sin", "cos") and \
-        isinstance(n.args[1], Node) and n.args[1].op == "in"
-
-
 # Calls with a vector variant declared in PROLOGUE (besides sin and cos of
 # the inputs, which get loops of their own).
 VECTOR_CALLS = ("tanh",)
@@ -78,144 +72,20 @@ VECTOR_CALLS = ("tanh",)
 def emit_batch(kernel, prefix, loop_macro, vector_trig="%s",
                precision=cgen.DOUBLE):
     """cgen.Emitted for the batched variant of kernel, named
-    <prefix>_batch_<name>. vector_trig % "SIN" is the name of the sin the
-    vectorisable kernels call (kernels in EXACT call sin itself), likewise
-    for the VECTOR_CALLS. precision cgen.FLOAT spells it in float (float
-    literals, sinf, sqrtf, ...; vector_trig % "SINF" for every kernel: the
-    float batches are not held to the scalar kernels bit for bit)."""
-    single = precision is not cgen.DOUBLE
-    if single:
-        trig_name = lambda fn: vector_trig % (fn.upper() + "F")
+    <prefix>_batch_<name> (cgen.emit's batched form). vector_trig % "SIN"
+    is the name of the sin the vectorisable kernels call (kernels in EXACT
+    call sin itself), likewise for the VECTOR_CALLS. precision cgen.FLOAT
+    spells it in float (float literals, sinf, sqrtf, ...; vector_trig %
+    "SINF" for every kernel: the float batches are not held to the scalar
+    kernels bit for bit)."""
+    if precision is not cgen.DOUBLE:
+        call_name = lambda fn: vector_trig % (fn.upper() + "F")  # noqa: E731
     elif kernel.name in EXACT:
-        trig_name = lambda fn: fn
+        call_name = lambda fn: fn  # noqa: E731
     else:
-        trig_name = lambda fn: vector_trig % fn.upper()
-    real = precision.ctype
-    lit = precision.literal if single else (lambda text: text)
-    call = precision.call if single else None
-    params = kernel.params
-    low = cgen.Lowered(kernel)
-    names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
-    guard_nodes, finite_nodes, out_nodes = low.guard_nodes, low.finite_nodes, low.out_nodes
-
-    def materialized(n):
-        return n.op not in ("num", "in") and \
-            (uses.get(n.index, 0) > 1 or n.op == "call")
-
-    temp = {}
-
-    def expr(n, parent_prec=0, right=False):
-        if n.op == "in":
-            return n.args[0]
-        if n.op == "num":
-            return lit(n.args[0])
-        if n.index in temp:
-            return temp[n.index]
-        return inline(n, parent_prec, right)
-
-    def inline(n, parent_prec=0, right=False):
-        if n.op == "call" and n.args[0] in VECTOR_CALLS:
-            return "%s(%s)" % (trig_name(n.args[0]), expr(n.args[1]))
-        return cgen.print_op(n, expr, parent_prec, right, call)
-
-    used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
-    trig = [g.nodes[i] for i in sorted(live) if _is_input_trig(g.nodes[i])]
-    trig_inputs = sorted({n.args[1].args[0] for n in trig})
-    # Input name -> row index in its array.
-    row = {}
-    for arr, syms in kernel.inputs:
-        for i, _ in enumerate(syms):
-            row["%s%d" % (arr, i + 1)] = (arr, i)
-
-    def load(name, index):
-        arr, i = row[name]
-        at = index if i == 0 else "%d * s + %s" % (i, index) if i > 1 \
-            else "s + " + index
-        return "const %s %s = %s[%s];" % (real, name, arr, at)
-
-    lines = []
-    if params is not None:
-        # A float batch converts each parameter once, explicitly.
-        cast = "(float)" if single else ""
-        lines += ["const %s %s = %s%s;" % (real, params.local(s), cast,
-                                           params.access(s))
-                  for s in params.order if params.local(s) in used_inputs]
-    lines.append("const long s = n;")
-    lines.append("for (long k0 = 0; k0 < s; k0 += %d) {" % BATCH_CHUNK)
-    lines.append("  const long m = s - k0 < %d ? s - k0 : %d;"
-                 % (BATCH_CHUNK, BATCH_CHUNK))
-    body = []
-    if trig:
-        body.append("%s %s;" % (real, ", ".join("w%d[%d]" % (j, BATCH_CHUNK)
-                                              for j in range(len(trig)))))
-        # One loop per function: sin and cos of one argument in one loop
-        # would be merged into a sincos call, which has no vector variant.
-        for fn in ("cos", "sin"):
-            group = [(j, n) for j, n in enumerate(trig) if n.args[0] == fn]
-            if not group:
-                continue
-            body.append(loop_macro)
-            body.append("for (long k = 0; k < m; k++) {")
-            body += ["  " + load(name, "k0 + k") for name in trig_inputs
-                     if any(n.args[1].args[0] == name for _, n in group)]
-            for j, n in group:
-                body.append("  w%d[k] = %s(%s);" % (j, trig_name(fn),
-                                                   n.args[1].args[0]))
-                temp[n.index] = "w%d[k]" % j
-            body.append("}")
-    body.append(loop_macro)
-    body.append("for (long k = 0; k < m; k++) {")
-    inner = ["const long i = k0 + k;"]
-    inner += [load(name, "i") for arr, syms in kernel.inputs
-              for name in ("%s%d" % (arr, j + 1) for j in range(len(syms)))
-              if name in used_inputs]
-    for i in sorted(live):
-        n = g.nodes[i]
-        if i in temp or not materialized(n):
-            continue
-        name = "t%d" % len(temp)
-        inner.append("const %s %s = %s;" % (real, name, inline(n)))
-        temp[i] = name
-    if guard_nodes:
-        fabs = precision.call("fabs")
-        conds = ["islessequal(%s(%s), %s)" % (fabs, expr(n), lit("1.0"))
-                 for n in guard_nodes]
-        conds += ["islessequal(%s(%s), %s)" % (fabs, expr(n), precision.huge)
-                  for n in finite_nodes]
-        inner.append("/* Unreachable or non-finite q: NaN (a select, not a "
-                     "branch). */")
-        inner.append("const int ok = %s;" % " &\n    ".join(conds))
-    calls = any(g.nodes[i].op == "call" and g.nodes[i].args[0] != "sqrt"
-                and not _is_input_trig(g.nodes[i]) for i in live)
-    if guard_nodes and calls:
-        inner.append("const %s okf = ok ? %s : %s;"
-                     % (real, lit("1.0"), precision.nan))
-    for arr, ns in out_nodes:
-        for j, n in enumerate(ns):
-            at = "i" if j == 0 else "s + i" if j == 1 else "%d * s + i" % j
-            value = expr(n)
-            if guard_nodes and calls:
-                value = "%s * okf" % expr(n, cgen.PREC["mul"])
-            elif guard_nodes:
-                value = "ok ? %s : %s" % (value, precision.nan)
-            inner.append("%s[%s] = %s;" % (arr, at, value))
-    body += ["  " + l.replace("\n", "\n  ") for l in inner]
-    body.append("}")
-    lines += ["  " + l.replace("\n", "\n  ") for l in body]
-    lines.append("}")
-    args = []
-    if params is not None:
-        args.append("const %s *p" % params.ctype)
-    args.append("int n")
-    args += ["const %s *%s" % (real, arr) for arr, _ in kernel.inputs]
-    args += ["%s *%s" % (real, arr) for arr, _ in out_nodes]
-    unused = [arr for arr, syms in kernel.inputs
-              if not any(("%s%d" % (arr, i + 1)) in used_inputs
-                         for i in range(len(syms)))]
-    lines = ["(void)%s;" % a for a in unused] + lines
-    signature = "void %s_batch_%s(%s)" % (prefix, kernel.name, ", ".join(args))
-    text = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
-    return cgen.Emitted(kernel.name, signature, text, counts, kernel.doc)
+        call_name = lambda fn: vector_trig % fn.upper()  # noqa: E731
+    form = cgen.Batched(loop_macro, call_name, VECTOR_CALLS, BATCH_CHUNK)
+    return cgen.emit(kernel, prefix, precision, form)
 
 
 PROLOGUE = """/* Batched kernels. ${PREFIX}_BATCH_LOOP marks each loop over states whose

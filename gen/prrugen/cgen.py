@@ -413,7 +413,7 @@ class Emitted:
 class Lowered:
     """A kernel lowered to one graph: its guard, finiteness and output
     nodes, how often each node is used, the live nodes and the operation
-    counts (what the scalar and the batched emitters share)."""
+    counts (what both forms of emit(), scalar and batched, share)."""
 
     def __init__(self, kernel):
         self.names = names = _Names(kernel.params)
@@ -440,76 +440,115 @@ class Lowered:
                 counts[key] = counts.get(key, 0) + 1
 
 
-def emit(kernel, prefix, precision=DOUBLE):
-    """The C function of kernel, named <prefix>_<kernel.name>, in the
-    precision given (DOUBLE or FLOAT): the same graph, spelled for that
-    type. RangeError if a constant does not fit the type."""
-    params = kernel.params
-    real, lit = precision.ctype, precision.literal
-    low = Lowered(kernel)
-    names, g, uses, live, counts = low.names, low.graph, low.uses, low.live, low.counts
-    guard_nodes, finite_nodes, out_nodes = low.guard_nodes, low.finite_nodes, low.out_nodes
+class Batched:
+    """The batched (structure-of-arrays) form of a kernel for emit(): n
+    states per call, component i of state k at x[i n + k], in chunks of
+    chunk states. loop_macro precedes every loop over states (empty unless
+    the build defines it, e.g. as _Pragma("omp simd")); call_name(fn) spells
+    a call the loops may vectorise (sin and cos of an input, which get
+    loops of their own, and the functions in vector_calls), e.g. as a
+    vector-variant declaration of batch.py's prologue."""
 
-    def materialized(n):
+    def __init__(self, loop_macro, call_name, vector_calls=(), chunk=32):
+        self.loop_macro, self.call_name = loop_macro, call_name
+        self.vector_calls, self.chunk = tuple(vector_calls), chunk
+
+
+def _is_input_trig(n):
+    return n.op == "call" and n.args[0] in ("sin", "cos") and \
+        isinstance(n.args[1], Node) and n.args[1].op == "in"
+
+
+class _Writer:
+    """What the scalar and the batched forms of one kernel print alike:
+    operands inline or as the temporaries tN (a node used more than once,
+    and every call, is a temporary), literals and calls in the kernel's
+    precision, the parameters' locals."""
+
+    def __init__(self, low, precision, vector_calls=(), call_name=None):
+        self.low, self.precision = low, precision
+        self.real, self.lit = precision.ctype, precision.literal
+        self.vector_calls, self.call_name = vector_calls, call_name
+        self.temp = {}
+        g = low.graph
+        self.used_inputs = {g.nodes[i].args[0] for i in low.live
+                            if g.nodes[i].op == "in"}
+
+    def materialized(self, n):
         return n.op not in ("num", "in") and \
-            (uses.get(n.index, 0) > 1 or n.op == "call")
+            (self.low.uses.get(n.index, 0) > 1 or n.op == "call")
 
-    temp = {}
-
-    def expr(n, parent_prec=0, right=False):
+    def expr(self, n, parent_prec=0, right=False):
         if n.op == "in":
             return n.args[0]
         if n.op == "num":
-            return lit(n.args[0])
-        if n.index in temp:
-            return temp[n.index]
-        return inline(n, parent_prec, right)
+            return self.lit(n.args[0])
+        if n.index in self.temp:
+            return self.temp[n.index]
+        return self.inline(n, parent_prec, right)
 
-    def inline(n, parent_prec=0, right=False):
-        return print_op(n, expr, parent_prec, right, precision.call)
+    def inline(self, n, parent_prec=0, right=False):
+        if n.op == "call" and n.args[0] in self.vector_calls:
+            return "%s(%s)" % (self.call_name(n.args[0]), self.expr(n.args[1]))
+        return print_op(n, self.expr, parent_prec, right, self.precision.call)
 
-    # Inputs of the guard first, then the guard, then everything else.
-    guard_live = _uses(guard_nodes)[1] if guard_nodes else set()
-    lines = []
-    for arr, syms in kernel.inputs:
-        for i, s in enumerate(syms):
-            lines.append("const %s %s%d = %s[%d];" % (real, arr, i + 1, arr, i))
-    used_inputs = {g.nodes[i].args[0] for i in live if g.nodes[i].op == "in"}
-    if params is not None:
-        lines += ["const %s %s = %s;" % (real, params.local(s), params.access(s))
-                  for s in params.order]
-    lines = [l for l in lines if l.split()[2] in used_inputs]
+    def define(self, n):
+        """The line of n's temporary, named in order of definition."""
+        name = self.temp[n.index] = "t%d" % len(self.temp)
+        return "const %s %s = %s;" % (self.real, name, self.inline(n))
 
-    def emit_temps(indices):
-        for i in sorted(indices):
+    def param_locals(self, params):
+        """A local per parameter the kernel uses (a float kernel converts
+        each once, explicitly)."""
+        cast = "" if self.real == "double" else "(%s)" % self.real
+        return ["const %s %s = %s%s;" % (self.real, params.local(s), cast,
+                                         params.access(s))
+                for s in params.order if params.local(s) in self.used_inputs]
+
+    def guard_conditions(self, compare):
+        """The guard as conditions compare(value, bound): every guard
+        expression within [-1, 1] and, with guards, every q finite."""
+        fabs = self.precision.call("fabs")
+        return [compare("%s(%s)" % (fabs, self.expr(n)), self.lit("1.0"))
+                for n in self.low.guard_nodes] + \
+            [compare("%s(%s)" % (fabs, self.expr(n)), self.precision.huge)
+             for n in self.low.finite_nodes]
+
+    def unused_arrays(self, kernel):
+        return [arr for arr, syms in kernel.inputs
+                if not any(("%s%d" % (arr, i + 1)) in self.used_inputs
+                           for i in range(len(syms)))]
+
+
+def _scalar_lines(kernel, w):
+    """One state: inputs loaded into locals, the guard as an early return,
+    each temporary right before its first use and each output stored as
+    soon as it is complete."""
+    low, g, real = w.low, w.low.graph, w.real
+    lines = ["const %s %s%d = %s[%d];" % (real, arr, i + 1, arr, i)
+             for arr, syms in kernel.inputs for i, _ in enumerate(syms)
+             if "%s%d" % (arr, i + 1) in w.used_inputs]
+    if kernel.params is not None:
+        lines += w.param_locals(kernel.params)
+    if low.guard_nodes:
+        # Inputs of the guard first, then the guard, then everything else.
+        for i in sorted(_uses(low.guard_nodes)[1]):
             n = g.nodes[i]
-            if i in temp or not materialized(n):
-                continue
-            name = "t%d" % len(temp)
-            lines.append("const %s %s = %s;" % (real, name, inline(n)))
-            temp[i] = name
-
-    if guard_nodes:
-        emit_temps(guard_live)
-        fabs = precision.call("fabs")
-        conds = ["%s(%s) <= %s" % (fabs, expr(n), lit("1.0"))
-                 for n in guard_nodes]
-        conds += ["%s(%s) <= %s" % (fabs, expr(n), precision.huge)
-                  for n in finite_nodes]
-        fills = ["for (int i = 0; i < %d; i++) %s[i] = %s;"
-                 % (len(ns), arr, precision.nan) for arr, ns in out_nodes]
+            if i not in w.temp and w.materialized(n):
+                lines.append(w.define(n))
+        conds = w.guard_conditions(lambda x, bound: "%s <= %s" % (x, bound))
         lines.append("/* Unreachable or non-finite q: every output is NaN. */")
         lines.append("if (!(%s)) {" % " &&\n      ".join(conds))
-        lines += ["  " + f for f in fills]
+        lines += ["  for (int i = 0; i < %d; i++) %s[i] = %s;"
+                  % (len(ns), arr, w.precision.nan) for arr, ns in low.out_nodes]
         lines.append("  return;")
         lines.append("}")
-    # Each temporary right before its first use and each output stored as
-    # soon as it is complete, rather than every temporary first and the
-    # outputs last: GCC does not reorder straight-line code before register
-    # allocation on x86-64, so the order printed is the order run.
+    # GCC does not reorder straight-line code before register allocation on
+    # x86-64, so the order printed is the order run.
+
     def pending(n):
         return isinstance(n, Node) and n.op not in ("num", "in") and \
-            n.index not in temp
+            n.index not in w.temp
 
     def emit_needed(root):
         """root's temporaries in operand order, each after its operands
@@ -518,9 +557,8 @@ def emit(kernel, prefix, precision=DOUBLE):
         while stack:
             n, done = stack.pop()
             if done:
-                if materialized(n) and n.index not in temp:
-                    temp[n.index] = "t%d" % len(temp)
-                    lines.append("const %s %s = %s;" % (real, temp[n.index], inline(n)))
+                if w.materialized(n) and n.index not in w.temp:
+                    lines.append(w.define(n))
                 continue
             if not pending(n) or n.index in seen:
                 continue
@@ -528,25 +566,133 @@ def emit(kernel, prefix, precision=DOUBLE):
             stack.append((n, True))
             stack.extend((a, False) for a in reversed(n.args) if pending(a))
 
-    for arr, ns in out_nodes:
+    for arr, ns in low.out_nodes:
         for i, n in enumerate(ns):
             emit_needed(n)
-            lines.append("%s[%d] = %s;" % (arr, i, expr(n)))
-    for arr, syms in kernel.inputs:
-        if not any(("%s%d" % (arr, i + 1)) in used_inputs
-                   for i in range(len(syms))):
-            lines.insert(0, "(void)%s;" % arr)
+            lines.append("%s[%d] = %s;" % (arr, i, w.expr(n)))
+    lines = ["(void)%s;" % arr for arr in reversed(w.unused_arrays(kernel))] + lines
+    params = kernel.params
+    if params is not None and not any(params.local(s) in w.used_inputs
+                                      for s in params.order):
+        lines.insert(0, "(void)p;")
+    return lines
+
+
+def _row(i, index):
+    """Offset of component i of the state at index in a row-per-component
+    array of s states."""
+    return index if i == 0 else "s + " + index if i == 1 else \
+        "%d * s + %s" % (i, index)
+
+
+def _batched_lines(kernel, w, form):
+    """n states in chunks: sin and cos of the inputs in loops of their own
+    (so the arithmetic loop calls nothing that does not vectorise), then
+    every temporary in graph order in one loop, the guard as a per-state
+    select and each output stored to its row."""
+    low, g, real, lit, nan = w.low, w.low.graph, w.real, w.lit, w.precision.nan
+    loop = form.loop_macro
+    trig = [g.nodes[i] for i in sorted(low.live) if _is_input_trig(g.nodes[i])]
+    trig_inputs = sorted({n.args[1].args[0] for n in trig})
+    row = {"%s%d" % (arr, i + 1): (arr, i)
+           for arr, syms in kernel.inputs for i, _ in enumerate(syms)}
+
+    def load(name, index):
+        arr, i = row[name]
+        return "const %s %s = %s[%s];" % (real, name, arr, _row(i, index))
+
+    lines = w.param_locals(kernel.params) if kernel.params is not None else []
+    lines.append("const long s = n;")
+    lines.append("for (long k0 = 0; k0 < s; k0 += %d) {" % form.chunk)
+    lines.append("  const long m = s - k0 < %d ? s - k0 : %d;"
+                 % (form.chunk, form.chunk))
+    body = []
+    if trig:
+        body.append("%s %s;" % (real, ", ".join("w%d[%d]" % (j, form.chunk)
+                                              for j in range(len(trig)))))
+        # One loop per function: sin and cos of one argument in one loop
+        # would be merged into a sincos call, which has no vector variant.
+        for fn in ("cos", "sin"):
+            group = [(j, n) for j, n in enumerate(trig) if n.args[0] == fn]
+            if not group:
+                continue
+            body.append(loop)
+            body.append("for (long k = 0; k < m; k++) {")
+            body += ["  " + load(name, "k0 + k") for name in trig_inputs
+                     if any(n.args[1].args[0] == name for _, n in group)]
+            for j, n in group:
+                body.append("  w%d[k] = %s(%s);" % (j, form.call_name(fn),
+                                                   n.args[1].args[0]))
+                w.temp[n.index] = "w%d[k]" % j
+            body.append("}")
+    body.append(loop)
+    body.append("for (long k = 0; k < m; k++) {")
+    inner = ["const long i = k0 + k;"]
+    inner += [load(name, "i") for arr, syms in kernel.inputs
+              for name in ("%s%d" % (arr, j + 1) for j in range(len(syms)))
+              if name in w.used_inputs]
+    for i in sorted(low.live):
+        n = g.nodes[i]
+        if i not in w.temp and w.materialized(n):
+            inner.append(w.define(n))
+    guarded = bool(low.guard_nodes)
+    if guarded:
+        conds = w.guard_conditions(
+            lambda x, bound: "islessequal(%s, %s)" % (x, bound))
+        inner.append("/* Unreachable or non-finite q: NaN (a select, not a "
+                     "branch). */")
+        inner.append("const int ok = %s;" % " &\n    ".join(conds))
+    # Where the loop calls a function, each output is multiplied by 1 or
+    # NaN instead: GCC sinks the work a select guards into a branch, and a
+    # branch around a call stops the loop from being vectorised.
+    calls = any(g.nodes[i].op == "call" and g.nodes[i].args[0] != "sqrt"
+                and not _is_input_trig(g.nodes[i]) for i in low.live)
+    if guarded and calls:
+        inner.append("const %s okf = ok ? %s : %s;" % (real, lit("1.0"), nan))
+    for arr, ns in low.out_nodes:
+        for j, n in enumerate(ns):
+            value = w.expr(n)
+            if guarded and calls:
+                value = "%s * okf" % w.expr(n, PREC["mul"])
+            elif guarded:
+                value = "ok ? %s : %s" % (value, nan)
+            inner.append("%s[%s] = %s;" % (arr, _row(j, "i"), value))
+    body += ["  " + l.replace("\n", "\n  ") for l in inner]
+    body.append("}")
+    lines += ["  " + l.replace("\n", "\n  ") for l in body]
+    lines.append("}")
+    return ["(void)%s;" % a for a in w.unused_arrays(kernel)] + lines
+
+
+def emit(kernel, prefix, precision=DOUBLE, batched=None):
+    """The C function of kernel in the precision given (DOUBLE or FLOAT):
+    <prefix>_<kernel.name> for one state, or with batched (a Batched)
+    <prefix>_batch_<kernel.name> for n. The same graph, spelled for that
+    type and form: the forms differ only in their loads, stores and guard,
+    and in the order of their temporaries. RangeError if a constant does
+    not fit the type."""
+    low = Lowered(kernel)
+    real = precision.ctype
     args = []
-    if params is not None:
-        args.append("const %s *p" % params.ctype)
-        if not any(params.local(s) in used_inputs for s in params.order):
-            lines.insert(0, "(void)p;")
-    args += ["const %s %s[%d]" % (real, arr, len(syms))
-             for arr, syms in kernel.inputs]
-    args += ["%s %s[%d]" % (real, arr, len(ns)) for arr, ns in out_nodes]
-    signature = "void %s_%s(%s)" % (prefix, kernel.name, ", ".join(args))
+    if kernel.params is not None:
+        args.append("const %s *p" % kernel.params.ctype)
+    if batched is None:
+        w = _Writer(low, precision)
+        lines = _scalar_lines(kernel, w)
+        args += ["const %s %s[%d]" % (real, arr, len(syms))
+                 for arr, syms in kernel.inputs]
+        args += ["%s %s[%d]" % (real, arr, len(ns)) for arr, ns in low.out_nodes]
+        name = "%s_%s" % (prefix, kernel.name)
+    else:
+        w = _Writer(low, precision, batched.vector_calls, batched.call_name)
+        lines = _batched_lines(kernel, w, batched)
+        args.append("int n")
+        args += ["const %s *%s" % (real, arr) for arr, _ in kernel.inputs]
+        args += ["%s *%s" % (real, arr) for arr, _ in low.out_nodes]
+        name = "%s_batch_%s" % (prefix, kernel.name)
+    signature = "void %s(%s)" % (name, ", ".join(args))
     body = "\n".join("  " + l.replace("\n", "\n  ") for l in lines)
-    return Emitted(kernel.name, signature, body, counts, kernel.doc)
+    return Emitted(kernel.name, signature, body, low.counts, kernel.doc)
 
 
 def evaluate_lowered(exprs, env):
