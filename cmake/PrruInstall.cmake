@@ -45,7 +45,8 @@ install(TARGETS prru_shared prru_runtime prru_kernels EXPORT prruTargets
 # `pkg-config --static --libs prru` links: the objects prru_runtime and
 # prru_kernels are built from, archived once more (nothing is compiled
 # again). Not exported: CMake users link prru::prru_static.
-add_library(prru_archive STATIC $<TARGET_OBJECTS:prru_runtime> $<TARGET_OBJECTS:prru_kernels>)
+add_library(prru_archive STATIC $<TARGET_OBJECTS:prru_runtime_objects>
+            $<TARGET_OBJECTS:prru_kernel_objects>)
 set_target_properties(prru_archive PROPERTIES OUTPUT_NAME prru LINKER_LANGUAGE C)
 install(TARGETS prru_archive ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}")
 # Whole directories, so that a header added to runtime/include or a file
