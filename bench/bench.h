@@ -14,6 +14,7 @@
 
 #include "bench_timer.h"
 #include "prru.h"
+#include "prru_param_kernels.h"
 #include "prru_ref.h"
 
 #define PRRU_BENCH_PI 3.14159265358979323846
@@ -59,6 +60,9 @@ typedef struct {
   prru_data *d;
   prru_ref_params p;
   prru_ref_ws *w;
+  /* prru_params_model derived (prru_param_derive) for the parameter
+   * kernels, as a loaded model holds it: once, not timed. */
+  prru_param_derived pd;
   long failures; /* calls that returned an error while being timed */
 } bench_ctx;
 
@@ -152,7 +156,7 @@ typedef struct {
 typedef struct {
   bench_mode_row dynamics, forward, inverse;
   int paths_measured;             /* the model file loaded */
-  bench_path_row path_forward, path_inverse;
+  bench_path_row path_dynamics, path_forward, path_inverse, path_reactions;
   bench_batch_row batch_dynamics, batch_eom_solve, batch_dme_terms, batch_w_r;
   bench_precision_row float_dme_terms, float_w_r;
   int ncpu, scaling_measured;

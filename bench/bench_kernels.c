@@ -147,8 +147,7 @@ static inline int r_reactions(bench_ctx *c, const bench_state *s, double *out)
  * same reference as their constant-folded namesakes. */
 static inline int g_param_ik_jd(bench_ctx *c, const bench_state *s, double *out)
 {
-  (void)c;
-  prru_param_ik_jd(&prru_params_model, s->q, out, out + PRRU_NACT);
+  prru_param_ik_jd(&c->pd, s->q, out, out + PRRU_NACT);
   return 0;
 }
 static inline int r_param_ik_jd(bench_ctx *c, const bench_state *s, double *out)
@@ -157,8 +156,7 @@ static inline int r_param_ik_jd(bench_ctx *c, const bench_state *s, double *out)
 }
 static inline int g_param_mass(bench_ctx *c, const bench_state *s, double *out)
 {
-  (void)c;
-  prru_param_mass(&prru_params_model, s->q, out);
+  prru_param_mass(&c->pd, s->q, out);
   return 0;
 }
 static inline int r_param_mass(bench_ctx *c, const bench_state *s, double *out)
@@ -167,8 +165,7 @@ static inline int r_param_mass(bench_ctx *c, const bench_state *s, double *out)
 }
 static inline int g_param_dynamics(bench_ctx *c, const bench_state *s, double *out)
 {
-  (void)c;
-  prru_param_dynamics(&prru_params_model, s->q, s->qd, out, out + 9, out + 12);
+  prru_param_dynamics(&c->pd, s->q, s->qd, out, out + 9, out + 12);
   return 0;
 }
 static inline int r_param_dynamics(bench_ctx *c, const bench_state *s, double *out)

@@ -85,16 +85,32 @@ static double run_inverse(bench_ctx *c, long n, int chained)
 
 /* ---- the specialised against the parameter path ---- */
 
-/* Throughput of forward (kind 0) or inverse (kind 1) dynamics on model m,
- * ns per call; every output feeds the sink. */
+/* Throughput on model m of the calls the issue names, ns per call: the
+ * fused dynamics kernel (PATH_DYNAMICS, prru_model_dynamics), a forward
+ * step, inverse dynamics and the joint reactions; every output feeds the
+ * sink. */
+enum { PATH_DYNAMICS, PATH_FORWARD, PATH_INVERSE, PATH_REACTIONS };
 static double run_path(bench_ctx *c, const prru_model *m, int kind, long n)
 {
-  double out[PRRU_NACT > 3 ? PRRU_NACT : 3], acc = 0.0;
+  double out[PRRU_NLAMBDA > 15 ? PRRU_NLAMBDA : 15], acc = 0.0;
   double t0 = bench_now_ns();
   for (long i = 0; i < n; i++) {
     const bench_state *s = &c->st[i & (NSTATES - 1)];
-    c->failures += (kind == 0 ? prru_forward_dynamics(m, c->d, s->q, s->qd, &s->l, out)
-                              : prru_inverse_dynamics(m, c->d, s->q, s->qd, s->qdd, &s->l, out)) != PRRU_OK;
+    int st = PRRU_OK;
+    switch (kind) {
+    case PATH_DYNAMICS:
+      prru_model_dynamics(m, s->q, s->qd, out, out + 9, out + 12);
+      break;
+    case PATH_FORWARD:
+      st = prru_forward_dynamics(m, c->d, s->q, s->qd, &s->l, out);
+      break;
+    case PATH_INVERSE:
+      st = prru_inverse_dynamics(m, c->d, s->q, s->qd, s->qdd, &s->l, out);
+      break;
+    default:
+      st = prru_reactions(m, c->d, s->q, s->qd, &s->l, out);
+    }
+    c->failures += st != PRRU_OK;
     acc += out[0] + out[1] + out[2];
   }
   double t = bench_now_ns() - t0;
@@ -129,8 +145,10 @@ static void time_loaded(bench_ctx *c, long n, int reps, bench_modes *m)
     fprintf(stderr, "prru_bench: the parameter path not timed: %s\n", msg);
     return;
   }
-  time_paths(c, &param, 0, n, reps, &m->path_forward);
-  time_paths(c, &param, 1, n, reps, &m->path_inverse);
+  time_paths(c, &param, PATH_DYNAMICS, n, reps, &m->path_dynamics);
+  time_paths(c, &param, PATH_FORWARD, n, reps, &m->path_forward);
+  time_paths(c, &param, PATH_INVERSE, n, reps, &m->path_inverse);
+  time_paths(c, &param, PATH_REACTIONS, n, reps, &m->path_reactions);
   m->paths_measured = 1;
   prru_model_free(&param);
 }
@@ -478,8 +496,10 @@ void bench_modes_print_table(const bench_modes *m)
   if (m->paths_measured) {
     printf("the model's numbers on the specialised kernels and loaded onto the parameter kernels\n"
            "(prru_model_load + prru_model_use_parameter_kernels), throughput per call:\n");
+    path_row("dynamics", &m->path_dynamics);
     path_row("forward_dynamics", &m->path_forward);
     path_row("inverse_dynamics", &m->path_inverse);
+    path_row("reactions", &m->path_reactions);
   }
   printf("batched kernels (%d states a call, one thread) against the scalar loop:\n", NB);
   batch_row("dynamics", &m->batch_dynamics);
@@ -546,8 +566,10 @@ void bench_modes_print_json(const bench_modes *m)
   printf("}, \"loaded_paths\": ");
   if (m->paths_measured) {
     printf("{");
+    json_path("dynamics", &m->path_dynamics, 0);
     json_path("forward_dynamics", &m->path_forward, 0);
-    json_path("inverse_dynamics", &m->path_inverse, 1);
+    json_path("inverse_dynamics", &m->path_inverse, 0);
+    json_path("reactions", &m->path_reactions, 1);
     printf("}");
   } else {
     printf("null");

@@ -101,8 +101,10 @@ def main():
     # The model file loaded onto the parameter kernels, against the
     # specialised ones (both timed in the same run).
     paths = doc.get("loaded_paths")
-    if not isinstance(paths, dict) or set(paths) != {"forward_dynamics", "inverse_dynamics"}:
-        fail("'loaded_paths' must time forward and inverse dynamics: %r" % (paths,))
+    if not isinstance(paths, dict) or set(paths) != {"dynamics", "forward_dynamics",
+                                                      "inverse_dynamics", "reactions"}:
+        fail("'loaded_paths' must time dynamics, forward and inverse dynamics and the "
+             "reactions: %r" % (paths,))
     for name, r in paths.items():
         s = r.get("parameter_over_specialised", {})
         if not (positive(r.get("specialised_ns")) and positive(r.get("parameter_ns"))

@@ -16,7 +16,8 @@
  * generated once per topology, never per model), named here after this
  * model: paper3prru_param_<kernel> is prru_p3_<kernel> and paper3prru_params
  * is prru_params3. Compile prru_p3_kernels.c beside this file's .c.
- * Same arguments after p, same outputs, same conventions (row-major, body
+ * Their p is paper3prru_param_derived, filled from a paper3prru_params by
+ * paper3prru_param_derive. Same arguments after p, same outputs, same conventions (row-major, body
  * order, NaN on every output where q is unreachable or not finite). At
  * paper3prru_params_model they agree with the constant kernels to rounding.
  * The parameters are not checked: a design that cannot be built (a link of
@@ -49,6 +50,7 @@
 #define paper3prru_param_batch_eom prru_p3_batch_eom
 #define paper3prru_param_batch_dme_terms prru_p3_batch_dme_terms
 #define paper3prru_param_f_batch_dme_terms prru_p3_f_batch_dme_terms
+#define paper3prru_param_derive prru_p3_derive
 #define PAPER3PRRU_PARAM_ARITH_IK PRRU_P3_ARITH_IK
 #define PAPER3PRRU_PARAM_ARITH_JD PRRU_P3_ARITH_JD
 #define PAPER3PRRU_PARAM_ARITH_IK_JD PRRU_P3_ARITH_IK_JD
@@ -79,6 +81,10 @@ extern "C" {
 #endif
 
 typedef prru_params3 paper3prru_params;
+/* What the kernels read: the parameters and what is derived from them
+ * alone, paper3prru_param_derive(&params, &derived) (prru_p3_derive), once
+ * per set of numbers before the kernels are called with it. */
+typedef prru_p3_derived paper3prru_param_derived;
 
 /* The model's own numbers (those the constant kernels were generated from;
  * coulomb_velocity is 1 m/s where the model has no Coulomb friction). */

@@ -6,30 +6,31 @@
  * Edit the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   ik                 55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   jd                 83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   ik_jd              95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4
- *   jacobians          259 arithmetic (35 add, 29 sub, 175 mul, 7 div, 13 neg); calls: cos 2, sin 2, sqrt 4
- *   bias_terms         460 arithmetic (68 add, 42 sub, 335 mul, 7 div, 8 neg); calls: cos 2, sin 2, sqrt 4
- *   mass               343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   bias               730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   gravity            249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4
- *   dynamics           905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   eom                968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   platform_jacobian  26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1
- *   poses              177 arithmetic (43 add, 28 sub, 94 mul, 4 div, 8 neg); calls: cos 2, sin 2, sqrt 4
- *   inertia_world      328 arithmetic (54 add, 38 sub, 230 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   wrench_bias        631 arithmetic (96 add, 54 sub, 456 mul, 7 div, 18 neg); calls: cos 2, sin 2, sqrt 4
- *   energy             524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   actuator_rates     198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4
- *   passive            134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   reaction_basis     259 arithmetic (33 add, 47 sub, 134 mul, 4 div, 41 neg); calls: cos 2, sin 2, sqrt 4
- *   eom_solve          1000 arithmetic (224 add, 109 sub, 655 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   inverse_terms      1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   joint_reactions    1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   regressor          1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   eom_solve_derivs   3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
- *   inverse_derivs     3705 arithmetic (812 add, 427 sub, 2443 mul, 12 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   ik                 40 arithmetic (13 add, 26 mul, 1 div); calls: cos 2, sin 2, sqrt 4
+ *   jd                 63 arithmetic (11 add, 48 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   ik_jd              74 arithmetic (17 add, 53 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   jacobians          155 arithmetic (40 add, 111 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   bias_terms         297 arithmetic (76 add, 4 sub, 212 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4
+ *   mass               239 arithmetic (74 add, 2 sub, 159 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   bias               511 arithmetic (150 add, 7 sub, 350 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   gravity            164 arithmetic (51 add, 2 sub, 107 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   dynamics           667 arithmetic (203 add, 11 sub, 449 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   eom                729 arithmetic (229 add, 15 sub, 481 mul, 4 div); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   platform_jacobian  18 arithmetic (4 add, 13 mul, 1 div); calls: cos 2, sin 2, sqrt 1
+ *   poses              124 arithmetic (49 add, 67 mul, 1 div, 7 neg); calls: cos 2, sin 2, sqrt 4
+ *   inertia_world      253 arithmetic (82 add, 170 mul, 1 div); calls: cos 2, sin 2, sqrt 4
+ *   wrench_bias        435 arithmetic (107 add, 13 sub, 311 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   energy             361 arithmetic (136 add, 221 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   actuator_rates     157 arithmetic (27 add, 4 sub, 122 mul, 4 div); calls: cos 2, sin 2, sqrt 4
+ *   passive            113 arithmetic (26 add, 1 sub, 82 mul, 4 div); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   reaction_basis     247 arithmetic (79 add, 148 mul, 1 div, 19 neg); calls: cos 2, sin 2, sqrt 4
+ *   eom_solve          761 arithmetic (229 add, 25 sub, 501 mul, 6 div); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   inverse_terms      785 arithmetic (239 add, 24 sub, 512 mul, 5 div, 5 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   joint_reactions    1389 arithmetic (554 add, 96 sub, 729 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   regressor          1131 arithmetic (215 add, 152 sub, 739 mul, 11 div, 14 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   eom_solve_derivs   2953 arithmetic (861 add, 158 sub, 1914 mul, 9 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   inverse_derivs     2971 arithmetic (934 add, 91 sub, 1932 mul, 8 div, 6 neg); calls: cos 2, sin 2, sqrt 4, tanh 3
+ *   hoisted            740 arithmetic (79 add, 42 sub, 356 mul, 4 div, 259 neg)
  */
 #ifndef PRRU_P3_KERNELS_H
 #define PRRU_P3_KERNELS_H
@@ -40,7 +41,8 @@
  * conventions: row-major, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3, NaN on every output where q
  * is unreachable or not finite), with every number of the model (geometry,
  * gravity vector, masses, centres of mass, full inertia tensors, drives)
- * read from a prru_params3 argument. They are generated from the structure
+ * read at run time, from a prru_p3_derived argument (prru_p3_derive: the
+ * prru_params3 and what depends on it alone, computed once). They are generated from the structure
  * alone (the number of limbs; a = 0 for limbs 3 and 4, whose U joint is O'
  * itself), never from a model's values, so one library evaluates any model
  * of this topology, format 1 (a format-2 model with zeros) or 2, whatever
@@ -68,54 +70,56 @@
 #define PRRU_P3_NBODY 10
 #define PRRU_P3_NJOINT 12
 #define PRRU_P3_NLAMBDA 57
-#define PRRU_P3_ARITH_IK 55 /* arithmetic operations */
-#define PRRU_P3_ARITH_JD 83 /* arithmetic operations */
-#define PRRU_P3_ARITH_IK_JD 95 /* arithmetic operations */
-#define PRRU_P3_ARITH_JACOBIANS 259 /* arithmetic operations */
-#define PRRU_P3_ARITH_BIAS_TERMS 460 /* arithmetic operations */
-#define PRRU_P3_ARITH_MASS 343 /* arithmetic operations */
-#define PRRU_P3_ARITH_BIAS 730 /* arithmetic operations */
-#define PRRU_P3_ARITH_GRAVITY 249 /* arithmetic operations */
-#define PRRU_P3_ARITH_DYNAMICS 905 /* arithmetic operations */
-#define PRRU_P3_ARITH_EOM 968 /* arithmetic operations */
-#define PRRU_P3_ARITH_PLATFORM_JACOBIAN 26 /* arithmetic operations */
-#define PRRU_P3_ARITH_POSES 177 /* arithmetic operations */
-#define PRRU_P3_ARITH_INERTIA_WORLD 328 /* arithmetic operations */
-#define PRRU_P3_ARITH_WRENCH_BIAS 631 /* arithmetic operations */
-#define PRRU_P3_ARITH_ENERGY 524 /* arithmetic operations */
-#define PRRU_P3_ARITH_ACTUATOR_RATES 198 /* arithmetic operations */
-#define PRRU_P3_ARITH_PASSIVE 134 /* arithmetic operations */
-#define PRRU_P3_ARITH_REACTION_BASIS 259 /* arithmetic operations */
-#define PRRU_P3_ARITH_EOM_SOLVE 1000 /* arithmetic operations */
-#define PRRU_P3_ARITH_INVERSE_TERMS 1030 /* arithmetic operations */
-#define PRRU_P3_ARITH_JOINT_REACTIONS 1679 /* arithmetic operations */
-#define PRRU_P3_ARITH_REGRESSOR 1134 /* arithmetic operations */
-#define PRRU_P3_ARITH_EOM_SOLVE_DERIVS 3690 /* arithmetic operations */
-#define PRRU_P3_ARITH_INVERSE_DERIVS 3705 /* arithmetic operations */
-#define PRRU_P3_OPS_IK "55 arithmetic (6 add, 11 sub, 33 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_JD "83 arithmetic (8 add, 9 sub, 55 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_IK_JD "95 arithmetic (13 add, 12 sub, 59 mul, 7 div, 4 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_JACOBIANS "259 arithmetic (35 add, 29 sub, 175 mul, 7 div, 13 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_BIAS_TERMS "460 arithmetic (68 add, 42 sub, 335 mul, 7 div, 8 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_MASS "343 arithmetic (84 add, 31 sub, 219 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_BIAS "730 arithmetic (137 add, 74 sub, 511 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_GRAVITY "249 arithmetic (46 add, 36 sub, 159 mul, 7 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_DYNAMICS "905 arithmetic (202 add, 89 sub, 605 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_EOM "968 arithmetic (224 add, 99 sub, 635 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_PLATFORM_JACOBIAN "26 arithmetic (1 add, 5 sub, 15 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_P3_OPS_POSES "177 arithmetic (43 add, 28 sub, 94 mul, 4 div, 8 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_INERTIA_WORLD "328 arithmetic (54 add, 38 sub, 230 mul, 4 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_WRENCH_BIAS "631 arithmetic (96 add, 54 sub, 456 mul, 7 div, 18 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_ENERGY "524 arithmetic (131 add, 57 sub, 327 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_ACTUATOR_RATES "198 arithmetic (17 add, 24 sub, 148 mul, 7 div, 2 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_PASSIVE "134 arithmetic (21 add, 16 sub, 87 mul, 8 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_REACTION_BASIS "259 arithmetic (33 add, 47 sub, 134 mul, 4 div, 41 neg); calls: cos 2, sin 2, sqrt 4"
-#define PRRU_P3_OPS_EOM_SOLVE "1000 arithmetic (224 add, 109 sub, 655 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_INVERSE_TERMS "1030 arithmetic (235 add, 108 sub, 669 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_JOINT_REACTIONS "1679 arithmetic (431 add, 302 sub, 923 mul, 11 div, 12 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_REGRESSOR "1134 arithmetic (215 add, 152 sub, 741 mul, 11 div, 15 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_EOM_SOLVE_DERIVS "3690 arithmetic (756 add, 479 sub, 2429 mul, 13 div, 13 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
-#define PRRU_P3_OPS_INVERSE_DERIVS "3705 arithmetic (812 add, 427 sub, 2443 mul, 12 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_NDERIVED 544 /* slots h of prru_p3_derived */
+#define PRRU_P3_ARITH_DERIVE 740 /* arithmetic operations of prru_p3_derive */
+#define PRRU_P3_ARITH_IK 40 /* arithmetic operations */
+#define PRRU_P3_ARITH_JD 63 /* arithmetic operations */
+#define PRRU_P3_ARITH_IK_JD 74 /* arithmetic operations */
+#define PRRU_P3_ARITH_JACOBIANS 155 /* arithmetic operations */
+#define PRRU_P3_ARITH_BIAS_TERMS 297 /* arithmetic operations */
+#define PRRU_P3_ARITH_MASS 239 /* arithmetic operations */
+#define PRRU_P3_ARITH_BIAS 511 /* arithmetic operations */
+#define PRRU_P3_ARITH_GRAVITY 164 /* arithmetic operations */
+#define PRRU_P3_ARITH_DYNAMICS 667 /* arithmetic operations */
+#define PRRU_P3_ARITH_EOM 729 /* arithmetic operations */
+#define PRRU_P3_ARITH_PLATFORM_JACOBIAN 18 /* arithmetic operations */
+#define PRRU_P3_ARITH_POSES 124 /* arithmetic operations */
+#define PRRU_P3_ARITH_INERTIA_WORLD 253 /* arithmetic operations */
+#define PRRU_P3_ARITH_WRENCH_BIAS 435 /* arithmetic operations */
+#define PRRU_P3_ARITH_ENERGY 361 /* arithmetic operations */
+#define PRRU_P3_ARITH_ACTUATOR_RATES 157 /* arithmetic operations */
+#define PRRU_P3_ARITH_PASSIVE 113 /* arithmetic operations */
+#define PRRU_P3_ARITH_REACTION_BASIS 247 /* arithmetic operations */
+#define PRRU_P3_ARITH_EOM_SOLVE 761 /* arithmetic operations */
+#define PRRU_P3_ARITH_INVERSE_TERMS 785 /* arithmetic operations */
+#define PRRU_P3_ARITH_JOINT_REACTIONS 1389 /* arithmetic operations */
+#define PRRU_P3_ARITH_REGRESSOR 1131 /* arithmetic operations */
+#define PRRU_P3_ARITH_EOM_SOLVE_DERIVS 2953 /* arithmetic operations */
+#define PRRU_P3_ARITH_INVERSE_DERIVS 2971 /* arithmetic operations */
+#define PRRU_P3_OPS_IK "40 arithmetic (13 add, 26 mul, 1 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_JD "63 arithmetic (11 add, 48 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_IK_JD "74 arithmetic (17 add, 53 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_JACOBIANS "155 arithmetic (40 add, 111 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_BIAS_TERMS "297 arithmetic (76 add, 4 sub, 212 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_MASS "239 arithmetic (74 add, 2 sub, 159 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_BIAS "511 arithmetic (150 add, 7 sub, 350 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_GRAVITY "164 arithmetic (51 add, 2 sub, 107 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_DYNAMICS "667 arithmetic (203 add, 11 sub, 449 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_EOM "729 arithmetic (229 add, 15 sub, 481 mul, 4 div); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_PLATFORM_JACOBIAN "18 arithmetic (4 add, 13 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
+#define PRRU_P3_OPS_POSES "124 arithmetic (49 add, 67 mul, 1 div, 7 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_INERTIA_WORLD "253 arithmetic (82 add, 170 mul, 1 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_WRENCH_BIAS "435 arithmetic (107 add, 13 sub, 311 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_ENERGY "361 arithmetic (136 add, 221 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_ACTUATOR_RATES "157 arithmetic (27 add, 4 sub, 122 mul, 4 div); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_PASSIVE "113 arithmetic (26 add, 1 sub, 82 mul, 4 div); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_REACTION_BASIS "247 arithmetic (79 add, 148 mul, 1 div, 19 neg); calls: cos 2, sin 2, sqrt 4"
+#define PRRU_P3_OPS_EOM_SOLVE "761 arithmetic (229 add, 25 sub, 501 mul, 6 div); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_INVERSE_TERMS "785 arithmetic (239 add, 24 sub, 512 mul, 5 div, 5 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_JOINT_REACTIONS "1389 arithmetic (554 add, 96 sub, 729 mul, 7 div, 3 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_REGRESSOR "1131 arithmetic (215 add, 152 sub, 739 mul, 11 div, 14 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_EOM_SOLVE_DERIVS "2953 arithmetic (861 add, 158 sub, 1914 mul, 9 div, 11 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
+#define PRRU_P3_OPS_INVERSE_DERIVS "2971 arithmetic (934 add, 91 sub, 1932 mul, 8 div, 6 neg); calls: cos 2, sin 2, sqrt 4, tanh 3"
 /* Whether the inputs of prru_p3_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -165,6 +169,20 @@ typedef struct {
   double armature[3], damping[3], coulomb[3], coulomb_velocity;
 } prru_params3;
 
+/* What the kernels read: the parameters and the numbers derived from them
+ * alone (h: sums and products of the parameters that the kernels would
+ * otherwise compute at every call, where a constant kernel has them folded
+ * into its code). prru_p3_derive fills it; every kernel below takes it as
+ * p, so after any change to the parameters derive again. */
+typedef struct {
+  prru_params3 params;
+  double h[PRRU_P3_NDERIVED];
+} prru_p3_derived;
+
+/* d from the parameters p (p may be &d->params): once per model, before any
+ * kernel is called with d (PRRU_P3_ARITH_DERIVE operations). */
+void prru_p3_derive(const prru_params3 *p, prru_p3_derived *d);
+
 /* The numbers of the reference model 3prru_paper.json (a valid
  * 3-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
  * friction). Only this initializer depends on that file. */
@@ -173,79 +191,79 @@ extern const prru_params3 prru_p3_params_reference;
 /* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
 extern const char *const prru_p3_lambda_labels[PRRU_P3_NLAMBDA];
 
-/* Actuator displacements d_i (height of joint A_i on rail i). Parameters from *p. */
-void prru_p3_ik(const prru_params3 *p, const double q[3], double d[3]);
+/* Actuator displacements d_i (height of joint A_i on rail i). Numbers from *p. */
+void prru_p3_ik(const prru_p3_derived *p, const double q[3], double d[3]);
 
-/* Actuator Jacobian J_d = dd/dq (3x3). Parameters from *p. */
-void prru_p3_jd(const prru_params3 *p, const double q[3], double Jd[9]);
+/* Actuator Jacobian J_d = dd/dq (3x3). Numbers from *p. */
+void prru_p3_jd(const prru_p3_derived *p, const double q[3], double Jd[9]);
 
-/* ik and jd fused (one shared evaluation). Parameters from *p. */
-void prru_p3_ik_jd(const prru_params3 *p, const double q[3], double d[3], double Jd[9]);
+/* ik and jd fused (one shared evaluation). Numbers from *p. */
+void prru_p3_ik_jd(const prru_p3_derived *p, const double q[3], double d[3], double Jd[9]);
 
-/* H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3. Parameters from *p. */
-void prru_p3_jacobians(const prru_params3 *p, const double q[3], double H[180]);
+/* H (60x3) = [J_R,P; ..; J_R,S3; J_T,P; ..; J_T,S3], world frame, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3. Numbers from *p. */
+void prru_p3_jacobians(const prru_p3_derived *p, const double q[3], double H[180]);
 
-/* [delta_P..delta_S3; mu_P..mu_S3] (60): the parts of the angular and linear accelerations that are quadratic in qd. Parameters from *p. */
-void prru_p3_bias_terms(const prru_params3 *p, const double q[3], const double qd[3], double dm[60]);
+/* [delta_P..delta_S3; mu_P..mu_S3] (60): the parts of the angular and linear accelerations that are quadratic in qd. Numbers from *p. */
+void prru_p3_bias_terms(const prru_p3_derived *p, const double q[3], const double qd[3], double dm[60]);
 
-/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Parameters from *p. */
-void prru_p3_mass(const prru_params3 *p, const double q[3], double M[9]);
+/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Numbers from *p. */
+void prru_p3_mass(const prru_p3_derived *p, const double q[3], double M[9]);
 
-/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). Parameters from *p. */
-void prru_p3_bias(const prru_params3 *p, const double q[3], const double qd[3], double h[3]);
+/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). Numbers from *p. */
+void prru_p3_bias(const prru_p3_derived *p, const double q[3], const double qd[3], double h[3]);
 
-/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. Parameters from *p. */
-void prru_p3_gravity(const prru_params3 *p, const double q[3], double G[3]);
+/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. Numbers from *p. */
+void prru_p3_gravity(const prru_p3_derived *p, const double q[3], double G[3]);
 
-/* M, h and G fused (one shared evaluation). Parameters from *p. */
-void prru_p3_dynamics(const prru_params3 *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
+/* M, h and G fused (one shared evaluation). Numbers from *p. */
+void prru_p3_dynamics(const prru_p3_derived *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
 
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). Parameters from *p. */
-void prru_p3_eom(const prru_params3 *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3]);
+/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). Numbers from *p. */
+void prru_p3_eom(const prru_p3_derived *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3]);
 
-/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). Parameters from *p. */
-void prru_p3_platform_jacobian(const prru_params3 *p, const double q[3], double JP[18]);
+/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). Numbers from *p. */
+void prru_p3_platform_jacobian(const prru_p3_derived *p, const double q[3], double JP[18]);
 
-/* Body rotations R_b (3x3 each) and centres p_b, body order. Parameters from *p. */
-void prru_p3_poses(const prru_params3 *p, const double q[3], double R[90], double pos[30]);
+/* Body rotations R_b (3x3 each) and centres p_b, body order. Numbers from *p. */
+void prru_p3_poses(const prru_p3_derived *p, const double q[3], double R[90], double pos[30]);
 
-/* Inertia tensors I_b = R_b D_b R_b^T about each centre, in {S} (3x3 each), body order. Parameters from *p. */
-void prru_p3_inertia_world(const prru_params3 *p, const double q[3], double I[90]);
+/* Inertia tensors I_b = R_b D_b R_b^T about each centre, in {S} (3x3 each), body order. Numbers from *p. */
+void prru_p3_inertia_world(const prru_p3_derived *p, const double q[3], double I[90]);
 
-/* K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]. Parameters from *p. */
-void prru_p3_wrench_bias(const prru_params3 *p, const double q[3], const double qd[3], double K[60]);
+/* K (60) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]. Numbers from *p. */
+void prru_p3_wrench_bias(const prru_p3_derived *p, const double q[3], const double qd[3], double K[60]);
 
-/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. Parameters from *p. */
-void prru_p3_energy(const prru_params3 *p, const double q[3], const double qd[3], double E[2]);
+/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. Numbers from *p. */
+void prru_p3_energy(const prru_p3_derived *p, const double q[3], const double qd[3], double E[2]);
 
-/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. Parameters from *p. */
-void prru_p3_actuator_rates(const prru_params3 *p, const double q[3], const double qd[3], double dd[3], double ddb[3]);
+/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. Numbers from *p. */
+void prru_p3_actuator_rates(const prru_p3_derived *p, const double q[3], const double qd[3], double dd[3], double ddb[3]);
 
-/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Parameters from *p. */
-void prru_p3_passive(const prru_params3 *p, const double q[3], const double qd[3], double Qp[3]);
+/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Numbers from *p. */
+void prru_p3_passive(const prru_p3_derived *p, const double q[3], const double qd[3], double Qp[3]);
 
-/* The entries of Q (60x57) that are not identically zero, Q mapping the joint reaction coordinates lambda to body wrenches about each centre (Phi H qdd + K = Fbar + Q lambda): Q[k] is the dense row-major entry whose position is entry k of the index table declared next (231 of 3420; every other entry is 0). Parameters from *p. */
-void prru_p3_reaction_basis(const prru_params3 *p, const double q[3], double Q[231]);
+/* The entries of Q (60x57) that are not identically zero, Q mapping the joint reaction coordinates lambda to body wrenches about each centre (Phi H qdd + K = Fbar + Q lambda): Q[k] is the dense row-major entry whose position is entry k of the index table declared next (231 of 3420; every other entry is 0). Numbers from *p. */
+void prru_p3_reaction_basis(const prru_p3_derived *p, const double q[3], double Q[231]);
 /* Row-major positions (row * 57 + column) in the dense 60x57 Q of prru_p3_reaction_basis's outputs. */
 extern const int prru_p3_reaction_basis_index[PRRU_P3_REACTION_BASIS_NNZ];
 
-/* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Parameters from *p. */
-void prru_p3_eom_solve(const prru_params3 *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
+/* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Numbers from *p. */
+void prru_p3_eom_solve(const prru_p3_derived *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
 
-/* d, J_d (as ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. Parameters from *p. */
-void prru_p3_inverse_terms(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3]);
+/* d, J_d (as ik_jd), J_d^-1 (by the adjugate: NaN or infinite where J_d is singular) and fd = J_d^-T tau, tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive: the actuator forces of the motion. Numbers from *p. */
+void prru_p3_inverse_terms(const prru_p3_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3]);
 
-/* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. Parameters from *p. */
-void prru_p3_joint_reactions(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);
+/* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. Numbers from *p. */
+void prru_p3_joint_reactions(const prru_p3_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);
 
-/* Regressor Y (3x109, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
+/* Regressor Y (3x109, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Numbers from *p. */
 void prru_p3_regressor(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], double Y[327]);
 
-/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Parameters from *p. */
-void prru_p3_eom_solve_derivs(const prru_params3 *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[9], double Dfp[9], double Dmp[9]);
+/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Numbers from *p. */
+void prru_p3_eom_solve_derivs(const prru_p3_derived *p, const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[9], double Dfp[9], double Dmp[9]);
 
-/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). Parameters from *p. */
-void prru_p3_inverse_derivs(const prru_params3 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3], double Dq[9], double Dqd[9], double Dqdd[9]);
+/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). Numbers from *p. */
+void prru_p3_inverse_derivs(const prru_p3_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3], double Dq[9], double Dqd[9], double Dqdd[9]);
 
 /* Batched kernels, prru_p3_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n
@@ -264,34 +282,34 @@ void prru_p3_inverse_derivs(const prru_params3 *p, const double q[3], const doub
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
 
 /* ik and jd fused (one shared evaluation). */
-void prru_p3_batch_ik_jd(const prru_params3 *p, int n, const double *q, double *d, double *Jd);
+void prru_p3_batch_ik_jd(const prru_p3_derived *p, int n, const double *q, double *d, double *Jd);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */
-void prru_p3_batch_mass(const prru_params3 *p, int n, const double *q, double *M);
+void prru_p3_batch_mass(const prru_p3_derived *p, int n, const double *q, double *M);
 
 /* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). */
-void prru_p3_batch_platform_jacobian(const prru_params3 *p, int n, const double *q, double *JP);
+void prru_p3_batch_platform_jacobian(const prru_p3_derived *p, int n, const double *q, double *JP);
 
 /* M, h and G fused (one shared evaluation). */
-void prru_p3_batch_dynamics(const prru_params3 *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
+void prru_p3_batch_dynamics(const prru_p3_derived *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
 
 /* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
-void prru_p3_batch_eom(const prru_params3 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
+void prru_p3_batch_eom(const prru_p3_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
 
 /* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
-void prru_p3_batch_eom_solve(const prru_params3 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
+void prru_p3_batch_eom_solve(const prru_p3_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
 
 /* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
-void prru_p3_batch_eom_solve_derivs(const prru_params3 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
+void prru_p3_batch_eom_solve_derivs(const prru_p3_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
 
 /* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). */
-void prru_p3_batch_inverse_derivs(const prru_params3 *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *Jdinv, double *fd, double *Dq, double *Dqd, double *Dqdd);
+void prru_p3_batch_inverse_derivs(const prru_p3_derived *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *Jdinv, double *fd, double *Dq, double *Dqd, double *Dqdd);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
-void prru_p3_batch_dme_terms(const prru_params3 *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
+void prru_p3_batch_dme_terms(const prru_p3_derived *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. In single precision: prru_p3_f_batch.h's conventions, parameters from *p (rounded to float once). */
-void prru_p3_f_batch_dme_terms(const prru_params3 *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
+void prru_p3_f_batch_dme_terms(const prru_p3_derived *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
 
 #ifdef __cplusplus
 }

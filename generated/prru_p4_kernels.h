@@ -6,31 +6,32 @@
  * Edit the generator and regenerate instead.
  *
  * Operation counts per kernel:
- *   ik                 67 arithmetic (8 add, 13 sub, 40 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5
- *   jd                 108 arithmetic (8 add, 13 sub, 74 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5
- *   ik_jd              124 arithmetic (15 add, 16 sub, 80 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5
- *   jacobians          364 arithmetic (43 add, 43 sub, 254 mul, 9 div, 15 neg); calls: cos 2, sin 2, sqrt 5
- *   bias_terms         608 arithmetic (88 add, 57 sub, 445 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 5
- *   mass               426 arithmetic (101 add, 42 sub, 272 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5
- *   bias               928 arithmetic (173 add, 95 sub, 650 mul, 9 div, 1 neg); calls: cos 2, sin 2, sqrt 5
- *   gravity            309 arithmetic (54 add, 48 sub, 197 mul, 9 div, 1 neg); calls: cos 2, sin 2, sqrt 5
- *   dynamics           1135 arithmetic (249 add, 116 sub, 759 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5
- *   eom                1217 arithmetic (272 add, 133 sub, 800 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   platform_jacobian  30 arithmetic (1 add, 6 sub, 17 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 1
- *   poses              220 arithmetic (54 add, 35 sub, 117 mul, 5 div, 9 neg); calls: cos 2, sin 2, sqrt 5
- *   inertia_world      400 arithmetic (65 add, 47 sub, 281 mul, 5 div, 2 neg); calls: cos 2, sin 2, sqrt 5
- *   wrench_bias        818 arithmetic (120 add, 73 sub, 596 mul, 9 div, 20 neg); calls: cos 2, sin 2, sqrt 5
- *   energy             658 arithmetic (161 add, 74 sub, 412 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5
- *   actuator_rates     246 arithmetic (19 add, 31 sub, 185 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5
- *   passive            164 arithmetic (25 add, 21 sub, 106 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   reaction_basis     320 arithmetic (39 add, 57 sub, 167 mul, 5 div, 52 neg); calls: cos 2, sin 2, sqrt 5
- *   eom_solve          1249 arithmetic (272 add, 143 sub, 820 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   inverse_terms      1263 arithmetic (287 add, 132 sub, 830 mul, 10 div, 4 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   joint_reactions    2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4
- *   reaction_nullspace 77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4
- *   regressor          1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   eom_solve_derivs   5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
- *   inverse_derivs     5149 arithmetic (1078 add, 628 sub, 3422 mul, 14 div, 7 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   ik                 50 arithmetic (17 add, 32 mul, 1 div); calls: cos 2, sin 2, sqrt 5
+ *   jd                 81 arithmetic (15 add, 61 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   ik_jd              96 arithmetic (23 add, 68 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   jacobians          209 arithmetic (54 add, 150 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   bias_terms         375 arithmetic (103 add, 4 sub, 262 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5
+ *   mass               289 arithmetic (91 add, 2 sub, 191 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   bias               629 arithmetic (192 add, 7 sub, 425 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   gravity            200 arithmetic (64 add, 2 sub, 129 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   dynamics           816 arithmetic (258 add, 11 sub, 542 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   eom                897 arithmetic (290 add, 17 sub, 585 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   platform_jacobian  21 arithmetic (5 add, 15 mul, 1 div); calls: cos 2, sin 2, sqrt 1
+ *   poses              155 arithmetic (63 add, 83 mul, 1 div, 8 neg); calls: cos 2, sin 2, sqrt 5
+ *   inertia_world      304 arithmetic (100 add, 203 mul, 1 div); calls: cos 2, sin 2, sqrt 5
+ *   wrench_bias        544 arithmetic (140 add, 15 sub, 384 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   energy             440 arithmetic (169 add, 266 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   actuator_rates     191 arithmetic (36 add, 4 sub, 146 mul, 5 div); calls: cos 2, sin 2, sqrt 5
+ *   passive            141 arithmetic (34 add, 2 sub, 100 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   reaction_basis     303 arithmetic (95 add, 184 mul, 1 div, 23 neg); calls: cos 2, sin 2, sqrt 5
+ *   eom_solve          929 arithmetic (290 add, 27 sub, 605 mul, 7 div); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   inverse_terms      932 arithmetic (302 add, 18 sub, 607 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   joint_reactions    1876 arithmetic (761 add, 123 sub, 976 mul, 9 div, 7 neg); calls: cos 2, sin 2, sqrt 6, tanh 4
+ *   reaction_nullspace 54 arithmetic (11 add, 38 mul, 2 div, 3 neg); calls: cos 2, sin 1, sqrt 4
+ *   regressor          1537 arithmetic (302 add, 194 sub, 1013 mul, 14 div, 14 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   eom_solve_derivs   4006 arithmetic (1252 add, 167 sub, 2565 mul, 11 div, 11 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   inverse_derivs     3927 arithmetic (1304 add, 86 sub, 2526 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4
+ *   hoisted            1055 arithmetic (106 add, 61 sub, 528 mul, 5 div, 355 neg)
  */
 #ifndef PRRU_P4_KERNELS_H
 #define PRRU_P4_KERNELS_H
@@ -41,7 +42,8 @@
  * conventions: row-major, body order P L1 L2 L3 L4 U1 U2 U3 U4 S1 S2 S3 S4, NaN on every output where q
  * is unreachable or not finite), with every number of the model (geometry,
  * gravity vector, masses, centres of mass, full inertia tensors, drives)
- * read from a prru_params4 argument. They are generated from the structure
+ * read at run time, from a prru_p4_derived argument (prru_p4_derive: the
+ * prru_params4 and what depends on it alone, computed once). They are generated from the structure
  * alone (the number of limbs; a = 0 for limbs 3 and 4, whose U joint is O'
  * itself), never from a model's values, so one library evaluates any model
  * of this topology, format 1 (a format-2 model with zeros) or 2, whatever
@@ -69,56 +71,58 @@
 #define PRRU_P4_NBODY 13
 #define PRRU_P4_NJOINT 16
 #define PRRU_P4_NLAMBDA 76
-#define PRRU_P4_ARITH_IK 67 /* arithmetic operations */
-#define PRRU_P4_ARITH_JD 108 /* arithmetic operations */
-#define PRRU_P4_ARITH_IK_JD 124 /* arithmetic operations */
-#define PRRU_P4_ARITH_JACOBIANS 364 /* arithmetic operations */
-#define PRRU_P4_ARITH_BIAS_TERMS 608 /* arithmetic operations */
-#define PRRU_P4_ARITH_MASS 426 /* arithmetic operations */
-#define PRRU_P4_ARITH_BIAS 928 /* arithmetic operations */
-#define PRRU_P4_ARITH_GRAVITY 309 /* arithmetic operations */
-#define PRRU_P4_ARITH_DYNAMICS 1135 /* arithmetic operations */
-#define PRRU_P4_ARITH_EOM 1217 /* arithmetic operations */
-#define PRRU_P4_ARITH_PLATFORM_JACOBIAN 30 /* arithmetic operations */
-#define PRRU_P4_ARITH_POSES 220 /* arithmetic operations */
-#define PRRU_P4_ARITH_INERTIA_WORLD 400 /* arithmetic operations */
-#define PRRU_P4_ARITH_WRENCH_BIAS 818 /* arithmetic operations */
-#define PRRU_P4_ARITH_ENERGY 658 /* arithmetic operations */
-#define PRRU_P4_ARITH_ACTUATOR_RATES 246 /* arithmetic operations */
-#define PRRU_P4_ARITH_PASSIVE 164 /* arithmetic operations */
-#define PRRU_P4_ARITH_REACTION_BASIS 320 /* arithmetic operations */
-#define PRRU_P4_ARITH_EOM_SOLVE 1249 /* arithmetic operations */
-#define PRRU_P4_ARITH_INVERSE_TERMS 1263 /* arithmetic operations */
-#define PRRU_P4_ARITH_JOINT_REACTIONS 2333 /* arithmetic operations */
-#define PRRU_P4_ARITH_REACTION_NULLSPACE 77 /* arithmetic operations */
-#define PRRU_P4_ARITH_REGRESSOR 1540 /* arithmetic operations */
-#define PRRU_P4_ARITH_EOM_SOLVE_DERIVS 5194 /* arithmetic operations */
-#define PRRU_P4_ARITH_INVERSE_DERIVS 5149 /* arithmetic operations */
-#define PRRU_P4_OPS_IK "67 arithmetic (8 add, 13 sub, 40 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_JD "108 arithmetic (8 add, 13 sub, 74 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_IK_JD "124 arithmetic (15 add, 16 sub, 80 mul, 9 div, 4 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_JACOBIANS "364 arithmetic (43 add, 43 sub, 254 mul, 9 div, 15 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_BIAS_TERMS "608 arithmetic (88 add, 57 sub, 445 mul, 9 div, 9 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_MASS "426 arithmetic (101 add, 42 sub, 272 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_BIAS "928 arithmetic (173 add, 95 sub, 650 mul, 9 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_GRAVITY "309 arithmetic (54 add, 48 sub, 197 mul, 9 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_DYNAMICS "1135 arithmetic (249 add, 116 sub, 759 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_EOM "1217 arithmetic (272 add, 133 sub, 800 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_PLATFORM_JACOBIAN "30 arithmetic (1 add, 6 sub, 17 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 1"
-#define PRRU_P4_OPS_POSES "220 arithmetic (54 add, 35 sub, 117 mul, 5 div, 9 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_INERTIA_WORLD "400 arithmetic (65 add, 47 sub, 281 mul, 5 div, 2 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_WRENCH_BIAS "818 arithmetic (120 add, 73 sub, 596 mul, 9 div, 20 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_ENERGY "658 arithmetic (161 add, 74 sub, 412 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_ACTUATOR_RATES "246 arithmetic (19 add, 31 sub, 185 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_PASSIVE "164 arithmetic (25 add, 21 sub, 106 mul, 10 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_REACTION_BASIS "320 arithmetic (39 add, 57 sub, 167 mul, 5 div, 52 neg); calls: cos 2, sin 2, sqrt 5"
-#define PRRU_P4_OPS_EOM_SOLVE "1249 arithmetic (272 add, 143 sub, 820 mul, 12 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_INVERSE_TERMS "1263 arithmetic (287 add, 132 sub, 830 mul, 10 div, 4 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_JOINT_REACTIONS "2333 arithmetic (581 add, 425 sub, 1288 mul, 14 div, 25 neg); calls: cos 2, sin 2, sqrt 6, tanh 4"
-#define PRRU_P4_OPS_REACTION_NULLSPACE "77 arithmetic (8 add, 9 sub, 44 mul, 6 div, 10 neg); calls: cos 2, sin 1, sqrt 4"
-#define PRRU_P4_OPS_REGRESSOR "1540 arithmetic (302 add, 194 sub, 1015 mul, 14 div, 15 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_EOM_SOLVE_DERIVS "5194 arithmetic (1054 add, 683 sub, 3428 mul, 16 div, 13 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
-#define PRRU_P4_OPS_INVERSE_DERIVS "5149 arithmetic (1078 add, 628 sub, 3422 mul, 14 div, 7 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_NDERIVED 747 /* slots h of prru_p4_derived */
+#define PRRU_P4_ARITH_DERIVE 1055 /* arithmetic operations of prru_p4_derive */
+#define PRRU_P4_ARITH_IK 50 /* arithmetic operations */
+#define PRRU_P4_ARITH_JD 81 /* arithmetic operations */
+#define PRRU_P4_ARITH_IK_JD 96 /* arithmetic operations */
+#define PRRU_P4_ARITH_JACOBIANS 209 /* arithmetic operations */
+#define PRRU_P4_ARITH_BIAS_TERMS 375 /* arithmetic operations */
+#define PRRU_P4_ARITH_MASS 289 /* arithmetic operations */
+#define PRRU_P4_ARITH_BIAS 629 /* arithmetic operations */
+#define PRRU_P4_ARITH_GRAVITY 200 /* arithmetic operations */
+#define PRRU_P4_ARITH_DYNAMICS 816 /* arithmetic operations */
+#define PRRU_P4_ARITH_EOM 897 /* arithmetic operations */
+#define PRRU_P4_ARITH_PLATFORM_JACOBIAN 21 /* arithmetic operations */
+#define PRRU_P4_ARITH_POSES 155 /* arithmetic operations */
+#define PRRU_P4_ARITH_INERTIA_WORLD 304 /* arithmetic operations */
+#define PRRU_P4_ARITH_WRENCH_BIAS 544 /* arithmetic operations */
+#define PRRU_P4_ARITH_ENERGY 440 /* arithmetic operations */
+#define PRRU_P4_ARITH_ACTUATOR_RATES 191 /* arithmetic operations */
+#define PRRU_P4_ARITH_PASSIVE 141 /* arithmetic operations */
+#define PRRU_P4_ARITH_REACTION_BASIS 303 /* arithmetic operations */
+#define PRRU_P4_ARITH_EOM_SOLVE 929 /* arithmetic operations */
+#define PRRU_P4_ARITH_INVERSE_TERMS 932 /* arithmetic operations */
+#define PRRU_P4_ARITH_JOINT_REACTIONS 1876 /* arithmetic operations */
+#define PRRU_P4_ARITH_REACTION_NULLSPACE 54 /* arithmetic operations */
+#define PRRU_P4_ARITH_REGRESSOR 1537 /* arithmetic operations */
+#define PRRU_P4_ARITH_EOM_SOLVE_DERIVS 4006 /* arithmetic operations */
+#define PRRU_P4_ARITH_INVERSE_DERIVS 3927 /* arithmetic operations */
+#define PRRU_P4_OPS_IK "50 arithmetic (17 add, 32 mul, 1 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_JD "81 arithmetic (15 add, 61 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_IK_JD "96 arithmetic (23 add, 68 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_JACOBIANS "209 arithmetic (54 add, 150 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_BIAS_TERMS "375 arithmetic (103 add, 4 sub, 262 mul, 5 div, 1 neg); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_MASS "289 arithmetic (91 add, 2 sub, 191 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_BIAS "629 arithmetic (192 add, 7 sub, 425 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_GRAVITY "200 arithmetic (64 add, 2 sub, 129 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_DYNAMICS "816 arithmetic (258 add, 11 sub, 542 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_EOM "897 arithmetic (290 add, 17 sub, 585 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_PLATFORM_JACOBIAN "21 arithmetic (5 add, 15 mul, 1 div); calls: cos 2, sin 2, sqrt 1"
+#define PRRU_P4_OPS_POSES "155 arithmetic (63 add, 83 mul, 1 div, 8 neg); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_INERTIA_WORLD "304 arithmetic (100 add, 203 mul, 1 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_WRENCH_BIAS "544 arithmetic (140 add, 15 sub, 384 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_ENERGY "440 arithmetic (169 add, 266 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_ACTUATOR_RATES "191 arithmetic (36 add, 4 sub, 146 mul, 5 div); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_PASSIVE "141 arithmetic (34 add, 2 sub, 100 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_REACTION_BASIS "303 arithmetic (95 add, 184 mul, 1 div, 23 neg); calls: cos 2, sin 2, sqrt 5"
+#define PRRU_P4_OPS_EOM_SOLVE "929 arithmetic (290 add, 27 sub, 605 mul, 7 div); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_INVERSE_TERMS "932 arithmetic (302 add, 18 sub, 607 mul, 5 div); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_JOINT_REACTIONS "1876 arithmetic (761 add, 123 sub, 976 mul, 9 div, 7 neg); calls: cos 2, sin 2, sqrt 6, tanh 4"
+#define PRRU_P4_OPS_REACTION_NULLSPACE "54 arithmetic (11 add, 38 mul, 2 div, 3 neg); calls: cos 2, sin 1, sqrt 4"
+#define PRRU_P4_OPS_REGRESSOR "1537 arithmetic (302 add, 194 sub, 1013 mul, 14 div, 14 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_EOM_SOLVE_DERIVS "4006 arithmetic (1252 add, 167 sub, 2565 mul, 11 div, 11 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
+#define PRRU_P4_OPS_INVERSE_DERIVS "3927 arithmetic (1304 add, 86 sub, 2526 mul, 9 div, 2 neg); calls: cos 2, sin 2, sqrt 5, tanh 4"
 /* Whether the inputs of prru_p4_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -168,6 +172,20 @@ typedef struct {
   double armature[4], damping[4], coulomb[4], coulomb_velocity;
 } prru_params4;
 
+/* What the kernels read: the parameters and the numbers derived from them
+ * alone (h: sums and products of the parameters that the kernels would
+ * otherwise compute at every call, where a constant kernel has them folded
+ * into its code). prru_p4_derive fills it; every kernel below takes it as
+ * p, so after any change to the parameters derive again. */
+typedef struct {
+  prru_params4 params;
+  double h[PRRU_P4_NDERIVED];
+} prru_p4_derived;
+
+/* d from the parameters p (p may be &d->params): once per model, before any
+ * kernel is called with d (PRRU_P4_ARITH_DERIVE operations). */
+void prru_p4_derive(const prru_params4 *p, prru_p4_derived *d);
+
 /* The numbers of the reference model 4prru.json (a valid
  * 4-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
  * friction). Only this initializer depends on that file. */
@@ -176,82 +194,82 @@ extern const prru_params4 prru_p4_params_reference;
 /* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
 extern const char *const prru_p4_lambda_labels[PRRU_P4_NLAMBDA];
 
-/* Actuator displacements d_i (height of joint A_i on rail i). Parameters from *p. */
-void prru_p4_ik(const prru_params4 *p, const double q[3], double d[4]);
+/* Actuator displacements d_i (height of joint A_i on rail i). Numbers from *p. */
+void prru_p4_ik(const prru_p4_derived *p, const double q[3], double d[4]);
 
-/* Actuator Jacobian J_d = dd/dq (4x3). Parameters from *p. */
-void prru_p4_jd(const prru_params4 *p, const double q[3], double Jd[12]);
+/* Actuator Jacobian J_d = dd/dq (4x3). Numbers from *p. */
+void prru_p4_jd(const prru_p4_derived *p, const double q[3], double Jd[12]);
 
-/* ik and jd fused (one shared evaluation). Parameters from *p. */
-void prru_p4_ik_jd(const prru_params4 *p, const double q[3], double d[4], double Jd[12]);
+/* ik and jd fused (one shared evaluation). Numbers from *p. */
+void prru_p4_ik_jd(const prru_p4_derived *p, const double q[3], double d[4], double Jd[12]);
 
-/* H (78x3) = [J_R,P; ..; J_R,S4; J_T,P; ..; J_T,S4], world frame, body order P L1 L2 L3 L4 U1 U2 U3 U4 S1 S2 S3 S4. Parameters from *p. */
-void prru_p4_jacobians(const prru_params4 *p, const double q[3], double H[234]);
+/* H (78x3) = [J_R,P; ..; J_R,S4; J_T,P; ..; J_T,S4], world frame, body order P L1 L2 L3 L4 U1 U2 U3 U4 S1 S2 S3 S4. Numbers from *p. */
+void prru_p4_jacobians(const prru_p4_derived *p, const double q[3], double H[234]);
 
-/* [delta_P..delta_S4; mu_P..mu_S4] (78): the parts of the angular and linear accelerations that are quadratic in qd. Parameters from *p. */
-void prru_p4_bias_terms(const prru_params4 *p, const double q[3], const double qd[3], double dm[78]);
+/* [delta_P..delta_S4; mu_P..mu_S4] (78): the parts of the angular and linear accelerations that are quadratic in qd. Numbers from *p. */
+void prru_p4_bias_terms(const prru_p4_derived *p, const double q[3], const double qd[3], double dm[78]);
 
-/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Parameters from *p. */
-void prru_p4_mass(const prru_params4 *p, const double q[3], double M[9]);
+/* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). Numbers from *p. */
+void prru_p4_mass(const prru_p4_derived *p, const double q[3], double M[9]);
 
-/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). Parameters from *p. */
-void prru_p4_bias(const prru_params4 *p, const double q[3], const double qd[3], double h[3]);
+/* Bias forces h = H^T K (+ J_d^T K_arm Jd' qd) (3); drive damping and friction are not in h (see passive). Numbers from *p. */
+void prru_p4_bias(const prru_p4_derived *p, const double q[3], const double qd[3], double h[3]);
 
-/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. Parameters from *p. */
-void prru_p4_gravity(const prru_params4 *p, const double q[3], double G[3]);
+/* Generalized gravity G = sum_b J_T,b^T (m_b g), g the gravity vector. Numbers from *p. */
+void prru_p4_gravity(const prru_p4_derived *p, const double q[3], double G[3]);
 
-/* M, h and G fused (one shared evaluation). Parameters from *p. */
-void prru_p4_dynamics(const prru_params4 *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
+/* M, h and G fused (one shared evaluation). Numbers from *p. */
+void prru_p4_dynamics(const prru_p4_derived *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3]);
 
-/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). Parameters from *p. */
-void prru_p4_eom(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3]);
+/* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). Numbers from *p. */
+void prru_p4_eom(const prru_p4_derived *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3]);
 
-/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). Parameters from *p. */
-void prru_p4_platform_jacobian(const prru_params4 *p, const double q[3], double JP[18]);
+/* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). Numbers from *p. */
+void prru_p4_platform_jacobian(const prru_p4_derived *p, const double q[3], double JP[18]);
 
-/* Body rotations R_b (3x3 each) and centres p_b, body order. Parameters from *p. */
-void prru_p4_poses(const prru_params4 *p, const double q[3], double R[117], double pos[39]);
+/* Body rotations R_b (3x3 each) and centres p_b, body order. Numbers from *p. */
+void prru_p4_poses(const prru_p4_derived *p, const double q[3], double R[117], double pos[39]);
 
-/* Inertia tensors I_b = R_b D_b R_b^T about each centre, in {S} (3x3 each), body order. Parameters from *p. */
-void prru_p4_inertia_world(const prru_params4 *p, const double q[3], double I[117]);
+/* Inertia tensors I_b = R_b D_b R_b^T about each centre, in {S} (3x3 each), body order. Numbers from *p. */
+void prru_p4_inertia_world(const prru_p4_derived *p, const double q[3], double I[117]);
 
-/* K (78) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]. Parameters from *p. */
-void prru_p4_wrench_bias(const prru_params4 *p, const double q[3], const double qd[3], double K[78]);
+/* K (78) = [I_b delta_b + w_b x I_b w_b; m_b mu_b]. Numbers from *p. */
+void prru_p4_wrench_bias(const prru_p4_derived *p, const double q[3], const double qd[3], double K[78]);
 
-/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. Parameters from *p. */
-void prru_p4_energy(const prru_params4 *p, const double q[3], const double qd[3], double E[2]);
+/* E[0] = kinetic energy (with the drives' armature), E[1] = potential energy -sum_b m_b g . p_b. Numbers from *p. */
+void prru_p4_energy(const prru_p4_derived *p, const double q[3], const double qd[3], double E[2]);
 
-/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. Parameters from *p. */
-void prru_p4_actuator_rates(const prru_params4 *p, const double q[3], const double qd[3], double dd[4], double ddb[4]);
+/* Slider velocities dd = J_d qd and the qd-quadratic part of their accelerations, ddb = Jd' qd. Numbers from *p. */
+void prru_p4_actuator_rates(const prru_p4_derived *p, const double q[3], const double qd[3], double dd[4], double ddb[4]);
 
-/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Parameters from *p. */
-void prru_p4_passive(const prru_params4 *p, const double q[3], const double qd[3], double Qp[3]);
+/* Generalized drive forces J_d^T (-c dd - f tanh(dd / v_s)): viscous damping and smoothed Coulomb friction (zero without drives). Numbers from *p. */
+void prru_p4_passive(const prru_p4_derived *p, const double q[3], const double qd[3], double Qp[3]);
 
-/* The entries of Q (78x76) that are not identically zero, Q mapping the joint reaction coordinates lambda to body wrenches about each centre (Phi H qdd + K = Fbar + Q lambda): Q[k] is the dense row-major entry whose position is entry k of the index table declared next (308 of 5928; every other entry is 0). Parameters from *p. */
-void prru_p4_reaction_basis(const prru_params4 *p, const double q[3], double Q[308]);
+/* The entries of Q (78x76) that are not identically zero, Q mapping the joint reaction coordinates lambda to body wrenches about each centre (Phi H qdd + K = Fbar + Q lambda): Q[k] is the dense row-major entry whose position is entry k of the index table declared next (308 of 5928; every other entry is 0). Numbers from *p. */
+void prru_p4_reaction_basis(const prru_p4_derived *p, const double q[3], double Q[308]);
 /* Row-major positions (row * 76 + column) in the dense 78x76 Q of prru_p4_reaction_basis's outputs. */
 extern const int prru_p4_reaction_basis_index[PRRU_P4_REACTION_BASIS_NNZ];
 
-/* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Parameters from *p. */
-void prru_p4_eom_solve(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
+/* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. Numbers from *p. */
+void prru_p4_eom_solve(const prru_p4_derived *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3]);
 
-/* d, J_d (as ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. Parameters from *p. */
-void prru_p4_inverse_terms(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3]);
+/* d, J_d (as ik_jd) and tau = M qdd + h - G - J_T,O'^T fp - J_R,P^T mp - passive, the generalized force the drives supply: J_d^T fd = tau. Numbers from *p. */
+void prru_p4_inverse_terms(const prru_p4_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3]);
 
-/* The joint reaction coordinates lambda (76, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb: the solution of least norm, lambda . z = 0, and z, the unit null direction of Q (C3's force along e2 positive). Parameters from *p. */
-void prru_p4_joint_reactions(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], const double fd[4], const double fp[3], const double mp[3], double lambda[76], double z[76]);
+/* The joint reaction coordinates lambda (76, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb: the solution of least norm, lambda . z = 0, and z, the unit null direction of Q (C3's force along e2 positive). Numbers from *p. */
+void prru_p4_joint_reactions(const prru_p4_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fd[4], const double fp[3], const double mp[3], double lambda[76], double z[76]);
 
-/* z of joint_reactions at q alone. Parameters from *p. */
-void prru_p4_reaction_nullspace(const prru_params4 *p, const double q[3], double z[76]);
+/* z of joint_reactions at q alone. Numbers from *p. */
+void prru_p4_reaction_nullspace(const prru_p4_derived *p, const double q[3], double z[76]);
 
-/* Regressor Y (3x142, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Parameters from *p. */
+/* Regressor Y (3x142, row-major) with J_d^T fd = M qdd + h - G - passive = Y pi, pi the standard parameters (prru_regressor.h's order); geometry, gravity and the Coulomb smoothing velocity from *p, its inertial and drive numbers unused. Numbers from *p. */
 void prru_p4_regressor(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], double Y[426]);
 
-/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Parameters from *p. */
-void prru_p4_eom_solve_derivs(const prru_params4 *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[12], double Dfp[9], double Dmp[9]);
+/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. Numbers from *p. */
+void prru_p4_eom_solve_derivs(const prru_p4_derived *p, const double q[3], const double qd[3], const double fd[4], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[12], double Dfp[9], double Dmp[9]);
 
-/* inverse_terms (d, J_d, tau) and the derivatives the runtime composes those of the minimum-norm fd from, row-major with row i = tau_i and column k = the k-th variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), each 3x3; DJd = dJ_d/dq (36: block k, 4x3 row-major, is dJ_d/dq_k). Parameters from *p. */
-void prru_p4_inverse_derivs(const prru_params4 *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3], double Dq[9], double Dqd[9], double Dqdd[9], double DJd[36]);
+/* inverse_terms (d, J_d, tau) and the derivatives the runtime composes those of the minimum-norm fd from, row-major with row i = tau_i and column k = the k-th variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), each 3x3; DJd = dJ_d/dq (36: block k, 4x3 row-major, is dJ_d/dq_k). Numbers from *p. */
+void prru_p4_inverse_derivs(const prru_p4_derived *p, const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[4], double Jd[12], double tau[3], double Dq[9], double Dqd[9], double Dqdd[9], double DJd[36]);
 
 /* Batched kernels, prru_p4_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n
@@ -270,34 +288,34 @@ void prru_p4_inverse_derivs(const prru_params4 *p, const double q[3], const doub
  * cache line (unaligned, the AVX-512 loops ran up to 1.5x slower). */
 
 /* ik and jd fused (one shared evaluation). */
-void prru_p4_batch_ik_jd(const prru_params4 *p, int n, const double *q, double *d, double *Jd);
+void prru_p4_batch_ik_jd(const prru_p4_derived *p, int n, const double *q, double *d, double *Jd);
 
 /* Mass matrix M = H^T Phi H (+ J_d^T K_arm J_d) (3x3). */
-void prru_p4_batch_mass(const prru_params4 *p, int n, const double *q, double *M);
+void prru_p4_batch_mass(const prru_p4_derived *p, int n, const double *q, double *M);
 
 /* Platform Jacobians: rows 0-2 J_R,P, rows 3-5 J_T,O' of the tool point O' (6x3). */
-void prru_p4_batch_platform_jacobian(const prru_params4 *p, int n, const double *q, double *JP);
+void prru_p4_batch_platform_jacobian(const prru_p4_derived *p, int n, const double *q, double *JP);
 
 /* M, h and G fused (one shared evaluation). */
-void prru_p4_batch_dynamics(const prru_params4 *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
+void prru_p4_batch_dynamics(const prru_p4_derived *p, int n, const double *q, const double *qd, double *M, double *h, double *G);
 
 /* Forward-dynamics terms: M and b = G + J_d^T fd + J_T,O'^T fp + J_R,P^T mp + passive - h, so that M qdd = b (fp acts at the platform frame's origin O'). */
-void prru_p4_batch_eom(const prru_params4 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
+void prru_p4_batch_eom(const prru_p4_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b);
 
 /* eom's M and b, qdd = M^-1 b (M_22, constant in q and qd for any parameters (one division by it), eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
-void prru_p4_batch_eom_solve(const prru_params4 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
+void prru_p4_batch_eom_solve(const prru_p4_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
 
 /* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x4), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
-void prru_p4_batch_eom_solve_derivs(const prru_params4 *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
+void prru_p4_batch_eom_solve_derivs(const prru_p4_derived *p, int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
 
 /* inverse_terms (d, J_d, tau) and the derivatives the runtime composes those of the minimum-norm fd from, row-major with row i = tau_i and column k = the k-th variable: Dq = dtau/dq, Dqd = dtau/dqd, Dqdd = dtau/dqdd (= M), each 3x3; DJd = dJ_d/dq (36: block k, 4x3 row-major, is dJ_d/dq_k). */
-void prru_p4_batch_inverse_derivs(const prru_params4 *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *tau, double *Dq, double *Dqd, double *Dqdd, double *DJd);
+void prru_p4_batch_inverse_derivs(const prru_p4_derived *p, int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *tau, double *Dq, double *Dqd, double *Dqdd, double *DJd);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
-void prru_p4_batch_dme_terms(const prru_params4 *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
+void prru_p4_batch_dme_terms(const prru_p4_derived *p, int n, const double *q, double *d, double *Jd, double *M, double *JP);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. In single precision: prru_p4_f_batch.h's conventions, parameters from *p (rounded to float once). */
-void prru_p4_f_batch_dme_terms(const prru_params4 *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
+void prru_p4_f_batch_dme_terms(const prru_p4_derived *p, int n, const float *q, float *d, float *Jd, float *M, float *JP);
 
 #ifdef __cplusplus
 }

@@ -16,6 +16,9 @@
 #include "paper3prru_param_kernels.h"
 
 static int failures = 0;
+/* The model's numbers as the parameter kernels read them (derived once in
+ * main, as a program does when it loads a model). */
+static paper3prru_param_derived model_derived;
 
 /* Every element within tol * max|want| of want; the scale is the array's,
  * not the element's, so exact zeros in J_d do not demand exact zeros. */
@@ -93,10 +96,10 @@ static void check_nan_everywhere(const char *label, const double q[3], const dou
   NAN_CHECK(paper3prru_dynamics(q, qd, M, h, G), M, 9);
   check_all_nan("  dynamics h", h, 3);
   check_all_nan("  dynamics G", G, 3);
-  NAN_CHECK(paper3prru_param_dynamics(&paper3prru_params_model, q, qd, M, h, G), M, 9);
+  NAN_CHECK(paper3prru_param_dynamics(&model_derived, q, qd, M, h, G), M, 9);
   check_all_nan("  param_dynamics h", h, 3);
   check_all_nan("  param_dynamics G", G, 3);
-  NAN_CHECK(paper3prru_param_eom(&paper3prru_params_model, q, qd, f, f, f, M, b), b, 3);
+  NAN_CHECK(paper3prru_param_eom(&model_derived, q, qd, f, f, f, M, b), b, 3);
   check_all_nan("  param_eom M", M, 9);
 #undef NAN_CHECK
 }
@@ -120,6 +123,7 @@ int main(void)
   double M[9], h[3], G[3], d[3], Jd[9], b[3], b_ref[3];
   int i;
 
+  paper3prru_param_derive(&paper3prru_params_model, &model_derived);
   paper3prru_mass(q, M);
   check_array("paper3prru_mass M", M, M_ref, 9, 1e-12);
   paper3prru_bias(q, qd, h);
@@ -145,11 +149,11 @@ int main(void)
   paper3prru_ik(q0, d);
   check_array("paper3prru_ik d at q = 0", d, d0_ref, 3, 1e-12);
   /* The runtime-parameter kernels with the model's own numbers. */
-  paper3prru_param_dynamics(&paper3prru_params_model, q, qd, M, h, G);
+  paper3prru_param_dynamics(&model_derived, q, qd, M, h, G);
   check_array("paper3prru_param_dynamics M", M, M_ref, 9, 1e-12);
   check_array("paper3prru_param_dynamics h", h, h_ref, 3, 1e-12);
   check_array("paper3prru_param_dynamics G", G, G_ref, 3, 1e-12);
-  paper3prru_param_ik_jd(&paper3prru_params_model, q, d, Jd);
+  paper3prru_param_ik_jd(&model_derived, q, d, Jd);
   check_array("paper3prru_param_ik_jd d", d, d_ref, 3, 1e-12);
   check_array("paper3prru_param_ik_jd J_d", Jd, Jd_ref, 9, 1e-12);
   /* The descriptor describes these kernels: the paper's model, its sizes. */

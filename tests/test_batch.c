@@ -26,6 +26,7 @@
 #include "prru_kernels.h"
 #include "prru_mechanism.h"
 #include "prru_param_kernels.h"
+#include "testparam.h"
 #include "prru_ref.h"
 #include "testref.h"
 #include "testutil.h"
@@ -135,8 +136,8 @@ static void scalar_trig(const prru_params *p, const states *s, int k, const doub
 {
   double M[9], b[3];
   if (p) {
-    prru_param_dynamics(p, q, s->qd[k], o->M, o->h, o->G);
-    prru_param_eom(p, q, s->qd[k], s->fd[k], s->fp[k], s->mp[k], M, o->b);
+    prru_param_dynamics(tp_derived(p), q, s->qd[k], o->M, o->h, o->G);
+    prru_param_eom(tp_derived(p), q, s->qd[k], s->fd[k], s->fp[k], s->mp[k], M, o->b);
     memset(o->qdd, 0, sizeof o->qdd);
     memset(o->minors, 0, sizeof o->minors);
   } else {
@@ -327,30 +328,30 @@ static double run(const prru_params *p, const states *s, int n, int *nan_ok)
   if (e > worst) worst = e
   /* ik_jd */
   for (int i = 0; i < n; i++) {
-    if (p) prru_param_ik_jd(p, s->q[i], want.d[i], want.Jd[i]);
+    if (p) prru_param_ik_jd(tp_derived(p), s->q[i], want.d[i], want.Jd[i]);
     else prru_ik_jd(s->q[i], want.d[i], want.Jd[i]);
   }
-  if (p) prru_param_batch_ik_jd(p, n, q, got[0], got[1]);
+  if (p) prru_param_batch_ik_jd(tp_derived(p), n, q, got[0], got[1]);
   else prru_batch_ik_jd(n, q, got[0], got[1]);
   CMP("ik_jd", "d", got[0], d, NA);
   CMP("ik_jd", "Jd", got[1], Jd, 3 * NA);
   /* mass, platform_jacobian, dme_terms */
   for (int i = 0; i < n; i++) {
     if (p) {
-      prru_param_mass(p, s->q[i], want.M[i]);
-      prru_param_platform_jacobian(p, s->q[i], want.JP[i]);
+      prru_param_mass(tp_derived(p), s->q[i], want.M[i]);
+      prru_param_platform_jacobian(tp_derived(p), s->q[i], want.JP[i]);
     } else {
       prru_mass(s->q[i], want.M[i]);
       prru_platform_jacobian(s->q[i], want.JP[i]);
     }
   }
-  if (p) prru_param_batch_mass(p, n, q, got[2]);
+  if (p) prru_param_batch_mass(tp_derived(p), n, q, got[2]);
   else prru_batch_mass(n, q, got[2]);
   CMP("mass", "M", got[2], M, 9);
-  if (p) prru_param_batch_platform_jacobian(p, n, q, got[3]);
+  if (p) prru_param_batch_platform_jacobian(tp_derived(p), n, q, got[3]);
   else prru_batch_platform_jacobian(n, q, got[3]);
   CMP("platform_jacobian", "JP", got[3], JP, 18);
-  if (p) prru_param_batch_dme_terms(p, n, q, got[0], got[1], got[2], got[3]);
+  if (p) prru_param_batch_dme_terms(tp_derived(p), n, q, got[0], got[1], got[2], got[3]);
   else prru_batch_dme_terms(n, q, got[0], got[1], got[2], got[3]);
   CMP("dme_terms", "d", got[0], d, NA);
   CMP("dme_terms", "Jd", got[1], Jd, 3 * NA);
@@ -360,20 +361,20 @@ static double run(const prru_params *p, const states *s, int n, int *nan_ok)
   static sensitivity sens;
   rounding_sensitivity(p, s, n, &sens);
   for (int i = 0; i < n; i++) {
-    if (p) prru_param_dynamics(p, s->q[i], s->qd[i], want.M[i], want.h[i], want.G[i]);
+    if (p) prru_param_dynamics(tp_derived(p), s->q[i], s->qd[i], want.M[i], want.h[i], want.G[i]);
     else prru_dynamics(s->q[i], s->qd[i], want.M[i], want.h[i], want.G[i]);
   }
-  if (p) prru_param_batch_dynamics(p, n, q, qd, got[2], got[4], got[5]);
+  if (p) prru_param_batch_dynamics(tp_derived(p), n, q, qd, got[2], got[4], got[5]);
   else prru_batch_dynamics(n, q, qd, got[2], got[4], got[5]);
   CMP_TRIG("dynamics", "M", got[2], M, 9);
   CMP_TRIG("dynamics", "h", got[4], h, 3);
   CMP_TRIG("dynamics", "G", got[5], G, 3);
   /* eom */
   for (int i = 0; i < n; i++) {
-    if (p) prru_param_eom(p, s->q[i], s->qd[i], s->fd[i], s->fp[i], s->mp[i], want.M[i], want.b[i]);
+    if (p) prru_param_eom(tp_derived(p), s->q[i], s->qd[i], s->fd[i], s->fp[i], s->mp[i], want.M[i], want.b[i]);
     else prru_eom(s->q[i], s->qd[i], s->fd[i], s->fp[i], s->mp[i], want.M[i], want.b[i]);
   }
-  if (p) prru_param_batch_eom(p, n, q, qd, fd, fp, mp, got[2], got[6]);
+  if (p) prru_param_batch_eom(tp_derived(p), n, q, qd, fd, fp, mp, got[2], got[6]);
   else prru_batch_eom(n, q, qd, fd, fp, mp, got[2], got[6]);
   CMP_TRIG("eom", "M", got[2], M, 9);
   CMP_TRIG("eom", "b", got[6], b, 3);

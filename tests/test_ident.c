@@ -29,6 +29,7 @@
 #include "prru_ident.h"
 #include "prru_kernels.h"
 #include "prru_param_kernels.h"
+#include "testparam.h"
 #include "prru_regressor.h"
 #include "testutil.h"
 
@@ -144,8 +145,8 @@ static void check_random_designs(void)
       double q[3], qd[3], qdd[3], Y[3 * PRRU_NREG], M[9], h[3], G[3], Qp[3], tau[3], yp[3];
       random_state(q, qd, qdd);
       prru_regressor(q, qd, qdd, &p.coulomb_velocity, Y);
-      prru_param_dynamics(&p, q, qd, M, h, G);
-      prru_param_passive(&p, q, qd, Qp);
+      prru_param_dynamics(tp_derived(&p), q, qd, M, h, G);
+      prru_param_passive(tp_derived(&p), q, qd, Qp);
       for (int i = 0; i < 3; i++)
         tau[i] = M[3 * i] * qdd[0] + M[3 * i + 1] * qdd[1] + M[3 * i + 2] * qdd[2] + h[i] - G[i] - Qp[i];
       y_times(Y, pi, yp);
@@ -239,8 +240,8 @@ static int make_data(int n, double sigma, double *q, double *qd, double *qdd, do
     double *x = q + 3 * s, *v = qd + 3 * s, *a = qdd + 3 * s, M[9], h[3], G[3], Qp[3], tau[3];
     prru_fourier_eval(&f, f.period * s / n, x, v, a);
     if (prru_check_regular(&model, &data, x, NULL) != PRRU_OK) return 1;
-    prru_param_dynamics(p, x, v, M, h, G);
-    prru_param_passive(p, x, v, Qp);
+    prru_param_dynamics(tp_derived(p), x, v, M, h, G);
+    prru_param_passive(tp_derived(p), x, v, Qp);
     for (int i = 0; i < 3; i++) tau[i] = M[3 * i] * a[0] + M[3 * i + 1] * a[1] + M[3 * i + 2] * a[2] + h[i] - G[i] - Qp[i];
     /* J_d^T fd = tau, fd = J_d^+T tau. */
     for (int i = 0; i < NA; i++) {

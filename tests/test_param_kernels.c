@@ -23,6 +23,7 @@
 #include "prru_kernels.h"
 #include "prru_mechanism.h"
 #include "prru_param_kernels.h"
+#include "testparam.h"
 #include "prru_ref.h"
 #include "testref.h"
 #include "testsim.h"
@@ -63,18 +64,18 @@ typedef struct {
 
 static void eval_param(const prru_params *p, const state *s, outputs *o)
 {
-  prru_param_ik(p, s->q, o->d);
-  prru_param_jd(p, s->q, o->Jd);
-  prru_param_ik_jd(p, s->q, o->d2, o->Jd2);
-  prru_param_mass(p, s->q, o->M);
-  prru_param_bias(p, s->q, s->qd, o->h);
-  prru_param_gravity(p, s->q, o->G);
-  prru_param_dynamics(p, s->q, s->qd, o->M2, o->h2, o->G2);
-  prru_param_eom(p, s->q, s->qd, s->fd, s->fp, s->mp, o->Me, o->be);
-  prru_param_platform_jacobian(p, s->q, o->JP);
-  prru_param_energy(p, s->q, s->qd, o->E);
-  prru_param_actuator_rates(p, s->q, s->qd, o->dd, o->ddb);
-  prru_param_passive(p, s->q, s->qd, o->Qp);
+  prru_param_ik(tp_derived(p), s->q, o->d);
+  prru_param_jd(tp_derived(p), s->q, o->Jd);
+  prru_param_ik_jd(tp_derived(p), s->q, o->d2, o->Jd2);
+  prru_param_mass(tp_derived(p), s->q, o->M);
+  prru_param_bias(tp_derived(p), s->q, s->qd, o->h);
+  prru_param_gravity(tp_derived(p), s->q, o->G);
+  prru_param_dynamics(tp_derived(p), s->q, s->qd, o->M2, o->h2, o->G2);
+  prru_param_eom(tp_derived(p), s->q, s->qd, s->fd, s->fp, s->mp, o->Me, o->be);
+  prru_param_platform_jacobian(tp_derived(p), s->q, o->JP);
+  prru_param_energy(tp_derived(p), s->q, s->qd, o->E);
+  prru_param_actuator_rates(tp_derived(p), s->q, s->qd, o->dd, o->ddb);
+  prru_param_passive(tp_derived(p), s->q, s->qd, o->Qp);
 }
 
 static void eval_const(const state *s, outputs *o)
@@ -456,7 +457,7 @@ static void test_designs(void)
       floor[O_EN] = potential_terms(r.mass, r.g, pos);
       note_all(&got, &want, floor, worst);
       /* The design's M is not the model's: the test can tell them apart. */
-      prru_param_dynamics(&prru_params_model, s.q, s.qd, model_out.M, model_out.h, model_out.G);
+      prru_param_dynamics(tp_derived(&prru_params_model), s.q, s.qd, model_out.M, model_out.h, model_out.G);
       const double e = tu_relerr(model_out.M, want.M, 9, 1e-300);
       if (!(e >= moved)) moved = e;
     }
@@ -496,9 +497,9 @@ static void test_linearity(void)
   for (int n = 0; n < 200; n++) {
     double q[3], qd[3], M[9], h[3], G[3], M2[9], h2[3], G2[3], Mg[9], hg[3], Gg[3];
     ts_random_state(&model, &data, q, qd);
-    prru_param_dynamics(&prru_params_model, q, qd, M, h, G);
-    prru_param_dynamics(&p2, q, qd, M2, h2, G2);
-    prru_param_dynamics(&pg, q, qd, Mg, hg, Gg);
+    prru_param_dynamics(tp_derived(&prru_params_model), q, qd, M, h, G);
+    prru_param_dynamics(tp_derived(&p2), q, qd, M2, h2, G2);
+    prru_param_dynamics(tp_derived(&pg), q, qd, Mg, hg, Gg);
     for (int i = 0; i < 9; i++) M[i] *= 2;
     for (int i = 0; i < 3; i++) h[i] *= 2, G[i] *= 2;
     const double e[4] = {tu_relerr(M2, M, 9, 1e-300), tu_relerr(h2, h, 3, 1e-300),

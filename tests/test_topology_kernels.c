@@ -118,10 +118,12 @@ static double tt_compare(const char *kernel, const char *name, const double *bat
 #define NL PRRU_NLAMBDA
 #if NA == 3
 typedef prru_params3 own_params;
+typedef prru_p3_derived own_derived;
 #define OWN(name) prru_p3_##name
 #define OWN_NNZ PRRU_P3_REACTION_BASIS_NNZ
 #else
 typedef prru_params4 own_params;
+typedef prru_p4_derived own_derived;
 #define OWN(name) prru_p4_##name
 #define OWN_NNZ PRRU_P4_REACTION_BASIS_NNZ
 #endif
@@ -158,7 +160,7 @@ static void scatter(const double *nz, const int *index, int nnz, double *Q)
   for (int k = 0; k < nnz; k++) Q[index[k]] = nz[k];
 }
 
-static void eval_own(const own_params *p, const state *s, outs *o)
+static void eval_own(const own_derived *p, const state *s, outs *o)
 {
   static double nz[6 * NB * NL];
   OWN(ik)(p, s->q, o->d);
@@ -369,6 +371,8 @@ static void test_own_topology(void)
 {
   own_params p;
   TU_TRUE(own_from_model(&p), "prru_params_model maps member by member into the topology's struct");
+  static own_derived dp;
+  OWN(derive)(&p, &dp);
   prru_model model;
   prru_data data;
   prru_model_default(&model);
@@ -392,7 +396,7 @@ static void test_own_topology(void)
     double M[9], b[3], minors[3];
     prru_eom_solve(s.q, s.qd, s.fd, s.fp, s.mp, M, b, s.qdd, minors);
     static outs got, want;
-    eval_own(&p, &s, &got);
+    eval_own(&dp, &s, &got);
     eval_const(&s, &want);
     for (int k = 0; k < NFIELD; k++) {
       double err;
@@ -430,14 +434,18 @@ static void test_batches(void)
   own_from_model(&p4);
   p3 = prru_p3_params_reference;
 #endif
+  static prru_p3_derived d3;
+  static prru_p4_derived d4;
+  prru_p3_derive(&p3, &d3);
+  prru_p4_derive(&p4, &d4);
   for (size_t t = 0; t < sizeof sizes / sizeof sizes[0]; t++) {
     const int n = sizes[t];
-    draw3(&p3, &st, n);
+    draw3(&d3, &st, n);
     for (int k = 0; k < n; k++) compared += st.compared[k];
-    worst = fmax(worst, check_batch3(&p3, &st, n, &nan_ok));
-    draw4(&p4, &st, n);
+    worst = fmax(worst, check_batch3(&d3, &st, n, &nan_ok));
+    draw4(&d4, &st, n);
     for (int k = 0; k < n; k++) compared += st.compared[k];
-    worst = fmax(worst, check_batch4(&p4, &st, n, &nan_ok));
+    worst = fmax(worst, check_batch4(&d4, &st, n, &nan_ok));
   }
   TU_TRUE(nan_ok, "batched topology kernels: NaN exactly where the scalar ones give NaN");
   TU_TRUE(compared > 100, "batched topology kernels: regular states compared");
@@ -474,6 +482,10 @@ static void test_massless_fourth_limb(void)
     memcpy(p3.com[j], p4.com[body4(j)], sizeof p3.com[j]);
     memcpy(p3.inertia[j], p4.inertia[body4(j)], sizeof p3.inertia[j]);
   }
+  static prru_p3_derived dp3;
+  static prru_p4_derived dp4;
+  prru_p3_derive(&p3, &dp3);
+  prru_p4_derive(&p4, &dp4);
   /* lambda coordinates of limbs 1 and 2, by label. */
   int pair[2][PRRU_P3_NLAMBDA], npair = 0;
   for (int i = 0; i < PRRU_P3_NLAMBDA; i++) {
@@ -491,7 +503,7 @@ static void test_massless_fourth_limb(void)
   int n = 0;
   for (int tries = 0; n < 300 && tries < 30000; tries++) {
     double q[3] = {tu_uniform(-0.4, 0.4), tu_uniform(-0.5, 0.4), tu_uniform(-1.0, -0.5)};
-    if (!(margin3(&p3, q) >= MARGIN && margin4(&p4, q) >= MARGIN)) continue;
+    if (!(margin3(&dp3, q) >= MARGIN && margin4(&dp4, q) >= MARGIN)) continue;
     n++;
     double qd[3], fd[4] = {0, 0, 0, 0}, fp[3], mp[3];
     for (int i = 0; i < 3; i++) {
@@ -505,24 +517,24 @@ static void test_massless_fourth_limb(void)
     double R3[90], P3[30], di[3], Ji[9], Jinv[9], fd3[3], lam3[57];
     double d4[4], J4[12], M4[9], h4[3], G4[3], b4[3], q4dd[3], E4[2], JP4[18], Qp4[3], R4[117],
         P4[39], di4[4], Ji4[12], tau4[3], lam4[76], z4[76];
-    prru_p3_ik_jd(&p3, q, d3, J3);
-    prru_p3_dynamics(&p3, q, qd, M3, h3, G3);
-    prru_p3_eom_solve(&p3, q, qd, fd, fp, mp, Me, b3, q3dd, mi);
-    prru_p3_energy(&p3, q, qd, E3);
-    prru_p3_platform_jacobian(&p3, q, JP3);
-    prru_p3_passive(&p3, q, qd, Qp3);
-    prru_p3_poses(&p3, q, R3, P3);
-    prru_p3_inverse_terms(&p3, q, qd, q3dd, fp, mp, di, Ji, Jinv, fd3);
-    prru_p3_joint_reactions(&p3, q, qd, q3dd, fd, fp, mp, lam3);
-    prru_p4_ik_jd(&p4, q, d4, J4);
-    prru_p4_dynamics(&p4, q, qd, M4, h4, G4);
-    prru_p4_eom_solve(&p4, q, qd, fd, fp, mp, Me, b4, q4dd, mi);
-    prru_p4_energy(&p4, q, qd, E4);
-    prru_p4_platform_jacobian(&p4, q, JP4);
-    prru_p4_passive(&p4, q, qd, Qp4);
-    prru_p4_poses(&p4, q, R4, P4);
-    prru_p4_inverse_terms(&p4, q, qd, q3dd, fp, mp, di4, Ji4, tau4);
-    prru_p4_joint_reactions(&p4, q, qd, q3dd, fd, fp, mp, lam4, z4);
+    prru_p3_ik_jd(&dp3, q, d3, J3);
+    prru_p3_dynamics(&dp3, q, qd, M3, h3, G3);
+    prru_p3_eom_solve(&dp3, q, qd, fd, fp, mp, Me, b3, q3dd, mi);
+    prru_p3_energy(&dp3, q, qd, E3);
+    prru_p3_platform_jacobian(&dp3, q, JP3);
+    prru_p3_passive(&dp3, q, qd, Qp3);
+    prru_p3_poses(&dp3, q, R3, P3);
+    prru_p3_inverse_terms(&dp3, q, qd, q3dd, fp, mp, di, Ji, Jinv, fd3);
+    prru_p3_joint_reactions(&dp3, q, qd, q3dd, fd, fp, mp, lam3);
+    prru_p4_ik_jd(&dp4, q, d4, J4);
+    prru_p4_dynamics(&dp4, q, qd, M4, h4, G4);
+    prru_p4_eom_solve(&dp4, q, qd, fd, fp, mp, Me, b4, q4dd, mi);
+    prru_p4_energy(&dp4, q, qd, E4);
+    prru_p4_platform_jacobian(&dp4, q, JP4);
+    prru_p4_passive(&dp4, q, qd, Qp4);
+    prru_p4_poses(&dp4, q, R4, P4);
+    prru_p4_inverse_terms(&dp4, q, qd, q3dd, fp, mp, di4, Ji4, tau4);
+    prru_p4_joint_reactions(&dp4, q, qd, q3dd, fd, fp, mp, lam4, z4);
     double R4s[90], P4s[30], tau3[3], l3[38], l4[38];
     for (int j = 0; j < 10; j++) {
       memcpy(R4s + 9 * j, R4 + 9 * body4(j), 9 * sizeof(double));

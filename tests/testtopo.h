@@ -1,14 +1,14 @@
 /* The checks of tests/test_topology_kernels.c that do not need the build's
  * own topology, written once for either set of topology kernels: included
- * twice, with TT_N defined as 3 (prru_p3_*, prru_params3) and as 4
- * (prru_p4_*, prru_params4). Needs tt_states, tt_compare and the TOL_*
+ * twice, with TT_N defined as 3 (prru_p3_*, prru_p3_derived) and as 4
+ * (prru_p4_*, prru_p4_derived). Needs tt_states, tt_compare and the TOL_*
  * constants of the including file. */
 #define TT_CAT_(a, b) a##b
 #define TT_CAT(a, b) TT_CAT_(a, b)
 #define TT_K(name) TT_CAT(TT_CAT(prru_p, TT_N), TT_CAT(_, name))     /* prru_p3_name */
 #define TT_M(name) TT_CAT(TT_CAT(PRRU_P, TT_N), TT_CAT(_, name))     /* PRRU_P3_NAME */
 #define TT_F(name) TT_CAT(name, TT_N)                                /* name3 */
-#define TT_T TT_CAT(prru_params, TT_N)
+#define TT_T TT_CAT(TT_CAT(prru_p, TT_N), _derived)                  /* prru_p3_derived */
 #define TT_NA TT_M(NACT)
 #define TT_NB TT_M(NBODY)
 
@@ -35,7 +35,7 @@ static double TT_F(margin)(const TT_T *p, const double q[3])
 static void TT_F(draw)(const TT_T *p, tt_states *s, int n)
 {
   double L = 0;
-  for (int i = 0; i < TT_NA; i++) L = fmax(L, p->l1[i] + p->l2[i]);
+  for (int i = 0; i < TT_NA; i++) L = fmax(L, p->params.l1[i] + p->params.l2[i]);
   for (int k = 0; k < n; k++) {
     s->q[k][0] = tu_uniform(-1.57, 1.57);
     s->q[k][1] = tu_uniform(-1.57, 1.57);

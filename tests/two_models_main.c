@@ -42,16 +42,23 @@ int main(void)
 {
   const double q[3] = {0.1, -0.2, 0.05}, qd[3] = {0.3, -0.1, 0.2};
   double M[3][9], h[3][3], G[3][3], Mp[9], hp[3], Gp[3];
+  /* Each model's numbers as its parameter kernels read them. */
+  static paper3prru_param_derived paper_d;
+  static proto_param_derived proto_d;
+  static prru4_param_derived prru4_d;
+  paper3prru_param_derive(&paper3prru_params_model, &paper_d);
+  proto_param_derive(&proto_params_model, &proto_d);
+  prru4_param_derive(&prru4_params_model, &prru4_d);
   paper3prru_dynamics(q, qd, M[0], h[0], G[0]);
-  paper3prru_param_dynamics(&paper3prru_params_model, q, qd, Mp, hp, Gp);
+  paper3prru_param_dynamics(&paper_d, q, qd, Mp, hp, Gp);
   check("paper3prru: constant = parameter kernels (M)", relerr(M[0], Mp, 9), 1e-12);
   check("paper3prru: constant = parameter kernels (h)", relerr(h[0], hp, 3), 1e-12);
   proto_dynamics(q, qd, M[1], h[1], G[1]);
-  proto_param_dynamics(&proto_params_model, q, qd, Mp, hp, Gp);
+  proto_param_dynamics(&proto_d, q, qd, Mp, hp, Gp);
   check("proto: constant = parameter kernels (M)", relerr(M[1], Mp, 9), 1e-12);
   check("proto: constant = parameter kernels (h)", relerr(h[1], hp, 3), 1e-12);
   prru4_dynamics(q, qd, M[2], h[2], G[2]);
-  prru4_param_dynamics(&prru4_params_model, q, qd, Mp, hp, Gp);
+  prru4_param_dynamics(&prru4_d, q, qd, Mp, hp, Gp);
   check("prru4: constant = parameter kernels (M)", relerr(M[2], Mp, 9), 1e-12);
   check("prru4: constant = parameter kernels (h)", relerr(h[2], hp, 3), 1e-12);
   /* Distinct models give distinct numbers (a shadowed symbol would not). */

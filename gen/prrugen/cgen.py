@@ -299,14 +299,28 @@ class Kernel:
 class ParamsArg:
     """A leading `const TYPE *p` argument whose members are symbols: each
     member a kernel uses is loaded once into a local (local(name)) at the
-    top, so the CSE graph treats it as an input like q1."""
+    top, so the CSE graph treats it as an input like q1. With hoisted (a
+    hoist.Hoisted), the kernels are lowered by hoist.HoistGraph and the
+    slots p->h[k] are members too."""
 
-    def __init__(self, ctype, order, local, access):
+    def __init__(self, ctype, order, local, access, hoisted=None):
         self.ctype = ctype            # C struct type name
         self.order = order            # symbol names, in struct order
         self.local = local            # symbol name -> C local name
         self.access = access          # symbol name -> C expression
         self.order_set = frozenset(order)
+        self.hoisted = hoisted
+
+    def members(self):
+        """Every member's symbol name: the parameters, then the slots."""
+        if self.hoisted is None:
+            return self.order
+        from .hoist import slot_name
+        return list(self.order) + [slot_name(k) for k in range(len(self.hoisted.exprs))]
+
+    def knows(self, name):
+        return name in self.order_set or (
+            self.hoisted is not None and name.startswith("p->h["))
 
 
 class _Names(dict):
@@ -317,7 +331,7 @@ class _Names(dict):
         self.params = params
 
     def __missing__(self, key):
-        if self.params is None or key not in self.params.order_set:
+        if self.params is None or not self.params.knows(key):
             raise KeyError(key)
         self[key] = self.params.local(key)
         return self[key]
@@ -420,7 +434,12 @@ class Lowered:
         for arr, syms in kernel.inputs:
             for i, s in enumerate(syms):
                 names[s] = "%s%d" % (arr, i + 1)
-        self.graph = g = Graph(names)
+        hoisted = kernel.params.hoisted if kernel.params is not None else None
+        if hoisted is None:
+            self.graph = g = Graph(names)
+        else:
+            from .hoist import HoistGraph
+            self.graph = g = HoistGraph(names, hoisted)
         self.guard_nodes = [g.lower(x) for x in kernel.guards]
         # With guards, q itself must be finite too (q3 appears in no guard).
         self.finite_nodes = [g.node("in", names[s]) for s in kernel.inputs[0][1]] \
@@ -503,7 +522,7 @@ class _Writer:
         cast = "" if self.real == "double" else "(%s)" % self.real
         return ["const %s %s = %s%s;" % (self.real, params.local(s), cast,
                                          params.access(s))
-                for s in params.order if params.local(s) in self.used_inputs]
+                for s in params.members() if params.local(s) in self.used_inputs]
 
     def guard_conditions(self, compare):
         """The guard as conditions compare(value, bound): every guard
@@ -573,7 +592,7 @@ def _scalar_lines(kernel, w):
     lines = ["(void)%s;" % arr for arr in reversed(w.unused_arrays(kernel))] + lines
     params = kernel.params
     if params is not None and not any(params.local(s) in w.used_inputs
-                                      for s in params.order):
+                                      for s in params.members()):
         lines.insert(0, "(void)p;")
     return lines
 
@@ -695,14 +714,27 @@ def emit(kernel, prefix, precision=DOUBLE, batched=None):
     return Emitted(kernel.name, signature, body, low.counts, kernel.doc)
 
 
-def evaluate_lowered(exprs, env):
-    """Evaluate exprs through the lowered graph, as the C code would.
+def evaluate_lowered(exprs, env, hoisted=None):
+    """Evaluate exprs through the lowered graph, as the C code would; with
+    hoisted (a hoist.Hoisted), through hoist.HoistGraph, the slots'
+    values first evaluated from env as <prefix>_derive would.
 
     Used by the tests to show that lowering and CSE preserve values."""
     import math
-    names = {k: k for k in env}
-    g = Graph(names)
-    roots = [g.lower(sym.as_expr(e)) for e in exprs]
+    if hoisted is None:
+        g = Graph({k: k for k in env})
+        roots = [g.lower(sym.as_expr(e)) for e in exprs]
+    else:
+        from .hoist import HoistGraph, slot_name
+
+        class SlotNames(dict):
+            def __missing__(self, key):
+                return key
+        g = HoistGraph(SlotNames(), hoisted)
+        roots = [g.lower(sym.as_expr(e)) for e in exprs]
+        env = dict(env)
+        for k, v in enumerate(evaluate_lowered(hoisted.exprs, env)):
+            env[slot_name(k)] = v
     fns = {"sin": math.sin, "cos": math.cos, "tan": math.tan,
            "tanh": math.tanh,
            "asin": math.asin, "acos": math.acos, "atan2": math.atan2,

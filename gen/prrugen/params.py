@@ -130,13 +130,44 @@ def param_kernels(deriv, pmodel, prefix):
             for k in kernels(deriv) if k.name in PARAM_KERNELS]
 
 
-def topology_kernels(deriv, pmodel, ctype, extra=()):
+def _derived_access(symbol_name):
+    """A member of the derived numbers (<prefix>_derived): the parameters
+    as given are its member params, the slots its h."""
+    if symbol_name.startswith(_PREFIX + "h["):
+        return _access(symbol_name)
+    return symbol_name.replace(_PREFIX, "p->params.", 1)
+
+
+def derive_kernel(pmodel, ctype, hoisted):
+    """The kernel that computes the slots of hoisted (hoist.Hoisted) from
+    the parameters, `const <ctype> *p`: the output h of
+    <prefix>_derive."""
+    arg = ParamsArg(ctype, pmodel.order, local_name, _access)
+    return Kernel("hoisted", "The derived numbers h of the topology kernels "
+                  "(hoisted subexpressions of the parameters alone) from *p.",
+                  [], [("h", list(hoisted.exprs))], (), arg)
+
+
+def topology_kernels(deriv, pmodel, ctype, extra=(), hoisted=None):
     """Every kernel of deriv, the derivation of ParamModel pmodel, and the
     kernels extra of the same derivation, each with the leading `const
-    <ctype> *p` argument: the topology kernels."""
-    arg = ParamsArg(ctype, pmodel.order, local_name, _access)
-    # p is the parameters: poses' output p (the centres) becomes pos.
+    <ctype> *p` argument: the topology kernels. With hoisted (a
+    hoist.Hoisted), ctype is the derived numbers' struct and every
+    parameter-only subexpression is read from its slots."""
+    if hoisted is None:
+        arg = ParamsArg(ctype, pmodel.order, local_name, _access)
+    else:
+        arg = ParamsArg(ctype, pmodel.order, local_name, _derived_access, hoisted)
     return [Kernel(k.name, k.doc, k.inputs,
                    [("pos" if arr == "p" else arr, x) for arr, x in k.outputs],
                    k.guards, arg, k.witnesses, k.pattern)
             for k in list(kernels(deriv)) + list(extra)]
+
+
+def plain_kernel(k, pmodel, ctype):
+    """Kernel k with the leading `const <ctype> *p` argument of the
+    parameters as given, nothing hoisted: for a kernel whose caller changes
+    a parameter at every call (the regressor's smoothing velocity)."""
+    arg = ParamsArg(ctype, pmodel.order, local_name, _access)
+    return Kernel(k.name, k.doc, k.inputs, k.outputs, k.guards, arg,
+                  k.witnesses, k.pattern)

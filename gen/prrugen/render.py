@@ -5,7 +5,7 @@ import os
 import re
 from string import Template
 
-from . import batch, cgen, params, regressor
+from . import batch, cgen, hoist, params, regressor
 from .ctext import c_comment, c_string
 from .kernels import derivative_kernels, kernels, lambda_labels
 from .model import ACTUATOR_KEYS, c_double
@@ -221,6 +221,7 @@ def render_params(model, templates_dir, prefix=None):
     tupper = tprefix.upper()
     names = param_kernel_names()
     macros = ["#define %s_param_%s %s_%s" % (prefix, k, tprefix, k) for k in names]
+    macros.append("#define %s_param_derive %s_derive" % (prefix, tprefix))
     macros += ["#define %s_PARAM_ARITH_%s %s_ARITH_%s" % (upper, k.upper(), tupper, k.upper())
                for k in params.PARAM_KERNELS]
     macros += ["#define %s_PARAM_OPS_%s %s_OPS_%s" % (upper, k.upper(), tupper, k.upper())
@@ -258,6 +259,11 @@ def topology_ctype(nlimb):
     return "prru_params%d" % nlimb
 
 
+def topology_derived_ctype(nlimb):
+    """The struct their kernels read: prru_p3_derived, prru_p4_derived."""
+    return "%s_derived" % topology_prefix(nlimb)
+
+
 def render_topology(reference, pmodel, deriv, templates_dir):
     """{file name: text} for the topology kernels of pmodel =
     params.ParamModel(params.Topology(n)), whose derivation is deriv, and
@@ -265,28 +271,43 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     <prefix>_params_reference."""
     n = pmodel.nlimb
     prefix, ctype = topology_prefix(n), topology_ctype(n)
+    dtype = topology_derived_ctype(n)
     upper = prefix.upper()
+    hoisted = hoist.Hoisted(pmodel.order)
     kernel_list = params.topology_kernels(
-        deriv, pmodel, ctype, [regressor.topology_regressor_kernel(deriv, pmodel)]
-        + derivative_kernels(deriv))
+        deriv, pmodel, dtype, derivative_kernels(deriv), hoisted)
+    # The regressor after the kernels of the constant set, as before the
+    # derivatives; it reads the parameters as given (its caller sets the
+    # smoothing velocity at every call).
+    nbase = len(kernel_list) - len(derivative_kernels(deriv))
+    kernel_list.insert(nbase, params.plain_kernel(
+        regressor.topology_regressor_kernel(deriv, pmodel), pmodel, ctype))
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
-    banner = _banner(_topology_head(n, reference), emitted)
     macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
               % (upper, e.name.upper(), e.arithmetic) for e in emitted]
     macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
                                           c_string(e.summary()))
                for e in emitted]
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros,
-                             " Parameters from *p.")
+                             " Numbers from *p.")
     # The optimiser's and the maps' --precision float: the fused dme_terms
-    # in float, <prefix>_f_batch_dme_terms (the parameters converted once).
+    # in float, <prefix>_f_batch_dme_terms (the numbers converted once).
     fdecls, fbodies = _float_param_batch(kernel_list, prefix, prefix + "_f")
     decls += "\n\n" + fdecls
     bodies += "\n\n" + fbodies
+    # Last, when every kernel has named its slots: the slots from the
+    # parameters, once per model.
+    derive = cgen.emit(params.derive_kernel(pmodel, ctype, hoisted), prefix)
+    macros.insert(0, "#define %s_NDERIVED %d /* slots h of %s */"
+                  % (upper, len(hoisted.exprs), dtype))
+    macros.insert(1, "#define %s_ARITH_DERIVE %d /* arithmetic operations of "
+                  "%s_derive */" % (upper, derive.arithmetic, prefix))
+    derive_body = "static %s\n{\n%s\n}" % (derive.signature, derive.body)
+    banner = _banner(_topology_head(n, reference), emitted + [derive])
     mech = deriv.mech
     labels = lambda_labels(mech)
     values = dict(banner=banner, prefix=prefix, PREFIX=upper, ctype=ctype,
-                  nlimb=n, nbody=len(mech.bodies), njoint=len(mech.joints),
+                  dtype=dtype, derive=derive_body, nlimb=n, nbody=len(mech.bodies), njoint=len(mech.joints),
                   nlambda=len(labels),
                   bodies=" ".join(b.name for b in mech.bodies),
                   a3=", a[3]" if n == 4 else "",

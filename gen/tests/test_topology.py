@@ -52,11 +52,16 @@ class TopologyKernels(unittest.TestCase):
                 dynamics.Derivation(mechanism.build(m), m))]
             self.assertIn("joint_reactions", names)
             self.assertEqual("reaction_nullspace" in names, n == 4)
+            # Every kernel reads the derived numbers (prru_pN_derive), the
+            # regressor the parameters as given (its caller sets v_s).
             for k in names:
-                self.assertRegex(h, r"void prru_p%d_%s\(const prru_params%d \*p, "
+                self.assertRegex(h, r"void prru_p%d_%s\(const prru_p%d_derived \*p, "
                                  r"const double q\[3\]" % (n, k, n))
+            self.assertRegex(h, r"void prru_p%d_regressor\(const prru_params%d \*p, " % (n, n))
+            self.assertRegex(h, r"void prru_p%d_derive\(const prru_params%d \*p, "
+                             r"prru_p%d_derived \*d\);" % (n, n, n))
             for k in BATCHED:
-                self.assertRegex(h, r"void prru_p%d_batch_%s\(const prru_params%d "
+                self.assertRegex(h, r"void prru_p%d_batch_%s\(const prru_p%d_derived "
                                  r"\*p, int n," % (n, k, n))
             declared = re.findall(r"^void (\w+)\(", h, re.M)
             self.assertTrue(all(d.startswith("prru_p%d_" % n) for d in declared))

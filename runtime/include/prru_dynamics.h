@@ -177,7 +177,8 @@ typedef struct {
    * to 2e-10 relative, and ID(FD(fd)) returns fd to 1e-7 of its terms. */
   double mass_rcond_min;
   const prru_kernel_table *kernels; /* the code (see prru_kernel_table) */
-  const void *kernel_params;        /* its numbers (NULL: specialised) */
+  const void *kernel_params;        /* its numbers, derived (prru_param_derived;
+                                       NULL: specialised) */
   void *own;                        /* a loaded model's storage, else NULL */
 } prru_model;
 

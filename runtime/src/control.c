@@ -55,8 +55,9 @@ static int spd3_solve(const double M[9], const double b[3], double x[3])
   return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) ? 0 : -1;
 }
 
-int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
-                     const double fd[PRRU_NACT], double qdd[3])
+/* prru_plant_accel with the plant's numbers derived (prru_param_derive). */
+static int plant_accel(const prru_param_derived *p, const double q[3], const double qd[3],
+                       const double fd[PRRU_NACT], double qdd[3])
 {
   static const double zero[3] = {0.0, 0.0, 0.0};
   double M[9], b[3];
@@ -72,6 +73,14 @@ int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3]
     return prru_finite_n(b, 3) ? PRRU_EINPUT : PRRU_ESINGULAR;
   }
   return spd3_solve(M, b, qdd) == 0 ? PRRU_OK : PRRU_ESINGULAR;
+}
+
+int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
+                     const double fd[PRRU_NACT], double qdd[3])
+{
+  prru_param_derived dp;
+  prru_param_derive(p, &dp);
+  return plant_accel(&dp, q, qd, fd, qdd);
 }
 
 int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
@@ -428,6 +437,7 @@ typedef struct {
   const prru_track_options *o;
   prru_data *d;
   const prru_lqr_schedule *lqr; /* the LQR's gains, NULL for computed torque */
+  const prru_param_derived *plant; /* o->plant derived, once per run */
   int continuous;
   double fd_hold[PRRU_NACT];
   int status; /* why the right-hand side last failed */
@@ -458,7 +468,7 @@ static int track_rhs(double t, const double y[], double f[], void *p)
   c->in_plant = st == PRRU_OK;
   if (st == PRRU_OK && c->continuous)
     for (int i = 0; i < PRRU_NACT; i++) c->fd_step_peak = fmax(c->fd_step_peak, fabs(fd_cmd[i]));
-  if (st == PRRU_OK) st = prru_plant_accel(&c->o->plant, y, y + 3, fd, f + 3);
+  if (st == PRRU_OK) st = plant_accel(c->plant, y, y + 3, fd, f + 3);
   if (st != PRRU_OK) {
     c->status = st;
     c->fail_t = t;
@@ -541,11 +551,11 @@ static int track_tick(track_ctx *c, gsl_rng *rng, long k, double t, const double
     if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
   }
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
-  st = prru_plant_accel(&o->plant, y, y + 3, s->fd, s->qdd);
+  st = plant_accel(c->plant, y, y + 3, s->fd, s->qdd);
   if (st != PRRU_OK)
     return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g) (the plant's "
                      "equations of motion)", t, prru_strerror(st), y[0], y[1], y[2]);
-  prru_param_ik(&o->plant, y, s->d);
+  prru_param_ik(c->plant, y, s->d);
   if (!prru_finite_n(s->d, PRRU_NACT))
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                      "stopped at t = %.9g s: the plant left the workspace: %s at q = (%.9g, "
@@ -590,7 +600,7 @@ static int stroke_violation(const prru_track_options *o, const double d[PRRU_NAC
  * ticks a slider can leave its stroke and come back. GSL_SUCCESS, the evolve's or
  * the driver's error, or GSL_EDOM with *bad the slider out of its stroke
  * (*t, y the state there). */
-static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, double *t,
+static int track_advance(gsl_odeiv2_driver *drv, const track_ctx *c, double *t,
                          double t1, double y[6], int *bad)
 {
   drv->n = 0;
@@ -603,8 +613,8 @@ static int track_advance(gsl_odeiv2_driver *drv, const prru_track_options *o, do
     drv->n++;
     if (*t >= t1) break; /* the tick itself: track_run checks its sample */
     double d[PRRU_NACT];
-    prru_param_ik(&o->plant, y, d); /* the plant's sliders, as at the ticks */
-    if ((*bad = stroke_violation(o, d)) >= 0) return GSL_EDOM;
+    prru_param_ik(c->plant, y, d); /* the plant's sliders, as at the ticks */
+    if ((*bad = stroke_violation(c->o, d)) >= 0) return GSL_EDOM;
   }
   return GSL_SUCCESS;
 }
@@ -647,11 +657,11 @@ static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk
   c->status = PRRU_OK;
   c->fd_step_peak = 0.0;
   gsl_odeiv2_driver_reset(drv);
-  int bad = -1, gs = track_advance(drv, c->o, t, tk, y, &bad);
+  int bad = -1, gs = track_advance(drv, c, t, tk, y, &bad);
   if (gs == GSL_SUCCESS) return PRRU_OK;
   if (gs == GSL_EDOM && bad >= 0) {
     double d[PRRU_NACT];
-    prru_param_ik(&c->o->plant, y, d);
+    prru_param_ik(c->plant, y, d);
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                      "stopped at t = %.9g s (between samples): slider %d at d = %.9g m "
                      "left its stroke [%g, %g]", *t, bad + 1, d[bad], c->o->d_min[bad],
@@ -715,6 +725,9 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   c.ref = ref;
   c.o = o;
   c.d = malloc(sizeof(prru_data));
+  prru_param_derived *plant = malloc(sizeof *plant);
+  if (plant) prru_param_derive(&o->plant, plant);
+  c.plant = plant;
   c.continuous = o->control_period == 0.0;
   prru_lqr_schedule lqr;
   memset(&lqr, 0, sizeof lqr);
@@ -722,6 +735,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
     st = prru_lqr_schedule_build(m, ref, o, &lqr, msg, msglen);
     if (st != PRRU_OK) {
       free(c.d);
+      free(plant);
       return st;
     }
     c.lqr = &lqr;
@@ -733,7 +747,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
       gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, h0, o->abs_tol, o->rel_tol);
   int noisy = o->noise_q > 0.0 || o->noise_qd > 0.0;
   gsl_rng *rng = noisy ? gsl_rng_alloc(gsl_rng_mt19937) : NULL;
-  if (!c.d || !s || !drv || (noisy && !rng)) {
+  if (!c.d || !plant || !s || !drv || (noisy && !rng)) {
     st = prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
   } else {
     if (rng) gsl_rng_set(rng, o->seed);
@@ -745,6 +759,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   if (drv) gsl_odeiv2_driver_free(drv);
   if (rng) gsl_rng_free(rng);
   free(c.d);
+  free(plant);
   free(s);
   prru_lqr_schedule_free(&lqr);
   if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';

@@ -449,7 +449,7 @@ static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_N
 /* The assembly mode of the design at home, (0, 0, q3), as
  * prru_map_home_mode tells the model's (0: no point is in "the other"
  * mode). */
-static int home_mode(const prru_params *p, double q3)
+static int home_mode(const prru_param_derived *p, double q3)
 {
   const double q[3] = {0.0, 0.0, q3};
   double d[PRRU_NACT], Jd[PRRU_NACT * 3];
@@ -502,7 +502,7 @@ static int float_point_clear(const prru_design_problem *pr, const grid_block_f *
 /* b (q filled, n points) in float: w_R into w, and b's d, rc, st, other
  * as the double path gives them (d of the points taken in float: float's
  * converted; rc: rcond_min there, whose violation is 0 as the true rcond's). */
-static void grid_block_float(const prru_design_problem *pr, const prru_params *p, double L, int home,
+static void grid_block_float(const prru_design_problem *pr, const prru_param_derived *p, double L, int home,
                              grid_block *b, grid_block_f *f, double *w)
 {
   const int n = b->n;
@@ -558,7 +558,7 @@ static double point_violation(const prru_design_problem *pr, const grid_block *b
  * point's regularity differs from the status dd holds from before. */
 typedef struct {
   const prru_design_problem *pr;
-  const prru_params *p;
+  const prru_param_derived *p;
   prru_design_data *dd;
   double L;
   int home, compare, next_row;
@@ -634,7 +634,10 @@ static void *grid_worker(void *arg)
 static void grid_eval(const prru_design_problem *pr, const prru_params *p, prru_design_data *dd,
                       int compare)
 {
-  grid_job j = {pr, p, dd, prru_design_length_scale(p), home_mode(p, pr->grid.q3), compare, 0,
+  /* The design's numbers as the kernels read them: derived once here. */
+  prru_param_derived dp;
+  prru_param_derive(p, &dp);
+  grid_job j = {pr, &dp, dd, prru_design_length_scale(p), home_mode(&dp, pr->grid.q3), compare, 0,
                 PTHREAD_MUTEX_INITIALIZER};
   enum { MAX_THREADS = 64 };
   pthread_t tid[MAX_THREADS];

@@ -17,20 +17,23 @@
 #define P(name) prru_p3_##name
 #define UNSEEN_P(name) PRRU_P3_UNSEEN_FINITE_##name
 typedef prru_params3 topo_params;
+typedef prru_p3_derived topo_derived;
 #elif PRRU_NLIMB == 4
 #include "prru_p4_kernels.h"
 #define P(name) prru_p4_##name
 #define UNSEEN_P(name) PRRU_P4_UNSEEN_FINITE_##name
 typedef prru_params4 topo_params;
+typedef prru_p4_derived topo_derived;
 #else
 #error "prru: a build's model has 3 or 4 limbs"
 #endif
 
-/* The loaded numbers are stored as prru_params (the build's layout) and
- * read as the topology's: the same members in the same order. */
-typedef char params_layout_check[sizeof(topo_params) == sizeof(prru_params) ? 1 : -1];
+/* The loaded numbers are stored as prru_param_derived (the build's
+ * layout) and read as the topology's: the same members in the same
+ * order. */
+typedef char params_layout_check[sizeof(topo_derived) == sizeof(prru_param_derived) ? 1 : -1];
 
-#define TP(p) ((const topo_params *)(p))
+#define TP(p) ((const topo_derived *)(p))
 
 /* ---- specialised: the constant-folded kernels, p ignored ---- */
 static void s_ik(const void *p, const double q[3], double d[PRRU_NACT]) { (void)p, prru_ik(q, d); }
@@ -261,11 +264,11 @@ static void p_batch_dme_terms(const void *p, int n, const double *q, double *d, 
 }
 
 /* The topology's regressor reads the smoothing velocity from its
- * parameters: a copy with vs in it. */
+ * parameters (as given, nothing derived): a copy with vs in it. */
 static void p_regressor(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
                         double *Y)
 {
-  topo_params c = *TP(p);
+  topo_params c = TP(p)->params;
   c.coulomb_velocity = vs;
   P(regressor)(&c, q, qd, qdd, Y);
 }

@@ -13,7 +13,8 @@
 /* A loaded model's storage (prru_model.own). */
 typedef struct {
   prru_mechanism mech;
-  prru_params params;
+  /* Its numbers as the parameter kernels read them (prru_param_derive). */
+  prru_param_derived derived;
   char name[PRRU_MODEL_NAME_MAX + 1];
   char description[4 * PRRU_MODEL_DESCRIPTION_MAX + 1];
   char sha256[65];
@@ -185,7 +186,7 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
   *out = *src;
   out->mech = &c->mech;
   out->own = c;
-  if (src->kernel_params) out->kernel_params = &c->params;
+  if (src->kernel_params) out->kernel_params = &c->derived;
   return PRRU_OK;
 }
 
@@ -333,10 +334,11 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   prru_model_default(&tmp);
   tmp.mech = &l->mech;
   tmp.own = l;
-  prru_model_params(&tmp, &l->params);
+  prru_model_params(&tmp, &l->derived.params);
+  prru_param_derive(&l->derived.params, &l->derived);
   if (!prru_model_is_built(&tmp, 0)) {
     tmp.kernels = &prru_kernels_parameter;
-    tmp.kernel_params = &l->params;
+    tmp.kernel_params = &l->derived;
   }
   /* Settings kept from m only where it was a model already: a fresh
    * struct is defaults. */
@@ -349,7 +351,7 @@ int prru_model_use_parameter_kernels(prru_model *m)
   loaded_model *l = m->own;
   if (!l) return PRRU_EINPUT;
   m->kernels = &prru_kernels_parameter;
-  m->kernel_params = &l->params;
+  m->kernel_params = &l->derived;
   return PRRU_OK;
 }
 
