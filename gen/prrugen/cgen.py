@@ -547,14 +547,39 @@ def _scalar_lines(kernel, w):
     lines = ["const %s %s%d = %s[%d];" % (real, arr, i + 1, arr, i)
              for arr, syms in kernel.inputs for i, _ in enumerate(syms)
              if "%s%d" % (arr, i + 1) in w.used_inputs]
-    if kernel.params is not None:
-        lines += w.param_locals(kernel.params)
+    # Each parameter is loaded into its local right before the first line
+    # that uses it, not all at the top: a topology kernel reads hundreds,
+    # and loads printed first stay first (see below), all live at once.
+    params = kernel.params
+    access = {} if params is None else \
+        {params.local(s): params.access(s) for s in params.members()}
+
+    def load_params(root):
+        stack, seen = [root], set()
+        while stack:
+            n = stack.pop()
+            if not isinstance(n, Node) or n.index in seen:
+                continue
+            seen.add(n.index)
+            if n.op == "in":
+                name = n.args[0]
+                if name in access:
+                    lines.append("const %s %s = %s;" % (real, name, access.pop(name)))
+            elif n.op != "num" and (n is root or n.index not in w.temp):
+                stack.extend(n.args)
+
+    def define(n):
+        load_params(n)
+        lines.append(w.define(n))
+
     if low.guard_nodes:
         # Inputs of the guard first, then the guard, then everything else.
         for i in sorted(_uses(low.guard_nodes)[1]):
             n = g.nodes[i]
             if i not in w.temp and w.materialized(n):
-                lines.append(w.define(n))
+                define(n)
+        for n in low.guard_nodes:
+            load_params(n)
         conds = w.guard_conditions(lambda x, bound: "%s <= %s" % (x, bound))
         lines.append("/* Unreachable or non-finite q: every output is NaN. */")
         lines.append("if (!(%s)) {" % " &&\n      ".join(conds))
@@ -577,7 +602,7 @@ def _scalar_lines(kernel, w):
             n, done = stack.pop()
             if done:
                 if w.materialized(n) and n.index not in w.temp:
-                    lines.append(w.define(n))
+                    define(n)
                 continue
             if not pending(n) or n.index in seen:
                 continue
@@ -588,9 +613,9 @@ def _scalar_lines(kernel, w):
     for arr, ns in low.out_nodes:
         for i, n in enumerate(ns):
             emit_needed(n)
+            load_params(n)
             lines.append("%s[%d] = %s;" % (arr, i, w.expr(n)))
     lines = ["(void)%s;" % arr for arr in reversed(w.unused_arrays(kernel))] + lines
-    params = kernel.params
     if params is not None and not any(params.local(s) in w.used_inputs
                                       for s in params.members()):
         lines.insert(0, "(void)p;")

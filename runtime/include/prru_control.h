@@ -223,7 +223,8 @@ PRRU_API int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_tra
 /* The plant's accelerations under fd (no platform loads): M qdd = b from
  * prru_param_eom with o->plant, solved by Cholesky. PRRU_EUNREACHABLE
  * where the plant's q is unreachable (NaN), PRRU_ESINGULAR when M is not
- * positive definite. */
+ * positive definite. Derives p (prru_param_derive) at every call, about
+ * as long as the solve: prru_track derives its plant once per run. */
 PRRU_API int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
                               const double fd[PRRU_NACT], double qdd[3]);
 
