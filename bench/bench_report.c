@@ -131,7 +131,7 @@ void bench_print_json(const bench_options *op, const char *cpu, const sim_result
  * against its constant-folded namesake, batches interleaved. */
 static void print_param_cost(void)
 {
-  printf("runtime-parameter kernels (numbers from a prru_params) against the constant-folded ones,\n"
+  printf("runtime-parameter kernels (numbers derived once, prru_param_derive) against the constant-folded ones,\n"
          "batches interleaved, median [min-max] of the per-repetition time ratio:\n");
   for (int i = 0; i < bench_nkernels; i++) {
     const bench_kernel *k = &bench_kernels[i], *c = k->constant ? bench_kernel_named(k->constant) : NULL;

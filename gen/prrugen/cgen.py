@@ -104,7 +104,14 @@ class Graph:
         c, terms = e.args
         if negate:
             c, terms = -c, [(-k, t) for k, t in terms]
-        # Terms that share a coefficient are summed first and scaled once.
+        signed = self._scaled(terms)
+        if c != 0:
+            signed.append((c > 0, self.num(abs(c))))
+        return self._fold(signed)
+
+    def _scaled(self, terms):
+        """(positive?, node) per coefficient of the terms (k, expression):
+        terms that share a coefficient are summed first and scaled once."""
         groups = {}
         for k, t in terms:
             groups.setdefault(abs(k), []).append((k > 0, self.lower(t)))
@@ -116,9 +123,7 @@ class Graph:
             positive = members[0][0]
             inner = self._fold([(p == positive, n) for p, n in members])
             signed.append((positive, self.node("mul", self.num(k), inner)))
-        if c != 0:
-            signed.append((c > 0, self.num(abs(c))))
-        return self._fold(signed)
+        return signed
 
     def _fold(self, signed):
         """The sum of (positive?, node), the two operands ready first added

@@ -120,18 +120,8 @@ class HoistGraph(Graph):
             else:
                 signed.append((True, self.node("mul", self.lower(coef),
                                                self.lower(key))))
-        # Terms with a numeric coefficient as cgen.Graph lowers them: those
-        # sharing a coefficient summed first and scaled once.
-        scaled = {}
-        for k, key in numeric:
-            scaled.setdefault(abs(k), []).append((k > 0, self.lower(key)))
-        for k, members in scaled.items():
-            if k == 1:
-                signed += members
-                continue
-            positive = members[0][0]
-            inner = self._fold([(p == positive, n) for p, n in members])
-            signed.append((positive, self.node("mul", self.num(k), inner)))
+        # Terms with a numeric coefficient as cgen.Graph lowers them.
+        signed += self._scaled(numeric)
         if c != 0:
             signed.append((c > 0, self.num(abs(c))))
         if not signed:

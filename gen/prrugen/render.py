@@ -274,12 +274,12 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     dtype = topology_derived_ctype(n)
     upper = prefix.upper()
     hoisted = hoist.Hoisted(pmodel.order)
-    kernel_list = params.topology_kernels(
-        deriv, pmodel, dtype, derivative_kernels(deriv), hoisted)
+    derivs = derivative_kernels(deriv)
+    kernel_list = params.topology_kernels(deriv, pmodel, dtype, derivs, hoisted)
     # The regressor after the kernels of the constant set, as before the
     # derivatives; it reads the parameters as given (its caller sets the
     # smoothing velocity at every call).
-    nbase = len(kernel_list) - len(derivative_kernels(deriv))
+    nbase = len(kernel_list) - len(derivs)
     kernel_list.insert(nbase, params.plain_kernel(
         regressor.topology_regressor_kernel(deriv, pmodel), pmodel, ctype))
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
@@ -307,7 +307,8 @@ def render_topology(reference, pmodel, deriv, templates_dir):
     mech = deriv.mech
     labels = lambda_labels(mech)
     values = dict(banner=banner, prefix=prefix, PREFIX=upper, ctype=ctype,
-                  dtype=dtype, derive=derive_body, nlimb=n, nbody=len(mech.bodies), njoint=len(mech.joints),
+                  dtype=dtype, derive=derive_body, nlimb=n, nbody=len(mech.bodies),
+                  njoint=len(mech.joints),
                   nlambda=len(labels),
                   bodies=" ".join(b.name for b in mech.bodies),
                   a3=", a[3]" if n == 4 else "",
