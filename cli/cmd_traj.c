@@ -760,15 +760,18 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   prru_cli_json_model(f);
   fprintf(f, ",\n \"control\": \"%s\", \"period\": ", o->control_period > 0 ? "zero-order hold" : "continuous");
   prru_cli_json_number(f, o->control_period);
-  fputs(", \"kp\": ", f);
-  prru_cli_json_array(f, o->kp, 3);
-  fputs(", \"kd\": ", f);
-  prru_cli_json_array(f, o->kd, 3);
+  /* Each controller's own gains: the LQR's feedback comes from its
+   * weights, kp and kd are not used. */
   if (o->controller == PRRU_TRACK_LQR) {
     fputs(",\n \"controller\": \"lqr\", \"lqr_q\": ", f);
     prru_cli_json_array(f, o->lqr_q, 6);
     fputs(", \"lqr_r\": ", f);
     prru_cli_json_array(f, o->lqr_r, PRRU_NACT);
+  } else {
+    fputs(",\n \"controller\": \"computed_torque\", \"kp\": ", f);
+    prru_cli_json_array(f, o->kp, 3);
+    fputs(", \"kd\": ", f);
+    prru_cli_json_array(f, o->kd, 3);
   }
   fputs(",\n \"plant\": ", f);
   prru_cli_json_string(f, plant ? plant : "");

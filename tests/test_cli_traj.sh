@@ -302,7 +302,9 @@ def drives(k):  # format 2 under actuators, format 1 at the top
     a = m.get('actuators', {}).get(k, m.get(k, 0))
     return any(x != 0 for x in (a if isinstance(a, list) else [a]))
 friction = drives('damping') or drives('coulomb')
-assert l['controller'] == 'lqr' and 'controller' not in c, (l.get('controller'), c.get('controller'))
+assert l['controller'] == 'lqr' and c['controller'] == 'computed_torque', (l.get('controller'), c.get('controller'))
+# Each summary names only its controller's gains (the LQR uses no kp, kd).
+assert len(c['kp']) == len(c['kd']) == 3 and 'kp' not in l and 'kd' not in l and 'lqr_q' not in c, (c, l)
 assert len(l['lqr_q']) == 6 and len(l['lqr_r']) == n and min(l['lqr_q']) > 0 and min(l['lqr_r']) > 0, l
 assert l['samples'] == c['samples'] == 1001 and l['status'] == 'complete', l
 if friction:

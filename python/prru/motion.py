@@ -452,8 +452,11 @@ def _track_run(model, tr, o, lim, guard):
             "over_speed_fraction": stats["over"] / samples if samples else 0.0,
             "feedforward_peak": ff.value, "limits": lim,
             "status": "complete" if st == errors.OK else msg.value.decode("utf-8", "replace")}
+    # The controller and its own gains, as `prru track --summary` names them.
     if o.controller == 1:
         summ.update(controller="lqr", lqr_q=tuple(o.lqr_q), lqr_r=tuple(o.lqr_r))
+    else:
+        summ.update(controller="computed_torque", kp=tuple(o.kp), kd=tuple(o.kd))
     run = TrackRun(out.vec(cols["t"]), *(mat[k] for k in names[1:]), summ)
     err = failure[0] if failure else interrupt
     if err is None and st != errors.OK:

@@ -628,8 +628,10 @@ class TestMotion(unittest.TestCase):
             self.assertEqual(bits(run.q_ref[k]), bits([r["qr%d" % (i + 1)] for i in range(3)]))
             self.assertEqual(bits(run.fd[k]), bits([r["fd%d" % (i + 1)] for i in range(n)]))
             self.assertEqual(bits(run.qdd[k]), bits([r["qdd%d" % (i + 1)] for i in range(3)]))
-        for key in ("rms_error", "max_error", "max_fd", "max_dd", "feedforward_peak", "samples"):
+        for key in ("rms_error", "max_error", "max_fd", "max_dd", "feedforward_peak", "samples",
+                    "kp", "kd"):
             self.assertEqual(bits(run.summary[key]), bits(s[key]), key)
+        self.assertEqual((run.summary["controller"], s["controller"]), ("computed_torque",) * 2)
         self.assertEqual(run.summary["status"], "complete")
         self.assertGreater(max(run.summary["max_error"]), 0)  # the mismatch shows
         exact = MODEL.track(ref)
