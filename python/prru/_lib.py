@@ -352,6 +352,8 @@ class Library:
         self.forward_dynamics = _declare(dll, "prru_forward_dynamics", i, mp, dp, vp, vp, lp, vp)
         self.linearize_why = _declare(dll, "prru_linearize_why", i, mp, dp, vp, vp, lp, d,
                                       ctypes.POINTER(t.Linearization), ctypes.c_char_p, i)
+        self.linearize_batch = _declare(dll, "prru_linearize_batch", i, mp, i, vp, vp, lp, d,
+                                        ctypes.POINTER(t.Linearization), c_int_p)
         self.inverse_dynamics_preload = _declare(dll, "prru_inverse_dynamics_preload", i,
                                                  mp, dp, vp, vp, vp, lp, d, vp)
         self.actuator_null = _declare(dll, "prru_actuator_null", i, mp, dp, vp, vp)

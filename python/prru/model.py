@@ -347,6 +347,44 @@ class Model:
                              dt, mat(o.Ad, 6, 6) if dt else None,
                              mat(o.Bd, 6, n) if dt else None)
 
+    def linearize_batch(self, states, dt=None):
+        """linearize at many states in one call, through the batched
+        derivative kernel (prru_linearize_batch): states is a sequence of
+        (q, qd, fd) or (q, qd, fd, fp, mp). Returns a list with, per state,
+        its Linearization (the numbers linearize gives, within a few ulp
+        where the build's vector sin and cos take part), or where the state
+        is not trusted the exception linearize would raise there, returned
+        and not raised, so that the other states stand."""
+        states = _convert.ordered("states", states, "a sequence of (q, qd, fd[, fp, mp])")
+        n, t = len(states), self.lib.types
+        if dt is not None:
+            dt = _convert.scalar("dt", dt, positive=True, allow_zero=False)
+        q, qd, loads = (ctypes.c_double * (3 * n))(), (ctypes.c_double * (3 * n))(), (t.Loads * n)()
+        for k, s in enumerate(states):
+            s = _convert.ordered("states[%d]" % k, s, "(q, qd, fd[, fp, mp])")
+            if len(s) not in (3, 5):
+                raise ValueError("states[%d] must be (q, qd, fd) or (q, qd, fd, fp, mp), got %d items"
+                                 % (k, len(s)))
+            q[3 * k:3 * k + 3] = list(vector("states[%d] q" % k, s[0], 3))
+            qd[3 * k:3 * k + 3] = list(vector("states[%d] qd" % k, s[1], 3))
+            vector("states[%d] fd" % k, s[2], self.nact)  # required, as for linearize
+            loads[k] = self._loads(s[2], *(s[3:] or (None, None)))
+        out, status = (t.Linearization * n)(), (ctypes.c_int * n)()
+        self.lib.linearize_batch(ctypes.byref(self._m), n, q, qd, loads, dt or 0.0, out, status)
+        na, mat, result = self.nact, self._out.mat, []
+        for k in range(n):
+            if status[k] != errors.OK:
+                result.append(errors.make_error(status[k], "linearize_batch: state %d, q = %s: %s" % (
+                    k, _fmt(q[3 * k:3 * k + 3]), self.lib.status_text(status[k]))))
+                continue
+            o = out[k]
+            result.append(Linearization(
+                self._out.vec(o.qdd), mat(o.dqdd_dq, 3, 3), mat(o.dqdd_dqd, 3, 3),
+                mat(o.dqdd_dfd, 3, na), mat(o.dqdd_dfp, 3, 3), mat(o.dqdd_dmp, 3, 3),
+                mat(o.A, 6, 6), mat(o.B, 6, na), dt, mat(o.Ad, 6, 6) if dt else None,
+                mat(o.Bd, 6, na) if dt else None))
+        return result
+
     def inverse_dynamics(self, q, qd, qdd, fp=None, mp=None, preload=0.0):
         """Actuator forces fd (N, nact) producing qdd under fp, mp: the
         least-norm solution of J_d^T fd = tau, plus preload (N) along the

@@ -76,6 +76,12 @@ def flat(m):
     return out
 
 
+def Linearization_keys(dt):
+    """The fields of a Linearization that hold numbers (Ad, Bd with dt)."""
+    keys = ("qdd", "dqdd_dq", "dqdd_dqd", "dqdd_dfd", "dqdd_dfp", "dqdd_dmp", "A", "B")
+    return keys + (("Ad", "Bd") if dt else ())
+
+
 def bits(x):
     """A float's identity: equal bits compare equal, NaN too."""
     if isinstance(x, (int, float)):
@@ -297,6 +303,39 @@ class TestAgainstCli(unittest.TestCase):
                 self.assertEqual(bits(n), bits(out["actuator_null"]))
             if MODEL.nreaction_null:
                 self.assertEqual(bits(MODEL.reaction_null(q)), bits(out["reaction_null"]))
+
+    def test_linearize_batch(self):
+        """Model.linearize_batch: per state, linearize's numbers, or the
+        exception linearize raises there, returned; the other states stand.
+        The batched kernel's own rule (a few ulp of q1, q2 propagated,
+        where the vector sin and cos take part) is test_batch's, in C; this
+        checks the binding, whose mistakes (a state's or a block's place)
+        are O(1) of a block: 1e-12 of the block's largest entry is above
+        that rule's few ulp by four orders and below a misplaced entry by
+        twelve."""
+        states = [tuple(s) for s in random_states(6, 11)]
+        bad = [3.0, 0.0, 0.0]
+        states.insert(2, (bad,) + states[0][1:])
+        for dt in (None, 0.002):
+            got = MODEL.linearize_batch(states, dt=dt)
+            self.assertEqual(len(got), len(states))
+            self.assertIsInstance(got[2], prru.Unreachable)
+            with self.assertRaises(prru.Unreachable):
+                MODEL.linearize(*states[2], dt=dt)
+            for k, (lin, st) in enumerate(zip(got, states)):
+                if k == 2:
+                    continue
+                want = MODEL.linearize(*st, dt=dt)
+                for key in Linearization_keys(dt):
+                    a, b = flat(getattr(lin, key)), flat(getattr(want, key))
+                    scale = max(1e-300, max(abs(x) for x in b))
+                    self.assertLessEqual(max(abs(x - y) for x, y in zip(a, b)), 1e-12 * scale,
+                                         "state %d %s" % (k, key))
+        self.assertEqual(MODEL.linearize_batch([]), [])
+        with self.assertRaises(ValueError):
+            MODEL.linearize_batch([states[0][:2]])
+        with self.assertRaises(ValueError):
+            MODEL.linearize_batch(states, dt=-1.0)
 
     def test_linearize(self):
         """Model.linearize equals `prru linearize` to the bit, with and
