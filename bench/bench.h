@@ -220,7 +220,12 @@ void bench_derivs_print_table(const bench_derivs *r);
 void bench_derivs_print_json(const bench_derivs *r);
 
 /* bench_regen.c */
-int bench_time_regeneration(int reps, bench_stats *out);
+enum { BENCH_REGEN_NSETS = 5 };
+typedef struct {
+  const char *name, *options; /* options: the generator's, after the model */
+} bench_regen_set;
+extern const bench_regen_set bench_regen_sets[BENCH_REGEN_NSETS];
+int bench_time_regeneration(int reps, bench_stats out[BENCH_REGEN_NSETS]);
 
 /* bench_report.c */
 typedef struct {

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "bench.h"
+#include "prru_derivs.h"
 #include "prru_kernels.h"
 #include "prru_linearize.h"
 

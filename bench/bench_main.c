@@ -167,18 +167,18 @@ int main(int argc, char **argv)
   }
   bench_modes_done = 1;
   if (!op.json) fprintf(stderr, "regenerating...\n");
-  bench_stats regen = {0, 0, 0};
-  int regen_ok = bench_time_regeneration(op.quick ? 1 : 3, &regen) == 0;
+  bench_stats regen[BENCH_REGEN_NSETS];
+  int regen_ok = bench_time_regeneration(op.quick ? 1 : 3, regen) == 0;
 
   char cpu[256];
   bench_cpu_model(cpu, sizeof cpu);
   /* Without --json the table comes first and the same numbers follow as the
    * last line, so `make bench` shows both from one run. */
   if (!op.json) {
-    bench_print_table(&op, cpu, &sim, &map, regen_ok, &regen);
+    bench_print_table(&op, cpu, &sim, &map, regen_ok, regen);
     printf("\n");
   }
-  bench_print_json(&op, cpu, &sim, &map, regen_ok, &regen);
+  bench_print_json(&op, cpu, &sim, &map, regen_ok, regen);
   free(c.d);
   prru_ref_free(c.w);
   /* A failed simulation or regeneration is a broken project, not a slow one. */

@@ -27,10 +27,22 @@ static void remove_tree_flat(const char *dir)
     fprintf(stderr, "prru_bench: cannot remove %s: %s\n", dir, strerror(errno));
 }
 
-/* Wall seconds of `python3 gen/prru_gen.py MODEL --out TMP --quiet`, the
- * whole process including the interpreter's start, as a user pays it.
- * Returns 0 or -1 (with the reason on stderr). */
-int bench_time_regeneration(int reps, bench_stats *out)
+/* The generator's sets (gen/prru_gen.py): the default double set a
+ * controller drops in, each opt-in set with it, the single-precision set,
+ * and everything the library's build asks for. */
+const bench_regen_set bench_regen_sets[BENCH_REGEN_NSETS] = {
+    {"default", ""},
+    {"derivatives", "--derivatives"},
+    {"regressor", "--regressor"},
+    {"float", "--precision float"},
+    {"build", "--derivatives --regressor"},
+};
+
+/* Wall seconds of `python3 gen/prru_gen.py MODEL --out TMP --quiet` with
+ * each set's options, the whole process including the interpreter's start,
+ * as a user pays it; the sets interleaved, rep after rep. Returns 0 or -1
+ * (with the reason on stderr). */
+int bench_time_regeneration(int reps, bench_stats out[BENCH_REGEN_NSETS])
 {
   const char *paths[] = {PRRU_BENCH_PYTHON, PRRU_BENCH_SOURCE_DIR, PRRU_BENCH_MODEL};
   for (int i = 0; i < 3; i++)
@@ -45,23 +57,24 @@ int bench_time_regeneration(int reps, bench_stats *out)
     fprintf(stderr, "prru_bench: regeneration: cannot create %s: %s\n", dir, strerror(errno));
     return -1;
   }
+  static double s[BENCH_REGEN_NSETS][MAXREPS];
   char cmd[8192];
-  /* The generator's stdout goes to stderr so it cannot corrupt --json. */
-  snprintf(cmd, sizeof cmd, "'%s' '%s/gen/prru_gen.py' '%s' --out '%s' --quiet 1>&2",
-           PRRU_BENCH_PYTHON, PRRU_BENCH_SOURCE_DIR, PRRU_BENCH_MODEL, dir);
-  double s[MAXREPS];
   int rc = 0;
-  for (int i = 0; i < reps && rc == 0; i++) {
-    double t0 = bench_now_ns();
-    rc = system(cmd);
-    s[i] = (bench_now_ns() - t0) * 1e-9;
-  }
+  for (int i = 0; i < reps && rc == 0; i++)
+    for (int k = 0; k < BENCH_REGEN_NSETS && rc == 0; k++) {
+      /* The generator's stdout goes to stderr so it cannot corrupt --json. */
+      snprintf(cmd, sizeof cmd, "'%s' '%s/gen/prru_gen.py' '%s' %s --out '%s' --quiet 1>&2",
+               PRRU_BENCH_PYTHON, PRRU_BENCH_SOURCE_DIR, PRRU_BENCH_MODEL,
+               bench_regen_sets[k].options, dir);
+      double t0 = bench_now_ns();
+      rc = system(cmd);
+      s[k][i] = (bench_now_ns() - t0) * 1e-9;
+    }
   remove_tree_flat(dir);
   if (rc != 0) {
     fprintf(stderr, "prru_bench: regeneration failed (status %d): %s\n", rc, cmd);
     return -1;
   }
-  *out = bench_stats_of(s, reps);
+  for (int k = 0; k < BENCH_REGEN_NSETS; k++) out[k] = bench_stats_of(s[k], reps);
   return 0;
 }
-

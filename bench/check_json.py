@@ -150,6 +150,14 @@ def main():
         fail("'derivs' incomplete: %r" % (derivs,))
     if not positive(doc.get("regeneration_s")):
         fail("regeneration_s missing")
+    # Every set of the generator, each timed (bench_regen.c).
+    sets = doc.get("regeneration_sets_s")
+    set_names = ("default", "derivatives", "regressor", "float", "build")
+    if not isinstance(sets, dict) or sorted(sets) != sorted(set_names) or \
+            not all(positive(sets[k]) for k in set_names):
+        fail("regeneration_sets_s incomplete: %r" % (sets,))
+    if sets["default"] != doc["regeneration_s"]:
+        fail("regeneration_s is not the default set's time")
     print("bench_smoke: JSON complete, %d kernels" % len(names))
 
 

@@ -1,16 +1,19 @@
 #!/usr/bin/env python3
 """Generate the C dynamics kernels of a 3-PRRU model file.
 
-usage: python3 gen/prru_gen.py MODEL.json --out DIR [--prefix NAME] [--quiet]
+usage: python3 gen/prru_gen.py MODEL.json --out DIR [--prefix NAME]
+           [--derivatives] [--regressor] [--quiet]
        python3 gen/prru_gen.py MODEL.json --precision float --out DIR [...]
        python3 gen/prru_gen.py --topology {3,4} --out DIR [--quiet]
 
 Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
 (the mechanism descriptor) and DIR/<prefix>_param_kernels.{h,c} (the kernels
-with the model's numbers as a run-time argument) and DIR/<prefix>_regressor.{h,c}
+with the model's numbers as a run-time argument), where <prefix> is the
+model's "name" unless --prefix says otherwise. Two sets more on request:
+--derivatives writes DIR/<prefix>_derivs.{h,c} (the closed-form derivatives
+of forward and inverse dynamics), --regressor DIR/<prefix>_regressor.{h,c}
 (the dynamics as a linear function of the inertial and drive parameters, for
-identification), where <prefix> is the model's "name" unless
---prefix says otherwise. With --topology N instead of a model file, writes
+identification); the library's build asks for both. With --topology N instead of a model file, writes
 DIR/prru_pN_kernels.{h,c}: every kernel with every number of the model read
 from a prru_paramsN argument, derived from the structure of the N-limb
 machine alone (the same files whatever model a build uses; the library of
@@ -40,22 +43,40 @@ TEMPLATES = os.path.join(ROOT, "templates")
 _NAME = "prru_gen"
 
 
-def generate(model_path, templates_dir=TEMPLATES, prefix=None):
+# The opt-in sets of a model's double generation (--derivatives,
+# --regressor): what the library's build asks for, and most of the
+# generator's time (the default set is the drop-in controller's).
+SETS = ("derivatives", "regressor")
+
+
+def generate(model_path, templates_dir=TEMPLATES, prefix=None, sets=()):
     """(files {name: text}, emitted kernels) for a model file."""
-    return generate_model(model_mod.load(model_path), templates_dir, prefix)
+    return generate_model(model_mod.load(model_path), templates_dir, prefix,
+                          sets)
 
 
-def generate_model(model, templates_dir=TEMPLATES, prefix=None):
+def generate_model(model, templates_dir=TEMPLATES, prefix=None, sets=()):
     """(files {name: text}, emitted kernels) for a loaded model: the
-    constant kernels, the mechanism descriptor, the runtime-parameter
-    kernels' names (the topology kernels', render.render_params) and the
-    regressor."""
+    constant kernels, the mechanism descriptor and the runtime-parameter
+    kernels' names (the topology kernels', render.render_params); and the
+    sets of SETS that sets names: the derivative kernels, the regressor.
+    Each set's files are the same whichever others are asked for."""
+    unknown = set(sets) - set(SETS)
+    if unknown:
+        raise ValueError("unknown kernel sets %s" % sorted(unknown))
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
     files, emitted = render.render(model, deriv, templates_dir, prefix)
     # The parameter kernels are the topology's (--topology N), named
     # after the model: nothing to derive.
     files.update(render.render_params(model, templates_dir, prefix))
+    if "derivatives" in sets:
+        dfiles, demitted = render.render_derivs(model, deriv, templates_dir,
+                                                prefix)
+        files.update(dfiles)
+        emitted = emitted + demitted
+    if "regressor" not in sets:
+        return files, emitted
     # A fresh start, so the regressor never depends on the constant
     # kernels' creation order.
     sym.reset()
@@ -146,11 +167,21 @@ def main(argv=None, prog="prru_gen.py"):
                         "(default: the model's name)")
     parser.add_argument("--precision", choices=("double", "float"),
                         default="double",
-                        help="double (default): every kernel, the descriptor, "
-                        "the runtime-parameter kernels and the regressor; "
+                        help="double (default): the kernels, the descriptor "
+                        "and the runtime-parameter kernels' names (with "
+                        "--derivatives, --regressor their sets); "
                         "float: only the controller kernels in single "
                         "precision, named <prefix>_f_* (writes "
                         "<prefix>_f_kernels.{h,c})")
+    parser.add_argument("--derivatives", action="store_true",
+                        help="also write <prefix>_derivs.{h,c}: the "
+                        "closed-form derivatives of forward and inverse "
+                        "dynamics (a model file, double precision)")
+    parser.add_argument("--regressor", action="store_true",
+                        help="also write <prefix>_regressor.{h,c}: the "
+                        "dynamics linear in the inertial and drive "
+                        "parameters, for identification (a model file, "
+                        "double precision)")
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
@@ -160,6 +191,11 @@ def main(argv=None, prog="prru_gen.py"):
     if args.topology is not None and args.precision != "double":
         parser.error("--precision float applies to a model file's kernels "
                      "only (the topology kernels are double)")
+    sets = tuple(name for name in SETS if getattr(args, name))
+    if sets and (args.topology is not None or args.precision != "double"):
+        parser.error("--%s applies to a model file's double kernels only "
+                     "(the topology kernels carry every set)" % sets[0])
+    args.sets = sets
     if args.topology is not None and args.prefix:
         parser.error("--prefix applies to a model file's kernels only "
                      "(the topology kernels are prru_p<N>_*)")
@@ -184,7 +220,8 @@ def _run(args):
             if args.precision == "float":
                 files, emitted = generate_float(model, prefix=args.prefix)
             else:
-                files, emitted = generate_model(model, prefix=args.prefix)
+                files, emitted = generate_model(model, prefix=args.prefix,
+                                                sets=args.sets)
         except model_mod.ModelError as exc:
             print("%s: error: %s" % (_NAME, exc), file=sys.stderr)
             return 1

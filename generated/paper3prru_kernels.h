@@ -26,8 +26,6 @@
  *   eom_solve          305 arithmetic (48 add, 49 sub, 203 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3
  *   inverse_terms      328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3
  *   joint_reactions    686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3
- *   eom_solve_derivs   1499 arithmetic (215 add, 273 sub, 993 mul, 6 div, 12 neg); calls: cos 2, sin 2, sqrt 3
- *   inverse_derivs     1486 arithmetic (256 add, 225 sub, 992 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3
  */
 #ifndef PAPER3PRRU_KERNELS_H
 #define PAPER3PRRU_KERNELS_H
@@ -69,8 +67,6 @@
 #define PAPER3PRRU_ARITH_EOM_SOLVE 305 /* arithmetic operations */
 #define PAPER3PRRU_ARITH_INVERSE_TERMS 328 /* arithmetic operations */
 #define PAPER3PRRU_ARITH_JOINT_REACTIONS 686 /* arithmetic operations */
-#define PAPER3PRRU_ARITH_EOM_SOLVE_DERIVS 1499 /* arithmetic operations */
-#define PAPER3PRRU_ARITH_INVERSE_DERIVS 1486 /* arithmetic operations */
 #define PAPER3PRRU_OPS_IK "31 arithmetic (5 add, 7 sub, 18 mul, 1 div); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_JD "50 arithmetic (2 add, 8 sub, 37 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_IK_JD "60 arithmetic (6 add, 10 sub, 41 mul, 3 div); calls: cos 2, sin 2, sqrt 3"
@@ -92,8 +88,6 @@
 #define PAPER3PRRU_OPS_EOM_SOLVE "305 arithmetic (48 add, 49 sub, 203 mul, 4 div, 1 neg); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_INVERSE_TERMS "328 arithmetic (55 add, 49 sub, 215 mul, 4 div, 5 neg); calls: cos 2, sin 2, sqrt 3"
 #define PAPER3PRRU_OPS_JOINT_REACTIONS "686 arithmetic (136 add, 150 sub, 387 mul, 5 div, 8 neg); calls: cos 2, sin 2, sqrt 3"
-#define PAPER3PRRU_OPS_EOM_SOLVE_DERIVS "1499 arithmetic (215 add, 273 sub, 993 mul, 6 div, 12 neg); calls: cos 2, sin 2, sqrt 3"
-#define PAPER3PRRU_OPS_INVERSE_DERIVS "1486 arithmetic (256 add, 225 sub, 992 mul, 6 div, 7 neg); calls: cos 2, sin 2, sqrt 3"
 /* Whether the inputs of paper3prru_eom_solve that may not show in its b and qdd are finite:
    a NaN or an infinity in any other input makes one of those outputs NaN or
    infinite (the inputs tested here do not reach them, or reach them only through
@@ -105,18 +99,6 @@
    infinite (the inputs tested here do not reach them, or reach them only through
    tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
 #define PAPER3PRRU_UNSEEN_FINITE_INVERSE_TERMS(q, qd, qdd, fp, mp) \
-  (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
-/* Whether the inputs of paper3prru_eom_solve_derivs that may not show in its b and qdd are finite:
-   a NaN or an infinity in any other input makes one of those outputs NaN or
-   infinite (the inputs tested here do not reach them, or reach them only through
-   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
-#define PAPER3PRRU_UNSEEN_FINITE_EOM_SOLVE_DERIVS(q, qd, fd, fp, mp) \
-  (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
-/* Whether the inputs of paper3prru_inverse_derivs that may not show in its d and fd are finite:
-   a NaN or an infinity in any other input makes one of those outputs NaN or
-   infinite (the inputs tested here do not reach them, or reach them only through
-   tanh, atan2 or a denominator), so testing the outputs tests those inputs (isfinite: <math.h>). */
-#define PAPER3PRRU_UNSEEN_FINITE_INVERSE_DERIVS(q, qd, qdd, fp, mp) \
   (isfinite((qd)[2]) && isfinite((fp)[0]) && isfinite((fp)[1]))
 #define PAPER3PRRU_REACTION_BASIS_NNZ 167 /* entries of paper3prru_reaction_basis's Q */
 
@@ -189,12 +171,6 @@ void paper3prru_inverse_terms(const double q[3], const double qd[3], const doubl
 /* The joint reaction coordinates lambda (57, docs/model.md section 7) at the accelerations qdd (which must solve the equations of motion: M qdd = b of prru_eom), in closed form limb by limb. */
 void paper3prru_joint_reactions(const double q[3], const double qd[3], const double qdd[3], const double fd[3], const double fp[3], const double mp[3], double lambda[57]);
 
-/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
-void paper3prru_eom_solve_derivs(const double q[3], const double qd[3], const double fd[3], const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3], double minors[3], double Dq[9], double Dqd[9], double Dfd[9], double Dfp[9], double Dmp[9]);
-
-/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). */
-void paper3prru_inverse_derivs(const double q[3], const double qd[3], const double qdd[3], const double fp[3], const double mp[3], double d[3], double Jd[9], double Jdinv[9], double fd[3], double Dq[9], double Dqd[9], double Dqdd[9]);
-
 /* Batched kernels, paper3prru_batch_<name>(n, inputs..., outputs...): the
  * kernel of the same name (or, for dme_terms, the named ones fused) for n
  * states in one call. Every array holds one row of n per component:
@@ -228,12 +204,6 @@ void paper3prru_batch_eom(int n, const double *q, const double *qd, const double
 
 /* eom's M and b, qdd = M^-1 b (M_22, a constant, eliminated first, then the 2x2 Schur complement S by its adjugate), and three principal minors of M on nested index sets ({2}, {2, 0}, {0, 1, 2}): M is positive definite exactly when all three are positive (Sylvester), and qdd is meaningful only then. */
 void paper3prru_batch_eom_solve(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors);
-
-/* eom_solve's M, b, qdd and minors, and the derivatives of qdd, each row-major with row i = qdd_i and column k = the k-th variable: Dq = dqdd/dq (3x3), Dqd = dqdd/dqd (3x3), Dfd = dqdd/dfd (3x3), Dfp = dqdd/dfp (3x3), Dmp = dqdd/dmp (3x3); d qdd/dx = M^-1 (db/dx - (dM/dx) qdd), the solves by eom_solve's factorization of M. */
-void paper3prru_batch_eom_solve_derivs(int n, const double *q, const double *qd, const double *fd, const double *fp, const double *mp, double *M, double *b, double *qdd, double *minors, double *Dq, double *Dqd, double *Dfd, double *Dfp, double *Dmp);
-
-/* inverse_terms (d, J_d, J_d^-1, fd) and the derivatives of fd, row-major with row i = fd_i and column k = the k-th variable: Dq = dfd/dq, Dqd = dfd/dqd, Dqdd = dfd/dqdd (= J_d^-T M), each 3x3; dfd/dx = J_d^-T (dtau/dx - (dJ_d/dx)^T fd). */
-void paper3prru_batch_inverse_derivs(int n, const double *q, const double *qd, const double *qdd, const double *fp, const double *mp, double *d, double *Jd, double *Jdinv, double *fd, double *Dq, double *Dqd, double *Dqdd);
 
 /* prru_ik_jd, prru_mass and prru_platform_jacobian fused: what the manipulability maps need at each q. */
 void paper3prru_batch_dme_terms(int n, const double *q, double *d, double *Jd, double *M, double *JP);

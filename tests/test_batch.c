@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "prru_derivs.h"
 #include "prru_kernels.h"
 #include "prru_mechanism.h"
 #include "prru_param_kernels.h"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Drop-in quality of the committed generated kernels: a user copies
 # generated/ (the kernels, the descriptor, the runtime-parameter kernels,
+# the opt-in derivative and regressor sets,
 # the topology kernels prru_p3_*, prru_p4_*)
 # into their own controller and builds it with their compiler and
 # their warning flags. So copy ONLY generated/ (plus tests/dropin_main.c as
@@ -37,7 +38,7 @@ skipped=()
 # runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"paper3prru_kernels\.h"|"paper3prru_mechanism\.h"|"paper3prru_param_kernels\.h"|"paper3prru_regressor\.h"|"prru_p[34]_kernels\.h"'
+  allowed='<math\.h>|"paper3prru_kernels\.h"|"paper3prru_mechanism\.h"|"paper3prru_param_kernels\.h"|"paper3prru_regressor\.h"|"paper3prru_derivs\.h"|"prru_p[34]_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   case "$f" in ./paper3prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_kernels\.h"' ;; esac
   case "$f" in ./paper3prru_f_batch.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_batch\.h"' ;; esac

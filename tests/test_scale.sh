@@ -23,7 +23,8 @@ json.dump(m, open(sys.argv[3], "w"), default=str)
 PY
   # json.dump of Decimal as strings: turn them back into numbers.
   sed -i -E 's/"(-?[0-9.]+(E[-+]?[0-9]+)?)"/\1/g' "$tmp/model_$s.json"
-  python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru --quiet || return 1
+  python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru \
+    --derivatives --regressor --quiet || return 1
   # Only the model's own kernels are compiled: the build's runtime
   # (compiled against headers that differ from these in their comments
   # and operation counts alone, checked: constants that fold at one scale
@@ -32,12 +33,12 @@ PY
   # member the objects given first leave unused (a clash would fail the
   # link, not pass silently).
   body() { sed "1,/\*\//d" "$1" | grep -v -E '^#define PRRU_(ARITH|OPS)_'; }
-  for h in prru_kernels.h prru_mechanism.h prru_param_kernels.h prru_regressor.h; do
+  for h in prru_kernels.h prru_mechanism.h prru_param_kernels.h prru_regressor.h prru_derivs.h; do
     diff <(body "$dir/$h") <(body "$BUILD/generated/$h") >/dev/null || {
       echo "scale $s: $h differs from the build's beyond its comment"; return 1; }
   done
   local objs=()
-  for c in prru_kernels prru_mechanism prru_param_kernels prru_regressor; do
+  for c in prru_kernels prru_mechanism prru_param_kernels prru_regressor prru_derivs; do
     # The build's generated/ after the model's own: prru_param_kernels.h
     # names the topology kernels (prru_p3_kernels.h), which no model's
     # generation writes.

@@ -17,10 +17,13 @@ ROOT = os.path.dirname(GEN_DIR)
 MODEL = os.path.join(ROOT, "models", "3prru_paper.json")
 ENTRY = os.path.join(GEN_DIR, "prru_gen.py")
 # Every file one generation of the paper's model writes (its name,
-# paper3prru, the prefix), in sorted order.
+# paper3prru, the prefix), in sorted order: the default set, and with both
+# opt-in sets (--derivatives, --regressor).
 OUTPUT_FILES = ["paper3prru_kernels.c", "paper3prru_kernels.h", "paper3prru_mechanism.c",
                 "paper3prru_mechanism.h", "paper3prru_param_kernels.c",
-                "paper3prru_param_kernels.h", "paper3prru_regressor.c", "paper3prru_regressor.h"]
+                "paper3prru_param_kernels.h"]
+ALL_FILES = sorted(OUTPUT_FILES + ["paper3prru_derivs.c", "paper3prru_derivs.h",
+                                   "paper3prru_regressor.c", "paper3prru_regressor.h"])
 
 
 def read_dir(d):
@@ -170,6 +173,42 @@ class CommandLine(unittest.TestCase):
                 outs.append(read_dir(d))
         self.assertEqual(outs[0], outs[1])
         self.assertEqual(sorted(outs[0]), OUTPUT_FILES)
+
+    def test_opt_in_sets_add_files_and_change_none(self):
+        # Each set's files are the same whichever others are asked for,
+        # and the committed generated/ is the whole set.
+        outs = {}
+        for flags in ((), ("--derivatives",), ("--regressor",),
+                      ("--derivatives", "--regressor")):
+            with tempfile.TemporaryDirectory() as d:
+                r = run_gen(MODEL, "--out", d, "--quiet", *flags)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                outs[flags] = read_dir(d)
+        whole = outs[("--derivatives", "--regressor")]
+        self.assertEqual(sorted(whole), ALL_FILES)
+        self.assertEqual(sorted(outs[("--derivatives",)]), sorted(
+            OUTPUT_FILES + ["paper3prru_derivs.c", "paper3prru_derivs.h"]))
+        self.assertEqual(sorted(outs[("--regressor",)]), sorted(
+            OUTPUT_FILES + ["paper3prru_regressor.c", "paper3prru_regressor.h"]))
+        for files in outs.values():
+            for name, text in files.items():
+                self.assertEqual(text, whole[name], name)
+        committed = read_dir(os.path.join(ROOT, "generated"))
+        for name, text in whole.items():
+            self.assertEqual(committed.get(name), text,
+                             "generated/%s is stale: make regenerate" % name)
+        self.assertIn("--derivatives --out <dir>",
+                      whole["paper3prru_derivs.h"].decode())
+        self.assertNotIn(b"eom_solve_derivs", whole["paper3prru_kernels.c"])
+
+    def test_sets_apply_to_a_model_files_double_kernels_only(self):
+        for args in (("--topology", "3", "--derivatives"),
+                     (MODEL, "--precision", "float", "--regressor")):
+            with tempfile.TemporaryDirectory() as d:
+                r = run_gen(*args, "--out", os.path.join(d, "out"))
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertIn("double kernels only", r.stderr)
+                self.assertFalse(os.path.exists(os.path.join(d, "out")))
 
     def test_help_and_summary(self):
         r = run_gen("--help")

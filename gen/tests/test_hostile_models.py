@@ -496,7 +496,8 @@ class HostileDescriptionGenerates(unittest.TestCase):
             f.write(set_top("description", HOSTILE_DESCRIPTION))
         cls.out = os.path.join(cls.tmp.name, "out")
         cls.gen = subprocess.run([sys.executable, ENTRY, cls.model, "--out",
-                                  cls.out, "--quiet"], capture_output=True,
+                                  cls.out, "--derivatives", "--regressor",
+                                  "--quiet"], capture_output=True,
                                  text=True, timeout=600)
 
     @classmethod

@@ -10,6 +10,7 @@
 #include "internal.h"
 #include "prru.h"
 #include "prru_param_kernels.h"
+#include "prru_derivs.h"
 #include "prru_regressor.h"
 
 #if PRRU_NLIMB == 3
