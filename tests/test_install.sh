@@ -76,11 +76,13 @@ fi
 # The generator installed for `prru gen` runs on its own (its templates
 # beside it, in share/prru) and writes what the source tree's writes;
 # the installed prru gen (which takes the generator installed beside it)
-# too.
+# too. Every set, so that every template is found.
 gen_model="$PRRU_SOURCE_DIR/models/prototype_example.json"
-if env -i PATH="$PATH" python3 "$prefix/share/prru/gen/prru_gen.py" "$gen_model" --out "$tmp/gen_inst" --quiet &&
-   "$prefix/bin/prru" gen "$gen_model" --out "$tmp/gen_inst_cli" --quiet &&
-   python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$gen_model" --out "$tmp/gen_src" --quiet &&
+sets=(--derivatives --regressor)
+if env -i PATH="$PATH" python3 "$prefix/share/prru/gen/prru_gen.py" "$gen_model" "${sets[@]}" --out "$tmp/gen_inst" --quiet &&
+   "$prefix/bin/prru" gen "$gen_model" "${sets[@]}" --out "$tmp/gen_inst_cli" --quiet &&
+   python3 "$PRRU_SOURCE_DIR/gen/prru_gen.py" "$gen_model" "${sets[@]}" --out "$tmp/gen_src" --quiet &&
+   [ -e "$tmp/gen_inst/proto_derivs.c" ] && [ -e "$tmp/gen_inst/proto_regressor.c" ] &&
    diff -r "$tmp/gen_inst" "$tmp/gen_src" >/dev/null && diff -r "$tmp/gen_inst_cli" "$tmp/gen_src" >/dev/null; then
   ok "install: the generator (share/prru/gen) and prru gen write the source tree's kernels"
 else
