@@ -113,23 +113,27 @@ fuzz: deps-fuzz build
 	FUZZ_SECONDS=$(FUZZ_SECONDS) PRRU_GEN_DIR=$(abspath $(BUILD))/generated fuzz/run.sh
 
 # Fails when the committed generated/ (the paper model's kernels and the
-# topology kernels prru_p3_*, prru_p4_* of every build) is not what the
+# topology kernels prru_p3_*, prru_p4_* and their variants prru_p3s_*,
+# prru_p4s_* of every build) is not what the
 # generator makes now, whichever MODEL the build uses.
 # The committed set is whole: the opt-in derivative and regressor sets too.
 TOPOLOGIES = 3 4
+STRUCTURES = general simple
 GEN_SETS = --derivatives --regressor
 check-generated:
 	@tmp=$$(mktemp -d) && \
 	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) $(GEN_SETS) --out $$tmp --quiet && \
-	for n in $(TOPOLOGIES); do $(PYTHON) gen/prru_gen.py --topology $$n --out $$tmp --quiet || \
-	  { rm -rf $$tmp; exit 1; }; done && \
+	for n in $(TOPOLOGIES); do for s in $(STRUCTURES); do \
+	  $(PYTHON) gen/prru_gen.py --topology $$n --structure $$s --out $$tmp --quiet || \
+	  { rm -rf $$tmp; exit 1; }; done; done && \
 	if diff -r -q $$tmp generated >/dev/null; then echo "generated/ is up to date"; rm -rf $$tmp; \
 	else diff -r -u generated $$tmp | head -40; rm -rf $$tmp; \
 	  echo "generated/ is stale: run 'make regenerate' and commit"; exit 1; fi
 
 regenerate:
 	$(PYTHON) gen/prru_gen.py $(PAPER_MODEL) $(GEN_SETS) --out generated
-	for n in $(TOPOLOGIES); do $(PYTHON) gen/prru_gen.py --topology $$n --out generated || exit 1; done
+	for n in $(TOPOLOGIES); do for s in $(STRUCTURES); do \
+	  $(PYTHON) gen/prru_gen.py --topology $$n --structure $$s --out generated || exit 1; done; done
 
 # docs/cli.md, the command-line reference, from the help texts of the
 # paper model's build (tests/paper_cli_doc.sh fails when it is stale).

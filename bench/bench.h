@@ -143,10 +143,12 @@ typedef struct {
 } bench_batch_row;
 /* The same model's numbers through the runtime on the specialised kernels
  * and loaded from its file onto the parameter kernels
- * (prru_model_use_parameter_kernels): ns per call, and per repetition
- * parameter / specialised. */
+ * (prru_model_use_parameter_kernels: the simple structural variant where
+ * the numbers allow it) and onto the general ones
+ * (prru_model_use_general_kernels): ns per call, and per repetition
+ * parameter / specialised and general / specialised. */
 typedef struct {
-  bench_stats specialised_ns, parameter_ns, ratio;
+  bench_stats specialised_ns, parameter_ns, ratio, general_ns, general_ratio;
 } bench_path_row;
 /* Single against double precision (--precision float): ns per state of
  * each, and per repetition double / float. */
@@ -156,6 +158,7 @@ typedef struct {
 typedef struct {
   bench_mode_row dynamics, forward, inverse;
   int paths_measured;             /* the model file loaded */
+  int paths_simple;               /* its parameter path is the simple variant */
   bench_path_row path_dynamics, path_forward, path_inverse, path_reactions;
   bench_batch_row batch_dynamics, batch_eom_solve, batch_dme_terms, batch_w_r;
   bench_precision_row float_dme_terms, float_w_r;

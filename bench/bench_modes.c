@@ -118,39 +118,52 @@ static double run_path(bench_ctx *c, const prru_model *m, int kind, long n)
   return t / (double)n;
 }
 
-static void time_paths(bench_ctx *c, const prru_model *param, int kind, long n, int reps, bench_path_row *r)
+static void time_paths(bench_ctx *c, const prru_model *param, const prru_model *general, int kind, long n,
+                       int reps, bench_path_row *r)
 {
-  double a[MAXREPS], b[MAXREPS], ratio[MAXREPS];
+  double a[MAXREPS], b[MAXREPS], ratio[MAXREPS], g[MAXREPS], gratio[MAXREPS];
   for (int i = -2; i < reps; i++) { /* two warm-up rounds */
     const double ts = run_path(c, &c->m, kind, n), tp = run_path(c, param, kind, n);
+    const double tg = run_path(c, general, kind, n);
     if (i < 0) continue;
     a[i] = ts;
     b[i] = tp;
     ratio[i] = tp / ts;
+    g[i] = tg;
+    gratio[i] = tg / ts;
   }
   r->specialised_ns = bench_stats_of(a, reps);
   r->parameter_ns = bench_stats_of(b, reps);
   r->ratio = bench_stats_of(ratio, reps);
+  r->general_ns = bench_stats_of(g, reps);
+  r->general_ratio = bench_stats_of(gratio, reps);
 }
 
 /* The bench's model file loaded at run time and switched to the
  * parameter kernels: what a user's own model costs against a build of it. */
 static void time_loaded(bench_ctx *c, long n, int reps, bench_modes *m)
 {
-  prru_model param;
-  char msg[512];
+  prru_model param, general;
+  char msg[512] = "";
   prru_model_default(&param);
+  prru_model_default(&general);
   if (prru_model_load(&param, PRRU_BENCH_MODEL, msg, sizeof msg) != PRRU_OK ||
-      prru_model_use_parameter_kernels(&param) != PRRU_OK) {
+      prru_model_use_parameter_kernels(&param) != PRRU_OK ||
+      prru_model_load(&general, PRRU_BENCH_MODEL, msg, sizeof msg) != PRRU_OK ||
+      prru_model_use_general_kernels(&general) != PRRU_OK) {
     fprintf(stderr, "prru_bench: the parameter path not timed: %s\n", msg);
+    prru_model_free(&param);
+    prru_model_free(&general);
     return;
   }
-  time_paths(c, &param, PATH_DYNAMICS, n, reps, &m->path_dynamics);
-  time_paths(c, &param, PATH_FORWARD, n, reps, &m->path_forward);
-  time_paths(c, &param, PATH_INVERSE, n, reps, &m->path_inverse);
-  time_paths(c, &param, PATH_REACTIONS, n, reps, &m->path_reactions);
+  m->paths_simple = param.kernels->dynamics != general.kernels->dynamics;
+  time_paths(c, &param, &general, PATH_DYNAMICS, n, reps, &m->path_dynamics);
+  time_paths(c, &param, &general, PATH_FORWARD, n, reps, &m->path_forward);
+  time_paths(c, &param, &general, PATH_INVERSE, n, reps, &m->path_inverse);
+  time_paths(c, &param, &general, PATH_REACTIONS, n, reps, &m->path_reactions);
   m->paths_measured = 1;
   prru_model_free(&param);
+  prru_model_free(&general);
 }
 
 typedef double (*mode_fn)(bench_ctx *c, long n, int chained);
@@ -482,8 +495,9 @@ static void precision_row(const char *name, const bench_precision_row *r)
 
 static void path_row(const char *name, const bench_path_row *r)
 {
-  printf("  %-17s %7.1f ns specialised, %7.1f parameter: %.2fx [%.2f-%.2f]\n", name, r->specialised_ns.median,
-         r->parameter_ns.median, r->ratio.median, r->ratio.min, r->ratio.max);
+  printf("  %-17s %7.1f ns specialised, %7.1f parameter: %.2fx [%.2f-%.2f]; %7.1f general: %.2fx\n", name,
+         r->specialised_ns.median, r->parameter_ns.median, r->ratio.median, r->ratio.min, r->ratio.max,
+         r->general_ns.median, r->general_ratio.median);
 }
 
 void bench_modes_print_table(const bench_modes *m)
@@ -495,7 +509,9 @@ void bench_modes_print_table(const bench_modes *m)
   row("inverse_dynamics", &m->inverse);
   if (m->paths_measured) {
     printf("the model's numbers on the specialised kernels and loaded onto the parameter kernels\n"
-           "(prru_model_load + prru_model_use_parameter_kernels), throughput per call:\n");
+           "(prru_model_load + prru_model_use_parameter_kernels: %s), and onto the general\n"
+           "ones, throughput per call:\n",
+           m->paths_simple ? "the simple structural variant" : "general, as the numbers need");
     path_row("dynamics", &m->path_dynamics);
     path_row("forward_dynamics", &m->path_forward);
     path_row("inverse_dynamics", &m->path_inverse);
@@ -551,9 +567,11 @@ static void json_precision(const char *name, const bench_precision_row *r, int l
 
 static void json_path(const char *name, const bench_path_row *r, int last)
 {
-  printf("\"%s\": {\"specialised_ns\": %.4g, \"parameter_ns\": %.4g, ", name, r->specialised_ns.median,
-         r->parameter_ns.median);
+  printf("\"%s\": {\"specialised_ns\": %.4g, \"parameter_ns\": %.4g, \"general_ns\": %.4g, ", name,
+         r->specialised_ns.median, r->parameter_ns.median, r->general_ns.median);
   json_stats("parameter_over_specialised", &r->ratio);
+  printf(", ");
+  json_stats("general_over_specialised", &r->general_ratio);
   printf("}%s", last ? "" : ", ");
 }
 
@@ -565,7 +583,7 @@ void bench_modes_print_json(const bench_modes *m)
   json_mode("inverse_dynamics", &m->inverse, 1);
   printf("}, \"loaded_paths\": ");
   if (m->paths_measured) {
-    printf("{");
+    printf("{\"structure\": \"%s\", ", m->paths_simple ? "simple" : "general");
     json_path("dynamics", &m->path_dynamics, 0);
     json_path("forward_dynamics", &m->path_forward, 0);
     json_path("inverse_dynamics", &m->path_inverse, 0);

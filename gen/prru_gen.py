@@ -4,7 +4,7 @@
 usage: python3 gen/prru_gen.py MODEL.json --out DIR [--prefix NAME]
            [--derivatives] [--regressor] [--quiet]
        python3 gen/prru_gen.py MODEL.json --precision float --out DIR [...]
-       python3 gen/prru_gen.py --topology {3,4} --out DIR [--quiet]
+       python3 gen/prru_gen.py --topology {3,4} [--structure simple] --out DIR
 
 Writes DIR/<prefix>_kernels.{h,c} (the kernels), DIR/<prefix>_mechanism.{h,c}
 (the mechanism descriptor) and DIR/<prefix>_param_kernels.{h,c} (the kernels
@@ -13,10 +13,13 @@ model's "name" unless --prefix says otherwise. Two sets more on request:
 --derivatives writes DIR/<prefix>_derivs.{h,c} (the closed-form derivatives
 of forward and inverse dynamics), --regressor DIR/<prefix>_regressor.{h,c}
 (the dynamics as a linear function of the inertial and drive parameters, for
-identification); the library's build asks for both. With --topology N instead of a model file, writes
-DIR/prru_pN_kernels.{h,c}: every kernel with every number of the model read
-from a prru_paramsN argument, derived from the structure of the N-limb
-machine alone (the same files whatever model a build uses; the library of
+identification); the library's build asks for both. With --topology N
+instead of a model file, writes DIR/prru_pN_kernels.{h,c}: every kernel
+with every number of the model read from a prru_paramsN argument, derived
+from the structure of the N-limb machine alone (--structure simple:
+DIR/prru_pNs_kernels.{h,c}, the variant for models with no centre-of-mass
+offsets, products of inertia or drives and gravity along -z; the same
+files whatever model a build uses; the library of
 every build carries both). With --precision float instead, writes only
 DIR/<prefix>_f_kernels.{h,c}: the controller kernels (render.CONTROLLER_KERNELS)
 in single precision, named <prefix>_f_*, so that they link beside the double
@@ -123,11 +126,12 @@ def _range_error(model, exc):
         % (exc.kernel, exc.value, exc.reason, blame))
 
 
-def generate_topology(nlimb, templates_dir=TEMPLATES):
+def generate_topology(nlimb, templates_dir=TEMPLATES, structure="general"):
     """(files {name: text}, emitted kernels) of the topology kernels of
     nlimb limbs (params.Topology): from the structure alone; the reference
     model (params.TOPOLOGY_REFERENCE) supplies only the initializer of
-    prru_p<n>_params_reference."""
+    prru_p<n>_params_reference. structure "simple": the structural variant
+    prru_p<n>s (params.STRUCTURES)."""
     reference = model_mod.load(os.path.join(
         ROOT, params.TOPOLOGY_REFERENCE[nlimb]))
     if reference.nlimb != nlimb:
@@ -135,7 +139,7 @@ def generate_topology(nlimb, templates_dir=TEMPLATES):
                                    "has %d limbs, the topology %d"
                                    % (reference.nlimb, nlimb))
     sym.reset()
-    pmodel = params.ParamModel(params.Topology(nlimb))
+    pmodel = params.ParamModel(params.Topology(nlimb), structure)
     deriv = dynamics.Derivation(mechanism.build(pmodel), pmodel)
     return render.render_topology(reference, pmodel, deriv, templates_dir)
 
@@ -160,6 +164,13 @@ def main(argv=None, prog="prru_gen.py"):
                         help="instead of a model file: the kernels of every "
                         "model with this many limbs, the numbers a run-time "
                         "argument (writes prru_p<N>_kernels.{h,c})")
+    parser.add_argument("--structure", choices=params.STRUCTURES,
+                        default="general",
+                        help="with --topology: general (default), every "
+                        "number read at run time; simple, the variant for "
+                        "models with no centre-of-mass offsets, no products "
+                        "of inertia, no drives and gravity along -z (writes "
+                        "prru_p<N>s_kernels.{h,c})")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="output directory (created if missing)")
     parser.add_argument("--prefix", metavar="NAME", type=_prefix,
@@ -196,6 +207,8 @@ def main(argv=None, prog="prru_gen.py"):
         parser.error("--%s applies to a model file's double kernels only "
                      "(the topology kernels carry every set)" % sets[0])
     args.sets = sets
+    if args.topology is None and args.structure != "general":
+        parser.error("--structure applies to --topology only")
     if args.topology is not None and args.prefix:
         parser.error("--prefix applies to a model file's kernels only "
                      "(the topology kernels are prru_p<N>_*)")
@@ -206,7 +219,8 @@ def _run(args):
     start = time.perf_counter()
     try:
         if args.topology is not None:
-            files, emitted = generate_topology(args.topology)
+            files, emitted = generate_topology(args.topology,
+                                               structure=args.structure)
         else:
             model = model_mod.load(args.model)
     except model_mod.ModelError as exc:

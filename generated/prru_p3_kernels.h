@@ -169,6 +169,14 @@ typedef struct {
   double armature[3], damping[3], coulomb[3], coulomb_velocity;
 } prru_params3;
 
+/* The numbers of the reference model 3prru_paper.json (a valid
+ * 3-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
+ * friction). Only this initializer depends on that file. */
+extern const prru_params3 prru_p3_params_reference;
+
+/* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
+extern const char *const prru_p3_lambda_labels[PRRU_P3_NLAMBDA];
+
 /* What the kernels read: the parameters and the numbers derived from them
  * alone (h: sums and products of the parameters that the kernels would
  * otherwise compute at every call, where a constant kernel has them folded
@@ -182,14 +190,6 @@ typedef struct {
 /* d from the parameters p (p may be &d->params): once per model, before any
  * kernel is called with d (PRRU_P3_ARITH_DERIVE operations). */
 void prru_p3_derive(const prru_params3 *p, prru_p3_derived *d);
-
-/* The numbers of the reference model 3prru_paper.json (a valid
- * 3-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
- * friction). Only this initializer depends on that file. */
-extern const prru_params3 prru_p3_params_reference;
-
-/* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
-extern const char *const prru_p3_lambda_labels[PRRU_P3_NLAMBDA];
 
 /* Actuator displacements d_i (height of joint A_i on rail i). Numbers from *p. */
 void prru_p3_ik(const prru_p3_derived *p, const double q[3], double d[3]);

@@ -172,6 +172,14 @@ typedef struct {
   double armature[4], damping[4], coulomb[4], coulomb_velocity;
 } prru_params4;
 
+/* The numbers of the reference model 4prru.json (a valid
+ * 4-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
+ * friction). Only this initializer depends on that file. */
+extern const prru_params4 prru_p4_params_reference;
+
+/* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
+extern const char *const prru_p4_lambda_labels[PRRU_P4_NLAMBDA];
+
 /* What the kernels read: the parameters and the numbers derived from them
  * alone (h: sums and products of the parameters that the kernels would
  * otherwise compute at every call, where a constant kernel has them folded
@@ -185,14 +193,6 @@ typedef struct {
 /* d from the parameters p (p may be &d->params): once per model, before any
  * kernel is called with d (PRRU_P4_ARITH_DERIVE operations). */
 void prru_p4_derive(const prru_params4 *p, prru_p4_derived *d);
-
-/* The numbers of the reference model 4prru.json (a valid
- * 4-limb model; coulomb_velocity is 1 m/s where it has no Coulomb
- * friction). Only this initializer depends on that file. */
-extern const prru_params4 prru_p4_params_reference;
-
-/* Names of the reaction coordinates lambda, in order (as prru_mech.lambda_labels). */
-extern const char *const prru_p4_lambda_labels[PRRU_P4_NLAMBDA];
 
 /* Actuator displacements d_i (height of joint A_i on rail i). Numbers from *p. */
 void prru_p4_ik(const prru_p4_derived *p, const double q[3], double d[4]);

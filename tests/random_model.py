@@ -2,7 +2,7 @@
 """A seeded generator of valid model files, for the generic test suite.
 
 usage: python3 tests/random_model.py --seed N --out FILE [--limbs 3|4]
-                                     [--format 1|2]
+                                     [--format 1|2] [--structure S]
 
 The same seed (and options) always writes the same file. What varies, within
 the spec (sections 11-13) and what gen/prrugen/model.py accepts:
@@ -18,7 +18,13 @@ the spec (sections 11-13) and what gen/prrugen/model.py accepts:
     positive definite with strict triangle inequalities);
   - drives: armature, viscous damping and smoothed Coulomb force per
     actuator, each present or absent by the seed;
-  - gravity tilted up to 15 degrees off -z, magnitude 9.0 .. 10.6 m/s^2.
+  - gravity tilted up to 15 degrees off -z, magnitude 9.0 .. 10.6 m/s^2;
+  - structure (--structure; default: general except one format-2 seed in
+    ten, seed % 10 == 5): simple is a format-2 model with every centre of
+    mass, product of inertia and drive written as exactly 0 and gravity
+    along -z, what the topology kernels' simple variant (prru_p3s_*,
+    prru_p4s_*) evaluates, so that 4-limb models exercise it too (format 1
+    is always of that structure).
 Every model keeps the workspace the generic tests use: the limbs assemble
 at q = 0 with the upper links between 25 % and 55 % of full stretch (the
 paper's is 39 %), and every pose in TEST_POSES is reachable with J_d well
@@ -187,7 +193,7 @@ def body_size(name, limbs, scale):
     return (thin, length, thin) if i < 2 else (length, thin, thin)
 
 
-def draw_body(rng, name, limbs, scale, mass_factor, fmt):
+def draw_body(rng, name, limbs, scale, mass_factor, fmt, simple=False):
     mass = PAPER_MASS[name[0]] * mass_factor * rng.uniform(0.7, 1.3)
     size = body_size(name, limbs, scale)
     # second moments int x_k^2 dm of a uniform box of these sides, each
@@ -201,6 +207,10 @@ def draw_body(rng, name, limbs, scale, mass_factor, fmt):
     body = {"mass": num(mass)}
     if fmt == 1:
         body["inertia"] = [num(x) for x in principal]
+        return body
+    if simple:
+        body["inertia"] = [num(x) for x in principal] + [0, 0, 0]
+        body["com"] = [0, 0, 0]
         return body
     r = random_rotation(rng, 0.4)
     t = [[sum(r[i][k] * principal[k] * r[j][k] for k in range(3))
@@ -231,10 +241,12 @@ def draw_actuators(rng, nlimb, total_mass):
     return out
 
 
-def draw_gravity(rng, fmt):
+def draw_gravity(rng, fmt, simple=False):
     g = rng.uniform(9.0, 10.6)
     if fmt == 1:
         return num(g)
+    if simple:
+        return [0, 0, num(-g)]
     tilt = math.radians(rng.uniform(0, 15))
     azimuth = rng.uniform(0, 2 * math.pi)
     return [num(-g * math.sin(tilt) * math.cos(azimuth)),
@@ -242,7 +254,7 @@ def draw_gravity(rng, fmt):
             num(-g * math.cos(tilt))]
 
 
-def draw_model(seed, nlimb, fmt):
+def draw_model(seed, nlimb, fmt, simple=False):
     rng = random.Random(seed)
     scale = log_uniform(rng, 0.1, 10)
     mass_factor = log_uniform(rng, 0.3, 3)
@@ -253,7 +265,7 @@ def draw_model(seed, nlimb, fmt):
     else:
         return None, scale, mass_factor
     names = model_mod.body_names(nlimb)
-    bodies = {n: draw_body(rng, n, limbs, scale, mass_factor, fmt)
+    bodies = {n: draw_body(rng, n, limbs, scale, mass_factor, fmt, simple)
               for n in names}
     total = sum(b["mass"] for b in bodies.values())
     doc = {}
@@ -261,9 +273,11 @@ def draw_model(seed, nlimb, fmt):
         doc["format"] = 2
     doc["name"] = "rand%d" % seed
     doc["description"] = ("Random valid model (tests/random_model.py --seed "
-                          "%d --limbs %d --format %d): size x%.3g, masses "
-                          "x%.3g" % (seed, nlimb, fmt, scale, mass_factor))
-    doc["gravity"] = draw_gravity(rng, fmt)
+                          "%d --limbs %d --format %d%s): size x%.3g, masses "
+                          "x%.3g" % (seed, nlimb, fmt,
+                                     " --structure simple" if simple else "",
+                                     scale, mass_factor))
+    doc["gravity"] = draw_gravity(rng, fmt, simple)
     if fmt == 1:
         doc["geometry"] = {"b12": limbs[0][0], "b3": limbs[2][0],
                            "l1": limbs[0][1], "l2": limbs[0][2],
@@ -274,7 +288,7 @@ def draw_model(seed, nlimb, fmt):
                            "l2": [l[2] for l in limbs],
                            "a": [limbs[0][3], limbs[1][3]]}
     doc["bodies"] = bodies
-    if fmt == 2:
+    if fmt == 2 and not simple:
         act = draw_actuators(rng, nlimb, total)
         if act:
             doc["actuators"] = act
@@ -295,6 +309,7 @@ def main(argv=None):
     ap.add_argument("--out", required=True)
     ap.add_argument("--limbs", type=int, choices=(3, 4))
     ap.add_argument("--format", type=int, choices=(1, 2))
+    ap.add_argument("--structure", choices=("general", "simple"))
     args = ap.parse_args(argv)
     if args.seed < 0 or args.seed >= 10 ** 12:
         ap.error("--seed must be in [0, 1e12) (the model's name is rand<seed>)")
@@ -303,7 +318,13 @@ def main(argv=None):
     fmt = args.format or (fmt if nlimb == 3 else 2)
     if fmt == 1 and nlimb == 4:
         ap.error("format 1 has 3 limbs (spec section 11)")
-    doc, scale, mass_factor = draw_model(args.seed, nlimb, fmt)
+    structure = args.structure or ("simple" if fmt == 1 or args.seed % 10 == 5
+                                   else "general")
+    if fmt == 1 and structure == "general":
+        ap.error("format 1 is of the simple structure (no centre-of-mass "
+                 "offsets, products of inertia or drives)")
+    doc, scale, mass_factor = draw_model(args.seed, nlimb, fmt,
+                                         structure == "simple" and fmt == 2)
     if doc is None:
         print("random_model.py: seed %d: no geometry with the tests' "
               "workspace in %d draws" % (args.seed, MAX_DRAWS), file=sys.stderr)
@@ -324,8 +345,9 @@ def main(argv=None):
     with os.fdopen(fd, "w") as f:
         f.write(text)
     os.replace(tmp, args.out)
-    print("%s: seed %d, %d limbs, format %d, size x%.3g, masses x%.3g"
-          % (args.out, args.seed, nlimb, fmt, scale, mass_factor))
+    print("%s: seed %d, %d limbs, format %d, %s structure, size x%.3g, "
+          "masses x%.3g" % (args.out, args.seed, nlimb, fmt, structure, scale,
+                            mass_factor))
     return 0
 
 

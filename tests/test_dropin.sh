@@ -38,7 +38,7 @@ skipped=()
 # runtime-parameter kernels only on the kernels' header): any other include would be a dependency the user has to
 # discover by a failed build.
 for f in ./*.c ./*.h; do
-  allowed='<math\.h>|"paper3prru_kernels\.h"|"paper3prru_mechanism\.h"|"paper3prru_param_kernels\.h"|"paper3prru_regressor\.h"|"paper3prru_derivs\.h"|"prru_p[34]_kernels\.h"'
+  allowed='<math\.h>|"paper3prru_kernels\.h"|"paper3prru_mechanism\.h"|"paper3prru_param_kernels\.h"|"paper3prru_regressor\.h"|"paper3prru_derivs\.h"|"prru_p[34]s?_kernels\.h"'
   [ "$f" = ./main.c ] && allowed="$allowed|<stdio\.h>|<string\.h>"
   case "$f" in ./paper3prru_f_kernels.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_kernels\.h"' ;; esac
   case "$f" in ./paper3prru_f_batch.*) allowed='<math\.h>|<float\.h>|"paper3prru_f_batch\.h"' ;; esac
@@ -59,23 +59,24 @@ fi
 
 kernels=()
 for f in ./*.c; do
-  case "$f" in ./main.c | ./float_main.c | ./paper3prru_f_kernels.c | ./paper3prru_f_batch.c | ./prru_p[34]_kernels.c) ;;
+  case "$f" in ./main.c | ./float_main.c | ./paper3prru_f_kernels.c | ./paper3prru_f_batch.c | ./prru_p[34]*_kernels.c) ;;
     *) kernels+=("$f") ;;
   esac
 done
 
 # The topology kernels (prru_p3_*, prru_p4_*: 12 and 15 thousand lines,
-# most of this test's time) are compiled once per compiler, in its first
-# mode (C99, or C++), under the same flags, and those objects are linked
-# into its other mode (C11): the C11 builds then recompile only the model's
-# own files. The paper's program links prru_p3 (its parameter kernels);
-# prru_p4 is compiled for its warnings alone.
+# most of this test's time, and their simple variants prru_p3s_*,
+# prru_p4s_*) are compiled once per compiler, in its first mode (C99, or
+# C++), under the same flags, and those objects are linked into its other
+# mode (C11): the C11 builds then recompile only the model's own files.
+# The paper's program links prru_p3 (its parameter kernels); the others
+# are compiled for their warnings alone.
 topology_objects() { # compiler args...: sets topo to the objects, 1 on a failure
   local cc=$1 key=${1//[^a-z0-9]/_}
   shift
   topo=("./topo_${key}_p3.o")
   [ -f "./topo_${key}_p3.o" ] && return 0
-  for n in 3 4; do
+  for n in 3 4 3s 4s; do
     if ! "$cc" "$@" "${FLAGS[@]}" -I. -c "./prru_p${n}_kernels.c" -o "./topo_${key}_p${n}.o" \
       >"./topo_${key}_p${n}.log" 2>&1 || [ -s "./topo_${key}_p${n}.log" ]; then
       echo "FAIL $cc: prru_p${n}_kernels.c does not compile cleanly:"

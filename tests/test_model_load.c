@@ -93,7 +93,8 @@ typedef struct {
 /* One state: forward and inverse dynamics and the reactions against the
  * reference from the loaded numbers; refusals by the trust criterion skip. */
 static void check_state(const prru_model *m, const prru_ref_params *P, const double q[3], const double qd[3],
-                        const prru_loads *l, worst *w, const char *file, int reactions, const prru_model *alt)
+                        const prru_loads *l, worst *w, const char *file, int reactions,
+                        const prru_model *const alts[2])
 {
   double qdd[3], qdd_ref[3], fd[PRRU_NACT], fd_ref[PRRU_NACT], lam[PRRU_NLAMBDA], lam_ref[PRRU_NLAMBDA];
   if (prru_forward_dynamics(m, &data, q, qd, l, qdd) != PRRU_OK) return;
@@ -118,14 +119,15 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
    * within K bfd of the exact qdd, so they differ by at most twice that;
    * likewise ID below. */
   double qdd_alt[3], fd_alt[PRRU_NACT];
-  if (alt && prru_forward_dynamics(alt, &data, q, qd, l, qdd_alt) == PRRU_OK) {
-    double ea = 0;
-    for (int i = 0; i < 3; i++) ea = fmax(ea, fabs(qdd[i] - qdd_alt[i]));
-    w->paths = fmax(w->paths, ea / bfd);
-    snprintf(what, sizeof what, "%s: specialised vs parameter kernels, |qdd - qdd_p| / (u (kappa |qdd| + |M^-1| S))",
-             file);
-    tu_check(ea <= 2 * K * bfd, what, ea / bfd, 2 * K);
-  }
+  for (int a = 0; a < 2; a++)
+    if (alts[a] && prru_forward_dynamics(alts[a], &data, q, qd, l, qdd_alt) == PRRU_OK) {
+      double ea = 0;
+      for (int i = 0; i < 3; i++) ea = fmax(ea, fabs(qdd[i] - qdd_alt[i]));
+      w->paths = fmax(w->paths, ea / bfd);
+      snprintf(what, sizeof what, "%s: two kernel tables (%s), |qdd - qdd_p| / (u (kappa |qdd| + |M^-1| S))",
+               file, a ? "general" : "parameter");
+      tu_check(ea <= 2 * K * bfd, what, ea / bfd, 2 * K);
+    }
 
   /* Inverse dynamics at the same state and qdd, against the reference's
    * (minimum-norm with four actuators, as the runtime's). */
@@ -138,14 +140,15 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
     w->id = fmax(w->id, r / bid);
     snprintf(what, sizeof what, "%s: |fd - fd_ref| / (u |J_d^+| (|M| |qdd| + S))", file);
     tu_check(r <= K * bid, what, r / bid, K);
-    if (alt && prru_inverse_dynamics(alt, &data, q, qd, qdd, l, fd_alt) == PRRU_OK) {
-      double ra = 0;
-      for (int i = 0; i < PRRU_NACT; i++) ra = fmax(ra, fabs(fd[i] - fd_alt[i]));
-      w->paths = fmax(w->paths, ra / bid);
-      snprintf(what, sizeof what, "%s: specialised vs parameter kernels, |fd - fd_p| / (u |J_d^+| (|M| |qdd| + S))",
-               file);
-      tu_check(ra <= 2 * K * bid, what, ra / bid, 2 * K);
-    }
+    for (int a = 0; a < 2; a++)
+      if (alts[a] && prru_inverse_dynamics(alts[a], &data, q, qd, qdd, l, fd_alt) == PRRU_OK) {
+        double ra = 0;
+        for (int i = 0; i < PRRU_NACT; i++) ra = fmax(ra, fabs(fd[i] - fd_alt[i]));
+        w->paths = fmax(w->paths, ra / bid);
+        snprintf(what, sizeof what, "%s: two kernel tables (%s), |fd - fd_p| / (u |J_d^+| (|M| |qdd| + S))",
+                 file, a ? "general" : "parameter");
+        tu_check(ra <= 2 * K * bid, what, ra / bid, 2 * K);
+      }
     /* The round trip ID(FD(fd)) = fd, compared as generalised forces
      * J_d^T fd (with four actuators ID returns fd less its component along
      * the null vector of J_d^T, which J_d^T removes). Bound: qdd carries
@@ -400,8 +403,14 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   worst w = {0, 0, 0, 0, 0, 0, 0};
   /* The build's own numbers: the same file again, on the parameter
    * kernels, compared state by state with the specialised path. */
-  prru_model alt;
+  /* And the general parameter kernels where the model's own path is
+   * their simple variant (a model with none of its numbers: exactly the
+   * zeros the variant drops). The simple variant is chosen exactly when
+   * every centre of mass, product of inertia and drive number is 0 and
+   * gravity is along z. */
+  prru_model alt, general;
   prru_model_default(&alt);
+  prru_model_default(&general);
   const int two_paths = built && prru_model_load(&alt, path, msg, sizeof msg) == PRRU_OK &&
                         prru_model_use_parameter_kernels(&alt) == PRRU_OK &&
                         strcmp(alt.kernels->path, "parameter") == 0;
@@ -409,6 +418,23 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
     snprintf(what, sizeof what, "%s: a second copy switched to the parameter kernels", path);
     TU_TRUE(two_paths, what);
   }
+  const prru_model *paramd = built ? &alt : &m;
+  const prru_mechanism *me = m.mech;
+  int simple = me->gravity[0] == 0 && me->gravity[1] == 0;
+  for (int b = 0; b < PRRU_NBODY; b++) /* inertia: 3x3 row-major, products off the diagonal */
+    simple &= !me->com[b][0] && !me->com[b][1] && !me->com[b][2] && !me->inertia[b][1] && !me->inertia[b][2] &&
+              !me->inertia[b][5];
+  for (int i = 0; i < PRRU_NACT; i++) simple &= !me->armature[i] && !me->damping[i] && !me->coulomb[i];
+  prru_model probe;
+  prru_model_default(&probe);
+  const int loaded_general = paramd->own && prru_model_load(&probe, path, msg, sizeof msg) == PRRU_OK &&
+                             prru_model_use_general_kernels(&probe) == PRRU_OK;
+  snprintf(what, sizeof what, "%s: the parameter kernels are the simple variant exactly when its numbers are %s", path,
+           simple ? "simple" : "not");
+  TU_TRUE(loaded_general && (paramd->kernels->dynamics != probe.kernels->dynamics) == simple, what);
+  if (loaded_general && simple) general = probe;
+  else prru_model_free(&probe);
+  const prru_model *alts[2] = {two_paths ? &alt : NULL, simple && general.own ? &general : NULL};
   if (!home_height(&m, L, &q3)) {
     printf("%s: SKIPPED the dynamics: no regular pose at q1 = q2 = 0\n", path);
   } else {
@@ -416,7 +442,7 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
       double q[3], qd[3];
       prru_loads l;
       if (!random_state(&m, &P, L, q3, q, qd, &l)) break;
-      check_state(&m, &P, q, qd, &l, &w, path, reactions, two_paths ? &alt : NULL);
+      check_state(&m, &P, q, qd, &l, &w, path, reactions, alts);
     }
     printf("home %s 0,0,%.17g\n", path, q3); /* the CLI check of test_random_loaded.sh starts there */
     const double q0[3] = {0.05, -0.05, q3};
@@ -426,8 +452,11 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
          "energy %.2g of its bound\n",
          path, m.kernels->path, ms, w.states, w.fd, w.id, w.rt, w.lam, reactions ? "" : " (not compared: see main)",
          w.energy);
-  if (two_paths) printf("  specialised vs parameter kernels: %.2f u-bounds (FD, ID)\n", w.paths);
+  if (alts[0] || alts[1])
+    printf("  against the other kernel tables (%s%s): %.2f u-bounds (FD, ID)\n", alts[0] ? "parameter " : "",
+           alts[1] ? "general" : "", w.paths);
   prru_model_free(&alt);
+  prru_model_free(&general);
   snprintf(what, sizeof what, "%s: dynamics compared at regular states", path);
   TU_TRUE(w.states >= STATES / 2, what);
   prru_model_free(&m);

@@ -60,10 +60,25 @@ class Topology:
 TOPOLOGY_REFERENCE = {3: "models/3prru_paper.json", 4: "models/4prru.json"}
 
 
-class ParamModel:
-    """The fields of a Model that the derivation reads, as symbols."""
+# The structures a topology's kernels are generated for: general (every
+# number a parameter) and simple, the structural variant of models with
+# no centre-of-mass offsets, principal-axis inertias (no products of
+# inertia), no drives and gravity along -z (the paper's model and its
+# 4-limb variant): those numbers are zero in its kernels, not read, and the
+# runtime chooses it at load when a model's numbers are exactly so
+# (prru_param_structure_simple).
+STRUCTURES = ("general", "simple")
 
-    def __init__(self, model):
+
+class ParamModel:
+    """The fields of a Model that the derivation reads, as symbols; with
+    structure "simple", the numbers STRUCTURES says are zero are zero."""
+
+    def __init__(self, model, structure="general"):
+        if structure not in STRUCTURES:
+            raise ValueError("unknown structure %r" % structure)
+        simple = structure == "simple"
+        zero = Fraction(0)
         n, nb = model.nlimb, len(model.body_names)
         vec = lambda key: tuple(member("%s[%d]" % (key, i))  # noqa: E731
                                 for i in range(n))
@@ -71,23 +86,29 @@ class ParamModel:
         self.limbs = tuple(Limb(b[i], l1[i], l2[i],
                                 a[i] if i < 2 else Fraction(0))
                            for i in range(n))
-        self.gravity = tuple(member("gravity[%d]" % k) for k in range(3))
+        self.gravity = tuple(zero if simple and k < 2 else
+                             member("gravity[%d]" % k) for k in range(3))
         self.masses = tuple(member("mass[%d]" % j) for j in range(nb))
-        self.coms = tuple(tuple(member("com[%d][%d]" % (j, k))
+        self.coms = tuple(tuple(zero if simple else
+                                member("com[%d][%d]" % (j, k))
                                 for k in range(3)) for j in range(nb))
-        self.inertias = tuple(tuple(member("inertia[%d][%d]" % (j, k))
+        self.inertias = tuple(tuple(zero if simple and k >= 3 else
+                                    member("inertia[%d][%d]" % (j, k))
                                     for k in range(6)) for j in range(nb))
-        self.armature = vec("armature")
-        self.damping = vec("damping")
-        self.coulomb = vec("coulomb")
+        drive = (lambda key: (zero,) * n) if simple else vec  # noqa: E731
+        self.armature = drive("armature")
+        self.damping = drive("damping")
+        self.coulomb = drive("coulomb")
         self.coulomb_velocity = member("coulomb_velocity")
         self.body_names = model.body_names
         self.nlimb = n
+        self.structure = structure
         self.order = [x.args[0] for x in
                       b + l1 + l2 + a + self.gravity + self.masses
                       + sum(self.coms, ()) + sum(self.inertias, ())
                       + self.armature + self.damping + self.coulomb
-                      + (self.coulomb_velocity,)]
+                      + (self.coulomb_velocity,)
+                      if not isinstance(x, Fraction)]
 
 
 def is_param(name):

@@ -199,10 +199,16 @@ PRRU_API void prru_model_default(prru_model *m);
 PRRU_API int prru_model_load(prru_model *m, const char *path, char *msg, int msglen);
 /* Switches a loaded model to the parameter kernels even where its numbers
  * are the build's: to measure what the fast path saves (bench/) and to
- * check both paths against each other (test_model_load). PRRU_EINPUT for
- * a model not loaded from a file (prru_model_default's has no parameter
- * set of its own). */
+ * check both paths against each other (test_model_load). The parameter
+ * kernels a loaded model gets: their simple structural variant where its
+ * numbers have exactly no centre-of-mass offset, product of inertia or
+ * drive and gravity along z (the paper's model), else the general ones.
+ * PRRU_EINPUT for a model not loaded from a file (prru_model_default's has
+ * no parameter set of its own); PRRU_ENOMEM. */
 PRRU_API int prru_model_use_parameter_kernels(prru_model *m);
+/* The same with the general parameter kernels whatever the structure: to
+ * compare the variant with them (test_model_load, bench/). */
+PRRU_API int prru_model_use_general_kernels(prru_model *m);
 /* Frees a loaded model's storage (nothing for prru_model_default's);
  * then m is prru_model_default's. */
 PRRU_API void prru_model_free(prru_model *m);

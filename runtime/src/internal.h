@@ -5,9 +5,19 @@
 #include <stddef.h>
 
 #include "prru.h"
+#include "prru_param_kernels.h"
 
-/* The build's two kernel tables (kernels.c). */
-extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter;
+/* The build's kernel tables (kernels.c): specialised, and the parameter
+ * kernels in their general and simple structures. */
+extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter,
+    prru_kernels_parameter_simple;
+/* Whether d's numbers have the simple structure exactly (no centre-of-mass
+ * offset, product of inertia or drive, gravity along z), so that
+ * prru_kernels_parameter_simple evaluates them; that table's numbers
+ * (prru_param_simple_size bytes) from d's parameters. */
+int prru_param_structure_simple(const prru_param_derived *d);
+size_t prru_param_simple_size(void);
+void prru_param_simple_derive(const prru_param_derived *d, void *out);
 /* A model's kernel K with its parameters: K(m, ik)(m->kernel_params, ...). */
 #define KERNEL(m, k) ((m)->kernels->k)
 

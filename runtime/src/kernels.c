@@ -1,9 +1,12 @@
-/* The two kernel tables of a build (prru_kernel_table in prru.h): the
+/* The kernel tables of a build (prru_kernel_table in prru.h): the
  * specialised kernels of the build's model, and the parameter kernels of
- * its topology, which a model loaded at run time evaluates with. Thin
- * adapters to one signature; the topology is the build's (its data sizes
- * are compile-time constants), the only place the runtime chooses between
- * the three- and four-limb kernel sets. */
+ * its topology, which a model loaded at run time evaluates with, in two
+ * structures: general, and the simple variant for models with no
+ * centre-of-mass offsets, products of inertia or drives and gravity along
+ * -z (prru_param_structure_simple). Thin adapters to one signature; the
+ * topology is the build's (its data sizes are compile-time constants), the
+ * only place the runtime chooses between the three- and four-limb kernel
+ * sets. */
 #include <math.h>
 #include <stddef.h>
 
@@ -15,16 +18,26 @@
 
 #if PRRU_NLIMB == 3
 #include "prru_p3_kernels.h"
+#include "prru_p3s_kernels.h"
 #define P(name) prru_p3_##name
+#define G(name) prru_p3_##name /* the regressor of every structure */
 #define UNSEEN_P(name) PRRU_P3_UNSEEN_FINITE_##name
+#define PS(name) prru_p3s_##name
+#define UNSEEN_PS(name) PRRU_P3S_UNSEEN_FINITE_##name
 typedef prru_params3 topo_params;
 typedef prru_p3_derived topo_derived;
+typedef prru_p3s_derived simple_derived;
 #elif PRRU_NLIMB == 4
 #include "prru_p4_kernels.h"
+#include "prru_p4s_kernels.h"
 #define P(name) prru_p4_##name
+#define G(name) prru_p4_##name
 #define UNSEEN_P(name) PRRU_P4_UNSEEN_FINITE_##name
+#define PS(name) prru_p4s_##name
+#define UNSEEN_PS(name) PRRU_P4S_UNSEEN_FINITE_##name
 typedef prru_params4 topo_params;
 typedef prru_p4_derived topo_derived;
+typedef prru_p4s_derived simple_derived;
 #else
 #error "prru: a build's model has 3 or 4 limbs"
 #endif
@@ -35,6 +48,29 @@ typedef prru_p4_derived topo_derived;
 typedef char params_layout_check[sizeof(topo_derived) == sizeof(prru_param_derived) ? 1 : -1];
 
 #define TP(p) ((const topo_derived *)(p))
+
+/* Whether the simple variant's kernels are exact for these numbers: every
+ * centre of mass at its body frame's origin, every product of inertia,
+ * armature, damping and Coulomb force zero, gravity along z. Exactly zero,
+ * not small: a number the variant drops must not matter at all. */
+int prru_param_structure_simple(const prru_param_derived *d)
+{
+  const topo_params *p = &TP(d)->params;
+  int ok = p->gravity[0] == 0 && p->gravity[1] == 0;
+  for (int b = 0; b < PRRU_NBODY && ok; b++)
+    ok = p->com[b][0] == 0 && p->com[b][1] == 0 && p->com[b][2] == 0 && p->inertia[b][3] == 0 &&
+         p->inertia[b][4] == 0 && p->inertia[b][5] == 0;
+  for (int i = 0; i < PRRU_NACT && ok; i++)
+    ok = p->armature[i] == 0 && p->damping[i] == 0 && p->coulomb[i] == 0;
+  return ok;
+}
+
+size_t prru_param_simple_size(void) { return sizeof(simple_derived); }
+
+void prru_param_simple_derive(const prru_param_derived *d, void *out)
+{
+  PS(derive)(&TP(d)->params, out);
+}
 
 /* ---- specialised: the constant-folded kernels, p ignored ---- */
 static void s_ik(const void *p, const double q[3], double d[PRRU_NACT]) { (void)p, prru_ik(q, d); }
@@ -181,148 +217,20 @@ const prru_kernel_table prru_kernels_specialised = {
   s_inverse_derivs, s_unseen_inverse_derivs, s_batch_eom_solve_derivs,
 };
 
-/* ---- parameter: the topology's kernels, p a prru_params ---- */
-static void p_ik(const void *p, const double q[3], double d[PRRU_NACT]) { P(ik)(TP(p), q, d); }
-static void p_jd(const void *p, const double q[3], double Jd[PRRU_NACT * 3]) { P(jd)(TP(p), q, Jd); }
-static void p_ik_jd(const void *p, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
-{
-  P(ik_jd)(TP(p), q, d, Jd);
-}
-static void p_mass(const void *p, const double q[3], double M[9]) { P(mass)(TP(p), q, M); }
-static void p_dynamics(const void *p, const double q[3], const double qd[3], double M[9], double h[3], double G[3])
-{
-  P(dynamics)(TP(p), q, qd, M, h, G);
-}
-static void p_eom(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
-                  const double fp[3], const double mp[3], double M[9], double b[3])
-{
-  P(eom)(TP(p), q, qd, fd, fp, mp, M, b);
-}
-static void p_eom_solve(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
-                        const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3],
-                        double minors[3])
-{
-  P(eom_solve)(TP(p), q, qd, fd, fp, mp, M, b, qdd, minors);
-}
-static int p_unseen_eom_solve(const double q[3], const double qd[3], const double fd[PRRU_NACT],
-                              const double fp[3], const double mp[3])
-{
-  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
-  return UNSEEN_P(EOM_SOLVE)(q, qd, fd, fp, mp);
-}
-static void p_inverse_terms(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                            const double fp[3], const double mp[3], double d[PRRU_NACT],
-                            double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3])
-{
-#if PRRU_NACT == 3
-  P(inverse_terms)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, out);
-#else
-  (void)Jdinv;
-  P(inverse_terms)(TP(p), q, qd, qdd, fp, mp, d, Jd, out);
-#endif
-}
-static int p_unseen_inverse_terms(const double q[3], const double qd[3], const double qdd[3],
-                                  const double fp[3], const double mp[3])
-{
-  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
-  return UNSEEN_P(INVERSE_TERMS)(q, qd, qdd, fp, mp);
-}
-static void p_joint_reactions(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                              const double fd[PRRU_NACT], const double fp[3], const double mp[3],
-                              double lambda[PRRU_NLAMBDA], double z[PRRU_NLAMBDA])
-{
-#if PRRU_NACT == 3
-  (void)z;
-  P(joint_reactions)(TP(p), q, qd, qdd, fd, fp, mp, lambda);
-#else
-  P(joint_reactions)(TP(p), q, qd, qdd, fd, fp, mp, lambda, z);
-#endif
-}
-static void p_platform_jacobian(const void *p, const double q[3], double JP[18])
-{
-  P(platform_jacobian)(TP(p), q, JP);
-}
-static void p_poses(const void *p, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY])
-{
-  P(poses)(TP(p), q, R, pos);
-}
-static void p_energy(const void *p, const double q[3], const double qd[3], double E[2])
-{
-  P(energy)(TP(p), q, qd, E);
-}
-static void p_actuator_rates(const void *p, const double q[3], const double qd[3], double dd[PRRU_NACT],
-                             double ddb[PRRU_NACT])
-{
-  P(actuator_rates)(TP(p), q, qd, dd, ddb);
-}
-static void p_passive(const void *p, const double q[3], const double qd[3], double Qp[3])
-{
-  P(passive)(TP(p), q, qd, Qp);
-}
-static void p_batch_dme_terms(const void *p, int n, const double *q, double *d, double *Jd, double *M, double *JP)
-{
-  P(batch_dme_terms)(TP(p), n, q, d, Jd, M, JP);
-}
+/* ---- parameter: the topology's kernels, p its derived numbers ---- */
+#define A(name) p_##name
+#define TABLE prru_kernels_parameter
+#include "kernels_param.inc"
+#undef A
+#undef TABLE
 
-/* The topology's regressor reads the smoothing velocity from its
- * parameters (as given, nothing derived): a copy with vs in it. */
-static void p_regressor(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
-                        double *Y)
-{
-  topo_params c = TP(p)->params;
-  c.coulomb_velocity = vs;
-  P(regressor)(&c, q, qd, qdd, Y);
-}
-
-static void p_eom_solve_derivs(const void *p, const double q[3], const double qd[3],
-                               const double fd[PRRU_NACT], const double fp[3], const double mp[3],
-                               double M[9], double b[3], double qdd[3], double minors[3],
-                               double Dq[9], double Dqd[9], double Dfd[3 * PRRU_NACT], double Dfp[9],
-                               double Dmp[9])
-{
-  P(eom_solve_derivs)(TP(p), q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
-}
-static int p_unseen_eom_solve_derivs(const double q[3], const double qd[3], const double fd[PRRU_NACT],
-                                     const double fp[3], const double mp[3])
-{
-  (void)q, (void)qd, (void)fd, (void)fp, (void)mp;
-  return UNSEEN_P(EOM_SOLVE_DERIVS)(q, qd, fd, fp, mp);
-}
-static void p_inverse_derivs(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                             const double fp[3], const double mp[3], double d[PRRU_NACT],
-                             double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3],
-                             double Dq[9], double Dqd[9], double Dqdd[9], double DJd[9 * PRRU_NACT])
-{
-#if PRRU_NACT == 3
-  (void)DJd;
-  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, Jdinv, out, Dq, Dqd, Dqdd);
-#else
-  (void)Jdinv;
-  P(inverse_derivs)(TP(p), q, qd, qdd, fp, mp, d, Jd, out, Dq, Dqd, Dqdd, DJd);
-#endif
-}
-static int p_unseen_inverse_derivs(const double q[3], const double qd[3], const double qdd[3],
-                                   const double fp[3], const double mp[3])
-{
-  (void)q, (void)qd, (void)qdd, (void)fp, (void)mp;
-  return UNSEEN_P(INVERSE_DERIVS)(q, qd, qdd, fp, mp);
-}
-
-static void p_batch_eom_solve_derivs(const void *p, int n, const double *q, const double *qd,
-                                     const double *fd, const double *fp, const double *mp, double *M,
-                                     double *b, double *qdd, double *minors, double *Dq, double *Dqd,
-                                     double *Dfd, double *Dfp, double *Dmp)
-{
-  P(batch_eom_solve_derivs)(TP(p), n, q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
-}
-
-const prru_kernel_table prru_kernels_parameter = {
-  "parameter",    p_ik,      p_jd,
-  p_ik_jd,        p_mass,    p_dynamics,
-  p_eom,          p_eom_solve, p_unseen_eom_solve,
-  p_inverse_terms, p_unseen_inverse_terms, p_joint_reactions,
-  p_platform_jacobian, p_poses, p_energy,
-  p_actuator_rates, p_passive, p_batch_dme_terms,
-  p_regressor,    p_eom_solve_derivs, p_unseen_eom_solve_derivs,
-  p_inverse_derivs, p_unseen_inverse_derivs, p_batch_eom_solve_derivs,
-};
+/* ---- the simple structural variant (prru_p3s_*, prru_p4s_*) ---- */
+#undef P
+#undef UNSEEN_P
+#undef TP
+#define P(name) PS(name)
+#define UNSEEN_P(name) UNSEEN_PS(name)
+#define TP(p) ((const simple_derived *)(p))
+#define A(name) ps_##name
+#define TABLE prru_kernels_parameter_simple
+#include "kernels_param.inc"

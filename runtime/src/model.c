@@ -13,8 +13,11 @@
 /* A loaded model's storage (prru_model.own). */
 typedef struct {
   prru_mechanism mech;
-  /* Its numbers as the parameter kernels read them (prru_param_derive). */
+  /* Its numbers as the parameter kernels read them (prru_param_derive),
+   * and as their simple variant reads them where it applies (NULL if not
+   * asked for: prru_param_simple_size bytes). */
   prru_param_derived derived;
+  void *simple;
   char name[PRRU_MODEL_NAME_MAX + 1];
   char description[4 * PRRU_MODEL_DESCRIPTION_MAX + 1];
   char sha256[65];
@@ -174,6 +177,12 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
   if (s) {
     *c = *s;
     c->mech.name = c->name, c->mech.description = c->description, c->mech.sha256 = c->sha256;
+    c->simple = NULL;
+    if (s->simple && !(c->simple = malloc(prru_param_simple_size()))) {
+      free(c), free(p);
+      return PRRU_ENOMEM;
+    }
+    if (s->simple) memcpy(c->simple, s->simple, prru_param_simple_size());
   } else {
     c->mech = *src->mech;
   }
@@ -186,7 +195,8 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
   *out = *src;
   out->mech = &c->mech;
   out->own = c;
-  if (src->kernel_params) out->kernel_params = &c->derived;
+  if (src->kernel_params)
+    out->kernel_params = src->kernels == &prru_kernels_parameter_simple ? c->simple : (void *)&c->derived;
   return PRRU_OK;
 }
 
@@ -203,7 +213,7 @@ void prru_model_default(prru_model *m)
 void prru_model_free(prru_model *m)
 {
   loaded_model *l = m->own;
-  if (l) free(l->path);
+  if (l) free(l->path), free(l->simple);
   free(l);
   prru_model_default(m);
 }
@@ -336,9 +346,10 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   tmp.own = l;
   prru_model_params(&tmp, &l->derived.params);
   prru_param_derive(&l->derived.params, &l->derived);
-  if (!prru_model_is_built(&tmp, 0)) {
-    tmp.kernels = &prru_kernels_parameter;
-    tmp.kernel_params = &l->derived;
+  if (!prru_model_is_built(&tmp, 0) && (st = prru_model_use_parameter_kernels(&tmp)) != PRRU_OK) {
+    free(l->path), free(l);
+    if (msg && msglen > 0) snprintf(msg, (size_t)msglen, "%s: out of memory", path);
+    return st;
   }
   /* Settings kept from m only where it was a model already: a fresh
    * struct is defaults. */
@@ -346,12 +357,24 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   return PRRU_OK;
 }
 
-int prru_model_use_parameter_kernels(prru_model *m)
+int prru_model_use_general_kernels(prru_model *m)
 {
   loaded_model *l = m->own;
   if (!l) return PRRU_EINPUT;
   m->kernels = &prru_kernels_parameter;
   m->kernel_params = &l->derived;
+  return PRRU_OK;
+}
+
+int prru_model_use_parameter_kernels(prru_model *m)
+{
+  loaded_model *l = m->own;
+  if (!l) return PRRU_EINPUT;
+  if (!prru_param_structure_simple(&l->derived)) return prru_model_use_general_kernels(m);
+  if (!l->simple && !(l->simple = malloc(prru_param_simple_size()))) return PRRU_ENOMEM;
+  prru_param_simple_derive(&l->derived, l->simple);
+  m->kernels = &prru_kernels_parameter_simple;
+  m->kernel_params = l->simple;
   return PRRU_OK;
 }
 
