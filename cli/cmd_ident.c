@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "prru_measure.h"
 #include "prru_model_file.h"
 #include "prru_control.h"
 #include "prru_ident.h"
@@ -392,33 +393,31 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
   return 0;
 }
 
-/* q of every row by forward kinematics from the slider columns. */
-/* A least-squares pose is the sliders' when its residual is within the
- * encoders' resolution dres (with four quantised sliders the true pose
- * leaves each within dres / 2, so the least-squares one within dres in the
- * 2-norm over four) plus the solver's tolerance. */
+/* q of every row by forward kinematics from the slider columns
+ * (prru_measure_poses: the residual judged against --d-resolution). */
 static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, double dres, ident_data *D)
 {
-  prru_model m = *prru_cli_model();
-  prru_data *d = malloc(sizeof *d);
-  double seed[3] = {0, 0, 0};
-  int rc = d ? 0 : 1;
-  for (int i = 0; i < t->nrows && !rc; i++) {
-    const double *row = t->data + (size_t)i * (size_t)t->ncols;
-    double act[PRRU_NACT], res;
-    for (int k = 0; k < PRRU_NACT; k++) act[k] = row[cd[k]];
-    int st = prru_forward_kinematics_lsq(&m, d, act, seed, D->q + 3 * i, &res);
-    if (st != PRRU_OK || !(res <= dres + 1e-9 * (1 + fabs(act[0])))) {
-      prru_cli_error("identify", "%s: data row %d: no pose for the sliders (%s)", path, i + 1,
-                     st != PRRU_OK ? prru_strerror(st) :
-                     dres > 0 ? "inconsistent slider positions: beyond --d-resolution" :
-                                "inconsistent slider positions: quantised readings? give --d-resolution");
-      rc = 1;
-    }
-    memcpy(seed, D->q + 3 * i, sizeof seed);
+  double *act = malloc(sizeof(double) * PRRU_NACT * (size_t)(t->nrows > 0 ? t->nrows : 1));
+  if (!act) {
+    prru_cli_error("identify", "out of memory for %d rows", t->nrows);
+    return 1;
   }
-  free(d);
-  return rc;
+  for (int i = 0; i < t->nrows; i++)
+    for (int k = 0; k < PRRU_NACT; k++) act[PRRU_NACT * i + k] = t->data[(size_t)i * (size_t)t->ncols + (size_t)cd[k]];
+  int row;
+  double res;
+  const int st = prru_measure_poses(prru_cli_model(), t->nrows, act, dres, D->q, &row, &res, NULL, 0);
+  free(act);
+  if (st == PRRU_ENOMEM) {
+    prru_cli_error("identify", "out of memory for %d rows", t->nrows);
+    return 1;
+  }
+  if (st != PRRU_OK)
+    prru_cli_error("identify", "%s: data row %d: no pose for the sliders (%s)", path, row + 1,
+                   isnan(res) ? prru_strerror(st) :
+                   dres > 0 ? "inconsistent slider positions: beyond --d-resolution" :
+                              "inconsistent slider positions: quantised readings? give --d-resolution");
+  return st != PRRU_OK;
 }
 
 static int read_data(const char *path, const prru_diff_options *dopt, double dres, ident_data *D)

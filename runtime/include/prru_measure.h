@@ -55,6 +55,21 @@ PRRU_API int prru_measure_rows(const double *t, int n, const prru_measure_option
 PRRU_API int prru_measure_apply(const prru_measure_options *o, int n, int nact, double *d, double *fd, char *msg,
                                 int msglen);
 
+/* q (n x 3) of n rows of slider positions d (n x PRRU_NACT) by least-squares
+ * forward kinematics (prru_forward_kinematics_lsq), each row seeded from the
+ * previous row's pose and the first from q = 0: a motion sampled densely
+ * enough stays in its assembly mode. A converged pose is the sliders' when
+ * its residual is within dres (m, the encoders' resolution: four sliders
+ * quantised to dres leave the least-squares pose within dres in the
+ * 2-norm) plus the solver's tolerance 1e-9 (1 + |d_1|); dres = INFINITY
+ * accepts every converged pose (exact or three sliders). On failure *row is
+ * the first row refused (0-based; -1 on success) and *residual its residual
+ * where the solver converged (NaN where it did not): PRRU_EINPUT for a
+ * residual beyond dres, prru_forward_kinematics_lsq's statuses otherwise,
+ * PRRU_ENOMEM; msg names the row and the reason. */
+PRRU_API int prru_measure_poses(const prru_model *m, int n, const double *d, double dres, double *q, int *row,
+                                double *residual, char *msg, int msglen);
+
 /* How well a differentiation setting recovers qdd from measured sliders:
  * the poses by forward kinematics (least squares from the previous row's
  * pose, as identify does), their second derivative as prru_diff_signal

@@ -108,17 +108,32 @@ static double setting_error(int n, const double *t, const double *q, const doubl
   return worst;
 }
 
-static int poses(const prru_model *m, int n, const double *d, double *q, char *msg, int msglen)
+int prru_measure_poses(const prru_model *m, int n, const double *d, double dres, double *q, int *row,
+                       double *residual, char *msg, int msglen)
 {
+  *row = -1;
+  *residual = NAN;
   prru_data *ws = malloc(sizeof *ws);
   if (!ws) return PRRU_ENOMEM;
   double seed[3] = {0, 0, 0};
   int st = PRRU_OK;
   for (int i = 0; i < n && st == PRRU_OK; i++) {
-    double res;
-    st = prru_forward_kinematics_lsq(m, ws, d + (size_t)PRRU_NACT * i, seed, q + 3 * i, &res);
-    if (st != PRRU_OK && msg && msglen > 0)
-      snprintf(msg, (size_t)msglen, "row %d: no pose for the measured sliders (%s)", i + 1, prru_strerror(st));
+    const double *act = d + (size_t)PRRU_NACT * i;
+    double res = NAN;
+    st = prru_forward_kinematics_lsq(m, ws, act, seed, q + 3 * i, &res);
+    if (st != PRRU_OK) {
+      *row = i;
+      if (msg && msglen > 0)
+        snprintf(msg, (size_t)msglen, "row %d: no pose for the measured sliders (%s)", i + 1, prru_strerror(st));
+    } else if (!(res <= dres + 1e-9 * (1 + fabs(act[0])))) {
+      /* The solver stops within 1e-9 (1 + |d_1|) of the least-squares
+       * pose, which quantisation moves by at most dres. */
+      *row = i, *residual = res;
+      st = PRRU_EINPUT;
+      if (msg && msglen > 0)
+        snprintf(msg, (size_t)msglen, "row %d: inconsistent slider positions: residual %.3g m beyond the "
+                 "resolution %.3g m", i + 1, res, dres);
+    }
     memcpy(seed, q + 3 * i, sizeof seed);
   }
   free(ws);
@@ -139,8 +154,9 @@ int prru_measure_best_diff(const prru_model *m, int n, const double *t, const do
     if (msg && msglen > 0) snprintf(msg, (size_t)msglen, "the exact qdd is zero throughout: nothing to compare");
     return PRRU_EINPUT;
   }
-  double *q = malloc(sizeof(double) * 3 * (size_t)n);
-  int st = q ? poses(m, n, d, q, msg, msglen) : PRRU_ENOMEM;
+  double *q = malloc(sizeof(double) * 3 * (size_t)n), res;
+  int row;
+  int st = q ? prru_measure_poses(m, n, d, INFINITY, q, &row, &res, msg, msglen) : PRRU_ENOMEM;
   prru_diff_options def;
   prru_diff_options_default(&def);
   c->best_error = INFINITY;
