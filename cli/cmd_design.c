@@ -1087,10 +1087,7 @@ static int stage_report(const char *cmd, const char *stage, const char *dir, con
 
 static int check_name(const char *cmd, const char *name)
 {
-  size_t n = strlen(name);
-  int ok = n >= 1 && n <= 16 && name[0] >= 'a' && name[0] <= 'z';
-  for (size_t i = 0; ok && i < n; i++)
-    ok = (name[i] >= 'a' && name[i] <= 'z') || (name[i] >= '0' && name[i] <= '9') || name[i] == '_';
+  const int ok = prru_model_name_valid(name);
   if (!ok) prru_cli_error(cmd, "--name '%s': a lower-case C identifier of at most 16 characters", name);
   return ok ? 0 : 2;
 }
@@ -1174,7 +1171,7 @@ int prru_cmd_optimize(int argc, char **argv)
     if (check_name(cmd, name_s)) return 2;
     snprintf(name, sizeof name, "%s", name_s);
   } else {
-    snprintf(name, sizeof name, "%.12s_opt", prru_cli_model()->mech->name);
+    prru_model_name_derive(prru_cli_model()->mech->name, "_opt", name);
   }
   prru_design_var vars[PRRU_DESIGN_MAX_VARS];
   int nvar = 0, rc = parse_vars(cmd, vars_s, pct, &start, vars, &nvar);

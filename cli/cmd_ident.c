@@ -547,15 +547,6 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   }
 }
 
-static int valid_name(const char *s)
-{
-  size_t n = strlen(s);
-  if (n < 1 || n > 16 || s[0] < 'a' || s[0] > 'z') return 0;
-  for (size_t i = 0; i < n; i++)
-    if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') || s[i] == '_')) return 0;
-  return 1;
-}
-
 typedef struct {
   const char *data, *out, *report, *name, *vs, *window, *degree, *dres;
   int help;
@@ -579,9 +570,11 @@ static int identify_options(identify_args *a, char *name, size_t len, prru_diff_
   if (prru_cli_refuse_same_file("identify", "data", a->data, "out", a->out) ||
       prru_cli_refuse_same_file("identify", "data", a->data, "report", a->report))
     return 2;
-  snprintf(name, len, "%.13s_id", prru_cli_model()->mech->name);
+  char derived[PRRU_MODEL_NAME_MAX + 1];
+  prru_model_name_derive(prru_cli_model()->mech->name, "_id", derived);
+  snprintf(name, len, "%s", derived);
   if (a->name) {
-    if (!valid_name(a->name)) {
+    if (!prru_model_name_valid(a->name)) {
       prru_cli_error("identify", "--name: '%s' must be a lower-case C identifier of at most 16 characters",
                      a->name);
       return 2;

@@ -358,6 +358,23 @@ static void check_written(const char *path, const prru_model *m, const prru_mode
   TU_TRUE(st == PRRU_EINPUT && text == NULL && strstr(msg, "Bad-Name"), what);
 }
 
+/* Model names (spec 11) and the names identify and optimize derive: cut
+ * to fit 16 characters with their suffix, valid whenever the base is. */
+static void check_names(void)
+{
+  static const char *const good[] = {"a", "paper3prru", "p_1", "abcdefghijklmnop"};
+  static const char *const bad[] = {"", "Paper", "3prru", "_x", "a-b", "abcdefghijklmnopq", "a b", "\303\251"};
+  for (int i = 0; i < 4; i++) TU_TRUE(prru_model_name_valid(good[i]), good[i]);
+  for (int i = 0; i < 8; i++) TU_TRUE(!prru_model_name_valid(bad[i]), bad[i]);
+  char out[PRRU_MODEL_NAME_MAX + 1];
+  prru_model_name_derive("abcdefghijklmnop", "_id", out);
+  TU_TRUE(strcmp(out, "abcdefghijklm_id") == 0 && prru_model_name_valid(out), "a 16-character base cut for _id");
+  prru_model_name_derive("paper3prru", "_opt", out);
+  TU_TRUE(strcmp(out, "paper3prru_opt") == 0, "a short base kept whole");
+  prru_model_name_derive("abcdefghijklmnop", "_opt", out);
+  TU_TRUE(strlen(out) == PRRU_MODEL_NAME_MAX && prru_model_name_valid(out), "a 16-character base cut for _opt");
+}
+
 static void check_file(const char *path, int *loaded, int *other, int *specialised, int reactions)
 {
   prru_model_spec spec;
@@ -592,6 +609,7 @@ int main(int argc, char **argv)
   if (!TU_TRUE(src && built, "PRRU_SOURCE_DIR and PRRU_MODEL set (ctest sets them)")) return tu_finish("test_model_load");
   int loaded = 0, other = 0, specialised = 0;
   char dir[2048];
+  check_names();
   check_file(built, &loaded, &other, &specialised, 1);
   TU_TRUE(specialised == 1, "the build's own model file: specialised kernels");
   snprintf(dir, sizeof dir, "%s/models", src);

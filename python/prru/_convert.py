@@ -125,3 +125,11 @@ class Output:
         if count == 1:
             return [flat[r * width + start] for r in range(nrows)]
         return [list(flat[r * width + start:r * width + start + count]) for r in range(nrows)]
+
+
+def derived_name(lib, base, suffix):
+    """The library's name of a model made from the model named base
+    (prru_model_name_derive: identify's "_id", optimize's "_opt")."""
+    out = ctypes.create_string_buffer(17)
+    lib.model_name_derive(base.encode(), suffix.encode(), out)
+    return out.value.decode()

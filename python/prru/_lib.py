@@ -451,6 +451,8 @@ class Library:
         self.ident_model_params = _declare(dll, "prru_ident_model_params", i, mp, bp, vp, pp, cp, i)
         self.model_file_text = _declare(dll, "prru_model_file_text", i, mp, pp, cp, cp,
                                         ctypes.POINTER(ctypes.c_void_p), cp, i)
+        self.model_name_valid = _declare(dll, "prru_model_name_valid", i, cp)
+        self.model_name_derive = _declare(dll, "prru_model_name_derive", None, cp, cp, cp)
         self.excite_options_default = _declare(dll, "prru_excite_options_default", None, eop)
         self.excite_options_limits = _declare(dll, "prru_excite_options_limits", None, eop, lmp)
         self.excite = _declare(dll, "prru_excite", i, mp, bp, eop, c_int_p, fp,

@@ -134,7 +134,7 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
                                 "defined there" % (s0.n_singular - r.start_eval.n_other_mode,
                                                    r.start_eval.n_other_mode, s0.n_unreachable, s0.n_points))
     if name is None:
-        name = self.name[:12] + "_opt"  # as prru optimize
+        name = _convert.derived_name(self.lib, self.name, "_opt")  # as prru optimize
     desc = "%s optimised by prru.Model.optimize (%s of w_R over q1 in [%.4g, %.4g], q2 in [%.4g, %.4g], q3 = %.4g; " \
            "variables %s)" % (self.name, objective, grid.q1_lo, grid.q1_hi, grid.q2_lo, grid.q2_hi, grid.q3,
                               " ".join(v.name.decode() for v in cv))

@@ -212,7 +212,7 @@ def identify(self, t, q, qd, qdd, fd, *, name=None, coulomb_velocity=None):
     qa, qda, qdda = _rows("q", q, n, 3), _rows("qd", qd, n, 3), _rows("qdd", qdd, n, 3)
     fda = _rows("fd", fd, n, self.nact)
     if name is None:
-        name = self.name[:13] + "_id"  # as prru identify
+        name = _convert.derived_name(self.lib, self.name, "_id")  # as prru identify
     b = _base(self, coulomb_velocity)
     out = T.Identification()
     desc = "Identified by prru.Model.identify from %d samples (prior: model %s)" % (n, self.name)

@@ -60,6 +60,14 @@ PRRU_API void prru_model_params(const prru_model *m, prru_params *p);
  * and optimize write. */
 PRRU_API int prru_model_file_text(const prru_model *m, const prru_params *p, const char *name, const char *description,
                                   char **text, char *msg, int msglen);
+/* Whether name is a model name (spec 11): a lower-case C identifier,
+ * [a-z][a-z0-9_]*, of at most PRRU_MODEL_NAME_MAX (16) characters. */
+PRRU_API int prru_model_name_valid(const char *name);
+/* The name of a model made from one named base, into out (17 bytes,
+ * PRRU_MODEL_NAME_MAX + 1 of prru_model_file.h): base cut so that base +
+ * suffix fits 16 characters, then suffix (identify's "_id", optimize's
+ * "_opt"): a valid name whenever base is and suffix is [a-z0-9_]*. */
+PRRU_API void prru_model_name_derive(const char *base, const char *suffix, char *out);
 
 typedef struct {
   double t;                   /* s */

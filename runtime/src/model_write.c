@@ -111,14 +111,19 @@ static void drive_keys(text_buf *b, const prru_model *m, const double armature[P
   if (k & PRRU_DRIVE_MOTOR_SPEED_MAX) drive_key(b, "motor_speed_max", me->motor_speed_max);
 }
 
-/* A model name: [a-z][a-z0-9_]{0,15} (spec 11). */
-static int valid_name(const char *s)
+int prru_model_name_valid(const char *s)
 {
   size_t n = s ? strlen(s) : 0;
   if (n == 0 || n > PRRU_MODEL_NAME_MAX || !(s[0] >= 'a' && s[0] <= 'z')) return 0;
   for (size_t i = 1; i < n; i++)
     if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') || s[i] == '_')) return 0;
   return 1;
+}
+
+void prru_model_name_derive(const char *base, const char *suffix, char *out)
+{
+  const int keep = PRRU_MODEL_NAME_MAX - (int)strlen(suffix);
+  snprintf(out, PRRU_MODEL_NAME_MAX + 1, "%.*s%s", keep > 0 ? keep : 0, base, suffix);
 }
 
 static void model_json(text_buf *b, const prru_model *m, const prru_params *p, const char *name,
@@ -165,7 +170,7 @@ int prru_model_file_text(const prru_model *m, const prru_params *p, const char *
                          char **text, char *msg, int msglen)
 {
   *text = NULL;
-  if (!valid_name(name))
+  if (!prru_model_name_valid(name))
     return prru_fail(msg, msglen, PRRU_EINPUT, "model name '%s' is not [a-z][a-z0-9_]{0,15}", name ? name : "");
   text_buf b = {NULL, 0, 0, 0};
   model_json(&b, m, p, name, description);
