@@ -37,32 +37,6 @@ static const char animate_help[] =
 /* Body colours: gnuplot line types set in the script. */
 enum { COL_RAIL = 1, COL_SLIDER, COL_UPPER, COL_LOWER, COL_PLATFORM };
 
-/* The origin of body b's frame: prru_poses gives the centre of mass p_b =
- * origin + R_b com_b (the two differ for a model with offset centres). */
-static void frame_origin(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_NBODY], int b,
-                         double o[3])
-{
-  const double *Rb = R + 9 * b, *cb = prru_cli_model()->mech->com[b];
-  for (int c = 0; c < 3; c++)
-    o[c] = p[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
-}
-
-/* The joint centres of limb i at the poses (R, p) of prru_poses: slider
- * A_i (the slider's frame origin), B_i and C_i from the link frames'
- * origins, which are the links' midpoints (docs/model.md section 4). */
-static void limb_points(const double R[9 * PRRU_NBODY], const double p[3 * PRRU_NBODY], int i,
-                        double A[3], double B[3], double C[3])
-{
-  double u[3], l[3];
-  frame_origin(R, p, prru_cli_model()->mech->slider[i], A);
-  frame_origin(R, p, prru_cli_model()->mech->upper[i], u);
-  frame_origin(R, p, prru_cli_model()->mech->lower[i], l);
-  for (int c = 0; c < 3; c++) {
-    B[c] = 2.0 * u[c] - A[c];
-    C[c] = 2.0 * l[c] - B[c];
-  }
-}
-
 /* One segment as a row "x y z dx dy dz colour" (gnuplot vectors: lines
  * between rows would be drawn as a mesh by splot). */
 static void seg(FILE *f, const double a[3], const double b[3], int col)
@@ -107,7 +81,7 @@ static int frame(FILE *out, const double q[3], extent *e)
   const int P = prru_cli_model()->mech->platform;
   const double *RP = R + 9 * P, h = plate_half();
   double O[3];
-  frame_origin(R, p, P, O);
+  prru_body_origin(prru_cli_model(), R, p, P, O);
   double corner[4][3], normal[3];
   for (int k = 0; k < 4; k++) {
     double x = (k == 0 || k == 3) ? -h : h, y = k < 2 ? -h : h;
@@ -116,7 +90,7 @@ static int frame(FILE *out, const double q[3], extent *e)
   for (int c = 0; c < 3; c++) normal[c] = O[c] + RP[3 * c + 2] * h;
   for (int i = 0; i < PRRU_NLIMB; i++) {
     double A[3], B[3], C[3];
-    limb_points(R, p, i, A, B, C);
+    prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
     if (!out) {
       grow(e, A);
       grow(e, B);
@@ -141,8 +115,8 @@ static int frame(FILE *out, const double q[3], extent *e)
    * alone is small beside the links. */
   for (int i = 0; i < PRRU_NLIMB; i++) {
     double A[3], B[3], C[3], A2[3], B2[3], C2[3];
-    limb_points(R, p, i, A, B, C);
-    limb_points(R, p, (i + 1) % PRRU_NLIMB, A2, B2, C2);
+    prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
+    prru_limb_joints(prru_cli_model(), R, p, (i + 1) % PRRU_NLIMB, A2, B2, C2);
     seg(out, C, C2, COL_PLATFORM);
   }
   fputs("\n\n", out); /* frames are gnuplot data blocks (index) */

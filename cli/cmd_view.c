@@ -132,28 +132,6 @@ static void out_array(prru_cli_out *o, const double *v, int n)
 
 /* ---- the mechanism at a frame ---- */
 
-/* The origin of body b's frame (prru_poses gives the centre of mass). */
-static void frame_origin(const double *R, const double *p, int b, double o[3])
-{
-  const double *Rb = R + 9 * b, *cb = prru_cli_model()->mech->com[b];
-  for (int c = 0; c < 3; c++)
-    o[c] = p[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
-}
-
-/* The joint centres A_i, B_i, C_i of limb i: the slider's frame origin and
- * the links' frame origins, their midpoints (docs/model.md section 4). */
-static void limb_points(const double *R, const double *p, int i, double A[3], double B[3], double C[3])
-{
-  double u[3], l[3];
-  frame_origin(R, p, prru_cli_model()->mech->slider[i], A);
-  frame_origin(R, p, prru_cli_model()->mech->upper[i], u);
-  frame_origin(R, p, prru_cli_model()->mech->lower[i], l);
-  for (int c = 0; c < 3; c++) {
-    B[c] = 2.0 * u[c] - A[c];
-    C[c] = 2.0 * l[c] - B[c];
-  }
-}
-
 /* A link's long axis in its own frame, unit, and its length: from the
  * joint centres at one pose (constant: the frame moves with the link). */
 static void link_axis(const double *R, const double a[3], const double b[3], double axis[3], double *len)
@@ -234,7 +212,7 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
     }
     for (int i = 0; i < PRRU_NLIMB; i++) {
       double A[3], B[3], C[3];
-      limb_points(R, p, i, A, B, C);
+      prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
       grow(f, A);
       grow(f, B);
       grow(f, C);
@@ -405,7 +383,7 @@ static void out_bodies(prru_cli_out *o, const frames *f)
     const char *kind = b == prru_cli_model()->mech->platform ? "platform" : "link";
     double axis[3] = {0, 0, 1}, len = 0, A[3], B[3], C[3];
     if (i >= 0) {
-      limb_points(R, p, i, A, B, C);
+      prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
       if (b == prru_cli_model()->mech->slider[i]) kind = "slider";
       if (b == prru_cli_model()->mech->upper[i]) {
         kind = "upper";
@@ -509,7 +487,7 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
     const double *R = f->R + (size_t)k * 9 * PRRU_NBODY, *p = f->p + (size_t)k * 3 * PRRU_NBODY;
     for (int i = 0; i < PRRU_NLIMB; i++) {
       double A[3], B[3];
-      limb_points(R, p, i, A, B, at + 3 * i);
+      prru_limb_joints(prru_cli_model(), R, p, i, A, B, at + 3 * i);
     }
     if (k) prru_cli_out_write(o, ",", 1);
     out_array(o, at, 3 * PRRU_NLIMB);
@@ -578,7 +556,7 @@ static void out_data(prru_cli_out *o, const prru_table *t, const frames *f, cons
   prru_cli_out_printf(o, "},\"rails\":[");
   for (int i = 0; i < PRRU_NLIMB; i++) {
     double A[3], B[3], C[3];
-    limb_points(f->R, f->p, i, A, B, C);
+    prru_limb_joints(prru_cli_model(), f->R, f->p, i, A, B, C);
     const double r[4] = {A[0], A[1], lo[2], hi[2]};
     if (i) prru_cli_out_write(o, ",", 1);
     out_array(o, r, 4);

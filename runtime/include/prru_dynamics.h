@@ -230,6 +230,16 @@ PRRU_API void prru_model_dynamics(const prru_model *m, const double q[3], const 
 PRRU_API void prru_model_passive(const prru_model *m, const double q[3], const double qd[3], double Qp[3]);
 PRRU_API void prru_model_platform_jacobian(const prru_model *m, const double q[3], double JP[18]);
 PRRU_API void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY]);
+/* From the poses (R, pos) of prru_model_poses, which place each body's
+ * centre of mass: the origin of body b's frame, pos_b - R_b com_b (they
+ * differ for a model with offset centres), and the joint centres of limb
+ * i (0-based): A_i, the slider's frame origin, then B_i and C_i from the
+ * link frames' origins, which are the links' midpoints (docs/model.md
+ * section 4). What drawings and animations place their segments on. */
+PRRU_API void prru_body_origin(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY],
+                               int b, double o[3]);
+PRRU_API void prru_limb_joints(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY],
+                               int i, double A[3], double B[3], double C[3]);
 PRRU_API void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
                                         double ddb[PRRU_NACT]);
 /* "model NAME (FILE, sha256 HEX, KERNELS kernels)": the identity every

@@ -410,6 +410,26 @@ void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_
   KERNEL(m, poses)(m->kernel_params, q, R, pos);
 }
 
+void prru_body_origin(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY], int b,
+                      double o[3])
+{
+  const double *Rb = R + 9 * b, *cb = m->mech->com[b];
+  for (int c = 0; c < 3; c++) o[c] = pos[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
+}
+
+void prru_limb_joints(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY], int i,
+                      double A[3], double B[3], double C[3])
+{
+  double u[3], l[3];
+  prru_body_origin(m, R, pos, m->mech->slider[i], A);
+  prru_body_origin(m, R, pos, m->mech->upper[i], u);
+  prru_body_origin(m, R, pos, m->mech->lower[i], l);
+  for (int c = 0; c < 3; c++) {
+    B[c] = 2.0 * u[c] - A[c];
+    C[c] = 2.0 * l[c] - B[c];
+  }
+}
+
 void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
                                double ddb[PRRU_NACT])
 {
