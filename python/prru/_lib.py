@@ -349,6 +349,7 @@ class Library:
         self.forward_kinematics = _declare(dll, "prru_forward_kinematics", i, mp, dp, vp, vp, vp)
         self.forward_kinematics_lsq = _declare(dll, "prru_forward_kinematics_lsq", i,
                                                mp, dp, vp, vp, vp, vp)
+        self.fk_default_seed = _declare(dll, "prru_fk_default_seed", None, mp, vp, vp)
         self.forward_dynamics = _declare(dll, "prru_forward_dynamics", i, mp, dp, vp, vp, lp, vp)
         self.linearize_why = _declare(dll, "prru_linearize_why", i, mp, dp, vp, vp, lp, d,
                                       ctypes.POINTER(t.Linearization), ctypes.c_char_p, i)
@@ -360,6 +361,7 @@ class Library:
         self.reactions = _declare(dll, "prru_reactions", i, mp, dp, vp, vp, lp, vp)
         self.reaction_null = _declare(dll, "prru_reaction_null", i, mp, dp, vp, vp)
         self.energies = _declare(dll, "prru_energies", i, mp, vp, vp, vp, vp)
+        self.power = _declare(dll, "prru_power", None, mp, vp, vp, lp, vp, vp)
         # A model's kernels (prru_model_*: the specialised ones or, for a
         # loaded model, the parameter ones): NaN outputs where q is unreachable.
         self.model_ik_jd = _declare(dll, "prru_model_ik_jd", None, mp, vp, vp, vp)
@@ -386,6 +388,7 @@ class Library:
         # Manipulability and maps (prru_dme.h).
         self.dme_eval = _declare(dll, "prru_dme_eval", i, mp, dp, vp, ctypes.POINTER(t.Dme))
         self.map_axis = _declare(dll, "prru_map_axis", d, d, d, i, i)
+        self.dme_status_name = _declare(dll, "prru_dme_status_name", ctypes.c_char_p, i)
         self.map_check = _declare(dll, "prru_map_check", i, ctypes.POINTER(_MapGrid))
         self.map_options_default = _declare(dll, "prru_map_options_default", None,
                                             ctypes.POINTER(_MapOptions))

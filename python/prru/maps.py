@@ -5,19 +5,15 @@ import ctypes
 
 from . import _convert, _interrupt, _lib, errors
 
-# PRRU_DME_OTHER_MODE (prru_dme.h): a regular pose of the other assembly mode.
-OTHER_MODE = 0xFE
-STATUS_NAMES = {errors.OK: "ok", errors.ESINGULAR: "singular",
-                errors.EUNREACHABLE: "unreachable", OTHER_MODE: "other_mode",
-                errors.EINPUT: "invalid"}
 
 MapResult = collections.namedtuple("MapResult", "q1 q2 q3 w_R status summary")
 MapResult.__doc__ = """A w_R map: axes q1 (n1 values) and q2 (n2), the height q3;
 w_R[i][j] at (q1[i], q2[j]) (NaN where not ok; a NumPy array (n1, n2) for a
-model with numpy=True); status[i][j] "ok", "singular", "unreachable" or
-"other_mode" (regular, but det J_d has the opposite sign to the home pose's
-(0, 0, q3): beyond the singular locus, out of reach of the robot assembled
-at home; three actuators only); summary: a dict with n_points, n_ok,
+model with numpy=True); status[i][j] "ok", "singular", "unreachable",
+"out_of_stroke" (a slider beyond its stroke) or "other_mode" (regular, but
+det J_d has the opposite sign to the home pose's (0, 0, q3): beyond the
+singular locus, out of reach of the robot assembled at home; three
+actuators only), the library's names (prru_dme_status_name); summary: a dict with n_points, n_ok,
 n_singular (counting the other_mode points too), n_unreachable,
 n_other_mode, index (mean of w_R - 1 over the ok points, the paper's global
 index), index_log (mean of ln w_R), singular_fraction, w_min, w_max and
@@ -94,7 +90,9 @@ def map(self, q1, q2, q3=0.0, *, threads=2, jd_rcond_min=None, precision="double
         raise errors.make_error(rc, "map: %s" % self.lib.status_text(rc))
     axis1 = [self.lib.map_axis(lo1, hi1, n1, i) for i in range(n1)]
     axis2 = [self.lib.map_axis(lo2, hi2, n2, j) for j in range(n2)]
-    names = [STATUS_NAMES.get(v, "invalid") for v in st]
+    # The library's names (prru_dme_status_name), once per status seen.
+    known = {v: self.lib.dme_status_name(v).decode() for v in set(st)}
+    names = [known[v] for v in st]
     summary = {k: getattr(s, k) for k in ("n_points", "n_ok", "n_singular", "n_unreachable",
                                           "n_other_mode", "index", "index_log",
                                           "singular_fraction", "w_min", "w_max")}

@@ -242,6 +242,17 @@ class TestModelFile(unittest.TestCase):
             m.check([0.0, 0.0, 0.3])
         self.assertIsInstance(e.exception, prru.Unreachable)
         self.assertEqual(e.exception.status, 9)
+        # A map over the stroke's edge names those points as the library
+        # does (prru_dme_status_name), each one a pose check() refuses.
+        r = m.map((-0.3, 0.3, 7), (-0.3, 0.3, 7), q3=0.2)
+        seen = set()
+        for i, q1 in enumerate(r.q1):
+            for j, q2 in enumerate(r.q2):
+                seen.add(r.status[i][j])
+                if r.status[i][j] == "out_of_stroke":
+                    with self.assertRaises(prru.OutOfStroke):
+                        m.check([q1, q2, 0.2])
+        self.assertEqual(seen, {"ok", "out_of_stroke"})
 
     def test_refusals(self):
         with self.assertRaises(prru.PrruIOError) as e:
