@@ -19,8 +19,8 @@ the spec (sections 11-13) and what gen/prrugen/model.py accepts:
   - drives: armature, viscous damping and smoothed Coulomb force per
     actuator, each present or absent by the seed;
   - gravity tilted up to 15 degrees off -z, magnitude 9.0 .. 10.6 m/s^2;
-  - structure (--structure; default: general except one format-2 seed in
-    ten, seed % 10 == 5): simple is a format-2 model with every centre of
+  - structure (--structure; default: general except two format-2 seeds in
+    ten, seed % 10 in (4, 5), so one of each number of limbs): simple is a format-2 model with every centre of
     mass, product of inertia and drive written as exactly 0 and gravity
     along -z, what the topology kernels' simple variant (prru_p3s_*,
     prru_p4s_*) evaluates, so that 4-limb models exercise it too (format 1
@@ -318,7 +318,7 @@ def main(argv=None):
     fmt = args.format or (fmt if nlimb == 3 else 2)
     if fmt == 1 and nlimb == 4:
         ap.error("format 1 has 3 limbs (spec section 11)")
-    structure = args.structure or ("simple" if fmt == 1 or args.seed % 10 == 5
+    structure = args.structure or ("simple" if fmt == 1 or args.seed % 10 in (4, 5)
                                    else "general")
     if fmt == 1 and structure == "general":
         ap.error("format 1 is of the simple structure (no centre-of-mass "
