@@ -78,7 +78,7 @@ static int parse_set(const char *cmd, const char *text, prru_params *p)
       prru_cli_error(cmd, "--set %s='%s': not a finite number", item, eq + 1);
       return 2;
     }
-    for (int i = 0; i < v.n; i++) *(double *)(void *)((char *)p + v.offset[i]) = x;
+    prru_design_assign(p, &v, x);
   }
   return 0;
 }

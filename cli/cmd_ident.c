@@ -99,18 +99,15 @@ static int parse_positive(const char *cmd, const char *name, const char *text, d
   return 0;
 }
 
-static int excite_options(const excite_args *a, prru_excite_options *o, prru_fourier *f, int *periods,
-                          double *dt, prru_limits *lim)
+static int excite_options(const excite_args *a, prru_excite_options *o, prru_fourier *f, prru_limits *lim)
 {
   const char *c = "excite";
   prru_excite_options_default(o);
-  memset(f, 0, sizeof *f);
-  f->period = 10, f->harmonics = 5, *periods = 1, *dt = 0.01;
-  int seed = 1;
+  prru_fourier_default(f);
   if (a->period && parse_positive(c, "period", a->period, &f->period)) return 2;
   if (a->harm && parse_count(c, "harmonics", a->harm, 1, PRRU_EXCITE_MAX_HARMONICS, &f->harmonics)) return 2;
-  if (a->periods && parse_count(c, "periods", a->periods, 1, 1000, periods)) return 2;
-  if (a->dt && parse_positive(c, "dt", a->dt, dt)) return 2;
+  if (a->periods && parse_count(c, "periods", a->periods, 1, 1000, &o->periods)) return 2;
+  if (a->dt && parse_positive(c, "dt", a->dt, &o->dt)) return 2;
   if (a->centre && prru_cli_numbers(c, "centre", a->centre, f->centre, 3)) return 2;
   if (a->amp) {
     if (prru_cli_numbers(c, "amplitude", a->amp, o->amplitude_max, 3)) return 2;
@@ -132,12 +129,18 @@ static int excite_options(const excite_args *a, prru_excite_options *o, prru_fou
   }
   if (a->evals && parse_count(c, "evals", a->evals, 1, 10000000, &o->max_evals)) return 2;
   if (a->samples && parse_count(c, "samples", a->samples, 1, 100000, &o->samples)) return 2;
+  int seed;
   if (a->seed && parse_count(c, "seed", a->seed, 0, 2000000000, &seed)) return 2;
-  o->seed = (unsigned long)seed;
-  o->check_samples = 20 * o->samples;
-  if (*dt > f->period * *periods) {
-    prru_cli_error(c, "--dt: %g s%s is longer than the run (%g s: --period %g s x --periods %d)", *dt,
-                   a->dt ? "" : " (the default)", f->period * *periods, f->period, *periods);
+  if (a->seed) o->seed = (unsigned long)seed;
+  const double run = f->period * o->periods;
+  if (prru_excite_rows(f, o) == 0) {
+    /* The library refuses; the words name the flags (and a dt the user
+     * never gave). */
+    if (o->dt > run)
+      prru_cli_error(c, "--dt: %g s%s is longer than the run (%g s: --period %g s x --periods %d)", o->dt,
+                     a->dt ? "" : " (the default)", run, f->period, o->periods);
+    else
+      prru_cli_error(c, "--dt: %g s gives more than 1e15 rows over the run (%g s)", o->dt, run);
     return 2;
   }
   return 0;
@@ -188,7 +191,7 @@ static void excite_comments(prru_cli_out *o, const prru_fourier *f, const prru_e
 }
 
 /* The rows; a failing inverse dynamics (never after the check) stops. */
-static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier *f, int periods, double dt)
+static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier *f, const prru_excite_options *eo)
 {
   prru_data *d = malloc(sizeof *d);
   if (!d) return PRRU_ENOMEM;
@@ -197,17 +200,16 @@ static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier 
   prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
   prru_cli_out_printf(o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n", dn, fn);
   prru_cli_out_line(o);
-  const double t_end = f->period * periods;
-  const long n = (long)floor(t_end / dt * (1 + 1e-12));
+  const long n = prru_excite_rows(f, eo);
   prru_loads l;
   memset(&l, 0, sizeof l);
   int st = PRRU_OK;
-  for (long i = 0; i <= n && st == PRRU_OK && !o->err; i++) {
+  for (long i = 0; i < n && st == PRRU_OK && !o->err; i++) {
     if (prru_cli_interrupted) {
       st = PRRU_EINTERRUPTED;
       break;
     }
-    const double t = i * dt;
+    const double t = i * eo->dt;
     double q[3], qd[3], qdd[3], fd[PRRU_NACT];
     prru_fourier_eval(f, t, q, qd, qdd);
     st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
@@ -237,10 +239,9 @@ int prru_cmd_excite(int argc, char **argv)
   }
   prru_excite_options o;
   prru_fourier f;
-  int periods;
-  double dt, vs;
+  double vs;
   prru_limits lim;
-  if (excite_options(&a, &o, &f, &periods, &dt, &lim) || coulomb_velocity("excite", a.vs, &vs)) return 2;
+  if (excite_options(&a, &o, &f, &lim) || coulomb_velocity("excite", a.vs, &vs)) return 2;
   /* the run's model: the run's stroke bounds its reach */
   prru_model m;
   if (prru_model_with_limits(&m, prru_cli_model(), &lim) != PRRU_OK) return 1;
@@ -273,7 +274,7 @@ int prru_cmd_excite(int argc, char **argv)
   prru_cli_out_comment(&out);
   excite_limits_comment(&out, &lim, &o);
   excite_comments(&out, &f, &r, b);
-  st = excite_rows(&out, &m, &f, periods, dt);
+  st = excite_rows(&out, &m, &f, &o);
   int io = out.err != 0;
   if (prru_cli_out_close(&out, !io && st == PRRU_OK)) {
     free(b);

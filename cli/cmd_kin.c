@@ -1,5 +1,4 @@
 /* prru ik, fk and id: kinematics both ways and inverse dynamics. */
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -93,16 +92,6 @@ static const char fk_method_redundant[] =
     "no pose reproduces all the sliders (exit 1, the best fit and its residual\n"
     "in the message).\n";
 
-/* The fk residual accepted without --lsq: 10 times the runtime's 100 ulps
- * of the larger of the model's length and the slider heights (as
- * prru_forward_kinematics). */
-static double fk_tolerance(const double act[PRRU_NACT])
-{
-  double scale = prru_length_scale(prru_cli_model()->mech);
-  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
-  return 10 * 100 * DBL_EPSILON * scale;
-}
-
 int prru_cmd_fk(int argc, char **argv)
 {
   const char *ds = NULL, *seeds = NULL;
@@ -131,16 +120,11 @@ int prru_cmd_fk(int argc, char **argv)
   if (seeds) {
     if (prru_cli_numbers("fk", "seed", seeds, seed, PRRU_NQ)) { free(d); return 2; }
   } else {
-    /* At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0). */
-    double zero[PRRU_NQ] = {0, 0, 0}, d0[PRRU_NACT], Jd0[PRRU_NACT * PRRU_NQ], sum = 0.0;
-    prru_model_ik_jd(&m, zero, d0, Jd0);
-    for (int i = 0; i < PRRU_NACT; i++) sum += act[i] - d0[i];
-    seed[0] = seed[1] = 0.0;
-    seed[2] = sum / PRRU_NACT;
+    prru_fk_default_seed(&m, act, seed);
   }
   /* Three sliders: Newton unless --lsq; more: always least squares. */
   int use_lsq = lsq || PRRU_NACT > 3;
-  double res = NAN, tol = fk_tolerance(act);
+  double res = NAN, tol = prru_fk_tolerance(&m, act);
   int st = use_lsq ? prru_forward_kinematics_lsq(&m, d, act, seed, q, &res)
                    : prru_forward_kinematics(&m, d, act, seed, q);
   char dtext[32 * PRRU_NACT], qs[128];
@@ -151,12 +135,7 @@ int prru_cmd_fk(int argc, char **argv)
     free(d);
     return 1;
   }
-  if (!use_lsq) {
-    double dq[PRRU_NACT], Jdq[PRRU_NACT * PRRU_NQ];
-    res = 0;
-    prru_model_ik_jd(&m, q, dq, Jdq);
-    for (int i = 0; i < PRRU_NACT; i++) res = fmax(res, fabs(dq[i] - act[i]));
-  }
+  if (!use_lsq) res = prru_fk_residual(&m, q, act);
   /* |d(q) - d|^2 overflows for |d| beyond ~1e154 m: no step of the
    * least-squares iteration can then be judged and it stops at the seed
    * as if stationary. Such sliders are out of any robot's reach. */

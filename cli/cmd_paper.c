@@ -53,8 +53,8 @@ static const char paper_help_redundant[] =
 typedef struct {
   prru_cli_csv csv;
   prru_sample first, last;
-  double work;         /* integral of fd . dd/dt + fp . v_P + mp . w_P (trapezoid) */
-  double work_passive; /* integral of the drives' passive forces . qd */
+  double work;         /* integral of prru_power's load power (trapezoid) */
+  double work_passive; /* and of its passive power, the drives' */
   double prev_power, prev_passive;
   double max_abs[PRRU_NLAMBDA];
   long n;
@@ -65,25 +65,8 @@ static int on_sample(const prru_sample *s, void *ctx)
   paper_run *r = ctx;
   prru_loads l;
   prru_schedule_eval(r->csv.loads, s->t, &l);
-  const prru_model *m = prru_cli_model();
-  double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ], JP[6 * PRRU_NQ], Qp[PRRU_NQ], power = 0, passive = 0;
-  prru_model_ik_jd(m, s->q, act, Jd);
-  prru_model_platform_jacobian(m, s->q, JP);
-  prru_model_passive(m, s->q, s->qd, Qp);
-  for (int i = 0; i < PRRU_NACT; i++) {
-    double dd = 0;
-    for (int k = 0; k < PRRU_NQ; k++) dd += Jd[PRRU_NQ * i + k] * s->qd[k];
-    power += l.fd[i] * dd;
-  }
-  for (int i = 0; i < 3; i++) {
-    double w = 0, v = 0;
-    for (int k = 0; k < PRRU_NQ; k++) {
-      w += JP[PRRU_NQ * i + k] * s->qd[k];
-      v += JP[PRRU_NQ * (3 + i) + k] * s->qd[k];
-    }
-    power += l.fp[i] * v + l.mp[i] * w;
-  }
-  for (int k = 0; k < PRRU_NQ; k++) passive += Qp[k] * s->qd[k];
+  double power, passive;
+  prru_power(prru_cli_model(), s->q, s->qd, &l, &power, &passive);
   if (r->n == 0) {
     r->first = *s;
   } else {

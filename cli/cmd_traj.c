@@ -1,6 +1,7 @@
 /* prru traj (quintic point-to-point trajectories) and prru track
  * (computed-torque or LQR tracking simulated in closed loop). */
 #define _XOPEN_SOURCE 700 /* realpath, open_memstream */
+#include <ctype.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -190,13 +191,13 @@ typedef struct {
  * distinct times. */
 static long topp_nrows(const prru_topp *tp, double dt)
 {
-  if (dt > 0) return (long)fmax(1.0, ceil(tp->duration / dt - 1e-9)) + 1;
+  if (dt > 0) return prru_row_count(0.0, tp->duration, dt);
   return (long)tp->nseg * tp->grid + 1;
 }
 
 static double topp_time(const prru_topp *tp, double dt, long k, long n)
 {
-  if (dt > 0) return k == n - 1 ? tp->duration : (double)k * dt;
+  if (dt > 0) return prru_row_time(0.0, tp->duration, dt, k, n);
   const long N = tp->grid;
   if (k == n - 1) return tp->duration;
   return tp->t[(k / N) * (N + 1) + k % N];
@@ -360,7 +361,7 @@ static int traj_time_optimal(const topp_args *a)
     prru_cli_error("traj", "--time-optimal: %s; nothing written", msg);
     return 1;
   }
-  if (dt > 0 && !(tp.duration / dt <= 1e8)) {
+  if (dt > 0 && prru_row_count(0.0, tp.duration, dt) == 0) {
     prru_cli_error("traj", "--dt: %g s gives more than 1e8 rows over %g s", dt, tp.duration);
     prru_topp_free(&tp);
     return 2;
@@ -429,15 +430,14 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
     return PRRU_ENOMEM;
   }
   const double t0 = prru_quintic_t_begin(tr), t1 = prru_quintic_t_end(tr);
-  /* The rows t0 + k dt and t1 (a remainder below 1e-9 dt merged into the
-   * last row); at least those two, however short the span. */
-  const long n = (long)fmax(1.0, ceil((t1 - t0) / dt - 1e-9));
+  /* The rows t0 + k dt and t1 (prru_row_count, checked by the caller). */
+  const long n = prru_row_count(t0, t1, dt) - 1;
   int st = PRRU_OK, crossed;
   prru_path_side side;
   prru_path_side_init(&side);
   double t_prev = t0;
   for (long k = 0; k <= n && !o->err; k++) {
-    double t = k == n ? t1 : t0 + (double)k * dt, q[3], qd[3], qdd[3], dd[PRRU_NACT],
+    double t = prru_row_time(t0, t1, dt, k, n + 1), q[3], qd[3], qdd[3], dd[PRRU_NACT],
            ddb[PRRU_NACT], rc;
     if (prru_cli_interrupted) {
       st = PRRU_EINTERRUPTED;
@@ -531,7 +531,7 @@ int prru_cmd_traj(int argc, char **argv)
   prru_quintic tr;
   if (waypoint_reference("traj", wps, durs, &tr)) return 2;
   double span = prru_quintic_t_end(&tr) - prru_quintic_t_begin(&tr);
-  if (!(span / dt <= 1e8)) {
+  if (prru_row_count(prru_quintic_t_begin(&tr), prru_quintic_t_end(&tr), dt) == 0) {
     prru_cli_error("traj", "--dt: %g s gives more than 1e8 samples over %g s", dt, span);
     prru_quintic_free(&tr);
     return 2;
@@ -582,8 +582,8 @@ static const char track_help[] =
     "linearisation there (A_k, B_k); gains K_k from the backward Riccati\n"
     "recursion along the whole reference (terminal cost Q), computed before the\n"
     "run; fd = u_ff - K_k (x - x_ref) with x = (q, qd), clipped as above.\n"
-    "Weights: --lqr-q on q1..3 then qd1..3 (>= 0, not all 0), --lqr-r per\n"
-    "actuator (1/N^2, > 0); by default Bryson's rule matched to computed\n"
+    "Weights: --lqr-q on q1..3 then qd1..3 (>= 0), --lqr-r per actuator\n"
+    "(1/N^2, > 0); each left out or all 0: Bryson's rule matched to computed\n"
     "torque's default: R = 1/F^2 (F the feed-forward peak), Q = 1/e^2 with the\n"
     "errors e_q = a/20^2, e_qd = a/(sqrt(2) 20) where a = F |dqdd/dfd| is the\n"
     "acceleration that force scale gives each coordinate (the summary gives\n"
@@ -640,9 +640,6 @@ typedef struct {
   prru_cli_out *out;
   const prru_model *m;
   int motor, current;                 /* --units motor columns */
-  double speed_max[PRRU_NACT];        /* the run's speed limits (reported, not enforced) */
-  double max_dd[PRRU_NACT];           /* largest |slider speed| of the plant */
-  long over_speed;                    /* samples with a speed above its limit */
 } track_output;
 
 static int track_row(const prru_track_sample *s, void *ctx)
@@ -661,16 +658,6 @@ static int track_row(const prru_track_sample *s, void *ctx)
   prru_cli_out_numbers(o, s->qdd, 3);
   prru_cli_out_motor(o, to->m, s->fd, to->motor, to->current);
   prru_cli_out_printf(o, "\n");
-  /* The plant's slider speeds against the speed limits: computed torque
-   * cannot hold a speed, so the run reports them. */
-  double dd[PRRU_NACT], ddb[PRRU_NACT];
-  int over = 0;
-  prru_model_actuator_rates(to->m, s->q, s->qd, dd, ddb);
-  for (int i = 0; i < PRRU_NACT; i++) {
-    to->max_dd[i] = fmax(to->max_dd[i], fabs(dd[i]));
-    over |= fabs(dd[i]) > to->speed_max[i];
-  }
-  to->over_speed += over;
   return prru_cli_out_row(o) == 0 ? PRRU_OK : PRRU_EIO;
 }
 
@@ -754,7 +741,7 @@ static int csv_reference(const char *path, prru_quintic *tr)
 
 static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_options *o,
                          const char *plant, const char *mismatch, double ff_peak, const char *status,
-                         const char *limits, const track_output *to)
+                         const char *limits)
 {
   fputc('{', f);
   prru_cli_json_model(f);
@@ -798,9 +785,9 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   fputs(",\n \"limits\": ", f);
   prru_cli_json_string(f, limits);
   fputs(", \"max_dd\": ", f);
-  prru_cli_json_array(f, to->max_dd, PRRU_NACT);
+  prru_cli_json_array(f, s->max_dd, PRRU_NACT);
   fprintf(f, ", \"over_speed_fraction\": ");
-  prru_cli_json_number(f, s->samples ? (double)to->over_speed / (double)s->samples : 0.0);
+  prru_cli_json_number(f, s->samples ? (double)s->over_speed / (double)s->samples : 0.0);
   fputs(",\n \"feedforward_peak\": ", f);
   prru_cli_json_number(f, ff_peak);
   fputs(", \"status\": ", f);
@@ -812,18 +799,18 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
  * stderr when the CSV went to stdout. 0 or 1 after a message. */
 static int write_summary(const char *sums, const char *out, const prru_track_summary *s,
                          const prru_track_options *o, const char *plant, const char *mismatch,
-                         double ff_peak, const char *status, const char *limits, const track_output *to)
+                         double ff_peak, const char *status, const char *limits)
 {
   if (!sums) {
     json_summary((!out || strcmp(out, "-") == 0) ? stderr : stdout, s, o, plant, mismatch, ff_peak, status,
-                 limits, to);
+                 limits);
     return 0;
   }
   char *buf = NULL;
   size_t len = 0;
   FILE *g = open_memstream(&buf, &len);
   if (!g) return 1;
-  json_summary(g, s, o, plant, mismatch, ff_peak, status, limits, to);
+  json_summary(g, s, o, plant, mismatch, ff_peak, status, limits);
   fclose(g);
   prru_cli_out so;
   int rc = prru_cli_out_open(&so, "track", sums);
@@ -864,19 +851,16 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
   return rc;
 }
 
-/* Gains, timing, noise and tolerances into o. 0 or 2. */
+/* Gains, timing, noise and tolerances into o, as numbers: their rules are
+ * the library's (track_options_checked). 0 or 2. */
 static int parse_track_settings(const char **a, prru_track_options *o)
 {
   /* a: bandwidth kp kd period dt noise seed q0-offset atol rtol */
-  double w = 20, v[3];
+  double w, v[3];
   if (a[0] && prru_cli_number("track", "bandwidth", a[0], &w)) return 2;
-  if (!(w > 0)) {
-    prru_cli_error("track", "--bandwidth: %g is not > 0 (rad/s)", w);
+  if (a[0] && prru_track_gains_bandwidth(w, o) != PRRU_OK) {
+    prru_cli_error("track", "--bandwidth: %g is not > 0 with finite gains (rad/s)", w);
     return 2;
-  }
-  for (int i = 0; i < 3; i++) {
-    o->kp[i] = w * w;
-    o->kd[i] = 2 * w;
   }
   if (a[0] && (a[1] || a[2])) {
     prru_cli_error("track", "--bandwidth excludes --kp and --kd");
@@ -884,21 +868,8 @@ static int parse_track_settings(const char **a, prru_track_options *o)
   }
   if (a[1] && prru_cli_numbers("track", "kp", a[1], o->kp, 3)) return 2;
   if (a[2] && prru_cli_numbers("track", "kd", a[2], o->kd, 3)) return 2;
-  for (int i = 0; i < 3; i++)
-    if (!(o->kp[i] >= 0 && o->kd[i] >= 0)) {
-      prru_cli_error("track", "--kp/--kd: gains must be >= 0");
-      return 2;
-    }
   if (a[3] && prru_cli_number("track", "period", a[3], &o->control_period)) return 2;
-  if (!(o->control_period >= 0)) {
-    prru_cli_error("track", "--period: %g is not >= 0 (s)", o->control_period);
-    return 2;
-  }
   if (a[4] && prru_cli_number("track", "dt", a[4], &o->dt_out)) return 2;
-  if (!(o->dt_out > 0)) {
-    prru_cli_error("track", "--dt: %g is not > 0 (s)", o->dt_out);
-    return 2;
-  }
   if (a[4] && o->control_period > 0) {
     prru_cli_error("track", "--dt: with --period > 0 there is one row per control period");
     return 2;
@@ -906,15 +877,6 @@ static int parse_track_settings(const char **a, prru_track_options *o)
   if (a[5]) {
     double nz[2];
     if (prru_cli_numbers("track", "noise", a[5], nz, 2)) return 2;
-    if (!(nz[0] >= 0 && nz[1] >= 0)) {
-      prru_cli_error("track", "--noise: standard deviations must be >= 0");
-      return 2;
-    }
-    if (o->control_period == 0 && (nz[0] > 0 || nz[1] > 0)) {
-      prru_cli_error("track", "--noise needs --period > 0: a continuous controller inside the "
-                     "integrator cannot read noisy samples");
-      return 2;
-    }
     o->noise_q = nz[0];
     o->noise_qd = nz[1];
   }
@@ -931,10 +893,6 @@ static int parse_track_settings(const char **a, prru_track_options *o)
   if (a[7]) memcpy(o->q0_offset, v, sizeof v);
   if (a[8] && prru_cli_number("track", "atol", a[8], &o->abs_tol)) return 2;
   if (a[9] && prru_cli_number("track", "rtol", a[9], &o->rel_tol)) return 2;
-  if (!(o->abs_tol >= PRRU_TOL_MIN && o->rel_tol >= PRRU_TOL_MIN)) {
-    prru_cli_error("track", "--atol/--rtol: must be at least %.2g", PRRU_TOL_MIN);
-    return 2;
-  }
   return 0;
 }
 
@@ -951,32 +909,48 @@ static int parse_controller(const char *ctl, const char *q, const char *r, prru_
     return 2;
   }
   if (!lqr) return 0;
-  if (!(o->control_period > 0)) {
-    prru_cli_error("track", "--controller lqr needs --period S > 0: the LQR's gains are those of a "
-                   "sampled controller");
-    return 2;
-  }
   o->controller = PRRU_TRACK_LQR;
   if (q && prru_cli_numbers("track", "lqr-q", q, o->lqr_q, 6)) return 2;
-  int any = 0;
-  for (int i = 0; q && i < 6; i++) {
-    if (!(o->lqr_q[i] >= 0)) {
-      prru_cli_error("track", "--lqr-q: weight %d is %g, not >= 0", i + 1, o->lqr_q[i]);
-      return 2;
-    }
-    any |= o->lqr_q[i] > 0;
-  }
-  if (q && !any) {
-    prru_cli_error("track", "--lqr-q: all weights 0 leave no feedback (omit --lqr-q for the default)");
-    return 2;
-  }
   if (r && prru_cli_numbers("track", "lqr-r", r, o->lqr_r, PRRU_NACT)) return 2;
-  for (int i = 0; r && i < PRRU_NACT; i++)
-    if (!(o->lqr_r[i] > 0)) {
-      prru_cli_error("track", "--lqr-r: weight %d is %g, not > 0", i + 1, o->lqr_r[i]);
-      return 2;
-    }
   return 0;
+}
+
+static int word_char(char c)
+{
+  return isalnum((unsigned char)c) || c == '_';
+}
+
+/* prru_track_options_check on the whole of o, its message in the flags'
+ * words: the library names the options by its members. 0, or 2 after
+ * the message. */
+static int track_options_checked(const prru_track_options *o)
+{
+  static const char *const flag[][2] = {
+      {"controller PRRU_TRACK_LQR", "--controller lqr"}, {"control period", "--period"},
+      {"sensor noise", "--noise"}, {"dt_out", "--dt"}, {"kp", "--kp"}, {"kd", "--kd"},
+      {"q0_offset", "--q0-offset"}, {"abs_tol", "--atol"}, {"rel_tol", "--rtol"},
+      {"lqr_q", "--lqr-q"}, {"lqr_r", "--lqr-r"}};
+  char msg[600], text[800];
+  if (prru_track_options_check(o, msg, sizeof msg) == PRRU_OK) return 0;
+  const int nflag = (int)(sizeof flag / sizeof flag[0]);
+  size_t n = 0;
+  for (const char *p = msg; *p && n + 1 < sizeof text;) {
+    int k = -1;
+    for (int j = 0; j < nflag && k < 0 && (p == msg || !word_char(p[-1])); j++) {
+      size_t len = strlen(flag[j][0]);
+      if (strncmp(p, flag[j][0], len) == 0 && !word_char(p[len])) k = j;
+    }
+    if (k < 0) {
+      text[n++] = *p++;
+      continue;
+    }
+    int w = snprintf(text + n, sizeof text - n, "%s", flag[k][1]);
+    n = w > 0 && (size_t)w < sizeof text - n ? n + (size_t)w : sizeof text - 1;
+    p += strlen(flag[k][0]);
+  }
+  text[n] = '\0';
+  prru_cli_error("track", "%s", text);
+  return 2;
 }
 
 /* The weights of an LQR run that --lqr-q / --lqr-r left out: the
@@ -1090,7 +1064,9 @@ int prru_cmd_track(int argc, char **argv)
       prru_cli_limits("track", "fmax", &lim, &limits) || prru_cli_units("track", units, &motor, &current))
     return 2;
   for (int i = 0; i < PRRU_NACT; i++)
-    o.f_max[i] = limits.force_max[i], o.d_min[i] = limits.d_min[i], o.d_max[i] = limits.d_max[i];
+    o.f_max[i] = limits.force_max[i], o.speed_max[i] = limits.speed_max[i], o.d_min[i] = limits.d_min[i],
+    o.d_max[i] = limits.d_max[i];
+  if (track_options_checked(&o)) return 2;
   char limits_text[400];
   prru_limits_describe(&limits, limits_text, sizeof limits_text);
   if (mism && parse_mismatch(mism, &o.plant)) return 2;
@@ -1140,8 +1116,7 @@ int prru_cmd_track(int argc, char **argv)
   prru_cli_out_printf(&co, "\n");
   prru_cli_out_line(&co);
   prru_model m = *prru_cli_model();
-  track_output to = {&co, &m, motor, current, {0}, {0}, 0};
-  memcpy(to.speed_max, limits.speed_max, sizeof to.speed_max);
+  track_output to = {&co, &m, motor, current};
   o.on_sample = track_row;
   o.ctx = &to;
   o.interrupt = &prru_cli_interrupted;
@@ -1157,7 +1132,7 @@ int prru_cmd_track(int argc, char **argv)
     else
       prru_cli_error("track", "%s; %ld rows written to %s", msg, rows, name);
   }
-  if (write_summary(sums, out, &sum, &o, plants, mism, ff_peak, st == PRRU_OK ? "complete" : msg, limits_text, &to))
+  if (write_summary(sums, out, &sum, &o, plants, mism, ff_peak, st == PRRU_OK ? "complete" : msg, limits_text))
     return 1;
   if (st != PRRU_OK) return prru_cli_exit_for(st);
   if (plot) return track_plot(out, plot, &o);

@@ -328,7 +328,13 @@ expect 2 "--controller lqr needs --period" -- track --waypoints "$WP" --duration
 expect 2 "--controller: 'pid'" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller pid --out "$tmp/x.csv"
 expect 2 "--lqr-q: '1,1,1,1,1' is not 6" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 1,1,1,1,1 --out "$tmp/x.csv"
 expect 2 "--lqr-q: weight 4 is -1" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 1,1,1,-1,1,1 --out "$tmp/x.csv"
-expect 2 "--lqr-q: all weights 0" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 0,0,0,0,0,0 --out "$tmp/x.csv"
+# All weights 0 is the library's rule for "the default" (prru_control.h):
+# the same run, to the byte, as leaving --lqr-q and --lqr-r out.
+"$PRRU" track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q 0,0,0,0,0,0 \
+  --lqr-r "$(nlist 0)" --out "$tmp/lqr0.csv" --summary "$tmp/lqr0.json" 2>"$tmp/err" \
+  || bad "track lqr with all weights 0: $(cat "$tmp/err")"
+cmp -s "$tmp/lqr.csv" "$tmp/lqr0.csv" && cmp -s "$tmp/lqr.json" "$tmp/lqr0.json" && ok \
+  || bad "track lqr: all weights 0 is not the default run"
 expect 2 "--lqr-q: 'inf,1,1,1,1,1' is not 6" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-q inf,1,1,1,1,1 --out "$tmp/x.csv"
 expect 2 "--lqr-r: weight $nact is 0, not > 0" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-r "$rzero" --out "$tmp/x.csv"
 expect 2 "--lqr-r: '$(nlist 1),1' is not $nact" -- track --waypoints "$WP" --durations 1,1 --period 0.002 --controller lqr --lqr-r "$(nlist 1),1" --out "$tmp/x.csv"

@@ -8,7 +8,11 @@
  * falls with the gains (as 1/w^2); a sampled controller with sensor noise
  * is deterministic per seed; force limits are reported as saturation and
  * never exceeded; a stroke limit stops the run; bad options are refused
- * with the option named. The time-varying LQR: on a pose held at rest its
+ * with the option named. Each sample's slider speeds are J_d qd (1e-12),
+ * the summary's max_dd their maxima and over_speed the samples over a
+ * speed limit (counted here from J_d), the limit changing nothing else;
+ * the gains of a bandwidth w are w^2, 2 w (the defaults w = 20); all-zero
+ * LQR weights are the default ones. The time-varying LQR: on a pose held at rest its
  * Riccati recursion reaches the discrete algebraic Riccati equation's
  * solution to rounding, with a stable closed loop; on the exact plant it
  * tracks like computed torque at the same period (within the
@@ -338,6 +342,112 @@ static void refusals(void)
               prru_params_scale(&o.plant, "mass", 0) == PRRU_EINPUT &&
               prru_params_scale(&o.plant, "mass", NAN) == PRRU_EINPUT,
           "unknown mismatch key or bad factor refused");
+}
+
+/* ---- slider speeds, the option checks, the bandwidth rule ---- */
+
+typedef struct {
+  double speed_max[PRRU_NACT], max_dd[PRRU_NACT], worst;
+  long over, samples;
+} speed_ctx;
+
+/* The slider speeds J_d(q) qd from the model's J_d (not the rates kernel
+ * the library uses), their maxima and the samples over a limit. */
+static int speed_check(const prru_track_sample *s, void *p)
+{
+  speed_ctx *c = p;
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3], dd[PRRU_NACT];
+  prru_model_ik_jd(&model, s->q, d, Jd);
+  int over = 0;
+  for (int i = 0; i < PRRU_NACT; i++) {
+    dd[i] = Jd[3 * i] * s->qd[0] + Jd[3 * i + 1] * s->qd[1] + Jd[3 * i + 2] * s->qd[2];
+    c->max_dd[i] = fmax(c->max_dd[i], fabs(dd[i]));
+    over |= fabs(dd[i]) > c->speed_max[i];
+  }
+  c->worst = fmax(c->worst, tu_relerr(s->dd, dd, PRRU_NACT, 1e-3));
+  c->over += over;
+  c->samples++;
+  return 0;
+}
+
+static void slider_speeds(void)
+{
+  prru_track_options o;
+  prru_track_options_default(&o);
+  /* Off the reference and a heavier plant: the speeds are the plant's
+   * state's, not the reference's. */
+  prru_params_scale(&o.plant, "mass", 1.2);
+  o.q0_offset[0] = 0.01;
+  speed_ctx c;
+  memset(&c, 0, sizeof c);
+  for (int i = 0; i < PRRU_NACT; i++) c.speed_max[i] = o.speed_max[i];
+  o.on_sample = speed_check;
+  o.ctx = &c;
+  prru_track_summary s;
+  char msg[512];
+  TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_OK, msg);
+  tu_check(c.worst <= 1e-12, "sample dd = J_d qd", c.worst, 1e-12);
+  TU_CLOSE(s.max_dd, c.max_dd, PRRU_NACT, 1e-12, "max_dd = max over the samples of |J_d qd|");
+  TU_TRUE(s.over_speed == 0 && c.over == 0, "no speed limit: nothing over it");
+  /* Limits at half of each slider's peak speed: counted where any slider
+   * is over its own, and reported, not enforced (the same run). */
+  prru_track_summary s2;
+  memset(&c, 0, sizeof c);
+  for (int i = 0; i < PRRU_NACT; i++) o.speed_max[i] = c.speed_max[i] = 0.5 * s.max_dd[i];
+  TU_TRUE(prru_track(&model, &ref, &o, &s2, msg, sizeof msg) == PRRU_OK, msg);
+  printf("speed limits at half the peaks: %ld of %ld samples over\n", s2.over_speed, s2.samples);
+  TU_TRUE(s2.over_speed == c.over && c.samples == s2.samples && s2.over_speed > 0 &&
+              s2.over_speed < s2.samples,
+          "over_speed counts the samples with a slider over its limit");
+  TU_TRUE(memcmp(s2.max_dd, s.max_dd, sizeof s.max_dd) == 0 && memcmp(s2.max_e, s.max_e, sizeof s.max_e) == 0,
+          "a speed limit changes nothing in the run");
+  o.speed_max[1] = 0;
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "speed limit of actuator 2"),
+          "zero speed limit refused");
+}
+
+static void option_checks(void)
+{
+  prru_track_options o, d;
+  char msg[512] = "stale";
+  prru_track_options_default(&o);
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0', "defaults pass");
+  /* The bandwidth rule: the defaults are w = 20; bad w leaves o alone. */
+  prru_track_options_default(&d);
+  TU_TRUE(prru_track_gains_bandwidth(20.0, &o) == PRRU_OK && memcmp(&o, &d, sizeof o) == 0,
+          "default gains = bandwidth 20 rad/s");
+  TU_TRUE(prru_track_gains_bandwidth(7.0, &o) == PRRU_OK && o.kp[0] == 49.0 && o.kp[2] == 49.0 &&
+              o.kd[0] == 14.0 && o.kd[1] == 14.0,
+          "bandwidth 7: kp = 49, kd = 14");
+  const double bad[] = {0.0, -1.0, NAN, INFINITY, 1e200};
+  int refused = 1;
+  for (int k = 0; k < 5; k++) refused &= prru_track_gains_bandwidth(bad[k], &o) == PRRU_EINPUT && o.kp[1] == 49.0;
+  TU_TRUE(refused, "bandwidth not > 0 or with infinite gains refused, gains kept");
+  /* The names a front end replaces (prru_control.h). */
+  prru_track_options_default(&o);
+  o.noise_qd = 1e-3;
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "sensor noise needs control period > 0"),
+          "noise needs a control period");
+  prru_track_options_default(&o);
+  o.controller = PRRU_TRACK_LQR;
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "controller PRRU_TRACK_LQR needs control period > 0"),
+          "LQR needs a control period");
+  o.control_period = 1e-2;
+  o.rel_tol = 1e-15;
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT && strncmp(msg, "rel_tol: ", 9) == 0,
+          "tolerance below PRRU_TOL_MIN refused");
+  /* One rule for all-zero weights: the defaults, Q and R alike. */
+  o.rel_tol = 1e-12;
+  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0', "LQR weights all 0 accepted");
+  prru_lqr_schedule sch;
+  double q[6], r[PRRU_NACT];
+  TU_TRUE(prru_lqr_default_weights(&model, &ref, o.control_period, q, r, msg, sizeof msg) == PRRU_OK, msg);
+  TU_TRUE(prru_lqr_schedule_build(&model, &ref, &o, &sch, msg, sizeof msg) == PRRU_OK, msg);
+  TU_TRUE(memcmp(sch.q, q, sizeof q) == 0 && memcmp(sch.r, r, sizeof r) == 0,
+          "all-zero weights are prru_lqr_default_weights'");
+  prru_lqr_schedule_free(&sch);
 }
 
 /* ---- LQR ---- */
@@ -713,6 +823,8 @@ int main(void)
   stroke();
   stroke_between_samples();
   refusals();
+  slider_speeds();
+  option_checks();
   lqr_stationary();
   lqr_tracking();
   lqr_wrong_gain();

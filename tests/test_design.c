@@ -300,6 +300,11 @@ static void variables(void)
   TU_TRUE(p.l1[0] == prru_params_model.l1[0] + 0.002 &&
               fabs(p.l1[1] - (prru_params_model.l1[1] + 0.012)) < 1e-15,
           "tied variable shifts every member");
+  /* Assigned, every tied member takes the value itself. */
+  prru_design_assign(&p, &v, 0.5);
+  int all = 1;
+  for (int i = 0; i < PRRU_NLIMB; i++) all &= p.l1[i] == 0.5;
+  TU_TRUE(all && p.l2[0] == prru_params_model.l2[0], "tied variable assigned: every member, nothing else");
 }
 
 static void check_refuses(const prru_params *p, const char *needle, const char *what)

@@ -18,7 +18,11 @@
  *    noise-free, beta to 1e-9 relative; with Gaussian noise of known sigma
  *    on fd, every base parameter within 4 standard errors, the mean
  *    squared normalised error near 1 and the residual sigma near the
- *    noise's; an unreachable sample is named. */
+ *    noise's; an unreachable sample is named;
+ *  - the excitation's defaults (prru_fourier_default,
+ *    prru_excite_options_default, check samples 0 = 20 samples) and the
+ *    rows of a run (prru_excite_rows) exactly, and at random runs: up to
+ *    the end, none a dt past it. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -394,6 +398,69 @@ static void check_excite(const prru_base *b)
   TU_TRUE(prru_excite(&model, b, &o, NULL, &f2, &r2, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "centre") != NULL,
           "an unreachable centre is refused by name");
+}
+
+/* The defaults prru excite and the binding take from the library, and the
+ * rows of a run: n = floor(T N / dt (1 + 1e-12)) + 1, exactly. */
+static void check_excite_defaults(const prru_base *b)
+{
+  prru_fourier f;
+  memset(&f, 0xff, sizeof f);
+  prru_fourier_default(&f);
+  int zero = f.centre[0] == 0 && f.centre[1] == 0 && f.centre[2] == 0;
+  for (int k = 0; k < 3; k++)
+    for (int l = 0; l < PRRU_EXCITE_MAX_HARMONICS; l++) zero &= f.a[k][l] == 0 && f.b[k][l] == 0;
+  TU_TRUE(f.period == 10 && f.harmonics == 5 && zero, "Fourier default: 10 s, 5 harmonics, all 0");
+  prru_excite_options o;
+  prru_excite_options_default(&o);
+  TU_TRUE(o.dt == 0.01 && o.periods == 1 && o.samples == 100 && o.check_samples == 0 && o.max_evals == 3000 &&
+              o.seed == 1,
+          "excite defaults: rows every 0.01 s over 1 period, check samples follow samples");
+  TU_TRUE(prru_excite_rows(&f, &o) == 1001, "default run: 1001 rows");
+  f.period = 0.3, o.dt = 0.1; /* 0.3 / 0.1 = 2.9999999999999996 */
+  TU_TRUE(prru_excite_rows(&f, &o) == 4, "the end's row kept against rounding");
+  f.period = 8, o.periods = 3, o.dt = 0.007;
+  TU_TRUE(prru_excite_rows(&f, &o) == 3429, "8 s x 3 every 7 ms: 3429 rows");
+  o.dt = 24;
+  TU_TRUE(prru_excite_rows(&f, &o) == 2, "dt = the run: its two ends");
+  const double bad_dt[] = {24.000001, 0, -0.01, NAN, INFINITY, 1e-15};
+  int refused = 1;
+  for (int k = 0; k < 6; k++) {
+    o.dt = bad_dt[k];
+    refused &= prru_excite_rows(&f, &o) == 0;
+  }
+  o.dt = 0.01, o.periods = 0;
+  refused &= prru_excite_rows(&f, &o) == 0;
+  o.periods = 1, f.period = -1;
+  refused &= prru_excite_rows(&f, &o) == 0;
+  TU_TRUE(refused, "no rows without a run (dt past its end, not > 0, > 1e15 rows; bad period or periods)");
+  /* Random runs: the last row at the end or less than dt before it. */
+  int held = 1;
+  for (int k = 0; k < 1000; k++) {
+    f.period = tu_uniform(0.01, 20), o.periods = 1 + (int)tu_uniform(0, 5), o.dt = tu_uniform(1e-4, 0.5);
+    const double run = f.period * o.periods;
+    long n = prru_excite_rows(&f, &o);
+    held &= o.dt > run ? n == 0 : n >= 2 && (n - 1) * o.dt <= run * (1 + 1e-12) && n * o.dt > run;
+  }
+  TU_TRUE(held, "rows up to the run's end, none a dt past it");
+  /* check_samples 0 is 20 samples: the same excitation as giving them. */
+  prru_excite_options_default(&o);
+  o.max_evals = 60;
+  o.samples = 40;
+  prru_excite_options o20 = o;
+  o20.check_samples = 800;
+  prru_fourier f0, f20;
+  prru_fourier_default(&f0);
+  f0.period = 5, f0.harmonics = 3;
+  f20 = f0;
+  prru_excite_result r0, r20;
+  char msg[256];
+  int st0 = prru_excite(&model, b, &o, NULL, &f0, &r0, msg, sizeof msg);
+  int st20 = prru_excite(&model, b, &o20, NULL, &f20, &r20, msg, sizeof msg);
+  TU_TRUE(st0 == st20 && memcmp(&f0, &f20, sizeof f0) == 0 && memcmp(&r0, &r20, sizeof r0) == 0,
+          "check samples 0 = 20 times samples");
+  o.check_samples = -1;
+  TU_TRUE(prru_excite(&model, b, &o, NULL, &f0, &r0, msg, sizeof msg) == PRRU_EINPUT, "negative check samples refused");
 }
 
 /* ---- physically consistent identification ---- */
@@ -787,6 +854,7 @@ int main(void)
   check_base(b);
   hand_excitation();
   check_excite(b);
+  check_excite_defaults(b);
   check_identify(b);
   check_identify_model(b);
   check_model_params_of_pi(b);

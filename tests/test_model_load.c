@@ -10,9 +10,11 @@
  * loaded numbers, at seeded random regular states with velocities and
  * loads, within the bounds of test_trust and test_reactions (derived from
  * the rounding unit and the state's conditioning, K u (kappa |qdd| +
- * |M^-1| S) and so on; see there). A file with another number of limbs
- * is refused with a message naming it; a refused file leaves the model
- * untouched. Loading takes well under 1 ms (timed, printed). */
+ * |M^-1| S) and so on; see there); prru_power matches the kernels'
+ * products and closes the work-energy balance. A file with another
+ * number of limbs is refused with a message naming it; a refused file
+ * leaves the model untouched. Loading takes well under 1 ms (timed,
+ * printed). */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <float.h>
@@ -34,6 +36,7 @@
 static prru_data data;
 static prru_ref_ws *W;
 static int energy_checked; /* files whose work-energy balance was checked */
+static int power_checked;  /* and with prru_power */
 
 /* The most regular height of q = (0, 0, q3) on a grid down to 4 lengths
  * below the rails' top (every valid model assembles at q1 = q2 = 0);
@@ -86,9 +89,64 @@ static double terms_scale(const prru_model *m, const double q[3], const double q
 }
 
 typedef struct {
-  double fd, id, rt, lam, energy, paths;
+  double fd, id, rt, lam, energy, paths, power, balance;
   int states;
 } worst;
+
+/* gamma_n = n u / (1 - n u), u = DBL_EPSILON / 2: the bound on the
+ * relative rounding of a chain of n floating-point operations. */
+static double gamma_n(int n)
+{
+  const double u = DBL_EPSILON / 2;
+  return n * u / (1 - n * u);
+}
+
+/* prru_power against the same powers summed the other way round from the
+ * model's kernels: the loads' as qd . tau, tau = J_d^T fd + J_T,O'^T fp +
+ * J_R,P^T mp the generalized force they exert (the virtual power that
+ * the equations of motion use), the drives' as Q_p . qd from the last
+ * term. Both sides are the same real sum of products f_i J_ik qd_k of the
+ * same doubles, evaluated in different orders: each within gamma_n S of
+ * the exact sum, S the sum of the products' magnitudes and n the most
+ * operations any one product passes through (library: 1 product and 3
+ * adds for J qd, 1 product by the load, 1 add of fp v + mp w, NACT + 3
+ * adds into the total; here: 1 product, 1 add of the fp and mp terms,
+ * NACT + 6 adds into tau, 1 product by qd, 3 adds; n = NACT + 12 covers
+ * both), so they differ by at most 2 gamma_n S; the drives' sums (1
+ * product, 3 adds) by 2 gamma_4 sum |Q_p,k qd_k|. S's own rounding is a
+ * relative gamma_n: second order, left out. */
+static void check_power_state(const prru_model *m, const double q[3], const double qd[3], const prru_loads *l,
+                              worst *w, const char *file)
+{
+  double load, passive, act[PRRU_NACT], Jd[PRRU_NACT * 3], JP[18], Qp[3];
+  prru_power(m, q, qd, l, &load, &passive);
+  prru_model_ik_jd(m, q, act, Jd);
+  prru_model_platform_jacobian(m, q, JP);
+  prru_model_passive(m, q, qd, Qp);
+  double load_t = 0, passive_t = 0, S = 0, Sp = 0;
+  for (int k = 2; k >= 0; k--) {
+    double tau = 0;
+    for (int i = 0; i < 3; i++) {
+      tau += JP[9 + 3 * i + k] * l->fp[i] + JP[3 * i + k] * l->mp[i];
+      S += (fabs(JP[9 + 3 * i + k] * l->fp[i]) + fabs(JP[3 * i + k] * l->mp[i])) * fabs(qd[k]);
+    }
+    for (int i = PRRU_NACT - 1; i >= 0; i--) {
+      tau += Jd[3 * i + k] * l->fd[i];
+      S += fabs(Jd[3 * i + k] * l->fd[i]) * fabs(qd[k]);
+    }
+    load_t += qd[k] * tau;
+    passive_t += Qp[k] * qd[k];
+    Sp += fabs(Qp[k] * qd[k]);
+  }
+  const double bl = 2 * gamma_n(PRRU_NACT + 12) * S, bp = 2 * gamma_n(4) * Sp;
+  const double el = fabs(load - load_t), ep = fabs(passive - passive_t);
+  /* An exact 0 (a model without drives) has a zero bound: compared as such. */
+  const double r = fmax(bl > 0 ? el / bl : el > 0, bp > 0 ? ep / bp : ep > 0);
+  w->power = fmax(w->power, r);
+  char what[700];
+  snprintf(what, sizeof what, "%s: prru_power = qd . tau and Q_p . qd, within 2 gamma_n of the terms", file);
+  tu_check(el <= bl && ep <= bp, what, r, 1.0);
+}
 
 /* One state: forward and inverse dynamics and the reactions against the
  * reference from the loaded numbers; refusals by the trust criterion skip. */
@@ -193,12 +251,23 @@ static void check_state(const prru_model *m, const prru_ref_params *P, const dou
  * in the largest of |T|, |V|, |W|. A dynamics whose energy kernel
  * disagrees with its forward dynamics leaves a residual that does not
  * shrink with the step, and fails. check_energy returns 1 when checked,
- * 0 when the motion left the regular workspace (reported, not checked). */
-static void work_rhs(const prru_model *m, const prru_loads *l, const double y[7], double f[7])
+ * 0 when the motion left the regular workspace (reported, not checked).
+ * With library_power, the same balance with prru_power as dW/dt and a
+ * platform force and moment as well (a tenth of the machine's weight W
+ * and W L / 30 in each direction, held at the start like gravity): the
+ * library's power against the energy kernel and the forward dynamics,
+ * which share none of its code, with the same bound. */
+static void work_rhs(const prru_model *m, const prru_loads *l, const double y[7], double f[7], int library_power)
 {
   double d[PRRU_NACT], Jd[3 * PRRU_NACT], Qp[3], dd[PRRU_NACT], ddb[PRRU_NACT];
   memcpy(f, y + 3, 3 * sizeof f[0]);
   if (prru_forward_dynamics(m, &data, y, y + 3, l, f + 3) != PRRU_OK) f[3] = NAN;
+  if (library_power) {
+    double load, passive;
+    prru_power(m, y, y + 3, l, &load, &passive);
+    f[6] = load + passive;
+    return;
+  }
   prru_model_ik_jd(m, y, d, Jd);
   prru_model_passive(m, y, y + 3, Qp);
   prru_model_actuator_rates(m, y, y + 3, dd, ddb);
@@ -209,18 +278,18 @@ static void work_rhs(const prru_model *m, const prru_loads *l, const double y[7]
 }
 
 static double balance_residual(const prru_model *m, const prru_loads *l, const double q0[3], const double qd0[3],
-                               double t_end, int n, double *scale)
+                               double t_end, int n, double *scale, int library_power)
 {
   double y[7] = {q0[0], q0[1], q0[2], qd0[0], qd0[1], qd0[2], 0}, k1[7], k2[7], k3[7], k4[7], yt[7];
   const double h = t_end / n;
   for (int s = 0; s < n; s++) {
-    work_rhs(m, l, y, k1);
+    work_rhs(m, l, y, k1, library_power);
     for (int j = 0; j < 7; j++) yt[j] = y[j] + 0.5 * h * k1[j];
-    work_rhs(m, l, yt, k2);
+    work_rhs(m, l, yt, k2, library_power);
     for (int j = 0; j < 7; j++) yt[j] = y[j] + 0.5 * h * k2[j];
-    work_rhs(m, l, yt, k3);
+    work_rhs(m, l, yt, k3, library_power);
     for (int j = 0; j < 7; j++) yt[j] = y[j] + h * k3[j];
-    work_rhs(m, l, yt, k4);
+    work_rhs(m, l, yt, k4, library_power);
     for (int j = 0; j < 7; j++) y[j] += h / 6 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
     if (!isfinite(y[3])) return NAN;
   }
@@ -230,7 +299,8 @@ static double balance_residual(const prru_model *m, const prru_loads *l, const d
   return T1 + V1 - T0 - V0 - y[6];
 }
 
-static int check_energy(const prru_model *m, const double q0[3], double L, const char *file, double *ratio)
+static int check_energy(const prru_model *m, const double q0[3], double L, const char *file, double *ratio,
+                        int library_power)
 {
   const double g = sqrt(m->mech->gravity[0] * m->mech->gravity[0] + m->mech->gravity[1] * m->mech->gravity[1] +
                         m->mech->gravity[2] * m->mech->gravity[2]);
@@ -238,20 +308,30 @@ static int check_energy(const prru_model *m, const double q0[3], double L, const
   const double qd0[3] = {0.3 / tau, -0.2 / tau, 0.3 * L / tau};
   prru_loads l;
   memset(&l, 0, sizeof l);
+  if (library_power) {
+    double weight = 0;
+    for (int b = 0; b < PRRU_NBODY; b++) weight += m->mech->mass[b] * g;
+    for (int i = 0; i < 3; i++) {
+      l.fp[i] = 0.1 * weight * (i == 1 ? -1 : 1);
+      l.mp[i] = weight * L / 30 * (i == 2 ? -1 : 1);
+    }
+  }
   if (prru_inverse_dynamics(m, &data, q0, zero, zero, &l, l.fd) != PRRU_OK) return 0;
   for (int i = 0; i < PRRU_NACT; i++) l.fd[i] *= 1.0 + 0.05 * (i + 1); /* a push: the forces do work */
   const int n = 200;
   double s1 = 0, s2 = 0;
-  const double r1 = balance_residual(m, &l, q0, qd0, 0.5 * tau, n, &s1);
-  const double r2 = balance_residual(m, &l, q0, qd0, 0.5 * tau, 2 * n, &s2);
+  const double r1 = balance_residual(m, &l, q0, qd0, 0.5 * tau, n, &s1, library_power);
+  const double r2 = balance_residual(m, &l, q0, qd0, 0.5 * tau, 2 * n, &s2, library_power);
   if (!isfinite(r1) || !isfinite(r2)) {
-    printf("%s: energy balance not checked: the motion left the regular workspace\n", file);
+    printf("%s: %s not checked: the motion left the regular workspace\n", file,
+           library_power ? "prru_power's energy balance" : "energy balance");
     return 0;
   }
   const double bound = 2 * fabs(r1 - r2) / 15 + 16 * DBL_EPSILON * 2 * n * s2;
   *ratio = fabs(r2) / bound;
   char what[600];
-  snprintf(what, sizeof what, "%s: work-energy balance |r_2n| / (2 |r_n - r_2n| / 15 + 16 u 2n max(T, V, W))", file);
+  snprintf(what, sizeof what, "%s: work-energy balance%s |r_2n| / (2 |r_n - r_2n| / 15 + 16 u 2n max(T, V, W))", file,
+           library_power ? " with prru_power and platform loads" : "");
   tu_check(fabs(r2) <= bound, what, *ratio, 1.0);
   return 1;
 }
@@ -417,7 +497,7 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
   ref_params_of(m.mech, &P);
   const double L = (m.mech->l1[0] + m.mech->l1[1] + m.mech->l1[2]) / 3;
   double q3 = 0;
-  worst w = {0, 0, 0, 0, 0, 0, 0};
+  worst w = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   /* The build's own numbers: the same file again, on the parameter
    * kernels, compared state by state with the specialised path. */
   /* And the general parameter kernels where the model's own path is
@@ -460,15 +540,17 @@ static void check_file(const char *path, int *loaded, int *other, int *specialis
       prru_loads l;
       if (!random_state(&m, &P, L, q3, q, qd, &l)) break;
       check_state(&m, &P, q, qd, &l, &w, path, reactions, alts);
+      check_power_state(&m, q, qd, &l, &w, path);
     }
     printf("home %s 0,0,%.17g\n", path, q3); /* the CLI check of test_random_loaded.sh starts there */
     const double q0[3] = {0.05, -0.05, q3};
-    energy_checked += check_energy(&m, q0, L, path, &w.energy);
+    energy_checked += check_energy(&m, q0, L, path, &w.energy, 0);
+    power_checked += check_energy(&m, q0, L, path, &w.balance, 1);
   }
   printf("%-60s %s, %.3f ms to load; %d states: FD %.1f, ID %.1f, ID(FD) %.1f u-bounds, reactions %.1f u kappa%s; "
-         "energy %.2g of its bound\n",
+         "energy %.2g of its bound; prru_power %.2g of its bound, in the balance %.2g\n",
          path, m.kernels->path, ms, w.states, w.fd, w.id, w.rt, w.lam, reactions ? "" : " (not compared: see main)",
-         w.energy);
+         w.energy, w.power, w.balance);
   if (alts[0] || alts[1])
     printf("  against the other kernel tables (%s%s): %.2f u-bounds (FD, ID)\n", alts[0] ? "parameter " : "",
            alts[1] ? "general" : "", w.paths);
@@ -588,11 +670,13 @@ static int check_given(int n, char **files)
 {
   int loaded = 0, other = 0, specialised = 0;
   for (int i = 0; i < n; i++) {
-    const int before = tu_failures, energy_before = energy_checked;
+    const int before = tu_failures, energy_before = energy_checked, power_before = power_checked;
     check_file(files[i], &loaded, &other, &specialised, 1);
     char what[600];
     snprintf(what, sizeof what, "%s: the work-energy balance checked", files[i]);
     TU_TRUE(energy_checked == energy_before + 1, what);
+    snprintf(what, sizeof what, "%s: the work-energy balance with prru_power checked", files[i]);
+    TU_TRUE(power_checked == power_before + 1, what);
     if (tu_failures != before) printf("FAILED: %s\n", files[i]);
   }
   TU_TRUE(loaded == n && other == 0 && specialised == 0, "every file loaded, on the parameter kernels");

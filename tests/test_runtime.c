@@ -1,8 +1,9 @@
 /* Runtime properties that hold for any valid model: the work-energy
  * balance (with the drives' dissipation), inverse of the forward dynamics,
- * FK(IK), reactions (H^T Q = 0, platform Newton-Euler, machine force
- * balance, agreement with the dense reference), the integrators against an
- * independent RK4, clean stops, bounded integrator work (tolerance floor,
+ * FK(IK) and its seed, tolerance and residual, reactions (H^T Q = 0,
+ * platform Newton-Euler, machine force balance, agreement with the dense
+ * reference), the integrators against an independent RK4, clean stops,
+ * bounded integrator work (tolerance floor,
  * step budget, interrupts inside a step), msbdf at the workspace boundary,
  * parsing. The paper's scenario is checked in paper_runtime.c.
  * Models with 3 or 4 actuators (spec section 12): sizes follow PRRU_NACT;
@@ -12,6 +13,7 @@
  * the simulations' constant loads are built from the model's static
  * actuator forces. test_redundant.c checks the redundancy itself. */
 #define _XOPEN_SOURCE 700 /* setitimer, sigaction, clock_gettime, write, _exit */
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -158,6 +160,98 @@ static void test_fk(void)
   }
   double bad[PRRU_NACT] = {NAN, 0, 0};
   TU_TRUE(prru_forward_kinematics(&model, &data, bad, seed, sol) == PRRU_EINPUT, "FK of NaN d");
+}
+
+/* The pieces prru fk and Model.fk use around the solvers.
+ * prru_fk_tolerance: its documented rule, 1000 DBL_EPSILON max(L, |act|),
+ * exactly (the same operations on the same doubles), on sliders shorter
+ * than L and with one far down its rail.
+ * prru_fk_default_seed, at level and tilted regular poses q with act =
+ * d(q): (0, 0, h), regular; at a level pose it reproduces act within the
+ * tolerance (d_i = q3 + d_i(0, 0, 0) up to the kernel's rounding, far
+ * below 1000 ulps); prru_forward_kinematics and its least-squares
+ * variant converge from it to q. Bound on q: the answer's residual r is
+ * at most tol, and q_sol - q = J_d^+ (d(q_sol) - d(q)) to first order,
+ * so |q_sol,i - q_i| <= sum_j |J_d^+_ij| tol; allowed twice that for the
+ * kernel's own rounding of d at both points (tens of operations: well
+ * under tol / 2, 500 ulps of the scale) and the second-order term.
+ * prru_fk_residual: bit for bit the least-squares solver's residual at
+ * its answer (the same kernel and operations); against the GSL
+ * reference's d_ref(q) with act = d_ref + delta (delta ~ 1e-4 L, so the
+ * norm is what is checked), |res - res_ref| <= max_i |d_i - d_ref_i| +
+ * u / (1 - u) (res + res_ref): max_i |x_i| moves by at most
+ * max_i |x_i - y_i| (triangle inequality), and each side rounds its
+ * differences once (u = DBL_EPSILON / 2); NaN out of reach or for NaN
+ * sliders. */
+static void test_fk_helpers(void)
+{
+  const double L = prru_length_scale(model.mech), u = DBL_EPSILON / 2;
+  double small[PRRU_NACT], big[PRRU_NACT];
+  for (int i = 0; i < PRRU_NACT; i++) small[i] = big[i] = 0.25 * L * (i % 2 ? -1 : 1);
+  big[PRRU_NACT - 1] = -40 * L;
+  TU_TRUE(prru_fk_tolerance(&model, small) == 1000 * DBL_EPSILON * L &&
+              prru_fk_tolerance(&model, big) == 1000 * DBL_EPSILON * fabs(big[PRRU_NACT - 1]),
+          "prru_fk_tolerance = 1000 eps max(L, |act|_inf)");
+  static const double poses[5][3] = {
+      {0, 0, -0.8}, {0, 0, -0.65}, {0.1, 0.2, -0.8}, {-0.15, 0.1, -0.7}, {0.2, -0.25, -0.9}};
+  prru_ref_params P;
+  prru_ref_params_default(&P);
+  int checked = 0;
+  double worst_q = 0, worst_res = 0;
+  for (int p = 0; p < 5; p++) {
+    const double *q = poses[p];
+    if (prru_check_regular(&model, &data, q, NULL) != PRRU_OK) continue;
+    double act[PRRU_NACT], rows[3] = {0, 0, 0}, seed[3], sol[3], fit[3], res_fit = NAN;
+    memcpy(act, data.d, sizeof act);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < PRRU_NACT; j++) rows[i] += fabs(data.Jdpinv[PRRU_NACT * i + j]);
+    const double tol = prru_fk_tolerance(&model, act);
+    prru_fk_default_seed(&model, act, seed);
+    char what[200];
+    snprintf(what, sizeof what, "pose %d: the default seed is (0, 0, h) and regular", p);
+    TU_TRUE(seed[0] == 0 && seed[1] == 0 && prru_check_regular(&model, &data, seed, NULL) == PRRU_OK, what);
+    if (q[0] == 0 && q[1] == 0) {
+      const double r = prru_fk_residual(&model, seed, act);
+      snprintf(what, sizeof what, "pose %d (level): the default seed reproduces the sliders within tol", p);
+      tu_check(r <= tol, what, r, tol);
+    }
+    snprintf(what, sizeof what, "pose %d: Newton and least squares converge from the default seed", p);
+    if (!TU_TRUE(prru_forward_kinematics(&model, &data, act, seed, sol) == PRRU_OK &&
+                     prru_forward_kinematics_lsq(&model, &data, act, seed, fit, &res_fit) == PRRU_OK,
+                 what))
+      continue;
+    for (int i = 0; i < 3; i++) {
+      worst_q = fmax(worst_q, fabs(sol[i] - q[i]) / (2 * rows[i] * tol));
+      worst_q = fmax(worst_q, fabs(fit[i] - q[i]) / (2 * rows[i] * tol));
+    }
+    const double r_sol = prru_fk_residual(&model, sol, act);
+    snprintf(what, sizeof what, "pose %d: FK's residual within tol, the least-squares one bit for bit", p);
+    TU_TRUE(r_sol <= tol && res_fit <= tol && res_fit == prru_fk_residual(&model, fit, act), what);
+    /* Against the reference's d. */
+    double d_ref[PRRU_NACT], off[PRRU_NACT], dk = 0, res_ref = 0;
+    if (!TU_TRUE(prru_ref_ik(&P, q, d_ref) == GSL_SUCCESS, "reference ik")) continue;
+    for (int i = 0; i < PRRU_NACT; i++) {
+      off[i] = d_ref[i] + 1e-4 * L * (i + 1) * (i % 2 ? -1 : 1);
+      dk = fmax(dk, fabs(act[i] - d_ref[i]));
+      res_ref = fmax(res_ref, fabs(d_ref[i] - off[i]));
+    }
+    const double res = prru_fk_residual(&model, q, off);
+    const double bound = dk + u / (1 - u) * (res + res_ref);
+    worst_res = fmax(worst_res, fabs(res - res_ref) / bound);
+    snprintf(what, sizeof what, "pose %d: prru_fk_residual = max |d_ref - act| within the rounding", p);
+    tu_check(fabs(res - res_ref) <= bound, what, fabs(res - res_ref) / bound, 1.0);
+    checked++;
+  }
+  printf("FK from the default seed at %d poses: q within %.2g of its bound; residual vs reference %.2g of its bound\n",
+         checked, worst_q, worst_res);
+  tu_check(worst_q <= 1.0, "FK from the default seed: |q_sol - q| <= 2 |J_d^+| tol", worst_q, 1.0);
+  TU_TRUE(checked >= 4, "FK helpers checked at 4 or more regular poses");
+  double far[3], bad[PRRU_NACT];
+  unreachable_pose(far);
+  memcpy(bad, small, sizeof bad);
+  bad[0] = NAN;
+  TU_TRUE(isnan(prru_fk_residual(&model, far, small)) && isnan(prru_fk_residual(&model, poses[0], bad)),
+          "prru_fk_residual: NaN out of reach and for NaN sliders");
 }
 
 static void test_bad_input(void)
@@ -1049,6 +1143,7 @@ int main(void)
   test_description();
   test_inverse_of_forward();
   test_fk();
+  test_fk_helpers();
   test_bad_input();
   test_every_bad_input();
   test_reactions();

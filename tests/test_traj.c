@@ -383,8 +383,40 @@ static void path_side(void)
   TU_TRUE(s.sign == (square ? 1 : 0), "path side: a crossing keeps the sign before it");
 }
 
+/* The rows of a sampled motion (prru_row_count, prru_row_time): every dt
+ * from t0 and t1 itself, a remainder of rounding's size merged into the
+ * last row, at least two rows, and no run of more than 1e8 steps. */
+static void row_times(void)
+{
+  TU_TRUE(prru_row_count(0, 1, 0.25) == 5 && prru_row_time(0, 1, 0.25, 3, 5) == 0.75 &&
+              prru_row_time(0, 1, 0.25, 4, 5) == 1.0,
+          "rows: 1 s every 0.25 s is 0, 0.25, 0.5, 0.75, 1");
+  /* 0.3 / 0.1 is 2.9999999999999996 in double: three steps, not four. */
+  TU_TRUE(prru_row_count(0, 0.3, 0.1) == 4 && prru_row_time(0, 0.3, 0.1, 3, 4) == 0.3,
+          "rows: a quotient a rounding below a whole number");
+  TU_TRUE(prru_row_count(0, 1, 0.3) == 5 && prru_row_time(0, 1, 0.3, 3, 5) == 0.3 * 3 &&
+              prru_row_time(0, 1, 0.3, 4, 5) == 1.0,
+          "rows: a remainder gets the end's row");
+  TU_TRUE(prru_row_count(2, 2.001, 1) == 2 && prru_row_time(2, 2.001, 1, 1, 2) == 2.001,
+          "rows: a span below dt still has both ends");
+  TU_TRUE(prru_row_count(0, 1, 0) == 0 && prru_row_count(0, 1, -1) == 0 && prru_row_count(0, 1, NAN) == 0 &&
+              prru_row_count(0, 1e9, 1) == 0 && prru_row_count(0, 1e8, 1) == 100000001,
+          "rows: dt not > 0 or more than 1e8 steps refused, 1e8 steps allowed");
+  /* Every row before the end within the span, the last at t1, steps of dt. */
+  tu_rng_state = 7;
+  int ok = 1;
+  for (int i = 0; i < 1000; i++) {
+    const double t0 = tu_uniform(-5, 5), t1 = t0 + tu_uniform(1e-3, 10), dt = tu_uniform(1e-3, 1);
+    const long n = prru_row_count(t0, t1, dt);
+    ok &= n >= 2 && prru_row_time(t0, t1, dt, n - 1, n) == t1 && prru_row_time(t0, t1, dt, n - 2, n) < t1 &&
+          t1 - prru_row_time(t0, t1, dt, n - 2, n) <= dt * (1 + 1e-9);
+  }
+  TU_TRUE(ok, "rows: the last at t1, the one before within dt of it");
+}
+
 int main(void)
 {
+  row_times();
   path_side();
   polynomial_exact(4, 4);
   polynomial_exact(3, 2);

@@ -244,13 +244,14 @@ class Types:
         self.TrackSample = type("prru_track_sample", (ctypes.Structure,), {"_fields_": [
             ("t", d), ("q_ref", _arr(d, 3)), ("qd_ref", _arr(d, 3)), ("qdd_ref", _arr(d, 3)),
             ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("e", _arr(d, 3)), ("fd", _arr(d, nact)),
-            ("fd_cmd", _arr(d, nact)), ("d", _arr(d, nact)), ("qdd", _arr(d, 3)),
+            ("fd_cmd", _arr(d, nact)), ("d", _arr(d, nact)), ("dd", _arr(d, nact)), ("qdd", _arr(d, 3)),
             ("saturated", _arr(ctypes.c_int, nact))]})
         self.TrackFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.TrackSample),
                                         ctypes.c_void_p)
         self.TrackOptions = type("prru_track_options", (ctypes.Structure,), {"_fields_": [
             ("kp", _arr(d, 3)), ("kd", _arr(d, 3)), ("control_period", d), ("dt_out", d),
-            ("f_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)),
+            ("f_max", _arr(d, nact)), ("speed_max", _arr(d, nact)), ("d_min", _arr(d, nact)),
+            ("d_max", _arr(d, nact)),
             ("noise_q", d), ("noise_qd", d), ("seed", ctypes.c_ulong), ("q0_offset", _arr(d, 3)),
             ("plant", self.Params), ("abs_tol", d), ("rel_tol", d), ("on_sample", self.TrackFn),
             ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("controller", ctypes.c_int),
@@ -258,7 +259,7 @@ class Types:
         self.TrackSummary = type("prru_track_summary", (ctypes.Structure,), {"_fields_": [
             ("samples", ctypes.c_long), ("t_end", d), ("rms_e", _arr(d, 3)), ("max_e", _arr(d, 3)),
             ("max_fd", _arr(d, nact)), ("saturated", _arr(ctypes.c_long, nact)),
-            ("any_saturated", ctypes.c_long)]})
+            ("any_saturated", ctypes.c_long), ("max_dd", _arr(d, nact)), ("over_speed", ctypes.c_long)]})
         # Identification: PRRU_NREG standard parameters (10 per body, 3 per
         # actuator; prru_regressor_names' last is checked at load).
         self.nreg = nreg = 10 * nbody + 3 * nact
@@ -280,7 +281,7 @@ class Types:
         self.ExciteOptions = type("prru_excite_options", (ctypes.Structure,), {"_fields_": [
             ("fd_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)), ("rcond_min", d),
             ("amplitude_max", _arr(d, 3)), ("samples", i), ("check_samples", i), ("max_evals", i),
-            ("seed", ctypes.c_ulong), ("speed_max", _arr(d, nact))]})
+            ("seed", ctypes.c_ulong), ("speed_max", _arr(d, nact)), ("dt", d), ("periods", i)]})
         self.ExciteResult = type("prru_excite_result", (ctypes.Structure,), {"_fields_": [
             ("cond", d), ("cond_start", d), ("fd_peak", _arr(d, nact)), ("rcond_worst", d), ("evals", i),
             ("shrunk", i)]})
@@ -302,6 +303,7 @@ class Types:
             ("evaluations", i), ("restarts_done", i), ("converged", i)]})
         self.GuardedLimits = _guarded(self.Limits, 4096)
         self.GuardedTrackOptions = _guarded(self.TrackOptions, 4096)
+        self.GuardedExciteOptions = _guarded(self.ExciteOptions, 4096)
         self.GuardedData = _guarded(self.Data, ctypes.sizeof(self.Data) // 2 + 4096)
         self.GuardedDme = _guarded(self.Dme, 4096)
         self.GuardedScenario = _guarded(self.Scenario, 4096)
@@ -415,6 +417,8 @@ class Library:
         self.quintic_eval = _declare(dll, "prru_quintic_eval", i, qp, d, vp, vp, vp)
         self.quintic_t_begin = _declare(dll, "prru_quintic_t_begin", d, qp)
         self.quintic_t_end = _declare(dll, "prru_quintic_t_end", d, qp)
+        self.row_count = _declare(dll, "prru_row_count", ctypes.c_long, d, d, d)
+        self.row_time = _declare(dll, "prru_row_time", d, d, d, d, ctypes.c_long, ctypes.c_long)
         self.quintic_free = _declare(dll, "prru_quintic_free", None, qp)
         self.quintic_fastest = _declare(dll, "prru_quintic_fastest", i, mp, i, vp, lmp, i, vp, cp, i)
         self.path_side_init = _declare(dll, "prru_path_side_init", None, ctypes.POINTER(_PathSide))
@@ -427,6 +431,8 @@ class Library:
         self.topp_row = _declare(dll, "prru_topp_row", i, mp, dp, lmp, tpp, d, vp, vp, vp, vp, vp, cp, i)
         top, pp = ctypes.POINTER(t.TrackOptions), ctypes.POINTER(t.Params)
         self.track_options_default = _declare(dll, "prru_track_options_default", None, top)
+        self.track_options_check = _declare(dll, "prru_track_options_check", i, top, cp, i)
+        self.track_gains_bandwidth = _declare(dll, "prru_track_gains_bandwidth", i, d, top)
         self.track_check_reference = _declare(dll, "prru_track_check_reference", i, mp, qp, top, d,
                                               vp, cp, i)
         self.track = _declare(dll, "prru_track", i, mp, qp, top, ctypes.POINTER(t.TrackSummary), cp, i)
@@ -458,6 +464,8 @@ class Library:
         self.model_name_derive = _declare(dll, "prru_model_name_derive", None, cp, cp, cp)
         self.excite_options_default = _declare(dll, "prru_excite_options_default", None, eop)
         self.excite_options_limits = _declare(dll, "prru_excite_options_limits", None, eop, lmp)
+        self.excite_rows = _declare(dll, "prru_excite_rows", ctypes.c_long, fp, eop)
+        self.fourier_default = _declare(dll, "prru_fourier_default", None, fp)
         self.excite = _declare(dll, "prru_excite", i, mp, bp, eop, c_int_p, fp,
                                ctypes.POINTER(t.ExciteResult), cp, i)
         self.fourier_eval = _declare(dll, "prru_fourier_eval", None, fp, d, vp, vp, vp)
@@ -588,9 +596,10 @@ class Library:
             raise self._layout_error("prru_map_summary")
 
     def _check_motion(self):
-        """prru_track_options_default and prru_model_limits into guarded
-        mirrors: the defaults the header states, the plant the model's own
-        numbers (prru_model_params), and nothing written past the mirror."""
+        """prru_track_options_default, prru_model_limits and
+        prru_excite_options_default into guarded mirrors: the defaults the
+        headers state, the plant the model's own numbers
+        (prru_model_params), and nothing written past the mirror."""
         t, m = self.types, self.new_model()
         g = t.GuardedTrackOptions()
         fill_guard(g)
@@ -599,7 +608,8 @@ class Library:
         self.model_params(ctypes.byref(m), ctypes.byref(p))
         if (list(o.kp) != [400.0] * 3 or list(o.kd) != [40.0] * 3 or o.control_period != 0
                 or o.dt_out != 1e-3 or o.seed != 1 or o.abs_tol != 1e-12 or o.rel_tol != 1e-12
-                or any(v != math.inf for v in o.f_max) or any(v != -math.inf for v in o.d_min)
+                or any(v != math.inf for v in o.f_max) or any(v != math.inf for v in o.speed_max)
+                or any(v != -math.inf for v in o.d_min)
                 or bytes(o.plant) != bytes(p) or p.coulomb_velocity <= 0 or o.on_sample
                 or o.controller != 0 or any(o.lqr_q) or any(o.lqr_r) or not guard_intact(g)):
             raise self._layout_error("prru_track_options")
@@ -610,6 +620,13 @@ class Library:
         if (not guard_intact(gl) or any(not lim.d_min[i] < lim.d_max[i] for i in range(t.nact))
                 or any(not lim.force_max[i] > 0 or not lim.speed_max[i] > 0 for i in range(t.nact))):
             raise self._layout_error("prru_limits")
+        ge = t.GuardedExciteOptions()
+        fill_guard(ge)
+        self.excite_options_default(ctypes.byref(ge.s))
+        e = ge.s
+        if (not guard_intact(ge) or e.samples != 100 or e.check_samples != 0 or e.max_evals != 3000
+                or e.seed != 1 or e.dt != 0.01 or e.periods != 1 or any(v != math.inf for v in e.speed_max)):
+            raise self._layout_error("prru_excite_options")
         last = self.regressor_names[t.nreg - 1]
         if last != ("coulomb%d" % t.nact).encode():
             raise self._layout_error("PRRU_NREG (prru_regressor_names' last is %r)" % last)

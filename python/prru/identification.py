@@ -88,8 +88,8 @@ def _base(model, vs, m=None):
     return b
 
 
-def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0.0, 0.0), amplitude=None,
-           limits=None, rcond_min=1e-2, evals=3000, samples=100, seed=1, coulomb_velocity=None):
+def excite(self, *, period=None, harmonics=None, periods=None, dt=None, centre=None, amplitude=None,
+           limits=None, rcond_min=None, evals=None, samples=None, seed=None, coulomb_velocity=None):
     """An excitation trajectory for identification (prru excite): each
     coordinate a Fourier series of harmonics harmonics about centre with
     the given period (s), its coefficients chosen (Nelder-Mead, seeded)
@@ -98,35 +98,51 @@ def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0
     rad, 0.1 L), J_d's rcond >= rcond_min, and the limits (a Limits;
     default the model's, with 500 N where it has no force limit), then
     checked at 20 times as many points. Sampled every dt over periods
-    periods. Returns Excitation. Raises InputError for bad options or
-    centre, NoConvergence when no feasible trajectory is found."""
+    periods. An option left None is the library's default
+    (prru_fourier_default, prru_excite_options_default: period 10 s, 5
+    harmonics, centre 0, rcond_min 1e-2, 3000 evals, 100 samples, seed 1,
+    dt 0.01 s, 1 period). Returns Excitation. Raises InputError for bad
+    options or centre, NoConvergence when no feasible trajectory is
+    found."""
     lib, t = self.lib, self.lib.types
     lim, c = _c_limits(self, limits)
     o = t.ExciteOptions()
     lib.excite_options_default(ctypes.byref(o))
     lib.excite_options_limits(ctypes.byref(o), ctypes.byref(c))
     f = _lib._Fourier()
-    f.period = _convert.scalar("period", period, positive=True, allow_zero=False)
-    f.harmonics = _convert.integer("harmonics", harmonics, 1)
+    lib.fourier_default(ctypes.byref(f))
+    if period is not None:
+        f.period = _convert.scalar("period", period, positive=True, allow_zero=False)
+    if harmonics is not None:
+        f.harmonics = _convert.integer("harmonics", harmonics, 1)
     if f.harmonics > _lib.EXCITE_MAX_HARMONICS:
         raise ValueError("harmonics must be at most %d, got %d" % (_lib.EXCITE_MAX_HARMONICS, harmonics))
-    f.centre[:] = list(_convert.vector("centre", centre, 3))
+    if centre is not None:
+        f.centre[:] = list(_convert.vector("centre", centre, 3))
     if amplitude is not None:
         amp = list(_convert.vector("amplitude", amplitude, 3))
         if not all(a > 0 for a in amp):
             raise ValueError("amplitude must be positive, got %r" % amp)
         o.amplitude_max[:] = amp
-    o.rcond_min = _convert.scalar("rcond_min", rcond_min, positive=True, allow_zero=False)
+    if rcond_min is not None:
+        o.rcond_min = _convert.scalar("rcond_min", rcond_min, positive=True, allow_zero=False)
     if not o.rcond_min < 1:
         raise ValueError("rcond_min must lie between 0 and 1, got %r" % rcond_min)
-    o.max_evals = _convert.integer("evals", evals, 1)
-    o.samples = _convert.integer("samples", samples, 1)
-    o.check_samples = 20 * o.samples  # as prru excite
-    o.seed = _convert.integer("seed", seed, 0)
-    periods = _convert.integer("periods", periods, 1)
-    dt = _convert.scalar("dt", dt, positive=True, allow_zero=False)
-    if dt > f.period * periods:
-        raise ValueError("dt %g s is longer than the run (%g s)" % (dt, f.period * periods))
+    if evals is not None:
+        o.max_evals = _convert.integer("evals", evals, 1)
+    if samples is not None:
+        o.samples = _convert.integer("samples", samples, 1)
+    if seed is not None:
+        o.seed = _convert.integer("seed", seed, 0)
+    if periods is not None:
+        o.periods = _convert.integer("periods", periods, 1)
+    if dt is not None:
+        o.dt = _convert.scalar("dt", dt, positive=True, allow_zero=False)
+    rows = lib.excite_rows(ctypes.byref(f), ctypes.byref(o))
+    if rows == 0:
+        run = f.period * o.periods
+        raise ValueError("dt %g s is longer than the run (%g s)" % (o.dt, run) if o.dt > run
+                         else "dt %g s gives more than 1e15 rows over the run (%g s)" % (o.dt, run))
     # The run's model: its stroke bounds the reach.
     m = _lib._Model()
     if lib.model_with_limits(ctypes.byref(m), ctypes.byref(self._m), ctypes.byref(c)) != errors.OK:
@@ -143,7 +159,7 @@ def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0
         if st != errors.OK:
             raise errors.make_error(st, "excite: " + (msg.value.decode("utf-8", "replace")
                                                       or lib.status_text(st)))
-        motion = _excite_rows(self, m, f, periods, dt)
+        motion = _excite_rows(self, m, f, rows, o.dt)
     finally:
         lib.model_free(ctypes.byref(m))
     L = f.harmonics
@@ -152,20 +168,17 @@ def excite(self, *, period=10.0, harmonics=5, periods=1, dt=0.01, centre=(0.0, 0
                       r.rcond_worst, r.evals, r.shrunk, b.nbase, lim)
 
 
-def _excite_rows(model, m, f, periods, dt):
-    """Rows every dt to periods periods (the last at or before the end, as
-    prru excite): q, qd, qdd of the series, d, dd and fd of the run's
-    model (inverse dynamics, no loads)."""
+def _excite_rows(model, m, f, rows, dt):
+    """rows rows every dt (prru_excite_rows): q, qd, qdd of the series, d,
+    dd and fd of the run's model (inverse dynamics, no loads)."""
     lib, n = model.lib, model.nact
     g = model.lib.new_data()
-    t_end = f.period * periods
-    count = int(t_end / dt * (1 + 1e-12))
     cols = {k: [] for k in Motion._fields}
     q, qd, qdd = (ctypes.c_double * 3)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
     fd, dd, ddb = (ctypes.c_double * n)(), (ctypes.c_double * n)(), (ctypes.c_double * n)()
     loads = lib.types.Loads()
     with model._lock:
-        for i in range(count + 1):
+        for i in range(rows):
             t = i * dt
             lib.fourier_eval(ctypes.byref(f), t, q, qd, qdd)
             st = lib.inverse_dynamics_preload(ctypes.byref(m), ctypes.byref(g.s), q, qd, qdd, ctypes.byref(loads),

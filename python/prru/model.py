@@ -229,12 +229,8 @@ class Model:
     def _fk_seed(self, act, seed):
         if seed is not None:
             return vector("seed", seed, 3)
-        # At q1 = q2 = 0 every d_i = q3 + d_i(0, 0, 0): the height matching the mean.
-        zero, d0 = (ctypes.c_double * 3)(), (ctypes.c_double * self.nact)()
-        jd = (ctypes.c_double * (3 * self.nact))()
-        self.lib.model_ik_jd(ctypes.byref(self._m), zero, d0, jd)
         s = (ctypes.c_double * 3)()
-        s[2] = sum(act[i] - d0[i] for i in range(self.nact)) / self.nact
+        self.lib.fk_default_seed(ctypes.byref(self._m), act, s)
         return s
 
     def fk(self, d, seed=None):
@@ -452,6 +448,20 @@ class Model:
             self._fail(st, "energy: q = %s, qd = %s" % (_fmt(q), _fmt(qd)))
         self._require_finite("energy", q, (T.value, V.value), (("qd", qd),))
         return T.value, V.value
+
+    def power(self, q, qd=None, fd=None, fp=None, mp=None):
+        """(load, passive) (W): the power of the loads, fd . d' + fp . v_O' +
+        mp . w_P, and of the drives' damping and friction, passive . qd;
+        d/dt (T + V) is their sum. Raises Unreachable."""
+        q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
+        l = self._loads(fd, fp, mp)
+        self._reachable("power", q)
+        load, passive = ctypes.c_double(), ctypes.c_double()
+        self.lib.power(ctypes.byref(self._m), q, qd, ctypes.byref(l), ctypes.byref(load),
+                       ctypes.byref(passive))
+        self._require_finite("power", q, (load.value, passive.value),
+                             (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp)))
+        return load.value, passive.value
 
     # ---- manipulability ----
     def dme(self, q):

@@ -7,6 +7,7 @@ import collections
 import ctypes
 import math
 import numbers
+import re
 
 from . import _convert, _interrupt, _lib, errors
 
@@ -129,12 +130,13 @@ def _fail(model, st, what, msg):
                                              or model.lib.status_text(st)))
 
 
-def _row_times(t0, t1, dt):
-    """t0, t0 + dt, ... and t1 (the last row at the end, as prru traj)."""
-    n = max(1, math.ceil((t1 - t0) / dt - 1e-9))
-    if n > 10 ** 8:
+def _row_times(lib, t0, t1, dt):
+    """t0, t0 + dt, ... and t1: the library's rows (prru_row_count,
+    prru_row_time), as prru traj writes them."""
+    rows = lib.row_count(t0, t1, dt)
+    if rows == 0:
         raise ValueError("dt: more than 1e8 rows (span %g s, dt %g s)" % (t1 - t0, dt))
-    return [t1 if k == n else t0 + k * dt for k in range(n + 1)]
+    return [lib.row_time(t0, t1, dt, k, rows) for k in range(rows)]
 
 
 class _Rows:
@@ -205,7 +207,7 @@ def quintic(self, waypoints, durations, *, dt=1e-3):
         rows = _Rows(self, "quintic")
         a, b, c = (ctypes.c_double * 3)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
         with self._lock:
-            for t in _row_times(lib.quintic_t_begin(ctypes.byref(tr)), lib.quintic_t_end(ctypes.byref(tr)), dt):
+            for t in _row_times(lib, lib.quintic_t_begin(ctypes.byref(tr)), lib.quintic_t_end(ctypes.byref(tr)), dt):
                 lib.quintic_eval(ctypes.byref(tr), t, a, b, c)
                 rows.add(t, a, b, c)
         return rows.motion()
@@ -247,7 +249,7 @@ def time_optimal(self, waypoints, *, limits=None, grid=0, dt=1e-3):
         a, b, cc = (ctypes.c_double * 3)(), (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
         fd, dd, g = (ctypes.c_double * n)(), (ctypes.c_double * n)(), self._g
         with self._lock:
-            for t in _row_times(0.0, tp.duration, dt):
+            for t in _row_times(lib, 0.0, tp.duration, dt):
                 # Each row checked again with the exact inverse dynamics
                 # (prru_topp_row, as prru traj --time-optimal's).
                 st = lib.topp_row(ctypes.byref(self._m), ctypes.byref(g.s), ctypes.byref(c), ctypes.byref(tp),
@@ -289,15 +291,15 @@ def _reference(model, ref):
     return tr
 
 
-def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1e-3, limits=None,
+def track(self, reference, *, bandwidth=None, kp=None, kd=None, period=0.0, dt=1e-3, limits=None,
           noise=(0.0, 0.0), seed=1, q0_offset=(0.0, 0.0, 0.0), plant=None, mismatch=None,
           atol=1e-12, rtol=1e-12, controller="ct", lqr_q=None, lqr_r=None):
     """Computed-torque tracking of reference (a Motion, e.g. from quintic or
     time_optimal, or (t, q, qd, qdd) rows), simulated in closed loop, as
     prru track: fd = J_d^-T (M qdd_c + h - G - passive) with qdd_c =
     qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q), each force clipped to its
-    force_max. Gains: bandwidth W (rad/s) gives Kp = W^2, Kd = 2 W; kp, kd
-    (3 each) replace them. period 0: continuous control, rows every dt;
+    force_max. Gains: bandwidth W (rad/s, default the library's 20) gives
+    Kp = W^2, Kd = 2 W; kp, kd (3 each) replace them. period 0: continuous control, rows every dt;
     period > 0: a digital controller with zero-order hold, a row per
     tick, noise = (std on q, std on qd) from a generator seeded by seed.
     limits: a Limits (default the model's): forces clipped to force_max,
@@ -309,8 +311,8 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
     (needs period > 0) is prru track --controller lqr: a time-varying
     discrete LQR from the backward Riccati recursion along the reference
     (prru_control.h), fd = u_ff - K_k (x - x_ref), with the diagonal
-    weights lqr_q (6: q then qd, >= 0, not all 0) and lqr_r (one per
-    actuator, > 0), each by default Bryson's rule (prru_lqr_default_weights;
+    weights lqr_q (6: q then qd, >= 0) and lqr_r (one per actuator, > 0),
+    each left out or all 0 Bryson's rule (prru_lqr_default_weights;
     the summary's lqr_q, lqr_r give the weights used). Returns TrackRun.
     Raises InputError for a reference outside the workspace, across a
     singularity or outside the stroke (naming the sample) and for bad
@@ -323,12 +325,18 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
     _lib.fill_guard(g)
     lib.track_options_default(ctypes.byref(g.s))
     o = g.s
-    w = _convert.scalar("bandwidth", bandwidth, positive=True, allow_zero=False)
-    o.kp[:] = list(_convert.vector("kp", kp, 3)) if kp is not None else [w * w] * 3
-    o.kd[:] = list(_convert.vector("kd", kd, 3)) if kd is not None else [2 * w] * 3
+    if bandwidth is not None:
+        w = _convert.scalar("bandwidth", bandwidth, positive=True, allow_zero=False)
+        if lib.track_gains_bandwidth(w, ctypes.byref(o)) != errors.OK:
+            raise ValueError("bandwidth %r rad/s gives no finite gains" % (bandwidth,))
+    if kp is not None:
+        o.kp[:] = list(_convert.vector("kp", kp, 3))
+    if kd is not None:
+        o.kd[:] = list(_convert.vector("kd", kd, 3))
     o.control_period = _convert.scalar("period", period, positive=True)
     o.dt_out = _convert.scalar("dt", dt, positive=True, allow_zero=False)
-    o.f_max[:], o.d_min[:], o.d_max[:] = list(c.force_max), list(c.d_min), list(c.d_max)
+    o.f_max[:], o.speed_max[:] = list(c.force_max), list(c.speed_max)
+    o.d_min[:], o.d_max[:] = list(c.d_min), list(c.d_max)
     o.noise_q, o.noise_qd = _convert.vector("noise", noise, 2)
     o.seed = _convert.integer("seed", seed, 0)
     if o.seed != seed:
@@ -345,6 +353,7 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
     if plant_model.lib is not self.lib:
         raise ValueError("plant must use this model's library (%s)" % self.lib.path)
     _track_controller(self, o, controller, lqr_q, lqr_r)
+    _track_options_check(lib, o)
     lib.model_params(ctypes.byref(plant_model._m), ctypes.byref(o.plant))
     for key, f in (mismatch or {}).items():
         f = _convert.scalar("mismatch[%r]" % key, f, positive=True, allow_zero=False)
@@ -359,27 +368,36 @@ def track(self, reference, *, bandwidth=20.0, kp=None, kd=None, period=0.0, dt=1
 
 
 def _track_controller(model, o, controller, lqr_q, lqr_r):
-    """The controller choice and the LQR's weights into o (checked as prru
-    track checks --controller, --lqr-q, --lqr-r)."""
+    """The controller choice and the LQR's weights into o (their rules:
+    _track_options_check)."""
     if controller not in ("ct", "lqr"):
         raise ValueError("controller must be 'ct' (computed torque) or 'lqr', got %r" % (controller,))
     if controller == "ct":
         if lqr_q is not None or lqr_r is not None:
             raise ValueError("lqr_q and lqr_r belong to controller='lqr'")
         return
-    if not o.control_period > 0:
-        raise ValueError("controller 'lqr' needs period > 0 (a sampled controller)")
     o.controller = 1  # PRRU_TRACK_LQR
     if lqr_q is not None:
-        q = list(_convert.vector("lqr_q", lqr_q, 6))
-        if any(not v >= 0 for v in q) or not any(v > 0 for v in q):
-            raise ValueError("lqr_q: weights must be >= 0, not all 0, got %r" % (q,))
-        o.lqr_q[:] = q
+        o.lqr_q[:] = list(_convert.vector("lqr_q", lqr_q, 6))
     if lqr_r is not None:
-        r = list(_convert.vector("lqr_r", lqr_r, model.nact))
-        if any(not v > 0 for v in r):
-            raise ValueError("lqr_r: weights must be > 0, got %r" % (r,))
-        o.lqr_r[:] = r
+        o.lqr_r[:] = list(_convert.vector("lqr_r", lqr_r, model.nact))
+
+
+# The library names the options by prru_track_options' members; these are
+# track's keywords for them (the others are spelt alike).
+_TRACK_OPTION_NAMES = {"controller PRRU_TRACK_LQR": "controller 'lqr'", "control period": "period",
+                       "sensor noise": "noise", "dt_out": "dt", "abs_tol": "atol", "rel_tol": "rtol"}
+_TRACK_OPTION_RE = re.compile(r"(?<![\w-])(%s)(?!\w)" % "|".join(map(re.escape, _TRACK_OPTION_NAMES)))
+
+
+def _track_options_check(lib, o):
+    """prru_track_options_check: InputError in track's words."""
+    msg = ctypes.create_string_buffer(600)
+    st = lib.track_options_check(ctypes.byref(o), msg, len(msg))
+    if st != errors.OK:
+        text = _TRACK_OPTION_RE.sub(lambda m: _TRACK_OPTION_NAMES[m.group(1)],
+                                    msg.value.decode("utf-8", "replace"))
+        raise errors.make_error(st, "track: " + text)
 
 
 def _lqr_default_weights(model, tr, o):
@@ -399,7 +417,7 @@ def _lqr_default_weights(model, tr, o):
 
 
 def _track_run(model, tr, o, lim, guard):
-    lib, n, msg = model.lib, model.nact, ctypes.create_string_buffer(600)
+    lib, msg = model.lib, ctypes.create_string_buffer(600)
     step = o.control_period if o.control_period > 0 else o.dt_out
     ff = ctypes.c_double()
     with model._lock:
@@ -411,20 +429,14 @@ def _track_run(model, tr, o, lim, guard):
         _lqr_default_weights(model, tr, o)
     names = ("t", "q_ref", "q", "e", "qd", "fd", "fd_cmd", "saturated", "d", "qdd", "dd")
     cols = {k: [] for k in names}
-    dd, ddb = (ctypes.c_double * n)(), (ctypes.c_double * n)()
-    stats = {"max_dd": [0.0] * n, "over": 0}
     failure = []
 
     def consume(ptr, ctx):
         try:
             s = ptr.contents
-            lib.model_actuator_rates(ctypes.byref(model._m), s.q, s.qd, dd, ddb)
-            for k in names[:-1]:
+            for k in names:
                 v = getattr(s, k)
                 cols[k].append(v if k == "t" else list(v))
-            cols["dd"].append(list(dd))
-            stats["max_dd"] = [max(a, abs(b)) for a, b in zip(stats["max_dd"], dd)]
-            stats["over"] += any(abs(dd[i]) > lim.speed_max[i] for i in range(n))
             return 0
         except BaseException as e:  # stop; re-raised after the call
             failure.append(e)
@@ -448,8 +460,8 @@ def _track_run(model, tr, o, lim, guard):
             "max_error": tuple(summary.max_e), "max_fd": tuple(summary.max_fd),
             "saturated_fraction": tuple(x / samples if samples else 0.0 for x in summary.saturated),
             "any_saturated_fraction": summary.any_saturated / samples if samples else 0.0,
-            "max_dd": tuple(stats["max_dd"]),
-            "over_speed_fraction": stats["over"] / samples if samples else 0.0,
+            "max_dd": tuple(summary.max_dd),
+            "over_speed_fraction": summary.over_speed / samples if samples else 0.0,
             "feedforward_peak": ff.value, "limits": lim,
             "status": "complete" if st == errors.OK else msg.value.decode("utf-8", "replace")}
     # The controller and its own gains, as `prru track --summary` names them.

@@ -678,10 +678,12 @@ class TestMotion(unittest.TestCase):
             self.assertEqual(bits(run.q_ref[k]), bits([r["qr%d" % (i + 1)] for i in range(3)]))
             self.assertEqual(bits(run.fd[k]), bits([r["fd%d" % (i + 1)] for i in range(n)]))
             self.assertEqual(bits(run.qdd[k]), bits([r["qdd%d" % (i + 1)] for i in range(3)]))
-        for key in ("rms_error", "max_error", "max_fd", "max_dd", "feedforward_peak", "samples",
-                    "kp", "kd"):
+        for key in ("rms_error", "max_error", "max_fd", "max_dd", "over_speed_fraction", "feedforward_peak",
+                    "samples", "kp", "kd"):
             self.assertEqual(bits(run.summary[key]), bits(s[key]), key)
         self.assertEqual((run.summary["controller"], s["controller"]), ("computed_torque",) * 2)
+        # The library's summary is over the rows' own slider speeds.
+        self.assertEqual(list(run.summary["max_dd"]), [max(abs(r[i]) for r in run.dd) for i in range(n)])
         self.assertEqual(run.summary["status"], "complete")
         self.assertGreater(max(run.summary["max_error"]), 0)  # the mismatch shows
         exact = MODEL.track(ref)
@@ -732,11 +734,15 @@ class TestMotion(unittest.TestCase):
                             mismatch={"mass": 1.2}, limits=MODEL.limits(model_limits=False))
         self.assertEqual(bits(stiff.summary["lqr_q"]), bits(q))
         self.assertLess(max(stiff.summary["max_error"]), max(run.summary["max_error"]))
+        # All weights 0 is the default (prru_control.h's rule, prru track's too).
+        zero = MODEL.track(ref, period=0.002, controller="lqr", lqr_q=[0] * 6, lqr_r=[0] * n,
+                           mismatch={"mass": 1.2}, limits=MODEL.limits(model_limits=False))
+        for key in ("lqr_q", "lqr_r", "max_error"):
+            self.assertEqual(bits(zero.summary[key]), bits(run.summary[key]), key)
         for kw, msg in ((dict(controller="lqr"), "needs period > 0"),
                         (dict(controller="pid", period=0.002), "controller must be"),
                         (dict(period=0.002, lqr_q=[1] * 6), "belong to controller='lqr'"),
                         (dict(controller="lqr", period=0.002, lqr_q=[1, 1, 1, -1, 1, 1]), "lqr_q"),
-                        (dict(controller="lqr", period=0.002, lqr_q=[0] * 6), "lqr_q"),
                         (dict(controller="lqr", period=0.002, lqr_r=[1] * (n - 1) + [0]), "lqr_r"),
                         (dict(controller="lqr", period=0.002, lqr_r=[1] * (n + 1)), "lqr_r")):
             with self.subTest(**{k: str(v) for k, v in kw.items()}):
@@ -930,6 +936,27 @@ class TestRoundTrips(unittest.TestCase):
         T, V = MODEL.energy(q, qd)
         self.assertEqual(bits([run.T[0], run.V[0]]), bits([T, V]))
         self.assertEqual(bits(run.q[0]), bits(q))
+
+    def test_power(self):
+        """power() against the products of ik's J_d, platform_jacobian and
+        passive summed exactly (fsum): the library's sums round each product
+        through at most nact + 12 operations, these 3, so they differ by at
+        most 2 gamma_(nact+12) times the sum of the products' magnitudes."""
+        u = 2.0 ** -53
+        gamma = (MODEL.nact + 12) * u / (1 - (MODEL.nact + 12) * u)
+        for q, qd, fd, fp, mp in random_states(5, 11):
+            load, passive = MODEL.power(q, qd, fd, fp, mp)
+            _, Jd = MODEL.ik(q)
+            JR, JT = MODEL.platform_jacobian(q)
+            terms = ([fd[i] * Jd[i][k] * qd[k] for i in range(MODEL.nact) for k in range(3)]
+                     + [fp[i] * JT[i][k] * qd[k] for i in range(3) for k in range(3)]
+                     + [mp[i] * JR[i][k] * qd[k] for i in range(3) for k in range(3)])
+            self.assertLessEqual(abs(load - math.fsum(terms)),
+                                 2 * gamma * math.fsum(map(abs, terms)))
+            pterms = [a * b for a, b in zip(MODEL.passive(q, qd), qd)]
+            self.assertLessEqual(abs(passive - math.fsum(pterms)),
+                                 2 * gamma * math.fsum(map(abs, pterms)))
+            self.assertEqual(MODEL.power(q, qd)[0], 0.0)
 
 
 class TestPoses(unittest.TestCase):
@@ -1177,7 +1204,7 @@ class TestErrors(unittest.TestCase):
         text = MODEL.lib.status_text(prru.Unreachable.status)
         self.assertIn(text, err)
         for call in (MODEL.ik, MODEL.dynamics, MODEL.forward_dynamics, MODEL.check,
-                     MODEL.dme, MODEL.poses, MODEL.energy):
+                     MODEL.dme, MODEL.poses, MODEL.energy, MODEL.power):
             with self.assertRaises(prru.Unreachable) as e:
                 call(q)
             self.assertIn(text, str(e.exception))

@@ -77,6 +77,10 @@ typedef struct {
   double fd[PRRU_NACT];       /* applied (after clipping) actuator forces, N */
   double fd_cmd[PRRU_NACT];   /* the controller's forces before clipping */
   double d[PRRU_NACT];        /* the plant's slider positions, m */
+  /* The slider speeds J_d(q) qd, m/s, of the controller's model at the
+   * plant's state (the plant's own where it has the model's geometry):
+   * what a speed limit is compared with. */
+  double dd[PRRU_NACT];
   /* The plant's acceleration at t under fd (the force it sees from t on):
    * (q, qd, qdd, fd) satisfy the plant's equations of motion exactly, as
    * identification data with exact rates. */
@@ -93,6 +97,10 @@ typedef struct {
   double dt_out;              /* s, output sampling when continuous
                                  (ignored otherwise: one sample per tick) */
   double f_max[PRRU_NACT];    /* N, > 0; INFINITY: unlimited */
+  /* m/s, > 0; INFINITY: unlimited. Computed torque cannot hold a speed,
+   * so this limit is reported (prru_track_summary's over_speed), never
+   * enforced. */
+  double speed_max[PRRU_NACT];
   double d_min[PRRU_NACT], d_max[PRRU_NACT]; /* m; -/+INFINITY: unlimited */
   double noise_q, noise_qd;   /* sensor noise std (rad or m, per s), >= 0 */
   unsigned long seed;
@@ -118,6 +126,26 @@ enum { PRRU_TRACK_CT = 0, PRRU_TRACK_LQR = 1 };
  * 1e-12; computed torque, the LQR weights 0 (prru_lqr_default_weights). */
 PRRU_API void prru_track_options_default(prru_track_options *o);
 
+/* Critically damped computed-torque gains of bandwidth w (rad/s): kp_i =
+ * w^2, kd_i = 2 w for every coordinate (e'' + kd e' + kp e = 0 has the
+ * double pole -w). PRRU_EINPUT, o unchanged, unless w is finite, > 0 and
+ * w^2 finite. */
+PRRU_API int prru_track_gains_bandwidth(double w, prru_track_options *o);
+
+/* The checks prru_track makes of o before it runs (prru_lqr_schedule_build
+ * makes the LQR's part): gains finite and >= 0; control_period finite and
+ * >= 0, dt_out finite and > 0 when continuous; force and speed limits > 0
+ * (INFINITY allowed), strokes d_min < d_max; sensor noise finite, >= 0
+ * and only with control_period > 0; q0_offset finite; tolerances finite
+ * and >= PRRU_TOL_MIN; a known controller; for PRRU_TRACK_LQR
+ * control_period > 0, lqr_q finite and >= 0 (all 0: the default
+ * weights), lqr_r all 0 (the default weights) or each finite and > 0.
+ * PRRU_OK, or PRRU_EINPUT with msg naming the option by its member's
+ * name (kp, kd, dt_out, q0_offset, abs_tol, rel_tol, lqr_q, lqr_r), or
+ * as "control period", "sensor noise", "controller PRRU_TRACK_LQR", so
+ * that a front end can put its own option names in their place. */
+PRRU_API int prru_track_options_check(const prru_track_options *o, char *msg, int msglen);
+
 typedef struct {
   long samples;
   double t_end;               /* time of the last sample */
@@ -125,11 +153,13 @@ typedef struct {
   double max_fd[PRRU_NACT];   /* largest |fd| applied */
   long saturated[PRRU_NACT];  /* samples with actuator i saturated */
   long any_saturated;         /* samples with any actuator saturated */
+  double max_dd[PRRU_NACT];   /* largest |dd| (the samples' slider speeds) */
+  long over_speed;            /* samples with any |dd_i| > speed_max_i */
 } prru_track_summary;
 
 /* Tracks ref over its whole time span from q_ref(t_0) - q0_offset,
  * qd_ref(t_0). Fills *sum with the samples delivered (also after a stop).
- * PRRU_EINPUT for bad options (msg names the option); the plant leaving
+ * PRRU_EINPUT for bad options (prru_track_options_check); the plant leaving
  * the workspace or its stroke PRRU_EUNREACHABLE, the controller meeting a
  * singular J_d PRRU_ESINGULAR, integrator failure PRRU_ENOCONV,
  * *interrupt or the consumer PRRU_EINTERRUPTED; msg says when and why.

@@ -76,6 +76,10 @@ PRRU_API double prru_design_get(const prru_params *p, const prru_design_var *v);
 /* Sets the variable to x: every tied parameter moves by x minus the
  * first one's value in base (p and base may be the same). */
 PRRU_API void prru_design_set(prru_params *p, const prru_params *base, const prru_design_var *v, double x);
+/* Sets every parameter the variable ties to x itself (b12 = 0.3 makes b1
+ * and b2 both 0.3): a start design stated outright (prru optimize
+ * --set), where prru_design_set keeps the tied parameters' differences. */
+PRRU_API void prru_design_assign(prru_params *p, const prru_design_var *v, double x);
 /* A natural scale of the variable at p, for difference steps and scaled
  * sensitivities: |value|, or where the value may be 0, the body's mean
  * principal moment (products of inertia), the design's length scale

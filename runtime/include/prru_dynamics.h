@@ -392,7 +392,8 @@ PRRU_API int prru_actuators(const prru_model *m, prru_data *d, const double q[3]
  * Gauss-Newton with J_d^+ and step halving (prru_forward_kinematics_lsq,
  * no allocation). The residual max_i |d_i(q) - act_i| must reach
  * tol = 100 DBL_EPSILON max(L, |act|_inf) (L the model's length scale;
- * 10 tol is accepted where the iteration stalls a few ulps short).
+ * 10 tol, prru_fk_tolerance, is accepted where the iteration stalls a few
+ * ulps short).
  * PRRU_ENOCONV when act is out of reach, the iteration meets a
  * singularity, or, with four actuators, act is inconsistent beyond 10 tol:
  * no pose reproduces all four sliders (the fourth is not where the other
@@ -410,6 +411,24 @@ PRRU_API int prru_forward_kinematics(const prru_model *m, prru_data *d, const do
  * the workspace, PRRU_ESINGULAR at a singular J_d. */
 PRRU_API int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
                                          const double seed[3], double q[3], double *residual);
+/* The residual (m) prru_forward_kinematics accepts for act and a caller
+ * holds a least-squares fit to before calling the sliders consistent:
+ * 1000 DBL_EPSILON max(L, |act|_inf), ten times the iteration's target
+ * (above). Relative, so that it means the same for a robot of any size
+ * and for sliders far down their rails. */
+PRRU_API double prru_fk_tolerance(const prru_model *m, const double act[PRRU_NACT]);
+/* The seed the forward kinematics starts from when the caller has none:
+ * q0 = (0, 0, h) with h the mean of act_i - d_i(0, 0, 0). At q1 = q2 = 0
+ * every slider is the platform height plus a constant, d_i = q3 +
+ * d_i(0, 0, 0), so h solves the sliders of a level pose exactly and is
+ * the level pose nearest to those of a tilted one. NaN in act gives a NaN
+ * q0[2]. */
+PRRU_API void prru_fk_default_seed(const prru_model *m, const double act[PRRU_NACT], double q0[3]);
+/* max_i |d_i(q) - act_i| (m), the residual prru_forward_kinematics_lsq
+ * reports and prru_fk_tolerance bounds, for any q (a Newton solution's,
+ * whose solver does not return it); NaN where q is out of reach or an
+ * input is NaN. */
+PRRU_API double prru_fk_residual(const prru_model *m, const double q[3], const double act[PRRU_NACT]);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved
  * inside the generated prru_eom_solve; PRRU_ESINGULAR unless M is positive
  * definite (three nested principal minors positive) and
@@ -496,6 +515,17 @@ PRRU_API int prru_reaction_null(const prru_model *m, prru_data *d, const double 
 /* T, V (J). */
 PRRU_API int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
                            double *V);
+/* The power (W) delivered to the machine at (q, qd): *load_power =
+ * fd . d' + fp . v_O' + mp . w_P, the actuator forces on the sliders
+ * (d' = J_d qd), the platform force at O' (v_O' = J_T,O' qd) and the
+ * platform moment (w_P = J_R,P qd); *passive_power = Q_p . qd, the drives'
+ * damping and friction (prru_model_passive; dissipated: <= 0). Gravity is
+ * in V, so d/dt (T + V) = *load_power + *passive_power along every motion:
+ * integrated, the work-energy balance of a run (prru paper). Raw kernel
+ * outputs as prru_model_*: NaN where q is out of reach. Either pointer
+ * may be NULL. */
+PRRU_API void prru_power(const prru_model *m, const double q[3], const double qd[3], const prru_loads *l,
+                         double *load_power, double *passive_power);
 
 #ifdef __cplusplus
 }

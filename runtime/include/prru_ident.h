@@ -295,6 +295,9 @@ typedef struct {
 } prru_fourier;
 
 PRRU_API void prru_fourier_eval(const prru_fourier *f, double t, double q[3], double qd[3], double qdd[3]);
+/* Period 10 s, 5 harmonics, centre 0, every coefficient 0: prru excite's
+ * series before its options and the optimisation. */
+PRRU_API void prru_fourier_default(prru_fourier *f);
 
 typedef struct {
   double fd_max[PRRU_NACT];  /* |fd_i| limit (N), > 0 */
@@ -302,19 +305,31 @@ typedef struct {
   double rcond_min;          /* regularity along the path (prru_check_regular's rcond) */
   double amplitude_max[3];   /* |q_k - c_k| bound of the start and of each coordinate's sum of |a|, |b| */
   int samples;               /* points per period the objective stacks (>= nbase/3 + 1) */
-  int check_samples;         /* points per period of the final feasibility check */
+  int check_samples;         /* points per period of the final feasibility check; 0: 20 samples */
   int max_evals;             /* Nelder-Mead budget */
   unsigned long seed;
   double speed_max[PRRU_NACT]; /* |d_i'| limit (m/s), INFINITY: none */
+  /* The rows a run writes of the result (prru_excite_rows): every dt
+   * seconds over periods periods. prru_excite does not read them. */
+  double dt;
+  int periods;
 } prru_excite_options;
 
 /* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
- * 100 samples, 2000 check samples, 3000 evaluations, seed 1. */
+ * 100 samples, check samples 0 (20 times samples, whatever samples becomes), 3000 evaluations,
+ * seed 1; rows every 0.01 s over 1 period. */
 PRRU_API void prru_excite_options_default(prru_excite_options *o);
 /* A run's limits (prru_limits_for_run) into o: the force bounds where
  * finite (an excitation needs one: o's, 500 N by default, where the run
  * has none), the speed limits and the strokes. */
 PRRU_API void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
+/* The rows t_i = i o->dt, i = 0..n-1, of a run of o->periods periods of
+ * f: n = floor(periods period / dt (1 + 1e-12)) + 1, the last row at the
+ * run's end or less than dt before it (the factor keeps the end's row
+ * that rounding would push past it). 0 where there is no such run: dt not
+ * finite and > 0, or longer than the run (period x periods); period not
+ * finite and > 0; periods < 1; n above 1e15. */
+PRRU_API long prru_excite_rows(const prru_fourier *f, const prru_excite_options *o);
 
 typedef struct {
   double cond;          /* condition number of the column-scaled stacked base regressor */

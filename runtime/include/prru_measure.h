@@ -57,7 +57,8 @@ PRRU_API int prru_measure_apply(const prru_measure_options *o, int n, int nact, 
 
 /* q (n x 3) of n rows of slider positions d (n x PRRU_NACT) by least-squares
  * forward kinematics (prru_forward_kinematics_lsq), each row seeded from the
- * previous row's pose and the first from q = 0: a motion sampled densely
+ * previous row's pose and the first from prru_fk_default_seed's level
+ * pose: a motion sampled densely
  * enough stays in its assembly mode. A converged pose is the sliders' when
  * its residual is within dres (m, the encoders' resolution: four sliders
  * quantised to dres leave the least-squares pose within dres in the

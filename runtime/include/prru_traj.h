@@ -107,6 +107,16 @@ PRRU_API double prru_quintic_t_begin(const prru_quintic *tr);
 PRRU_API double prru_quintic_t_end(const prru_quintic *tr);
 PRRU_API void prru_quintic_free(prru_quintic *tr);
 
+/* The rows of a motion sampled every dt over [t0, t1]: t0 + k dt for k =
+ * 0 .. n - 1, then t1 itself (a remainder below 1e-9 dt merged into that
+ * last row), at least those two however short the span. prru_row_count:
+ * the number of rows, n + 1 = max(1, ceil((t1 - t0) / dt - 1e-9)) + 1; 0
+ * where dt is not > 0 or (t1 - t0) / dt exceeds 1e8 (or either is not a
+ * number). prru_row_time: row k's time (k = rows - 1: t1). What prru traj
+ * and the Python binding write. */
+PRRU_API long prru_row_count(double t0, double t1, double dt);
+PRRU_API double prru_row_time(double t0, double t1, double dt, long k, long rows);
+
 /* A pose on a trajectory is usable when it is reachable and J_d regular:
  * prru_check_regular's status (PRRU_OK, PRRU_EINPUT, PRRU_EUNREACHABLE,
  * PRRU_ESINGULAR), with *rcond as there. */

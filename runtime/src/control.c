@@ -14,16 +14,27 @@
 #include "prru_linearize.h"
 #include "internal.h"
 
+/* Computed torque's default bandwidth, rad/s (the LQR's defaults match it). */
+#define TRACK_BANDWIDTH 20.0
+
+int prru_track_gains_bandwidth(double w, prru_track_options *o)
+{
+  if (!(w > 0.0 && isfinite(w * w))) return PRRU_EINPUT;
+  for (int i = 0; i < 3; i++) {
+    o->kp[i] = w * w;
+    o->kd[i] = 2.0 * w;
+  }
+  return PRRU_OK;
+}
+
 void prru_track_options_default(prru_track_options *o)
 {
   memset(o, 0, sizeof *o);
-  for (int i = 0; i < 3; i++) {
-    o->kp[i] = 400.0;
-    o->kd[i] = 40.0;
-  }
+  prru_track_gains_bandwidth(TRACK_BANDWIDTH, o);
   o->dt_out = 1e-3;
   for (int i = 0; i < PRRU_NACT; i++) {
     o->f_max[i] = INFINITY;
+    o->speed_max[i] = INFINITY;
     o->d_min[i] = -INFINITY;
     o->d_max[i] = INFINITY;
   }
@@ -114,7 +125,7 @@ static double clamp_time(const prru_quintic *ref, double t)
 }
 
 /* The bandwidth the default weights aim at: computed torque's default. */
-#define LQR_BANDWIDTH 20.0
+#define LQR_BANDWIDTH TRACK_BANDWIDTH
 
 /* Tick k's time: t_0 + k step, the last one exactly the reference's end. */
 static double tick_time(const prru_quintic *ref, double step, long k, long nticks)
@@ -238,20 +249,22 @@ int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, doubl
   return st;
 }
 
+/* The option names as prru_track_options_check promises them: front ends
+ * replace them by their own. */
 static int lqr_weights_check(const prru_track_options *o, char *msg, int msglen)
 {
   if (!(o->control_period > 0.0))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "control period: the LQR controller needs a sampled "
-                     "controller (control period > 0)");
+    return prru_fail(msg, msglen, PRRU_EINPUT, "controller PRRU_TRACK_LQR needs control period > 0: "
+                     "the LQR's gains are those of a sampled controller");
   for (int i = 0; i < 6; i++)
     if (!(o->lqr_q[i] >= 0.0 && isfinite(o->lqr_q[i])))
-      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_q: weight %d must be finite and >= 0, got %g",
-                       i + 1, o->lqr_q[i]);
+      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_q: weight %d is %g, not >= 0 and finite", i + 1,
+                       o->lqr_q[i]);
   if (all_zero(o->lqr_r, PRRU_NACT)) return PRRU_OK;
   for (int i = 0; i < PRRU_NACT; i++)
     if (!(o->lqr_r[i] > 0.0 && isfinite(o->lqr_r[i])))
-      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_r: weight %d must be finite and > 0, got %g",
-                       i + 1, o->lqr_r[i]);
+      return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_r: weight %d is %g, not > 0 and finite", i + 1,
+                       o->lqr_r[i]);
   return PRRU_OK;
 }
 
@@ -390,44 +403,56 @@ int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_option
   return PRRU_OK;
 }
 
-static int track_options_check(const prru_track_options *o, char *msg, int msglen)
+int prru_track_options_check(const prru_track_options *o, char *msg, int msglen)
 {
   for (int i = 0; i < 3; i++) {
     if (!(o->kp[i] >= 0.0 && isfinite(o->kp[i])))
-      return prru_fail(msg, msglen, PRRU_EINPUT, "kp: gain %d must be finite and >= 0", i + 1);
+      return prru_fail(msg, msglen, PRRU_EINPUT, "kp: gain %d is %g, not >= 0 and finite", i + 1, o->kp[i]);
     if (!(o->kd[i] >= 0.0 && isfinite(o->kd[i])))
-      return prru_fail(msg, msglen, PRRU_EINPUT, "kd: gain %d must be finite and >= 0", i + 1);
+      return prru_fail(msg, msglen, PRRU_EINPUT, "kd: gain %d is %g, not >= 0 and finite", i + 1, o->kd[i]);
   }
   if (!(o->control_period >= 0.0 && isfinite(o->control_period)))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "control period must be finite and >= 0");
+    return prru_fail(msg, msglen, PRRU_EINPUT, "control period: %g s is not >= 0 and finite",
+                     o->control_period);
   if (o->control_period == 0.0 && !(o->dt_out > 0.0 && isfinite(o->dt_out)))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "dt_out must be finite and > 0");
+    return prru_fail(msg, msglen, PRRU_EINPUT, "dt_out: %g s is not > 0 and finite", o->dt_out);
   for (int i = 0; i < PRRU_NACT; i++) {
     if (!(o->f_max[i] > 0.0))
       return prru_fail(msg, msglen, PRRU_EINPUT,
                        "force limit of actuator %d must be > 0 (or infinite), got %g", i + 1,
                        o->f_max[i]);
+    if (!(o->speed_max[i] > 0.0))
+      return prru_fail(msg, msglen, PRRU_EINPUT,
+                       "speed limit of actuator %d must be > 0 (or infinite), got %g", i + 1,
+                       o->speed_max[i]);
     if (!(o->d_min[i] < o->d_max[i]))
       return prru_fail(msg, msglen, PRRU_EINPUT,
                        "stroke of slider %d: minimum %g must be below maximum %g", i + 1,
                        o->d_min[i], o->d_max[i]);
   }
   if (!(o->noise_q >= 0.0 && isfinite(o->noise_q)) || !(o->noise_qd >= 0.0 && isfinite(o->noise_qd)))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "sensor noise must be finite and >= 0");
+    return prru_fail(msg, msglen, PRRU_EINPUT, "sensor noise: standard deviations %g, %g are not >= 0 "
+                     "and finite", o->noise_q, o->noise_qd);
   if ((o->noise_q > 0.0 || o->noise_qd > 0.0) && o->control_period == 0.0)
     return prru_fail(msg, msglen, PRRU_EINPUT,
-                     "sensor noise needs a sampled controller (control period > 0): a "
-                     "continuous controller inside the integrator cannot read noisy samples");
+                     "sensor noise needs control period > 0: a continuous controller inside the "
+                     "integrator cannot read noisy samples");
   if (!prru_finite_n(o->q0_offset, 3))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "initial offset must be finite");
-  if (!(o->abs_tol >= PRRU_TOL_MIN) || !(o->rel_tol >= PRRU_TOL_MIN) || !isfinite(o->abs_tol) ||
-      !isfinite(o->rel_tol))
-    return prru_fail(msg, msglen, PRRU_EINPUT, "tolerances must be finite and >= %g",
+    return prru_fail(msg, msglen, PRRU_EINPUT, "q0_offset: the initial offset must be finite");
+  if (!(o->abs_tol >= PRRU_TOL_MIN && isfinite(o->abs_tol)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "abs_tol: %g is not >= %.2g and finite", o->abs_tol,
+                     PRRU_TOL_MIN);
+  if (!(o->rel_tol >= PRRU_TOL_MIN && isfinite(o->rel_tol)))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "rel_tol: %g is not >= %.2g and finite", o->rel_tol,
                      PRRU_TOL_MIN);
   if (o->controller != PRRU_TRACK_CT && o->controller != PRRU_TRACK_LQR)
     return prru_fail(msg, msglen, PRRU_EINPUT, "controller: %d is neither PRRU_TRACK_CT nor "
                      "PRRU_TRACK_LQR", o->controller);
-  if (o->controller == PRRU_TRACK_LQR) return lqr_weights_check(o, msg, msglen);
+  if (o->controller == PRRU_TRACK_LQR) {
+    int st = lqr_weights_check(o, msg, msglen);
+    if (st != PRRU_OK) return st;
+  }
+  if (msg && msglen > 0) msg[0] = '\0';
   return PRRU_OK;
 }
 
@@ -560,14 +585,19 @@ static int track_tick(track_ctx *c, gsl_rng *rng, long k, double t, const double
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                      "stopped at t = %.9g s: the plant left the workspace: %s at q = (%.9g, "
                      "%.9g, %.9g)", t, prru_strerror(PRRU_EUNREACHABLE), y[0], y[1], y[2]);
+  /* The controller's model's kernels, which prru track and the binding
+   * used before this moved here: the plant's parameter kernels agree with
+   * them only to rounding, and the reported speeds stay to the bit. */
+  double ddb[PRRU_NACT];
+  prru_model_actuator_rates(c->m, s->q, s->qd, s->dd, ddb);
   return PRRU_OK;
 }
 
-static void summary_add(prru_track_summary *sum, const prru_track_sample *s)
+static void summary_add(prru_track_summary *sum, const prru_track_sample *s, const prru_track_options *o)
 {
   sum->samples++;
   sum->t_end = s->t;
-  int any = 0;
+  int any = 0, over = 0;
   for (int i = 0; i < 3; i++) {
     sum->rms_e[i] += s->e[i] * s->e[i]; /* a sum of squares until the end */
     sum->max_e[i] = fmax(sum->max_e[i], fabs(s->e[i]));
@@ -576,8 +606,11 @@ static void summary_add(prru_track_summary *sum, const prru_track_sample *s)
     sum->max_fd[i] = fmax(sum->max_fd[i], fabs(s->fd[i]));
     sum->saturated[i] += s->saturated[i];
     any |= s->saturated[i];
+    sum->max_dd[i] = fmax(sum->max_dd[i], fabs(s->dd[i]));
+    over |= fabs(s->dd[i]) > o->speed_max[i];
   }
   sum->any_saturated += any;
+  sum->over_speed += over;
 }
 
 static void summary_finish(prru_track_summary *sum)
@@ -701,7 +734,7 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
       return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                        "stopped at t = %.9g s: slider %d at d = %.9g m left its stroke [%g, %g]",
                        tk, bad + 1, s->d[bad], o->d_min[bad], o->d_max[bad]);
-    summary_add(sum, s);
+    summary_add(sum, s, o);
     if (o->on_sample && o->on_sample(s, o->ctx) != 0)
       return prru_fail(msg, msglen, PRRU_EINTERRUPTED,
                        "stopped at t = %.9g s by the sample consumer", tk);
@@ -716,7 +749,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
 {
   memset(sum, 0, sizeof *sum);
   if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
-  int st = track_options_check(o, msg, msglen);
+  int st = prru_track_options_check(o, msg, msglen);
   if (st != PRRU_OK) return st;
   prru_gsl_init();
   track_ctx c;

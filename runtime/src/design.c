@@ -211,6 +211,11 @@ void prru_design_set(prru_params *p, const prru_params *base, const prru_design_
   for (int i = 0; i < v->n; i++) *at(p, v->offset[i]) = i == 0 ? x : vals[i] + shift;
 }
 
+void prru_design_assign(prru_params *p, const prru_design_var *v, double x)
+{
+  for (int i = 0; i < v->n; i++) *at(p, v->offset[i]) = x;
+}
+
 double prru_design_length_scale(const prru_params *p)
 {
   /* The same sum as prru_length_scale, so that a design and its

@@ -1,6 +1,7 @@
 /* Periodic (Fourier) excitation trajectories for identification
  * (prru_ident.h): coefficients chosen for a well-conditioned stacked base
  * regressor inside the workspace and the actuator force limits. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,9 +23,36 @@ void prru_excite_options_default(prru_excite_options *o)
   o->amplitude_max[0] = o->amplitude_max[1] = 0.25;
   o->amplitude_max[2] = -0.1; /* negative: that many length scales L */
   o->samples = 100;
-  o->check_samples = 2000;
+  o->check_samples = 0;
   o->max_evals = 3000;
   o->seed = 1;
+  o->dt = 0.01;
+  o->periods = 1;
+}
+
+/* The dense check's points per period: 0 follows samples, so that a
+ * caller raising samples gets a check as much finer. */
+static int check_points(const prru_excite_options *o)
+{
+  if (o->check_samples != 0) return o->check_samples;
+  return o->samples > 0 && o->samples <= INT_MAX / 20 ? 20 * o->samples : -1;
+}
+
+void prru_fourier_default(prru_fourier *f)
+{
+  memset(f, 0, sizeof *f);
+  f->period = 10.0;
+  f->harmonics = 5;
+}
+
+long prru_excite_rows(const prru_fourier *f, const prru_excite_options *o)
+{
+  const double run = f->period * o->periods;
+  if (!(f->period > 0 && isfinite(f->period)) || o->periods < 1 || !(o->dt > 0 && isfinite(o->dt)) ||
+      !(o->dt <= run && isfinite(run)))
+    return 0;
+  const double n = floor(run / o->dt * (1 + 1e-12));
+  return n <= 1e15 ? (long)n + 1 : 0;
 }
 
 void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim)
@@ -268,7 +296,7 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
       snprintf(msg, (size_t)msglen, "amplitude bound of q%d must be positive", k + 1);
       return PRRU_EINPUT;
     }
-  if (3 * o->samples < b->nbase + 1 || o->check_samples < o->samples || o->max_evals < 1) {
+  if (3 * o->samples < b->nbase + 1 || check_points(o) < o->samples || o->max_evals < 1) {
     snprintf(msg, (size_t)msglen, "need samples >= %d (3 rows each for %d base parameters), "
              "check samples >= samples and at least one evaluation", b->nbase / 3 + 1, b->nbase);
     return PRRU_EINPUT;
@@ -377,13 +405,13 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
   }
   if (st == PRRU_OK) {
     double tb = 0;
-    int cs = prru_excite_check(m, f, o, o->check_samples, r->fd_peak, &r->rcond_worst, &tb);
+    int cs = prru_excite_check(m, f, o, check_points(o), r->fd_peak, &r->rcond_worst, &tb);
     /* Between the optimisation samples a limit can be crossed: shrink the
      * motion about the centre until the dense check passes. */
     for (int shrink = 0; cs != PRRU_OK && cs != PRRU_ENOMEM && shrink < 30; shrink++) {
       for (int k = 0; k < 3; k++)
         for (int l = 0; l < f->harmonics; l++) f->a[k][l] *= 0.95, f->b[k][l] *= 0.95;
-      cs = prru_excite_check(m, f, o, o->check_samples, r->fd_peak, &r->rcond_worst, &tb);
+      cs = prru_excite_check(m, f, o, check_points(o), r->fd_peak, &r->rcond_worst, &tb);
       r->shrunk = shrink + 1;
     }
     if (cs == PRRU_OK && r->shrunk) {

@@ -12,13 +12,51 @@
 #include "prru.h"
 #include "internal.h"
 
-/* The residual tolerance is relative: 100 ulps of the larger of the
- * model's length and the slider heights, whatever the robot's size. */
-static double fk_tol(const prru_model *m, const double act[PRRU_NACT])
+/* The residual tolerances are relative to the larger of the model's
+ * length and the slider heights, whatever the robot's size. */
+static double fk_scale(const prru_model *m, const double act[PRRU_NACT])
 {
   double scale = prru_length_scale(m->mech);
   for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
-  return 100 * DBL_EPSILON * scale;
+  return scale;
+}
+
+/* What the iterations aim at: 100 ulps of the scale. */
+static double fk_tol(const prru_model *m, const double act[PRRU_NACT])
+{
+  return 100 * DBL_EPSILON * fk_scale(m, act);
+}
+
+/* Ten times fk_tol: hybridsj may stall a few ulps short of it. */
+double prru_fk_tolerance(const prru_model *m, const double act[PRRU_NACT])
+{
+  return 1000 * DBL_EPSILON * fk_scale(m, act);
+}
+
+void prru_fk_default_seed(const prru_model *m, const double act[PRRU_NACT], double q0[3])
+{
+  /* ik_jd, the kernel prru_check_regular evaluates: d(0) as the solvers
+   * see it, to the bit. */
+  const double zero[3] = {0, 0, 0};
+  double d0[PRRU_NACT], Jd0[PRRU_NACT * 3], sum = 0.0;
+  KERNEL(m, ik_jd)(m->kernel_params, zero, d0, Jd0);
+  for (int i = 0; i < PRRU_NACT; i++) sum += act[i] - d0[i];
+  q0[0] = q0[1] = 0.0;
+  q0[2] = sum / PRRU_NACT;
+}
+
+double prru_fk_residual(const prru_model *m, const double q[3], const double act[PRRU_NACT])
+{
+  /* The kernel prru_check_regular fills d->d with: the same residual as
+   * prru_forward_kinematics_lsq's at its answer, to the bit. */
+  double d[PRRU_NACT], Jd[PRRU_NACT * 3], res = 0;
+  KERNEL(m, ik_jd)(m->kernel_params, q, d, Jd);
+  for (int i = 0; i < PRRU_NACT; i++) {
+    const double r = fabs(d[i] - act[i]);
+    if (isnan(r)) return NAN; /* fmax would drop it */
+    res = fmax(res, r);
+  }
+  return res;
 }
 
 static int act_finite(const double act[PRRU_NACT])
@@ -169,8 +207,7 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   double res = 0;
   for (int i = 0; i < 3; i++) res = fmax(res, fabs(gsl_vector_get(s->f, (size_t)i)));
   gsl_multiroot_fdfsolver_free(s);
-  /* hybridsj may stall a few ulps short of tol; accept ten times it. */
-  if (!converged && !(res <= 10 * tol)) return PRRU_ENOCONV;
+  if (!converged && !(res <= prru_fk_tolerance(m, act))) return PRRU_ENOCONV;
   st = prru_check_regular(m, d, sol, NULL);
   if (st != PRRU_OK) return st == PRRU_EUNREACHABLE ? PRRU_ENOCONV : st;
   memcpy(q, sol, sizeof sol);
@@ -186,7 +223,7 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   double sol[3], res;
   int st = prru_forward_kinematics_lsq(m, d, act, seed, sol, &res);
   if (st != PRRU_OK) return st;
-  if (!(res <= 10 * fk_tol(m, act))) return PRRU_ENOCONV;
+  if (!(res <= prru_fk_tolerance(m, act))) return PRRU_ENOCONV;
   memcpy(q, sol, sizeof sol);
   return PRRU_OK;
 }

@@ -116,6 +116,7 @@ int prru_measure_poses(const prru_model *m, int n, const double *d, double dres,
   prru_data *ws = malloc(sizeof *ws);
   if (!ws) return PRRU_ENOMEM;
   double seed[3] = {0, 0, 0};
+  if (n > 0) prru_fk_default_seed(m, d, seed);
   int st = PRRU_OK;
   for (int i = 0; i < n && st == PRRU_OK; i++) {
     const double *act = d + (size_t)PRRU_NACT * i;

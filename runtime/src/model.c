@@ -436,6 +436,32 @@ void prru_model_actuator_rates(const prru_model *m, const double q[3], const dou
   KERNEL(m, actuator_rates)(m->kernel_params, q, qd, dd, ddb);
 }
 
+void prru_power(const prru_model *m, const double q[3], const double qd[3], const prru_loads *l,
+                double *load_power, double *passive_power)
+{
+  double act[PRRU_NACT], Jd[PRRU_NACT * 3], JP[18], Qp[3], power = 0, passive = 0;
+  KERNEL(m, ik_jd)(m->kernel_params, q, act, Jd);
+  KERNEL(m, platform_jacobian)(m->kernel_params, q, JP);
+  KERNEL(m, passive)(m->kernel_params, q, qd, Qp);
+  for (int i = 0; i < PRRU_NACT; i++) {
+    double dd = 0;
+    for (int k = 0; k < 3; k++) dd += Jd[3 * i + k] * qd[k];
+    power += l->fd[i] * dd;
+  }
+  /* JP: rows 0-2 J_R,P, rows 3-5 J_T,O'. */
+  for (int i = 0; i < 3; i++) {
+    double w = 0, v = 0;
+    for (int k = 0; k < 3; k++) {
+      w += JP[3 * i + k] * qd[k];
+      v += JP[3 * (3 + i) + k] * qd[k];
+    }
+    power += l->fp[i] * v + l->mp[i] * w;
+  }
+  for (int k = 0; k < 3; k++) passive += Qp[k] * qd[k];
+  if (load_power) *load_power = power;
+  if (passive_power) *passive_power = passive;
+}
+
 void prru_model_identity(const prru_model *m, char *buf, size_t len)
 {
   if (len == 0) return;

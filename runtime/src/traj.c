@@ -323,6 +323,19 @@ int prru_quintic_eval(const prru_quintic *tr, double t, double q[3], double qd[3
 double prru_quintic_t_begin(const prru_quintic *tr) { return tr->t[0]; }
 double prru_quintic_t_end(const prru_quintic *tr) { return tr->t[tr->n - 1]; }
 
+long prru_row_count(double t0, double t1, double dt)
+{
+  const double span = t1 - t0;
+  if (!(dt > 0) || !(span / dt <= 1e8)) return 0;
+  /* A remainder of a rounding's size is no row of its own. */
+  return (long)fmax(1.0, ceil(span / dt - 1e-9)) + 1;
+}
+
+double prru_row_time(double t0, double t1, double dt, long k, long rows)
+{
+  return k == rows - 1 ? t1 : t0 + (double)k * dt;
+}
+
 void prru_quintic_free(prru_quintic *tr)
 {
   free(tr->t);
