@@ -177,6 +177,15 @@ def _head(model, precision=None, option=""):
                c_comment(model.description)))
 
 
+def _op_macros(upper, emitted):
+    """PREFIX_ARITH_NAME (the count) and PREFIX_OPS_NAME (the summary
+    text) of every emitted kernel: what the bench and the docs quote."""
+    return (["#define %s_ARITH_%s %d /* arithmetic operations */"
+             % (upper, e.name.upper(), e.arithmetic) for e in emitted] +
+            ['#define %s_OPS_%s %s' % (upper, e.name.upper(), c_string(e.summary()))
+             for e in emitted])
+
+
 def _banner(head, emitted):
     op_table = "\n".join(" *   %-18s %s" % (e.name, c_comment(e.summary()))
                          for e in emitted)
@@ -305,11 +314,7 @@ def render_topology(reference, pmodel, deriv, templates_dir):
         kernel_list.insert(nbase, params.plain_kernel(
             regressor.topology_regressor_kernel(deriv, pmodel), pmodel, ctype))
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
-    macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
-              % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
-                                          c_string(e.summary()))
-               for e in emitted]
+    macros = _op_macros(upper, emitted)
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros,
                              " Numbers from *p.")
     # The optimiser's and the maps' --precision float: the fused dme_terms
@@ -372,11 +377,7 @@ def render_regressor(model, rmodel, deriv, templates_dir, prefix=None):
     emitted = [cgen.emit(regressor.regressor_kernel(model, deriv, rmodel),
                          prefix)]
     names = regressor.param_names(model)
-    macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
-              % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
-                                          c_string(e.summary()))
-               for e in emitted]
+    macros = _op_macros(upper, emitted)
     decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
                          for e in emitted)
     bodies = "\n\n".join("%s\n{\n%s\n}" % (e.signature, e.body)
@@ -495,11 +496,7 @@ def render(model, deriv, templates_dir, prefix=None):
               "/* Body order of every array: %s. The model's numbers and "
               "layout tables\n   are in %s_mechanism.h. */"
               % (c_comment(" ".join(b.name for b in mech.bodies)), prefix)]
-    macros += ["#define %s_ARITH_%s %d /* arithmetic operations */"
-               % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
-                                          c_string(e.summary()))
-               for e in emitted]
+    macros += _op_macros(upper, emitted)
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros, "")
     values = dict(banner=banner, head=head + " */", prefix=prefix,
                   PREFIX=upper, macros="\n".join(macros),
@@ -525,11 +522,7 @@ def render_derivs(model, deriv, templates_dir, prefix=None):
     upper = prefix.upper()
     kernel_list = derivative_kernels(deriv)
     emitted = [cgen.emit(k, prefix) for k in kernel_list]
-    macros = ["#define %s_ARITH_%s %d /* arithmetic operations */"
-              % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
-                                          c_string(e.summary()))
-               for e in emitted]
+    macros = _op_macros(upper, emitted)
     decls, bodies = _sources(emitted, kernel_list, upper, prefix, macros, "")
     values = dict(banner=_banner(_head(model, option=" --derivatives"), emitted),
                   prefix=prefix, PREFIX=upper, macros="\n".join(macros),
@@ -572,11 +565,7 @@ def render_float(model, deriv, templates_dir, prefix=None):
             raise
     macros = ["#define %s_NQ %d" % (upper, len(mech.q)),
               "#define %s_NACT %d" % (upper, len(mech.actuators))]
-    macros += ["#define %s_ARITH_%s %d /* arithmetic operations */"
-               % (upper, e.name.upper(), e.arithmetic) for e in emitted]
-    macros += ['#define %s_OPS_%s %s' % (upper, e.name.upper(),
-                                          c_string(e.summary()))
-               for e in emitted]
+    macros += _op_macros(upper, emitted)
     macros += _unseen_macros(kernel_list, upper, prefix)
     decls = "\n\n".join("/* %s */\n%s;" % (e.doc, e.signature)
                          for e in emitted)
