@@ -18,6 +18,7 @@
  * tracks like computed torque at the same period (within the
  * zero-order-hold error), an initial offset decays, and a wrong gain (sign
  * or layout) is caught. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -347,12 +348,18 @@ static void refusals(void)
 /* ---- slider speeds, the option checks, the bandwidth rule ---- */
 
 typedef struct {
-  double speed_max[PRRU_NACT], max_dd[PRRU_NACT], worst;
+  double speed_max[PRRU_NACT], max_dd[PRRU_NACT], max_size[PRRU_NACT], worst;
   long over, samples;
 } speed_ctx;
 
 /* The slider speeds J_d(q) qd from the model's J_d (not the rates kernel
- * the library uses), their maxima and the samples over a limit. */
+ * the library uses), their maxima and the samples over a limit. worst:
+ * max_i |dd_i - dd'_i| / (u sum_k |J_d,ik qd_k|). Bound, derived: each
+ * kernel's J_d entries are a few dozen roundings from the exact ones
+ * (sin, cos, sqrt and products of the model's lengths), each within u of
+ * the row's magnitude, and the three-term sum adds 3 u of it: 256 u of
+ * sum_k |J_d,ik qd_k| (test_model_load's K for two kernel paths) covers
+ * both sides with room, while a wrong speed is off by its whole size. */
 static int speed_check(const prru_track_sample *s, void *p)
 {
   speed_ctx *c = p;
@@ -363,8 +370,12 @@ static int speed_check(const prru_track_sample *s, void *p)
     dd[i] = Jd[3 * i] * s->qd[0] + Jd[3 * i + 1] * s->qd[1] + Jd[3 * i + 2] * s->qd[2];
     c->max_dd[i] = fmax(c->max_dd[i], fabs(dd[i]));
     over |= fabs(dd[i]) > c->speed_max[i];
+    const double size =
+        fabs(Jd[3 * i] * s->qd[0]) + fabs(Jd[3 * i + 1] * s->qd[1]) + fabs(Jd[3 * i + 2] * s->qd[2]);
+    c->max_size[i] = fmax(c->max_size[i], size);
+    c->worst = fmax(c->worst, size > 0 ? fabs(s->dd[i] - dd[i]) / (DBL_EPSILON * size)
+                                       : (s->dd[i] == 0 ? 0 : INFINITY));
   }
-  c->worst = fmax(c->worst, tu_relerr(s->dd, dd, PRRU_NACT, 1e-3));
   c->over += over;
   c->samples++;
   return 0;
@@ -386,8 +397,15 @@ static void slider_speeds(void)
   prru_track_summary s;
   char msg[512];
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_OK, msg);
-  tu_check(c.worst <= 1e-12, "sample dd = J_d qd", c.worst, 1e-12);
-  TU_CLOSE(s.max_dd, c.max_dd, PRRU_NACT, 1e-12, "max_dd = max over the samples of |J_d qd|");
+  tu_check(c.worst <= 256, "sample dd = J_d qd, in u sum_k |J_d,ik qd_k|", c.worst, 256);
+  printf("slider speeds: %.2f u of |J_d| |qd| at worst\n", c.worst);
+  /* The maxima of two sequences that differ sample by sample by at most
+   * 256 u of that sample's size differ by at most 256 u of the largest
+   * size. */
+  int same = 1;
+  for (int i = 0; i < PRRU_NACT; i++)
+    same &= fabs(s.max_dd[i] - c.max_dd[i]) <= 256 * DBL_EPSILON * c.max_size[i];
+  TU_TRUE(same, "max_dd = max over the samples of |J_d qd|");
   TU_TRUE(s.over_speed == 0 && c.over == 0, "no speed limit: nothing over it");
   /* Limits at half of each slider's peak speed: counted where any slider
    * is over its own, and reported, not enforced (the same run). */
