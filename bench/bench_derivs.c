@@ -80,16 +80,16 @@ static void run_side(bench_ctx *c, int side, long n)
       double x[6 + PRRU_NACT], col[3];
       prru_loads l = s->l;
       memcpy(x, s->q, sizeof s->q), memcpy(x + 3, s->qd, sizeof s->qd);
-      memcpy(x + 6, s->l.fd, sizeof s->l.fd);
+      memcpy(x + 6, s->l.fd, PRRU_NACT * sizeof(double));
       for (int j = 0; j < 6 + PRRU_NACT; j++) {
         const double h = 1e-6 * (1 + fabs(x[j]));
         double up[3], dn[3], y[6 + PRRU_NACT];
         memcpy(y, x, sizeof y);
         y[j] = x[j] + h;
-        memcpy(l.fd, y + 6, sizeof l.fd);
+        memcpy(l.fd, y + 6, PRRU_NACT * sizeof(double));
         bad += prru_forward_dynamics(&c->m, c->d, y, y + 3, &l, up) != 0;
         y[j] = x[j] - h;
-        memcpy(l.fd, y + 6, sizeof l.fd);
+        memcpy(l.fd, y + 6, PRRU_NACT * sizeof(double));
         bad += prru_forward_dynamics(&c->m, c->d, y, y + 3, &l, dn) != 0;
         for (int i = 0; i < 3; i++) col[i] = (up[i] - dn[i]) / (2 * h);
         acc += col[j % 3];

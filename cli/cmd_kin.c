@@ -461,7 +461,7 @@ int prru_cmd_id(int argc, char **argv)
       for (int k = 0; k < PRRU_NACT; k++) pw[k] = fd[k] * dd[k];
     }
     if (st == PRRU_OK && reactions) {
-      memcpy(l.fd, fd, sizeof l.fd);
+      memcpy(l.fd, fd, PRRU_NACT * sizeof(double));
       st = prru_reactions(&m, d, v + 1, v + 4, &l, lambda);
     }
     if (st != PRRU_OK) {

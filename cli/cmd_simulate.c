@@ -8,10 +8,6 @@
 #include "progress.h"
 #include "prru.h"
 
-/* The runtime's samples and loads carry one d and fd per actuator. */
-typedef char prru_cli_sample_d_is_nact[sizeof ((prru_sample *)0)->d == PRRU_NACT * sizeof(double) ? 1 : -1];
-typedef char prru_cli_loads_fd_is_nact[sizeof ((prru_loads *)0)->fd == PRRU_NACT * sizeof(double) ? 1 : -1];
-
 void prru_cli_csv_header(prru_cli_csv *c)
 {
   const char *const *labels = prru_cli_model()->mech->lambda_labels;

@@ -417,7 +417,7 @@ static void slider_speeds(void)
   TU_TRUE(s2.over_speed == c.over && c.samples == s2.samples && s2.over_speed > 0 &&
               s2.over_speed < s2.samples,
           "over_speed counts the samples with a slider over its limit");
-  TU_TRUE(memcmp(s2.max_dd, s.max_dd, sizeof s.max_dd) == 0 && memcmp(s2.max_e, s.max_e, sizeof s.max_e) == 0,
+  TU_TRUE(memcmp(s2.max_dd, s.max_dd, PRRU_NACT * sizeof(double)) == 0 && memcmp(s2.max_e, s.max_e, sizeof s.max_e) == 0,
           "a speed limit changes nothing in the run");
   o.speed_max[1] = 0;
   TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "speed limit of actuator 2"),
@@ -587,7 +587,7 @@ static void lqr_stationary(void)
   prru_linearization *lin = malloc(sizeof *lin);
   prru_loads l;
   memset(&l, 0, sizeof l);
-  memcpy(l.fd, s.u_ff, sizeof l.fd);
+  memcpy(l.fd, s.u_ff, PRRU_NACT * sizeof(double));
   double qd0[3] = {0, 0, 0};
   TU_TRUE(prru_linearize(&model, d, q, qd0, &l, period, lin) == PRRU_OK, "linearise the held pose");
   double ratio, rho;
@@ -659,7 +659,7 @@ static double hold_deficit(double period)
     if (prru_inverse_dynamics(&model, d, q0, qd0, a0, &l, f0) != PRRU_OK ||
         prru_inverse_dynamics(&model, d, q1, qd1, a1, &l, f1) != PRRU_OK)
       continue;
-    memcpy(l.fd, f0, sizeof l.fd);
+    memcpy(l.fd, f0, PRRU_NACT * sizeof(double));
     if (prru_linearize(&model, d, q0, qd0, &l, 0.0, lin) != PRRU_OK) continue;
     memset(l.fd, 0, sizeof l.fd);
     for (int i = 0; i < 3; i++) {

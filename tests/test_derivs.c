@@ -225,7 +225,7 @@ static double step_for(int v, double m)
 static void check_forward(state *s, double m)
 {
   prru_loads l;
-  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  memcpy(l.fd, s->fd, PRRU_NACT * sizeof(double)), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
   prru_linearization o;
   const int st = prru_linearize(&model, &data, s->q, s->qd, &l, 0.0, &o);
   if (!TU_TRUE(st == PRRU_OK, "prru_linearize at a trusted state")) return;
@@ -352,7 +352,7 @@ static void check_inverse(state *s, double m, double t)
   for (int i = 0; i < NA; i++)
     for (int k = 0; k < 3; k++) jdt[NA * k + i] = jd[3 * i + k];
   check_identity(identity_error(jdt, Dqdd, M, -1, 3, NA, 3), "J_d^T dfd/dqdd = M");
-  memcpy(l.fd, fd, sizeof l.fd);
+  memcpy(l.fd, fd, PRRU_NACT * sizeof(double));
   prru_linearization o;
   if (!TU_TRUE(prru_linearize(&model, &data, s->q, s->qd, &l, 0.0, &o) == PRRU_OK, "linearize"))
     return;
@@ -380,7 +380,7 @@ static void check_hold(const state *s)
 {
   enum { S = 6 + NA };
   prru_loads l;
-  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  memcpy(l.fd, s->fd, PRRU_NACT * sizeof(double)), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
   const double dts[] = {1e-3, 2e-2, 0.5};
   for (int t = 0; t < 3; t++) {
     prru_linearization o;
@@ -441,7 +441,7 @@ static void check_hold(const state *s)
 static int trusted_state(state *s, double *m)
 {
   prru_loads l;
-  memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+  memcpy(l.fd, s->fd, PRRU_NACT * sizeof(double)), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
   double qdd[3];
   *m = ref_margin(&P, s->q);
   return *m >= MARGIN && prru_forward_dynamics(&model, &data, s->q, s->qd, &l, qdd) == PRRU_OK;
@@ -559,7 +559,7 @@ static int state_at_margin(state *s, double target, double *m)
     }
     for (int i = 0; i < NA; i++) s->fd[i] = tu_uniform(-60, 60);
     prru_loads l;
-    memcpy(l.fd, s->fd, sizeof l.fd), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
+    memcpy(l.fd, s->fd, PRRU_NACT * sizeof(double)), memcpy(l.fp, s->fp, sizeof l.fp), memcpy(l.mp, s->mp, sizeof l.mp);
     double qdd[3];
     if (prru_forward_dynamics(&model, &data, s->q, s->qd, &l, qdd) == PRRU_OK) {
       *m = mm;
@@ -579,7 +579,7 @@ static void check_boundary(const char *name, int nstates)
     const double target = MARGIN * pow(BOUNDARY_MIN / MARGIN, (k + 1.0) / nstates);
     if (!state_at_margin(&s, target, &m)) continue;
     prru_loads l;
-    memcpy(l.fd, s.fd, sizeof l.fd), memcpy(l.fp, s.fp, sizeof l.fp), memcpy(l.mp, s.mp, sizeof l.mp);
+    memcpy(l.fd, s.fd, PRRU_NACT * sizeof(double)), memcpy(l.fp, s.fp, sizeof l.fp), memcpy(l.mp, s.mp, sizeof l.mp);
     prru_linearization o;
     if (!TU_TRUE(prru_linearize(&model, &data, s.q, s.qd, &l, 0.0, &o) == PRRU_OK,
                  "prru_linearize where forward dynamics is trusted"))
@@ -718,7 +718,7 @@ static void draw_batch(void)
     double mt;
     if (k % 5 == 2 && random_state(&t, &mt)) {
       memcpy(bq[k], t.q, sizeof t.q), memcpy(bqd[k], t.qd, sizeof t.qd);
-      memcpy(bl[k].fd, t.fd, sizeof t.fd), memcpy(bl[k].fp, t.fp, sizeof t.fp), memcpy(bl[k].mp, t.mp, sizeof t.mp);
+      memcpy(bl[k].fd, t.fd, PRRU_NACT * sizeof(double)), memcpy(bl[k].fp, t.fp, sizeof t.fp), memcpy(bl[k].mp, t.mp, sizeof t.mp);
     }
   }
   bq[5][0] = NAN, bqd[40][1] = INFINITY, bl[41].fd[0] = NAN;

@@ -31,6 +31,14 @@ c_double_p = ctypes.POINTER(ctypes.c_double)
 c_int_p = ctypes.POINTER(ctypes.c_int)
 
 
+# The maxima every public struct's arrays are sized by (prru_sizes.h): the
+# layouts are the same for every model and build; a model's own counts are
+# its descriptor's.
+MAX_ACT, MAX_LIMB, MAX_BODY, MAX_JOINT, MAX_LAMBDA = 4, 4, 13, 16, 76
+MAX_REG = 10 * MAX_BODY + 3 * MAX_ACT
+MA, ML = MAX_ACT, MAX_LAMBDA
+
+
 def _arr(ctype, n):
     return ctype * n
 
@@ -191,22 +199,22 @@ class Types:
             ("drive_keys", ctypes.c_uint), ("rotor_inertia", _arr(d, nact)),
             ("torque_max", _arr(d, nact)), ("motor_speed_max", _arr(d, nact))]})
         self.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": [
-            ("fd", _arr(d, nact)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
+            ("fd", _arr(d, MA)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
         self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [
-            ("d", _arr(d, nact)), ("Jd", _arr(d, nact * 3)), ("Jdpinv", _arr(d, 3 * nact)),
+            ("d", _arr(d, MA)), ("Jd", _arr(d, MA * 3)), ("Jdpinv", _arr(d, 3 * MA)),
             ("M", _arr(d, 9)), ("b", _arr(d, 3)), ("qdd", _arr(d, 3)),
-            ("r", _arr(d, nlambda)), ("lambda_null", _arr(d, nlambda))]})
+            ("r", _arr(d, ML)), ("lambda_null", _arr(d, ML))]})
         self.Linearization = type("prru_linearization", (ctypes.Structure,), {"_fields_": [
             ("qdd", _arr(d, 3)), ("dqdd_dq", _arr(d, 9)), ("dqdd_dqd", _arr(d, 9)),
-            ("dqdd_dfd", _arr(d, 3 * nact)), ("dqdd_dfp", _arr(d, 9)),
-            ("dqdd_dmp", _arr(d, 9)), ("A", _arr(d, 36)), ("B", _arr(d, 6 * nact)),
-            ("dt", d), ("Ad", _arr(d, 36)), ("Bd", _arr(d, 6 * nact))]})
+            ("dqdd_dfd", _arr(d, 3 * MA)), ("dqdd_dfp", _arr(d, 9)),
+            ("dqdd_dmp", _arr(d, 9)), ("A", _arr(d, 36)), ("B", _arr(d, 6 * MA)),
+            ("dt", d), ("Ad", _arr(d, 36)), ("Bd", _arr(d, 6 * MA))]})
         self.Schedule = type("prru_load_schedule", (ctypes.Structure,), {"_fields_": [
             ("kind", ctypes.c_int), ("base", self.Loads), ("amp", d), ("omega", d),
             ("nrows", ctypes.c_int), ("rows", c_double_p)]})
         self.Sample = type("prru_sample", (ctypes.Structure,), {"_fields_": [
             ("t", d), ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("qdd", _arr(d, 3)),
-            ("d", _arr(d, nact)), ("lambda_", _arr(d, nlambda)), ("T", d), ("V", d)]})
+            ("d", _arr(d, MA)), ("lambda_", _arr(d, ML)), ("T", d), ("V", d)]})
         self.SampleFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.Sample), ctypes.c_void_p)
         self.SimOptions = type("prru_sim_options", (ctypes.Structure,), {"_fields_": [
             ("stepper", ctypes.c_int), ("t_end", d), ("dt_out", d), ("abs_tol", d),
@@ -220,21 +228,22 @@ class Types:
         self.Dme = type("prru_dme", (ctypes.Structure,), {"_fields_": [
             ("status", ctypes.c_int), ("jd_rcond", d), ("w_R", d), ("sigma", _arr(d, 2)),
             ("semi_axis", _arr(d, 2)), ("axis_dir", _arr(_arr(d, 3), 2)), ("sigma_T", d),
-            ("half_length_T", d), ("dir_T", _arr(d, 3)), ("Mt", _arr(d, nact * nact)),
-            ("JtR", _arr(d, 3 * nact)), ("JtT", _arr(d, 3 * nact))]})
-        # Sample columns as doubles: the struct is all doubles, no padding.
+            ("half_length_T", d), ("dir_T", _arr(d, 3)), ("Mt", _arr(d, MA * MA)),
+            ("JtR", _arr(d, 3 * MA)), ("JtT", _arr(d, 3 * MA))]})
+        # Sample columns as doubles: the struct is all doubles, no padding;
+        # (first, count) of the model's values, each array holding its maximum.
         self.sample_columns = {}
         col = 0
-        for name, width in (("t", 1), ("q", 3), ("qd", 3), ("qdd", 3), ("d", nact),
-                            ("lambda", nlambda), ("T", 1), ("V", 1)):
+        for name, width, room in (("t", 1, 1), ("q", 3, 3), ("qd", 3, 3), ("qdd", 3, 3),
+                                  ("d", nact, MA), ("lambda", nlambda, ML), ("T", 1, 1), ("V", 1, 1)):
             self.sample_columns[name] = (col, width)
-            col += width
+            col += room
         self.sample_width = col
         # Motion planning and tracking (prru.h, prru_traj.h, prru_control.h,
         # prru_param_kernels.h).
         self.Limits = type("prru_limits", (ctypes.Structure,), {"_fields_": [
-            ("force_max", _arr(d, nact)), ("speed_max", _arr(d, nact)),
-            ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact))]})
+            ("force_max", _arr(d, MA)), ("speed_max", _arr(d, MA)),
+            ("d_min", _arr(d, MA)), ("d_max", _arr(d, MA))]})
         self.Params = type("prru_params", (ctypes.Structure,), {"_fields_": [
             ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
             ("a", _arr(d, nlimb)), ("gravity", _arr(d, 3)), ("mass", _arr(d, nbody)),
@@ -243,33 +252,34 @@ class Types:
             ("coulomb_velocity", d)]})
         self.TrackSample = type("prru_track_sample", (ctypes.Structure,), {"_fields_": [
             ("t", d), ("q_ref", _arr(d, 3)), ("qd_ref", _arr(d, 3)), ("qdd_ref", _arr(d, 3)),
-            ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("e", _arr(d, 3)), ("fd", _arr(d, nact)),
-            ("fd_cmd", _arr(d, nact)), ("d", _arr(d, nact)), ("dd", _arr(d, nact)), ("qdd", _arr(d, 3)),
-            ("saturated", _arr(ctypes.c_int, nact))]})
+            ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("e", _arr(d, 3)), ("fd", _arr(d, MA)),
+            ("fd_cmd", _arr(d, MA)), ("d", _arr(d, MA)), ("dd", _arr(d, MA)), ("qdd", _arr(d, 3)),
+            ("saturated", _arr(ctypes.c_int, MA))]})
         self.TrackFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.TrackSample),
                                         ctypes.c_void_p)
         self.TrackOptions = type("prru_track_options", (ctypes.Structure,), {"_fields_": [
             ("kp", _arr(d, 3)), ("kd", _arr(d, 3)), ("control_period", d), ("dt_out", d),
-            ("f_max", _arr(d, nact)), ("speed_max", _arr(d, nact)), ("d_min", _arr(d, nact)),
-            ("d_max", _arr(d, nact)),
+            ("f_max", _arr(d, MA)), ("speed_max", _arr(d, MA)), ("d_min", _arr(d, MA)),
+            ("d_max", _arr(d, MA)),
             ("noise_q", d), ("noise_qd", d), ("seed", ctypes.c_ulong), ("q0_offset", _arr(d, 3)),
             ("plant", self.Params), ("abs_tol", d), ("rel_tol", d), ("on_sample", self.TrackFn),
             ("ctx", ctypes.c_void_p), ("interrupt", c_int_p), ("controller", ctypes.c_int),
-            ("lqr_q", _arr(d, 6)), ("lqr_r", _arr(d, nact))]})
+            ("lqr_q", _arr(d, 6)), ("lqr_r", _arr(d, MA))]})
         self.TrackSummary = type("prru_track_summary", (ctypes.Structure,), {"_fields_": [
             ("samples", ctypes.c_long), ("t_end", d), ("rms_e", _arr(d, 3)), ("max_e", _arr(d, 3)),
-            ("max_fd", _arr(d, nact)), ("saturated", _arr(ctypes.c_long, nact)),
-            ("any_saturated", ctypes.c_long), ("max_dd", _arr(d, nact)), ("over_speed", ctypes.c_long)]})
+            ("max_fd", _arr(d, MA)), ("saturated", _arr(ctypes.c_long, MA)),
+            ("any_saturated", ctypes.c_long), ("max_dd", _arr(d, MA)), ("over_speed", ctypes.c_long)]})
         # Identification: PRRU_NREG standard parameters (10 per body, 3 per
         # actuator; prru_regressor_names' last is checked at load).
-        self.nreg = nreg = 10 * nbody + 3 * nact
+        self.nreg = 10 * nbody + 3 * nact
+        nreg = MAX_REG
         i = ctypes.c_int
         self.Base = type("prru_base", (ctypes.Structure,), {"_fields_": [
             ("nbase", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
             ("vs", d), ("last_kept", d), ("first_dropped", d), ("nstates", i), ("seed", ctypes.c_ulong)]})
         self.IdentResult = type("prru_ident_result", (ctypes.Structure,), {"_fields_": [
             ("nsamples", i), ("nrows", i), ("dof", i), ("beta", _arr(d, nreg)), ("se", _arr(d, nreg)),
-            ("scale", _arr(d, nreg)), ("sigma", d), ("rms", _arr(d, nact)), ("cond", d), ("yrms", d),
+            ("scale", _arr(d, nreg)), ("sigma", d), ("rms", _arr(d, MA)), ("cond", d), ("yrms", d),
             ("inflation", d), ("hac_lags", i), ("R", _arr(d, nreg * nreg))]})
         self.ConsistentResult = type("prru_consistent_result", (ctypes.Structure,), {"_fields_": [
             ("how", i), ("beta", _arr(d, nreg)), ("t", _arr(d, nreg)), ("w", _arr(d, nreg)), ("d2", d),
@@ -279,15 +289,15 @@ class Types:
             ("consistent", self.ConsistentResult), ("pi0", _arr(d, nreg)), ("prior", _arr(d, nreg)),
             ("pi", _arr(d, nreg)), ("text", ctypes.c_void_p), ("msg", _arr(ctypes.c_char, 1024))]})
         self.ExciteOptions = type("prru_excite_options", (ctypes.Structure,), {"_fields_": [
-            ("fd_max", _arr(d, nact)), ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)), ("rcond_min", d),
+            ("fd_max", _arr(d, MA)), ("d_min", _arr(d, MA)), ("d_max", _arr(d, MA)), ("rcond_min", d),
             ("amplitude_max", _arr(d, 3)), ("samples", i), ("check_samples", i), ("max_evals", i),
-            ("seed", ctypes.c_ulong), ("speed_max", _arr(d, nact)), ("dt", d), ("periods", i)]})
+            ("seed", ctypes.c_ulong), ("speed_max", _arr(d, MA)), ("dt", d), ("periods", i)]})
         self.ExciteResult = type("prru_excite_result", (ctypes.Structure,), {"_fields_": [
-            ("cond", d), ("cond_start", d), ("fd_peak", _arr(d, nact)), ("rcond_worst", d), ("evals", i),
+            ("cond", d), ("cond_start", d), ("fd_peak", _arr(d, MA)), ("rcond_worst", d), ("evals", i),
             ("shrunk", i)]})
         # Design optimisation (prru_design.h).
         self.DesignVar = type("prru_design_var", (ctypes.Structure,), {"_fields_": [
-            ("name", _arr(ctypes.c_char, 24)), ("n", i), ("offset", _arr(ctypes.c_size_t, nbody)),
+            ("name", _arr(ctypes.c_char, 24)), ("n", i), ("offset", _arr(ctypes.c_size_t, MAX_BODY)),
             ("lo", d), ("hi", d)]})
         self.DesignEval = type("prru_design_eval", (ctypes.Structure,), {"_fields_": [
             ("valid", i), ("sum", _MapSummary), ("objective", d), ("n_other_mode", ctypes.c_long),
@@ -525,7 +535,34 @@ class Library:
             "the package and the library come from different versions of prru; use the "
             "python/ directory of the tree the library was built from" % (self.path, what))
 
+    # The mirrors defined at module level, by their C names (Types' are
+    # named after their C structs).
+    _MODULE_MIRRORS = {"prru_model": _Model, "prru_joint_info": _JointInfo, "prru_map_grid": _MapGrid,
+                       "prru_map_summary": _MapSummary, "prru_map_options": _MapOptions,
+                       "prru_measure_options": _MeasureOptions, "prru_diff_options": _DiffOptions,
+                       "prru_diff_choice": _DiffChoice, "prru_quintic": _Quintic, "prru_topp": _Topp,
+                       "prru_path_side": _PathSide, "prru_design_problem": _DesignProblem,
+                       "prru_fourier": _Fourier, "prru_consistent_options": _ConsistentOptions}
+
+    def mirrors(self):
+        """{C name: ctypes mirror} of every public struct this package mirrors."""
+        out = dict(self._MODULE_MIRRORS)
+        for v in vars(self.types).values():
+            if isinstance(v, type) and issubclass(v, ctypes.Structure) and v.__name__.startswith("prru_"):
+                out[v.__name__] = v
+        return out
+
+    def _check_struct_sizes(self):
+        """Every mirror's size against the library's own sizeof
+        (prru_struct_size): a field missing, added or resized in either."""
+        size = _declare(self.dll, "prru_struct_size", ctypes.c_size_t, ctypes.c_char_p)
+        for name, mirror in sorted(self.mirrors().items()):
+            if size(name.encode()) != ctypes.sizeof(mirror):
+                raise self._layout_error("sizeof(%s): %d in the library, %d in the mirror"
+                                         % (name, size(name.encode()), ctypes.sizeof(mirror)))
+
     def _self_check(self):
+        self._check_struct_sizes()
         self._check_mechanism()
         self._check_scenario()
         self._check_data_and_dme()
@@ -608,8 +645,8 @@ class Library:
         self.model_params(ctypes.byref(m), ctypes.byref(p))
         if (list(o.kp) != [400.0] * 3 or list(o.kd) != [40.0] * 3 or o.control_period != 0
                 or o.dt_out != 1e-3 or o.seed != 1 or o.abs_tol != 1e-12 or o.rel_tol != 1e-12
-                or any(v != math.inf for v in o.f_max) or any(v != math.inf for v in o.speed_max)
-                or any(v != -math.inf for v in o.d_min)
+                or any(v != math.inf for v in o.f_max[:t.nact]) or any(v != math.inf for v in o.speed_max[:t.nact])
+                or any(v != -math.inf for v in o.d_min[:t.nact])
                 or bytes(o.plant) != bytes(p) or p.coulomb_velocity <= 0 or o.on_sample
                 or o.controller != 0 or any(o.lqr_q) or any(o.lqr_r) or not guard_intact(g)):
             raise self._layout_error("prru_track_options")
@@ -625,7 +662,7 @@ class Library:
         self.excite_options_default(ctypes.byref(ge.s))
         e = ge.s
         if (not guard_intact(ge) or e.samples != 100 or e.check_samples != 0 or e.max_evals != 3000
-                or e.seed != 1 or e.dt != 0.01 or e.periods != 1 or any(v != math.inf for v in e.speed_max)):
+                or e.seed != 1 or e.dt != 0.01 or e.periods != 1 or any(v != math.inf for v in e.speed_max[:t.nact])):
             raise self._layout_error("prru_excite_options")
         last = self.regressor_names[t.nreg - 1]
         if last != ("coulomb%d" % t.nact).encode():
@@ -654,9 +691,9 @@ class Library:
         self.forward_dynamics(ctypes.byref(m), ctypes.byref(g2.s), q, zero3, ctypes.byref(loads),
                               qdd_ref)
         s = g.s
-        if list(s.d) != list(d_ref) or list(s.Jd) != list(jd_ref):
+        if s.d[:n] != list(d_ref) or s.Jd[:3 * n] != list(jd_ref):
             raise self._layout_error("prru_data.d, prru_data.Jd")
-        if list(s.qdd) != list(qdd_ref) or list(s.r) != list(lam):
+        if list(s.qdd) != list(qdd_ref) or s.r[:t.nlambda] != list(lam):
             raise self._layout_error("prru_data.qdd, prru_data.r")
         if self.mech.nlambda - (t.nh - 3) == 0 and any(s.lambda_null):
             raise self._layout_error("prru_data.lambda_null")

@@ -164,7 +164,7 @@ def excite(self, *, period=None, harmonics=None, periods=None, dt=None, centre=N
         lib.model_free(ctypes.byref(m))
     L = f.harmonics
     return Excitation(motion, f.period, L, tuple(f.centre), tuple(tuple(f.a[k][:L]) for k in range(3)),
-                      tuple(tuple(f.b[k][:L]) for k in range(3)), r.cond, r.cond_start, tuple(r.fd_peak),
+                      tuple(tuple(f.b[k][:L]) for k in range(3)), r.cond, r.cond_start, tuple(r.fd_peak[:self.nact]),
                       r.rcond_worst, r.evals, r.shrunk, b.nbase, lim)
 
 
@@ -187,7 +187,7 @@ def _excite_rows(model, m, f, rows, dt):
                 raise errors.make_error(st, "excite: t = %.9g s: %s" % (t, lib.status_text(st)))
             lib.model_actuator_rates(ctypes.byref(m), q, qd, dd, ddb)
             for key, v in (("t", t), ("q", list(q)), ("qd", list(qd)), ("qdd", list(qdd)),
-                           ("d", list(g.s.d)), ("dd", list(dd)), ("fd", list(fd))):
+                           ("d", g.s.d[:n]), ("dd", list(dd)), ("fd", list(fd))):
                 cols[key].append(v)
     out, rows = model._out, len(cols["t"])
     return Motion(out.vec(cols["t"]), *(out.mat([x for r in cols[k] for x in r], rows, len(cols[k][0]))

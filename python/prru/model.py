@@ -112,26 +112,28 @@ class Model:
         self.model_file, self.sha256, self.format = s(me.model_file), s(me.sha256), me.format
         self.nq, self.nact, self.nlimb = me.nq, me.nact, me.nlimb
         self.nbody, self.nlambda, self.njoint = me.nbody, me.nlambda, me.njoint
-        self.body_names = tuple(s(me.body_names[i]) for i in range(me.nbody))
-        self.body_limb = tuple(me.body_limb)
+        nb, nl, na = me.nbody, me.nlimb, me.nact
+        self.body_names = tuple(s(me.body_names[i]) for i in range(nb))
+        self.body_limb = tuple(me.body_limb[:nb])
         self.platform = me.platform
-        self.lower, self.upper, self.slider = tuple(me.lower), tuple(me.upper), tuple(me.slider)
+        self.lower, self.upper = tuple(me.lower[:nl]), tuple(me.upper[:nl])
+        self.slider = tuple(me.slider[:nl])
         self.gravity = out.vec(me.gravity)
-        self.mass, self.total_mass = out.vec(me.mass), me.total_mass
-        self.com = [out.vec(c) for c in me.com]
-        self.inertia = [out.mat(i, 3, 3) for i in me.inertia]
-        self.b, self.l1, self.l2, self.a = (out.vec(me.b), out.vec(me.l1), out.vec(me.l2),
-                                            out.vec(me.a))
-        self.armature, self.damping = out.vec(me.armature), out.vec(me.damping)
-        self.coulomb, self.coulomb_velocity = out.vec(me.coulomb), me.coulomb_velocity
+        self.mass, self.total_mass = out.vec(me.mass, nb), me.total_mass
+        self.com = [out.vec(me.com[b]) for b in range(nb)]
+        self.inertia = [out.mat(me.inertia[b], 3, 3) for b in range(nb)]
+        self.b, self.l1, self.l2, self.a = (out.vec(me.b, nl), out.vec(me.l1, nl),
+                                            out.vec(me.l2, nl), out.vec(me.a, nl))
+        self.armature, self.damping = out.vec(me.armature, na), out.vec(me.damping, na)
+        self.coulomb, self.coulomb_velocity = out.vec(me.coulomb, na), me.coulomb_velocity
         # spec 13: lead 0 and torque_constant 0 mean none; limits in rail
         # units, inf (-inf for d_min) where the model sets none
-        self.lead, self.gear = out.vec(me.lead), out.vec(me.gear)
-        self.torque_constant = out.vec(me.torque_constant)
-        self.force_max, self.speed_max = out.vec(me.force_max), out.vec(me.speed_max)
-        self.d_min, self.d_max = out.vec(me.d_min), out.vec(me.d_max)
+        self.lead, self.gear = out.vec(me.lead, na), out.vec(me.gear, na)
+        self.torque_constant = out.vec(me.torque_constant, na)
+        self.force_max, self.speed_max = out.vec(me.force_max, na), out.vec(me.speed_max, na)
+        self.d_min, self.d_max = out.vec(me.d_min, na), out.vec(me.d_max, na)
         self.joints = tuple(Joint(s(j.name), s(j.type), j.limb, j.proximal, j.distal,
-                                  j.lambda_offset, j.lambda_count) for j in me.joint)
+                                  j.lambda_offset, j.lambda_count) for j in me.joint[:me.njoint])
         self.lambda_labels = tuple(s(me.lambda_labels[i]) for i in range(me.nlambda))
         self.npreload = self.nact - 3
         self.nreaction_null = self.nlambda - (6 * self.nbody - 3)
@@ -168,8 +170,9 @@ class Model:
             self._fail(st, what, rates)
 
     def _loads(self, fd, fp, mp):
-        return self.lib.types.Loads(optional_vector("fd", fd, self.nact),
-                                    optional_vector("fp", fp, 3), optional_vector("mp", mp, 3))
+        l = self.lib.types.Loads(fp=optional_vector("fp", fp, 3), mp=optional_vector("mp", mp, 3))
+        l.fd[:self.nact] = list(optional_vector("fd", fd, self.nact))
+        return l
 
     def _reachable(self, what, q):
         self._call(lambda: "%s: q = %s" % (what, _fmt(q)), self.lib.check_reachable, q)
@@ -312,7 +315,7 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         qdd = (ctypes.c_double * 3)()
-        rates = lambda: (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp))
+        rates = lambda: (("qd", qd), ("fd", l.fd[:self.nact]), ("fp", l.fp), ("mp", l.mp))
         self._call(lambda: "forward_dynamics: q = %s" % _fmt(q), self.lib.forward_dynamics,
                    q, qd, ctypes.byref(l), qdd, rates=rates)
         self._require_finite("forward_dynamics", q, (qdd,), rates)
@@ -419,7 +422,7 @@ class Model:
         q, qd = vector("q", q, 3), optional_vector("qd", qd, 3)
         l = self._loads(fd, fp, mp)
         lam = (ctypes.c_double * self.nlambda)()
-        rates = lambda: (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp))
+        rates = lambda: (("qd", qd), ("fd", l.fd[:self.nact]), ("fp", l.fp), ("mp", l.mp))
         self._call(lambda: "reactions: q = %s" % _fmt(q), self.lib.reactions, q, qd,
                    ctypes.byref(l), lam, rates=rates)
         self._require_finite("reactions", q, (lam,), rates)
@@ -460,7 +463,7 @@ class Model:
         self.lib.power(ctypes.byref(self._m), q, qd, ctypes.byref(l), ctypes.byref(load),
                        ctypes.byref(passive))
         self._require_finite("power", q, (load.value, passive.value),
-                             (("qd", qd), ("fd", l.fd), ("fp", l.fp), ("mp", l.mp)))
+                             (("qd", qd), ("fd", l.fd[:self.nact]), ("fp", l.fp), ("mp", l.mp)))
         return load.value, passive.value
 
     # ---- manipulability ----
@@ -473,7 +476,7 @@ class Model:
         o, out, n = g.s, self._out, self.nact
         self._require_finite("dme", q, (o.w_R, o.jd_rcond, o.sigma, o.semi_axis, o.axis_dir[0],
                                         o.axis_dir[1], o.sigma_T, o.half_length_T, o.dir_T,
-                                        o.Mt, o.JtR, o.JtT))
+                                        o.Mt[:n * n], o.JtR[:3 * n], o.JtT[:3 * n]))
         return Dme(o.w_R, o.jd_rcond, out.vec(o.sigma), out.vec(o.semi_axis),
                    [out.vec(o.axis_dir[0]), out.vec(o.axis_dir[1])], o.sigma_T,
                    o.half_length_T, out.vec(o.dir_T), out.mat(o.Mt, n, n),

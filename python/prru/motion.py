@@ -78,8 +78,8 @@ def limits(self, *, force_max=None, speed_max=None, stroke=None, model_limits=Tr
         lib.model_limits(ctypes.byref(self._m), ctypes.byref(c))
     else:
         lib.limits_none(ctypes.byref(c))
-    f, v = tuple(c.force_max), tuple(c.speed_max)
-    s = tuple(zip(c.d_min, c.d_max))
+    f, v = tuple(c.force_max[:n]), tuple(c.speed_max[:n])
+    s = tuple(zip(c.d_min[:n], c.d_max[:n]))
     if force_max is not None:
         f = _limit_values("force_max", force_max, n)
     if speed_max is not None:
@@ -106,8 +106,8 @@ def _c_limits(model, lim):
     if not isinstance(lim, Limits):
         raise TypeError("limits must be a prru.Limits (Model.limits()), got %s" % type(lim).__name__)
     n, c = model.nact, model.lib.types.Limits()
-    c.force_max[:] = list(_limit_values("limits.force_max", lim.force_max, n))
-    c.speed_max[:] = list(_limit_values("limits.speed_max", lim.speed_max, n))
+    c.force_max[:n] = list(_limit_values("limits.force_max", lim.force_max, n))
+    c.speed_max[:n] = list(_limit_values("limits.speed_max", lim.speed_max, n))
     if len(lim.stroke) != n:
         raise ValueError("limits.stroke must have %d pairs, got %d" % (n, len(lim.stroke)))
     for i, p in enumerate(lim.stroke):
@@ -166,7 +166,7 @@ class _Rows:
                                     "(det J_d changes sign) since the previous sample")
         if st != errors.OK:
             raise errors.make_error(st, "%s: %s" % (where, lib.status_text(st)))
-        d = list(g.s.d)
+        d = g.s.d[:n]
         fd, dd = (ctypes.c_double * n)(), (ctypes.c_double * n)()
         st = lib.limits_ratio(ctypes.byref(m._m), ctypes.byref(g.s), ctypes.byref(self.none), q, qd, qdd, fd, dd,
                               None, None, None)
@@ -256,7 +256,7 @@ def time_optimal(self, waypoints, *, limits=None, grid=0, dt=1e-3):
                                   t, a, b, cc, fd, dd, msg, len(msg))
                 if st != errors.OK:
                     raise _fail(self, st, "time_optimal", msg)
-                rows.record(t, a, b, cc, g.s.d, dd, fd)
+                rows.record(t, a, b, cc, g.s.d[:n], dd, fd)
         return TimeOptimal(rows.motion(), tp.duration, tp.active_fraction, tp.iterations,
                            tuple(durs), lim, tp.grid)
     finally:
@@ -335,8 +335,8 @@ def track(self, reference, *, bandwidth=None, kp=None, kd=None, period=0.0, dt=1
         o.kd[:] = list(_convert.vector("kd", kd, 3))
     o.control_period = _convert.scalar("period", period, positive=True)
     o.dt_out = _convert.scalar("dt", dt, positive=True, allow_zero=False)
-    o.f_max[:], o.speed_max[:] = list(c.force_max), list(c.speed_max)
-    o.d_min[:], o.d_max[:] = list(c.d_min), list(c.d_max)
+    o.f_max[:], o.speed_max[:] = c.force_max[:], c.speed_max[:]
+    o.d_min[:], o.d_max[:] = c.d_min[:], c.d_max[:]
     o.noise_q, o.noise_qd = _convert.vector("noise", noise, 2)
     o.seed = _convert.integer("seed", seed, 0)
     if o.seed != seed:
@@ -380,7 +380,7 @@ def _track_controller(model, o, controller, lqr_q, lqr_r):
     if lqr_q is not None:
         o.lqr_q[:] = list(_convert.vector("lqr_q", lqr_q, 6))
     if lqr_r is not None:
-        o.lqr_r[:] = list(_convert.vector("lqr_r", lqr_r, model.nact))
+        o.lqr_r[:model.nact] = list(_convert.vector("lqr_r", lqr_r, model.nact))
 
 
 # The library names the options by prru_track_options' members; these are
@@ -413,7 +413,7 @@ def _lqr_default_weights(model, tr, o):
     if not any(o.lqr_q):
         o.lqr_q[:] = list(q)
     if not any(o.lqr_r):
-        o.lqr_r[:] = list(r)
+        o.lqr_r[:n] = list(r)
 
 
 def _track_run(model, tr, o, lim, guard):
@@ -431,12 +431,14 @@ def _track_run(model, tr, o, lim, guard):
     cols = {k: [] for k in names}
     failure = []
 
+    per_actuator, n = ("fd", "fd_cmd", "saturated", "d", "dd"), model.nact
+
     def consume(ptr, ctx):
         try:
             s = ptr.contents
             for k in names:
                 v = getattr(s, k)
-                cols[k].append(v if k == "t" else list(v))
+                cols[k].append(v if k == "t" else v[:n] if k in per_actuator else list(v))
             return 0
         except BaseException as e:  # stop; re-raised after the call
             failure.append(e)
@@ -457,16 +459,16 @@ def _track_run(model, tr, o, lim, guard):
            for k in names[1:]}
     samples = summary.samples
     summ = {"samples": samples, "t_end": summary.t_end, "rms_error": tuple(summary.rms_e),
-            "max_error": tuple(summary.max_e), "max_fd": tuple(summary.max_fd),
-            "saturated_fraction": tuple(x / samples if samples else 0.0 for x in summary.saturated),
+            "max_error": tuple(summary.max_e), "max_fd": tuple(summary.max_fd[:model.nact]),
+            "saturated_fraction": tuple(x / samples if samples else 0.0 for x in summary.saturated[:model.nact]),
             "any_saturated_fraction": summary.any_saturated / samples if samples else 0.0,
-            "max_dd": tuple(summary.max_dd),
+            "max_dd": tuple(summary.max_dd[:model.nact]),
             "over_speed_fraction": summary.over_speed / samples if samples else 0.0,
             "feedforward_peak": ff.value, "limits": lim,
             "status": "complete" if st == errors.OK else msg.value.decode("utf-8", "replace")}
     # The controller and its own gains, as `prru track --summary` names them.
     if o.controller == 1:
-        summ.update(controller="lqr", lqr_q=tuple(o.lqr_q), lqr_r=tuple(o.lqr_r))
+        summ.update(controller="lqr", lqr_q=tuple(o.lqr_q), lqr_r=tuple(o.lqr_r[:model.nact]))
     else:
         summ.update(controller="computed_torque", kp=tuple(o.kp), kd=tuple(o.kd))
     run = TrackRun(out.vec(cols["t"]), *(mat[k] for k in names[1:]), summ)

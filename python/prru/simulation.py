@@ -93,7 +93,7 @@ def _scenario_from_c(model, s):
         table = tuple(tuple(s.loads.rows[r * w + k] for k in range(w))
                       for r in range(s.loads.nrows))
     o = s.opt
-    return Scenario(q0=tuple(s.q0), qd0=tuple(s.qd0), fd=tuple(s.loads.base.fd),
+    return Scenario(q0=tuple(s.q0), qd0=tuple(s.qd0), fd=tuple(s.loads.base.fd[:n]),
                     fp=tuple(s.loads.base.fp), mp=tuple(s.loads.base.mp), harmonic=harmonic,
                     table=table, t_end=o.t_end, dt=o.dt_out, stepper=_lib.STEPPERS[o.stepper],
                     atol=o.abs_tol, rtol=o.rel_tol, h0=o.h0, max_steps=o.max_steps)
@@ -156,7 +156,7 @@ def _table_rows(rows, nact):
 def _schedule(model, sc):
     t = model.lib.types
     s = t.Schedule()
-    s.base.fd[:] = list(optional_vector("fd", sc.fd, model.nact))
+    s.base.fd[:model.nact] = list(optional_vector("fd", sc.fd, model.nact))
     s.base.fp[:] = list(optional_vector("fp", sc.fp, 3))
     s.base.mp[:] = list(optional_vector("mp", sc.mp, 3))
     s.kind, keep = _lib.LOAD_CONSTANT, None
@@ -207,7 +207,7 @@ class _Collector:
         T, V = self.model.energy(self.q0, self.qd0)
         d, _ = self.model.ik(self.q0)
         return (s.t == 0.0 and list(s.q) == self.q0 and list(s.qd) == self.qd0
-                and list(s.d) == list(d) and s.T == T and s.V == V)
+                and s.d[:self.model.nact] == list(d) and s.T == T and s.V == V)
 
     def _consume(self, ptr, ctx):
         try:
@@ -216,9 +216,9 @@ class _Collector:
                 raise self.model.lib._layout_error("prru_sample")
             self.chunks.append(ctypes.string_at(ptr, self.size))
             if self.on_sample is not None:
-                lam = tuple(s.lambda_) if self.reactions else None
+                lam = tuple(s.lambda_[:self.model.nlambda]) if self.reactions else None
                 if self.on_sample(Sample(s.t, tuple(s.q), tuple(s.qd), tuple(s.qdd),
-                                         tuple(s.d), lam, s.T, s.V)):
+                                         tuple(s.d[:self.model.nact]), lam, s.T, s.V)):
                     self.stopped = True
                     return 1
             return 0

@@ -1479,7 +1479,9 @@ class TestLayout(unittest.TestCase):
         m = MODEL
         return {"PRRU_NACT": m.nact, "PRRU_NBODY": m.nbody, "PRRU_NLIMB": m.nlimb,
                 "PRRU_NREG": 10 * m.nbody + 3 * m.nact, "PRRU_EXCITE_MAX_HARMONICS": 8,
-                "PRRU_DESIGN_MAX_TIE": m.nbody, "PRRU_DESIGN_MAX_VARS": 64,
+                "PRRU_MAX_ACT": 4, "PRRU_MAX_LIMB": 4, "PRRU_MAX_BODY": 13, "PRRU_MAX_JOINT": 16,
+                "PRRU_MAX_LAMBDA": 76, "PRRU_MAX_REG": 142,
+                "PRRU_DESIGN_MAX_TIE": 13, "PRRU_DESIGN_MAX_VARS": 64,
                 "PRRU_NLAMBDA": m.nlambda, "PRRU_NJOINT": m.njoint, "PRRU_NH": 6 * m.nbody,
                 "PRRU_NQ": 3,
                 # generated/'s descriptor carries the paper model's name
@@ -1561,19 +1563,37 @@ class TestLayout(unittest.TestCase):
         self.assertEqual(ctypes.sizeof(t.Sample), 8 * t.sample_width)
 
     def test_self_check_detects_a_wrong_mirror(self):
-        """A mirror with one actuator too many fails the load-time check."""
-        class Shifted(_lib.Library):
-            def __init__(self, path):
-                self.path = path
-                self.dll = ctypes.CDLL(path)
-                head = _lib._MechHead.in_dll(self.dll, "prru_mech")
-                self.types = _lib.Types(head.nact + 1, head.nbody, head.nlimb, head.nlambda,
-                                        head.njoint)
-                self.mech = self.types.Mechanism.in_dll(self.dll, "prru_mech")
-                self._declare_functions()
-                self._check_data_and_dme()
-        with self.assertRaises(prru.LayoutError):
-            Shifted(LIB)
+        """A mirror with one field too many, or an array one entry short,
+        fails the load-time check against the library's own sizeof."""
+        def widened(fields):
+            return fields + [("extra", ctypes.c_double)]
+
+        def shortened(fields):
+            (name, t), rest = fields[0], fields[1:]
+            return [(name, t._type_ * (t._length_ - 1))] + rest
+
+        for change in (widened, shortened):
+            class Shifted(_lib.Library):
+                def __init__(self, path):
+                    self.path = path
+                    self.dll = ctypes.CDLL(path)
+                    head = _lib._MechHead.in_dll(self.dll, "prru_mech")
+                    self.types = _lib.Types(head.nact, head.nbody, head.nlimb, head.nlambda,
+                                            head.njoint)
+                    t = self.types
+                    t.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": change(t.Loads._fields_)})
+                    self._check_struct_sizes()
+            with self.subTest(change=change.__name__), self.assertRaises(prru.LayoutError):
+                Shifted(LIB)
+
+    def test_layout_is_the_same_for_every_model(self):
+        """The structs are sized by the maxima of prru_sizes.h, not by the
+        model: the mirror built for any descriptor sizes is the same."""
+        a = _lib.Types(3, 10, 3, 57, 12)
+        b = _lib.Types(4, 13, 4, 76, 16)
+        for name in ("Loads", "Data", "Sample", "Limits", "Dme", "Linearization", "TrackSample",
+                     "TrackSummary", "Base", "IdentResult", "ExciteOptions"):
+            self.assertEqual(ctypes.sizeof(getattr(a, name)), ctypes.sizeof(getattr(b, name)), name)
 
 
 @unittest.skipIf(numpy is None, "NumPy is not installed (the list path is tested)")

@@ -74,18 +74,18 @@ typedef struct {
   double q_ref[3], qd_ref[3], qdd_ref[3];
   double q[3], qd[3];         /* the plant's true state */
   double e[3];                /* q_ref - q */
-  double fd[PRRU_NACT];       /* applied (after clipping) actuator forces, N */
-  double fd_cmd[PRRU_NACT];   /* the controller's forces before clipping */
-  double d[PRRU_NACT];        /* the plant's slider positions, m */
+  double fd[PRRU_MAX_ACT];       /* applied (after clipping) actuator forces, N */
+  double fd_cmd[PRRU_MAX_ACT];   /* the controller's forces before clipping */
+  double d[PRRU_MAX_ACT];        /* the plant's slider positions, m */
   /* The slider speeds J_d(q) qd, m/s, of the controller's model at the
    * plant's state (the plant's own where it has the model's geometry):
    * what a speed limit is compared with. */
-  double dd[PRRU_NACT];
+  double dd[PRRU_MAX_ACT];
   /* The plant's acceleration at t under fd (the force it sees from t on):
    * (q, qd, qdd, fd) satisfy the plant's equations of motion exactly, as
    * identification data with exact rates. */
   double qdd[3];
-  int saturated[PRRU_NACT];   /* 1 where |fd_cmd_i| > f_max_i */
+  int saturated[PRRU_MAX_ACT];   /* 1 where |fd_cmd_i| > f_max_i */
 } prru_track_sample;
 
 /* Non-zero stops the run after this sample (as prru_sample_fn). */
@@ -96,12 +96,12 @@ typedef struct {
   double control_period;      /* s; 0: continuous */
   double dt_out;              /* s, output sampling when continuous
                                  (ignored otherwise: one sample per tick) */
-  double f_max[PRRU_NACT];    /* N, > 0; INFINITY: unlimited */
+  double f_max[PRRU_MAX_ACT];    /* N, > 0; INFINITY: unlimited */
   /* m/s, > 0; INFINITY: unlimited. Computed torque cannot hold a speed,
    * so this limit is reported (prru_track_summary's over_speed), never
    * enforced. */
-  double speed_max[PRRU_NACT];
-  double d_min[PRRU_NACT], d_max[PRRU_NACT]; /* m; -/+INFINITY: unlimited */
+  double speed_max[PRRU_MAX_ACT];
+  double d_min[PRRU_MAX_ACT], d_max[PRRU_MAX_ACT]; /* m; -/+INFINITY: unlimited */
   double noise_q, noise_qd;   /* sensor noise std (rad or m, per s), >= 0 */
   unsigned long seed;
   double q0_offset[3];        /* initial error: q(t_0) = q_ref(t_0) - offset */
@@ -116,7 +116,7 @@ typedef struct {
    * > 0, finite). All of lqr_q zero, or all of lqr_r zero (the default):
    * that group is prru_lqr_default_weights'. */
   int controller;
-  double lqr_q[6], lqr_r[PRRU_NACT];
+  double lqr_q[6], lqr_r[PRRU_MAX_ACT];
 } prru_track_options;
 
 enum { PRRU_TRACK_CT = 0, PRRU_TRACK_LQR = 1 };
@@ -150,10 +150,10 @@ typedef struct {
   long samples;
   double t_end;               /* time of the last sample */
   double rms_e[3], max_e[3];  /* over the samples */
-  double max_fd[PRRU_NACT];   /* largest |fd| applied */
-  long saturated[PRRU_NACT];  /* samples with actuator i saturated */
+  double max_fd[PRRU_MAX_ACT];   /* largest |fd| applied */
+  long saturated[PRRU_MAX_ACT];  /* samples with actuator i saturated */
   long any_saturated;         /* samples with any actuator saturated */
-  double max_dd[PRRU_NACT];   /* largest |dd| (the samples' slider speeds) */
+  double max_dd[PRRU_MAX_ACT];   /* largest |dd| (the samples' slider speeds) */
   long over_speed;            /* samples with any |dd_i| > speed_max_i */
 } prru_track_summary;
 
@@ -209,7 +209,7 @@ PRRU_API int prru_computed_torque(const prru_model *m, prru_data *d, const prru_
 typedef struct {
   long n;              /* ticks */
   double period;       /* s */
-  double q[6], r[PRRU_NACT]; /* the weights used */
+  double q[6], r[PRRU_MAX_ACT]; /* the weights used */
   double *K;           /* n x PRRU_NACT x 6: K_k at K + 6 PRRU_NACT k, row-major */
   double *u_ff;        /* n x PRRU_NACT: u_ff,k at u_ff + PRRU_NACT k */
   double *x_ref;       /* n x 6 */

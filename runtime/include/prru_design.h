@@ -54,7 +54,7 @@ extern "C" {
 
 /* The most parameters one design variable can tie (every body of a kind,
  * every limb). */
-#define PRRU_DESIGN_MAX_TIE (PRRU_NBODY)
+#define PRRU_DESIGN_MAX_TIE (PRRU_MAX_BODY)
 
 typedef struct {
   char name[24];                       /* as parsed, e.g. "b12", "I_U_xx" */

@@ -88,7 +88,7 @@ typedef struct {
   double half_length_T;   /* 1 / sigma_T: half-length of the translational segment (m/s^2 per N) */
   double dir_T[3];        /* its unit direction in {S} (e3) */
   /* Row-major, as defined above: Mt N x N, JtR and JtT 3 x N (N = PRRU_NACT). */
-  double Mt[PRRU_NACT * PRRU_NACT], JtR[3 * PRRU_NACT], JtT[3 * PRRU_NACT];
+  double Mt[PRRU_MAX_ACT * PRRU_MAX_ACT], JtR[3 * PRRU_MAX_ACT], JtT[3 * PRRU_MAX_ACT];
 } prru_dme;
 
 /* A regular pose of the other assembly mode: det J_d has the opposite sign

@@ -28,6 +28,7 @@
 #include <stddef.h>
 
 #include "prru_kernels.h"
+#include "prru_sizes.h"
 #include "prru_mechanism.h"
 
 /* The public API: libprru.so is built with hidden visibility, so that
@@ -72,6 +73,11 @@ typedef enum {
 
 /* A short, stable description of a status code. */
 PRRU_API const char *prru_strerror(int status);
+/* sizeof the public struct named name ("prru_data", "prru_mechanism",
+ * ...; every struct a binding mirrors), 0 for a name that is not one:
+ * bindings check their mirrors against it (python/prru/_lib.py). The
+ * sizes are the same for every model and build (prru_sizes.h). */
+PRRU_API size_t prru_struct_size(const char *name);
 
 /* The code a model evaluates with. MuJoCo's Model holds its numbers; a
  * prru_model also chooses its kernels: the specialised set, constant-folded
@@ -254,9 +260,9 @@ PRRU_API void prru_model_identity(const prru_model *m, char *buf, size_t len);
  * and the stroke d_min[i] <= d_i <= d_max[i] (m). No limit is INFINITY
  * (-INFINITY for d_min). */
 typedef struct {
-  double force_max[PRRU_NACT];
-  double speed_max[PRRU_NACT];
-  double d_min[PRRU_NACT], d_max[PRRU_NACT];
+  double force_max[PRRU_MAX_ACT];
+  double speed_max[PRRU_MAX_ACT];
+  double d_min[PRRU_MAX_ACT], d_max[PRRU_MAX_ACT];
 } prru_limits;
 /* The section 13 keys a model file gives, as bits (prru_mechanism.drive_keys,
  * prru_model_spec.keys): bit k for the k-th key of this list. */
@@ -318,23 +324,23 @@ PRRU_API void prru_limits_describe(const prru_limits *l, char *buf, size_t len);
 PRRU_API int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_limits *l);
 
 typedef struct {
-  double fd[PRRU_NACT]; /* actuator forces along +e3 on the sliders (N) */
+  double fd[PRRU_MAX_ACT]; /* actuator forces along +e3 on the sliders (N) */
   double fp[3]; /* force on the platform at O', {S} (N) */
   double mp[3]; /* moment on the platform, {S} (N m) */
 } prru_loads;
 
 /* Per-call workspace and last results. */
 typedef struct {
-  double d[PRRU_NACT], Jd[PRRU_NACT * 3]; /* actuators, J_d (NACT x 3) */
+  double d[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3]; /* actuators, J_d (NACT x 3) */
   /* J_d^+ = (J_d^T J_d)^-1 J_d^T (3 x NACT), the left inverse of J_d
    * (J_d^+ J_d = I): J_d^-1 for three actuators. */
-  double Jdpinv[3 * PRRU_NACT];
+  double Jdpinv[3 * PRRU_MAX_ACT];
   double M[9], b[3];              /* M qdd = b (prru_eom) */
   double qdd[3];
-  double r[PRRU_NLAMBDA];         /* the last prru_reactions' lambda */
+  double r[PRRU_MAX_LAMBDA];         /* the last prru_reactions' lambda */
   /* The unit null vector z of Q at the last prru_reactions (see
    * prru_reaction_null); all 0 when PRRU_NREACTION_NULL = 0. */
-  double lambda_null[PRRU_NLAMBDA];
+  double lambda_null[PRRU_MAX_LAMBDA];
 } prru_data;
 
 /* PRRU_OK, PRRU_EINPUT (non-finite q), PRRU_EUNREACHABLE or PRRU_ESTROKE

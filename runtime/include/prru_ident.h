@@ -57,9 +57,9 @@ enum { PRRU_PAR_BASE = 0, PRRU_PAR_COMBINED = 1, PRRU_PAR_NONE = 2 };
 
 typedef struct {
   int nbase;                      /* number of base parameters */
-  int col[PRRU_NREG];             /* col[i], i < nbase: base parameter i's own standard one */
-  int role[PRRU_NREG];            /* per standard parameter */
-  double B[PRRU_NREG * PRRU_NREG];/* rows i < nbase: beta_i = sum_j B[i][j] pi_j */
+  int col[PRRU_MAX_REG];             /* col[i], i < nbase: base parameter i's own standard one */
+  int role[PRRU_MAX_REG];            /* per standard parameter */
+  double B[PRRU_MAX_REG * PRRU_MAX_REG];/* rows i < nbase: beta_i = sum_j B[i][j] pi_j */
   double vs;                      /* Coulomb smoothing velocity Y was evaluated with (m/s) */
   double last_kept, first_dropped;/* |R_ii| / |R_00| on either side of the cut */
   int nstates;
@@ -110,14 +110,14 @@ PRRU_API int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base 
 
 typedef struct {
   int nsamples, nrows, dof;   /* dof = 3 nsamples - nbase */
-  double beta[PRRU_NREG];     /* the estimate, nbase values */
-  double se[PRRU_NREG];       /* standard errors */
+  double beta[PRRU_MAX_REG];     /* the estimate, nbase values */
+  double se[PRRU_MAX_REG];       /* standard errors */
   /* Resolution: rms(y) / rms(X_i), the value at which parameter i alone
    * would give forces of the data's RMS size; an estimate within 1e-9 of
    * it of a bound is at the bound to rounding. */
-  double scale[PRRU_NREG];
+  double scale[PRRU_MAX_REG];
   double sigma;               /* residual standard deviation s (N) */
-  double rms[PRRU_NACT];      /* residual RMS per row of a sample (N) */
+  double rms[PRRU_MAX_ACT];      /* residual RMS per row of a sample (N) */
   double cond;                /* 2-norm condition number of the column-scaled X */
   double yrms;                /* RMS of the rows' forces y (N) */
   /* The residuals' variance inflation f >= 1: sigma^2 (R^T R)^-1 is the
@@ -131,7 +131,7 @@ typedef struct {
   /* X = Q R (R: nbase x nbase upper triangular, row stride PRRU_NREG), so
    * that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2: the
    * covariance of beta^ is s^2 (R^T R)^-1. */
-  double R[PRRU_NREG * PRRU_NREG];
+  double R[PRRU_MAX_REG * PRRU_MAX_REG];
 } prru_ident_result;
 
 /* Least squares of the base parameters from n samples (q, qd, qdd, fd:
@@ -201,9 +201,9 @@ enum { PRRU_CONSISTENT_EXACT = 0, PRRU_CONSISTENT_COVARIANCE = 1 };
 
 typedef struct {
   int how;                   /* PRRU_CONSISTENT_EXACT or _COVARIANCE */
-  double beta[PRRU_NREG];    /* B pi, nbase values */
-  double t[PRRU_NREG];       /* (B pi - beta^)_i / (sigma_w sqrt(C_ii)), C = (R^T R)^-1 */
-  double w[PRRU_NREG];       /* drive weights w_k at the drive parameters, else 0 */
+  double beta[PRRU_MAX_REG];    /* B pi, nbase values */
+  double t[PRRU_MAX_REG];       /* (B pi - beta^)_i / (sigma_w sqrt(C_ii)), C = (R^T R)^-1 */
+  double w[PRRU_MAX_REG];       /* drive weights w_k at the drive parameters, else 0 */
   double d2, d2_max;         /* d^2 and the chi^2 quantile */
   double sigma_w;            /* N */
   double prior_dist;         /* |pi - pi0|_W */
@@ -257,9 +257,9 @@ typedef struct {
   prru_ident_result fit;             /* from stage PRRU_IDENTIFY_CONSISTENT on */
   prru_consistent_options options;   /* prru_consistent_options_default */
   prru_consistent_result consistent; /* from stage PRRU_IDENTIFY_PHYSICS on */
-  double pi0[PRRU_NREG];             /* the prior: the model's standard parameters */
-  double prior[PRRU_NREG];           /* its base parameters, nbase values */
-  double pi[PRRU_NREG];              /* the consistent standard parameters */
+  double pi0[PRRU_MAX_REG];             /* the prior: the model's standard parameters */
+  double prior[PRRU_MAX_REG];           /* its base parameters, nbase values */
+  double pi[PRRU_MAX_REG];              /* the consistent standard parameters */
   char *text;                        /* the model file on PRRU_OK, to free(); else NULL */
   char msg[1024];                    /* why it stopped, without the data's name */
 } prru_identification;
@@ -300,15 +300,15 @@ PRRU_API void prru_fourier_eval(const prru_fourier *f, double t, double q[3], do
 PRRU_API void prru_fourier_default(prru_fourier *f);
 
 typedef struct {
-  double fd_max[PRRU_NACT];  /* |fd_i| limit (N), > 0 */
-  double d_min[PRRU_NACT], d_max[PRRU_NACT]; /* slider strokes (m), -inf/+inf by default */
+  double fd_max[PRRU_MAX_ACT];  /* |fd_i| limit (N), > 0 */
+  double d_min[PRRU_MAX_ACT], d_max[PRRU_MAX_ACT]; /* slider strokes (m), -inf/+inf by default */
   double rcond_min;          /* regularity along the path (prru_check_regular's rcond) */
   double amplitude_max[3];   /* |q_k - c_k| bound of the start and of each coordinate's sum of |a|, |b| */
   int samples;               /* points per period the objective stacks (>= nbase/3 + 1) */
   int check_samples;         /* points per period of the final feasibility check; 0: 20 samples */
   int max_evals;             /* Nelder-Mead budget */
   unsigned long seed;
-  double speed_max[PRRU_NACT]; /* |d_i'| limit (m/s), INFINITY: none */
+  double speed_max[PRRU_MAX_ACT]; /* |d_i'| limit (m/s), INFINITY: none */
   /* The rows a run writes of the result (prru_excite_rows): every dt
    * seconds over periods periods. prru_excite does not read them. */
   double dt;
@@ -334,7 +334,7 @@ PRRU_API long prru_excite_rows(const prru_fourier *f, const prru_excite_options 
 typedef struct {
   double cond;          /* condition number of the column-scaled stacked base regressor */
   double cond_start;    /* the same for the starting coefficients (inf: infeasible start) */
-  double fd_peak[PRRU_NACT];
+  double fd_peak[PRRU_MAX_ACT];
   double rcond_worst;
   int evals;
   int shrunk;           /* times the motion was scaled by 0.95 to pass the dense check */

@@ -21,21 +21,21 @@
 extern "C" {
 #endif
 
-/* The derivative blocks are contiguous, in this order (one finiteness
- * test covers them). */
+/* The matrices with a column per actuator are compact (row stride nact,
+ * the model's m->mech->nact); their entries past it are 0. */
 typedef struct {
   double qdd[3];
   double dqdd_dq[9], dqdd_dqd[9];  /* 3x3 */
-  double dqdd_dfd[3 * PRRU_NACT];  /* 3 x PRRU_NACT */
+  double dqdd_dfd[3 * PRRU_MAX_ACT]; /* 3 x nact */
   double dqdd_dfp[9], dqdd_dmp[9]; /* 3x3: the platform force and moment */
   double A[36];                    /* 6x6 */
-  double B[6 * PRRU_NACT];         /* 6 x PRRU_NACT */
+  double B[6 * PRRU_MAX_ACT];        /* 6 x nact */
   /* With dt > 0: the zero-order-hold discrete pair x_{k+1} = Ad x_k + Bd
    * u_k, [Ad Bd; 0 I] = exp([A B; 0 0] dt) (gsl_linalg_exponential_ss,
    * GSL_PREC_DOUBLE); with dt = 0 they are not computed (left 0). */
   double dt;
   double Ad[36];
-  double Bd[6 * PRRU_NACT];
+  double Bd[6 * PRRU_MAX_ACT];
 } prru_linearization;
 
 /* Whether this model's kernel table has the derivative kernels (every

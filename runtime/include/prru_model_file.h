@@ -13,8 +13,6 @@
 extern "C" {
 #endif
 
-#define PRRU_MAX_LIMB 4                        /* the 4-PRRU (spec 12) */
-#define PRRU_MAX_BODY (1 + 3 * PRRU_MAX_LIMB)  /* P, L1.., U1.., S1.. */
 #define PRRU_MODEL_NAME_MAX 16                 /* [a-z][a-z0-9_]{0,15} */
 #define PRRU_MODEL_DESCRIPTION_MAX 400         /* characters, UTF-8 */
 #define PRRU_MODEL_FILE_MAX_BYTES (1 << 20)    /* as the generator */

@@ -42,8 +42,8 @@ PRRU_API int prru_stepper_parse(const char *name, prru_stepper *s);
 PRRU_API const char *prru_stepper_name(prru_stepper s);
 
 typedef struct {
-  double t, q[3], qd[3], qdd[3], d[PRRU_NACT];
-  double lambda[PRRU_NLAMBDA]; /* when options.reactions */
+  double t, q[3], qd[3], qdd[3], d[PRRU_MAX_ACT];
+  double lambda[PRRU_MAX_LAMBDA]; /* when options.reactions */
   double T, V;
 } prru_sample;
 

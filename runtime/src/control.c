@@ -173,7 +173,7 @@ static int lqr_linearize_tick(const prru_model *m, prru_data *d, const double x[
 {
   prru_loads l;
   memset(&l, 0, sizeof l);
-  memcpy(l.fd, u, sizeof l.fd);
+  memcpy(l.fd, u, PRRU_NACT * sizeof(double));
   char why[300];
   int st = prru_linearize_why(m, d, x, x + 3, &l, step, lin, why, sizeof why);
   if (st != PRRU_OK)
@@ -327,7 +327,7 @@ static int lqr_schedule_fill(const prru_model *m, const prru_quintic *ref, prru_
                               msglen);
     if (st != PRRU_OK) return st;
     memcpy(AB + NAB * k, lin->Ad, sizeof lin->Ad);
-    memcpy(AB + NAB * k + 36, lin->Bd, sizeof lin->Bd);
+    memcpy(AB + NAB * k + 36, lin->Bd, 6 * PRRU_NACT * sizeof(double));
   }
   double P[36];
   memset(P, 0, sizeof P);

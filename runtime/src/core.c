@@ -267,7 +267,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT])
 {
   int st = prru_check_reachable(m, d, q);
-  if (st == PRRU_OK) memcpy(act, d->d, sizeof d->d);
+  if (st == PRRU_OK) memcpy(act, d->d, PRRU_NACT * sizeof(double));
   return st;
 }
 

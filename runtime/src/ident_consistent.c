@@ -734,7 +734,7 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
     c->d2 = mahalanobis2(b, r, c->sigma_w, c->beta);
     c->d2_max = gsl_cdf_chisq_Qinv(o->alpha, b->nbase);
     for (int i = 0; i < b->nbase; i++) c->t[i] = (c->beta[i] - r->beta[i]) / v[i];
-    memcpy(c->w, G->w, sizeof c->w);
+    memcpy(c->w, G->w, sizeof G->w);
     c->prior_dist = sqrt(prior_norm2(G, pi, pi0));
     c->margin = smallest_margin(G, pi);
     c->newton = o->max_newton - steps;

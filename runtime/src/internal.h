@@ -7,6 +7,12 @@
 #include "prru.h"
 #include "prru_param_kernels.h"
 
+/* The build's model fits the public structs (prru_sizes.h). */
+typedef char prru_build_fits_public_structs[(PRRU_NACT <= PRRU_MAX_ACT && PRRU_NLIMB <= PRRU_MAX_LIMB &&
+                                             PRRU_NBODY <= PRRU_MAX_BODY && PRRU_NJOINT <= PRRU_MAX_JOINT &&
+                                             PRRU_NLAMBDA <= PRRU_MAX_LAMBDA)
+                                                ? 1
+                                                : -1];
 /* The build's kernel tables (kernels.c): specialised, and the parameter
  * kernels in their general and simple structures. */
 extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter,

@@ -10,13 +10,6 @@
 #include "prru_linearize.h"
 #include "internal.h"
 
-/* prru_linearize tests the five derivative blocks as one array. */
-typedef char prru_blocks_contiguous[offsetof(prru_linearization, dqdd_dmp) + sizeof(double[9]) -
-                                            offsetof(prru_linearization, dqdd_dq) ==
-                                        sizeof(double[9 + 9 + 3 * PRRU_NACT + 9 + 9])
-                                    ? 1
-                                    : -1];
-
 int prru_linearize_available(const prru_model *m)
 {
   return m->kernels->eom_solve_derivs != NULL;
@@ -72,15 +65,17 @@ static int linearization_from(const prru_model *m, prru_data *d, const double q[
   /* Trusted qdd from finite inputs: the derivatives are products of the
    * same finite terms and one division by det M, which the test bounds;
    * they overflow only where qdd nearly does. */
-  if (st == PRRU_OK && !prru_finite_n(o->dqdd_dq, 9 + 9 + 3 * PRRU_NACT + 9 + 9)) st = PRRU_EINPUT;
+  if (st == PRRU_OK &&
+      !(prru_finite_n(o->dqdd_dq, 9) && prru_finite_n(o->dqdd_dqd, 9) &&
+        prru_finite_n(o->dqdd_dfd, 3 * PRRU_NACT) && prru_finite_n(o->dqdd_dfp, 9) &&
+        prru_finite_n(o->dqdd_dmp, 9)))
+    st = PRRU_EINPUT;
   if (st == PRRU_OK) {
     memcpy(o->qdd, d->qdd, sizeof o->qdd);
     state_space(o);
     o->dt = dt;
-    if (dt > 0)
-      st = zero_order_hold(o, dt);
-    else
-      memset(o->Ad, 0, sizeof o->Ad), memset(o->Bd, 0, sizeof o->Bd);
+    memset(o->Ad, 0, sizeof o->Ad), memset(o->Bd, 0, sizeof o->Bd);
+    if (dt > 0) st = zero_order_hold(o, dt);
   }
   if (st != PRRU_OK) memset(o, 0, sizeof *o);
   return st;
@@ -90,8 +85,10 @@ int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const d
                    const prru_loads *l, double dt, prru_linearization *out)
 {
   if (!prru_linearize_available(m) || !(dt >= 0) || !isfinite(dt)) return PRRU_EINPUT;
-  /* Straight into out (a copy of its 1.4 kB costs a tenth of the call). */
+  /* Straight into out (a copy of its 1.4 kB costs a tenth of the call);
+   * the entries past the model's actuators stay 0. */
   prru_linearization *o = out;
+  memset(o->dqdd_dfd, 0, sizeof o->dqdd_dfd);
   double minors[3];
   KERNEL(m, eom_solve_derivs)(m->kernel_params, q, qd, l->fd, l->fp, l->mp, d->M, d->b, d->qdd,
                                minors, o->dqdd_dq, o->dqdd_dqd, o->dqdd_dfd, o->dqdd_dfp,
@@ -101,7 +98,7 @@ int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const d
 
 /* The batched kernel's chunk of states: its inputs and outputs in rows
  * of CHUNK (component i of state k at [i * CHUNK + k]); the derivative
- * blocks in prru_linearization's order, one row each. */
+ * blocks in prru_linearization's order, one row per entry. */
 enum { CHUNK = 32, NDERIV = 9 + 9 + 3 * PRRU_NACT + 9 + 9 };
 typedef struct {
   double q[3 * CHUNK], qd[3 * CHUNK], fd[PRRU_NACT * CHUNK], fp[3 * CHUNK], mp[3 * CHUNK];
@@ -140,7 +137,12 @@ static int linearize_chunk_at(const prru_model *m, int o, int n, const double *q
     double minors[3];
     prru_linearization *x = out + o + k;
     from_rows(d.M, c->M, 9, k, n), from_rows(d.b, c->b, 3, k, n), from_rows(d.qdd, c->qdd, 3, k, n);
-    from_rows(minors, c->minors, 3, k, n), from_rows(x->dqdd_dq, D, NDERIV, k, n);
+    from_rows(minors, c->minors, 3, k, n);
+    memset(x->dqdd_dfd, 0, sizeof x->dqdd_dfd);
+    from_rows(x->dqdd_dq, D, 9, k, n), from_rows(x->dqdd_dqd, D + 9 * n, 9, k, n);
+    from_rows(x->dqdd_dfd, D + 18 * n, 3 * N, k, n);
+    from_rows(x->dqdd_dfp, D + (18 + 3 * N) * n, 9, k, n);
+    from_rows(x->dqdd_dmp, D + (27 + 3 * N) * n, 9, k, n);
     int st = linearization_from(m, &d, q + 3 * (o + k), qd + 3 * (o + k), l + o + k, minors, dt, x);
     /* A failure is judged again the scalar way: the batch's vector sin and
      * cos may move a state within a few ulp of a threshold across it, and

@@ -85,7 +85,7 @@ int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
   prru_reaction_nullspace(q, d->lambda_null);
   if (!prru_finite_n(d->lambda_null, NL)) return PRRU_ESINGULAR;
   orient_null(d->lambda_null);
-  memcpy(z, d->lambda_null, sizeof d->lambda_null);
+  memcpy(z, d->lambda_null, PRRU_NLAMBDA * sizeof(double));
   return PRRU_OK;
 #endif
 }
@@ -106,6 +106,6 @@ int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const d
     memset(d->lambda_null, 0, sizeof d->lambda_null);
     return st;
   }
-  memcpy(lambda, d->r, sizeof d->r);
+  memcpy(lambda, d->r, PRRU_NLAMBDA * sizeof(double));
   return PRRU_OK;
 }
