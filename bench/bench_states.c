@@ -37,7 +37,7 @@ static double rows_det(const double *J, int a, int b, int c)
  * so a 3-limb model gets the same states whatever PRRU_NACT allows. */
 int bench_make_states(bench_ctx *c)
 {
-  prru_param_derive(&prru_params_model, &c->pd);
+  prru_params_derive(&prru_params_model, &c->pd);
   int n = 0;
   for (long attempt = 0; attempt < 100000 && n < NSTATES; attempt++) {
     bench_state *s = &c->st[n];

@@ -9,6 +9,13 @@
 #include <stdio.h>
 
 #include "prru.h"
+/* The build's model: the sizes (PRRU_NACT, ...) the CLI's arrays and
+ * output columns still have, its descriptor and regressor names. The
+ * library's public headers carry none of them (one ABI for every model);
+ * the CLI is built with the library, for the same model. */
+#include "prru_kernels.h"
+#include "prru_mechanism.h"
+#include "prru_regressor.h"
 
 /* The program's version, the CMake project version (cli/CMakeLists.txt). */
 #ifndef PRRU_VERSION

@@ -16,10 +16,11 @@
 #   share/man/man1/prru.1, prru-COMMAND.1   man pages (help2man when found)
 # (lib is GNUInstallDirs' CMAKE_INSTALL_LIBDIR.)
 #
-# The kernels, and with them the array sizes in the runtime's structs
-# (PRRU_NACT, PRRU_NLAMBDA), belong to one model: an install is of one
-# model, named in the package by prru_MODEL_FILE / prru_MODEL_SHA256 and in
-# prru.pc by the variables model_file / model_sha256.
+# The runtime's structs are the same for every model (prru_sizes.h); the
+# specialised kernels and prru_model_default are of one model, named in the
+# package by prru_MODEL_FILE / prru_MODEL_SHA256 and in prru.pc by the
+# variables model_file / model_sha256, whose number of limbs the install's
+# runtime computes with.
 include(CMakePackageConfigHelpers)
 
 set(PRRU_INSTALL_INCLUDEDIR "${CMAKE_INSTALL_INCLUDEDIR}/prru")

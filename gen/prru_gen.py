@@ -52,27 +52,33 @@ _NAME = "prru_gen"
 SETS = ("derivatives", "regressor")
 
 
-def generate(model_path, templates_dir=TEMPLATES, prefix=None, sets=()):
+def generate(model_path, templates_dir=TEMPLATES, prefix=None, sets=(),
+             types_header=None):
     """(files {name: text}, emitted kernels) for a model file."""
     return generate_model(model_mod.load(model_path), templates_dir, prefix,
-                          sets)
+                          sets, types_header)
 
 
-def generate_model(model, templates_dir=TEMPLATES, prefix=None, sets=()):
+def generate_model(model, templates_dir=TEMPLATES, prefix=None, sets=(),
+                   types_header=None):
     """(files {name: text}, emitted kernels) for a loaded model: the
     constant kernels, the mechanism descriptor and the runtime-parameter
     kernels' names (the topology kernels', render.render_params); and the
     sets of SETS that sets names: the derivative kernels, the regressor.
-    Each set's files are the same whichever others are asked for."""
+    Each set's files are the same whichever others are asked for.
+    types_header: the descriptor's and parameters' types come from this
+    header (render.render, render.render_params)."""
     unknown = set(sets) - set(SETS)
     if unknown:
         raise ValueError("unknown kernel sets %s" % sorted(unknown))
     sym.reset()
     deriv = dynamics.Derivation(mechanism.build(model), model)
-    files, emitted = render.render(model, deriv, templates_dir, prefix)
+    files, emitted = render.render(model, deriv, templates_dir, prefix,
+                                   types_header)
     # The parameter kernels are the topology's (--topology N), named
     # after the model: nothing to derive.
-    files.update(render.render_params(model, templates_dir, prefix))
+    files.update(render.render_params(model, templates_dir, prefix,
+                                      types_header))
     if "derivatives" in sets:
         dfiles, demitted = render.render_derivs(model, deriv, templates_dir,
                                                 prefix)
@@ -193,6 +199,12 @@ def main(argv=None, prog="prru_gen.py"):
                         "dynamics linear in the inertial and drive "
                         "parameters, for identification (a model file, "
                         "double precision)")
+    parser.add_argument("--types", metavar="HEADER",
+                        help="include HEADER for the types <prefix>_mechanism, "
+                        "<prefix>_joint_info and <prefix>_params instead of "
+                        "defining them (the runtime library's build: "
+                        "--prefix prru --types prru_descriptor.h, one type "
+                        "for every model)")
     parser.add_argument("--quiet", action="store_true",
                         help="print nothing on success")
     args = parser.parse_args(argv)
@@ -209,6 +221,11 @@ def main(argv=None, prog="prru_gen.py"):
     args.sets = sets
     if args.topology is None and args.structure != "general":
         parser.error("--structure applies to --topology only")
+    if args.types and (args.model is None or args.precision != "double"):
+        parser.error("--types applies to a model file's double kernels only")
+    if args.types and not re.fullmatch(r"[A-Za-z0-9_./-]+\.h", args.types):
+        parser.error("--types: %r is not a header name of letters, digits, "
+                     "_ . / - ending in .h" % args.types)
     if args.topology is not None and args.prefix:
         parser.error("--prefix applies to a model file's kernels only "
                      "(the topology kernels are prru_p<N>_*)")
@@ -235,7 +252,8 @@ def _run(args):
                 files, emitted = generate_float(model, prefix=args.prefix)
             else:
                 files, emitted = generate_model(model, prefix=args.prefix,
-                                                sets=args.sets)
+                                                sets=args.sets,
+                                                types_header=args.types)
         except model_mod.ModelError as exc:
             print("%s: error: %s" % (_NAME, exc), file=sys.stderr)
             return 1

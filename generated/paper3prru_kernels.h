@@ -44,6 +44,13 @@
 #define PAPER3PRRU_NBODY 10
 #define PAPER3PRRU_NJOINT 12
 #define PAPER3PRRU_NLAMBDA 57
+/* Rows of H, Phi, K and the body wrenches (6 per body); the dimensions of
+   null(J_d^T), actuator forces that move nothing (an internal preload),
+   and of null(Q), reaction coordinates no motion or load determines
+   (spec section 12: 0 and 0 with three limbs, 1 and 1 with four). */
+#define PAPER3PRRU_NH 60
+#define PAPER3PRRU_NPRELOAD 0
+#define PAPER3PRRU_NREACTION_NULL 0
 /* Body order of every array: P L1 L2 L3 U1 U2 U3 S1 S2 S3. The model's numbers and layout tables
    are in paper3prru_mechanism.h. */
 #define PAPER3PRRU_ARITH_IK 31 /* arithmetic operations */

@@ -15,8 +15,9 @@
  * topology kernels, prru_p3_kernels.{h,c} (`prru_gen.py --topology 3`,
  * generated once per topology, never per model), named here after this
  * model: paper3prru_param_<kernel> is prru_p3_<kernel> and paper3prru_params
- * is prru_params3. Compile prru_p3_kernels.c beside this file's .c.
- * Their p is paper3prru_param_derived, filled from a paper3prru_params by
+ * is prru_params3.
+ * Compile prru_p3_kernels.c beside this file's .c.
+ * Their p is paper3prru_param_derived, filled from a prru_params3 by
  * paper3prru_param_derive. Same arguments after p, same outputs, same conventions (row-major, body
  * order, NaN on every output where q is unreachable or not finite). At
  * paper3prru_params_model they agree with the constant kernels to rounding.

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "prru.h"
+#include "prru_kernels.h" /* the build's PRRU_NACT */
 
 int main(int argc, char **argv)
 {

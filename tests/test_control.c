@@ -28,6 +28,7 @@
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 
+#include "testbuild.h"
 #include "prru_control.h"
 #include "prru_linearize.h"
 #include "testutil.h"

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "testbuild.h"
 #include "prru_design.h"
 #include "testutil.h"
 

@@ -18,6 +18,7 @@
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
 
+#include "testbuild.h"
 #include "prru_dme.h"
 #include "prru_ref.h"
 #include "testutil.h"

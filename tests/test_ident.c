@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "testbuild.h"
 #include "prru.h"
 #include "prru_control.h"
 #include "prru_ident.h"

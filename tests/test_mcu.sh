@@ -57,7 +57,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   fi
   exit 0
 fi
-for f in prru_f_kernels.c prru_f_kernels.h prru_kernels.c prru_mechanism.c; do
+for f in prru_f_kernels.c prru_f_kernels.h prru_kernels.c; do
   [ -f "$GEN/$f" ] || { echo "FAIL: $GEN/$f missing (build the project first)"; exit 1; }
 done
 [ -x "$CHECK" ] || { echo "FAIL: $CHECK missing (build the project first)"; exit 1; }
@@ -66,6 +66,14 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/prru-mcu.XXXXXX") || exit 1
 trap 'rm -rf "$work"' EXIT
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
+# The descriptor a controller drops in: the generator's own types, sized
+# for the model (the build's prru_mechanism.{h,c} take the library's
+# descriptor type, sized for every model: --types prru_descriptor.h).
+[ -n "${PRRU_MODEL:-}" ] || { echo "FAIL: PRRU_MODEL: the build's model file (ctest sets it)"; exit 1; }
+mkdir "$work/dropin" &&
+  "${PYTHON:-python3}" "$SRC/gen/prru_gen.py" "$PRRU_MODEL" --out "$work/dropin" --prefix prru --quiet ||
+  { echo "FAIL: generating the drop-in descriptor of $PRRU_MODEL"; exit 1; }
+cp "$work/dropin/prru_mechanism.c" "$work/dropin/prru_mechanism.h" "$work/"
 
 COMMON=(-mthumb -mfloat-abi=hard -Os -ffp-contract=off -std=c99 -Wall -Wextra -Werror
         -ffunction-sections -fdata-sections)
@@ -91,10 +99,10 @@ echo "#define MCU_SWEEP $SWEEP" >>"$work/mcu_states.h"
 ok=1
 for s in fw_float startup; do cc_obj "$work/m4_$s.o" M4 "$SRC/tests/mcu/$s.c" || ok=0; done
 cc_obj "$work/m4_kernels.o" M4 "$GEN/prru_f_kernels.c" || ok=0
-cc_obj "$work/m4_mechanism.o" M4 "$GEN/prru_mechanism.c" || ok=0
+cc_obj "$work/m4_mechanism.o" M4 "$work/prru_mechanism.c" || ok=0
 for s in fw_double startup; do cc_obj "$work/m7_$s.o" M7 "$SRC/tests/mcu/$s.c" || ok=0; done
 cc_obj "$work/m7_kernels.o" M7 "$GEN/prru_kernels.c" || ok=0
-cc_obj "$work/m7_mechanism.o" M7 "$GEN/prru_mechanism.c" || ok=0
+cc_obj "$work/m7_mechanism.o" M7 "$work/prru_mechanism.c" || ok=0
 [ $ok = 1 ] || exit 1
 arm-none-eabi-gcc "${M4[@]}" "${LINK[@]}" "$work"/m4_*.o -lm -o "$work/m4.elf" ||
   { echo "FAIL: link the M4 firmware"; exit 1; }

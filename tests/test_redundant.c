@@ -28,6 +28,7 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_sort_vector.h>
 
+#include "testbuild.h"
 #include "prru.h"
 #include "prru_dme.h"
 #include "testsim.h"

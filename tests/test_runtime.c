@@ -23,6 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "testbuild.h"
 #include "prru.h"
 #include "prru_ref.h"
 #include "testsim.h"

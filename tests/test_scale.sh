@@ -24,7 +24,7 @@ PY
   # json.dump of Decimal as strings: turn them back into numbers.
   sed -i -E 's/"(-?[0-9.]+(E[-+]?[0-9]+)?)"/\1/g' "$tmp/model_$s.json"
   python3 "$SRC/gen/prru_gen.py" "$tmp/model_$s.json" --out "$dir" --prefix prru \
-    --derivatives --regressor --quiet || return 1
+    --types prru_descriptor.h --derivatives --regressor --quiet || return 1
   # Only the model's own kernels are compiled: the build's runtime
   # (compiled against headers that differ from these in their comments
   # and operation counts alone, checked: constants that fold at one scale
@@ -42,7 +42,7 @@ PY
     # The build's generated/ after the model's own: prru_param_kernels.h
     # names the topology kernels (prru_p3_kernels.h), which no model's
     # generation writes.
-    cc -I"$dir" -I"$BUILD/generated" -c "$dir/$c.c" -o "$dir/$c.o" || return 1
+    cc -I"$dir" -I"$BUILD/generated" -I"$SRC/runtime/include" -c "$dir/$c.c" -o "$dir/$c.o" || return 1
     objs+=("$dir/$c.o")
   done
   link "$tmp/scale_$s" "${objs[@]}"

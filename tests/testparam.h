@@ -6,14 +6,14 @@
  * four can be live at once) and returns it. Single-threaded. */
 #ifndef PRRU_TESTPARAM_H
 #define PRRU_TESTPARAM_H
-#include "prru_param_kernels.h"
+#include "testbuild.h"
 
 static const prru_param_derived *tp_derived(const prru_params *p)
 {
   static prru_param_derived buf[4];
   static int next;
   prru_param_derived *d = &buf[next++ % 4];
-  prru_param_derive(p, d);
+  prru_params_derive(p, d);
   return d;
 }
 

@@ -27,6 +27,8 @@
 #include <mujoco/mujoco.h>
 
 #include "prru.h"
+#include "prru_kernels.h"
+#include "prru_mechanism.h"
 
 /* Sizes of the MJCF, from the descriptor: per limb five tree DOF (slide,
  * two hinges, the U joint's two hinges) and one platform copy; the copies

@@ -218,12 +218,21 @@ def param_kernel_names():
     return names
 
 
-def render_params(model, templates_dir, prefix=None):
+def _types_include(header, names):
+    """The include that replaces the generated type definitions when they
+    come from the library's public header."""
+    return "#include \"%s\" /* %s: one type for every model */" % (header, names)
+
+
+def render_params(model, templates_dir, prefix=None, types_header=None):
     """{file name: text} for model's runtime-parameter kernels: the
     topology kernels of its number of limbs (generated once per topology,
     prru_pN_kernels.h), under the names <prefix>_param_<kernel> and the
     type <prefix>_params, with <prefix>_params_model, the model's numbers.
-    Nothing is derived: a model's regeneration no longer pays for them."""
+    Nothing is derived: a model's regeneration no longer pays for them.
+    types_header: a header defining <prefix>_params (render's), included
+    instead of the typedef to the topology's type; the caller then converts
+    its parameters to the topology's type before <prefix>_param_derive."""
     prefix = prefix or model.name
     upper = prefix.upper()
     n = len(model.limbs)
@@ -240,6 +249,11 @@ def render_params(model, templates_dir, prefix=None):
                   tprefix=tprefix, ctype=topology_ctype(n), nlimb=n,
                   macros="\n".join(macros), designate=DESIGNATE_MACRO,
                   initializer=_initializer(model))
+    values["params_type"] = (_types_include(types_header, "%s_params" % prefix) if types_header else
+                             "typedef %s %s_params;" % (values["ctype"], prefix))
+    values["params_is"] = ("%s_params (%s's, converted to %s by the caller)"
+                           % (prefix, types_header, values["ctype"]) if types_header else
+                           "%s_params\n * is %s" % (prefix, values["ctype"]))
     files = {}
     for tmpl, out in (("param_kernels.h.in", "%s_param_kernels.h" % prefix),
                       ("param_kernels.c.in", "%s_param_kernels.c" % prefix)):
@@ -476,9 +490,12 @@ def _patterns(kernel_list, upper, prefix):
     return out
 
 
-def render(model, deriv, templates_dir, prefix=None):
+def render(model, deriv, templates_dir, prefix=None, types_header=None):
     """{file name: text} for the kernels and mechanism descriptor of model,
-    and the emitted kernels. prefix: the C prefix (default: model name)."""
+    and the emitted kernels. prefix: the C prefix (default: model name).
+    types_header: a header that defines <prefix>_joint_info and
+    <prefix>_mechanism (the runtime library's prru_descriptor.h, one
+    type for every model), included instead of defining them here."""
     prefix = prefix or model.name
     upper = prefix.upper()
     mech = deriv.mech
@@ -493,6 +510,15 @@ def render(model, deriv, templates_dir, prefix=None):
               "#define %s_NBODY %d" % (upper, len(mech.bodies)),
               "#define %s_NJOINT %d" % (upper, len(mech.joints)),
               "#define %s_NLAMBDA %d" % (upper, len(labels)),
+              "/* Rows of H, Phi, K and the body wrenches (6 per body); the "
+              "dimensions of\n   null(J_d^T), actuator forces that move "
+              "nothing (an internal preload),\n   and of null(Q), reaction "
+              "coordinates no motion or load determines\n   (spec section "
+              "12: 0 and 0 with three limbs, 1 and 1 with four). */",
+              "#define %s_NH %d" % (upper, 6 * len(mech.bodies)),
+              "#define %s_NPRELOAD %d" % (upper, len(mech.actuators) - 3),
+              "#define %s_NREACTION_NULL %d"
+              % (upper, len(labels) - (6 * len(mech.bodies) - 3)),
               "/* Body order of every array: %s. The model's numbers and "
               "layout tables\n   are in %s_mechanism.h. */"
               % (c_comment(" ".join(b.name for b in mech.bodies)), prefix)]
@@ -503,6 +529,9 @@ def render(model, deriv, templates_dir, prefix=None):
                   declarations=decls, functions=bodies,
                   designate=DESIGNATE_MACRO,
                   descriptor=_descriptor(model, mech, prefix, labels))
+    values["types"] = (_types_include(types_header, "%s_joint_info, %s_mechanism" % (prefix, prefix))
+                       if types_header else
+                       _template(templates_dir, "mechanism_types.h.in").substitute(values))
     files = {}
     for tmpl, out in (("kernels.h.in", "%s_kernels.h" % prefix),
                       ("kernels.c.in", "%s_kernels.c" % prefix),

@@ -210,6 +210,35 @@ class CommandLine(unittest.TestCase):
                 self.assertIn("double kernels only", r.stderr)
                 self.assertFalse(os.path.exists(os.path.join(d, "out")))
 
+    def test_types_header_replaces_the_type_definitions_only(self):
+        # --types (the library's build): the descriptor and parameter
+        # types come from the named header; every other byte is the same.
+        outs = {}
+        for flags in ((), ("--types", "prru_descriptor.h")):
+            with tempfile.TemporaryDirectory() as d:
+                r = run_gen(MODEL, "--out", d, "--quiet", "--prefix", "prru", *flags)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                outs[flags] = read_dir(d)
+        plain, typed = outs[()], outs[("--types", "prru_descriptor.h")]
+        self.assertEqual(sorted(plain), sorted(typed))
+        changed = sorted(n for n in plain if plain[n] != typed[n])
+        self.assertEqual(changed, ["prru_mechanism.h", "prru_param_kernels.h"])
+        mech = typed["prru_mechanism.h"].decode()
+        self.assertIn('#include "prru_descriptor.h"', mech)
+        self.assertNotIn("typedef struct", mech)
+        self.assertIn("typedef struct", plain["prru_mechanism.h"].decode())
+        params = typed["prru_param_kernels.h"].decode()
+        self.assertIn('#include "prru_descriptor.h"', params)
+        self.assertNotIn("typedef prru_params3 prru_params;", params)
+        self.assertIn("typedef prru_params3 prru_params;", plain["prru_param_kernels.h"].decode())
+        # A header name lands in an #include: refused unless it is plain.
+        for bad in ('a".h', "x.c", "a b.h", "a\nb.h"):
+            with tempfile.TemporaryDirectory() as d:
+                r = run_gen(MODEL, "--out", os.path.join(d, "out"), "--types", bad)
+                self.assertEqual(r.returncode, 2, (bad, r.stderr))
+                self.assertIn("--types", r.stderr)
+                self.assertFalse(os.path.exists(os.path.join(d, "out")))
+
     def test_help_and_summary(self):
         r = run_gen("--help")
         self.assertEqual(r.returncode, 0)

@@ -132,7 +132,7 @@ class FailedWrites(unittest.TestCase):
         err = io.StringIO()
         with full_disk(), contextlib.redirect_stderr(err), \
                 mock.patch.object(prru_gen, "generate_model",
-                                  lambda model, prefix, sets: (self.files, [])):
+                                  lambda model, prefix, sets, types_header: (self.files, [])):
             rc = prru_gen.main([PAPER, "--out", out, "--quiet"])
         self.assertEqual(rc, 1)
         self.assertEqual(err.getvalue(), "prru_gen: error: %s: cannot write: "

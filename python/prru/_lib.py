@@ -1,20 +1,22 @@
 """Finding and loading libprru.so, and the ctypes mirror of its headers.
 
-The C structs (runtime/include/prru_dynamics.h, prru_sim.h, prru_dme.h, the generated
-prru_mechanism.h) have arrays sized by the model: PRRU_NACT actuators,
-PRRU_NBODY bodies, PRRU_NLAMBDA reaction coordinates. Their sizes are read
-from the library's own descriptor prru_mech, whose leading fields (four
-strings, then seven ints) do not depend on them, and every struct is then
-laid out for that library. ctypes applies the C ABI's alignment rules, so
-mirroring a struct field by field reproduces the compiler's layout.
+Every array of a public C struct (runtime/include/prru_descriptor.h,
+prru_dynamics.h, prru_sim.h, ...) is sized by the maxima of prru_sizes.h
+(MAX_ACT actuators, MAX_BODY bodies, MAX_LAMBDA reaction coordinates), so
+the layout is the same for every model and every build; a model's own
+counts are its descriptor's (nact, nbody, nlambda), and the binding reads
+the first that many entries of each array. ctypes applies the C ABI's
+alignment rules, so mirroring a struct field by field reproduces the
+compiler's layout.
 
-There is no library call that returns sizeof a struct, so a header change
-the mirror does not follow would go unnoticed by the C compiler; Library
-therefore checks the layout when it loads (_self_check: fields the library
-fills must hold what independent calls compute, a pointer the library
-stores must point where the mirror puts its target, and guard bytes after
-each struct must stay untouched), and the Python tests compare the mirror
-with the struct definitions in prru.h field by field.
+A header change the mirror does not follow would go unnoticed by the C
+compiler; Library therefore checks the layout when it loads (_self_check:
+every mirror's size against the library's own sizeof, prru_struct_size;
+fields the library fills must hold what independent calls compute, a
+pointer the library stores must point where the mirror puts its target,
+and guard bytes after each struct must stay untouched), and the Python
+tests compare the mirror with the struct definitions in the headers field
+by field.
 """
 
 import ctypes
@@ -175,29 +177,30 @@ def guard_intact(g):
 
 
 class Types:
-    """The struct types of one library, sized from its descriptor."""
+    """The struct types of the library (every array of the maxima, the same
+    for every model) and the counts of its built-in model's descriptor."""
 
     def __init__(self, nact, nbody, nlimb, nlambda, njoint):
         nh = 6 * nbody
         d = ctypes.c_double
         self.nact, self.nh, self.nlambda = nact, nh, nlambda
         self.Mechanism = type("prru_mechanism", (ctypes.Structure,), {"_fields_": _MECH_HEAD + [
-            ("body_names", _arr(ctypes.c_char_p, nbody)), ("body_limb", _arr(ctypes.c_int, nbody)),
-            ("platform", ctypes.c_int), ("lower", _arr(ctypes.c_int, nlimb)),
-            ("upper", _arr(ctypes.c_int, nlimb)), ("slider", _arr(ctypes.c_int, nlimb)),
-            ("gravity", _arr(d, 3)), ("mass", _arr(d, nbody)), ("total_mass", d),
-            ("com", _arr(_arr(d, 3), nbody)), ("inertia", _arr(_arr(d, 9), nbody)),
-            ("inertia_inv", _arr(_arr(d, 9), nbody)),
-            ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
-            ("a", _arr(d, nlimb)),
-            ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
-            ("coulomb_velocity", d), ("joint", _arr(_JointInfo, njoint)),
-            ("lambda_labels", _arr(ctypes.c_char_p, nlambda)),
-            ("lead", _arr(d, nact)), ("gear", _arr(d, nact)), ("torque_constant", _arr(d, nact)),
-            ("force_max", _arr(d, nact)), ("speed_max", _arr(d, nact)),
-            ("d_min", _arr(d, nact)), ("d_max", _arr(d, nact)),
-            ("drive_keys", ctypes.c_uint), ("rotor_inertia", _arr(d, nact)),
-            ("torque_max", _arr(d, nact)), ("motor_speed_max", _arr(d, nact))]})
+            ("body_names", _arr(ctypes.c_char_p, MAX_BODY)), ("body_limb", _arr(ctypes.c_int, MAX_BODY)),
+            ("platform", ctypes.c_int), ("lower", _arr(ctypes.c_int, MAX_LIMB)),
+            ("upper", _arr(ctypes.c_int, MAX_LIMB)), ("slider", _arr(ctypes.c_int, MAX_LIMB)),
+            ("gravity", _arr(d, 3)), ("mass", _arr(d, MAX_BODY)), ("total_mass", d),
+            ("com", _arr(_arr(d, 3), MAX_BODY)), ("inertia", _arr(_arr(d, 9), MAX_BODY)),
+            ("inertia_inv", _arr(_arr(d, 9), MAX_BODY)),
+            ("b", _arr(d, MAX_LIMB)), ("l1", _arr(d, MAX_LIMB)), ("l2", _arr(d, MAX_LIMB)),
+            ("a", _arr(d, MAX_LIMB)),
+            ("armature", _arr(d, MA)), ("damping", _arr(d, MA)), ("coulomb", _arr(d, MA)),
+            ("coulomb_velocity", d), ("joint", _arr(_JointInfo, MAX_JOINT)),
+            ("lambda_labels", _arr(ctypes.c_char_p, ML)),
+            ("lead", _arr(d, MA)), ("gear", _arr(d, MA)), ("torque_constant", _arr(d, MA)),
+            ("force_max", _arr(d, MA)), ("speed_max", _arr(d, MA)),
+            ("d_min", _arr(d, MA)), ("d_max", _arr(d, MA)),
+            ("drive_keys", ctypes.c_uint), ("rotor_inertia", _arr(d, MA)),
+            ("torque_max", _arr(d, MA)), ("motor_speed_max", _arr(d, MA))]})
         self.Loads = type("prru_loads", (ctypes.Structure,), {"_fields_": [
             ("fd", _arr(d, MA)), ("fp", _arr(d, 3)), ("mp", _arr(d, 3))]})
         self.Data = type("prru_data", (ctypes.Structure,), {"_fields_": [
@@ -245,10 +248,10 @@ class Types:
             ("force_max", _arr(d, MA)), ("speed_max", _arr(d, MA)),
             ("d_min", _arr(d, MA)), ("d_max", _arr(d, MA))]})
         self.Params = type("prru_params", (ctypes.Structure,), {"_fields_": [
-            ("b", _arr(d, nlimb)), ("l1", _arr(d, nlimb)), ("l2", _arr(d, nlimb)),
-            ("a", _arr(d, nlimb)), ("gravity", _arr(d, 3)), ("mass", _arr(d, nbody)),
-            ("com", _arr(_arr(d, 3), nbody)), ("inertia", _arr(_arr(d, 6), nbody)),
-            ("armature", _arr(d, nact)), ("damping", _arr(d, nact)), ("coulomb", _arr(d, nact)),
+            ("b", _arr(d, MAX_LIMB)), ("l1", _arr(d, MAX_LIMB)), ("l2", _arr(d, MAX_LIMB)),
+            ("a", _arr(d, MAX_LIMB)), ("gravity", _arr(d, 3)), ("mass", _arr(d, MAX_BODY)),
+            ("com", _arr(_arr(d, 3), MAX_BODY)), ("inertia", _arr(_arr(d, 6), MAX_BODY)),
+            ("armature", _arr(d, MA)), ("damping", _arr(d, MA)), ("coulomb", _arr(d, MA)),
             ("coulomb_velocity", d)]})
         self.TrackSample = type("prru_track_sample", (ctypes.Structure,), {"_fields_": [
             ("t", d), ("q_ref", _arr(d, 3)), ("qd_ref", _arr(d, 3)), ("qdd_ref", _arr(d, 3)),

@@ -1529,16 +1529,13 @@ class TestLayout(unittest.TestCase):
                 ("runtime/include/prru_dme.h", "prru_map_grid", _lib._MapGrid),
                 ("runtime/include/prru_dme.h", "prru_map_summary", _lib._MapSummary),
                 ("runtime/include/prru_dme.h", "prru_map_options", _lib._MapOptions),
-                # The committed descriptor carries the paper model's name;
-                # the build's (prru_*) has the same layout.
-                ("generated/paper3prru_mechanism.h", "paper3prru_joint_info", _lib._JointInfo),
-                ("generated/paper3prru_mechanism.h", "paper3prru_mechanism", t.Mechanism),
+                ("runtime/include/prru_descriptor.h", "prru_joint_info", _lib._JointInfo),
+                ("runtime/include/prru_descriptor.h", "prru_mechanism", t.Mechanism),
                 ("runtime/include/prru_dynamics.h", "prru_limits", t.Limits),
                 ("runtime/include/prru_traj.h", "prru_quintic", _lib._Quintic),
                 ("runtime/include/prru_traj.h", "prru_topp", _lib._Topp),
                 ("runtime/include/prru_traj.h", "prru_path_side", _lib._PathSide),
-                # prru_params is the topology kernels' struct of the model's limbs.
-                ("generated/prru_p%d_kernels.h" % MODEL.nlimb, "prru_params%d" % MODEL.nlimb, t.Params),
+                ("runtime/include/prru_descriptor.h", "prru_params", t.Params),
                 ("runtime/include/prru_control.h", "prru_track_sample", t.TrackSample),
                 ("runtime/include/prru_control.h", "prru_track_options", t.TrackOptions),
                 ("runtime/include/prru_control.h", "prru_track_summary", t.TrackSummary),
@@ -1591,8 +1588,9 @@ class TestLayout(unittest.TestCase):
         model: the mirror built for any descriptor sizes is the same."""
         a = _lib.Types(3, 10, 3, 57, 12)
         b = _lib.Types(4, 13, 4, 76, 16)
-        for name in ("Loads", "Data", "Sample", "Limits", "Dme", "Linearization", "TrackSample",
-                     "TrackSummary", "Base", "IdentResult", "ExciteOptions"):
+        for name in ("Mechanism", "Params", "Loads", "Data", "Sample", "Limits", "Dme", "Linearization",
+                     "TrackSample", "TrackOptions", "TrackSummary", "Base", "IdentResult", "ExciteOptions",
+                     "DesignVar", "DesignResult"):
             self.assertEqual(ctypes.sizeof(getattr(a, name)), ctypes.sizeof(getattr(b, name)), name)
 
 

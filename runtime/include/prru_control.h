@@ -36,7 +36,6 @@
 #include <signal.h>
 
 #include "prru.h"
-#include "prru_param_kernels.h"
 #include "prru_traj.h"
 
 #ifdef __cplusplus
@@ -185,8 +184,8 @@ PRRU_API int prru_track_check_reference(const prru_model *m, const prru_quintic 
  * qdd_ref); sat[i] set where clipped. prru_inverse_dynamics's statuses. */
 PRRU_API int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
                                   const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
-                                  const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
-                                  double fd[PRRU_NACT], int sat[PRRU_NACT]);
+                                  const double q[3], const double qd[3], double fd_cmd[],
+                                  double fd[], int sat[]);
 
 /* Time-varying discrete LQR tracking (controller PRRU_TRACK_LQR).
  *
@@ -210,8 +209,8 @@ typedef struct {
   long n;              /* ticks */
   double period;       /* s */
   double q[6], r[PRRU_MAX_ACT]; /* the weights used */
-  double *K;           /* n x PRRU_NACT x 6: K_k at K + 6 PRRU_NACT k, row-major */
-  double *u_ff;        /* n x PRRU_NACT: u_ff,k at u_ff + PRRU_NACT k */
+  double *K;           /* n x nact x 6: K_k at K + 6 nact k, row-major */
+  double *u_ff;        /* n x nact: u_ff,k at u_ff + nact k */
   double *x_ref;       /* n x 6 */
   double P0[36];       /* P_0, row-major */
 } prru_lqr_schedule;
@@ -234,7 +233,7 @@ typedef struct {
  * follow (PRRU_ESINGULAR where G G^T is singular); PRRU_EINPUT for
  * period <= 0. */
 PRRU_API int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period,
-                                      double q[6], double r[PRRU_NACT], char *msg, int msglen);
+                                      double q[6], double r[], char *msg, int msglen);
 
 /* The schedule of the run prru_track makes with o (o->controller is not
  * read; o->control_period > 0 and the weights are), into *s (allocated
@@ -255,8 +254,8 @@ PRRU_API void prru_lqr_schedule_free(prru_lqr_schedule *s);
  * set where clipped. PRRU_EINPUT where fd_cmd is not finite (k out of
  * range, x not finite or overflowing). */
 PRRU_API int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_options *o,
-                              const double x[6], double fd_cmd[PRRU_NACT], double fd[PRRU_NACT],
-                              int sat[PRRU_NACT]);
+                              const double x[6], double fd_cmd[], double fd[],
+                              int sat[]);
 
 /* The plant's accelerations under fd (no platform loads): M qdd = b from
  * prru_param_eom with o->plant, solved by Cholesky. PRRU_EUNREACHABLE
@@ -264,7 +263,7 @@ PRRU_API int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_tra
  * positive definite. Derives p (prru_param_derive) at every call, about
  * as long as the solve: prru_track derives its plant once per run. */
 PRRU_API int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
-                              const double fd[PRRU_NACT], double qdd[3]);
+                              const double fd[], double qdd[3]);
 
 /* Model mismatch: multiplies one group of *p's parameters by factor
  * (finite, > 0): "mass" every body's mass and inertia tensor (the same

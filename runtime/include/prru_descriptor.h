@@ -68,4 +68,22 @@ typedef struct {
   double rotor_inertia[PRRU_MAX_ACT], torque_max[PRRU_MAX_ACT], motor_speed_max[PRRU_MAX_ACT];
 } prru_mechanism;
 
+/* A design: every number of a model that the parameter kernels read
+ * (prru_model_params gives a model's; the design optimiser, the tracking
+ * plant and the identification write them). The layout of the 4-limb
+ * topology kernels' prru_params4, whose arrays are the maxima; a model
+ * uses the first nlimb, nbody and nact entries. */
+typedef struct {
+  /* geometry per limb, m: rail offset b, upper link l1, lower link l2,
+     U-joint offset a (limbs 1 and 2 only; the others' are ignored) */
+  double b[PRRU_MAX_LIMB], l1[PRRU_MAX_LIMB], l2[PRRU_MAX_LIMB], a[PRRU_MAX_LIMB];
+  double gravity[3]; /* m/s^2 in {S} */
+  /* per body, in body order: mass (kg), centre of mass in the body frame
+     (m), inertia Ixx Iyy Izz Ixy Ixz Iyz about it in body axes (kg m^2) */
+  double mass[PRRU_MAX_BODY], com[PRRU_MAX_BODY][3], inertia[PRRU_MAX_BODY][6];
+  /* drives per actuator: armature (kg), viscous damping (N s/m), Coulomb
+     force (N); the Coulomb smoothing velocity v_s (m/s, > 0) */
+  double armature[PRRU_MAX_ACT], damping[PRRU_MAX_ACT], coulomb[PRRU_MAX_ACT], coulomb_velocity;
+} prru_params;
+
 #endif /* PRRU_DESCRIPTOR_H */

@@ -46,7 +46,6 @@
 #include <stddef.h>
 
 #include "prru_dme.h"
-#include "prru_param_kernels.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -12,7 +12,7 @@
  * here is then the paper's section 5) and the pseudo-inverse for the
  * redundant 4-PRRU (spec section 12): J_d is 4x3, Mt 4x4 (the least-norm
  * drive forces J_d^+T M qdd, F_d = Mt dd'' for dd'' in range(J_d)), JtR
- * and JtT 3x4. N = PRRU_NACT below.
+ * and JtT 3x4. N = nact below.
  * JtR has rank 2: the platform turns only about e1 and v (omega_P =
  * q1' e1 + q2' v, no parasitic motion), so its range is the plane
  * span{e1, v}. JtT has rank 1: O' moves only along e3.
@@ -87,7 +87,7 @@ typedef struct {
   double sigma_T;         /* the non-zero singular value of Mt JtT^+ (N s^2/m) */
   double half_length_T;   /* 1 / sigma_T: half-length of the translational segment (m/s^2 per N) */
   double dir_T[3];        /* its unit direction in {S} (e3) */
-  /* Row-major, as defined above: Mt N x N, JtR and JtT 3 x N (N = PRRU_NACT). */
+  /* Row-major, as defined above: Mt N x N, JtR and JtT 3 x N (N = nact). */
   double Mt[PRRU_MAX_ACT * PRRU_MAX_ACT], JtR[3 * PRRU_MAX_ACT], JtT[3 * PRRU_MAX_ACT];
 } prru_dme;
 
@@ -108,15 +108,15 @@ PRRU_API const char *prru_dme_status_name(int status);
  * sign of det J_d (prru_jd_det_sign), or 0 when it cannot be told (a
  * slider unreachable, det J_d = 0, more than three actuators); with home
  * 0 no pose is in "the other" mode. */
-PRRU_API int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3]);
+PRRU_API int prru_assembly_mode(const double d[], const double Jd[]);
 /* 1 when home != 0 and det J_d's sign is not home (a pose beyond the
  * singular locus, or on it), else 0. */
-PRRU_API int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home);
+PRRU_API int prru_jd_other_mode(const double Jd[], int home);
 /* A reachable pose's status from its regularity status (prru_jd_regular):
  * PRRU_DME_OTHER_MODE when it is PRRU_OK but prru_jd_other_mode, else
  * regular_status. The one classification of the map and the design
  * optimiser. */
-PRRU_API int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home);
+PRRU_API int prru_mode_status(int regular_status, const double Jd[], int home);
 
 /* Fills out at q (uses d->d, d->Jd, d->M as workspace) and returns
  * out->status. At a non-OK status every double of out except jd_rcond is
@@ -132,7 +132,7 @@ PRRU_API int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3],
  * operations in the same order, its branches as selects), so w_R has one
  * definition. Returns out->status (PRRU_ESINGULAR when a result is not
  * finite); out->jd_rcond is left as it is. */
-PRRU_API int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
+PRRU_API int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
                            prru_dme *out);
 
 /* ---- Maps over a rectangle of (q1, q2) at fixed q3 ---- */

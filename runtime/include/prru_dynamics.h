@@ -19,7 +19,12 @@
  * (gsl_set_error_handler_off); the runtime never changes it per call.
  *
  * Every function returns a prru_status; PRRU_OK is 0. Arrays are row-major,
- * body order prru_mech.body_names, lambda order prru_mech.lambda_labels. */
+ * body order prru_mech.body_names, lambda order prru_mech.lambda_labels.
+ * An array argument declared [] has the model's size (its descriptor
+ * m->mech): nact values per actuator (d, fd, dd), J_d nact x 3 and its
+ * inverse 3 x nact, nlambda reaction coordinates, rotations 9 nbody and
+ * positions 3 nbody; a struct's arrays have room for the largest model
+ * (prru_sizes.h). */
 #ifndef PRRU_DYNAMICS_H
 #define PRRU_DYNAMICS_H
 
@@ -27,9 +32,7 @@
 #include <signal.h>
 #include <stddef.h>
 
-#include "prru_kernels.h"
-#include "prru_sizes.h"
-#include "prru_mechanism.h"
+#include "prru_descriptor.h"
 
 /* The public API: libprru.so is built with hidden visibility, so that
  * only what the headers declare with PRRU_API (and the generated
@@ -40,17 +43,6 @@
 #else
 #define PRRU_API
 #endif
-
-/* Rows of H, Phi, K and the body wrenches: 3 rotational and 3 translational
- * per body (see prru_mechanism.h for the stacking). */
-#define PRRU_NH (6 * PRRU_NBODY)
-/* Redundancy (spec section 12). PRRU_NPRELOAD = PRRU_NACT - 3 is the
- * dimension of null(J_d^T): actuator forces along it move nothing (an
- * internal preload). PRRU_NREACTION_NULL = PRRU_NLAMBDA - (PRRU_NH - 3) is
- * the dimension of null(Q): reaction coordinates that no motion or load
- * determines. Both are 0 for the 3-PRRU and 1 for the 4-PRRU. */
-#define PRRU_NPRELOAD (PRRU_NACT - 3)
-#define PRRU_NREACTION_NULL (PRRU_NLAMBDA - PRRU_NH + 3)
 
 #ifdef __cplusplus
 extern "C" {
@@ -86,65 +78,65 @@ PRRU_API size_t prru_struct_size(const char *name);
  * reads the numbers of a model file loaded at run time (prru_model_load).
  * Each entry has the arguments and outputs of the prru_kernels.h kernel of
  * its name after p, the table's parameters (kernel_params of the model;
- * ignored by the specialised set); arrays as sized by this build's PRRU_N*
- * macros. The unseen_* entries are the generated finiteness witnesses
+ * ignored by the specialised set); arrays of the model's sizes (m->mech:
+ * nact, nbody, nlambda). The unseen_* entries are the generated finiteness witnesses
  * (PRRU_UNSEEN_FINITE_*) of the same set. */
 typedef struct prru_kernel_table {
   const char *path; /* "specialised" or "parameter" */
-  void (*ik)(const void *p, const double q[3], double d[PRRU_NACT]);
-  void (*jd)(const void *p, const double q[3], double Jd[PRRU_NACT * 3]);
-  void (*ik_jd)(const void *p, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3]);
+  void (*ik)(const void *p, const double q[3], double d[]);
+  void (*jd)(const void *p, const double q[3], double Jd[]);
+  void (*ik_jd)(const void *p, const double q[3], double d[], double Jd[]);
   void (*mass)(const void *p, const double q[3], double M[9]);
   void (*dynamics)(const void *p, const double q[3], const double qd[3], double M[9], double h[3],
                    double G[3]);
-  void (*eom)(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+  void (*eom)(const void *p, const double q[3], const double qd[3], const double fd[],
               const double fp[3], const double mp[3], double M[9], double b[3]);
-  void (*eom_solve)(const void *p, const double q[3], const double qd[3], const double fd[PRRU_NACT],
+  void (*eom_solve)(const void *p, const double q[3], const double qd[3], const double fd[],
                     const double fp[3], const double mp[3], double M[9], double b[3], double qdd[3],
                     double minors[3]);
-  int (*unseen_finite_eom_solve)(const double q[3], const double qd[3], const double fd[PRRU_NACT],
+  int (*unseen_finite_eom_solve)(const double q[3], const double qd[3], const double fd[],
                                  const double fp[3], const double mp[3]);
   /* Three actuators: d, J_d, J_d^-1 and fd = J_d^-T tau (out, 3 values);
    * four: d, J_d and tau (out, 3 values), Jdinv unused. */
   void (*inverse_terms)(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                        const double fp[3], const double mp[3], double d[PRRU_NACT],
-                        double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3]);
+                        const double fp[3], const double mp[3], double d[],
+                        double Jd[], double Jdinv[], double out[3]);
   int (*unseen_finite_inverse_terms)(const double q[3], const double qd[3], const double qdd[3],
                                      const double fp[3], const double mp[3]);
   /* z (the null vector of Q) only with four actuators; NULL otherwise. */
   void (*joint_reactions)(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                          const double fd[PRRU_NACT], const double fp[3], const double mp[3],
-                          double lambda[PRRU_NLAMBDA], double z[PRRU_NLAMBDA]);
+                          const double fd[], const double fp[3], const double mp[3],
+                          double lambda[], double z[]);
   void (*platform_jacobian)(const void *p, const double q[3], double JP[18]);
-  void (*poses)(const void *p, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY]);
+  void (*poses)(const void *p, const double q[3], double R[], double pos[]);
   void (*energy)(const void *p, const double q[3], const double qd[3], double E[2]);
-  void (*actuator_rates)(const void *p, const double q[3], const double qd[3], double dd[PRRU_NACT],
-                         double ddb[PRRU_NACT]);
+  void (*actuator_rates)(const void *p, const double q[3], const double qd[3], double dd[],
+                         double ddb[]);
   void (*passive)(const void *p, const double q[3], const double qd[3], double Qp[3]);
   void (*batch_dme_terms)(const void *p, int n, const double *q, double *d, double *Jd, double *M,
                           double *JP);
-  /* The identification regressor Y (3 x PRRU_NREG, prru_regressor.h) at
-   * the Coulomb smoothing velocity vs. */
+  /* The identification regressor Y (3 x nreg, nreg = 10 nbody + 3 nact:
+   * prru_regressor.h) at the Coulomb smoothing velocity vs. */
   void (*regressor)(const void *p, const double q[3], const double qd[3], const double qdd[3], double vs,
                     double *Y);
   /* The closed-form derivatives (prru_linearize.h): eom_solve's outputs,
-   * then dqdd/dq, dqdd/dqd (3x3), dqdd/dfd (3 x PRRU_NACT), dqdd/dfp,
+   * then dqdd/dq, dqdd/dqd (3x3), dqdd/dfd (3 x nact), dqdd/dfp,
    * dqdd/dmp (3x3), row-major, row i = qdd_i. */
   void (*eom_solve_derivs)(const void *p, const double q[3], const double qd[3],
-                           const double fd[PRRU_NACT], const double fp[3], const double mp[3],
+                           const double fd[], const double fp[3], const double mp[3],
                            double M[9], double b[3], double qdd[3], double minors[3], double Dq[9],
-                           double Dqd[9], double Dfd[3 * PRRU_NACT], double Dfp[9], double Dmp[9]);
+                           double Dqd[9], double Dfd[], double Dfp[9], double Dmp[9]);
   int (*unseen_finite_eom_solve_derivs)(const double q[3], const double qd[3],
-                                        const double fd[PRRU_NACT], const double fp[3],
+                                        const double fd[], const double fp[3],
                                         const double mp[3]);
   /* inverse_terms's outputs, then three 3x3 blocks, row-major, row i =
    * out_i: with three actuators dfd/dq, dfd/dqd, dfd/dqdd (DJd unused);
    * with four dtau/dq, dtau/dqd, dtau/dqdd (= M) and DJd = dJ_d/dq, block
-   * k (PRRU_NACT x 3, row-major) dJ_d/dq_k, Jdinv unused. */
+   * k (nact x 3, row-major) dJ_d/dq_k, Jdinv unused. */
   void (*inverse_derivs)(const void *p, const double q[3], const double qd[3], const double qdd[3],
-                         const double fp[3], const double mp[3], double d[PRRU_NACT],
-                         double Jd[PRRU_NACT * 3], double Jdinv[3 * PRRU_NACT], double out[3],
-                         double Dq[9], double Dqd[9], double Dqdd[9], double DJd[9 * PRRU_NACT]);
+                         const double fp[3], const double mp[3], double d[],
+                         double Jd[], double Jdinv[], double out[3],
+                         double Dq[9], double Dqd[9], double Dqdd[9], double DJd[]);
   int (*unseen_finite_inverse_derivs)(const double q[3], const double qd[3], const double qdd[3],
                                       const double fp[3], const double mp[3]);
   /* eom_solve_derivs batched (prru_batch_eom_solve_derivs in
@@ -198,9 +190,9 @@ PRRU_API void prru_model_default(prru_model *m);
  * robot, so a whitespace or comment edit keeps the fast path), else the
  * parameter set of the build's topology. PRRU_OK; PRRU_EIO or PRRU_EPARSE
  * with msg "path: key: reason"; PRRU_EINPUT with msg when the file has
- * another number of limbs than this build (whose data sizes are fixed at
- * compile time); PRRU_ENOMEM. m is untouched on failure: nothing is
- * computed with a partly loaded model. Allocates: prru_model_free (m must
+ * another number of limbs than this build's model (the runtime computes
+ * with its build's number of limbs); PRRU_ENOMEM. m is untouched on
+ * failure: nothing is computed with a partly loaded model. Allocates: prru_model_free (m must
  * not hold a loaded model already: free it first). */
 PRRU_API int prru_model_load(prru_model *m, const char *path, char *msg, int msglen);
 /* Switches a loaded model to the parameter kernels even where its numbers
@@ -230,24 +222,24 @@ PRRU_API int prru_model_is_built(const prru_model *m, int only_geometry);
 /* m's kernels of the same names (prru_kernel_table), for callers that
  * need a kernel's raw outputs (NaN where q is unreachable, no status):
  * the CLI and the Python binding. */
-PRRU_API void prru_model_ik_jd(const prru_model *m, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3]);
+PRRU_API void prru_model_ik_jd(const prru_model *m, const double q[3], double d[], double Jd[]);
 PRRU_API void prru_model_dynamics(const prru_model *m, const double q[3], const double qd[3], double M[9], double h[3],
                                   double G[3]);
 PRRU_API void prru_model_passive(const prru_model *m, const double q[3], const double qd[3], double Qp[3]);
 PRRU_API void prru_model_platform_jacobian(const prru_model *m, const double q[3], double JP[18]);
-PRRU_API void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY]);
+PRRU_API void prru_model_poses(const prru_model *m, const double q[3], double R[], double pos[]);
 /* From the poses (R, pos) of prru_model_poses, which place each body's
  * centre of mass: the origin of body b's frame, pos_b - R_b com_b (they
  * differ for a model with offset centres), and the joint centres of limb
  * i (0-based): A_i, the slider's frame origin, then B_i and C_i from the
  * link frames' origins, which are the links' midpoints (docs/model.md
  * section 4). What drawings and animations place their segments on. */
-PRRU_API void prru_body_origin(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY],
+PRRU_API void prru_body_origin(const prru_model *m, const double R[], const double pos[],
                                int b, double o[3]);
-PRRU_API void prru_limb_joints(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY],
+PRRU_API void prru_limb_joints(const prru_model *m, const double R[], const double pos[],
                                int i, double A[3], double B[3], double C[3]);
-PRRU_API void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
-                                        double ddb[PRRU_NACT]);
+PRRU_API void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[],
+                                        double ddb[]);
 /* "model NAME (FILE, sha256 HEX, KERNELS kernels)": the identity every
  * output states (KERNELS "specialised" or "parameter"); buf holds at least
  * len bytes, truncated with a NUL. FILE as given at load (any bytes; a
@@ -286,7 +278,7 @@ PRRU_API void prru_limits_none(prru_limits *l);
 PRRU_API void prru_model_limits(const prru_model *m, prru_limits *out);
 /* Motor radians per metre of slider i's travel, 2 pi gear_i / lead_i
  * (rad/m; the reflected armature of a rotor inertia J_r is J_r times its
- * square), NaN without a lead or for i outside 0..PRRU_NACT-1. */
+ * square), NaN without a lead or for i outside 0..nact-1. */
 PRRU_API double prru_model_drive_ratio(const prru_model *m, int i);
 /* Whether every actuator has a screw lead (the file's actuators.lead):
  * only then do rail quantities convert to the motor. */
@@ -296,8 +288,8 @@ PRRU_API int prru_model_has_lead(const prru_model *m);
  * tau_i / k_t,i (A; NaN for an actuator without torque_constant). tau
  * may be NULL. PRRU_EINPUT (outputs untouched) when an actuator has no
  * lead (prru_model_has_lead); else PRRU_OK. */
-PRRU_API int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
-                                    double current[PRRU_NACT]);
+PRRU_API int prru_model_motor_units(const prru_model *m, const double f[], double tau[],
+                                    double current[]);
 /* A run's overrides of the model's limits, as given on a command line
  * (--no-limits, --force-max, --speed-max, --stroke); NULL text: not given. */
 typedef struct {
@@ -339,7 +331,7 @@ typedef struct {
   double qdd[3];
   double r[PRRU_MAX_LAMBDA];         /* the last prru_reactions' lambda */
   /* The unit null vector z of Q at the last prru_reactions (see
-   * prru_reaction_null); all 0 when PRRU_NREACTION_NULL = 0. */
+   * prru_reaction_null); all 0 with three limbs (nlambda - 6 nbody + 3 = 0: no such z). */
   double lambda_null[PRRU_MAX_LAMBDA];
 } prru_data;
 
@@ -351,11 +343,11 @@ PRRU_API int prru_check_reachable(const prru_model *m, prru_data *d, const doubl
  * none does (NaN d_i: none; unreachability is tested apart). Every
  * reachability test of the library applies it: prru_check_reachable,
  * prru_check_regular, the dynamics, prru_simulate, the maps. */
-PRRU_API int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT]);
+PRRU_API int prru_stroke_actuator(const prru_model *m, const double d[]);
 /* At a q whose sliders are at d: PRRU_ESTROKE and msg "slider I at d = X m
  * is outside its stroke [D_MIN, D_MAX] m" (I 1-based), else PRRU_OK and
  * msg "". */
-PRRU_API int prru_stroke_why(const prru_model *m, const double d[PRRU_NACT], char *msg, int msglen);
+PRRU_API int prru_stroke_why(const prru_model *m, const double d[], char *msg, int msglen);
 /* Reachable and J_d regular (full column rank 3); fills d->d, d->Jd,
  * d->Jdpinv (when regular); *rcond if non-NULL: 1 / (|J|_1 |J^+|_1) for
  * J = J_d diag(1/L, 1/L, 1) (see prru_model), which for three actuators is
@@ -368,8 +360,8 @@ PRRU_API int prru_check_regular(const prru_model *m, prru_data *d, const double 
  * Jdpinv = J_d^+, or PRRU_ESINGULAR; *rcond as there. prru_check_regular is
  * this with the model's L and jd_rcond_min; the design optimiser calls it
  * with a candidate design's own L, so both judge regularity alike. */
-PRRU_API int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
-                             double Jdpinv[3 * PRRU_NACT], double *rcond);
+PRRU_API int prru_jd_regular(const double Jd[], double L, double rcond_min,
+                             double Jdpinv[], double *rcond);
 /* The reciprocal 1-norm condition number 1 / (|M_s|_1 |M_s^-1|_1) of
  * M_s = D^-1 M D^-1, D = diag(L, L, 1) with L the model's length scale (the
  * mass matrix with rotations measured as arc lengths at the robot's scale,
@@ -382,17 +374,17 @@ PRRU_API double prru_mass_rcond(const prru_model *m, const double M[9]);
  * platform motion (1 to 3 in the middle of the workspace, without bound
  * as an upper link turns horizontal); NaN propagates. The quantity
  * inverse dynamics tests: stretch^2 mass_rcond_min <= 1. */
-PRRU_API double prru_stretch(const prru_model *m, const double Jd[PRRU_NACT * 3]);
+PRRU_API double prru_stretch(const prru_model *m, const double Jd[]);
 /* With three actuators, the sign (+1 or -1) of det J_d, 0 where it is 0;
  * always 0 with more actuators (J_d has no determinant, and a path meets
  * a rank deficiency of J_d only by exception). det J_d changes sign only
  * through det J_d = 0, so two regular poses of opposite signs lie on
  * either side of the singular locus: the assembly mode (prru_dme.h) and
  * the crossing test of sampled paths (prru traj, prru track) rest on it. */
-PRRU_API int prru_jd_det_sign(const double Jd[PRRU_NACT * 3]);
+PRRU_API int prru_jd_det_sign(const double Jd[]);
 
 /* Actuator displacements (inverse kinematics). */
-PRRU_API int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT]);
+PRRU_API int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[]);
 /* q with d(q) = act from seed: three actuators, Newton's method
  * (gsl_multiroot, hybridsj with J_d; allocates: a set-up call); four,
  * Gauss-Newton with J_d^+ and step halving (prru_forward_kinematics_lsq,
@@ -406,7 +398,7 @@ PRRU_API int prru_actuators(const prru_model *m, prru_data *d, const double q[3]
  * three put it; measured or rounded slider positions: use
  * prru_forward_kinematics_lsq and judge its residual). PRRU_ESINGULAR when
  * the solution has a singular J_d. */
-PRRU_API int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+PRRU_API int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[],
                                      const double seed[3], double q[3]);
 /* Least squares: Gauss-Newton from seed to a q minimizing |d(q) - act|_2
  * (with four actuators act need not be consistent: measured sliders), and
@@ -415,26 +407,26 @@ PRRU_API int prru_forward_kinematics(const prru_model *m, prru_data *d, const do
  * consistent act it is at the tolerance of prru_forward_kinematics);
  * PRRU_ENOCONV when it does not settle within 200 iterations or leaves
  * the workspace, PRRU_ESINGULAR at a singular J_d. */
-PRRU_API int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+PRRU_API int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[],
                                          const double seed[3], double q[3], double *residual);
 /* The residual (m) prru_forward_kinematics accepts for act and a caller
  * holds a least-squares fit to before calling the sliders consistent:
  * 1000 DBL_EPSILON max(L, |act|_inf), ten times the iteration's target
  * (above). Relative, so that it means the same for a robot of any size
  * and for sliders far down their rails. */
-PRRU_API double prru_fk_tolerance(const prru_model *m, const double act[PRRU_NACT]);
+PRRU_API double prru_fk_tolerance(const prru_model *m, const double act[]);
 /* The seed the forward kinematics starts from when the caller has none:
  * q0 = (0, 0, h) with h the mean of act_i - d_i(0, 0, 0). At q1 = q2 = 0
  * every slider is the platform height plus a constant, d_i = q3 +
  * d_i(0, 0, 0), so h solves the sliders of a level pose exactly and is
  * the level pose nearest to those of a tilted one. NaN in act gives a NaN
  * q0[2]. */
-PRRU_API void prru_fk_default_seed(const prru_model *m, const double act[PRRU_NACT], double q0[3]);
+PRRU_API void prru_fk_default_seed(const prru_model *m, const double act[], double q0[3]);
 /* max_i |d_i(q) - act_i| (m), the residual prru_forward_kinematics_lsq
  * reports and prru_fk_tolerance bounds, for any q (a Newton solution's,
  * whose solver does not return it); NaN where q is out of reach or an
  * input is NaN. */
-PRRU_API double prru_fk_residual(const prru_model *m, const double q[3], const double act[PRRU_NACT]);
+PRRU_API double prru_fk_residual(const prru_model *m, const double q[3], const double act[]);
 /* qdd from M qdd = G + J_d^T fd + J_T,P^T fp + J_R,P^T mp - h, solved
  * inside the generated prru_eom_solve; PRRU_ESINGULAR unless M is positive
  * definite (three nested principal minors positive) and
@@ -462,7 +454,7 @@ PRRU_API int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const 
  * gives the same motion; this one has no preload (fd . n = 0). */
 PRRU_API int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                                    const double qd[3], const double qdd[3], const prru_loads *l,
-                                   double fd[PRRU_NACT]);
+                                   double fd[]);
 /* The same plus the internal preload t (N) along n: fd = J_d^+T tau + t n,
  * so fd . n = t (to rounding) and the motion is the same for every t. For
  * models/4prru.json n = (-1, -1, 1, 1)/2 at q1 = q2 = 0 (any q3): a
@@ -470,24 +462,24 @@ PRRU_API int prru_inverse_dynamics(const prru_model *m, prru_data *d, const doub
  * downward force on sliders 1 and 2, the two pairs bracing the platform
  * against each other. PRRU_EINPUT for a
  * non-finite t, and for a non-zero t on a model without redundant
- * actuators (PRRU_NPRELOAD = 0); t = 0 is prru_inverse_dynamics. */
+ * actuators (nact = 3); t = 0 is prru_inverse_dynamics. */
 PRRU_API int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const double q[3],
                                            const double qd[3], const double qdd[3], const prru_loads *l,
-                                           double preload, double fd[PRRU_NACT]);
+                                           double preload, double fd[]);
 /* n: the unit vector spanning null(J_d^T) (J_d^T n = 0, |n| = 1), with
  * n_NACT > 0 (the largest-magnitude component positive if n_NACT = 0 to
  * rounding): the actuator-force pattern that is in equilibrium by itself.
  * Computed from the 3x3 minors of J_d (the generalized cross product of its
  * columns). Needs a regular q (prru_check_regular's statuses); PRRU_EINPUT
- * when PRRU_NPRELOAD = 0 (n then does not exist; n is left untouched). */
+ * with three actuators (n then does not exist; n is left untouched). */
 PRRU_API int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
-                                double n[PRRU_NACT]);
-/* The joint reaction coordinates (eq. 31, PRRU_NLAMBDA of them) at the
+                                double n[]);
+/* The joint reaction coordinates (eq. 31, nlambda of them) at the
  * state's qdd, which it solves for first and leaves in d->qdd; lambda is
  * also left in d->r. The sliders receive the actuator forces net of the
  * drives' armature, damping and friction (model format 2). Computed by the
  * generated closed form prru_joint_reactions (no linear solve).
- * With PRRU_NREACTION_NULL = 1 (the 4-PRRU) Q^T Phi^-1 Q is singular: every
+ * With four limbs (the 4-PRRU, null(Q) of dimension 1) Q^T Phi^-1 Q is singular: every
  * lambda + s z (z: prru_reaction_null) satisfies the equations of motion
  * equally well, and the reactions reported are the solution of least
  * Euclidean norm, lambda . z = 0 (coordinates in N and N m as they stand).
@@ -495,7 +487,7 @@ PRRU_API int prru_actuator_null(const prru_model *m, prru_data *d, const double 
  * carry the loads at all (a constraint singularity, which shows at rest
  * too), PRRU_EINPUT where velocities or loads overflow the arithmetic. */
 PRRU_API int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
-                            const prru_loads *l, double lambda[PRRU_NLAMBDA]);
+                            const prru_loads *l, double lambda[]);
 /* z: the unit vector spanning null(Q) at q (Q z = 0, |z| = 1), the one
  * statically indeterminate reaction pattern of the 4-PRRU. Physically: a
  * lateral force along e2 (normal to the plane y = 0 of limbs 3 and 4,
@@ -514,10 +506,10 @@ PRRU_API int prru_reactions(const prru_model *m, prru_data *d, const double q[3]
  * compliance and fit; prru_reactions reports none of it). Sign: the first
  * coordinate (in lambda order) of magnitude at least half the largest is
  * positive, here C3's force along e2. PRRU_EINPUT when
- * PRRU_NREACTION_NULL = 0 (z untouched); otherwise the statuses of
+ * three limbs (z untouched); otherwise the statuses of
  * prru_reactions at q. */
 PRRU_API int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
-                                double z[PRRU_NLAMBDA]);
+                                double z[]);
 /* T, V (J). */
 PRRU_API int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
                            double *V);

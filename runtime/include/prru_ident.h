@@ -2,7 +2,7 @@
  * squares from measured motion and actuator forces, and periodic excitation
  * trajectories.
  *
- * The standard parameters pi (PRRU_NREG, order and units in
+ * The standard parameters pi (nreg = 10 nbody + 3 nact of them, order and units in
  * prru_regressor.h) are per body m, m c (c the centre of mass in the body
  * frame) and the inertia I_O about the body-frame origin, then per actuator
  * the armature, damping and Coulomb force. With no platform loads the
@@ -32,8 +32,6 @@
 #define PRRU_IDENT_H
 
 #include "prru.h"
-#include "prru_param_kernels.h"
-#include "prru_regressor.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -45,7 +43,7 @@ extern "C" {
 
 /* The standard parameters of a mechanism descriptor: pi from its mass,
  * com, inertia (about the centre) and drives. */
-PRRU_API void prru_ident_standard(const prru_mechanism *me, double pi[PRRU_NREG]);
+PRRU_API void prru_ident_standard(const prru_mechanism *me, double pi[]);
 /* One body's mass, centre of mass and inertia about the centre (Ixx Iyy
  * Izz Ixy Ixz Iyz, as in model files) from its 10 standard parameters:
  * PRRU_EINPUT when m <= 0 or a value is not finite. */
@@ -74,7 +72,7 @@ typedef struct {
 PRRU_API int prru_ident_random_state(const prru_model *m, prru_data *d, unsigned long long *s,
                                      double q[3], double qd[3], double qdd[3]);
 
-/* The regressor Y (3 x PRRU_NREG, row-major; prru_regressor.h's columns)
+/* The regressor Y (3 x nreg, row-major; prru_regressor.h's columns)
  * of model m at (q, qd, qdd) with Coulomb smoothing velocity vs: the
  * build's specialised kernel for the build's own numbers, the topology's
  * (geometry and gravity read at run time) for a loaded model, so that a
@@ -92,21 +90,21 @@ PRRU_API double prru_ident_default_vs(const prru_model *m);
 PRRU_API int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed,
                                prru_base *b);
 /* beta = B pi (nbase values). */
-PRRU_API void prru_base_params(const prru_base *b, const double pi[PRRU_NREG], double beta[PRRU_NREG]);
-/* The base columns of rows x PRRU_NREG Y: Yb (rows x nbase). */
+PRRU_API void prru_base_params(const prru_base *b, const double pi[], double beta[]);
+/* The base columns of rows x nreg Y: Yb (rows x nbase). */
 PRRU_API void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *Yb);
 /* A standard parameter vector with B pi = beta: pi0 (a prior, e.g. the
  * model's) with each base parameter's own standard parameter replaced so
  * that the combination equals beta (the others keep pi0's values). */
-PRRU_API void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
-                                    const double pi0[PRRU_NREG], double pi[PRRU_NREG]);
+PRRU_API void prru_base_to_standard(const prru_base *b, const double beta[],
+                                    const double pi0[], double pi[]);
 
-/* Observation rows of one sample: A (PRRU_NACT x nbase) = J_d^+T Y_base
- * and y (PRRU_NACT) = J_d^+T J_d^T fd. The status of prru_check_regular
+/* Observation rows of one sample: A (nact x nbase) = J_d^+T Y_base
+ * and y (nact) = J_d^+T J_d^T fd. The status of prru_check_regular
  * (unreachable or singular poses give no rows). */
 PRRU_API int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
-                             const double qd[3], const double qdd[3], const double fd[PRRU_NACT],
-                             double *A, double y[PRRU_NACT]);
+                             const double qd[3], const double qdd[3], const double fd[],
+                             double *A, double y[]);
 
 typedef struct {
   int nsamples, nrows, dof;   /* dof = 3 nsamples - nbase */
@@ -128,14 +126,14 @@ typedef struct {
    * anticorrelated. prru_ident_consistent judges with it. */
   double inflation;
   int hac_lags;
-  /* X = Q R (R: nbase x nbase upper triangular, row stride PRRU_NREG), so
+  /* X = Q R (R: nbase x nbase upper triangular, row stride nreg), so
    * that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2: the
    * covariance of beta^ is s^2 (R^T R)^-1. */
   double R[PRRU_MAX_REG * PRRU_MAX_REG];
 } prru_ident_result;
 
 /* Least squares of the base parameters from n samples (q, qd, qdd, fd:
- * row-major n x 3 and n x PRRU_NACT). PRRU_EINPUT when n is too small
+ * row-major n x 3 and n x nact). PRRU_EINPUT when n is too small
  * (3 n <= nbase), or with *bad the 0-based sample and its status
  * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, PRRU_EINPUT for non-finite values)
  * when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
@@ -219,8 +217,8 @@ typedef struct {
  * negative drive coefficient; PRRU_ENOCONV when the Newton budget runs
  * out; PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
-                                   const double pi0[PRRU_NREG], const prru_consistent_options *o,
-                                   double pi[PRRU_NREG], prru_consistent_result *c);
+                                   const double pi0[], const prru_consistent_options *o,
+                                   double pi[], prru_consistent_result *c);
 
 /* Standard parameters pi (e.g. prru_ident_consistent's) as the numbers of
  * a model file: m's geometry and gravity (the regressor's), each body's
@@ -231,7 +229,7 @@ PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, cons
  * with why naming the body or drive that is not physical (a mass <= 0,
  * an inertia not positive definite, a negative drive coefficient; never
  * for prru_ident_consistent's output). prru_model_file_text writes p. */
-PRRU_API int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
+PRRU_API int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[], prru_params *p,
                                      char *why, int len);
 
 /* ---- The whole identification ----
@@ -358,7 +356,7 @@ PRRU_API int prru_excite(const prru_model *m, const prru_base *b, const prru_exc
  * PRRU_ESINGULAR, or PRRU_EINPUT for a force, speed or stroke limit)
  * with *t_bad its time. */
 PRRU_API int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
-                               int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad);
+                               int n, double fd_peak[], double *rcond_worst, double *t_bad);
 
 #ifdef __cplusplus
 }

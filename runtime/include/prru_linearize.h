@@ -3,7 +3,7 @@
  * one evaluation with qdd) and of inverse dynamics (prru_inverse_derivs;
  * with four actuators composed from its dtau/dx and dJ_d/dq).
  *
- * State x = (q, qd) (6), input u = fd (PRRU_NACT), x' = f(x, u) =
+ * State x = (q, qd) (6), input u = fd (nact), x' = f(x, u) =
  * (qd, qdd(q, qd, fd, fp, mp)):
  *     A = df/dx = [0 I; dqdd/dq dqdd/dqd],  B = df/du = [0; dqdd/dfd].
  * Every matrix is row-major; row i of a derivative block is qdd_i (fd_i),
@@ -81,15 +81,15 @@ PRRU_API int prru_linearize_batch(const prru_model *m, int n, const double *q, c
 
 /* Inverse dynamics fd (as prru_inverse_dynamics: the same statuses and
  * trust test, and the same fd) and its derivatives dfd/dq, dfd/dqd,
- * dfd/dqdd (PRRU_NACT x 3 each), any of them NULL if not wanted. Three
+ * dfd/dqdd (nact x 3 each), any of them NULL if not wanted. Three
  * actuators: dfd/dqdd = J_d^-T M, from one generated evaluation. Four: the
  * minimum-norm fd = J_d^+T tau, dfd/dqdd = J_d^+T M; the derivatives are
  * composed from the generated dtau/dx and dJ_d/dq with the J_d^+ and n of
  * prru_inverse_dynamics_preload (see linearize.c). */
 PRRU_API int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
                                           const double qd[3], const double qdd[3], const prru_loads *l,
-                                          double fd[PRRU_NACT], double dfd_dq[3 * PRRU_NACT],
-                                          double dfd_dqd[3 * PRRU_NACT], double dfd_dqdd[3 * PRRU_NACT]);
+                                          double fd[], double dfd_dq[],
+                                          double dfd_dqd[], double dfd_dqdd[]);
 
 /* The same for prru_inverse_dynamics_preload's fd = J_d^+T tau + t n with
  * the preload t held fixed: dfd/dq then also has t dn/dq (n turns with
@@ -98,9 +98,9 @@ PRRU_API int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, con
 PRRU_API int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, const double q[3],
                                                   const double qd[3], const double qdd[3],
                                                   const prru_loads *l, double preload,
-                                                  double fd[PRRU_NACT], double dfd_dq[3 * PRRU_NACT],
-                                                  double dfd_dqd[3 * PRRU_NACT],
-                                                  double dfd_dqdd[3 * PRRU_NACT]);
+                                                  double fd[], double dfd_dq[],
+                                                  double dfd_dqd[],
+                                                  double dfd_dqdd[]);
 
 #ifdef __cplusplus
 }

@@ -55,7 +55,7 @@ PRRU_API int prru_measure_rows(const double *t, int n, const prru_measure_option
 PRRU_API int prru_measure_apply(const prru_measure_options *o, int n, int nact, double *d, double *fd, char *msg,
                                 int msglen);
 
-/* q (n x 3) of n rows of slider positions d (n x PRRU_NACT) by least-squares
+/* q (n x 3) of n rows of slider positions d (n x nact) by least-squares
  * forward kinematics (prru_forward_kinematics_lsq), each row seeded from the
  * previous row's pose and the first from prru_fk_default_seed's level
  * pose: a motion sampled densely
@@ -86,7 +86,7 @@ typedef struct {
 } prru_diff_choice;
 
 /* Tries m = 1 .. PRRU_DIFF_MAX_HALF with p = 2 and 4 (p <= 2m, 2m + 1 <=
- * n) on the measured d (n x PRRU_NACT, times t) and keeps the smallest
+ * n) on the measured d (n x nact, times t) and keeps the smallest
  * error; ties keep the narrower window. PRRU_EINPUT with msg for fewer
  * than 3 rows or exact qdd of zero RMS in every coordinate, the statuses of
  * prru_forward_kinematics_lsq for a row no pose reproduces (msg names the

@@ -17,10 +17,10 @@ typedef struct {
   prru_loads base;         /* constant part */
   /* harmonic: fp += amp * (sin(w t), -cos(w t), 0) (the paper's load) */
   double amp, omega;
-  /* table: rows of t, fd1..fdN, fp1..3, mp1..3 (N = PRRU_NACT), linear
+  /* table: rows of t, fd1..fdN, fp1..3, mp1..3 (N = nact), linear
    * interpolation, held constant outside [t_0, t_n] */
   int nrows;
-  double *rows;            /* (PRRU_NACT + 7) * nrows, owned by the schedule */
+  double *rows;            /* (nact + 7) * nrows, owned by the schedule */
 } prru_load_schedule;
 
 PRRU_API void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l);
@@ -29,7 +29,7 @@ PRRU_API void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l)
  * mirrors limb 3) gets limb 3's 25 N. */
 PRRU_API void prru_schedule_paper(prru_load_schedule *s);
 /* Reads a CSV with header t,fd1..fdN[,fp1,fp2,fp3[,mp1,mp2,mp3]] (N =
- * PRRU_NACT); times strictly increasing. On error fills msg (file:line:
+ * nact); times strictly increasing. On error fills msg (file:line:
  * reason). */
 PRRU_API int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen);
 PRRU_API void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out);

@@ -136,7 +136,7 @@ PRRU_API void prru_path_side_init(prru_path_side *s);
 /* 1 when the regular sample's J_d has the opposite sign to the samples
  * before (the path crossed the singular set since the last one; the sign
  * kept), else 0 (the sign recorded). */
-PRRU_API int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3]);
+PRRU_API int prru_path_side_crossed(prru_path_side *s, const double Jd[]);
 /* The next sample q of a path: prru_traj_pose_ok's status (d filled as
  * there), or PRRU_ESINGULAR with *crossed = 1 when the pose is regular but
  * on the other side of the singular set (crossed may be NULL). */
@@ -235,7 +235,7 @@ PRRU_API int prru_topp_eval(const prru_topp *tp, double t, double q[3], double q
  * points: the profile cannot be trusted); msg says which, at t. */
 #define PRRU_TOPP_ROW_TOL 1e-6
 PRRU_API int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
-                           double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
+                           double q[3], double qd[3], double qdd[3], double fd[], double dd[],
                            char *msg, int msglen);
 PRRU_API void prru_topp_free(prru_topp *tp);
 
@@ -249,7 +249,7 @@ PRRU_API void prru_topp_free(prru_topp *tp);
  * of prru_inverse_dynamics. */
 PRRU_API int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
                                const double q[3], const double qd[3], const double qdd[3],
-                               double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
+                               double fd[], double dd[], double *ratio, int *which,
                                int *kind);
 
 /* The fastest point-to-point quintic (prru_quintic_waypoints' time law)

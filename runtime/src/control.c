@@ -87,17 +87,17 @@ static int plant_accel(const prru_param_derived *p, const double q[3], const dou
 }
 
 int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
-                     const double fd[PRRU_NACT], double qdd[3])
+                     const double fd[], double qdd[3])
 {
   prru_param_derived dp;
-  prru_param_derive(p, &dp);
+  prru_params_derive(p, &dp);
   return plant_accel(&dp, q, qd, fd, qdd);
 }
 
 int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
                          const double q_ref[3], const double qd_ref[3], const double qdd_ref[3],
-                         const double q[3], const double qd[3], double fd_cmd[PRRU_NACT],
-                         double fd[PRRU_NACT], int sat[PRRU_NACT])
+                         const double q[3], const double qd[3], double fd_cmd[],
+                         double fd[], int sat[])
 {
   double qdd_c[3];
   for (int i = 0; i < 3; i++)
@@ -213,7 +213,7 @@ static int decoupled_accel(const double G[3 * PRRU_NACT], double F, double a[3])
 }
 
 int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, double period, double q[6],
-                             double r[PRRU_NACT], char *msg, int msglen)
+                             double r[], char *msg, int msglen)
 {
   if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
   if (!(period > 0.0 && isfinite(period)))
@@ -383,7 +383,7 @@ void prru_lqr_schedule_free(prru_lqr_schedule *s)
 }
 
 int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_options *o, const double x[6],
-                     double fd_cmd[PRRU_NACT], double fd[PRRU_NACT], int sat[PRRU_NACT])
+                     double fd_cmd[], double fd[], int sat[])
 {
   if (!(k >= 0 && k < s->n)) return PRRU_EINPUT;
   const double *K = s->K + 6 * PRRU_NACT * k, *xr = s->x_ref + 6 * k, *u = s->u_ff + PRRU_NACT * k;
@@ -759,7 +759,7 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   c.o = o;
   c.d = malloc(sizeof(prru_data));
   prru_param_derived *plant = malloc(sizeof *plant);
-  if (plant) prru_param_derive(&o->plant, plant);
+  if (plant) prru_params_derive(&o->plant, plant);
   c.plant = plant;
   c.continuous = o->control_period == 0.0;
   prru_lqr_schedule lqr;

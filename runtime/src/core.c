@@ -37,7 +37,7 @@ void prru_gsl_init(void) { pthread_once(&gsl_once, gsl_handler_off); }
 
 static int finite3(const double v[3]) { return prru_finite_n(v, 3); }
 
-int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT])
+int prru_stroke_actuator(const prru_model *m, const double d[])
 {
   const prru_mechanism *me = m->mech;
   for (int i = 0; i < PRRU_NACT; i++)
@@ -45,7 +45,7 @@ int prru_stroke_actuator(const prru_model *m, const double d[PRRU_NACT])
   return -1;
 }
 
-int prru_stroke_why(const prru_model *m, const double d[PRRU_NACT], char *msg, int msglen)
+int prru_stroke_why(const prru_model *m, const double d[], char *msg, int msglen)
 {
   const int i = prru_stroke_actuator(m, d);
   if (i < 0) return prru_fail(msg, msglen, PRRU_OK, "%s", "");
@@ -135,7 +135,7 @@ double prru_mass_rcond(const prru_model *m, const double M[9])
   return isfinite(rc) ? rc : 0.0;
 }
 
-double prru_stretch(const prru_model *m, const double Jd[PRRU_NACT * 3])
+double prru_stretch(const prru_model *m, const double Jd[])
 {
   const double s = 1.0 / prru_length_scale(m->mech);
   double big = 0;
@@ -218,8 +218,8 @@ static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
 }
 #endif
 
-int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
-                    double Jdpinv[3 * PRRU_NACT], double *rcond)
+int prru_jd_regular(const double Jd[], double L, double rcond_min,
+                    double Jdpinv[], double *rcond)
 {
   /* J_d's rotation columns are lengths per radian, its height column is
    * dimensionless: conditioned as it stands, a model scaled by 1e-7 would
@@ -245,7 +245,7 @@ int prru_jd_regular(const double Jd[PRRU_NACT * 3], double L, double rcond_min,
   return rc > 0 && rc >= rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
 
-int prru_jd_det_sign(const double Jd[PRRU_NACT * 3])
+int prru_jd_det_sign(const double Jd[])
 {
   if (PRRU_NACT != 3) return 0;
   const double *a = Jd;
@@ -264,7 +264,7 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
 
-int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[PRRU_NACT])
+int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[])
 {
   int st = prru_check_reachable(m, d, q);
   if (st == PRRU_OK) memcpy(act, d->d, PRRU_NACT * sizeof(double));
@@ -465,7 +465,7 @@ int prru_inverse_failure(int st, const double q[3], const double qd[3], const do
 
 int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           const double qd[3], const double qdd[3], const prru_loads *l,
-                          double fd[PRRU_NACT])
+                          double fd[])
 {
   int st;
 #if PRRU_NACT == 3
@@ -529,7 +529,7 @@ int prru_null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], doubl
 #endif
 
 int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
-                       double n[PRRU_NACT])
+                       double n[])
 {
 #if PRRU_NPRELOAD == 0
   (void)m, (void)d, (void)q, (void)n;
@@ -545,7 +545,7 @@ int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
 
 int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const double q[3],
                                   const double qd[3], const double qdd[3], const prru_loads *l,
-                                  double preload, double fd[PRRU_NACT])
+                                  double preload, double fd[])
 {
   if (!isfinite(preload)) return PRRU_EINPUT;
 #if PRRU_NPRELOAD == 0

@@ -641,7 +641,7 @@ static void grid_eval(const prru_design_problem *pr, const prru_params *p, prru_
 {
   /* The design's numbers as the kernels read them: derived once here. */
   prru_param_derived dp;
-  prru_param_derive(p, &dp);
+  prru_params_derive(p, &dp);
   grid_job j = {pr, &dp, dd, prru_design_length_scale(p), home_mode(&dp, pr->grid.q3), compare, 0,
                 PTHREAD_MUTEX_INITIALIZER};
   enum { MAX_THREADS = 64 };

@@ -18,19 +18,19 @@ const char *prru_dme_status_name(int status)
   }
 }
 
-int prru_assembly_mode(const double d[PRRU_NACT], const double Jd[PRRU_NACT * 3])
+int prru_assembly_mode(const double d[], const double Jd[])
 {
   for (int i = 0; i < PRRU_NACT; i++)
     if (!isfinite(d[i])) return 0;
   return prru_jd_det_sign(Jd);
 }
 
-int prru_jd_other_mode(const double Jd[PRRU_NACT * 3], int home)
+int prru_jd_other_mode(const double Jd[], int home)
 {
   return home != 0 && prru_jd_det_sign(Jd) != home;
 }
 
-int prru_mode_status(int regular_status, const double Jd[PRRU_NACT * 3], int home)
+int prru_mode_status(int regular_status, const double Jd[], int home)
 {
   return regular_status == PRRU_OK && prru_jd_other_mode(Jd, home) ? PRRU_DME_OTHER_MODE
                                                                    : regular_status;
@@ -105,7 +105,7 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   return prru_dme_from(d->M, d->Jdpinv, jp, out);
 }
 
-int prru_dme_from(const double M[9], const double Jdpinv[3 * PRRU_NACT], const double JP[18],
+int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
                   prru_dme *out)
 {
   const double *jinv = Jdpinv;

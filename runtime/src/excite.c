@@ -156,7 +156,7 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
 }
 
 int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_excite_options *o,
-                      int n, double fd_peak[PRRU_NACT], double *rcond_worst, double *t_bad)
+                      int n, double fd_peak[], double *rcond_worst, double *t_bad)
 {
   prru_data *d = malloc(sizeof *d);
   if (!d) return PRRU_ENOMEM;

@@ -28,12 +28,12 @@ static double fk_tol(const prru_model *m, const double act[PRRU_NACT])
 }
 
 /* Ten times fk_tol: hybridsj may stall a few ulps short of it. */
-double prru_fk_tolerance(const prru_model *m, const double act[PRRU_NACT])
+double prru_fk_tolerance(const prru_model *m, const double act[])
 {
   return 1000 * DBL_EPSILON * fk_scale(m, act);
 }
 
-void prru_fk_default_seed(const prru_model *m, const double act[PRRU_NACT], double q0[3])
+void prru_fk_default_seed(const prru_model *m, const double act[], double q0[3])
 {
   /* ik_jd, the kernel prru_check_regular evaluates: d(0) as the solvers
    * see it, to the bit. */
@@ -45,7 +45,7 @@ void prru_fk_default_seed(const prru_model *m, const double act[PRRU_NACT], doub
   q0[2] = sum / PRRU_NACT;
 }
 
-double prru_fk_residual(const prru_model *m, const double q[3], const double act[PRRU_NACT])
+double prru_fk_residual(const prru_model *m, const double q[3], const double act[])
 {
   /* The kernel prru_check_regular fills d->d with: the same residual as
    * prru_forward_kinematics_lsq's at its answer, to the bit. */
@@ -81,7 +81,7 @@ static double fk_residual(const prru_data *d, const double act[PRRU_NACT], doubl
   return f;
 }
 
-int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double act[],
                                 const double seed[3], double q[3], double *residual)
 {
   if (residual) *residual = NAN;
@@ -181,7 +181,7 @@ static int fk_df(const gsl_vector *x, void *p, gsl_matrix *J)
   return fk_fdf(x, p, &fv.vector, J);
 }
 
-int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[],
                             const double seed[3], double q[3])
 {
   if (!isfinite(act[0]) || !isfinite(act[1]) || !isfinite(act[2])) return PRRU_EINPUT;
@@ -217,7 +217,7 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
 /* Four actuators: d(q) = act has a solution only when act is consistent
  * (the fourth slider where the other three put it). Least squares, then
  * the same acceptance as hybridsj's above: 10 times the tolerance. */
-int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[PRRU_NACT],
+int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[],
                             const double seed[3], double q[3])
 {
   double sol[3], res;

@@ -12,7 +12,7 @@
 #include "internal.h"
 #include "prru_ident.h"
 
-void prru_ident_standard(const prru_mechanism *me, double pi[PRRU_NREG])
+void prru_ident_standard(const prru_mechanism *me, double pi[])
 {
   for (int b = 0; b < PRRU_NBODY; b++) {
     double *p = pi + PRRU_NBODYPAR * b;
@@ -214,7 +214,7 @@ int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long
   return st;
 }
 
-void prru_base_params(const prru_base *b, const double pi[PRRU_NREG], double beta[PRRU_NREG])
+void prru_base_params(const prru_base *b, const double pi[], double beta[])
 {
   for (int i = 0; i < b->nbase; i++) {
     double s = 0;
@@ -229,8 +229,8 @@ void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *
     for (int i = 0; i < b->nbase; i++) Yb[r * b->nbase + i] = Y[r * PRRU_NREG + b->col[i]];
 }
 
-void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
-                           const double pi0[PRRU_NREG], double pi[PRRU_NREG])
+void prru_base_to_standard(const prru_base *b, const double beta[],
+                           const double pi0[], double pi[])
 {
   memcpy(pi, pi0, sizeof(double) * PRRU_NREG);
   /* Row i of B has 1 at col[i] and otherwise entries only at non-base
@@ -244,8 +244,8 @@ void prru_base_to_standard(const prru_base *b, const double beta[PRRU_NREG],
 }
 
 int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
-                    const double qd[3], const double qdd[3], const double fd[PRRU_NACT],
-                    double *A, double y[PRRU_NACT])
+                    const double qd[3], const double qdd[3], const double fd[],
+                    double *A, double y[])
 {
   for (int k = 0; k < 3; k++)
     if (!isfinite(qd[k]) || !isfinite(qdd[k])) return PRRU_EINPUT;

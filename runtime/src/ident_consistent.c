@@ -682,8 +682,8 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
 }
 
 int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
-                          const double pi0[PRRU_NREG], const prru_consistent_options *o,
-                          double pi[PRRU_NREG], prru_consistent_result *c)
+                          const double pi0[], const prru_consistent_options *o,
+                          double pi[], prru_consistent_result *c)
 {
   memset(c, 0, sizeof *c);
   if (!(o->mu > 0) || !isfinite(o->mu) || !(o->alpha > 0 && o->alpha < 1) || !(o->sigma_floor >= 0) ||
@@ -748,7 +748,7 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
  * file (prru_model_file_text), which the loader refuses. */
 #define FILE_FLOOR 1e-9
 
-int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[PRRU_NREG], prru_params *p,
+int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[], prru_params *p,
                             char *why, int len)
 {
   /* Geometry and gravity: the model's (the regressor's, which identification needs). */

@@ -4,7 +4,7 @@
  * structures: general, and the simple variant for models with no
  * centre-of-mass offsets, products of inertia or drives and gravity along
  * -z (prru_param_structure_simple). Thin adapters to one signature; the
- * topology is the build's (its data sizes are compile-time constants), the
+ * topology is the build's (the runtime computes with its sizes), the
  * only place the runtime chooses between the three- and four-limb kernel
  * sets. */
 #include <math.h>
@@ -66,6 +66,22 @@ int prru_param_structure_simple(const prru_param_derived *d)
 }
 
 size_t prru_param_simple_size(void) { return sizeof(simple_derived); }
+
+void prru_params_derive(const prru_params *p, prru_param_derived *d)
+{
+  topo_params t;
+  for (int i = 0; i < PRRU_NLIMB; i++) t.b[i] = p->b[i], t.l1[i] = p->l1[i], t.l2[i] = p->l2[i], t.a[i] = p->a[i];
+  for (int k = 0; k < 3; k++) t.gravity[k] = p->gravity[k];
+  for (int b = 0; b < PRRU_NBODY; b++) {
+    t.mass[b] = p->mass[b];
+    for (int k = 0; k < 3; k++) t.com[b][k] = p->com[b][k];
+    for (int k = 0; k < 6; k++) t.inertia[b][k] = p->inertia[b][k];
+  }
+  for (int i = 0; i < PRRU_NACT; i++)
+    t.armature[i] = p->armature[i], t.damping[i] = p->damping[i], t.coulomb[i] = p->coulomb[i];
+  t.coulomb_velocity = p->coulomb_velocity;
+  P(derive)(&t, (topo_derived *)d);
+}
 
 void prru_param_simple_derive(const prru_param_derived *d, void *out)
 {

@@ -7,6 +7,7 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 
+#include "internal.h"
 #include "prru_measure.h"
 
 void prru_measure_options_default(prru_measure_options *o)

@@ -26,6 +26,7 @@ typedef struct {
 
 void prru_limits_none(prru_limits *l)
 {
+  memset(l, 0, sizeof *l); /* the entries past the model's actuators */
   for (int i = 0; i < PRRU_NACT; i++) {
     l->force_max[i] = l->speed_max[i] = l->d_max[i] = INFINITY;
     l->d_min[i] = -INFINITY;
@@ -35,6 +36,7 @@ void prru_limits_none(prru_limits *l)
 void prru_model_limits(const prru_model *m, prru_limits *out)
 {
   const prru_mechanism *me = m->mech;
+  memset(out, 0, sizeof *out);
   for (int i = 0; i < PRRU_NACT; i++) {
     out->force_max[i] = me->force_max[i], out->speed_max[i] = me->speed_max[i];
     out->d_min[i] = me->d_min[i], out->d_max[i] = me->d_max[i];
@@ -54,8 +56,8 @@ int prru_model_has_lead(const prru_model *m)
   return 1;
 }
 
-int prru_model_motor_units(const prru_model *m, const double f[PRRU_NACT], double tau[PRRU_NACT],
-                           double current[PRRU_NACT])
+int prru_model_motor_units(const prru_model *m, const double f[], double tau[],
+                           double current[])
 {
   const prru_mechanism *me = m->mech;
   if (!prru_model_has_lead(m)) return PRRU_EINPUT;
@@ -276,6 +278,7 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
 void prru_model_params(const prru_model *m, prru_params *p)
 {
   const prru_mechanism *me = m->mech;
+  memset(p, 0, sizeof *p); /* the entries past the model's sizes: 0, every time */
   for (int i = 0; i < PRRU_NLIMB; i++) {
     p->b[i] = me->b[i], p->l1[i] = me->l1[i], p->l2[i] = me->l2[i], p->a[i] = me->a[i];
     p->armature[i] = me->armature[i], p->damping[i] = me->damping[i], p->coulomb[i] = me->coulomb[i];
@@ -328,8 +331,8 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   int st = prru_model_file_read(path, s, msg, msglen);
   if (st == PRRU_OK && s->nlimb != PRRU_NLIMB) {
     snprintf(msg, (size_t)msglen,
-             "%s: a model with %d limbs; this build evaluates %d-limb models (its data sizes are fixed at "
-             "compile time): use a build of a %d-limb model (make build MODEL=%s)",
+             "%s: a model with %d limbs; this build evaluates %d-limb models (its runtime computes with "
+             "its model's number of limbs): use a build of a %d-limb model (make build MODEL=%s)",
              path, s->nlimb, PRRU_NLIMB, s->nlimb, path);
     st = PRRU_EINPUT;
   }
@@ -344,8 +347,9 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   prru_model_default(&tmp);
   tmp.mech = &l->mech;
   tmp.own = l;
-  prru_model_params(&tmp, &l->derived.params);
-  prru_param_derive(&l->derived.params, &l->derived);
+  prru_params numbers;
+  prru_model_params(&tmp, &numbers);
+  prru_params_derive(&numbers, &l->derived);
   if (!prru_model_is_built(&tmp, 0) && (st = prru_model_use_parameter_kernels(&tmp)) != PRRU_OK) {
     free(l->path), free(l);
     if (msg && msglen > 0) snprintf(msg, (size_t)msglen, "%s: out of memory", path);
@@ -378,7 +382,7 @@ int prru_model_use_parameter_kernels(prru_model *m)
   return PRRU_OK;
 }
 
-void prru_model_ik_jd(const prru_model *m, const double q[3], double d[PRRU_NACT], double Jd[PRRU_NACT * 3])
+void prru_model_ik_jd(const prru_model *m, const double q[3], double d[], double Jd[])
 {
   KERNEL(m, ik_jd)(m->kernel_params, q, d, Jd);
 }
@@ -405,19 +409,19 @@ void prru_model_platform_jacobian(const prru_model *m, const double q[3], double
   KERNEL(m, platform_jacobian)(m->kernel_params, q, JP);
 }
 
-void prru_model_poses(const prru_model *m, const double q[3], double R[9 * PRRU_NBODY], double pos[3 * PRRU_NBODY])
+void prru_model_poses(const prru_model *m, const double q[3], double R[], double pos[])
 {
   KERNEL(m, poses)(m->kernel_params, q, R, pos);
 }
 
-void prru_body_origin(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY], int b,
+void prru_body_origin(const prru_model *m, const double R[], const double pos[], int b,
                       double o[3])
 {
   const double *Rb = R + 9 * b, *cb = m->mech->com[b];
   for (int c = 0; c < 3; c++) o[c] = pos[3 * b + c] - (Rb[3 * c] * cb[0] + Rb[3 * c + 1] * cb[1] + Rb[3 * c + 2] * cb[2]);
 }
 
-void prru_limb_joints(const prru_model *m, const double R[9 * PRRU_NBODY], const double pos[3 * PRRU_NBODY], int i,
+void prru_limb_joints(const prru_model *m, const double R[], const double pos[], int i,
                       double A[3], double B[3], double C[3])
 {
   double u[3], l[3];
@@ -430,8 +434,8 @@ void prru_limb_joints(const prru_model *m, const double R[9 * PRRU_NBODY], const
   }
 }
 
-void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[PRRU_NACT],
-                               double ddb[PRRU_NACT])
+void prru_model_actuator_rates(const prru_model *m, const double q[3], const double qd[3], double dd[],
+                               double ddb[])
 {
   KERNEL(m, actuator_rates)(m->kernel_params, q, qd, dd, ddb);
 }

@@ -74,7 +74,7 @@ static int classify_failure(const prru_model *m, prru_data *d, const double q[3]
 }
 
 int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
-                       double z[PRRU_NLAMBDA])
+                       double z[])
 {
 #if PRRU_NREACTION_NULL == 0
   (void)m, (void)d, (void)q, (void)z;
@@ -91,7 +91,7 @@ int prru_reaction_null(const prru_model *m, prru_data *d, const double q[3],
 }
 
 int prru_reactions(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
-                   const prru_loads *l, double lambda[NL])
+                   const prru_loads *l, double lambda[])
 {
   double qdd[3];
   int st = prru_forward_dynamics(m, d, q, qd, l, qdd);

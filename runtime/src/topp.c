@@ -71,7 +71,7 @@ static int id(const topp_ctx *c, const double q[3], double v, double acc, double
 
 int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
                       const double q[3], const double qd[3], const double qdd[3],
-                      double fd[PRRU_NACT], double dd[PRRU_NACT], double *ratio, int *which,
+                      double fd[], double dd[], double *ratio, int *which,
                       int *kind)
 {
   double f[PRRU_NACT], v[PRRU_NACT];
@@ -739,7 +739,7 @@ int prru_topp_eval(const prru_topp *tp, double t, double q[3], double qd[3], dou
 }
 
 int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, const prru_topp *tp, double t,
-                  double q[3], double qd[3], double qdd[3], double fd[PRRU_NACT], double dd[PRRU_NACT],
+                  double q[3], double qd[3], double qdd[3], double fd[], double dd[],
                   char *msg, int msglen)
 {
   double r;

@@ -352,7 +352,7 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
 
 void prru_path_side_init(prru_path_side *s) { s->sign = 0; }
 
-int prru_path_side_crossed(prru_path_side *s, const double Jd[PRRU_NACT * 3])
+int prru_path_side_crossed(prru_path_side *s, const double Jd[])
 {
   const int sg = prru_jd_det_sign(Jd);
   if (sg * s->sign < 0) return 1;
