@@ -1583,6 +1583,30 @@ class TestLayout(unittest.TestCase):
             with self.subTest(change=change.__name__), self.assertRaises(prru.LayoutError):
                 Shifted(LIB)
 
+    def test_public_types_follow_the_generated(self):
+        """The library's prru_mechanism, prru_joint_info and prru_params
+        (prru_descriptor.h, arrays of the maxima) have the fields of the
+        generator's (a drop-in descriptor of any model, sized for it; the
+        4-limb topology kernels' prru_params4) in the same order and types,
+        and sized for the largest model the same."""
+        maxima = {"PAPER3PRRU_NACT": 4, "PAPER3PRRU_NLIMB": 4, "PAPER3PRRU_NBODY": 13,
+                  "PAPER3PRRU_NJOINT": 16, "PAPER3PRRU_NLAMBDA": 76, "PRRU_MAX_ACT": 4,
+                  "PRRU_MAX_LIMB": 4, "PRRU_MAX_BODY": 13, "PRRU_MAX_JOINT": 16,
+                  "PRRU_MAX_LAMBDA": 76}
+
+        def fields(header, name, rename=()):
+            out = []
+            for f, t, dims in c_struct_fields(read(os.path.join(SOURCE_DIR, header)), name):
+                for a, b in rename:
+                    t = t.replace(a, b)
+                out.append((f, t, [eval(d, {"__builtins__": {}}, maxima) for d in dims]))
+            return out
+        public = "runtime/include/prru_descriptor.h"
+        gen = ("generated/paper3prru_mechanism.h", [("paper3prru_", "prru_")])
+        self.assertEqual(fields(public, "prru_joint_info"), fields(gen[0], "paper3prru_joint_info", gen[1]))
+        self.assertEqual(fields(public, "prru_mechanism"), fields(gen[0], "paper3prru_mechanism", gen[1]))
+        self.assertEqual(fields(public, "prru_params"), fields("generated/prru_p4_kernels.h", "prru_params4"))
+
     def test_layout_is_the_same_for_every_model(self):
         """The structs are sized by the maxima of prru_sizes.h, not by the
         model: the mirror built for any descriptor sizes is the same."""
