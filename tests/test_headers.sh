@@ -64,7 +64,14 @@ structs=$(grep -o 'ENTRY(prru_[a-z0-9_]*)' "$PRRU_SOURCE_DIR/runtime/src/abi.c" 
   echo '  return bad != 0;'
   echo '}'
 } >"$tmp/sizes.c"
-if "$CC" -std=c99 -Wall -Wextra -Werror -Wno-pedantic -I"$inc" "$tmp/sizes.c" -o "$tmp/sizes" -ldl 2>"$tmp/err"; then
+# The build's compiler and flags: a sanitizer build's library loads only
+# into a program linked with the same runtime.
+cache() { sed -n "s/^$1:[A-Z]*=//p" "$PRRU_BUILD_DIR/CMakeCache.txt" | head -n 1; }
+CC_BUILD=$(cache CMAKE_C_COMPILER)
+read -r -a C_FLAGS <<<"$(cache CMAKE_C_FLAGS)"
+read -r -a LD_FLAGS <<<"$(cache CMAKE_EXE_LINKER_FLAGS)"
+if "${CC_BUILD:-$CC}" -std=c99 -Wall -Wextra -Werror -Wno-pedantic "${C_FLAGS[@]}" -I"$inc" "$tmp/sizes.c" \
+  "${LD_FLAGS[@]}" -o "$tmp/sizes" -ldl 2>"$tmp/err"; then
   if "$tmp/sizes" "$lib"; then
     pass=$((pass + 1))
     echo "ok   $(echo "$structs" | wc -w) structs: the headers alone give the library's sizes"
