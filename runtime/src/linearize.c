@@ -289,9 +289,7 @@ static int inverse4_derivs(const prru_model *m, prru_data *d, const double q[3],
 int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, const double q[3],
                                          const double qd[3], const double qdd[3],
                                          const prru_loads *l, double preload, double fd[],
-                                         double dfd_dq[],
-                                         double dfd_dqd[],
-                                         double dfd_dqdd[])
+                                         double dfd_dq[], double dfd_dqd[], double dfd_dqdd[])
 {
   if (!isfinite(preload)) return PRRU_EINPUT;
 #if PRRU_NACT == 3
@@ -304,8 +302,7 @@ int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, cons
 
 int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
                                  const double qd[3], const double qdd[3], const prru_loads *l,
-                                 double fd[], double dfd_dq[],
-                                 double dfd_dqd[], double dfd_dqdd[])
+                                 double fd[], double dfd_dq[], double dfd_dqd[], double dfd_dqdd[])
 {
 #if PRRU_NACT == 3
   return inverse3_derivs(m, d, q, qd, qdd, l, fd, dfd_dq, dfd_dqd, dfd_dqdd);
