@@ -19,10 +19,7 @@
 #include "prru_param_kernels.h"
 #include "prru_regressor.h"
 
-/* The runtime's own conversion of a public prru_params (arrays of the
- * maxima, prru_descriptor.h) to the build's topology's type, derived for
- * its parameter kernels (runtime/src/internal.h; in the static library). */
-void prru_params_derive(const prru_params *p, prru_param_derived *d);
+#include "params_derive.h" /* prru_params_derive (runtime/src) */
 #include "prru_ref.h"
 
 #define PRRU_BENCH_PI 3.14159265358979323846

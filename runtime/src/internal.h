@@ -27,10 +27,7 @@ extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter,
  * prru_kernels_parameter_simple evaluates them; that table's numbers
  * (prru_param_simple_size bytes) from d's parameters. */
 int prru_param_structure_simple(const prru_param_derived *d);
-/* p (the public prru_params, arrays of the maxima) in the build's
- * topology's own type, derived for its parameter kernels
- * (prru_param_derive). */
-void prru_params_derive(const prru_params *p, prru_param_derived *d);
+#include "params_derive.h" /* prru_params_derive */
 size_t prru_param_simple_size(void);
 void prru_param_simple_derive(const prru_param_derived *d, void *out);
 /* A model's kernel K with its parameters: K(m, ik)(m->kernel_params, ...). */
