@@ -18,18 +18,11 @@ typedef char prru_build_fits_public_structs[(PRRU_NACT <= PRRU_MAX_ACT && PRRU_N
                                              PRRU_NLAMBDA <= PRRU_MAX_LAMBDA)
                                                 ? 1
                                                 : -1];
-/* The build's kernel tables (kernels.c): specialised, and the parameter
- * kernels in their general and simple structures. */
-extern const prru_kernel_table prru_kernels_specialised, prru_kernels_parameter,
-    prru_kernels_parameter_simple;
-/* Whether d's numbers have the simple structure exactly (no centre-of-mass
- * offset, product of inertia or drive, gravity along z), so that
- * prru_kernels_parameter_simple evaluates them; that table's numbers
- * (prru_param_simple_size bytes) from d's parameters. */
-int prru_param_structure_simple(const prru_param_derived *d);
+/* The build's specialised kernel table (kernels.c); the parameter
+ * kernels of both topologies are topology.h's. */
+extern const prru_kernel_table prru_kernels_specialised;
 #include "params_derive.h" /* prru_params_derive */
-size_t prru_param_simple_size(void);
-void prru_param_simple_derive(const prru_param_derived *d, void *out);
+#include "topology.h"
 /* A model's kernel K with its parameters: K(m, ik)(m->kernel_params, ...). */
 #define KERNEL(m, k) ((m)->kernels->k)
 

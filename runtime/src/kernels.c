@@ -1,14 +1,11 @@
-/* The kernel tables of a build (prru_kernel_table in prru.h): the
- * specialised kernels of the build's model, and the parameter kernels of
- * its topology, which a model loaded at run time evaluates with, in two
- * structures: general, and the simple variant for models with no
- * centre-of-mass offsets, products of inertia or drives and gravity along
- * -z (prru_param_structure_simple). Thin adapters to one signature; the
- * topology is the build's (the runtime computes with its sizes), the
- * only place the runtime chooses between the three- and four-limb kernel
- * sets. */
+/* The specialised kernel table of a build (prru_kernel_table in
+ * prru_dynamics.h): the constant-folded kernels of the build's model,
+ * thin adapters to the table's one signature. The parameter kernels of
+ * both topologies, which a model loaded at run time evaluates with, are
+ * kernels_topology.c's. */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "internal.h"
 #include "prru.h"
@@ -16,76 +13,17 @@
 #include "prru_derivs.h"
 #include "prru_regressor.h"
 
-#if PRRU_NLIMB == 3
-#include "prru_p3_kernels.h"
-#include "prru_p3s_kernels.h"
-#define P(name) prru_p3_##name
-#define G(name) prru_p3_##name /* the regressor of every structure */
-#define UNSEEN_P(name) PRRU_P3_UNSEEN_FINITE_##name
-#define PS(name) prru_p3s_##name
-#define UNSEEN_PS(name) PRRU_P3S_UNSEEN_FINITE_##name
-typedef prru_params3 topo_params;
-typedef prru_p3_derived topo_derived;
-typedef prru_p3s_derived simple_derived;
-#elif PRRU_NLIMB == 4
-#include "prru_p4_kernels.h"
-#include "prru_p4s_kernels.h"
-#define P(name) prru_p4_##name
-#define G(name) prru_p4_##name
-#define UNSEEN_P(name) PRRU_P4_UNSEEN_FINITE_##name
-#define PS(name) prru_p4s_##name
-#define UNSEEN_PS(name) PRRU_P4S_UNSEEN_FINITE_##name
-typedef prru_params4 topo_params;
-typedef prru_p4_derived topo_derived;
-typedef prru_p4s_derived simple_derived;
-#else
-#error "prru: a build's model has 3 or 4 limbs"
-#endif
+#include "topology.h"
 
-/* The loaded numbers are stored as prru_param_derived (the build's
- * layout) and read as the topology's: the same members in the same
- * order. */
-typedef char params_layout_check[sizeof(topo_derived) == sizeof(prru_param_derived) ? 1 : -1];
-
-#define TP(p) ((const topo_derived *)(p))
-
-/* Whether the simple variant's kernels are exact for these numbers: every
- * centre of mass at its body frame's origin, every product of inertia,
- * armature, damping and Coulomb force zero, gravity along z. Exactly zero,
- * not small: a number the variant drops must not matter at all. */
-int prru_param_structure_simple(const prru_param_derived *d)
-{
-  const topo_params *p = &TP(d)->params;
-  int ok = p->gravity[0] == 0 && p->gravity[1] == 0;
-  for (int b = 0; b < PRRU_NBODY && ok; b++)
-    ok = p->com[b][0] == 0 && p->com[b][1] == 0 && p->com[b][2] == 0 && p->inertia[b][3] == 0 &&
-         p->inertia[b][4] == 0 && p->inertia[b][5] == 0;
-  for (int i = 0; i < PRRU_NACT && ok; i++)
-    ok = p->armature[i] == 0 && p->damping[i] == 0 && p->coulomb[i] == 0;
-  return ok;
-}
-
-size_t prru_param_simple_size(void) { return sizeof(simple_derived); }
+/* The tests and benchmarks call the build's parameter kernels directly:
+ * its topology's, with prru_param_derived its derived type. */
+typedef char params_layout_check[sizeof(prru_param_derived) <= sizeof(prru_topo_derived) ? 1 : -1];
 
 void prru_params_derive(const prru_params *p, prru_param_derived *d)
 {
-  topo_params t;
-  for (int i = 0; i < PRRU_NLIMB; i++) t.b[i] = p->b[i], t.l1[i] = p->l1[i], t.l2[i] = p->l2[i], t.a[i] = p->a[i];
-  for (int k = 0; k < 3; k++) t.gravity[k] = p->gravity[k];
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    t.mass[b] = p->mass[b];
-    for (int k = 0; k < 3; k++) t.com[b][k] = p->com[b][k];
-    for (int k = 0; k < 6; k++) t.inertia[b][k] = p->inertia[b][k];
-  }
-  for (int i = 0; i < PRRU_NACT; i++)
-    t.armature[i] = p->armature[i], t.damping[i] = p->damping[i], t.coulomb[i] = p->coulomb[i];
-  t.coulomb_velocity = p->coulomb_velocity;
-  P(derive)(&t, (topo_derived *)d);
-}
-
-void prru_param_simple_derive(const prru_param_derived *d, void *out)
-{
-  PS(derive)(&TP(d)->params, out);
+  prru_topo_derived t;
+  prru_topology_of(PRRU_NLIMB)->derive(p, &t);
+  memcpy(d, &t, sizeof *d);
 }
 
 /* ---- specialised: the constant-folded kernels, p ignored ---- */
@@ -232,21 +170,3 @@ const prru_kernel_table prru_kernels_specialised = {
   s_regressor,    s_eom_solve_derivs, s_unseen_eom_solve_derivs,
   s_inverse_derivs, s_unseen_inverse_derivs, s_batch_eom_solve_derivs,
 };
-
-/* ---- parameter: the topology's kernels, p its derived numbers ---- */
-#define A(name) p_##name
-#define TABLE prru_kernels_parameter
-#include "kernels_param.inc"
-#undef A
-#undef TABLE
-
-/* ---- the simple structural variant (prru_p3s_*, prru_p4s_*) ---- */
-#undef P
-#undef UNSEEN_P
-#undef TP
-#define P(name) PS(name)
-#define UNSEEN_P(name) UNSEEN_PS(name)
-#define TP(p) ((const simple_derived *)(p))
-#define A(name) ps_##name
-#define TABLE prru_kernels_parameter_simple
-#include "kernels_param.inc"

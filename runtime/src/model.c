@@ -13,11 +13,12 @@
 /* A loaded model's storage (prru_model.own). */
 typedef struct {
   prru_mechanism mech;
-  /* Its numbers as the parameter kernels read them (prru_param_derive),
-   * and as their simple variant reads them where it applies (NULL if not
-   * asked for: prru_param_simple_size bytes). */
-  prru_param_derived derived;
-  void *simple;
+  /* Its topology, its numbers as that topology's parameter kernels read
+   * them, and as their simple variant reads them where it applies (NULL
+   * if not asked for). */
+  const prru_topology *topo;
+  prru_topo_derived derived;
+  prru_topo_simple *simple;
   char name[PRRU_MODEL_NAME_MAX + 1];
   char description[4 * PRRU_MODEL_DESCRIPTION_MAX + 1];
   char sha256[65];
@@ -180,11 +181,11 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
     *c = *s;
     c->mech.name = c->name, c->mech.description = c->description, c->mech.sha256 = c->sha256;
     c->simple = NULL;
-    if (s->simple && !(c->simple = malloc(prru_param_simple_size()))) {
+    if (s->simple && !(c->simple = malloc(sizeof *c->simple))) {
       free(c), free(p);
       return PRRU_ENOMEM;
     }
-    if (s->simple) memcpy(c->simple, s->simple, prru_param_simple_size());
+    if (s->simple) *c->simple = *s->simple;
   } else {
     c->mech = *src->mech;
   }
@@ -198,7 +199,7 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
   out->mech = &c->mech;
   out->own = c;
   if (src->kernel_params)
-    out->kernel_params = src->kernels == &prru_kernels_parameter_simple ? c->simple : (void *)&c->derived;
+    out->kernel_params = src->kernels == s->topo->simple ? (void *)c->simple : (void *)&c->derived;
   return PRRU_OK;
 }
 
@@ -341,6 +342,7 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
     return st;
   }
   l->path = p;
+  l->topo = prru_topology_of(s->nlimb);
   fill_mechanism(s, l);
   free(s);
   prru_model tmp;
@@ -349,7 +351,7 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   tmp.own = l;
   prru_params numbers;
   prru_model_params(&tmp, &numbers);
-  prru_params_derive(&numbers, &l->derived);
+  l->topo->derive(&numbers, &l->derived);
   if (!prru_model_is_built(&tmp, 0) && (st = prru_model_use_parameter_kernels(&tmp)) != PRRU_OK) {
     free(l->path), free(l);
     if (msg && msglen > 0) snprintf(msg, (size_t)msglen, "%s: out of memory", path);
@@ -365,7 +367,7 @@ int prru_model_use_general_kernels(prru_model *m)
 {
   loaded_model *l = m->own;
   if (!l) return PRRU_EINPUT;
-  m->kernels = &prru_kernels_parameter;
+  m->kernels = l->topo->general;
   m->kernel_params = &l->derived;
   return PRRU_OK;
 }
@@ -374,10 +376,10 @@ int prru_model_use_parameter_kernels(prru_model *m)
 {
   loaded_model *l = m->own;
   if (!l) return PRRU_EINPUT;
-  if (!prru_param_structure_simple(&l->derived)) return prru_model_use_general_kernels(m);
-  if (!l->simple && !(l->simple = malloc(prru_param_simple_size()))) return PRRU_ENOMEM;
-  prru_param_simple_derive(&l->derived, l->simple);
-  m->kernels = &prru_kernels_parameter_simple;
+  if (!l->topo->structure_simple(&l->derived)) return prru_model_use_general_kernels(m);
+  if (!l->simple && !(l->simple = malloc(sizeof *l->simple))) return PRRU_ENOMEM;
+  l->topo->simple_derive(&l->derived, l->simple);
+  m->kernels = l->topo->simple;
   m->kernel_params = l->simple;
   return PRRU_OK;
 }
