@@ -455,6 +455,32 @@ static void check_names(void)
   TU_TRUE(strlen(out) == PRRU_MODEL_NAME_MAX && prru_model_name_valid(out), "a 16-character base cut for _opt");
 }
 
+/* The loader's descriptor of the build's own model file has the
+ * generator's layout (prru_topology_layout: sizes, bodies, joints, lambda
+ * labels), member by member. */
+static void check_layout(const char *path)
+{
+  prru_model m;
+  char msg[1024];
+  prru_model_default(&m);
+  if (!TU_TRUE(prru_model_load(&m, path, msg, sizeof msg) == PRRU_OK, "the build's model file loads")) return;
+  const prru_mechanism *a = m.mech, *g = &prru_mech;
+  int ok = a->nq == g->nq && a->nact == g->nact && a->nlimb == g->nlimb && a->nbody == g->nbody &&
+           a->nlambda == g->nlambda && a->njoint == g->njoint && a->platform == g->platform;
+  for (int b = 0; ok && b < g->nbody; b++)
+    ok = strcmp(a->body_names[b], g->body_names[b]) == 0 && a->body_limb[b] == g->body_limb[b];
+  for (int i = 0; ok && i < g->nlimb; i++)
+    ok = a->lower[i] == g->lower[i] && a->upper[i] == g->upper[i] && a->slider[i] == g->slider[i];
+  for (int j = 0; ok && j < g->njoint; j++) {
+    const prru_joint_info *x = &a->joint[j], *y = &g->joint[j];
+    ok = strcmp(x->name, y->name) == 0 && x->type == y->type && x->limb == y->limb && x->proximal == y->proximal &&
+         x->distal == y->distal && x->lambda_offset == y->lambda_offset && x->lambda_count == y->lambda_count;
+  }
+  for (int r = 0; ok && r < g->nlambda; r++) ok = strcmp(a->lambda_labels[r], g->lambda_labels[r]) == 0;
+  TU_TRUE(ok, "the loaded descriptor's layout (sizes, bodies, joints, lambda labels) is the generator's");
+  prru_model_free(&m);
+}
+
 static void check_file(const char *path, int *loaded, int *other, int *specialised, int reactions)
 {
   prru_model_spec spec;
@@ -694,6 +720,7 @@ int main(int argc, char **argv)
   int loaded = 0, other = 0, specialised = 0;
   char dir[2048];
   check_names();
+  check_layout(built);
   check_file(built, &loaded, &other, &specialised, 1);
   TU_TRUE(specialised == 1, "the build's own model file: specialised kernels");
   snprintf(dir, sizeof dir, "%s/models", src);

@@ -232,12 +232,13 @@ static void inverse3(const double a[9], double inv[9])
   for (int i = 0; i < 9; i++) inv[i] = c[i] / det;
 }
 
-/* The spec's numbers into a copy of the build's descriptor (names, joints
- * and layout are the topology's, hence the build's). */
+/* The spec's numbers into a descriptor of l's topology (names, joints
+ * and layout are the topology's). */
 static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
 {
   prru_mechanism *me = &l->mech;
-  *me = prru_mech;
+  memset(me, 0, sizeof *me);
+  prru_topology_layout(l->topo, me);
   memcpy(l->name, s->name, sizeof l->name);
   memcpy(l->description, s->description, sizeof l->description);
   memcpy(l->sha256, s->sha256, sizeof l->sha256);

@@ -42,9 +42,16 @@ typedef struct {
    * kernels' prru_pN_f_batch_dme_terms). */
   void (*f_batch_dme_terms)(const prru_topo_derived *d, int n, const float *q, float *dd, float *Jd,
                             float *M, float *JP);
+  const char *const *lambda_labels; /* the kernels' names of lambda's entries */
 } prru_topology;
 
 /* The topology of nlimb limbs; NULL for another number. */
 const prru_topology *prru_topology_of(int nlimb);
+/* The members of a descriptor that are the topology's, not the model's:
+ * sizes, bodies and their order (P, L1.., U1.., S1..), joints in lambda
+ * order (C_i, B_i, A_i, P_i) and lambda's labels; the generator's layout
+ * (tests/test_model_load.c compares them with the build's descriptor).
+ * Every other member of me is left as it was. */
+void prru_topology_layout(const prru_topology *t, prru_mechanism *me);
 
 #endif
