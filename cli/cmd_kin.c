@@ -453,7 +453,7 @@ int prru_cmd_id(int argc, char **argv)
     double n[PRRU_NACT];
     st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
     /* J_d of this row: on the side of the rows before? */
-    const int crossed = st == PRRU_OK && prru_path_side_crossed(&side, d->Jd);
+    const int crossed = st == PRRU_OK && prru_path_side_crossed(&side, d->Jd, m.mech->nact);
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
     double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
     if (st == PRRU_OK && rates) {

@@ -36,7 +36,7 @@ static int scalar_point(const prru_model *m, const prru_map_grid *g, int home, i
   double rc;
   *w = NAN;
   int st = prru_check_regular(m, D, q, &rc);
-  if (st == PRRU_OK) st = prru_mode_status(st, D->Jd, home);
+  if (st == PRRU_OK) st = prru_mode_status(st, D->Jd, m->mech->nact, home);
   if (st != PRRU_OK) return st;
   prru_dme r;
   st = prru_dme_eval(m, D, q, &r);

@@ -376,10 +376,10 @@ static void path_side(void)
   prru_path_side s;
   prru_path_side_init(&s);
   const int square = PRRU_NACT == 3;
-  TU_TRUE(!prru_path_side_crossed(&s, J0), "path side: a singular first sample records nothing");
-  TU_TRUE(!prru_path_side_crossed(&s, Jp) && s.sign == (square ? 1 : 0), "path side: the first sign");
-  TU_TRUE(!prru_path_side_crossed(&s, J0) && !prru_path_side_crossed(&s, Jp), "path side: the same side");
-  TU_TRUE(prru_path_side_crossed(&s, Jn) == square, "path side: the other side is a crossing (three actuators)");
+  TU_TRUE(!prru_path_side_crossed(&s, J0, PRRU_NACT), "path side: a singular first sample records nothing");
+  TU_TRUE(!prru_path_side_crossed(&s, Jp, PRRU_NACT) && s.sign == (square ? 1 : 0), "path side: the first sign");
+  TU_TRUE(!prru_path_side_crossed(&s, J0, PRRU_NACT) && !prru_path_side_crossed(&s, Jp, PRRU_NACT), "path side: the same side");
+  TU_TRUE(prru_path_side_crossed(&s, Jn, PRRU_NACT) == square, "path side: the other side is a crossing (three actuators)");
   TU_TRUE(s.sign == (square ? 1 : 0), "path side: a crossing keeps the sign before it");
 }
 

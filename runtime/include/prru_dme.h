@@ -104,19 +104,20 @@ typedef struct {
  * other code). */
 PRRU_API const char *prru_dme_status_name(int status);
 
-/* The assembly mode of a pose from its slider positions d and J_d: the
+/* The assembly mode of a pose from its slider positions d and J_d (nact
+ * actuators): the
  * sign of det J_d (prru_jd_det_sign), or 0 when it cannot be told (a
  * slider unreachable, det J_d = 0, more than three actuators); with home
  * 0 no pose is in "the other" mode. */
-PRRU_API int prru_assembly_mode(const double d[], const double Jd[]);
+PRRU_API int prru_assembly_mode(const double d[], const double Jd[], int nact);
 /* 1 when home != 0 and det J_d's sign is not home (a pose beyond the
  * singular locus, or on it), else 0. */
-PRRU_API int prru_jd_other_mode(const double Jd[], int home);
+PRRU_API int prru_jd_other_mode(const double Jd[], int nact, int home);
 /* A reachable pose's status from its regularity status (prru_jd_regular):
  * PRRU_DME_OTHER_MODE when it is PRRU_OK but prru_jd_other_mode, else
  * regular_status. The one classification of the map and the design
  * optimiser. */
-PRRU_API int prru_mode_status(int regular_status, const double Jd[], int home);
+PRRU_API int prru_mode_status(int regular_status, const double Jd[], int nact, int home);
 
 /* Fills out at q (uses d->d, d->Jd, d->M as workspace) and returns
  * out->status. At a non-OK status every double of out except jd_rcond is
@@ -132,7 +133,7 @@ PRRU_API int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3],
  * operations in the same order, its branches as selects), so w_R has one
  * definition. Returns out->status (PRRU_ESINGULAR when a result is not
  * finite); out->jd_rcond is left as it is. */
-PRRU_API int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
+PRRU_API int prru_dme_from(const double M[9], const double Jdpinv[], int nact, const double JP[18],
                            prru_dme *out);
 
 /* ---- Maps over a rectangle of (q1, q2) at fixed q3 ---- */

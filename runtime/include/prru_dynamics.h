@@ -355,12 +355,13 @@ PRRU_API int prru_stroke_why(const prru_model *m, const double d[], char *msg, i
 PRRU_API int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], double *rcond);
 /* (prru_check_regular: PRRU_ESTROKE before the regularity test, as
  * prru_check_reachable.) */
-/* The regularity test of prru_check_regular on a given J_d (finite), for a
- * mechanism of length scale L (m) and tolerance rcond_min: PRRU_OK and
- * Jdpinv = J_d^+, or PRRU_ESINGULAR; *rcond as there. prru_check_regular is
+/* The regularity test of prru_check_regular on a given J_d (finite, nact
+ * x 3), for a mechanism of length scale L (m) and tolerance rcond_min:
+ * PRRU_OK and Jdpinv = J_d^+ (3 x nact), or PRRU_ESINGULAR; *rcond as
+ * there; PRRU_EINPUT for nact other than 3 or 4. prru_check_regular is
  * this with the model's L and jd_rcond_min; the design optimiser calls it
  * with a candidate design's own L, so both judge regularity alike. */
-PRRU_API int prru_jd_regular(const double Jd[], double L, double rcond_min,
+PRRU_API int prru_jd_regular(const double Jd[], int nact, double L, double rcond_min,
                              double Jdpinv[], double *rcond);
 /* The reciprocal 1-norm condition number 1 / (|M_s|_1 |M_s^-1|_1) of
  * M_s = D^-1 M D^-1, D = diag(L, L, 1) with L the model's length scale (the
@@ -375,13 +376,13 @@ PRRU_API double prru_mass_rcond(const prru_model *m, const double M[9]);
  * as an upper link turns horizontal); NaN propagates. The quantity
  * inverse dynamics tests: stretch^2 mass_rcond_min <= 1. */
 PRRU_API double prru_stretch(const prru_model *m, const double Jd[]);
-/* With three actuators, the sign (+1 or -1) of det J_d, 0 where it is 0;
- * always 0 with more actuators (J_d has no determinant, and a path meets
+/* With three actuators (nact, J_d's rows), the sign (+1 or -1) of det
+ * J_d, 0 where it is 0; always 0 with more actuators (J_d has no determinant, and a path meets
  * a rank deficiency of J_d only by exception). det J_d changes sign only
  * through det J_d = 0, so two regular poses of opposite signs lie on
  * either side of the singular locus: the assembly mode (prru_dme.h) and
  * the crossing test of sampled paths (prru traj, prru track) rest on it. */
-PRRU_API int prru_jd_det_sign(const double Jd[]);
+PRRU_API int prru_jd_det_sign(const double Jd[], int nact);
 
 /* Actuator displacements (inverse kinematics). */
 PRRU_API int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[]);

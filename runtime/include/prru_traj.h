@@ -133,10 +133,10 @@ typedef struct {
 } prru_path_side;
 /* Before the first sample. */
 PRRU_API void prru_path_side_init(prru_path_side *s);
-/* 1 when the regular sample's J_d has the opposite sign to the samples
+/* 1 when the regular sample's J_d (nact x 3) has the opposite sign to the samples
  * before (the path crossed the singular set since the last one; the sign
  * kept), else 0 (the sign recorded). */
-PRRU_API int prru_path_side_crossed(prru_path_side *s, const double Jd[]);
+PRRU_API int prru_path_side_crossed(prru_path_side *s, const double Jd[], int nact);
 /* The next sample q of a path: prru_traj_pose_ok's status (d filled as
  * there), or PRRU_ESINGULAR with *crossed = 1 when the pose is regular but
  * on the other side of the singular set (crossed may be NULL). */

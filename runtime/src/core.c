@@ -40,7 +40,7 @@ static int finite3(const double v[3]) { return prru_finite_n(v, 3); }
 int prru_stroke_actuator(const prru_model *m, const double d[])
 {
   const prru_mechanism *me = m->mech;
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < me->nact; i++)
     if (d[i] < me->d_min[i] || d[i] > me->d_max[i]) return i;
   return -1;
 }
@@ -57,7 +57,7 @@ int prru_stroke_why(const prru_model *m, const double d[], char *msg, int msglen
  * skipped where it would cost a kernel call). */
 static int has_stroke(const prru_model *m)
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < m->mech->nact; i++)
     if (m->mech->d_min[i] > -INFINITY || m->mech->d_max[i] < INFINITY) return 1;
   return 0;
 }
@@ -67,7 +67,7 @@ int prru_check_reachable(const prru_model *m, prru_data *d, const double q[3])
   if (!finite3(q)) return PRRU_EINPUT;
   KERNEL(m, ik)(m->kernel_params, q, d->d);
   /* The kernels answer NaN exactly when an acos argument leaves [-1, 1]. */
-  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, m->mech->nact)) return PRRU_EUNREACHABLE;
   return prru_stroke_actuator(m, d->d) < 0 ? PRRU_OK : PRRU_ESTROKE;
 }
 
@@ -100,8 +100,8 @@ double prru_rcond3(const double a[9], double inv[9])
 double prru_length_scale(const prru_mechanism *me)
 {
   double s = 0;
-  for (int i = 0; i < PRRU_NLIMB; i++) s += me->l1[i];
-  return s / PRRU_NLIMB;
+  for (int i = 0; i < me->nlimb; i++) s += me->l1[i];
+  return s / me->nlimb;
 }
 
 /* For a symmetric M and s = 1 / L: the 1-norms of M_s = D^-1 M D^-1
@@ -139,24 +139,24 @@ double prru_stretch(const prru_model *m, const double Jd[])
 {
   const double s = 1.0 / prru_length_scale(m->mech);
   double big = 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < m->mech->nact; i++) {
     const double r = (fabs(Jd[3 * i]) + fabs(Jd[3 * i + 1])) * s + fabs(Jd[3 * i + 2]);
     if (!(r <= big)) big = r; /* NaN propagates */
   }
   return big;
 }
 
-#if PRRU_NACT > 3
-/* 1 / (|A|_1 |A^+|_1) of a full-column-rank NACT x 3 matrix A, with
+/* 1 / (|A|_1 |A^+|_1) of a full-column-rank 4 x 3 matrix A (the
+ * four-actuator topology's J_d, the only redundant one), with
  * X = A^+ = (A^T A)^-1 A^T = R^-1 Q1^T from a Householder QR A = Q R
  * (never the normal equations, which would square the condition number);
  * 0 when A is rank deficient or not finite (X is then unusable). For a
  * square A this is prru_rcond3's quantity, the 1-norm being the operator
- * norm of R^NACT -> R^3 for X: 1 = |X A|_1 <= |X|_1 |A|_1, so it lies in
+ * norm of R^4 -> R^3 for X: 1 = |X A|_1 <= |X|_1 |A|_1, so it lies in
  * (0, 1] and is unchanged by scaling A. */
-static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
+static double rcond_pinv(const double A[4 * 3], double X[3 * 4])
 {
-  enum { N = PRRU_NACT };
+  enum { N = 4 };
   double W[N][3], V[3][N], beta[3];
   PRRU_UNROLLED for (int i = 0; i < N; i++)
     PRRU_UNROLLED for (int j = 0; j < 3; j++) W[i][j] = A[3 * i + j];
@@ -216,9 +216,8 @@ static double rcond_pinv(const double A[PRRU_NACT * 3], double X[3 * PRRU_NACT])
   if (!isfinite(nx) || !(nx > 0)) return 0.0;
   return 1.0 / (na * nx);
 }
-#endif
 
-int prru_jd_regular(const double Jd[], double L, double rcond_min,
+int prru_jd_regular(const double Jd[], int nact, double L, double rcond_min,
                     double Jdpinv[], double *rcond)
 {
   /* J_d's rotation columns are lengths per radian, its height column is
@@ -228,26 +227,26 @@ int prru_jd_regular(const double Jd[], double L, double rcond_min,
    * model's own scale), the same for a robot of any size; and
    * J_d^+ = diag(1/L, 1/L, 1) Js^+ (for three actuators, J_d^-1 =
    * diag(1/L, 1/L, 1) Js^-1). */
-  double Js[3 * PRRU_NACT];
-  for (int i = 0; i < PRRU_NACT; i++) {
+  if (nact != 3 && nact != 4) {
+    if (rcond) *rcond = 0.0;
+    return PRRU_EINPUT;
+  }
+  double Js[3 * PRRU_MAX_ACT];
+  for (int i = 0; i < nact; i++) {
     Js[3 * i] = Jd[3 * i] / L;
     Js[3 * i + 1] = Jd[3 * i + 1] / L;
     Js[3 * i + 2] = Jd[3 * i + 2];
   }
-#if PRRU_NACT == 3
-  double rc = prru_rcond3(Js, Jdpinv);
-#else
-  double rc = rcond_pinv(Js, Jdpinv);
-#endif
-  for (int j = 0; j < 2 * PRRU_NACT; j++) Jdpinv[j] /= L;
+  double rc = nact == 3 ? prru_rcond3(Js, Jdpinv) : rcond_pinv(Js, Jdpinv);
+  for (int j = 0; j < 2 * nact; j++) Jdpinv[j] /= L;
   if (rcond) *rcond = rc;
   /* rc > 0 also when rcond_min is 0: an exactly singular J_d has no inverse. */
   return rc > 0 && rc >= rcond_min ? PRRU_OK : PRRU_ESINGULAR;
 }
 
-int prru_jd_det_sign(const double Jd[])
+int prru_jd_det_sign(const double Jd[], int nact)
 {
-  if (PRRU_NACT != 3) return 0;
+  if (nact != 3) return 0;
   const double *a = Jd;
   double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
                a[2] * (a[3] * a[7] - a[4] * a[6]);
@@ -259,21 +258,21 @@ int prru_check_regular(const prru_model *m, prru_data *d, const double q[3], dou
   if (rcond) *rcond = 0.0;
   if (!finite3(q)) return PRRU_EINPUT;
   KERNEL(m, ik_jd)(m->kernel_params, q, d->d, d->Jd);
-  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, m->mech->nact)) return PRRU_EUNREACHABLE;
   if (prru_stroke_actuator(m, d->d) >= 0) return PRRU_ESTROKE;
-  return prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
+  return prru_jd_regular(d->Jd, m->mech->nact, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, rcond);
 }
 
 int prru_actuators(const prru_model *m, prru_data *d, const double q[3], double act[])
 {
   int st = prru_check_reachable(m, d, q);
-  if (st == PRRU_OK) memcpy(act, d->d, PRRU_NACT * sizeof(double));
+  if (st == PRRU_OK) memcpy(act, d->d, (size_t)m->mech->nact * sizeof(double));
   return st;
 }
 
-static int loads_finite(const prru_loads *l)
+static int loads_finite(const prru_model *m, const prru_loads *l)
 {
-  return prru_finite_n(l->fd, PRRU_NACT) && finite3(l->fp) && finite3(l->mp);
+  return prru_finite_n(l->fd, m->mech->nact) && finite3(l->fp) && finite3(l->mp);
 }
 
 /* Why prru_eom produced non-finite output from finite inputs: q out of
@@ -282,7 +281,7 @@ static int loads_finite(const prru_loads *l)
  * that the arithmetic overflows at a regular q. */
 static int classify_failure(const prru_model *m, prru_data *d, const double q[3])
 {
-  static const double zero[3] = {0, 0, 0}, zero_fd[PRRU_NACT] = {0};
+  static const double zero[3] = {0, 0, 0}, zero_fd[PRRU_MAX_ACT] = {0};
   int st = prru_check_reachable(m, d, q);
   if (st != PRRU_OK) return st;
   double M[9], b[3];
@@ -295,7 +294,7 @@ PRRU_COLD static int forward_failure(const prru_model *m, prru_data *d, const do
                                      const double qd[3], const prru_loads *l,
                                      const double minors[3])
 {
-  if (!finite3(q) || !finite3(qd) || !loads_finite(l)) return PRRU_EINPUT;
+  if (!finite3(q) || !finite3(qd) || !loads_finite(m, l)) return PRRU_EINPUT;
   if (!finite3(d->b)) return classify_failure(m, d, q);
   if (!(minors[0] > 0) || !(minors[1] > 0) || !(minors[2] > 0)) return PRRU_ESINGULAR;
   return PRRU_EINPUT; /* b finite, M^-1 b overflowed */
@@ -337,7 +336,7 @@ int prru_forward_verdict(const prru_model *m, prru_data *d, const double q[3], c
       !(na * ni * m->mass_rcond_min <= det))
     return PRRU_ESINGULAR;
   if (has_stroke(m)) { /* the kernel leaves no d: one more for the stroke */
-    double act[PRRU_NACT];
+    double act[PRRU_MAX_ACT];
     KERNEL(m, ik)(m->kernel_params, q, act);
     if (prru_stroke_actuator(m, act) >= 0) return PRRU_ESTROKE;
   }
@@ -359,7 +358,7 @@ int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[
     return prru_fail(msg, msglen, st, "q = %s is outside the workspace (no inverse kinematics)", qs);
   case PRRU_ESTROKE: {
     char why[160];
-    double act[PRRU_NACT];
+    double act[PRRU_MAX_ACT];
     KERNEL(m, ik)(m->kernel_params, q, act);
     prru_stroke_why(m, act, why, sizeof why);
     return prru_fail(msg, msglen, st, "q = %s is out_of_stroke: %s", qs, why);
@@ -379,7 +378,7 @@ int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[
   }
   default: /* PRRU_EINPUT */
     if (!finite3(q)) return prru_fail(msg, msglen, st, "q is not finite");
-    if (!finite3(qd) || !loads_finite(l))
+    if (!finite3(qd) || !loads_finite(m, l))
       return prru_fail(msg, msglen, st, "the velocities or the loads are not finite");
     return prru_fail(msg, msglen, st,
                      "the dynamics overflow at q = %s: the velocities qd = (%.3g, %.3g, %.3g) or "
@@ -388,7 +387,6 @@ int prru_forward_dynamics_why(const prru_model *m, prru_data *d, const double q[
   }
 }
 
-#if PRRU_NACT == 3
 /* prru_jd_regular's test rc >= rcond_min, rc = 1 / (|Js|_1 |Js^-1|_1) with
  * Js = J_d diag(1/L, 1/L, 1), from J_d and J_d^-1 (Js^-1 = diag(L, L, 1)
  * J_d^-1) and without a division on the kernel's outputs: with
@@ -408,11 +406,10 @@ static int regular_from_inverse(const double J[9], const double inv[9], double L
   const double p = na * ni;
   return p > 0 && isfinite(p) && p * rcond_min <= L;
 }
-#endif
 
 /* Inverse dynamics' half of the trust criterion (prru_model.mass_rcond_min):
  * stretch^2 mass_rcond_min <= 1, false for a NaN stretch. */
-static int near_boundary_ok(const prru_model *m, const double Jd[PRRU_NACT * 3])
+static int near_boundary_ok(const prru_model *m, const double Jd[])
 {
   const double r = prru_stretch(m, Jd);
   return r * r * m->mass_rcond_min <= 1.0;
@@ -428,34 +425,31 @@ PRRU_COLD static int inverse_failure(int st, const double q[3], const double qd[
   return st;
 }
 
-#if PRRU_NACT == 3
 int prru_inverse3_status(const prru_model *m, const prru_data *d, const double fd[3])
 {
-  if (!prru_finite_n(d->d, PRRU_NACT)) return PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, 3)) return PRRU_EUNREACHABLE;
   if (prru_stroke_actuator(m, d->d) >= 0) return PRRU_ESTROKE;
   if (!regular_from_inverse(d->Jd, d->Jdpinv, prru_length_scale(m->mech), m->jd_rcond_min))
     return PRRU_ESINGULAR;
   if (!near_boundary_ok(m, d->Jd)) return PRRU_ESINGULAR;
   return prru_finite_n(fd, 3) ? PRRU_OK : PRRU_EINPUT;
 }
-#else
-int prru_inverse4_status(const prru_model *m, prru_data *d, const double tau[3],
-                         double f[PRRU_NACT])
+
+int prru_inverse4_status(const prru_model *m, prru_data *d, const double tau[3], double f[4])
 {
   int st;
-  if (!prru_finite_n(d->d, PRRU_NACT)) st = PRRU_EUNREACHABLE;
+  if (!prru_finite_n(d->d, 4)) st = PRRU_EUNREACHABLE;
   else if (prru_stroke_actuator(m, d->d) >= 0) st = PRRU_ESTROKE;
-  else st = prru_jd_regular(d->Jd, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
+  else st = prru_jd_regular(d->Jd, 4, prru_length_scale(m->mech), m->jd_rcond_min, d->Jdpinv, NULL);
   if (st == PRRU_OK && !near_boundary_ok(m, d->Jd)) st = PRRU_ESINGULAR;
   if (st != PRRU_OK) return st;
   const double *inv = d->Jdpinv;
-  enum { N = PRRU_NACT };
-  /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x NACT), the
+  enum { N = 4 };
+  /* fd = J_d^+T tau: row i of J_d^+T is column i of J_d^+ (3 x 4), the
    * solution of J_d^T fd = tau of least norm; non-finite where tau is. */
   for (int i = 0; i < N; i++) f[i] = inv[i] * tau[0] + inv[N + i] * tau[1] + inv[2 * N + i] * tau[2];
   return prru_finite_n(f, N) ? PRRU_OK : PRRU_EINPUT;
 }
-#endif
 
 int prru_inverse_failure(int st, const double q[3], const double qd[3], const double qdd[3],
                          const prru_loads *l)
@@ -468,23 +462,24 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
                           double fd[])
 {
   int st;
-#if PRRU_NACT == 3
-  /* One kernel gives d, J_d, J_d^-1 and fd = J_d^-T (M qdd - b); here only
-   * prru_check_regular's test, on that J_d and J_d^-1. */
-  double f[3];
-  KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
-  st = prru_inverse3_status(m, d, f);
-#else
-  /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T fp +
-   * J_R,P^T mp - h): prru_check_regular's test on that J_d. */
-  double tau[3], f[PRRU_NACT];
-  KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau);
-  st = prru_inverse4_status(m, d, tau, f);
-#endif
+  const int na = m->mech->nact;
+  double f[PRRU_MAX_ACT];
+  if (na == 3) {
+    /* One kernel gives d, J_d, J_d^-1 and fd = J_d^-T (M qdd - b); here
+     * only prru_check_regular's test, on that J_d and J_d^-1. */
+    KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, d->Jdpinv, f);
+    st = prru_inverse3_status(m, d, f);
+  } else {
+    /* One kernel gives d, J_d and J_d^T fd = tau = M qdd - (G + J_T,P^T
+     * fp + J_R,P^T mp - h): prru_check_regular's test on that J_d. */
+    double tau[3];
+    KERNEL(m, inverse_terms)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau);
+    st = prru_inverse4_status(m, d, tau, f);
+  }
   /* Inputs tested through the outputs, as in prru_forward_dynamics. */
   if (st != PRRU_OK || !KERNEL(m, unseen_finite_inverse_terms)(q, qd, qdd, l->fp, l->mp))
     return inverse_failure(st, q, qd, qdd, l);
-  memcpy(fd, f, sizeof f);
+  memcpy(fd, f, (size_t)na * sizeof *f);
   return PRRU_OK;
 }
 
@@ -492,10 +487,9 @@ int prru_inverse_dynamics(const prru_model *m, prru_data *d, const double q[3],
  * generalized cross product of J_d's three columns, orthogonal to each of
  * them. Column scaling (J_d diag(1/L, 1/L, 1)) scales every minor alike,
  * so the scaled J_d is used: no over- or underflow for any robot size. */
-#if PRRU_NPRELOAD == 1
-int prru_null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], double n[PRRU_NACT])
+int prru_null_from_jd(const prru_model *m, const double Jd[4 * 3], double n[4])
 {
-  enum { N = PRRU_NACT };
+  enum { N = 4 };
   const double L = prru_length_scale(m->mech);
   double Js[N][3], v[N], nn = 0;
   for (int i = 0; i < N; i++) {
@@ -526,21 +520,15 @@ int prru_null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], doubl
   for (int i = 0; i < N; i++) n[i] = sg * v[i] / nn;
   return PRRU_OK;
 }
-#endif
 
 int prru_actuator_null(const prru_model *m, prru_data *d, const double q[3],
                        double n[])
 {
-#if PRRU_NPRELOAD == 0
-  (void)m, (void)d, (void)q, (void)n;
-  return PRRU_EINPUT;
-#elif PRRU_NPRELOAD == 1
+  /* Four actuators have a one-dimensional null space; three have none. */
+  if (m->mech->nact != 4) return PRRU_EINPUT;
   int st = prru_check_regular(m, d, q, NULL);
   if (st != PRRU_OK) return st;
   return prru_null_from_jd(m, d->Jd, n);
-#else
-#error "more than one redundant actuator is not implemented"
-#endif
 }
 
 int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const double q[3],
@@ -548,22 +536,21 @@ int prru_inverse_dynamics_preload(const prru_model *m, prru_data *d, const doubl
                                   double preload, double fd[])
 {
   if (!isfinite(preload)) return PRRU_EINPUT;
-#if PRRU_NPRELOAD == 0
-  if (preload != 0.0) return PRRU_EINPUT;
-  return prru_inverse_dynamics(m, d, q, qd, qdd, l, fd);
-#else
-  double f[PRRU_NACT], n[PRRU_NACT];
+  if (m->mech->nact != 4) {
+    if (preload != 0.0) return PRRU_EINPUT;
+    return prru_inverse_dynamics(m, d, q, qd, qdd, l, fd);
+  }
+  double f[4], n[4];
   int st = prru_inverse_dynamics(m, d, q, qd, qdd, l, f);
   if (st != PRRU_OK) return st;
   if (preload != 0.0) {
     st = prru_null_from_jd(m, d->Jd, n);
     if (st != PRRU_OK) return st;
-    for (int i = 0; i < PRRU_NACT; i++) f[i] += preload * n[i];
-    if (!prru_finite_n(f, PRRU_NACT)) return PRRU_EINPUT;
+    for (int i = 0; i < 4; i++) f[i] += preload * n[i];
+    if (!prru_finite_n(f, 4)) return PRRU_EINPUT;
   }
   memcpy(fd, f, sizeof f);
   return PRRU_OK;
-#endif
 }
 
 int prru_energies(const prru_model *m, const double q[3], const double qd[3], double *T,
@@ -575,7 +562,7 @@ int prru_energies(const prru_model *m, const double q[3], const double qd[3], do
   if (!isfinite(E[0]) || !isfinite(E[1])) {
     /* NaN where q is out of reach; at a reachable q only an overflow of
      * huge velocities (bad input) makes the energy infinite. */
-    double act[PRRU_NACT];
+    double act[PRRU_MAX_ACT];
     KERNEL(m, ik)(m->kernel_params, q, act);
     return isfinite(act[0]) ? PRRU_EINPUT : PRRU_EUNREACHABLE;
   }

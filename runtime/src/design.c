@@ -459,7 +459,7 @@ static int home_mode(const prru_param_derived *p, double q3)
   const double q[3] = {0.0, 0.0, q3};
   double d[PRRU_NACT], Jd[PRRU_NACT * 3];
   prru_param_ik_jd(p, q, d, Jd);
-  return prru_assembly_mode(d, Jd);
+  return prru_assembly_mode(d, Jd, PRRU_NACT);
 }
 
 /* The design's kernels at a block of grid points, from the batched

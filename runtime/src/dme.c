@@ -18,35 +18,34 @@ const char *prru_dme_status_name(int status)
   }
 }
 
-int prru_assembly_mode(const double d[], const double Jd[])
+int prru_assembly_mode(const double d[], const double Jd[], int nact)
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < nact; i++)
     if (!isfinite(d[i])) return 0;
-  return prru_jd_det_sign(Jd);
+  return prru_jd_det_sign(Jd, nact);
 }
 
-int prru_jd_other_mode(const double Jd[], int home)
+int prru_jd_other_mode(const double Jd[], int nact, int home)
 {
-  return home != 0 && prru_jd_det_sign(Jd) != home;
+  return home != 0 && prru_jd_det_sign(Jd, nact) != home;
 }
 
-int prru_mode_status(int regular_status, const double Jd[], int home)
+int prru_mode_status(int regular_status, const double Jd[], int nact, int home)
 {
-  return regular_status == PRRU_OK && prru_jd_other_mode(Jd, home) ? PRRU_DME_OTHER_MODE
-                                                                   : regular_status;
+  return regular_status == PRRU_OK && prru_jd_other_mode(Jd, nact, home) ? PRRU_DME_OTHER_MODE
+                                                                         : regular_status;
 }
 
-/* N = PRRU_NACT: J_d^+ is 3 x N, Mt N x N, JtR and JtT 3 x N. Every sum
- * below runs left to right from its first term, as the three-term
+/* With N actuators J_d^+ is 3 x N, Mt N x N, JtR and JtT 3 x N. Every
+ * sum below runs left to right from its first term, as the three-term
  * expressions it generalizes did, so three actuators give the same bits. */
-#define N PRRU_NACT
 
 static double dot3(const double *a, const double *b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static double dotn(const double *a, const double *b)
+static double dotn(int N, const double *a, const double *b)
 {
   double s = a[0] * b[0];
   for (int i = 1; i < N; i++) s += a[i] * b[i];
@@ -54,7 +53,7 @@ static double dotn(const double *a, const double *b)
 }
 
 /* c = a b, a 3x3, b 3xN, row-major. */
-static void mul3n(const double a[9], const double *b, double *c)
+static void mul3n(int N, const double a[9], const double *b, double *c)
 {
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < N; j++)
@@ -81,8 +80,8 @@ static void set_undefined(prru_dme *out)
     out->axis_dir[i][0] = out->axis_dir[i][1] = out->axis_dir[i][2] = nan;
   }
   for (int i = 0; i < 3; i++) out->dir_T[i] = nan;
-  for (int i = 0; i < N * N; i++) out->Mt[i] = nan;
-  for (int i = 0; i < 3 * N; i++) out->JtR[i] = out->JtT[i] = nan;
+  for (int i = 0; i < PRRU_MAX_ACT * PRRU_MAX_ACT; i++) out->Mt[i] = nan;
+  for (int i = 0; i < 3 * PRRU_MAX_ACT; i++) out->JtR[i] = out->JtT[i] = nan;
 }
 
 static int fail(prru_dme *out, int status)
@@ -102,26 +101,28 @@ int prru_dme_eval(const prru_model *m, prru_data *d, const double q[3], prru_dme
   double jp[18];
   KERNEL(m, mass)(m->kernel_params, q, d->M);
   KERNEL(m, platform_jacobian)(m->kernel_params, q, jp);
-  return prru_dme_from(d->M, d->Jdpinv, jp, out);
+  return prru_dme_from(d->M, d->Jdpinv, m->mech->nact, jp, out);
 }
 
-int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
+int prru_dme_from(const double M[9], const double Jdpinv[], int nact, const double JP[18],
                   prru_dme *out)
 {
+  if (nact != 3 && nact != 4) return fail(out, PRRU_EINPUT);
+  const int N = nact == 3 ? 3 : 4; /* (what GCC can tell is at least 1) */
   const double *jinv = Jdpinv;
-  double tmp[3 * N];
+  double tmp[3 * PRRU_MAX_ACT];
   const double *jrp = JP, *jtp = JP + 9;
 
   /* Mt = J^+T M J^+ (symmetrized: it is symmetric in exact arithmetic). */
-  mul3n(M, jinv, tmp);
+  mul3n(N, M, jinv, tmp);
   for (int i = 0; i < N; i++)
     for (int j = i; j < N; j++) {
       double s = jinv[i] * tmp[j] + jinv[N + i] * tmp[N + j] + jinv[2 * N + i] * tmp[2 * N + j];
       double s2 = jinv[j] * tmp[i] + jinv[N + j] * tmp[N + i] + jinv[2 * N + j] * tmp[2 * N + i];
       out->Mt[N * i + j] = out->Mt[N * j + i] = 0.5 * (s + s2);
     }
-  mul3n(jrp, jinv, out->JtR);
-  mul3n(jtp, jinv, out->JtT);
+  mul3n(N, jrp, jinv, out->JtR);
+  mul3n(N, jtp, jinv, out->JtT);
 
   /* Orthonormal basis Q of range(J_R,P): the column of largest norm, then
    * the largest remainder of the others after removing it. */
@@ -154,19 +155,19 @@ int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
 
   /* C = Q^T JtR (rows c0, c1: 2 x N), S = C C^T (2x2 SPD),
    * G = Mt C^T S^-1 (N x 2, columns g0, g1). */
-  double c0[N], c1[N];
+  double c0[PRRU_MAX_ACT], c1[PRRU_MAX_ACT];
   for (int j = 0; j < N; j++) {
     c0[j] = q0[0] * out->JtR[j] + q0[1] * out->JtR[N + j] + q0[2] * out->JtR[2 * N + j];
     c1[j] = q1[0] * out->JtR[j] + q1[1] * out->JtR[N + j] + q1[2] * out->JtR[2 * N + j];
   }
-  double s00 = dotn(c0, c0), s01 = dotn(c0, c1), s11 = dotn(c1, c1);
+  double s00 = dotn(N, c0, c0), s01 = dotn(N, c0, c1), s11 = dotn(N, c1, c1);
   double det = s00 * s11 - s01 * s01;
   if (!(det > 0)) return fail(out, PRRU_ESINGULAR);
   double i00 = s11 / det, i01 = -s01 / det, i11 = s00 / det;
-  double mc0[N], mc1[N], g0[N], g1[N];
+  double mc0[PRRU_MAX_ACT], mc1[PRRU_MAX_ACT], g0[PRRU_MAX_ACT], g1[PRRU_MAX_ACT];
   for (int i = 0; i < N; i++) {
-    mc0[i] = dotn(out->Mt + N * i, c0);
-    mc1[i] = dotn(out->Mt + N * i, c1);
+    mc0[i] = dotn(N, out->Mt + N * i, c0);
+    mc1[i] = dotn(N, out->Mt + N * i, c1);
   }
   for (int i = 0; i < N; i++) {
     g0[i] = mc0[i] * i00 + mc1[i] * i01;
@@ -176,19 +177,19 @@ int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
   /* One-sided Jacobi: the rotation (c, -s; s, c) that diagonalizes
    * G^T G = [a g; g b] (Golub & Van Loan, sym.schur2) leaves G's columns
    * orthogonal, so their norms are the singular values. */
-  double a = dotn(g0, g0), b = dotn(g1, g1), g = dotn(g0, g1), cs = 1.0, sn = 0.0;
+  double a = dotn(N, g0, g0), b = dotn(N, g1, g1), g = dotn(N, g0, g1), cs = 1.0, sn = 0.0;
   if (g != 0.0) {
     double tau = (b - a) / (2.0 * g);
     double t = (tau >= 0 ? 1.0 : -1.0) / (fabs(tau) + sqrt(1.0 + tau * tau));
     cs = 1.0 / sqrt(1.0 + t * t);
     sn = t * cs;
   }
-  double h0[N], h1[N];
+  double h0[PRRU_MAX_ACT], h1[PRRU_MAX_ACT];
   for (int i = 0; i < N; i++) {
     h0[i] = cs * g0[i] - sn * g1[i];
     h1[i] = sn * g0[i] + cs * g1[i];
   }
-  double sa = sqrt(dotn(h0, h0)), sb = sqrt(dotn(h1, h1));
+  double sa = sqrt(dotn(N, h0, h0)), sb = sqrt(dotn(N, h1, h1));
   /* Right singular vectors in the (q0, q1) coordinates: (cs, -sn), (sn, cs). */
   double va[3], vb[3];
   for (int i = 0; i < 3; i++) {
@@ -220,7 +221,7 @@ int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
    * runs along u, the direction of JtT's largest column. */
   double f2 = 0, mf2 = 0;
   int kt = 0;
-  double cn[N];
+  double cn[PRRU_MAX_ACT];
   for (int j = 0; j < N; j++) { /* cn[j] = |column j of JtT|^2 */
     cn[j] = 0;
     for (int i = 0; i < 3; i++) {
@@ -233,7 +234,7 @@ int prru_dme_from(const double M[9], const double Jdpinv[], const double JP[18],
   for (int j = 0; j < 3; j++)
     for (int i = 0; i < N; i++) {
       /* (Mt JtT^T)_{ij} = sum_l Mt_il JtT_jl */
-      double y = dotn(out->Mt + N * i, out->JtT + N * j);
+      double y = dotn(N, out->Mt + N * i, out->JtT + N * j);
       mf2 += y * y;
     }
   if (!(f2 > 0) || !(mf2 > 0)) return fail(out, PRRU_ESINGULAR);

@@ -32,21 +32,16 @@ extern const prru_kernel_table prru_kernels_specialised;
  * PRRU_UNSEEN_FINITE_* test of the inputs its outputs do not witness. */
 int prru_forward_verdict(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                          const prru_loads *l, const double minors[3], int unseen_finite);
-#if PRRU_NACT == 3
 /* prru_inverse_dynamics's test (three actuators) of inverse_terms's
  * outputs: d, J_d and J_d^-1 in d (d->d, d->Jd, d->Jdpinv), fd. */
 int prru_inverse3_status(const prru_model *m, const prru_data *d, const double fd[3]);
-#else
 /* prru_inverse_dynamics's test (four actuators) of inverse_terms's
  * outputs d and J_d (d->d, d->Jd; d->Jdpinv = J_d^+ where regular), and
  * the minimum-norm fd = J_d^+T tau into f. */
-int prru_inverse4_status(const prru_model *m, prru_data *d, const double tau[3],
-                         double f[PRRU_NACT]);
-#endif
-#if PRRU_NPRELOAD == 1
-/* prru_actuator_null's n from a regular J_d: PRRU_OK or PRRU_ESINGULAR. */
-int prru_null_from_jd(const prru_model *m, const double Jd[PRRU_NACT * 3], double n[PRRU_NACT]);
-#endif
+int prru_inverse4_status(const prru_model *m, prru_data *d, const double tau[3], double f[4]);
+/* prru_actuator_null's n from a regular four-actuator J_d: PRRU_OK or
+ * PRRU_ESINGULAR. */
+int prru_null_from_jd(const prru_model *m, const double Jd[4 * 3], double n[4]);
 /* The status of a failed inverse test st once the inputs are examined:
  * PRRU_EINPUT where one is not finite, else st. */
 int prru_inverse_failure(int st, const double q[3], const double qd[3], const double qdd[3],

@@ -279,9 +279,9 @@ int prru_map_eval_rows(const prru_model *m, const prru_map_grid *g, int row_begi
 
 int prru_map_home_mode(const prru_model *m, const prru_map_grid *g)
 {
-  double d[PRRU_NACT], Jd[PRRU_NACT * 3];
+  double d[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3];
   KERNEL(m, ik_jd)(m->kernel_params, (const double[3]){0.0, 0.0, g->q3}, d, Jd);
-  return prru_assembly_mode(d, Jd);
+  return prru_assembly_mode(d, Jd, m->mech->nact);
 }
 
 int prru_map_eval(const prru_model *m, const prru_map_grid *g, const prru_map_options *o,

@@ -119,7 +119,7 @@ static int point_terms(topp_ctx *c, int j)
                      st == PRRU_EUNREACHABLE ? "outside the workspace"
                      : st == PRRU_ESINGULAR  ? "at a singularity (J_d singular)"
                                              : prru_strerror(st));
-  if (prru_path_side_crossed(&c->side, c->d->Jd))
+  if (prru_path_side_crossed(&c->side, c->d->Jd, c->m->mech->nact))
     return prru_fail(c->msg, c->msglen, PRRU_EINPUT,
                      "%s: the path crosses a singularity before q = (%.9g, %.9g, %.9g) (det J_d "
                      "changes sign)", at, q[0], q[1], q[2]);

@@ -352,9 +352,9 @@ int prru_traj_pose_ok(const prru_model *m, prru_data *d, const double q[3], doub
 
 void prru_path_side_init(prru_path_side *s) { s->sign = 0; }
 
-int prru_path_side_crossed(prru_path_side *s, const double Jd[])
+int prru_path_side_crossed(prru_path_side *s, const double Jd[], int nact)
 {
-  const int sg = prru_jd_det_sign(Jd);
+  const int sg = prru_jd_det_sign(Jd, nact);
   if (sg * s->sign < 0) return 1;
   if (sg) s->sign = sg;
   return 0;
@@ -366,7 +366,7 @@ int prru_path_sample(prru_path_side *s, const prru_model *m, prru_data *d, const
   if (crossed) *crossed = 0;
   const int st = prru_traj_pose_ok(m, d, q, rcond);
   if (st != PRRU_OK) return st;
-  if (prru_path_side_crossed(s, d->Jd)) {
+  if (prru_path_side_crossed(s, d->Jd, m->mech->nact)) {
     if (crossed) *crossed = 1;
     return PRRU_ESINGULAR;
   }
