@@ -937,7 +937,7 @@ static int write_report(const char *path, const opt_report *rp)
   if (pr->stroke) fprintf(f, "; sliders within [%.17g, %.17g] m", pr->stroke_lo, pr->stroke_hi);
   {
     char lt[400];
-    prru_limits_describe(rp->limits, lt, sizeof lt);
+    prru_limits_describe(prru_cli_model(), rp->limits, lt, sizeof lt);
     fprintf(f, "\nlimits: %s (w_R has no forces or speeds: only the stroke acts)", lt);
   }
   fprintf(f, "\nobjective: %s (%s), penalty weight %g\n", prru_objective_name(pr->objective),

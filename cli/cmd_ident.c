@@ -157,7 +157,7 @@ static void excite_limits_comment(prru_cli_out *out, const prru_limits *run, con
     dflt |= !isfinite(run->force_max[i]);
     applied.force_max[i] = o->fd_max[i];
   }
-  prru_limits_describe(&applied, text, sizeof text);
+  prru_limits_describe(prru_cli_model(), &applied, text, sizeof text);
   prru_cli_out_comment_line(out, "limits: %s%s", text, dflt ? " (force: excite's default where the run has none)" : "");
 }
 

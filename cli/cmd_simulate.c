@@ -138,12 +138,12 @@ int prru_cmd_simulate(int argc, char **argv)
   if (scen && strcmp(scen, "paper") == 0) {
     prru_scenario_paper(&s);
   } else if (scen) {
-    if (prru_scenario_read(&s, scen, msg, sizeof msg) != PRRU_OK) {
+    if (prru_scenario_read(prru_cli_model(), &s, scen, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error("simulate", "--scenario %s", msg);
       return 2;
     }
   } else {
-    prru_scenario_parse(&s, "", 0, "defaults", NULL, msg, sizeof msg);
+    prru_scenario_parse(prru_cli_model(), &s, "", 0, "defaults", NULL, msg, sizeof msg);
   }
   int bad = 0;
   if (q0s) bad |= prru_cli_numbers("simulate", "q0", q0s, s.q0, 3);
@@ -200,7 +200,7 @@ int prru_cmd_simulate(int argc, char **argv)
   }
   if (loads && !bad) {
     prru_load_schedule t;
-    if (prru_schedule_read_csv(&t, loads, msg, sizeof msg) != PRRU_OK) {
+    if (prru_schedule_read_csv(prru_cli_model(), &t, loads, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error("simulate", "--loads %s", msg);
       bad = 2;
     } else {

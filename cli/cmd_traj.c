@@ -1068,7 +1068,7 @@ int prru_cmd_track(int argc, char **argv)
     o.d_max[i] = limits.d_max[i];
   if (track_options_checked(&o)) return 2;
   char limits_text[400];
-  prru_limits_describe(&limits, limits_text, sizeof limits_text);
+  prru_limits_describe(prru_cli_model(), &limits, limits_text, sizeof limits_text);
   if (mism && parse_mismatch(mism, &o.plant)) return 2;
   prru_quintic tr;
   int rc = refs ? csv_reference(refs, &tr) : waypoint_reference("track", wps, durs, &tr);

@@ -18,7 +18,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
   char msg[512] = "";
   prru_scenario s;
-  int st = prru_scenario_parse(&s, (const char *)data, size, "fuzz.scn", NULL, msg, sizeof msg);
+  prru_model m;
+  prru_model_default(&m);
+  int st = prru_scenario_parse(&m, &s, (const char *)data, size, "fuzz.scn", NULL, msg, sizeof msg);
   if (st != PRRU_OK) {
     if (!msg[0] || strncmp(msg, "fuzz.scn", 8) != 0) abort();
     return 0;

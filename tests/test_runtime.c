@@ -715,6 +715,7 @@ static void busy_loads(prru_load_schedule *s, const double q[3], double t_from, 
   s->rows = calloc((size_t)n * R, sizeof(double));
   if (!s->rows) { TU_TRUE(0, "out of memory"); return; }
   s->kind = PRRU_LOAD_TABLE;
+  s->nact = model.mech->nact;
   s->nrows = n;
   for (int i = 0; i < n; i++) {
     s->rows[R * i] = t_from + i * tau;
@@ -977,7 +978,7 @@ static void test_parsing(void)
   csv_fd_header(fdh1, sizeof fdh1, PRRU_NACT - 1);
   snprintf(csv, sizeof csv, "%s,fp3\n0,0,10,20%s,1\n1,10,10,0%s,3\n", fdh,
            csv_repeat(",5", PRRU_NACT - 3), csv_repeat(",7", PRRU_NACT - 3));
-  TU_TRUE(prru_schedule_parse_csv(&s, csv, strlen(csv), "mem", msg, 300) == PRRU_OK, "load table parses");
+  TU_TRUE(prru_schedule_parse_csv(&model, &s, csv, strlen(csv), "mem", msg, 300) == PRRU_OK, "load table parses");
   prru_loads l;
   prru_schedule_eval(&s, 0.25, &l);
   int extra_ok = 1;
@@ -1013,7 +1014,7 @@ static void test_parsing(void)
       {t_twice, "appears twice"},
   };
   for (size_t i = 0; i < sizeof bad_csv / sizeof bad_csv[0]; i++) {
-    int st = prru_schedule_parse_csv(&s, bad_csv[i].text, strlen(bad_csv[i].text), "mem", msg, 300);
+    int st = prru_schedule_parse_csv(&model, &s, bad_csv[i].text, strlen(bad_csv[i].text), "mem", msg, 300);
     TU_TRUE(st == PRRU_EPARSE && strstr(msg, bad_csv[i].needle), bad_csv[i].needle);
     if (!(st == PRRU_EPARSE && strstr(msg, bad_csv[i].needle))) fprintf(stderr, "  got: %s\n", msg);
   }
@@ -1022,7 +1023,7 @@ static void test_parsing(void)
   snprintf(ok, sizeof ok,
            "# test\nq0 = 0, 0.5, -0.8\nfd = 50,40,25%s\nharmonic = 50, 12.566370614359172\n"
            "t_end = 0.5\ndt = 0.01\nstepper = rkck\n", csv_repeat(",25", PRRU_NACT - 3));
-  TU_TRUE(prru_scenario_parse(&sc, ok, strlen(ok), "mem", NULL, msg, 300) == PRRU_OK &&
+  TU_TRUE(prru_scenario_parse(&model, &sc, ok, strlen(ok), "mem", NULL, msg, 300) == PRRU_OK &&
               sc.q0[1] == 0.5 && sc.opt.stepper == PRRU_RKCK && sc.loads.kind == PRRU_LOAD_HARMONIC &&
               sc.loads.base.fd[PRRU_NACT - 1] == 25,
           "scenario parses");
@@ -1030,11 +1031,11 @@ static void test_parsing(void)
   /* fd takes exactly one number per actuator. */
   char fd_short[128];
   snprintf(fd_short, sizeof fd_short, "fd = 1%s\n", csv_repeat(",1", PRRU_NACT - 2));
-  TU_TRUE(prru_scenario_parse(&sc, fd_short, strlen(fd_short), "mem", NULL, msg, 300) == PRRU_EPARSE &&
+  TU_TRUE(prru_scenario_parse(&model, &sc, fd_short, strlen(fd_short), "mem", NULL, msg, 300) == PRRU_EPARSE &&
               strstr(msg, "mem:1: fd"),
           "scenario fd with one number fewer than the actuators refused");
   const char *budget = "max_steps = 500\natol = 0\nrtol = 2.3e-14\n";
-  TU_TRUE(prru_scenario_parse(&sc, budget, strlen(budget), "mem", NULL, msg, 300) == PRRU_OK &&
+  TU_TRUE(prru_scenario_parse(&model, &sc, budget, strlen(budget), "mem", NULL, msg, 300) == PRRU_OK &&
               sc.opt.max_steps == 500 && sc.opt.rel_tol == 2.3e-14,
           "scenario max_steps and a tolerance at the floor parse");
   prru_scenario_free(&sc);
@@ -1043,7 +1044,7 @@ static void test_parsing(void)
   const double pi = 3.14159265358979323846;
   const char *with_pi = "q0 = 0, pi/6, -pi/4\nqd0 = -2*pi/3, 0.5pi, +pi\n"
                         "harmonic = 50, 4pi\nt_end = pi/4\n";
-  int st_pi = prru_scenario_parse(&sc, with_pi, strlen(with_pi), "mem", NULL, msg, 300);
+  int st_pi = prru_scenario_parse(&model, &sc, with_pi, strlen(with_pi), "mem", NULL, msg, 300);
   TU_TRUE(st_pi == PRRU_OK &&
               sc.q0[0] == 0 && sc.q0[1] == pi / 6 && sc.q0[2] == -(pi / 4) &&
               sc.qd0[0] == -(2 * pi / 3) && sc.qd0[1] == 0.5 * pi && sc.qd0[2] == pi &&
@@ -1070,7 +1071,7 @@ static void test_parsing(void)
       {"max_steps = 2.5\n", "mem:1: max_steps"},
   };
   for (size_t i = 0; i < sizeof bad_sc / sizeof bad_sc[0]; i++) {
-    int st = prru_scenario_parse(&sc, bad_sc[i].text, strlen(bad_sc[i].text), "mem", NULL, msg, 300);
+    int st = prru_scenario_parse(&model, &sc, bad_sc[i].text, strlen(bad_sc[i].text), "mem", NULL, msg, 300);
     TU_TRUE(st == PRRU_EPARSE && strstr(msg, bad_sc[i].needle), bad_sc[i].needle);
     if (!(st == PRRU_EPARSE && strstr(msg, bad_sc[i].needle))) fprintf(stderr, "  got: %s\n", msg);
   }

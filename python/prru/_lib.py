@@ -214,7 +214,7 @@ class Types:
             ("dt", d), ("Ad", _arr(d, 36)), ("Bd", _arr(d, 6 * MA))]})
         self.Schedule = type("prru_load_schedule", (ctypes.Structure,), {"_fields_": [
             ("kind", ctypes.c_int), ("base", self.Loads), ("amp", d), ("omega", d),
-            ("nrows", ctypes.c_int), ("rows", c_double_p)]})
+            ("nact", ctypes.c_int), ("nrows", ctypes.c_int), ("rows", c_double_p)]})
         self.Sample = type("prru_sample", (ctypes.Structure,), {"_fields_": [
             ("t", d), ("q", _arr(d, 3)), ("qd", _arr(d, 3)), ("qdd", _arr(d, 3)),
             ("d", _arr(d, MA)), ("lambda_", _arr(d, ML)), ("T", d), ("V", d)]})
@@ -397,7 +397,7 @@ class Library:
         self.simulate = _declare(dll, "prru_simulate", i, mp, vp, vp, op, vp,
                                  ctypes.c_char_p, i)
         self.scenario_paper = _declare(dll, "prru_scenario_paper", None, sp)
-        self.scenario_read = _declare(dll, "prru_scenario_read", i, sp, ctypes.c_char_p,
+        self.scenario_read = _declare(dll, "prru_scenario_read", i, mp, sp, ctypes.c_char_p,
                                       ctypes.c_char_p, i)
         self.scenario_free = _declare(dll, "prru_scenario_free", None, sp)
         # Manipulability and maps (prru_dme.h).

@@ -119,7 +119,8 @@ def read_scenario(self, path):
     library's message (file:line: reason)."""
     g = self.lib.types.GuardedScenario()
     msg = ctypes.create_string_buffer(512)
-    st = self.lib.scenario_read(ctypes.byref(g.s), os.fsencode(path), msg, len(msg))
+    st = self.lib.scenario_read(ctypes.byref(self._m), ctypes.byref(g.s), os.fsencode(path), msg,
+                                len(msg))
     try:
         if st != errors.OK:
             raise errors.make_error(st, msg.value.decode("utf-8", "replace")
@@ -167,7 +168,7 @@ def _schedule(model, sc):
         s.kind, s.amp, s.omega = _lib.LOAD_HARMONIC, amp, omega
     elif sc.table is not None:
         keep = _table_rows(sc.table, model.nact)
-        s.kind, s.nrows = _lib.LOAD_TABLE, len(sc.table)
+        s.kind, s.nact, s.nrows = _lib.LOAD_TABLE, model.nact, len(sc.table)
         s.rows = ctypes.cast(keep, _lib.c_double_p)
     return s, keep
 

@@ -145,6 +145,9 @@ typedef struct prru_kernel_table {
                                  const double *fd, const double *fp, const double *mp, double *M,
                                  double *b, double *qdd, double *minors, double *Dq, double *Dqd,
                                  double *Dfd, double *Dfp, double *Dmp);
+  /* The unit null vector z of the reactions' Q (nlambda values, its sign
+   * the kernel's) with four actuators; NULL with three (Q has none). */
+  void (*reaction_nullspace)(const void *p, const double q[3], double z[]);
 } prru_kernel_table;
 
 typedef struct {
@@ -307,8 +310,8 @@ PRRU_API int prru_limits_for_run(const prru_model *m, const prru_limit_args *a, 
                                  int msglen);
 /* One line for a run's header: "force_max F N, speed_max V m/s, stroke
  * [LO, HI] m" (one value when every actuator has the same, else a list
- * per actuator; "none" for a kind that is off), into buf (len bytes). */
-PRRU_API void prru_limits_describe(const prru_limits *l, char *buf, size_t len);
+ * per actuator of m; "none" for a kind that is off), into buf (len bytes). */
+PRRU_API void prru_limits_describe(const prru_model *m, const prru_limits *l, char *buf, size_t len);
 /* out: src with l's limits in a descriptor of its own (the stroke then
  * bounds every reachability test of out, prru_stroke_actuator); src's
  * numbers, kernels and settings otherwise. Allocates: prru_model_free(out)

@@ -28,7 +28,7 @@ PRRU_API int prru_table_read(prru_table *t, const char *path, char *msg, int msg
 PRRU_API int prru_table_column(const prru_table *t, const char *name);
 PRRU_API void prru_table_free(prru_table *t);
 /* prru_schedule_read_csv from memory. */
-PRRU_API int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
+PRRU_API int prru_schedule_parse_csv(const prru_model *m, prru_load_schedule *s, const char *text, size_t len,
                                      const char *name, char *msg, int msglen);
 
 /* ---- Parsing shared by the CLI (fuzzed) ---- */

@@ -17,9 +17,10 @@ typedef struct {
   prru_loads base;         /* constant part */
   /* harmonic: fp += amp * (sin(w t), -cos(w t), 0) (the paper's load) */
   double amp, omega;
-  /* table: rows of t, fd1..fdN, fp1..3, mp1..3 (N = nact), linear
-   * interpolation, held constant outside [t_0, t_n] */
-  int nrows;
+  /* table: rows of t, fd1..fdN, fp1..3, mp1..3 (N = nact, the actuators
+   * of the model it was read for), linear interpolation, held constant
+   * outside [t_0, t_n] */
+  int nact, nrows;
   double *rows;            /* (nact + 7) * nrows, owned by the schedule */
 } prru_load_schedule;
 
@@ -29,9 +30,10 @@ PRRU_API void prru_schedule_constant(prru_load_schedule *s, const prru_loads *l)
  * mirrors limb 3) gets limb 3's 25 N. */
 PRRU_API void prru_schedule_paper(prru_load_schedule *s);
 /* Reads a CSV with header t,fd1..fdN[,fp1,fp2,fp3[,mp1,mp2,mp3]] (N =
- * nact); times strictly increasing. On error fills msg (file:line:
- * reason). */
-PRRU_API int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen);
+ * m's actuators); times strictly increasing. On error fills msg
+ * (file:line: reason). */
+PRRU_API int prru_schedule_read_csv(const prru_model *m, prru_load_schedule *s, const char *path, char *msg,
+                                    int msglen);
 PRRU_API void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out);
 PRRU_API void prru_schedule_free(prru_load_schedule *s);
 
@@ -101,8 +103,9 @@ PRRU_API int prru_sim_options_check(const prru_sim_options *o, const char **fiel
  * PRRU_ENOCONV (step failure, or the step budget max_steps exhausted:
  * "step budget of N steps exhausted at t = ..."), PRRU_EINTERRUPTED
  * (*interrupt, also in the middle of a step, or the sample consumer);
- * PRRU_EINPUT for bad options, among them a tolerance below PRRU_TOL_MIN
- * and abs_tol = 0 with msbdf. *t_stop is the time of the last sample
+ * PRRU_EINPUT for bad options, among them a tolerance below PRRU_TOL_MIN,
+ * abs_tol = 0 with msbdf and a loads table read for another number of
+ * actuators than m's. *t_stop is the time of the last sample
  * delivered; every sample delivered stays delivered. msg (may be NULL)
  * says why it stopped, naming the option for PRRU_EINPUT. */
 PRRU_API int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
@@ -120,18 +123,19 @@ typedef struct {
 /* The paper's section 4.3 study: q0 = (0, pi/6, -0.8), qd0 = 0, paper loads,
  * 1 s, samples every 1 ms, rk8pd at 1e-10. */
 PRRU_API void prru_scenario_paper(prru_scenario *s);
-/* A scenario file: one `key = value` per line, '#' comments; keys q0, qd0,
- * fd, fp, mp (3 numbers each), harmonic (amplitude N, angular frequency
+/* A scenario file for model m: one `key = value` per line, '#' comments;
+ * keys q0, qd0, fp, mp (3 numbers each), fd (one per actuator of m),
+ * harmonic (amplitude N, angular frequency
  * rad/s), loads (a CSV file for prru_schedule_read_csv, relative to the
  * scenario's directory), t_end, dt, stepper, atol, rtol, h0, max_steps
  * (opt.max_steps). Unset keys keep their defaults (zero state and loads,
  * 1 s, 1 ms, rk8pd, 1e-10, PRRU_MAX_STEPS_DEFAULT).
  * On error msg says `name:line: reason`. */
-PRRU_API int prru_scenario_read(prru_scenario *s, const char *path, char *msg, int msglen);
+PRRU_API int prru_scenario_read(const prru_model *m, prru_scenario *s, const char *path, char *msg, int msglen);
 /* The same from memory; name is used in messages, base_dir for `loads`
  * (NULL: loads not allowed). */
-PRRU_API int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const char *name,
-                                 const char *base_dir, char *msg, int msglen);
+PRRU_API int prru_scenario_parse(const prru_model *m, prru_scenario *s, const char *text, size_t len,
+                                 const char *name, const char *base_dir, char *msg, int msglen);
 PRRU_API void prru_scenario_free(prru_scenario *s);
 
 #ifdef __cplusplus

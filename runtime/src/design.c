@@ -513,7 +513,7 @@ static void grid_block_float(const prru_design_problem *pr, const prru_param_der
   const int n = b->n;
   for (int i = 0; i < 3 * n; i++) f->q[i] = (float)b->q[i];
   prru_param_f_batch_dme_terms(p, n, f->q, f->d, f->Jd, f->M, f->JP);
-  prru_dme_batch_f(n, f->d, f->Jd, f->M, f->JP, L, pr->rcond_min, home, &f->ws, w, b->st, f->sure);
+  prru_dme_batch_f(PRRU_NACT, n, f->d, f->Jd, f->M, f->JP, L, pr->rcond_min, home, &f->ws, w, b->st, f->sure);
   int nx = 0;
   for (int c = 0; c < n; c++) {
     for (int i = 0; i < PRRU_NACT; i++) b->d[(long)i * n + c] = f->d[(long)i * n + c];
@@ -528,7 +528,7 @@ static void grid_block_float(const prru_design_problem *pr, const prru_param_der
     for (int t = 0; t < nx; t++) x->q[(long)r * nx + t] = b->q[(long)r * n + f->redo[t]];
   double wx[GRID_BLOCK];
   prru_param_batch_dme_terms(p, nx, x->q, x->d, x->Jd, x->M, x->JP);
-  prru_dme_batch(nx, x->d, x->Jd, x->M, x->JP, L, pr->rcond_min, home, &x->ws, wx, x->st, x->rc, x->other);
+  prru_dme_batch(PRRU_NACT, nx, x->d, x->Jd, x->M, x->JP, L, pr->rcond_min, home, &x->ws, wx, x->st, x->rc, x->other);
   for (int t = 0; t < nx; t++) {
     const int c = f->redo[t];
     w[c] = wx[t];
@@ -599,7 +599,7 @@ static void grid_row(grid_job *j, int i)
       grid_block_float(pr, j->p, j->L, j->home, &b, f, &j->dd->w_R[k0]);
     } else {
       prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
-      prru_dme_batch(b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
+      prru_dme_batch(PRRU_NACT, b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
                      &j->dd->w_R[k0], b.st, b.rc, b.other);
     }
     for (int c = 0; c < b.n; c++) {

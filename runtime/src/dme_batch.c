@@ -35,12 +35,15 @@
 #define PRRU_BATCH_TARGETS
 #endif
 
-#define N PRRU_NACT
 #define CH PRRU_DME_BATCH_CHUNK
 
+/* One instance per number of actuators N and type: the loops over
+ * matrix entries keep constant bounds, unrolled inside the loops over
+ * poses. */
+#define N 3
 #define REAL double
 #define WS prru_dme_batch_ws
-#define STAGE(name) name##_d
+#define STAGE(name) name##_d3
 #define SQRT sqrt
 #define FABS fabs
 #define REAL_MAX DBL_MAX
@@ -53,27 +56,59 @@
 #undef REAL_MAX
 #define REAL float
 #define WS prru_dme_batch_wsf
-#define STAGE(name) name##_f
+#define STAGE(name) name##_f3
 #define SQRT sqrtf
 #define FABS fabsf
 #define REAL_MAX FLT_MAX
 #include "dme_batch_stages.h"
+#undef REAL
+#undef WS
+#undef STAGE
+#undef SQRT
+#undef FABS
+#undef REAL_MAX
+#undef N
+#define N 4
+#define REAL double
+#define WS prru_dme_batch_ws
+#define STAGE(name) name##_d4
+#define SQRT sqrt
+#define FABS fabs
+#define REAL_MAX DBL_MAX
+#include "dme_batch_stages.h"
+#undef REAL
+#undef WS
+#undef STAGE
+#undef SQRT
+#undef FABS
+#undef REAL_MAX
+#define REAL float
+#define WS prru_dme_batch_wsf
+#define STAGE(name) name##_f4
+#define SQRT sqrtf
+#define FABS fabsf
+#define REAL_MAX FLT_MAX
+#include "dme_batch_stages.h"
+#undef N
 
 PRRU_BATCH_TARGETS
-void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, const double *JP,
+void prru_dme_batch(int nact, int n, const double *d, const double *Jd, const double *M, const double *JP,
                     double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
                     unsigned char *status, double *rcond, unsigned char *other)
 {
   for (int o = 0; o < n; o += CH) {
     const int m = n - o < CH ? n - o : CH;
-#if N == 3
-    regular3_d(n, o, m, d, Jd, L, rcond_min, home, ws);
-#else
-    regular_qr_d(n, o, m, d, Jd, L, rcond_min, home, ws);
-#endif
-    transformed_d(n, o, m, M, JP, ws);
-    range_basis_d(n, o, m, JP, ws);
-    singular_values_d(m, ws);
+    if (nact == 3) {
+      regular3_d3(n, o, m, d, Jd, L, rcond_min, home, ws);
+      transformed_d3(n, o, m, M, JP, ws);
+      range_basis_d3(n, o, m, JP, ws);
+      singular_values_d3(m, ws);
+    } else {
+      regular_qr_d4(n, o, m, d, Jd, L, rcond_min, home, ws);
+      transformed_d4(n, o, m, M, JP, ws);
+      range_basis_d4(n, o, m, JP, ws);
+      singular_values_d4(m, ws);
+    }
     for (int k = 0; k < m; k++) {
       const int pre = (int)ws->pre[k];
       const int st = pre != PRRU_OK ? pre : ws->ok[k] != 0.0 ? PRRU_OK : PRRU_ESINGULAR;
@@ -103,21 +138,24 @@ void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, c
 #define RC_MARGIN (1024.0 * FLT_EPSILON)
 
 PRRU_BATCH_TARGETS
-void prru_dme_batch_f(int n, const float *d, const float *Jd, const float *M, const float *JP,
+void prru_dme_batch_f(int nact, int n, const float *d, const float *Jd, const float *M, const float *JP,
                       double L, double rcond_min, int home, prru_dme_batch_wsf *ws, double *w_R,
                       unsigned char *status, unsigned char *sure)
 {
   const float Lf = (float)L, rf = (float)rcond_min;
   for (int o = 0; o < n; o += CH) {
     const int m = n - o < CH ? n - o : CH;
-#if N == 3
-    regular3_f(n, o, m, d, Jd, Lf, rf, home, ws);
-#else
-    regular_qr_f(n, o, m, d, Jd, Lf, rf, home, ws);
-#endif
-    transformed_f(n, o, m, M, JP, ws);
-    range_basis_f(n, o, m, JP, ws);
-    singular_values_f(m, ws);
+    if (nact == 3) {
+      regular3_f3(n, o, m, d, Jd, Lf, rf, home, ws);
+      transformed_f3(n, o, m, M, JP, ws);
+      range_basis_f3(n, o, m, JP, ws);
+      singular_values_f3(m, ws);
+    } else {
+      regular_qr_f4(n, o, m, d, Jd, Lf, rf, home, ws);
+      transformed_f4(n, o, m, M, JP, ws);
+      range_basis_f4(n, o, m, JP, ws);
+      singular_values_f4(m, ws);
+    }
     for (int k = 0; k < m; k++) {
       const int pre = (int)ws->pre[k];
       const int st = pre != PRRU_OK ? pre : ws->ok[k] != 0 ? PRRU_OK : PRRU_ESINGULAR;

@@ -14,15 +14,15 @@
 
 /* The residual tolerances are relative to the larger of the model's
  * length and the slider heights, whatever the robot's size. */
-static double fk_scale(const prru_model *m, const double act[PRRU_NACT])
+static double fk_scale(const prru_model *m, const double act[])
 {
   double scale = prru_length_scale(m->mech);
-  for (int i = 0; i < PRRU_NACT; i++) scale = fmax(scale, fabs(act[i]));
+  for (int i = 0; i < m->mech->nact; i++) scale = fmax(scale, fabs(act[i]));
   return scale;
 }
 
 /* What the iterations aim at: 100 ulps of the scale. */
-static double fk_tol(const prru_model *m, const double act[PRRU_NACT])
+static double fk_tol(const prru_model *m, const double act[])
 {
   return 100 * DBL_EPSILON * fk_scale(m, act);
 }
@@ -38,20 +38,21 @@ void prru_fk_default_seed(const prru_model *m, const double act[], double q0[3])
   /* ik_jd, the kernel prru_check_regular evaluates: d(0) as the solvers
    * see it, to the bit. */
   const double zero[3] = {0, 0, 0};
-  double d0[PRRU_NACT], Jd0[PRRU_NACT * 3], sum = 0.0;
+  const int na = m->mech->nact;
+  double d0[PRRU_MAX_ACT], Jd0[PRRU_MAX_ACT * 3], sum = 0.0;
   KERNEL(m, ik_jd)(m->kernel_params, zero, d0, Jd0);
-  for (int i = 0; i < PRRU_NACT; i++) sum += act[i] - d0[i];
+  for (int i = 0; i < na; i++) sum += act[i] - d0[i];
   q0[0] = q0[1] = 0.0;
-  q0[2] = sum / PRRU_NACT;
+  q0[2] = sum / na;
 }
 
 double prru_fk_residual(const prru_model *m, const double q[3], const double act[])
 {
   /* The kernel prru_check_regular fills d->d with: the same residual as
    * prru_forward_kinematics_lsq's at its answer, to the bit. */
-  double d[PRRU_NACT], Jd[PRRU_NACT * 3], res = 0;
+  double d[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3], res = 0;
   KERNEL(m, ik_jd)(m->kernel_params, q, d, Jd);
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < m->mech->nact; i++) {
     const double r = fabs(d[i] - act[i]);
     if (isnan(r)) return NAN; /* fmax would drop it */
     res = fmax(res, r);
@@ -59,20 +60,19 @@ double prru_fk_residual(const prru_model *m, const double q[3], const double act
   return res;
 }
 
-static int act_finite(const double act[PRRU_NACT])
+static int act_finite(int na, const double act[])
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (!isfinite(act[i])) return 0;
   return 1;
 }
 
 /* Residual r = d - act at the pose prru_check_regular last evaluated
  * (d->d); returns |r|^2, *rmax = max |r_i|. */
-static double fk_residual(const prru_data *d, const double act[PRRU_NACT], double r[PRRU_NACT],
-                          double *rmax)
+static double fk_residual(int na, const prru_data *d, const double act[], double r[], double *rmax)
 {
   double f = 0, mx = 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     r[i] = d->d[i] - act[i];
     f += r[i] * r[i];
     mx = fmax(mx, fabs(r[i]));
@@ -85,7 +85,8 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
                                 const double seed[3], double q[3], double *residual)
 {
   if (residual) *residual = NAN;
-  if (!act_finite(act)) return PRRU_EINPUT;
+  const int na = m->mech->nact;
+  if (!act_finite(na, act)) return PRRU_EINPUT;
   int st = prru_check_regular(m, d, seed, NULL);
   if (st != PRRU_OK) return st;
   /* Steps need J_d^+ only to exist; the model's tolerance is applied to
@@ -93,8 +94,8 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
   prru_model m0 = *m;
   m0.jd_rcond_min = 0.0;
   const double tol = fk_tol(m, act), L = prru_length_scale(m->mech);
-  double x[3] = {seed[0], seed[1], seed[2]}, r[PRRU_NACT], rmax;
-  double f = fk_residual(d, act, r, &rmax);
+  double x[3] = {seed[0], seed[1], seed[2]}, r[PRRU_MAX_ACT], rmax;
+  double f = fk_residual(na, d, act, r, &rmax);
   /* Slider positions so far out that |r|^2 overflows: no step could ever
    * be accepted, and the seed would come back as a "fit". */
   if (!isfinite(f)) return PRRU_EINPUT;
@@ -102,10 +103,10 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
   for (iter = 0; iter < 200 && !settled; iter++) {
     if (rmax <= tol) { settled = 1; break; }
     /* Gauss-Newton step -J_d^+ r, halved until |r|^2 decreases. */
-    double step[3], xt[3], rt[PRRU_NACT], rmt = 0, ft = f;
+    double step[3], xt[3], rt[PRRU_MAX_ACT], rmt = 0, ft = f;
     for (int j = 0; j < 3; j++) {
       step[j] = 0;
-      for (int i = 0; i < PRRU_NACT; i++) step[j] -= d->Jdpinv[PRRU_NACT * j + i] * r[i];
+      for (int i = 0; i < na; i++) step[j] -= d->Jdpinv[na * j + i] * r[i];
     }
     /* Stationary: the step is below rounding of x (angles in rad, the
      * height in units of L). */
@@ -119,7 +120,7 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
     for (double t = 1.0; t > 1e-12 && !accepted; t *= 0.5) {
       for (int j = 0; j < 3; j++) xt[j] = x[j] + t * step[j];
       if (prru_check_regular(&m0, d, xt, NULL) != PRRU_OK) continue;
-      ft = fk_residual(d, act, rt, &rmt);
+      ft = fk_residual(na, d, act, rt, &rmt);
       accepted = ft < f;
     }
     if (!accepted) {
@@ -136,13 +137,12 @@ int prru_forward_kinematics_lsq(const prru_model *m, prru_data *d, const double 
   if (!settled) return PRRU_ENOCONV;
   st = prru_check_regular(m, d, x, NULL);
   if (st != PRRU_OK) return st == PRRU_EUNREACHABLE ? PRRU_ENOCONV : st;
-  fk_residual(d, act, r, &rmax);
+  fk_residual(na, d, act, r, &rmax);
   if (residual) *residual = rmax;
   memcpy(q, x, sizeof x);
   return PRRU_OK;
 }
 
-#if PRRU_NACT == 3
 typedef struct {
   const double *act;
   const prru_model *m;
@@ -181,8 +181,9 @@ static int fk_df(const gsl_vector *x, void *p, gsl_matrix *J)
   return fk_fdf(x, p, &fv.vector, J);
 }
 
-int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[],
-                            const double seed[3], double q[3])
+/* Three actuators: Newton's method on the square system. */
+static int fk_square(const prru_model *m, prru_data *d, const double act[], const double seed[3],
+                     double q[3])
 {
   if (!isfinite(act[0]) || !isfinite(act[1]) || !isfinite(act[2])) return PRRU_EINPUT;
   int st = prru_check_regular(m, d, seed, NULL);
@@ -213,13 +214,13 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   memcpy(q, sol, sizeof sol);
   return PRRU_OK;
 }
-#else
-/* Four actuators: d(q) = act has a solution only when act is consistent
- * (the fourth slider where the other three put it). Least squares, then
- * the same acceptance as hybridsj's above: 10 times the tolerance. */
 int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[],
                             const double seed[3], double q[3])
 {
+  if (m->mech->nact == 3) return fk_square(m, d, act, seed, q);
+  /* Four actuators: d(q) = act has a solution only when act is consistent
+   * (the fourth slider where the other three put it). Least squares, then
+   * the same acceptance as hybridsj's: 10 times the tolerance. */
   double sol[3], res;
   int st = prru_forward_kinematics_lsq(m, d, act, seed, sol, &res);
   if (st != PRRU_OK) return st;
@@ -227,4 +228,3 @@ int prru_forward_kinematics(const prru_model *m, prru_data *d, const double act[
   memcpy(q, sol, sizeof sol);
   return PRRU_OK;
 }
-#endif

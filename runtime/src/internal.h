@@ -56,7 +56,7 @@ int prru_inverse_failure(int st, const double q[3], const double qd[3], const do
 static inline void prru_model_unbounded(const prru_model *m, prru_model *out, prru_mechanism *mech)
 {
   *mech = *m->mech;
-  for (int i = 0; i < PRRU_NACT; i++) mech->d_min[i] = -INFINITY, mech->d_max[i] = INFINITY;
+  for (int i = 0; i < mech->nact; i++) mech->d_min[i] = -INFINITY, mech->d_max[i] = INFINITY;
   *out = *m;
   out->mech = mech;
 }
@@ -122,31 +122,29 @@ double prru_rcond3(const double a[9], double inv[9]);
  * call checks GSL's status codes itself. Thread-safe. */
 void prru_gsl_init(void);
 /* Poses per pass of prru_dme_batch's stages: its workspace (about 16 kB
- * with three actuators) stays in the first-level cache. */
+ * with three actuators, the rows it touches) stays in the first-level
+ * cache. */
 #define PRRU_DME_BATCH_CHUNK 32
 /* The workspace of one type T (double: prru_dme_batch_ws, float:
- * prru_dme_batch_wsf). */
-#if PRRU_NACT > 3 /* the Householder QR of J_d */
-#define PRRU_DME_BATCH_QR(T)                                                                     \
-  T W[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], V[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],             \
-      beta[3][PRRU_DME_BATCH_CHUNK], e[PRRU_NACT][PRRU_DME_BATCH_CHUNK];
-#else
-#define PRRU_DME_BATCH_QR(T)
-#endif
+ * prru_dme_batch_wsf), for either number of actuators: rows of the
+ * largest (prru_sizes.h), W, V, beta and e only for the Householder QR of
+ * a four-actuator J_d. */
 #define PRRU_DME_BATCH_WS(T)                                                                     \
   struct {                                                                                       \
-    T inv[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], tmp[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],        \
-        JtR[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK], JtT[3 * PRRU_NACT][PRRU_DME_BATCH_CHUNK],      \
-        Mt[PRRU_NACT * PRRU_NACT][PRRU_DME_BATCH_CHUNK], c0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],    \
-        c1[PRRU_NACT][PRRU_DME_BATCH_CHUNK], g0[PRRU_NACT][PRRU_DME_BATCH_CHUNK],                \
-        g1[PRRU_NACT][PRRU_DME_BATCH_CHUNK];                                                     \
+    T inv[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK], tmp[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK],  \
+        JtR[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK], JtT[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK],\
+        Mt[PRRU_MAX_ACT * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK],                                   \
+        c0[PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK], c1[PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK],          \
+        g0[PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK], g1[PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK];          \
     T pre[PRRU_DME_BATCH_CHUNK], rcond[PRRU_DME_BATCH_CHUNK], other[PRRU_DME_BATCH_CHUNK],       \
         ok[PRRU_DME_BATCH_CHUNK], w[PRRU_DME_BATCH_CHUNK], gap[PRRU_DME_BATCH_CHUNK];            \
-    PRRU_DME_BATCH_QR(T)                                                                         \
+    T W[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK], V[3 * PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK],      \
+        beta[3][PRRU_DME_BATCH_CHUNK], e[PRRU_MAX_ACT][PRRU_DME_BATCH_CHUNK];                    \
   }
 typedef PRRU_DME_BATCH_WS(double) prru_dme_batch_ws;
 typedef PRRU_DME_BATCH_WS(float) prru_dme_batch_wsf;
-/* w_R and the status of n poses from their kernel outputs in SoA layout
+/* w_R and the status of n poses of a model with nact actuators (3 or 4)
+ * from their kernel outputs in SoA layout
  * (entry i of pose k at [i * n + k], as prru_batch_dme_terms gives d, J_d,
  * M and [J_R,P; J_T,P]): at every pose bit for bit what prru_jd_regular
  * (length scale L, tolerance rcond_min), prru_mode_status (home) and
@@ -154,7 +152,7 @@ typedef PRRU_DME_BATCH_WS(float) prru_dme_batch_wsf;
  * where a slider is not finite). rcond (prru_jd_regular's, 0 where
  * unreachable) and other (prru_jd_other_mode at a reachable pose) may be
  * NULL. No allocation: ws is scratch. */
-void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, const double *JP,
+void prru_dme_batch(int nact, int n, const double *d, const double *Jd, const double *M, const double *JP,
                     double L, double rcond_min, int home, prru_dme_batch_ws *ws, double *w_R,
                     unsigned char *status, double *rcond, unsigned char *other);
 /* prru_dme_batch on float kernel outputs (prru_f_batch_dme_terms), in
@@ -164,7 +162,7 @@ void prru_dme_batch(int n, const double *d, const double *Jd, const double *M, c
  * rcond and the DME's tests clear of their thresholds by more than float's
  * error (dme_batch.c). Elsewhere the caller decides the status in double
  * (prru_dme_batch on the double kernels' outputs). */
-void prru_dme_batch_f(int n, const float *d, const float *Jd, const float *M, const float *JP,
+void prru_dme_batch_f(int nact, int n, const float *d, const float *Jd, const float *M, const float *JP,
                       double L, double rcond_min, int home, prru_dme_batch_wsf *ws, double *w_R,
                       unsigned char *status, unsigned char *sure);
 #endif

@@ -160,6 +160,16 @@ static void s_batch_eom_solve_derivs(const void *p, int n, const double *q, cons
   (void)p, prru_batch_eom_solve_derivs(n, q, qd, fd, fp, mp, M, b, qdd, minors, Dq, Dqd, Dfd, Dfp, Dmp);
 }
 
+#if PRRU_NREACTION_NULL == 1
+static void s_reaction_nullspace(const void *p, const double q[3], double z[])
+{
+  (void)p, prru_reaction_nullspace(q, z);
+}
+#define REACTION_NULLSPACE s_reaction_nullspace
+#else
+#define REACTION_NULLSPACE NULL
+#endif
+
 const prru_kernel_table prru_kernels_specialised = {
   "specialised",  s_ik,      s_jd,
   s_ik_jd,        s_mass,    s_dynamics,
@@ -169,4 +179,5 @@ const prru_kernel_table prru_kernels_specialised = {
   s_actuator_rates, s_passive, s_batch_dme_terms,
   s_regressor,    s_eom_solve_derivs, s_unseen_eom_solve_derivs,
   s_inverse_derivs, s_unseen_inverse_derivs, s_batch_eom_solve_derivs,
+  REACTION_NULLSPACE,
 };

@@ -15,10 +15,9 @@ int prru_linearize_available(const prru_model *m)
   return m->kernels->eom_solve_derivs != NULL;
 }
 
-/* A = [0 I; Dq Dqd], B = [0; Dfd]. */
-static void state_space(prru_linearization *o)
+/* A = [0 I; Dq Dqd], B = [0; Dfd] (N actuators). */
+static void state_space(int N, prru_linearization *o)
 {
-  enum { N = PRRU_NACT };
   memset(o->A, 0, sizeof o->A);
   memset(o->B, 0, sizeof o->B);
   for (int i = 0; i < 3; i++) {
@@ -33,15 +32,17 @@ static void state_space(prru_linearization *o)
 
 /* Ad, Bd from exp([A B; 0 0] dt): PRRU_OK, or PRRU_EINPUT where GSL fails
  * or the exponential is not finite. */
-static int zero_order_hold(prru_linearization *o, double dt)
+static int zero_order_hold(int N, prru_linearization *o, double dt)
 {
-  enum { N = PRRU_NACT, S = 6 + PRRU_NACT };
-  double aug[S * S] = {0}, ex[S * S];
+  enum { SMAX = 6 + PRRU_MAX_ACT };
+  const int S = 6 + N;
+  double aug[SMAX * SMAX] = {0}, ex[SMAX * SMAX];
   for (int i = 0; i < 6; i++) {
     for (int k = 0; k < 6; k++) aug[S * i + k] = o->A[6 * i + k] * dt;
     for (int k = 0; k < N; k++) aug[S * i + 6 + k] = o->B[N * i + k] * dt;
   }
-  gsl_matrix_view a = gsl_matrix_view_array(aug, S, S), e = gsl_matrix_view_array(ex, S, S);
+  gsl_matrix_view a = gsl_matrix_view_array(aug, (size_t)S, (size_t)S),
+                  e = gsl_matrix_view_array(ex, (size_t)S, (size_t)S);
   prru_gsl_init();
   if (gsl_linalg_exponential_ss(&a.matrix, &e.matrix, GSL_PREC_DOUBLE) != GSL_SUCCESS ||
       !prru_finite_n(ex, S * S))
@@ -67,15 +68,15 @@ static int linearization_from(const prru_model *m, prru_data *d, const double q[
    * they overflow only where qdd nearly does. */
   if (st == PRRU_OK &&
       !(prru_finite_n(o->dqdd_dq, 9) && prru_finite_n(o->dqdd_dqd, 9) &&
-        prru_finite_n(o->dqdd_dfd, 3 * PRRU_NACT) && prru_finite_n(o->dqdd_dfp, 9) &&
+        prru_finite_n(o->dqdd_dfd, 3 * m->mech->nact) && prru_finite_n(o->dqdd_dfp, 9) &&
         prru_finite_n(o->dqdd_dmp, 9)))
     st = PRRU_EINPUT;
   if (st == PRRU_OK) {
     memcpy(o->qdd, d->qdd, sizeof o->qdd);
-    state_space(o);
+    state_space(m->mech->nact, o);
     o->dt = dt;
     memset(o->Ad, 0, sizeof o->Ad), memset(o->Bd, 0, sizeof o->Bd);
-    if (dt > 0) st = zero_order_hold(o, dt);
+    if (dt > 0) st = zero_order_hold(m->mech->nact, o, dt);
   }
   if (st != PRRU_OK) memset(o, 0, sizeof *o);
   return st;
@@ -99,9 +100,9 @@ int prru_linearize(const prru_model *m, prru_data *d, const double q[3], const d
 /* The batched kernel's chunk of states: its inputs and outputs in rows
  * of CHUNK (component i of state k at [i * CHUNK + k]); the derivative
  * blocks in prru_linearization's order, one row per entry. */
-enum { CHUNK = 32, NDERIV = 9 + 9 + 3 * PRRU_NACT + 9 + 9 };
+enum { CHUNK = 32, NDERIV = 9 + 9 + 3 * PRRU_MAX_ACT + 9 + 9 };
 typedef struct {
-  double q[3 * CHUNK], qd[3 * CHUNK], fd[PRRU_NACT * CHUNK], fp[3 * CHUNK], mp[3 * CHUNK];
+  double q[3 * CHUNK], qd[3 * CHUNK], fd[PRRU_MAX_ACT * CHUNK], fp[3 * CHUNK], mp[3 * CHUNK];
   double M[9 * CHUNK], b[3 * CHUNK], qdd[3 * CHUNK], minors[3 * CHUNK], D[NDERIV * CHUNK];
 } linearize_chunk;
 
@@ -121,7 +122,7 @@ static int linearize_chunk_at(const prru_model *m, int o, int n, const double *q
                               const prru_loads *l, double dt, prru_linearization *out, int *status,
                               linearize_chunk *c)
 {
-  enum { N = PRRU_NACT };
+  const int N = m->mech->nact;
   for (int k = 0; k < n; k++) {
     to_rows(c->q, q + 3 * (o + k), 3, k, n), to_rows(c->qd, qd + 3 * (o + k), 3, k, n);
     to_rows(c->fd, l[o + k].fd, N, k, n), to_rows(c->fp, l[o + k].fp, 3, k, n);
@@ -196,7 +197,6 @@ int prru_linearize_why(const prru_model *m, prru_data *d, const double q[3], con
                    dt);
 }
 
-#if PRRU_NACT == 3
 static int inverse3_derivs(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
                            const double qdd[3], const prru_loads *l, double fd[3], double dfd_dq[9],
                            double dfd_dqd[9], double dfd_dqdd[9])
@@ -216,12 +216,12 @@ static int inverse3_derivs(const prru_model *m, prru_data *d, const double q[3],
   if (dfd_dqdd) memcpy(dfd_dqdd, D + 18, 9 * sizeof *D);
   return PRRU_OK;
 }
-#else
-/* rhs (3 x 3, row-major) mapped by J_d^+T (NACT x 3; its row i is column i
- * of J_d^+, Jp = d->Jdpinv) into out (NACT x 3). */
-static void map_pinv_t(const double *Jp, const double rhs[9], double out[3 * PRRU_NACT])
+
+/* rhs (3 x 3, row-major) mapped by J_d^+T (4 x 3; its row i is column i
+ * of J_d^+, Jp = d->Jdpinv) into out (4 x 3). */
+static void map_pinv_t(const double *Jp, const double rhs[9], double out[3 * 4])
 {
-  enum { N = PRRU_NACT };
+  enum { N = 4 };
   for (int i = 0; i < N; i++)
     for (int k = 0; k < 3; k++)
       out[3 * i + k] = Jp[i] * rhs[k] + Jp[N + i] * rhs[3 + k] + Jp[2 * N + i] * rhs[6 + k];
@@ -238,11 +238,10 @@ static void map_pinv_t(const double *Jp, const double rhs[9], double out[3 * PRR
  * dJ_d/dqd = dJ_d/dqdd = 0. Not the symbolic (J_d^T J_d)^-1: the normal
  * equations square J_d's condition number, up to 1e16 at jd_rcond_min. */
 static int inverse4_derivs(const prru_model *m, prru_data *d, const double q[3], const double qd[3],
-                           const double qdd[3], const prru_loads *l, double t, double fd[PRRU_NACT],
-                           double dfd_dq[3 * PRRU_NACT], double dfd_dqd[3 * PRRU_NACT],
-                           double dfd_dqdd[3 * PRRU_NACT])
+                           const double qdd[3], const prru_loads *l, double t, double fd[4],
+                           double dfd_dq[3 * 4], double dfd_dqd[3 * 4], double dfd_dqdd[3 * 4])
 {
-  enum { N = PRRU_NACT };
+  enum { N = 4 };
   if (!m->kernels->inverse_derivs) return PRRU_EINPUT;
   double tau[3], Tq[9], Tqd[9], Tqdd[9], DJ[9 * N], f[N], n[N], y[3];
   KERNEL(m, inverse_derivs)(m->kernel_params, q, qd, qdd, l->fp, l->mp, d->d, d->Jd, NULL, tau, Tq,
@@ -284,7 +283,6 @@ static int inverse4_derivs(const prru_model *m, prru_data *d, const double q[3],
   if (dfd_dqdd) memcpy(dfd_dqdd, Dqdd, sizeof Dqdd);
   return PRRU_OK;
 }
-#endif
 
 int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, const double q[3],
                                          const double qd[3], const double qdd[3],
@@ -292,21 +290,16 @@ int prru_inverse_dynamics_preload_derivs(const prru_model *m, prru_data *d, cons
                                          double dfd_dq[], double dfd_dqd[], double dfd_dqdd[])
 {
   if (!isfinite(preload)) return PRRU_EINPUT;
-#if PRRU_NACT == 3
+  if (m->mech->nact == 4)
+    return inverse4_derivs(m, d, q, qd, qdd, l, preload, fd, dfd_dq, dfd_dqd, dfd_dqdd);
   if (preload != 0.0) return PRRU_EINPUT;
   return inverse3_derivs(m, d, q, qd, qdd, l, fd, dfd_dq, dfd_dqd, dfd_dqdd);
-#else
-  return inverse4_derivs(m, d, q, qd, qdd, l, preload, fd, dfd_dq, dfd_dqd, dfd_dqdd);
-#endif
 }
 
 int prru_inverse_dynamics_derivs(const prru_model *m, prru_data *d, const double q[3],
                                  const double qd[3], const double qdd[3], const prru_loads *l,
                                  double fd[], double dfd_dq[], double dfd_dqd[], double dfd_dqdd[])
 {
-#if PRRU_NACT == 3
+  if (m->mech->nact == 4) return inverse4_derivs(m, d, q, qd, qdd, l, 0.0, fd, dfd_dq, dfd_dqd, dfd_dqdd);
   return inverse3_derivs(m, d, q, qd, qdd, l, fd, dfd_dq, dfd_dqd, dfd_dqdd);
-#else
-  return inverse4_derivs(m, d, q, qd, qdd, l, 0.0, fd, dfd_dq, dfd_dqd, dfd_dqdd);
-#endif
 }

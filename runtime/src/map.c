@@ -82,14 +82,14 @@ typedef struct {
 /* A worker's batch: q and the batched kernel's outputs, rows of MAP_BLOCK;
  * prru_dme_batch's scratch and the statuses when the caller wants none. */
 typedef struct {
-  double q[3 * MAP_BLOCK], d[PRRU_NACT * MAP_BLOCK], Jd[3 * PRRU_NACT * MAP_BLOCK],
+  double q[3 * MAP_BLOCK], d[PRRU_MAX_ACT * MAP_BLOCK], Jd[3 * PRRU_MAX_ACT * MAP_BLOCK],
       M[9 * MAP_BLOCK], JP[18 * MAP_BLOCK];
   unsigned char st[MAP_BLOCK];
   prru_dme_batch_ws ws;
   /* --precision float: the float kernels' inputs and outputs, and the
    * points whose status float leaves to double (their index, w_R and
    * status there). */
-  float qf[3 * MAP_BLOCK], df[PRRU_NACT * MAP_BLOCK], Jdf[3 * PRRU_NACT * MAP_BLOCK],
+  float qf[3 * MAP_BLOCK], df[PRRU_MAX_ACT * MAP_BLOCK], Jdf[3 * PRRU_MAX_ACT * MAP_BLOCK],
       Mf[9 * MAP_BLOCK], JPf[18 * MAP_BLOCK];
   unsigned char sure[MAP_BLOCK], stx[MAP_BLOCK];
   int redo[MAP_BLOCK];
@@ -115,14 +115,15 @@ typedef struct {
 static void map_points_double(map_job *j, map_block *b, int n, double *w, unsigned char *st)
 {
   KERNEL(j->m, batch_dme_terms)(j->m->kernel_params, n, b->q, b->d, b->Jd, b->M, b->JP);
-  prru_dme_batch(n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, w, st, NULL,
+  const int na = j->m->mech->nact;
+  prru_dme_batch(na, n, b->d, b->Jd, b->M, b->JP, j->L, j->m->jd_rcond_min, j->home, &b->ws, w, st, NULL,
                  NULL);
   /* The stroke ends bound the workspace as the reach does (the scalar
    * path's prru_check_regular tests it in the same place). */
   for (int c = 0; c < n; c++) {
     if (st[c] == PRRU_EUNREACHABLE) continue;
-    double dc[PRRU_NACT];
-    for (int i = 0; i < PRRU_NACT; i++) dc[i] = b->d[(long)i * n + c];
+    double dc[PRRU_MAX_ACT];
+    for (int i = 0; i < na; i++) dc[i] = b->d[(long)i * n + c];
     if (prru_stroke_actuator(j->m, dc) >= 0) st[c] = PRRU_ESTROKE, w[c] = NAN;
   }
 }
@@ -133,7 +134,7 @@ static void map_points_double(map_job *j, map_block *b, int n, double *w, unsign
  * lengths, i.e. |d| + 4 L; the margin takes 16 times that. */
 static int stroke_clear(const prru_model *m, const float *d, int n, int c, double L)
 {
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < m->mech->nact; i++) {
     const double di = d[(long)i * n + c], e = 256.0 * FLT_EPSILON * (fabs(di) + 4.0 * L);
     if (!(di - e >= m->mech->d_min[i] && di + e <= m->mech->d_max[i])) return 0;
   }
@@ -150,7 +151,7 @@ static void map_points_float(map_job *j, map_block *b, int n, double *w, unsigne
 {
   for (int c = 0; c < 3 * n; c++) b->qf[c] = (float)b->q[c];
   prru_f_batch_dme_terms(n, b->qf, b->df, b->Jdf, b->Mf, b->JPf);
-  prru_dme_batch_f(n, b->df, b->Jdf, b->Mf, b->JPf, j->L, j->m->jd_rcond_min, j->home, &b->wsf, w, st,
+  prru_dme_batch_f(j->m->mech->nact, n, b->df, b->Jdf, b->Mf, b->JPf, j->L, j->m->jd_rcond_min, j->home, &b->wsf, w, st,
                    b->sure);
   int nx = 0;
   for (int c = 0; c < n; c++)

@@ -25,20 +25,23 @@ typedef struct {
   char *path;
 } loaded_model;
 
-void prru_limits_none(prru_limits *l)
+/* Every entry from i on without a limit: a model's entries past its
+ * actuators are none, whatever the struct held. */
+static void limits_none_from(prru_limits *l, int i)
 {
-  memset(l, 0, sizeof *l); /* the entries past the model's actuators */
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (; i < PRRU_MAX_ACT; i++) {
     l->force_max[i] = l->speed_max[i] = l->d_max[i] = INFINITY;
     l->d_min[i] = -INFINITY;
   }
 }
 
+void prru_limits_none(prru_limits *l) { limits_none_from(l, 0); }
+
 void prru_model_limits(const prru_model *m, prru_limits *out)
 {
   const prru_mechanism *me = m->mech;
-  memset(out, 0, sizeof *out);
-  for (int i = 0; i < PRRU_NACT; i++) {
+  limits_none_from(out, me->nact);
+  for (int i = 0; i < me->nact; i++) {
     out->force_max[i] = me->force_max[i], out->speed_max[i] = me->speed_max[i];
     out->d_min[i] = me->d_min[i], out->d_max[i] = me->d_max[i];
   }
@@ -46,13 +49,13 @@ void prru_model_limits(const prru_model *m, prru_limits *out)
 
 double prru_model_drive_ratio(const prru_model *m, int i)
 {
-  if (i < 0 || i >= PRRU_NACT || !(m->mech->lead[i] > 0)) return NAN;
+  if (i < 0 || i >= m->mech->nact || !(m->mech->lead[i] > 0)) return NAN;
   return prru_drive_ratio(m->mech->lead[i], m->mech->gear[i]);
 }
 
 int prru_model_has_lead(const prru_model *m)
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < m->mech->nact; i++)
     if (!(m->mech->lead[i] > 0)) return 0;
   return 1;
 }
@@ -62,7 +65,7 @@ int prru_model_motor_units(const prru_model *m, const double f[], double tau[],
 {
   const prru_mechanism *me = m->mech;
   if (!prru_model_has_lead(m)) return PRRU_EINPUT;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < me->nact; i++) {
     /* tau_m = f lead / (2 pi gear): the drive's ideal transmission */
     double t = f[i] / prru_drive_ratio(me->lead[i], me->gear[i]);
     if (tau) tau[i] = t;
@@ -71,39 +74,39 @@ int prru_model_motor_units(const prru_model *m, const double f[], double tau[],
   return PRRU_OK;
 }
 
-/* text as one positive value for every actuator or one each. */
-static int limit_values(const char *name, const char *text, double v[PRRU_NACT], char *msg, int msglen)
+/* text as one positive value for each of na actuators or one each. */
+static int limit_values(int na, const char *name, const char *text, double v[], char *msg, int msglen)
 {
   if (!strchr(text, ',')) {
     if (prru_parse_double(text, &v[0]) != PRRU_OK || !(v[0] > 0))
       return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: '%s' is not a positive number", name, text);
-    for (int i = 1; i < PRRU_NACT; i++) v[i] = v[0];
+    for (int i = 1; i < na; i++) v[i] = v[0];
     return PRRU_OK;
   }
-  if (prru_parse_list(text, v, PRRU_NACT) != PRRU_OK)
+  if (prru_parse_list(text, v, na) != PRRU_OK)
     return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: '%s' is not one number or %d comma-separated numbers",
-                     name, text, PRRU_NACT);
-  for (int i = 0; i < PRRU_NACT; i++)
+                     name, text, na);
+  for (int i = 0; i < na; i++)
     if (!(v[i] > 0))
       return prru_fail(msg, msglen, PRRU_EINPUT, "--%s: the limit of actuator %d must be positive", name, i + 1);
   return PRRU_OK;
 }
 
 /* "LO,HI" / "LO:HI" for every slider or LO,HI per slider. */
-static int stroke_values(const char *text, double lo[PRRU_NACT], double hi[PRRU_NACT], char *msg, int msglen)
+static int stroke_values(int na, const char *text, double lo[], double hi[], char *msg, int msglen)
 {
   char buf[512];
-  double v[2 * PRRU_NACT];
+  double v[2 * PRRU_MAX_ACT];
   int n = 1;
   if (strlen(text) >= sizeof buf) return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: too long");
   strcpy(buf, text);
   char *colon = strchr(buf, ':');
   if (colon && !strchr(buf, ',') && !strchr(colon + 1, ':')) *colon = ',';
   for (const char *c = buf; *c; c++) n += *c == ',';
-  if ((n != 2 && n != 2 * PRRU_NACT) || prru_parse_list(buf, v, n) != PRRU_OK)
+  if ((n != 2 && n != 2 * na) || prru_parse_list(buf, v, n) != PRRU_OK)
     return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: '%s': give LO,HI for all sliders or %d numbers "
-                     "(LO,HI per slider)", text, 2 * PRRU_NACT);
-  for (int i = 0; i < PRRU_NACT; i++) {
+                     "(LO,HI per slider)", text, 2 * na);
+  for (int i = 0; i < na; i++) {
     const double a = v[n == 2 ? 0 : 2 * i], b = v[n == 2 ? 1 : 2 * i + 1];
     if (!(a < b))
       return prru_fail(msg, msglen, PRRU_EINPUT, "--stroke: slider %d's range [%g, %g] is empty (LO must be "
@@ -120,39 +123,41 @@ int prru_limits_for_run(const prru_model *m, const prru_limit_args *a, prru_limi
   if (a && a->none) prru_limits_none(&l);
   else prru_model_limits(m, &l);
   int st = PRRU_OK;
-  if (a && a->force_max) st = limit_values("force-max", a->force_max, l.force_max, msg, msglen);
-  if (!st && a && a->speed_max) st = limit_values("speed-max", a->speed_max, l.speed_max, msg, msglen);
-  if (!st && a && a->stroke) st = stroke_values(a->stroke, l.d_min, l.d_max, msg, msglen);
+  const int na = m->mech->nact;
+  if (a && a->force_max) st = limit_values(na, "force-max", a->force_max, l.force_max, msg, msglen);
+  if (!st && a && a->speed_max) st = limit_values(na, "speed-max", a->speed_max, l.speed_max, msg, msglen);
+  if (!st && a && a->stroke) st = stroke_values(na, a->stroke, l.d_min, l.d_max, msg, msglen);
   if (!st) *out = l;
   return st;
 }
 
 /* One kind of limit: "none", "X UNIT" or "X1,..,XN UNIT". */
-static void describe_kind(char *buf, size_t len, const char *name, const double *v, const char *unit)
+static void describe_kind(int na, char *buf, size_t len, const char *name, const double *v, const char *unit)
 {
   int same = 1, any = 0;
-  for (int i = 0; i < PRRU_NACT; i++) same &= v[i] == v[0], any |= isfinite(v[i]);
+  for (int i = 0; i < na; i++) same &= v[i] == v[0], any |= isfinite(v[i]);
   size_t n = strlen(buf);
   if (!any) {
     snprintf(buf + n, len - n, "%s none", name);
     return;
   }
   n += (size_t)snprintf(buf + n, len - n, "%s ", name);
-  for (int i = 0; i < (same ? 1 : PRRU_NACT) && n < len; i++)
+  for (int i = 0; i < (same ? 1 : na) && n < len; i++)
     n += (size_t)snprintf(buf + n, len - n, "%s%.9g", i ? "," : "", v[i]);
   if (n < len) snprintf(buf + n, len - n, " %s", unit);
 }
 
-void prru_limits_describe(const prru_limits *l, char *buf, size_t len)
+void prru_limits_describe(const prru_model *m, const prru_limits *l, char *buf, size_t len)
 {
   if (len == 0) return;
+  const int na = m->mech->nact;
   buf[0] = 0;
-  describe_kind(buf, len, "force_max", l->force_max, "N");
+  describe_kind(na, buf, len, "force_max", l->force_max, "N");
   strncat(buf, ", ", len - strlen(buf) - 1);
-  describe_kind(buf, len, "speed_max", l->speed_max, "m/s");
+  describe_kind(na, buf, len, "speed_max", l->speed_max, "m/s");
   strncat(buf, ", ", len - strlen(buf) - 1);
   int same = 1, any = 0;
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     same &= l->d_min[i] == l->d_min[0] && l->d_max[i] == l->d_max[0],
         any |= isfinite(l->d_min[i]) || isfinite(l->d_max[i]);
   size_t n = strlen(buf);
@@ -161,7 +166,7 @@ void prru_limits_describe(const prru_limits *l, char *buf, size_t len)
     return;
   }
   n += (size_t)snprintf(buf + n, len - n, "stroke");
-  for (int i = 0; i < (same ? 1 : PRRU_NACT) && n < len; i++)
+  for (int i = 0; i < (same ? 1 : na) && n < len; i++)
     n += (size_t)snprintf(buf + n, len - n, "%s[%.9g, %.9g]", i ? ", " : " ", l->d_min[i], l->d_max[i]);
   if (n < len) snprintf(buf + n, len - n, " m");
 }
@@ -191,7 +196,7 @@ int prru_model_with_limits(prru_model *out, const prru_model *src, const prru_li
   }
   c->path = p;
   c->mech.model_file = p;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->mech.nact; i++) {
     c->mech.force_max[i] = l->force_max[i], c->mech.speed_max[i] = l->speed_max[i];
     c->mech.d_min[i] = l->d_min[i], c->mech.d_max[i] = l->d_max[i];
   }
@@ -249,7 +254,7 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
   me->format = s->format;
   memcpy(me->gravity, s->gravity, sizeof me->gravity);
   me->total_mass = 0;
-  for (int b = 0; b < PRRU_NBODY; b++) {
+  for (int b = 0; b < me->nbody; b++) {
     const double *I = s->inertia[b];
     const double T[9] = {I[0], I[3], I[4], I[3], I[1], I[5], I[4], I[5], I[2]};
     me->mass[b] = s->mass[b];
@@ -258,7 +263,7 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
     memcpy(me->inertia[b], T, sizeof T);
     inverse3(T, me->inertia_inv[b]);
   }
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < me->nlimb; i++) {
     me->b[i] = s->limb[i].b, me->l1[i] = s->limb[i].l1;
     me->l2[i] = s->limb[i].l2, me->a[i] = s->limb[i].a;
     me->armature[i] = s->armature[i];
@@ -266,7 +271,7 @@ static void fill_mechanism(const prru_model_spec *s, loaded_model *l)
     me->coulomb[i] = s->coulomb[i];
   }
   me->coulomb_velocity = s->coulomb_velocity;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < me->nact; i++) {
     me->lead[i] = s->lead[i], me->gear[i] = s->gear[i];
     me->torque_constant[i] = s->torque_constant[i];
     me->force_max[i] = s->force_max[i], me->speed_max[i] = s->speed_max[i];
@@ -281,12 +286,12 @@ void prru_model_params(const prru_model *m, prru_params *p)
 {
   const prru_mechanism *me = m->mech;
   memset(p, 0, sizeof *p); /* the entries past the model's sizes: 0, every time */
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < me->nlimb; i++) {
     p->b[i] = me->b[i], p->l1[i] = me->l1[i], p->l2[i] = me->l2[i], p->a[i] = me->a[i];
     p->armature[i] = me->armature[i], p->damping[i] = me->damping[i], p->coulomb[i] = me->coulomb[i];
   }
   memcpy(p->gravity, me->gravity, sizeof p->gravity);
-  for (int b = 0; b < PRRU_NBODY; b++) {
+  for (int b = 0; b < me->nbody; b++) {
     const double *T = me->inertia[b];
     const double I[6] = {T[0], T[4], T[8], T[1], T[2], T[5]};
     p->mass[b] = me->mass[b];
@@ -307,15 +312,19 @@ static int same(const double *a, const double *b, int n)
 
 int prru_model_is_built(const prru_model *m, int only_geometry)
 {
+  /* The one comparison with the build's own model: its specialised
+   * kernels apply to no other. */
   const prru_mechanism *a = m->mech, *b = &prru_mech;
   if (a == b) return 1;
-  int ok = same(a->gravity, b->gravity, 3) && same(a->b, b->b, PRRU_NLIMB) && same(a->l1, b->l1, PRRU_NLIMB) &&
-           same(a->l2, b->l2, PRRU_NLIMB) && same(a->a, b->a, PRRU_NLIMB);
+  if (a->nlimb != b->nlimb) return 0;
+  const int nl = b->nlimb, na = b->nact;
+  int ok = same(a->gravity, b->gravity, 3) && same(a->b, b->b, nl) && same(a->l1, b->l1, nl) &&
+           same(a->l2, b->l2, nl) && same(a->a, b->a, nl);
   if (!ok || only_geometry) return ok;
-  for (int k = 0; k < PRRU_NBODY && ok; k++)
+  for (int k = 0; k < b->nbody && ok; k++)
     ok = a->mass[k] == b->mass[k] && same(a->com[k], b->com[k], 3) && same(a->inertia[k], b->inertia[k], 9);
-  return ok && same(a->armature, b->armature, PRRU_NACT) && same(a->damping, b->damping, PRRU_NACT) &&
-         same(a->coulomb, b->coulomb, PRRU_NACT) && a->coulomb_velocity == b->coulomb_velocity;
+  return ok && same(a->armature, b->armature, na) && same(a->damping, b->damping, na) &&
+         same(a->coulomb, b->coulomb, na) && a->coulomb_velocity == b->coulomb_velocity;
 }
 
 int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
@@ -446,11 +455,11 @@ void prru_model_actuator_rates(const prru_model *m, const double q[3], const dou
 void prru_power(const prru_model *m, const double q[3], const double qd[3], const prru_loads *l,
                 double *load_power, double *passive_power)
 {
-  double act[PRRU_NACT], Jd[PRRU_NACT * 3], JP[18], Qp[3], power = 0, passive = 0;
+  double act[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3], JP[18], Qp[3], power = 0, passive = 0;
   KERNEL(m, ik_jd)(m->kernel_params, q, act, Jd);
   KERNEL(m, platform_jacobian)(m->kernel_params, q, JP);
   KERNEL(m, passive)(m->kernel_params, q, qd, Qp);
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < m->mech->nact; i++) {
     double dd = 0;
     for (int k = 0; k < 3; k++) dd += Jd[3 * i + k] * qd[k];
     power += l->fd[i] * dd;

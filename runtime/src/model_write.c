@@ -69,46 +69,47 @@ static void put_string(text_buf *b, const char *text)
 }
 
 /* ",\n    \"key\": " then one number when every actuator has it, else the list. */
-static void drive_key(text_buf *b, const char *key, const double *v)
+static void drive_key(text_buf *b, int na, const char *key, const double *v)
 {
   int same = 1;
-  for (int i = 1; i < PRRU_NACT; i++) same &= v[i] == v[0];
+  for (int i = 1; i < na; i++) same &= v[i] == v[0];
   put(b, ",\n    \"%s\": ", key);
   if (same)
     put(b, "%.17g", file_number(v[0]));
   else
-    put_list(b, v, PRRU_NACT);
+    put_list(b, v, na);
 }
 
 /* The drive keys of spec 13 the model's file gave, kept as they were; a
  * changed armature goes back into rotor_inertia where the file gave that. */
-static void drive_keys(text_buf *b, const prru_model *m, const double armature[PRRU_NACT])
+static void drive_keys(text_buf *b, const prru_model *m, const double armature[])
 {
   const prru_mechanism *me = m->mech;
   const unsigned k = me->drive_keys;
-  if (k & PRRU_DRIVE_LEAD) drive_key(b, "lead", me->lead);
-  if (k & PRRU_DRIVE_GEAR) drive_key(b, "gear", me->gear);
+  const int na = me->nact;
+  if (k & PRRU_DRIVE_LEAD) drive_key(b, na, "lead", me->lead);
+  if (k & PRRU_DRIVE_GEAR) drive_key(b, na, "gear", me->gear);
   if (k & PRRU_DRIVE_ROTOR_INERTIA) {
-    double J[PRRU_NACT];
-    for (int i = 0; i < PRRU_NACT; i++) {
+    double J[PRRU_MAX_ACT];
+    for (int i = 0; i < na; i++) {
       const double w = prru_model_drive_ratio(m, i);
       J[i] = armature[i] == me->armature[i] ? me->rotor_inertia[i] : armature[i] / (w * w);
     }
-    drive_key(b, "rotor_inertia", J);
+    drive_key(b, na, "rotor_inertia", J);
   }
-  if (k & PRRU_DRIVE_TORQUE_CONSTANT) drive_key(b, "torque_constant", me->torque_constant);
+  if (k & PRRU_DRIVE_TORQUE_CONSTANT) drive_key(b, na, "torque_constant", me->torque_constant);
   if (k & PRRU_DRIVE_STROKE) {
     int same = 1;
-    for (int i = 1; i < PRRU_NACT; i++) same &= me->d_min[i] == me->d_min[0] && me->d_max[i] == me->d_max[0];
+    for (int i = 1; i < na; i++) same &= me->d_min[i] == me->d_min[0] && me->d_max[i] == me->d_max[0];
     put(b, ",\n    \"stroke\": %s", same ? "" : "[");
-    for (int i = 0; i < (same ? 1 : PRRU_NACT); i++)
+    for (int i = 0; i < (same ? 1 : na); i++)
       put(b, "%s[%.17g, %.17g]", i ? ", " : "", file_number(me->d_min[i]), file_number(me->d_max[i]));
     if (!same) put(b, "]");
   }
-  if (k & PRRU_DRIVE_FORCE_MAX) drive_key(b, "force_max", me->force_max);
-  if (k & PRRU_DRIVE_TORQUE_MAX) drive_key(b, "torque_max", me->torque_max);
-  if (k & PRRU_DRIVE_SPEED_MAX) drive_key(b, "speed_max", me->speed_max);
-  if (k & PRRU_DRIVE_MOTOR_SPEED_MAX) drive_key(b, "motor_speed_max", me->motor_speed_max);
+  if (k & PRRU_DRIVE_FORCE_MAX) drive_key(b, na, "force_max", me->force_max);
+  if (k & PRRU_DRIVE_TORQUE_MAX) drive_key(b, na, "torque_max", me->torque_max);
+  if (k & PRRU_DRIVE_SPEED_MAX) drive_key(b, na, "speed_max", me->speed_max);
+  if (k & PRRU_DRIVE_MOTOR_SPEED_MAX) drive_key(b, na, "motor_speed_max", me->motor_speed_max);
 }
 
 int prru_model_name_valid(const char *s)
@@ -135,32 +136,32 @@ static void model_json(text_buf *b, const prru_model *m, const prru_params *p, c
   put(b, ",\n  \"gravity\": ");
   put_list(b, p->gravity, 3);
   put(b, ",\n  \"geometry\": {\n    \"b\": ");
-  put_list(b, p->b, PRRU_NLIMB);
+  put_list(b, p->b, m->mech->nlimb);
   put(b, ",\n    \"l1\": ");
-  put_list(b, p->l1, PRRU_NLIMB);
+  put_list(b, p->l1, m->mech->nlimb);
   put(b, ",\n    \"l2\": ");
-  put_list(b, p->l2, PRRU_NLIMB);
+  put_list(b, p->l2, m->mech->nlimb);
   put(b, ",\n    \"a\": ");
   put_list(b, p->a, 2);
   put(b, "\n  },\n  \"bodies\": {\n");
-  for (int k = 0; k < PRRU_NBODY; k++) {
+  for (int k = 0; k < m->mech->nbody; k++) {
     put(b, "    \"%s\": {\"mass\": %.17g, \"com\": ", m->mech->body_names[k], file_number(p->mass[k]));
     put_list(b, p->com[k], 3);
     put(b, ",\n      \"inertia\": ");
     put_list(b, p->inertia[k], 6);
-    put(b, "}%s\n", k + 1 < PRRU_NBODY ? "," : "");
+    put(b, "}%s\n", k + 1 < m->mech->nbody ? "," : "");
   }
   put(b, "  },\n  \"actuators\": {\n    ");
   /* Where the file gave rotor_inertia, the armature goes back there. */
   if (!(m->mech->drive_keys & PRRU_DRIVE_ROTOR_INERTIA)) {
     put(b, "\"armature\": ");
-    put_list(b, p->armature, PRRU_NACT);
+    put_list(b, p->armature, m->mech->nact);
     put(b, ",\n    ");
   }
   put(b, "\"damping\": ");
-  put_list(b, p->damping, PRRU_NACT);
+  put_list(b, p->damping, m->mech->nact);
   put(b, ",\n    \"coulomb\": ");
-  put_list(b, p->coulomb, PRRU_NACT);
+  put_list(b, p->coulomb, m->mech->nact);
   put(b, ",\n    \"coulomb_velocity\": %.17g", p->coulomb_velocity);
   drive_keys(b, m, p->armature);
   put(b, "\n  }\n}\n");

@@ -42,11 +42,11 @@ static char *trim(char *s)
 /* Applies one key; returns PRRU_OK or fills msg. Numbers are read as on
  * the command line (prru_parse_value/s: decimal or [+-][K[*]]pi[/N]), so a
  * scenario file and the flags it stands for accept the same values. */
-static int apply_key(prru_scenario *s, const char *key, const char *val, const char *where,
+static int apply_key(const prru_model *m, prru_scenario *s, const char *key, const char *val, const char *where,
                      const char *base_dir, int *has_table, char *msg, int msglen)
 {
   struct { const char *name; double *dst; int n; } vec[] = {
-      {"q0", s->q0, 3}, {"qd0", s->qd0, 3}, {"fd", s->loads.base.fd, PRRU_NACT},
+      {"q0", s->q0, 3}, {"qd0", s->qd0, 3}, {"fd", s->loads.base.fd, m->mech->nact},
       {"fp", s->loads.base.fp, 3}, {"mp", s->loads.base.mp, 3}};
   for (size_t i = 0; i < sizeof vec / sizeof vec[0]; i++)
     if (strcmp(key, vec[i].name) == 0) {
@@ -103,7 +103,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
       return prru_fail(msg, msglen, PRRU_EPARSE, "%s: loads: path too long", where);
     prru_load_schedule t;
     char why[600];
-    int st = prru_schedule_read_csv(&t, path, why, (int)sizeof why);
+    int st = prru_schedule_read_csv(m, &t, path, why, (int)sizeof why);
     /* why names the loads file; where, the scenario file and line. */
     if (st != PRRU_OK) return prru_fail(msg, msglen, st, "%s: loads: %s", where, why);
     t.base = s->loads.base; /* constant parts given before add to the table */
@@ -115,7 +115,7 @@ static int apply_key(prru_scenario *s, const char *key, const char *val, const c
   return prru_fail(msg, msglen, PRRU_EPARSE, "%s: unknown key '%.40s' (known: q0 qd0 fd fp mp harmonic loads t_end dt stepper atol rtol h0 max_steps)", where, key);
 }
 
-int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const char *name,
+int prru_scenario_parse(const prru_model *m, prru_scenario *s, const char *text, size_t len, const char *name,
                         const char *base_dir, char *msg, int msglen)
 {
   scenario_defaults(s);
@@ -155,7 +155,7 @@ int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const ch
               st = prru_fail(msg, msglen, PRRU_EPARSE, "%s: %s given twice", where, key);
             seen |= 1u << k;
           }
-        if (st == PRRU_OK) st = apply_key(s, key, val, where, base_dir, &has_table, msg, msglen);
+        if (st == PRRU_OK) st = apply_key(m, s, key, val, where, base_dir, &has_table, msg, msglen);
       }
     }
     free(line);
@@ -166,7 +166,7 @@ int prru_scenario_parse(prru_scenario *s, const char *text, size_t len, const ch
   return st;
 }
 
-int prru_scenario_read(prru_scenario *s, const char *path, char *msg, int msglen)
+int prru_scenario_read(const prru_model *m, prru_scenario *s, const char *path, char *msg, int msglen)
 {
   size_t len;
   scenario_defaults(s);
@@ -176,7 +176,7 @@ int prru_scenario_read(prru_scenario *s, const char *path, char *msg, int msglen
   snprintf(dir, sizeof dir, "%s", path);
   char *slash = strrchr(dir, '/');
   if (slash) *slash = '\0'; else snprintf(dir, sizeof dir, ".");
-  int st = prru_scenario_parse(s, text, len, path, dir, msg, msglen);
+  int st = prru_scenario_parse(m, s, text, len, path, dir, msg, msglen);
   free(text);
   return st;
 }

@@ -9,16 +9,17 @@
 #include "prru.h"
 #include "internal.h"
 
-/* A table row: t, then the load values in prru_loads order. */
-#define NV (PRRU_NACT + 6)
-#define ROW (1 + NV)
+/* A table row: t, then the load values in prru_loads order, na forces
+ * first: NV(na) values, ROW(na) doubles. */
+#define NV(na) ((na) + 6)
+#define ROW(na) (1 + NV(na))
 
-static void loads_add(prru_loads *l, const double v[NV])
+static void loads_add(int na, prru_loads *l, const double v[])
 {
-  for (int k = 0; k < PRRU_NACT; k++) l->fd[k] += v[k];
+  for (int k = 0; k < na; k++) l->fd[k] += v[k];
   for (int k = 0; k < 3; k++) {
-    l->fp[k] += v[PRRU_NACT + k];
-    l->mp[k] += v[PRRU_NACT + 3 + k];
+    l->fp[k] += v[na + k];
+    l->mp[k] += v[na + 3 + k];
   }
 }
 
@@ -35,7 +36,7 @@ void prru_schedule_paper(prru_load_schedule *s)
   /* A redundant limb mirrors limb 3 (spec 12) and is driven like it:
    * with no force it would leave its share of the weight to the others and
    * the 4-PRRU leaves its workspace at t = 0.48 s. */
-  for (int i = 3; i < PRRU_NACT; i++) l.fd[i] = l.fd[2];
+  for (int i = 3; i < PRRU_MAX_ACT; i++) l.fd[i] = l.fd[2];
   prru_schedule_constant(s, &l);
   s->kind = PRRU_LOAD_HARMONIC;
   s->amp = 50.0;
@@ -50,29 +51,29 @@ void prru_schedule_eval(const prru_load_schedule *s, double t, prru_loads *out)
     out->fp[1] -= s->amp * cos(s->omega * t);
   } else if (s->kind == PRRU_LOAD_TABLE && s->nrows > 0) {
     const double *r = s->rows;
-    int n = s->nrows;
-    double v[NV];
+    const int n = s->nrows, na = s->nact, row = ROW(na), nv = NV(na);
+    double v[NV(PRRU_MAX_ACT)];
     if (t <= r[0]) {
-      memcpy(v, r + 1, sizeof v);
-    } else if (t >= r[ROW * (n - 1)]) {
-      memcpy(v, r + ROW * (n - 1) + 1, sizeof v);
+      memcpy(v, r + 1, (size_t)nv * sizeof *v);
+    } else if (t >= r[row * (n - 1)]) {
+      memcpy(v, r + row * (n - 1) + 1, (size_t)nv * sizeof *v);
     } else {
-      int lo = 0, hi = n - 1; /* r[ROW lo] <= t < r[ROW hi] */
+      int lo = 0, hi = n - 1; /* r[row lo] <= t < r[row hi] */
       while (hi - lo > 1) {
         int mid = (lo + hi) / 2;
-        if (r[ROW * mid] <= t) lo = mid; else hi = mid;
+        if (r[row * mid] <= t) lo = mid; else hi = mid;
       }
-      const double *a = r + ROW * lo, *b = r + ROW * hi;
+      const double *a = r + row * lo, *b = r + row * hi;
       /* Halved time differences, and a convex combination where b - a
        * overflows: no overflow for any finite table. a + w (b - a)
        * otherwise, so that a constant column stays exactly constant. */
       double w = (0.5 * t - 0.5 * a[0]) / (0.5 * b[0] - 0.5 * a[0]);
-      for (int k = 0; k < NV; k++) {
+      for (int k = 0; k < nv; k++) {
         double diff = b[1 + k] - a[1 + k];
         v[k] = isfinite(diff) ? a[1 + k] + w * diff : (1.0 - w) * a[1 + k] + w * b[1 + k];
       }
     }
-    loads_add(out, v);
+    loads_add(na, out, v);
   }
 }
 
@@ -83,47 +84,49 @@ void prru_schedule_free(prru_load_schedule *s)
   s->nrows = 0;
 }
 
-int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
+int prru_schedule_parse_csv(const prru_model *m, prru_load_schedule *s, const char *text, size_t len,
                             const char *name, char *msg, int msglen)
 {
   /* Column names: t, fd1..fdN (required), fp1..3, mp1..3 (optional). */
-  char cols[ROW][8];
+  const int na = m->mech->nact, row = ROW(na);
+  char cols[ROW(PRRU_MAX_ACT)][16];
   snprintf(cols[0], sizeof cols[0], "t");
-  for (int k = 0; k < NV; k++) {
-    const char *base = k < PRRU_NACT ? "fd" : k < PRRU_NACT + 3 ? "fp" : "mp";
-    int i = k < PRRU_NACT ? k : (k - PRRU_NACT) % 3;
+  for (int k = 0; k < NV(na); k++) {
+    const char *base = k < na ? "fd" : k < na + 3 ? "fp" : "mp";
+    int i = k < na ? k : (k - na) % 3;
     snprintf(cols[1 + k], sizeof cols[1 + k], "%s%d", base, i + 1);
   }
   prru_table t;
   memset(s, 0, sizeof *s);
+  s->nact = na;
   int st = prru_table_parse(&t, text, len, name, msg, msglen);
   if (st != PRRU_OK) return st;
-  int idx[ROW];
-  for (int k = 0; k < ROW; k++) {
+  int idx[ROW(PRRU_MAX_ACT)];
+  for (int k = 0; k < row; k++) {
     idx[k] = prru_table_column(&t, cols[k]);
-    if (idx[k] < 0 && k <= PRRU_NACT) {
+    if (idx[k] < 0 && k <= na) {
       prru_table_free(&t);
-      return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: missing column '%s' (need t,fd1..fd%d; fp1..3, mp1..3 optional)", name, cols[k], PRRU_NACT);
+      return prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: missing column '%s' (need t,fd1..fd%d; fp1..3, mp1..3 optional)", name, cols[k], na);
     }
   }
   for (int j = 0; j < t.ncols; j++) {
     int known = 0;
-    for (int k = 0; k < ROW; k++) known |= idx[k] == j;
+    for (int k = 0; k < row; k++) known |= idx[k] == j;
     if (!known) {
-      prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: unknown column '%s' (expected t,fd1..%d,fp1..3,mp1..3)", name, t.names[j], PRRU_NACT);
+      prru_fail(msg, msglen, PRRU_EPARSE, "%s:1: unknown column '%s' (expected t,fd1..%d,fp1..3,mp1..3)", name, t.names[j], na);
       prru_table_free(&t);
       return PRRU_EPARSE;
     }
   }
-  s->rows = malloc((size_t)t.nrows * ROW * sizeof *s->rows);
+  s->rows = malloc((size_t)t.nrows * (size_t)row * sizeof *s->rows);
   if (!s->rows) { prru_table_free(&t); return prru_fail(msg, msglen, PRRU_ENOMEM, "%s: out of memory", name); }
   for (int i = 0; i < t.nrows; i++)
-    for (int k = 0; k < ROW; k++)
-      s->rows[ROW * i + k] = idx[k] < 0 ? 0.0 : t.data[(size_t)i * (size_t)t.ncols + (size_t)idx[k]];
+    for (int k = 0; k < row; k++)
+      s->rows[row * i + k] = idx[k] < 0 ? 0.0 : t.data[(size_t)i * (size_t)t.ncols + (size_t)idx[k]];
   for (int i = 1; i < t.nrows; i++)
-    if (!(s->rows[ROW * i] > s->rows[ROW * (i - 1)])) {
+    if (!(s->rows[row * i] > s->rows[row * (i - 1)])) {
       prru_fail(msg, msglen, PRRU_EPARSE, "%s: data row %d: time %g does not increase", name,
-                i + 1, s->rows[ROW * i]);
+                i + 1, s->rows[row * i]);
       prru_table_free(&t);
       prru_schedule_free(s);
       return PRRU_EPARSE;
@@ -134,13 +137,13 @@ int prru_schedule_parse_csv(prru_load_schedule *s, const char *text, size_t len,
   return PRRU_OK;
 }
 
-int prru_schedule_read_csv(prru_load_schedule *s, const char *path, char *msg, int msglen)
+int prru_schedule_read_csv(const prru_model *m, prru_load_schedule *s, const char *path, char *msg, int msglen)
 {
   size_t len;
   memset(s, 0, sizeof *s);
   char *text = prru_read_file(path, &len, msg, msglen);
   if (!text) return PRRU_EIO;
-  int st = prru_schedule_parse_csv(s, text, len, path, msg, msglen);
+  int st = prru_schedule_parse_csv(m, s, text, len, path, msg, msglen);
   free(text);
   return st;
 }

@@ -158,8 +158,9 @@ static int jac(double t, const double y[], double *dfdy, double dfdt[], void *p)
   prru_schedule_eval(c->loads, t - ht, &lm);
   for (int i = 0; i < 3; i++) {
     double r = 0;
-    for (int k = 0; k < PRRU_NACT; k++)
-      r += lin.dqdd_dfd[PRRU_NACT * i + k] * (lp.fd[k] - lm.fd[k]);
+    const int na = c->m->mech->nact;
+    for (int k = 0; k < na; k++)
+      r += lin.dqdd_dfd[na * i + k] * (lp.fd[k] - lm.fd[k]);
     for (int k = 0; k < 3; k++)
       r += lin.dqdd_dfp[3 * i + k] * (lp.fp[k] - lm.fp[k]) + lin.dqdd_dmp[3 * i + k] * (lp.mp[k] - lm.mp[k]);
     dfdt[i] = 0;
@@ -197,7 +198,7 @@ static int make_sample(const prru_model *m, prru_data *d, const prru_load_schedu
   } else {
     st = prru_forward_dynamics(m, d, s->q, s->qd, &l, s->qdd);
     if (st != PRRU_OK) return st;
-    for (int i = 0; i < PRRU_NLAMBDA; i++) s->lambda[i] = NAN;
+    for (int i = 0; i < m->mech->nlambda; i++) s->lambda[i] = NAN;
   }
   return prru_energies(m, s->q, s->qd, &s->T, &s->V);
 }
@@ -262,6 +263,11 @@ int prru_simulate(const prru_model *m, const double q0[3], const double qd0[3],
     prru_schedule_constant(&none, &zero);
     ls = &none;
   }
+  /* A table's force columns are those of the model it was read for. */
+  if (ls->kind == PRRU_LOAD_TABLE && ls->nact != m->mech->nact)
+    return prru_fail(msg, msglen, PRRU_EINPUT,
+                     "the loads table has %d actuator force columns; model %s has %d actuators", ls->nact,
+                     m->mech->name, m->mech->nact);
   prru_data *d = malloc(sizeof *d);      /* ~55 kB: not for the stack */
   prru_data *drhs = malloc(sizeof *drhs);
   prru_sample *s = malloc(sizeof *s);
