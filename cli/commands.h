@@ -9,13 +9,6 @@
 #include <stdio.h>
 
 #include "prru.h"
-/* The build's model: the sizes (PRRU_NACT, ...) the CLI's arrays and
- * output columns still have, its descriptor and regressor names. The
- * library's public headers carry none of them (one ABI for every model);
- * the CLI is built with the library, for the same model. */
-#include "prru_kernels.h"
-#include "prru_mechanism.h"
-#include "prru_regressor.h"
 
 /* The program's version, the CMake project version (cli/CMakeLists.txt). */
 #ifndef PRRU_VERSION
@@ -23,10 +16,10 @@
 #endif
 
 /* The CLI writes q as q1,q2,q3 (names, help texts): the 3-PRRU's three
- * coordinates. Everything else sized by the mechanism uses the PRRU_N*
- * macros (the build's topology) and the current model's descriptor
- * (prru_cli_model()->mech: names and numbers). */
-typedef char prru_cli_nq_is_3[PRRU_NQ == 3 ? 1 : -1];
+ * coordinates. Everything else sized by the mechanism comes from the
+ * model a command computes with (prru_cli_model()->mech: its counts,
+ * names and numbers), so that one build serves every model the library
+ * loads; fixed arrays have the public maxima of prru_sizes.h. */
 
 int prru_cmd_eval(int argc, char **argv);
 int prru_cmd_gen(int argc, char **argv);
