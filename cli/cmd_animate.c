@@ -62,10 +62,11 @@ static void grow(extent *e, const double x[3])
  * quarter of the mean upper link when a is 0. */
 static double plate_half(void)
 {
+  const prru_mechanism *me = prru_cli_model()->mech;
   double h = 0.0, l = 0.0;
-  for (int i = 0; i < PRRU_NLIMB; i++) {
-    if (prru_cli_model()->mech->a[i] > h) h = prru_cli_model()->mech->a[i];
-    l += prru_cli_model()->mech->l1[i] / PRRU_NLIMB;
+  for (int i = 0; i < me->nlimb; i++) {
+    if (me->a[i] > h) h = me->a[i];
+    l += me->l1[i] / me->nlimb;
   }
   return h > 0.1 * l ? h : 0.25 * l;
 }
@@ -74,9 +75,10 @@ static double plate_half(void)
  * reach. */
 static int frame(FILE *out, const double q[3], extent *e)
 {
-  double R[9 * PRRU_NBODY], p[3 * PRRU_NBODY];
+  const int nlimb = prru_cli_model()->mech->nlimb;
+  double R[9 * PRRU_MAX_BODY], p[3 * PRRU_MAX_BODY];
   prru_model_poses(prru_cli_model(), q, R, p);
-  for (int k = 0; k < 3 * PRRU_NBODY; k++)
+  for (int k = 0; k < 3 * prru_cli_model()->mech->nbody; k++)
     if (!isfinite(p[k])) return -1;
   const int P = prru_cli_model()->mech->platform;
   const double *RP = R + 9 * P, h = plate_half();
@@ -88,7 +90,7 @@ static int frame(FILE *out, const double q[3], extent *e)
     for (int c = 0; c < 3; c++) corner[k][c] = O[c] + RP[3 * c] * x + RP[3 * c + 1] * y;
   }
   for (int c = 0; c < 3; c++) normal[c] = O[c] + RP[3 * c + 2] * h;
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < nlimb; i++) {
     double A[3], B[3], C[3];
     prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
     if (!out) {
@@ -113,10 +115,10 @@ static int frame(FILE *out, const double q[3], extent *e)
   seg(out, O, normal, COL_PLATFORM);
   /* The platform's outline through its U joints: the plate of side 2a
    * alone is small beside the links. */
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < nlimb; i++) {
     double A[3], B[3], C[3], A2[3], B2[3], C2[3];
     prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
-    prru_limb_joints(prru_cli_model(), R, p, (i + 1) % PRRU_NLIMB, A2, B2, C2);
+    prru_limb_joints(prru_cli_model(), R, p, (i + 1) % nlimb, A2, B2, C2);
     seg(out, C, C2, COL_PLATFORM);
   }
   fputs("\n\n", out); /* frames are gnuplot data blocks (index) */

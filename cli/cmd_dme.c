@@ -40,13 +40,14 @@ static const char dme_inverse_redundant[] =
 
 static void print_dme_help(void)
 {
+  const int nact = prru_cli_model()->mech->nact;
   char inv[sizeof dme_inverse_redundant + 32];
-  const char *pinv = PRRU_NACT > 3 ? "+" : "-1", *pinvT = PRRU_NACT > 3 ? "+T" : "-T";
-  if (PRRU_NACT > 3)
-    snprintf(inv, sizeof inv, dme_inverse_redundant, PRRU_NACT, PRRU_NACT);
+  const char *pinv = nact > 3 ? "+" : "-1", *pinvT = nact > 3 ? "+T" : "-T";
+  if (nact > 3)
+    snprintf(inv, sizeof inv, dme_inverse_redundant, nact, nact);
   else
     snprintf(inv, sizeof inv, "%s", dme_inverse_3);
-  printf(dme_help, pinvT, pinv, pinv, inv, PRRU_NACT, PRRU_NACT, PRRU_NACT, pinv);
+  printf(dme_help, pinvT, pinv, pinv, inv, nact, nact, nact, pinv);
 }
 
 static void json_vec(FILE *f, const double *v, int n)
@@ -68,9 +69,10 @@ int prru_cmd_dme(int argc, char **argv)
     prru_cli_error("dme", "--q is required (see 'prru dme --help')");
     return 2;
   }
-  double q[PRRU_NQ];
-  if (prru_cli_numbers("dme", "q", qs, q, PRRU_NQ)) return 2;
+  double q[3];
+  if (prru_cli_numbers("dme", "q", qs, q, 3)) return 2;
   prru_model m = *prru_cli_model();
+  const int nact = m.mech->nact;
   if (prru_cli_parse_rcond("dme", rcs, &m)) return 2;
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
@@ -85,7 +87,7 @@ int prru_cmd_dme(int argc, char **argv)
   fputc('{', f);
   prru_cli_json_model(f);
   fputs(",\n \"q\": ", f);
-  json_vec(f, q, PRRU_NQ);
+  json_vec(f, q, 3);
   fprintf(f, ", \"status\": \"%s\", \"w_R\": ", prru_dme_status_name(st));
   prru_cli_json_number(f, r.w_R);
   fputs(", \"Jd_rcond\": ", f);
@@ -103,11 +105,11 @@ int prru_cmd_dme(int argc, char **argv)
   fputs(", \"translational_direction\": ", f);
   json_vec(f, r.dir_T, 3);
   fputs(", \"Mt\": ", f);
-  prru_cli_json_matrix(f, r.Mt, PRRU_NACT, PRRU_NACT);
+  prru_cli_json_matrix(f, r.Mt, nact, nact);
   fputs(", \"JtR\": ", f);
-  prru_cli_json_matrix(f, r.JtR, 3, PRRU_NACT);
+  prru_cli_json_matrix(f, r.JtR, 3, nact);
   fputs(", \"JtT\": ", f);
-  prru_cli_json_matrix(f, r.JtT, 3, PRRU_NACT);
+  prru_cli_json_matrix(f, r.JtT, 3, nact);
   fputs("}\n", f);
   return ferror(f) ? 1 : 0;
 }

@@ -6,7 +6,7 @@
 #include "commands.h"
 #include "prru.h"
 
-/* %s: the --fd names; %d: PRRU_NLAMBDA. */
+/* %s: the --fd names; %d: the model's reaction coordinates (nlambda). */
 static const char eval_help[] =
     "usage: prru eval --q q1,q2,q3 [--qd qd1,qd2,qd3] [--fd %s]\n"
     "                 [--fp fx,fy,fz] [--mp mx,my,mz]\n"
@@ -72,30 +72,32 @@ int prru_cmd_eval(int argc, char **argv)
   prru_cli_option opts[] = {{"q", 1, &qs, NULL},   {"qd", 1, &qds, NULL}, {"fd", 1, &fds, NULL},
                             {"fp", 1, &fps, NULL}, {"mp", 1, &mps, NULL}, {"help", 0, NULL, &help}};
   if (prru_cli_parse("eval", argc, argv, opts, 6)) return 2;
+  const prru_mechanism *me = prru_cli_model()->mech;
+  const int nact = me->nact;
   if (help) {
     char fd_names[256];
     char redundant[sizeof eval_help_redundant + 32] = "";
-    if (PRRU_NACT > 3) snprintf(redundant, sizeof redundant, eval_help_redundant, PRRU_NACT, PRRU_NACT);
-    printf(eval_help, prru_cli_names(fd_names, sizeof fd_names, "f", PRRU_NACT, ","), PRRU_NLAMBDA,
-           prru_cli_model()->mech->lambda_labels[0], redundant);
+    if (nact > 3) snprintf(redundant, sizeof redundant, eval_help_redundant, nact, nact);
+    printf(eval_help, prru_cli_names(fd_names, sizeof fd_names, "f", nact, ","), me->nlambda,
+           me->lambda_labels[0], redundant);
     return 0;
   }
   if (!qs) {
     prru_cli_error("eval", "--q is required (see 'prru eval --help')");
     return 2;
   }
-  double q[PRRU_NQ], qd[PRRU_NQ];
+  double q[3], qd[3];
   prru_loads l;
-  if (read_vec("eval", "q", qs, q, PRRU_NQ) || read_vec("eval", "qd", qds, qd, PRRU_NQ) ||
-      read_vec("eval", "fd", fds, l.fd, PRRU_NACT) || read_vec("eval", "fp", fps, l.fp, 3) ||
+  if (read_vec("eval", "q", qs, q, 3) || read_vec("eval", "qd", qds, qd, 3) ||
+      read_vec("eval", "fd", fds, l.fd, nact) || read_vec("eval", "fp", fps, l.fp, 3) ||
       read_vec("eval", "mp", mps, l.mp, 3))
     return 2;
 
   const prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
-  double rcond, M[PRRU_NQ * PRRU_NQ], h[PRRU_NQ], G[PRRU_NQ], passive[PRRU_NQ];
-  double lambda[PRRU_NLAMBDA], qdd[PRRU_NQ];
+  double rcond, M[9], h[3], G[3], passive[3];
+  double lambda[PRRU_MAX_LAMBDA], qdd[3];
   char qtext[128];
   int st = prru_check_regular(&m, d, q, &rcond);
   if (st != PRRU_OK) {
@@ -128,8 +130,9 @@ int prru_cmd_eval(int argc, char **argv)
   memcpy(qdd, d->qdd, sizeof qdd);
   /* Redundant actuation: the actuator null vector n and the reaction null
    * vector z (left in d->lambda_null by prru_reactions). */
-  double n[PRRU_NACT], z[PRRU_NLAMBDA], preload = 0.0;
-  if (PRRU_NPRELOAD > 0) {
+  double n[PRRU_MAX_ACT], z[PRRU_MAX_LAMBDA], preload = 0.0;
+  const int npreload = prru_cli_npreload(&m), nreaction_null = prru_cli_nreaction_null(&m);
+  if (npreload > 0) {
     memcpy(z, d->lambda_null, sizeof z);
     st = prru_actuator_null(&m, d, q, n);
     if (st != PRRU_OK) {
@@ -138,39 +141,39 @@ int prru_cmd_eval(int argc, char **argv)
       free(d);
       return prru_cli_exit_for(st);
     }
-    for (int i = 0; i < PRRU_NACT; i++) preload += l.fd[i] * n[i];
+    for (int i = 0; i < nact; i++) preload += l.fd[i] * n[i];
   }
   prru_model_dynamics(&m, q, qd, M, h, G);
   prru_model_passive(&m, q, qd, passive);
-  double act[PRRU_NACT], Jd[PRRU_NACT * PRRU_NQ];
+  double act[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3];
   prru_model_ik_jd(&m, q, act, Jd);
   const char *const *labels = m.mech->lambda_labels;
 
   printf("{");
   prru_cli_json_model(stdout);
-  member(",\n ", "q", q, PRRU_NQ);
-  member(", ", "qd", qd, PRRU_NQ);
-  member_matrix(",\n ", "M", M, PRRU_NQ, PRRU_NQ);
-  member(",\n ", "h", h, PRRU_NQ);
-  member(", ", "G", G, PRRU_NQ);
-  member(", ", "passive", passive, PRRU_NQ);
-  member(",\n ", "d", act, PRRU_NACT);
-  member_matrix(", ", "Jd", Jd, PRRU_NACT, PRRU_NQ);
+  member(",\n ", "q", q, 3);
+  member(", ", "qd", qd, 3);
+  member_matrix(",\n ", "M", M, 3, 3);
+  member(",\n ", "h", h, 3);
+  member(", ", "G", G, 3);
+  member(", ", "passive", passive, 3);
+  member(",\n ", "d", act, nact);
+  member_matrix(", ", "Jd", Jd, nact, 3);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
-  member(",\n ", "fd", l.fd, PRRU_NACT);
+  member(",\n ", "fd", l.fd, nact);
   member(", ", "fp", l.fp, 3);
   member(", ", "mp", l.mp, 3);
-  member(",\n ", "qdd", qdd, PRRU_NQ);
-  if (PRRU_NPRELOAD > 0) {
-    member(",\n ", "actuator_null", n, PRRU_NACT);
+  member(",\n ", "qdd", qdd, 3);
+  if (npreload > 0) {
+    member(",\n ", "actuator_null", n, nact);
     printf(", \"preload\": ");
     prru_cli_json_number(stdout, preload);
   }
-  member(",\n ", "lambda", lambda, PRRU_NLAMBDA);
-  if (PRRU_NREACTION_NULL > 0) member(",\n ", "reaction_null", z, PRRU_NLAMBDA);
+  member(",\n ", "lambda", lambda, me->nlambda);
+  if (nreaction_null > 0) member(",\n ", "reaction_null", z, me->nlambda);
   printf(",\n \"lambda_labels\": [");
-  for (int i = 0; i < PRRU_NLAMBDA; i++) {
+  for (int i = 0; i < me->nlambda; i++) {
     if (i) fputs(", ", stdout);
     prru_cli_json_string(stdout, labels[i]);
   }

@@ -10,7 +10,6 @@
 #include "prru_model_file.h"
 #include "prru_control.h"
 #include "prru_ident.h"
-#include "prru_param_kernels.h"
 #include "prru_traj.h"
 
 /* The Coulomb smoothing velocity the regressor uses: --coulomb-velocity,
@@ -25,6 +24,32 @@ static int coulomb_velocity(const char *cmd, const char *text, double *vs)
     return 2;
   }
   return 0;
+}
+
+/* The standard parameters (regressor columns) of the current model:
+ * PRRU_NBODYPAR per body, then per actuator its armature, damping and
+ * Coulomb force (prru_ident.h). */
+static int nreg(void)
+{
+  const prru_mechanism *me = prru_cli_model()->mech;
+  return PRRU_NBODYPAR * me->nbody + 3 * me->nact;
+}
+
+/* Column j's name, as the generator writes prru_regressor_names: "P.m",
+ * "P.mcx", ..., "S3.Iyz" body by body, then "armature1".., "damping1"..,
+ * "coulomb1".. per actuator. Into buf (len bytes); returns buf. */
+static const char *reg_name(int j, char *buf, size_t len)
+{
+  static const char *const body_par[PRRU_NBODYPAR] = {"m", "mcx", "mcy", "mcz", "Ixx",
+                                                      "Iyy", "Izz", "Ixy", "Ixz", "Iyz"};
+  static const char *const drive_par[3] = {"armature", "damping", "coulomb"};
+  const prru_mechanism *me = prru_cli_model()->mech;
+  const int nb = PRRU_NBODYPAR * me->nbody;
+  if (j < nb)
+    snprintf(buf, len, "%s.%s", me->body_names[j / PRRU_NBODYPAR], body_par[j % PRRU_NBODYPAR]);
+  else
+    snprintf(buf, len, "%s%d", drive_par[(j - nb) / me->nact], (j - nb) % me->nact + 1);
+  return buf;
 }
 
 static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_base **b)
@@ -153,7 +178,7 @@ static void excite_limits_comment(prru_cli_out *out, const prru_limits *run, con
   prru_limits applied = *run;
   int dflt = 0;
   char text[400];
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < prru_cli_model()->mech->nact; i++) {
     dflt |= !isfinite(run->force_max[i]);
     applied.force_max[i] = o->fd_max[i];
   }
@@ -196,8 +221,8 @@ static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier 
   prru_data *d = malloc(sizeof *d);
   if (!d) return PRRU_ENOMEM;
   char dn[256], fn[256];
-  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
-  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_names(dn, sizeof dn, "d", m->mech->nact, ",");
+  prru_cli_names(fn, sizeof fn, "fd", m->mech->nact, ",");
   prru_cli_out_printf(o, "t,q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,%s,%s\n", dn, fn);
   prru_cli_out_line(o);
   const long n = prru_excite_rows(f, eo);
@@ -210,7 +235,7 @@ static int excite_rows(prru_cli_out *o, const prru_model *m, const prru_fourier 
       break;
     }
     const double t = i * eo->dt;
-    double q[3], qd[3], qdd[3], fd[PRRU_NACT];
+    double q[3], qd[3], qdd[3], fd[PRRU_MAX_ACT];
     prru_fourier_eval(f, t, q, qd, qdd);
     st = prru_inverse_dynamics(m, d, q, qd, qdd, &l, fd);
     if (st != PRRU_OK) break;
@@ -232,9 +257,9 @@ int prru_cmd_excite(int argc, char **argv)
       {"coulomb-velocity", 1, &a.vs, NULL}, PRRU_CLI_LIMIT_OPTIONS(a.lim), {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("excite", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (a.help) {
+    const int nact = prru_cli_model()->mech->nact;
     char dn[256], fn[256];
-    printf(excite_help, prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","),
-           prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","));
+    printf(excite_help, prru_cli_names(dn, sizeof dn, "d", nact, ","), prru_cli_names(fn, sizeof fn, "fd", nact, ","));
     return 0;
   }
   prru_excite_options o;
@@ -292,7 +317,7 @@ int prru_cmd_excite(int argc, char **argv)
   fprintf(stderr, "excite: %d base parameters; condition number %.6g (start %s, %d evaluations%s); "
                   "worst J_d rcond %.4g; peak |fd|",
           b->nbase, r.cond, start, r.evals, r.shrunk ? ", shrunk to pass the dense check" : "", r.rcond_worst);
-  for (int i = 0; i < PRRU_NACT; i++) fprintf(stderr, " %.4g", r.fd_peak[i]);
+  for (int i = 0; i < m.mech->nact; i++) fprintf(stderr, " %.4g", r.fd_peak[i]);
   fprintf(stderr, " N\n");
   free(b);
   prru_model_free(&m);
@@ -363,6 +388,7 @@ static void data_free(ident_data *D)
 static int data_columns(const char *path, const prru_table *t, int *cq, int *cd, int *cv, int *ca, int *cf)
 {
   char name[32];
+  const int nact = prru_cli_model()->mech->nact;
   int have_q = 1, have_d = 1, have_v = 1, have_a = 1;
   for (int k = 0; k < 3; k++) {
     snprintf(name, sizeof name, "q%d", k + 1);
@@ -372,7 +398,7 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
     snprintf(name, sizeof name, "qdd%d", k + 1);
     have_a &= (ca[k] = prru_table_column(t, name)) >= 0;
   }
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < nact; i++) {
     snprintf(name, sizeof name, "d%d", i + 1);
     have_d &= (cd[i] = prru_table_column(t, name)) >= 0;
     snprintf(name, sizeof name, "fd%d", i + 1);
@@ -386,7 +412,7 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
     return 2;
   }
   if (!have_q && !have_d) {
-    prru_cli_error("identify", "--data %s: no pose: need the columns q1,q2,q3 or d1..d%d", path, PRRU_NACT);
+    prru_cli_error("identify", "--data %s: no pose: need the columns q1,q2,q3 or d1..d%d", path, nact);
     return 2;
   }
   if (!have_q) cq[0] = -1;
@@ -398,13 +424,14 @@ static int data_columns(const char *path, const prru_table *t, int *cq, int *cd,
  * (prru_measure_poses: the residual judged against --d-resolution). */
 static int poses_from_sliders(const char *path, const prru_table *t, const int *cd, double dres, ident_data *D)
 {
-  double *act = malloc(sizeof(double) * PRRU_NACT * (size_t)(t->nrows > 0 ? t->nrows : 1));
+  const int nact = prru_cli_model()->mech->nact;
+  double *act = malloc(sizeof(double) * (size_t)nact * (size_t)(t->nrows > 0 ? t->nrows : 1));
   if (!act) {
     prru_cli_error("identify", "out of memory for %d rows", t->nrows);
     return 1;
   }
   for (int i = 0; i < t->nrows; i++)
-    for (int k = 0; k < PRRU_NACT; k++) act[PRRU_NACT * i + k] = t->data[(size_t)i * (size_t)t->ncols + (size_t)cd[k]];
+    for (int k = 0; k < nact; k++) act[nact * i + k] = t->data[(size_t)i * (size_t)t->ncols + (size_t)cd[k]];
   int row;
   double res;
   const int st = prru_measure_poses(prru_cli_model(), t->nrows, act, dres, D->q, &row, &res, NULL, 0);
@@ -435,7 +462,8 @@ static int read_data(const char *path, const prru_diff_options *dopt, double dre
     prru_cli_error("identify", "--data %s", msg);
     return 2;
   }
-  int cq[3], cd[PRRU_NACT], cv[3], ca[3], cf[PRRU_NACT];
+  const int nact = prru_cli_model()->mech->nact;
+  int cq[3], cd[PRRU_MAX_ACT], cv[3], ca[3], cf[PRRU_MAX_ACT];
   int rc = data_columns(path, &t, cq, cd, cv, ca, cf);
   const int ct = prru_table_column(&t, "t");
   const size_t n = (size_t)t.nrows;
@@ -445,7 +473,7 @@ static int read_data(const char *path, const prru_diff_options *dopt, double dre
     D->q = malloc(sizeof(double) * 3 * (n + 1));
     D->qd = malloc(sizeof(double) * 3 * (n + 1));
     D->qdd = malloc(sizeof(double) * 3 * (n + 1));
-    D->fd = malloc(sizeof(double) * PRRU_NACT * (n + 1));
+    D->fd = malloc(sizeof(double) * (size_t)nact * (n + 1));
     if (!D->t || !D->q || !D->qd || !D->qdd || !D->fd) {
       prru_cli_error("identify", "out of memory for %d rows", t.nrows);
       rc = 1;
@@ -458,7 +486,7 @@ static int read_data(const char *path, const prru_diff_options *dopt, double dre
       if (cq[0] >= 0) D->q[3 * i + k] = row[cq[k]];
       if (cv[0] >= 0) D->qd[3 * i + k] = row[cv[k]], D->qdd[3 * i + k] = row[ca[k]];
     }
-    for (int k = 0; k < PRRU_NACT; k++) D->fd[PRRU_NACT * i + k] = row[cf[k]];
+    for (int k = 0; k < nact; k++) D->fd[(size_t)nact * i + (size_t)k] = row[cf[k]];
     if (i > 0 && !(D->t[i] > D->t[i - 1])) {
       prru_cli_error("identify", "%s: data row %zu: t = %g is not after the previous row's", path, i + 1, D->t[i]);
       rc = 2;
@@ -479,11 +507,13 @@ static int read_data(const char *path, const prru_diff_options *dopt, double dre
 /* "U1.Ixx + 0.25 L1.m - ...": base parameter i as a combination. */
 static void combination(const prru_base *b, int i, char *buf, size_t len)
 {
-  size_t k = (size_t)snprintf(buf, len, "%s", prru_regressor_names[b->col[i]]);
-  for (int j = 0; j < PRRU_NREG && k < len; j++) {
-    const double c = b->B[i * PRRU_NREG + j];
+  const int n = nreg();
+  char name[64];
+  size_t k = (size_t)snprintf(buf, len, "%s", reg_name(b->col[i], name, sizeof name));
+  for (int j = 0; j < n && k < len; j++) {
+    const double c = b->B[i * n + j];
     if (j == b->col[i] || fabs(c) < 1e-12) continue;
-    k += (size_t)snprintf(buf + k, len - k, " %c %.10g %s", c < 0 ? '-' : '+', fabs(c), prru_regressor_names[j]);
+    k += (size_t)snprintf(buf + k, len - k, " %c %.10g %s", c < 0 ? '-' : '+', fabs(c), reg_name(j, name, sizeof name));
   }
 }
 
@@ -492,20 +522,22 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
                          const prru_consistent_options *co, const prru_consistent_result *c, const double *pi0,
                          const double *pi)
 {
+  const int n = nreg();
+  char name[64];
   prru_cli_out_comment(o);
   prru_cli_out_printf(o, "# identify: %d samples, %d rows, %d base parameters of %d, %d degrees of freedom; "
                       "residual sigma %.6g N; condition number %.6g; Coulomb smoothing velocity %.6g m/s\n",
-                      r->nsamples, r->nrows, b->nbase, PRRU_NREG, r->dof, r->sigma, r->cond, b->vs);
+                      r->nsamples, r->nrows, b->nbase, n, r->dof, r->sigma, r->cond, b->vs);
   prru_cli_out_line(o);
   prru_cli_out_printf(o, "# residual RMS per actuator (N):");
-  for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, " %.6g", r->rms[i]);
+  for (int i = 0; i < prru_cli_model()->mech->nact; i++) prru_cli_out_printf(o, " %.6g", r->rms[i]);
   prru_cli_out_printf(o, "\n# no effect on any actuator force (set by the prior):");
   prru_cli_out_line(o);
-  for (int j = 0; j < PRRU_NREG; j++)
-    if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
+  for (int j = 0; j < n; j++)
+    if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", reg_name(j, name, sizeof name));
   prru_cli_out_printf(o, "\n# only in combinations (split by the prior):");
-  for (int j = 0; j < PRRU_NREG; j++)
-    if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", prru_regressor_names[j]);
+  for (int j = 0; j < n; j++)
+    if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", reg_name(j, name, sizeof name));
   prru_cli_out_printf(o, "\n# physically consistent model (docs/control.md): %s; Mahalanobis distance^2 of its "
                       "base parameters to the estimate %.4g, chi^2 quantile (%d dof, 1 - %g) %.4g, sigma_w %.4g N "
                       "= max(sigma sqrt(inflation), %g rms(y)); distance to the prior %.4g (pseudo-inertia norm); smallest "
@@ -524,16 +556,16 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   prru_cli_out_line(o);
   prru_cli_out_printf(o, "# standard parameters moved from the prior (relative change):");
   int moved = 0;
-  for (int j = 0; j < PRRU_NREG; j++) {
+  for (int j = 0; j < n; j++) {
     /* Relative to the prior's value, or to the drive's weight where
      * the prior has none; below 1e-9 it is rounding. */
     const double ref = c->w[j] > 0 ? fmax(fabs(pi0[j]), c->w[j]) : fabs(pi0[j]);
     if (fabs(pi[j] - pi0[j]) <= 1e-9 * ref) continue;
     if (ref > 0)
-      prru_cli_out_printf(o, "\n#   %s %.4g (prior %.4g, %+.3g %%)", prru_regressor_names[j], pi[j], pi0[j],
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior %.4g, %+.3g %%)", reg_name(j, name, sizeof name), pi[j], pi0[j],
                           100 * (pi[j] - pi0[j]) / ref);
     else
-      prru_cli_out_printf(o, "\n#   %s %.4g (prior 0)", prru_regressor_names[j], pi[j]);
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior 0)", reg_name(j, name, sizeof name), pi[j]);
     moved++;
   }
   if (!moved) prru_cli_out_printf(o, " none");
@@ -542,7 +574,7 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   for (int i = 0; i < b->nbase; i++) {
     char comb[4096];
     combination(b, i, comb, sizeof comb);
-    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%s\n", i + 1, prru_regressor_names[b->col[i]],
+    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%s\n", i + 1, reg_name(b->col[i], name, sizeof name),
                         r->beta[i], r->se[i], prior[i], r->scale[i], c->beta[i], c->t[i], comb);
     prru_cli_out_row(o);
   }
@@ -682,9 +714,9 @@ int prru_cmd_identify(int argc, char **argv)
                             {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("identify", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
   if (a.help) {
+    const int nact = prru_cli_model()->mech->nact;
     char dn[256], fn[256];
-    printf(identify_help, prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","),
-           prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","));
+    printf(identify_help, prru_cli_names(fn, sizeof fn, "fd", nact, ","), prru_cli_names(dn, sizeof dn, "d", nact, ","));
     return 0;
   }
   char name[32];

@@ -28,13 +28,14 @@ int prru_cmd_ik(int argc, char **argv)
     fputs(ik_help, stdout);
     return 0;
   }
-  double q[PRRU_NQ];
+  double q[3];
   if (!qs) {
     prru_cli_error("ik", "--q is required (see 'prru ik --help')");
     return 2;
   }
-  if (prru_cli_numbers("ik", "q", qs, q, PRRU_NQ)) return 2;
+  if (prru_cli_numbers("ik", "q", qs, q, 3)) return 2;
   prru_model m = *prru_cli_model();
+  const int nact = m.mech->nact;
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   double rcond;
@@ -48,19 +49,19 @@ int prru_cmd_ik(int argc, char **argv)
   putchar('{');
   prru_cli_json_model(stdout);
   printf(",\n \"q\": ");
-  prru_cli_json_array(stdout, q, PRRU_NQ);
+  prru_cli_json_array(stdout, q, 3);
   printf(", \"d\": ");
-  prru_cli_json_array(stdout, d->d, PRRU_NACT);
+  prru_cli_json_array(stdout, d->d, nact);
   printf(", \"Jd\": ");
-  prru_cli_json_matrix(stdout, d->Jd, PRRU_NACT, PRRU_NQ);
+  prru_cli_json_matrix(stdout, d->Jd, nact, 3);
   printf(", \"Jd_rcond\": ");
   prru_cli_json_number(stdout, rcond);
   printf(", \"singular\": %s", st == PRRU_ESINGULAR ? "true" : "false");
   /* Redundant actuation: n spans null(J_d^T) (regular poses only). */
-  double n[PRRU_NACT];
-  if (PRRU_NPRELOAD > 0 && st == PRRU_OK && prru_actuator_null(&m, d, q, n) == PRRU_OK) {
+  double n[PRRU_MAX_ACT];
+  if (prru_cli_npreload(&m) > 0 && st == PRRU_OK && prru_actuator_null(&m, d, q, n) == PRRU_OK) {
     printf(", \"actuator_null\": ");
-    prru_cli_json_array(stdout, n, PRRU_NACT);
+    prru_cli_json_array(stdout, n, nact);
   }
   printf("}\n");
   free(d);
@@ -101,34 +102,35 @@ int prru_cmd_fk(int argc, char **argv)
                             {"lsq", 0, NULL, &lsq},
                             {"help", 0, NULL, &help}};
   if (prru_cli_parse("fk", argc, argv, opts, 4)) return 2;
+  const int nact = prru_cli_model()->mech->nact;
   if (help) {
     char names[256];
-    printf(fk_help, prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","),
-           PRRU_NACT > 3 ? fk_method_redundant : fk_method_3,
-           PRRU_NACT > 3 ? ",\nand without --lsq when the sliders are inconsistent" : "");
+    printf(fk_help, prru_cli_names(names, sizeof names, "d", nact, ","),
+           nact > 3 ? fk_method_redundant : fk_method_3,
+           nact > 3 ? ",\nand without --lsq when the sliders are inconsistent" : "");
     return 0;
   }
-  double act[PRRU_NACT], seed[PRRU_NQ], q[PRRU_NQ];
+  double act[PRRU_MAX_ACT], seed[3], q[3];
   if (!ds) {
     prru_cli_error("fk", "--d is required (see 'prru fk --help')");
     return 2;
   }
-  if (prru_cli_numbers("fk", "d", ds, act, PRRU_NACT)) return 2;
+  if (prru_cli_numbers("fk", "d", ds, act, nact)) return 2;
   prru_model m = *prru_cli_model();
   prru_data *d = malloc(sizeof *d);
   if (!d) return 1;
   if (seeds) {
-    if (prru_cli_numbers("fk", "seed", seeds, seed, PRRU_NQ)) { free(d); return 2; }
+    if (prru_cli_numbers("fk", "seed", seeds, seed, 3)) { free(d); return 2; }
   } else {
     prru_fk_default_seed(&m, act, seed);
   }
   /* Three sliders: Newton unless --lsq; more: always least squares. */
-  int use_lsq = lsq || PRRU_NACT > 3;
+  int use_lsq = lsq || nact > 3;
   double res = NAN, tol = prru_fk_tolerance(&m, act);
   int st = use_lsq ? prru_forward_kinematics_lsq(&m, d, act, seed, q, &res)
                    : prru_forward_kinematics(&m, d, act, seed, q);
-  char dtext[32 * PRRU_NACT], qs[128];
-  prru_cli_vec(dtext, sizeof dtext, act, PRRU_NACT);
+  char dtext[32 * PRRU_MAX_ACT], qs[128];
+  prru_cli_vec(dtext, sizeof dtext, act, nact);
   if (st != PRRU_OK) {
     prru_cli_error("fk", "d = %s from seed %s: %s%s", dtext, prru_cli_vec(qs, sizeof qs, seed, 3), prru_strerror(st),
                    st == PRRU_ENOCONV ? " (d out of reach, or a singularity near the path; try another --seed)" : "");
@@ -139,7 +141,7 @@ int prru_cmd_fk(int argc, char **argv)
   /* |d(q) - d|^2 overflows for |d| beyond ~1e154 m: no step of the
    * least-squares iteration can then be judged and it stops at the seed
    * as if stationary. Such sliders are out of any robot's reach. */
-  if (use_lsq && !isfinite(res * res * PRRU_NACT)) {
+  if (use_lsq && !isfinite(res * res * nact)) {
     prru_cli_error("fk", "d = %s: out of reach (the squared residual overflows)", dtext);
     free(d);
     return 1;
@@ -149,16 +151,16 @@ int prru_cmd_fk(int argc, char **argv)
     prru_cli_error("fk", "d = %s: no pose reproduces all %d slider positions, they are "
                    "inconsistent (or out of reach): the best least-squares fit q = %s leaves a "
                    "residual of %.3g m, tolerance %.3g m; --lsq accepts that fit",
-                   dtext, PRRU_NACT, prru_cli_vec(qs, sizeof qs, q, 3), res, tol);
+                   dtext, nact, prru_cli_vec(qs, sizeof qs, q, 3), res, tol);
     free(d);
     return 1;
   }
   putchar('{');
   prru_cli_json_model(stdout);
   printf(",\n \"d\": ");
-  prru_cli_json_array(stdout, act, PRRU_NACT);
+  prru_cli_json_array(stdout, act, nact);
   printf(", \"q\": ");
-  prru_cli_json_array(stdout, q, PRRU_NQ);
+  prru_cli_json_array(stdout, q, 3);
   printf(", \"residual\": ");
   prru_cli_json_number(stdout, res);
   printf(", \"method\": \"%s\"", use_lsq ? "least-squares" : "newton");
@@ -315,15 +317,17 @@ int prru_cmd_id(int argc, char **argv)
                             {"units", 1, &units, NULL},
                             {"help", 0, NULL, &help}};
   if (prru_cli_parse("id", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  const prru_model *cm = prru_cli_model();
+  const int nact = cm->mech->nact, npreload = prru_cli_npreload(cm);
   char fd_names[256], n_names[256], dd_names[256], pow_names[256];
-  prru_cli_names(fd_names, sizeof fd_names, "fd", PRRU_NACT, ",");
-  prru_cli_names(n_names, sizeof n_names, "n", PRRU_NACT, ",");
-  prru_cli_names(dd_names, sizeof dd_names, "dd", PRRU_NACT, ",");
-  prru_cli_names(pow_names, sizeof pow_names, "pow", PRRU_NACT, ",");
+  prru_cli_names(fd_names, sizeof fd_names, "fd", nact, ",");
+  prru_cli_names(n_names, sizeof n_names, "n", nact, ",");
+  prru_cli_names(dd_names, sizeof dd_names, "dd", nact, ",");
+  prru_cli_names(pow_names, sizeof pow_names, "pow", nact, ",");
   if (help) {
     char extra[sizeof id_help_redundant + 300];
-    if (PRRU_NPRELOAD > 0)
-      snprintf(extra, sizeof extra, id_help_redundant, PRRU_NACT, n_names);
+    if (npreload > 0)
+      snprintf(extra, sizeof extra, id_help_redundant, nact, n_names);
     else
       snprintf(extra, sizeof extra, "%s", id_help_3);
     printf(id_help, fd_names, dd_names, pow_names, extra);
@@ -338,11 +342,11 @@ int prru_cmd_id(int argc, char **argv)
   if (prru_cli_units("id", units, &motor, &current)) return 2;
   double preload = 0.0;
   if (pre && prru_cli_number("id", "preload", pre, &preload)) return 2;
-  if ((pre || null_vector) && PRRU_NPRELOAD == 0) {
+  if ((pre || null_vector) && npreload == 0) {
     prru_cli_error("id", "%s: model %s has %d actuators for 3 coordinates, so the actuator forces "
                    "are unique and no internal preload exists; it needs a model with a redundant "
                    "actuator such as models/4prru.json (see 'prru id --help')",
-                   pre ? "--preload" : "--null-vector", prru_cli_model()->mech->name, PRRU_NACT);
+                   pre ? "--preload" : "--null-vector", cm->mech->name, nact);
     return 2;
   }
   static const char *const need[10] = {"t", "q1", "q2", "q3", "qd1", "qd2", "qd3", "qdd1", "qdd2", "qdd3"};
@@ -411,7 +415,7 @@ int prru_cmd_id(int argc, char **argv)
   prru_data *d = malloc(sizeof *d);
   st = d ? PRRU_OK : PRRU_ENOMEM;
   prru_cli_out_comment(&o);
-  if (PRRU_NPRELOAD > 0) {
+  if (npreload > 0) {
     /* (No "null" in the text: it reads as a JSON null to a checker.) */
     prru_cli_out_printf(&o, "# fd = least-norm actuator forces + preload %.17g N along n, the unit "
                             "vector with J_d^T n = 0 (fd . n = %.17g)\n", preload, preload);
@@ -424,8 +428,8 @@ int prru_cmd_id(int argc, char **argv)
   prru_cli_out_printf(&o, "t,%s%s%s", fd_names, null_vector ? "," : "", null_vector ? n_names : "");
   if (derivs) prru_cli_out_printf(&o, ",qd1,qd2,qd3,qdd1,qdd2,qdd3");
   if (rates) prru_cli_out_printf(&o, ",%s,%s", dd_names, pow_names);
-  for (int k = 0; reactions && k < PRRU_NLAMBDA; k++)
-    prru_cli_out_printf(&o, ",%s", prru_cli_model()->mech->lambda_labels[k]);
+  for (int k = 0; reactions && k < cm->mech->nlambda; k++)
+    prru_cli_out_printf(&o, ",%s", cm->mech->lambda_labels[k]);
   prru_cli_out_motor_names(&o, motor, current);
   prru_cli_out_printf(&o, "\n");
   prru_cli_out_line(&o);
@@ -440,7 +444,7 @@ int prru_cmd_id(int argc, char **argv)
       break;
     }
     const double *row = t.data + (size_t)i * (size_t)t.ncols;
-    double v[16], fd[PRRU_NACT];
+    double v[16], fd[PRRU_MAX_ACT];
     for (int k = 0; k < 16; k++) v[k] = col[k] < 0 ? 0.0 : row[col[k]];
     if (diff) {
       memcpy(v + 4, rates_q + 3 * i, 3 * sizeof v[0]);
@@ -450,18 +454,18 @@ int prru_cmd_id(int argc, char **argv)
     memset(&l, 0, sizeof l);
     memcpy(l.fp, v + 10, sizeof l.fp);
     memcpy(l.mp, v + 13, sizeof l.mp);
-    double n[PRRU_NACT];
+    double n[PRRU_MAX_ACT];
     st = prru_inverse_dynamics_preload(&m, d, v + 1, v + 4, v + 7, &l, preload, fd);
     /* J_d of this row: on the side of the rows before? */
     const int crossed = st == PRRU_OK && prru_path_side_crossed(&side, d->Jd, m.mech->nact);
     if (st == PRRU_OK && null_vector) st = prru_actuator_null(&m, d, v + 1, n);
-    double dd[PRRU_NACT], ddb[PRRU_NACT], pw[PRRU_NACT], lambda[PRRU_NLAMBDA];
+    double dd[PRRU_MAX_ACT], ddb[PRRU_MAX_ACT], pw[PRRU_MAX_ACT], lambda[PRRU_MAX_LAMBDA];
     if (st == PRRU_OK && rates) {
       prru_model_actuator_rates(&m, v + 1, v + 4, dd, ddb);
-      for (int k = 0; k < PRRU_NACT; k++) pw[k] = fd[k] * dd[k];
+      for (int k = 0; k < nact; k++) pw[k] = fd[k] * dd[k];
     }
     if (st == PRRU_OK && reactions) {
-      memcpy(l.fd, fd, PRRU_NACT * sizeof(double));
+      memcpy(l.fd, fd, (size_t)nact * sizeof(double));
       st = prru_reactions(&m, d, v + 1, v + 4, &l, lambda);
     }
     if (st != PRRU_OK) {
@@ -480,14 +484,14 @@ int prru_cmd_id(int argc, char **argv)
     }
     t_prev = v[0];
     prru_cli_out_printf(&o, "%.17g", v[0]);
-    prru_cli_out_numbers(&o, fd, PRRU_NACT);
-    if (null_vector) prru_cli_out_numbers(&o, n, PRRU_NACT);
+    prru_cli_out_numbers(&o, fd, nact);
+    if (null_vector) prru_cli_out_numbers(&o, n, nact);
     if (derivs) prru_cli_out_numbers(&o, v + 4, 6);
     if (rates) {
-      prru_cli_out_numbers(&o, dd, PRRU_NACT);
-      prru_cli_out_numbers(&o, pw, PRRU_NACT);
+      prru_cli_out_numbers(&o, dd, nact);
+      prru_cli_out_numbers(&o, pw, nact);
     }
-    if (reactions) prru_cli_out_numbers(&o, lambda, PRRU_NLAMBDA);
+    if (reactions) prru_cli_out_numbers(&o, lambda, cm->mech->nlambda);
     prru_cli_out_motor(&o, &m, fd, motor, current);
     prru_cli_out_printf(&o, "\n");
     prru_cli_out_row(&o);

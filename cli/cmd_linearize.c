@@ -9,7 +9,7 @@
 #include "prru.h"
 #include "prru_linearize.h"
 
-/* %s: the --fd names; %d, %d: PRRU_NACT (B's and dqdd_dfd's columns). */
+/* %s: the --fd names; %d, %d: the model's actuators (B's and dqdd_dfd's columns). */
 static const char linearize_help[] =
     "usage: prru linearize --q q1,q2,q3 --qd qd1,qd2,qd3 --fd %s\n"
     "                      [--fp fx,fy,fz] [--mp mx,my,mz] [--dt DT]\n"
@@ -42,27 +42,27 @@ static void member(const char *sep, const char *name, const double *v, int n)
 static void print_linearization(const double q[3], const double qd[3], const prru_loads *l,
                                 const prru_linearization *o)
 {
-  enum { N = PRRU_NACT };
+  const int nact = prru_cli_model()->mech->nact;
   printf("{");
   prru_cli_json_model(stdout);
   member(",\n ", "q", q, 3);
   member(", ", "qd", qd, 3);
-  member(",\n ", "fd", l->fd, N);
+  member(",\n ", "fd", l->fd, nact);
   member(", ", "fp", l->fp, 3);
   member(", ", "mp", l->mp, 3);
   member(",\n ", "qdd", o->qdd, 3);
   member_matrix(",\n ", "dqdd_dq", o->dqdd_dq, 3, 3);
   member_matrix(",\n ", "dqdd_dqd", o->dqdd_dqd, 3, 3);
-  member_matrix(",\n ", "dqdd_dfd", o->dqdd_dfd, 3, N);
+  member_matrix(",\n ", "dqdd_dfd", o->dqdd_dfd, 3, nact);
   member_matrix(",\n ", "dqdd_dfp", o->dqdd_dfp, 3, 3);
   member_matrix(",\n ", "dqdd_dmp", o->dqdd_dmp, 3, 3);
   member_matrix(",\n ", "A", o->A, 6, 6);
-  member_matrix(",\n ", "B", o->B, 6, N);
+  member_matrix(",\n ", "B", o->B, 6, nact);
   if (o->dt > 0) {
     printf(",\n \"dt\": ");
     prru_cli_json_number(stdout, o->dt);
     member_matrix(",\n ", "Ad", o->Ad, 6, 6);
-    member_matrix(",\n ", "Bd", o->Bd, 6, N);
+    member_matrix(",\n ", "Bd", o->Bd, 6, nact);
   }
   printf("}\n");
 }
@@ -75,10 +75,10 @@ int prru_cmd_linearize(int argc, char **argv)
                             {"fp", 1, &fps, NULL}, {"mp", 1, &mps, NULL}, {"dt", 1, &dts, NULL},
                             {"help", 0, NULL, &help}};
   if (prru_cli_parse("linearize", argc, argv, opts, 7)) return 2;
+  const int nact = prru_cli_model()->mech->nact;
   if (help) {
     char fd_names[256];
-    printf(linearize_help, prru_cli_names(fd_names, sizeof fd_names, "f", PRRU_NACT, ","),
-           PRRU_NACT, PRRU_NACT);
+    printf(linearize_help, prru_cli_names(fd_names, sizeof fd_names, "f", nact, ","), nact, nact);
     return 0;
   }
   if (!qs || !qds || !fds) {
@@ -88,7 +88,7 @@ int prru_cmd_linearize(int argc, char **argv)
   double q[3], qd[3], dt = 0.0;
   prru_loads l = {{0}, {0, 0, 0}, {0, 0, 0}};
   if (prru_cli_numbers("linearize", "q", qs, q, 3) || prru_cli_numbers("linearize", "qd", qds, qd, 3) ||
-      prru_cli_numbers("linearize", "fd", fds, l.fd, PRRU_NACT) ||
+      prru_cli_numbers("linearize", "fd", fds, l.fd, nact) ||
       (fps && prru_cli_numbers("linearize", "fp", fps, l.fp, 3)) ||
       (mps && prru_cli_numbers("linearize", "mp", mps, l.mp, 3)) ||
       (dts && prru_cli_number("linearize", "dt", dts, &dt)))

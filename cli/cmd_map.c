@@ -70,9 +70,10 @@ int prru_cmd_map(int argc, char **argv)
                             {"shard", 1, &shs, NULL},     {"precision", 1, &prs, NULL}};
   if (prru_cli_parse("map", argc, argv, opts, 10)) return 2;
   if (help) {
-    printf(map_help, PRRU_NACT > 3 ? "(The test needs a square J_d: with more actuators than coordinates no\n"
-                                   "point is other_mode.)\n" : "",
-           PRRU_NACT > 3 ? "+" : "-1", PRRU_CLI_MAP_RCOND_MIN, 1.0 / PRRU_CLI_MAP_RCOND_MIN);
+    const int redundant = prru_cli_model()->mech->nact > 3;
+    printf(map_help, redundant ? "(The test needs a square J_d: with more actuators than coordinates no\n"
+                                 "point is other_mode.)\n" : "",
+           redundant ? "+" : "-1", PRRU_CLI_MAP_RCOND_MIN, 1.0 / PRRU_CLI_MAP_RCOND_MIN);
     return 0;
   }
   const char *missing = !q1s ? "--q1" : !q2s ? "--q2" : !out ? "--out" : NULL;

@@ -69,12 +69,13 @@ static int measure_options(const measure_args *a, prru_measure_options *o)
 static int run_columns(const char *path, const prru_table *t, int *ct, int *cd, int *cf, int *ca)
 {
   char name[16];
+  const int nact = prru_cli_model()->mech->nact;
   *ct = prru_table_column(t, "t");
   if (*ct < 0) {
     prru_cli_error("measure", "--run %s: missing column 't'", path);
     return 2;
   }
-  for (int k = 0; k < PRRU_NACT; k++) {
+  for (int k = 0; k < nact; k++) {
     snprintf(name, sizeof name, "d%d", k + 1);
     cd[k] = prru_table_column(t, name);
     if (cd[k] < 0) break;
@@ -82,10 +83,10 @@ static int run_columns(const char *path, const prru_table *t, int *ct, int *cd, 
     cf[k] = prru_table_column(t, name);
     if (cf[k] < 0) break;
   }
-  for (int k = 0; k < PRRU_NACT; k++)
+  for (int k = 0; k < nact; k++)
     if (cd[k] < 0 || cf[k] < 0) {
       prru_cli_error("measure", "--run %s: missing column '%s%d' (a run has t, d1..%d and fd1..%d)", path,
-                     cd[k] < 0 ? "d" : "fd", k + 1, PRRU_NACT, PRRU_NACT);
+                     cd[k] < 0 ? "d" : "fd", k + 1, nact, nact);
       return 2;
     }
   int nq = 0;
@@ -112,16 +113,17 @@ static void measured_free(measured *s) { free(s->t), free(s->d), free(s->fd), fr
 static int take_rows(const prru_table *t, const int *idx, int n, int ct, const int *cd, const int *cf,
                      const int *ca, measured *s)
 {
+  const int nact = prru_cli_model()->mech->nact;
   s->n = n;
   s->t = malloc(sizeof(double) * (size_t)n);
-  s->d = malloc(sizeof(double) * PRRU_NACT * (size_t)n);
-  s->fd = malloc(sizeof(double) * PRRU_NACT * (size_t)n);
+  s->d = malloc(sizeof(double) * (size_t)nact * (size_t)n);
+  s->fd = malloc(sizeof(double) * (size_t)nact * (size_t)n);
   s->qdd = ca[0] >= 0 ? malloc(sizeof(double) * 3 * (size_t)n) : NULL;
   if (!s->t || !s->d || !s->fd || (ca[0] >= 0 && !s->qdd)) return 1;
   for (int i = 0; i < n; i++) {
     const double *row = t->data + (size_t)idx[i] * (size_t)t->ncols;
     s->t[i] = row[ct];
-    for (int k = 0; k < PRRU_NACT; k++) s->d[PRRU_NACT * i + k] = row[cd[k]], s->fd[PRRU_NACT * i + k] = row[cf[k]];
+    for (int k = 0; k < nact; k++) s->d[nact * i + k] = row[cd[k]], s->fd[nact * i + k] = row[cf[k]];
     if (s->qdd)
       for (int k = 0; k < 3; k++) s->qdd[3 * i + k] = row[ca[k]];
   }
@@ -146,14 +148,15 @@ static int write_measured(const measure_args *a, const prru_measure_options *o, 
                               c->best.half_width, c->best.degree, dres, c->best_error, c->default_error);
   else
     prru_cli_out_comment_line(&out, "differentiation not assessed: %s", no_choice);
+  const int nact = prru_cli_model()->mech->nact;
   char dn[256], fn[256];
-  prru_cli_out_printf(&out, "t,%s,%s\n", prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ","),
-                      prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ","));
+  prru_cli_out_printf(&out, "t,%s,%s\n", prru_cli_names(dn, sizeof dn, "d", nact, ","),
+                      prru_cli_names(fn, sizeof fn, "fd", nact, ","));
   prru_cli_out_line(&out);
   for (int i = 0; i < s->n; i++) {
     prru_cli_out_printf(&out, "%.17g", s->t[i]);
-    prru_cli_out_numbers(&out, s->d + (size_t)PRRU_NACT * i, PRRU_NACT);
-    prru_cli_out_numbers(&out, s->fd + (size_t)PRRU_NACT * i, PRRU_NACT);
+    prru_cli_out_numbers(&out, s->d + (size_t)nact * (size_t)i, nact);
+    prru_cli_out_numbers(&out, s->fd + (size_t)nact * (size_t)i, nact);
     prru_cli_out_printf(&out, "\n");
     prru_cli_out_row(&out);
   }
@@ -169,9 +172,10 @@ int prru_cmd_measure(int argc, char **argv)
                             {"force-noise", 1, &a.noise, NULL}, {"seed", 1, &a.seed, NULL},
                             {"help", 0, NULL, &a.help}};
   if (prru_cli_parse("measure", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  const int nact = prru_cli_model()->mech->nact;
   char dn[256], fn[256];
-  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
-  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_names(dn, sizeof dn, "d", nact, ",");
+  prru_cli_names(fn, sizeof fn, "fd", nact, ",");
   if (a.help) {
     printf(measure_help, dn, fn, dn, fn, PRRU_DIFF_MAX_HALF);
     return 0;
@@ -193,7 +197,7 @@ int prru_cmd_measure(int argc, char **argv)
     if (!irc) prru_cli_error("measure", "--run %s", msg);
     return irc ? irc : 2;
   }
-  int ct, cd[PRRU_NACT], cf[PRRU_NACT], ca[3];
+  int ct, cd[PRRU_MAX_ACT], cf[PRRU_MAX_ACT], ca[3];
   int rc = run_columns(a.run, &t, &ct, cd, cf, ca);
   double *times = rc ? NULL : malloc(sizeof(double) * (size_t)t.nrows);
   int *idx = rc ? NULL : malloc(sizeof(int) * (size_t)t.nrows), n = 0;
@@ -222,7 +226,7 @@ int prru_cmd_measure(int argc, char **argv)
   free(times);
   free(idx);
   prru_table_free(&t);
-  if (!rc && (st = prru_measure_apply(&o, n, PRRU_NACT, s.d, s.fd, msg, sizeof msg)) != PRRU_OK) {
+  if (!rc && (st = prru_measure_apply(&o, n, nact, s.d, s.fd, msg, sizeof msg)) != PRRU_OK) {
     prru_cli_error("measure", "%s", msg);
     rc = prru_cli_exit_for(st);
   }

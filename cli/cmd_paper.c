@@ -56,7 +56,7 @@ typedef struct {
   double work;         /* integral of prru_power's load power (trapezoid) */
   double work_passive; /* and of its passive power, the drives' */
   double prev_power, prev_passive;
-  double max_abs[PRRU_NLAMBDA];
+  double max_abs[PRRU_MAX_LAMBDA];
   long n;
 } paper_run;
 
@@ -76,7 +76,7 @@ static int on_sample(const prru_sample *s, void *ctx)
   r->prev_power = power;
   r->prev_passive = passive;
   r->last = *s;
-  for (int i = 0; i < PRRU_NLAMBDA; i++)
+  for (int i = 0; i < prru_cli_model()->mech->nlambda; i++)
     if (fabs(s->lambda[i]) > r->max_abs[i]) r->max_abs[i] = fabs(s->lambda[i]);
   r->n++;
   return prru_cli_csv_row(s, &r->csv);
@@ -174,30 +174,31 @@ static void remove_stale(const char *out, const char *const *names, int n)
 static void summarize(FILE *f, const paper_run *r, const prru_scenario *s, double t_stop,
                       int is_paper)
 {
-  const char *const *labels = prru_cli_model()->mech->lambda_labels;
+  const prru_mechanism *me = prru_cli_model()->mech;
+  const char *const *labels = me->lambda_labels;
   const prru_sample *a = &r->first, *b = &r->last;
   fprintf(f, "Model: %s%s\n", prru_cli_model_id(),
           is_paper ? ", the paper's" : "; not the paper's model: the results below are this model's");
   fputs("Paper study (section 4.3): q(0) = (0, pi/6, -0.8), fd = (", f);
-  for (int i = 0; i < PRRU_NACT; i++) fprintf(f, "%s%g", i ? ", " : "", s->loads.base.fd[i]);
+  for (int i = 0; i < me->nact; i++) fprintf(f, "%s%g", i ? ", " : "", s->loads.base.fd[i]);
   const double w_pi = s->loads.omega / 3.14159265358979323846;
   fprintf(f, ") N,\nfp = %g (sin %g pi t, -cos %g pi t, 0) N, rk8pd at 1e-10, %ld samples to t = %.3f s\n",
           s->loads.amp, w_pi, w_pi, r->n, t_stop);
-  if (PRRU_NACT > 3)
+  if (me->nact > 3)
     fprintf(f, "%d actuators: the paper's loads name three; limb 4 mirrors limb 3 and gets its force "
-               "(see prru paper --help); reactions are the least-norm solution\n", PRRU_NACT);
+               "(see prru paper --help); reactions are the least-norm solution\n", me->nact);
   fprintf(f, "q(%.3f)   = (%.10f, %.10f, %.10f) rad, rad, m\n", b->t, b->q[0], b->q[1], b->q[2]);
   fprintf(f, "qd(%.3f)  = (%.10f, %.10f, %.10f)\n", b->t, b->qd[0], b->qd[1], b->qd[2]);
   fprintf(f, "d(%.3f)   = (", b->t);
-  for (int i = 0; i < PRRU_NACT; i++) fprintf(f, "%s%.10f", i ? ", " : "", b->d[i]);
+  for (int i = 0; i < me->nact; i++) fprintf(f, "%s%.10f", i ? ", " : "", b->d[i]);
   fputs(") m\n", f);
   double dE = (b->T + b->V) - (a->T + a->V), W = r->work + r->work_passive;
   fprintf(f, "energy balance: change of T + V = %.9f J, work of fd, fp and mp = %.9f J, of the "
              "drives' damping and friction = %.9f J (trapezoid on the samples), difference %.2e J\n",
           dE, r->work, r->work_passive, dE - W);
   fprintf(f, "peak reaction magnitudes over the run:\n");
-  for (int j = 0; j < PRRU_NLAMBDA; j++)
-    fprintf(f, "  %-6s %12.4f%s", labels[j], r->max_abs[j], j % 4 == 3 || j == PRRU_NLAMBDA - 1 ? "\n" : "");
+  for (int j = 0; j < me->nlambda; j++)
+    fprintf(f, "  %-6s %12.4f%s", labels[j], r->max_abs[j], j % 4 == 3 || j == me->nlambda - 1 ? "\n" : "");
 }
 
 /* The whole study into stage; an exit status, or PRRU_PLOT_NO_GNUPLOT when
@@ -307,8 +308,8 @@ int prru_cmd_paper(int argc, char **argv)
   if (prru_cli_parse("paper", argc, argv, opts, 4)) return 2;
   if (help) {
     char extra[sizeof paper_help_redundant + 200] = "";
-    if (PRRU_NACT > 3)
-      snprintf(extra, sizeof extra, paper_help_redundant, PRRU_NACT, prru_cli_paper_fd_text());
+    const int nact = prru_cli_model()->mech->nact;
+    if (nact > 3) snprintf(extra, sizeof extra, paper_help_redundant, nact, prru_cli_paper_fd_text());
     printf(paper_help, extra);
     return 0;
   }

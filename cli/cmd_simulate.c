@@ -10,14 +10,14 @@
 
 void prru_cli_csv_header(prru_cli_csv *c)
 {
-  const char *const *labels = prru_cli_model()->mech->lambda_labels;
+  const prru_mechanism *me = prru_cli_model()->mech;
   char names[256];
   prru_cli_out_comment(c->out);
   prru_cli_out_printf(c->out, "t,q1,q2,q3,qd1,qd2,qd3,%s",
-                      prru_cli_names(names, sizeof names, "d", PRRU_NACT, ","));
+                      prru_cli_names(names, sizeof names, "d", me->nact, ","));
   if (c->reactions)
-    for (int i = 0; i < PRRU_NLAMBDA; i++) prru_cli_out_printf(c->out, ",%s", labels[i]);
-  prru_cli_out_printf(c->out, ",qdd1,qdd2,qdd3,%s", prru_cli_names(names, sizeof names, "fd", PRRU_NACT, ","));
+    for (int i = 0; i < me->nlambda; i++) prru_cli_out_printf(c->out, ",%s", me->lambda_labels[i]);
+  prru_cli_out_printf(c->out, ",qdd1,qdd2,qdd3,%s", prru_cli_names(names, sizeof names, "fd", me->nact, ","));
   prru_cli_out_printf(c->out, ",fp1,fp2,fp3,mp1,mp2,mp3,T,V\n");
   prru_cli_out_line(c->out);
 }
@@ -25,16 +25,17 @@ void prru_cli_csv_header(prru_cli_csv *c)
 int prru_cli_csv_row(const prru_sample *s, void *ctx)
 {
   prru_cli_csv *c = ctx;
+  const prru_mechanism *me = prru_cli_model()->mech;
   prru_loads l;
   prru_schedule_eval(c->loads, s->t, &l);
   /* The whole row is formatted before any of it is written. */
   prru_cli_out_printf(c->out, "%.17g", s->t);
-  prru_cli_out_numbers(c->out, s->q, PRRU_NQ);
-  prru_cli_out_numbers(c->out, s->qd, PRRU_NQ);
-  prru_cli_out_numbers(c->out, s->d, PRRU_NACT);
-  if (c->reactions) prru_cli_out_numbers(c->out, s->lambda, PRRU_NLAMBDA);
-  prru_cli_out_numbers(c->out, s->qdd, PRRU_NQ);
-  prru_cli_out_numbers(c->out, l.fd, PRRU_NACT);
+  prru_cli_out_numbers(c->out, s->q, 3);
+  prru_cli_out_numbers(c->out, s->qd, 3);
+  prru_cli_out_numbers(c->out, s->d, me->nact);
+  if (c->reactions) prru_cli_out_numbers(c->out, s->lambda, me->nlambda);
+  prru_cli_out_numbers(c->out, s->qdd, 3);
+  prru_cli_out_numbers(c->out, l.fd, me->nact);
   prru_cli_out_numbers(c->out, l.fp, 3);
   prru_cli_out_numbers(c->out, l.mp, 3);
   prru_cli_out_printf(c->out, ",%.17g,%.17g\n", s->T, s->V);
@@ -56,7 +57,7 @@ static int on_sample(const prru_sample *s, void *ctx)
   return rc;
 }
 
-/* %s: d names, %d: PRRU_NLAMBDA, %s: the first label, %s: joint names in
+/* %s: d names, %d: the model's nlambda, %s: the first label, %s: joint names in
  * column order, %s: fd names, %s: fd names. */
 static const char simulate_help[] =
     "usage: prru simulate [--scenario paper|FILE] [--q0 ..] [--qd0 ..] [--fd ..]\n"
@@ -117,20 +118,17 @@ int prru_cmd_simulate(int argc, char **argv)
       {"no-reactions", 0, NULL, &no_reactions}, {"progress", 0, NULL, &progress},
       {"help", 0, NULL, &help}};
   if (prru_cli_parse("simulate", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  const prru_mechanism *me = prru_cli_model()->mech;
   if (help) {
-    char dn[256], fdn[256], joints[16 * PRRU_NJOINT + 1];
+    char dn[256], fdn[256], joints[16 * PRRU_MAX_JOINT + 1];
     size_t used = 0;
     joints[0] = '\0';
-    for (int j = 0; j < PRRU_NJOINT && used < sizeof joints; j++)
-      used += (size_t)snprintf(joints + used, sizeof joints - used, "%s%.12s", j ? " " : "",
-                               prru_cli_model()->mech->joint[j].name);
-    prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
-    prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
-    printf(simulate_help, dn, PRRU_NLAMBDA, prru_cli_model()->mech->lambda_labels[0], joints, fdn,
-           prru_cli_paper_fd_text(),
-           PRRU_NACT > 3 ? "\n(the redundant actuator gets limb 3's force, see 'prru paper --help')"
-                         : "",
-           fdn);
+    for (int j = 0; j < me->njoint && used < sizeof joints; j++)
+      used += (size_t)snprintf(joints + used, sizeof joints - used, "%s%.12s", j ? " " : "", me->joint[j].name);
+    prru_cli_names(dn, sizeof dn, "d", me->nact, ",");
+    prru_cli_names(fdn, sizeof fdn, "fd", me->nact, ",");
+    printf(simulate_help, dn, me->nlambda, me->lambda_labels[0], joints, fdn, prru_cli_paper_fd_text(),
+           me->nact > 3 ? "\n(the redundant actuator gets limb 3's force, see 'prru paper --help')" : "", fdn);
     return 0;
   }
   prru_scenario s;
@@ -148,7 +146,7 @@ int prru_cmd_simulate(int argc, char **argv)
   int bad = 0;
   if (q0s) bad |= prru_cli_numbers("simulate", "q0", q0s, s.q0, 3);
   if (qd0s) bad |= prru_cli_numbers("simulate", "qd0", qd0s, s.qd0, 3);
-  if (fds) bad |= prru_cli_numbers("simulate", "fd", fds, s.loads.base.fd, PRRU_NACT);
+  if (fds) bad |= prru_cli_numbers("simulate", "fd", fds, s.loads.base.fd, me->nact);
   if (fps) bad |= prru_cli_numbers("simulate", "fp", fps, s.loads.base.fp, 3);
   if (mps) bad |= prru_cli_numbers("simulate", "mp", mps, s.loads.base.mp, 3);
   if (tend) bad |= prru_cli_number("simulate", "t-end", tend, &s.opt.t_end);
@@ -229,7 +227,7 @@ int prru_cmd_simulate(int argc, char **argv)
       bad = 1;
     }
     prru_loads l0;
-    double qdd[PRRU_NQ], T, V;
+    double qdd[3], T, V;
     prru_schedule_eval(&s.loads, 0.0, &l0);
     if (!bad && (st = prru_forward_dynamics(&m, d, s.q0, s.qd0, &l0, qdd)) != PRRU_OK) {
       /* q0 is regular: what fails is the arithmetic (velocities or loads

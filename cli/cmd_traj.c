@@ -176,7 +176,7 @@ static int topp_limits(const topp_limit_args *a, prru_limits *lim, int *forces, 
   const prru_cli_limit_args la = {a->force[0], a->force[alias], a->speed, a->stroke, a->none};
   if (prru_cli_limits("traj", alias == 1 ? "fmax" : "fd-max", &la, lim)) return 2;
   *forces = *speeds = 0;
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < prru_cli_model()->mech->nact; i++)
     *forces += isfinite(lim->force_max[i]), *speeds += isfinite(lim->speed_max[i]);
   return 0;
 }
@@ -184,7 +184,7 @@ static int topp_limits(const topp_limit_args *a, prru_limits *lim, int *forces, 
 /* Peak |fd_i| and |dd_i| over the rows (each row checked again by
  * prru_topp_row). */
 typedef struct {
-  double f[PRRU_NACT], v[PRRU_NACT];
+  double f[PRRU_MAX_ACT], v[PRRU_MAX_ACT];
 } topp_peaks;
 
 /* The row times: every dt from 0 and the end, or (dt = 0) the grid's
@@ -217,7 +217,7 @@ static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *li
   const long n = topp_nrows(tp, dt);
   int st = PRRU_OK;
   for (long k = 0; k < n && st == PRRU_OK && !(o && o->err); k++) {
-    double q[3], qd[3], qdd[3], fd[PRRU_NACT], dd[PRRU_NACT];
+    double q[3], qd[3], qdd[3], fd[PRRU_MAX_ACT], dd[PRRU_MAX_ACT];
     const double t = topp_time(tp, dt, k, n);
     if (prru_cli_interrupted) {
       st = PRRU_EINTERRUPTED;
@@ -226,15 +226,15 @@ static int topp_rows(prru_cli_out *o, const prru_model *m, const prru_limits *li
     }
     st = prru_topp_row(m, d, lim, tp, t, q, qd, qdd, fd, dd, why, (int)whylen);
     if (st != PRRU_OK) continue;
-    for (int i = 0; i < PRRU_NACT; i++) pk->f[i] = fmax(pk->f[i], fabs(fd[i])), pk->v[i] = fmax(pk->v[i], fabs(dd[i]));
+    for (int i = 0; i < m->mech->nact; i++) pk->f[i] = fmax(pk->f[i], fabs(fd[i])), pk->v[i] = fmax(pk->v[i], fabs(dd[i]));
     if (!o) continue;
     prru_cli_out_printf(o, "%.17g", t);
     prru_cli_out_numbers(o, q, 3);
     prru_cli_out_numbers(o, qd, 3);
     prru_cli_out_numbers(o, qdd, 3);
-    prru_cli_out_numbers(o, d->d, PRRU_NACT);
-    prru_cli_out_numbers(o, dd, PRRU_NACT);
-    prru_cli_out_numbers(o, fd, PRRU_NACT);
+    prru_cli_out_numbers(o, d->d, m->mech->nact);
+    prru_cli_out_numbers(o, dd, m->mech->nact);
+    prru_cli_out_numbers(o, fd, m->mech->nact);
     prru_cli_out_motor(o, m, fd, units[0], units[1]);
     prru_cli_out_printf(o, "\n");
     prru_cli_out_row(o);
@@ -256,10 +256,11 @@ static const char *list6(char *buf, size_t len, const double *v, int n)
 static void topp_summary(prru_cli_out *o, const prru_topp *tp, const prru_limits *lim,
                          const double *qdur, const topp_peaks *pk, FILE *err)
 {
+  const int nact = prru_cli_model()->mech->nact;
   char a[400], b[400];
-  double qsum = 0, rf[PRRU_NACT], rv[PRRU_NACT];
+  double qsum = 0, rf[PRRU_MAX_ACT], rv[PRRU_MAX_ACT];
   for (int k = 0; k < tp->nseg; k++) qsum += qdur[k];
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < nact; i++)
     rf[i] = isfinite(lim->force_max[i]) ? pk->f[i] / lim->force_max[i] : NAN,
     rv[i] = isfinite(lim->speed_max[i]) ? pk->v[i] / lim->speed_max[i] : NAN;
   char lines[5][900];
@@ -269,12 +270,12 @@ static void topp_summary(prru_cli_out *o, const prru_topp *tp, const prru_limits
   snprintf(lines[1], sizeof lines[1], "fastest uniformly time-scaled quintic within the same "
            "limits: %.9g s (%.3gx the time-optimal)", qsum, qsum / tp->duration);
   snprintf(lines[2], sizeof lines[2], "limits: force_max (N) %s; speed_max (m/s) %s",
-           list6(a, sizeof a, lim->force_max, PRRU_NACT), list6(b, sizeof b, lim->speed_max, PRRU_NACT));
+           list6(a, sizeof a, lim->force_max, nact), list6(b, sizeof b, lim->speed_max, nact));
   snprintf(lines[3], sizeof lines[3], "peak |fd| (N) %s, of force_max %s%s",
-           list6(a, sizeof a, pk->f, PRRU_NACT), list6(b, sizeof b, rf, PRRU_NACT),
+           list6(a, sizeof a, pk->f, nact), list6(b, sizeof b, rf, nact),
            strchr(b, '-') ? " (- no limit)" : "");
   snprintf(lines[4], sizeof lines[4], "peak |dd| (m/s) %s, of speed_max %s%s",
-           list6(a, sizeof a, pk->v, PRRU_NACT), list6(b, sizeof b, rv, PRRU_NACT),
+           list6(a, sizeof a, pk->v, nact), list6(b, sizeof b, rv, nact),
            strchr(b, '-') ? " (- no limit)" : "");
   for (int k = 0; k < 5; k++) {
     prru_cli_out_comment_line(o, "%s", lines[k]);
@@ -381,9 +382,9 @@ static int traj_time_optimal(const topp_args *a)
     return 1;
   }
   char dn[256], ddn[256], fn[256];
-  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
-  prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
-  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_names(dn, sizeof dn, "d", m->mech->nact, ",");
+  prru_cli_names(ddn, sizeof ddn, "dd", m->mech->nact, ",");
+  prru_cli_names(fn, sizeof fn, "fd", m->mech->nact, ",");
   prru_cli_out_comment(&o);
   const int to_stdout = !a->out || strcmp(a->out, "-") == 0;
   topp_summary(&o, &tp, &lim, qdur, &pk, to_stdout ? NULL : stderr);
@@ -437,8 +438,8 @@ static int traj_rows(prru_cli_out *o, const prru_quintic *tr, double dt, char *w
   prru_path_side_init(&side);
   double t_prev = t0;
   for (long k = 0; k <= n && !o->err; k++) {
-    double t = prru_row_time(t0, t1, dt, k, n + 1), q[3], qd[3], qdd[3], dd[PRRU_NACT],
-           ddb[PRRU_NACT], rc;
+    double t = prru_row_time(t0, t1, dt, k, n + 1), q[3], qd[3], qdd[3], dd[PRRU_MAX_ACT],
+           ddb[PRRU_MAX_ACT], rc;
     if (prru_cli_interrupted) {
       st = PRRU_EINTERRUPTED;
       snprintf(why, whylen, "interrupted (%s) before sample %ld", prru_cli_signal_name(), k + 1);
@@ -490,13 +491,14 @@ int prru_cmd_traj(int argc, char **argv)
                             {"grid", 1, &ta.grid, NULL},
                             {"units", 1, &ta.units, NULL}};
   if (prru_cli_parse("traj", argc, argv, opts, (int)(sizeof opts / sizeof *opts))) return 2;
+  const int nact = prru_cli_model()->mech->nact;
   char dn[256], ddn[256], fn[256];
-  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
-  prru_cli_names(ddn, sizeof ddn, "dd", PRRU_NACT, ",");
-  prru_cli_names(fn, sizeof fn, "fd", PRRU_NACT, ",");
+  prru_cli_names(dn, sizeof dn, "d", nact, ",");
+  prru_cli_names(ddn, sizeof ddn, "dd", nact, ",");
+  prru_cli_names(fn, sizeof fn, "fd", nact, ",");
   if (help && topp) {
     printf(topp_help,
-           PRRU_NACT > 3 ? "With redundant actuators, the forces of least norm (no internal preload).\n"
+           nact > 3 ? "With redundant actuators, the forces of least norm (no internal preload).\n"
                          : "",
            dn, ddn, fn);
     return 0;
@@ -646,15 +648,16 @@ static int track_row(const prru_track_sample *s, void *ctx)
 {
   track_output *to = ctx;
   prru_cli_out *o = to->out;
+  const int nact = to->m->mech->nact;
   prru_cli_out_printf(o, "%.17g", s->t);
   prru_cli_out_numbers(o, s->q_ref, 3);
   prru_cli_out_numbers(o, s->q, 3);
   prru_cli_out_numbers(o, s->e, 3);
   prru_cli_out_numbers(o, s->qd, 3);
-  prru_cli_out_numbers(o, s->fd, PRRU_NACT);
-  prru_cli_out_numbers(o, s->fd_cmd, PRRU_NACT);
-  for (int i = 0; i < PRRU_NACT; i++) prru_cli_out_printf(o, ",%d", s->saturated[i]);
-  prru_cli_out_numbers(o, s->d, PRRU_NACT);
+  prru_cli_out_numbers(o, s->fd, nact);
+  prru_cli_out_numbers(o, s->fd_cmd, nact);
+  for (int i = 0; i < nact; i++) prru_cli_out_printf(o, ",%d", s->saturated[i]);
+  prru_cli_out_numbers(o, s->d, nact);
   prru_cli_out_numbers(o, s->qdd, 3);
   prru_cli_out_motor(o, to->m, s->fd, to->motor, to->current);
   prru_cli_out_printf(o, "\n");
@@ -743,6 +746,7 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
                          const char *plant, const char *mismatch, double ff_peak, const char *status,
                          const char *limits)
 {
+  const int nact = prru_cli_model()->mech->nact;
   fputc('{', f);
   prru_cli_json_model(f);
   fprintf(f, ",\n \"control\": \"%s\", \"period\": ", o->control_period > 0 ? "zero-order hold" : "continuous");
@@ -753,7 +757,7 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
     fputs(",\n \"controller\": \"lqr\", \"lqr_q\": ", f);
     prru_cli_json_array(f, o->lqr_q, 6);
     fputs(", \"lqr_r\": ", f);
-    prru_cli_json_array(f, o->lqr_r, PRRU_NACT);
+    prru_cli_json_array(f, o->lqr_r, nact);
   } else {
     fputs(",\n \"controller\": \"computed_torque\", \"kp\": ", f);
     prru_cli_json_array(f, o->kp, 3);
@@ -774,18 +778,18 @@ static void json_summary(FILE *f, const prru_track_summary *s, const prru_track_
   fputs(", \"max_error\": ", f);
   prru_cli_json_array(f, s->max_e, 3);
   fputs(",\n \"max_fd\": ", f);
-  prru_cli_json_array(f, s->max_fd, PRRU_NACT);
-  double frac[PRRU_NACT];
-  for (int i = 0; i < PRRU_NACT; i++)
+  prru_cli_json_array(f, s->max_fd, nact);
+  double frac[PRRU_MAX_ACT];
+  for (int i = 0; i < nact; i++)
     frac[i] = s->samples ? (double)s->saturated[i] / (double)s->samples : 0.0;
   fputs(", \"saturated_fraction\": ", f);
-  prru_cli_json_array(f, frac, PRRU_NACT);
+  prru_cli_json_array(f, frac, nact);
   fputs(", \"any_saturated_fraction\": ", f);
   prru_cli_json_number(f, s->samples ? (double)s->any_saturated / (double)s->samples : 0.0);
   fputs(",\n \"limits\": ", f);
   prru_cli_json_string(f, limits);
   fputs(", \"max_dd\": ", f);
-  prru_cli_json_array(f, s->max_dd, PRRU_NACT);
+  prru_cli_json_array(f, s->max_dd, nact);
   fprintf(f, ", \"over_speed_fraction\": ");
   prru_cli_json_number(f, s->samples ? (double)s->over_speed / (double)s->samples : 0.0);
   fputs(",\n \"feedforward_peak\": ", f);
@@ -834,7 +838,8 @@ static int track_plot(const char *csv, const char *png, const prru_track_options
   if (prru_plot_scratch("track", dir, sizeof dir)) return 1;
   char footer[1200];
   prru_plot_provenance(footer, sizeof footer, "track");
-  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_cli_model()->mech->name, footer, PRRU_NACT, o->f_max);
+  char *buf = prru_plot_track_script(abs_csv, "track.png", prru_cli_model()->mech->name, footer,
+                                     prru_cli_model()->mech->nact, o->f_max);
   int rc = buf ? prru_plot_run("track", dir, dir, "track.gp", buf) : 1;
   if (!buf) prru_cli_error("track", "--plot: out of memory");
   free(buf);
@@ -911,7 +916,7 @@ static int parse_controller(const char *ctl, const char *q, const char *r, prru_
   if (!lqr) return 0;
   o->controller = PRRU_TRACK_LQR;
   if (q && prru_cli_numbers("track", "lqr-q", q, o->lqr_q, 6)) return 2;
-  if (r && prru_cli_numbers("track", "lqr-r", r, o->lqr_r, PRRU_NACT)) return 2;
+  if (r && prru_cli_numbers("track", "lqr-r", r, o->lqr_r, prru_cli_model()->mech->nact)) return 2;
   return 0;
 }
 
@@ -958,8 +963,9 @@ static int track_options_checked(const prru_track_options *o)
  * or 1 after a message. */
 static int lqr_default_weights(const prru_quintic *tr, prru_track_options *o)
 {
-  double q[6], r[PRRU_NACT], zq[6] = {0}, zr[PRRU_NACT] = {0};
-  int dq = memcmp(o->lqr_q, zq, sizeof zq) == 0, dr = memcmp(o->lqr_r, zr, sizeof zr) == 0;
+  const size_t rsize = (size_t)prru_cli_model()->mech->nact * sizeof(double);
+  double q[6], r[PRRU_MAX_ACT], zq[6] = {0}, zr[PRRU_MAX_ACT] = {0};
+  int dq = memcmp(o->lqr_q, zq, sizeof zq) == 0, dr = memcmp(o->lqr_r, zr, rsize) == 0;
   if (!dq && !dr) return 0;
   char msg[600];
   int st = prru_lqr_default_weights(prru_cli_model(), tr, o->control_period, q, r, msg, sizeof msg);
@@ -968,7 +974,7 @@ static int lqr_default_weights(const prru_quintic *tr, prru_track_options *o)
     return 1;
   }
   if (dq) memcpy(o->lqr_q, q, sizeof q);
-  if (dr) memcpy(o->lqr_r, r, sizeof r);
+  if (dr) memcpy(o->lqr_r, r, rsize);
   return 0;
 }
 
@@ -977,7 +983,7 @@ static void lqr_weights_text(const prru_track_options *o, char *buf, size_t len)
   int n = snprintf(buf, len, "Q");
   for (int i = 0; i < 6 && n > 0 && (size_t)n < len; i++) n += snprintf(buf + n, len - (size_t)n, " %.6g", o->lqr_q[i]);
   if (n > 0 && (size_t)n < len) n += snprintf(buf + n, len - (size_t)n, ", R");
-  for (int i = 0; i < PRRU_NACT && n > 0 && (size_t)n < len; i++)
+  for (int i = 0; i < prru_cli_model()->mech->nact && n > 0 && (size_t)n < len; i++)
     n += snprintf(buf + n, len - (size_t)n, " %.6g", o->lqr_r[i]);
 }
 
@@ -1020,17 +1026,18 @@ int prru_cmd_track(int argc, char **argv)
       {"controller", 1, &ctl, NULL},  {"lqr-q", 1, &lqr_q, NULL},    {"lqr-r", 1, &lqr_r, NULL},
       {"help", 0, NULL, &help}};
   if (prru_cli_parse("track", argc, argv, opts, (int)(sizeof opts / sizeof opts[0]))) return 2;
+  const int nact = prru_cli_model()->mech->nact;
   char fdn[256], fdcn[256], satn[256], dn[256];
-  prru_cli_names(fdn, sizeof fdn, "fd", PRRU_NACT, ",");
-  prru_cli_names(fdcn, sizeof fdcn, "fdc", PRRU_NACT, ",");
-  prru_cli_names(satn, sizeof satn, "sat", PRRU_NACT, ",");
-  prru_cli_names(dn, sizeof dn, "d", PRRU_NACT, ",");
+  prru_cli_names(fdn, sizeof fdn, "fd", nact, ",");
+  prru_cli_names(fdcn, sizeof fdcn, "fdc", nact, ",");
+  prru_cli_names(satn, sizeof satn, "sat", nact, ",");
+  prru_cli_names(dn, sizeof dn, "d", nact, ",");
   if (help) {
     char fl[256];
     char rl[256];
-    printf(track_help, prru_cli_names(rl, sizeof rl, "R", PRRU_NACT, ","),
-           prru_cli_names(fl, sizeof fl, "F", PRRU_NACT, ","),
-           PRRU_NACT > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "");
+    printf(track_help, prru_cli_names(rl, sizeof rl, "R", nact, ","),
+           prru_cli_names(fl, sizeof fl, "F", nact, ","),
+           nact > 3 ? "\n  (J_d^+T, the least-norm forces, with redundant actuators)" : "");
     printf(track_help2, fdn, fdcn, satn, dn);
     return 0;
   }
@@ -1063,7 +1070,7 @@ int prru_cmd_track(int argc, char **argv)
   if (parse_track_settings(a, &o) || parse_controller(ctl, lqr_q, lqr_r, &o) ||
       prru_cli_limits("track", "fmax", &lim, &limits) || prru_cli_units("track", units, &motor, &current))
     return 2;
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < nact; i++)
     o.f_max[i] = limits.force_max[i], o.speed_max[i] = limits.speed_max[i], o.d_min[i] = limits.d_min[i],
     o.d_max[i] = limits.d_max[i];
   if (track_options_checked(&o)) return 2;

@@ -147,9 +147,9 @@ static void link_axis(const double *R, const double a[3], const double b[3], dou
 typedef struct {
   long n;            /* frames */
   long *row;         /* their rows in the table */
-  double *R, *p;     /* 9 NBODY and 3 NBODY per frame */
+  double *R, *p;     /* 9 nbody and 3 nbody per frame */
   double lo[3], hi[3];
-  int react_col[PRRU_NLIMB][3]; /* U-joint force columns, or -1 */
+  int react_col[PRRU_MAX_LIMB][3]; /* U-joint force columns, or -1 */
   int reactions;
 } frames;
 
@@ -171,8 +171,9 @@ static void grow(frames *f, const double x[3])
 /* The U joint of limb i (the platform's joint in its chain), or -1. */
 static int u_joint(int i)
 {
-  for (int j = 0; j < PRRU_NJOINT; j++)
-    if (prru_cli_model()->mech->joint[j].type == 'U' && prru_cli_model()->mech->joint[j].limb == i) return j;
+  const prru_mechanism *me = prru_cli_model()->mech;
+  for (int j = 0; j < me->njoint; j++)
+    if (me->joint[j].type == 'U' && me->joint[j].limb == i) return j;
   return -1;
 }
 
@@ -182,11 +183,13 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
 {
   int ct = prru_table_column(t, "t"), cq[3] = {prru_table_column(t, "q1"), prru_table_column(t, "q2"),
                                                 prru_table_column(t, "q3")};
+  const prru_mechanism *me = prru_cli_model()->mech;
+  const int nbody = me->nbody;
   memset(f, 0, sizeof *f);
   f->n = n;
   f->row = malloc((size_t)n * sizeof *f->row);
-  f->R = malloc((size_t)n * 9 * PRRU_NBODY * sizeof *f->R);
-  f->p = malloc((size_t)n * 3 * PRRU_NBODY * sizeof *f->p);
+  f->R = malloc((size_t)n * 9 * (size_t)nbody * sizeof *f->R);
+  f->p = malloc((size_t)n * 3 * (size_t)nbody * sizeof *f->p);
   if (!f->row || !f->R || !f->p) {
     prru_cli_error("view", "out of memory for %ld frames", n);
     return 1;
@@ -199,18 +202,18 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
     f->row[k] = n == 1 ? 0 : (long)llround((double)k * (t->nrows - 1) / (n - 1));
     const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
     const double q[3] = {r[cq[0]], r[cq[1]], r[cq[2]]};
-    double *R = f->R + (size_t)k * 9 * PRRU_NBODY, *p = f->p + (size_t)k * 3 * PRRU_NBODY;
+    double *R = f->R + (size_t)k * 9 * (size_t)nbody, *p = f->p + (size_t)k * 3 * (size_t)nbody;
     prru_model_poses(prru_cli_model(), q, R, p);
     int finite = 1;
-    for (int i = 0; i < 9 * PRRU_NBODY; i++) finite &= isfinite(R[i]) != 0;
-    for (int i = 0; i < 3 * PRRU_NBODY; i++) finite &= isfinite(p[i]) != 0;
+    for (int i = 0; i < 9 * nbody; i++) finite &= isfinite(R[i]) != 0;
+    for (int i = 0; i < 3 * nbody; i++) finite &= isfinite(p[i]) != 0;
     if (!finite) {
       char qs[128];
       prru_cli_error("view", "%s: row %ld (t = %g s): q = %s is out of reach of this model", path, f->row[k] + 1,
                      r[ct], prru_cli_vec(qs, sizeof qs, q, 3));
       return 1;
     }
-    for (int i = 0; i < PRRU_NLIMB; i++) {
+    for (int i = 0; i < me->nlimb; i++) {
       double A[3], B[3], C[3];
       prru_limb_joints(prru_cli_model(), R, p, i, A, B, C);
       grow(f, A);
@@ -219,10 +222,10 @@ static int compute_frames(const prru_table *t, const char *path, long n, frames 
     }
   }
   f->reactions = 1;
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < me->nlimb; i++) {
     int j = u_joint(i);
     for (int c = 0; c < 3; c++) {
-      f->react_col[i][c] = j < 0 ? -1 : prru_table_column(t, prru_cli_model()->mech->lambda_labels[prru_cli_model()->mech->joint[j].lambda_offset + c]);
+      f->react_col[i][c] = j < 0 ? -1 : prru_table_column(t, me->lambda_labels[me->joint[j].lambda_offset + c]);
       if (f->react_col[i][c] < 0) f->reactions = 0;
     }
   }
@@ -378,7 +381,7 @@ static void out_bodies(prru_cli_out *o, const frames *f)
 {
   const double *R = f->R, *p = f->p;
   prru_cli_out_printf(o, "\"bodies\":[");
-  for (int b = 0; b < PRRU_NBODY; b++) {
+  for (int b = 0; b < prru_cli_model()->mech->nbody; b++) {
     int i = prru_cli_model()->mech->body_limb[b];
     const char *kind = b == prru_cli_model()->mech->platform ? "platform" : "link";
     double axis[3] = {0, 0, 1}, len = 0, A[3], B[3], C[3];
@@ -409,10 +412,11 @@ static void out_bodies(prru_cli_out *o, const frames *f)
  * a, or a quarter of the mean upper link when a is small. */
 static double plate_half(void)
 {
+  const prru_mechanism *me = prru_cli_model()->mech;
   double h = 0.0, l = 0.0;
-  for (int i = 0; i < PRRU_NLIMB; i++) {
-    if (prru_cli_model()->mech->a[i] > h) h = prru_cli_model()->mech->a[i];
-    l += prru_cli_model()->mech->l1[i] / PRRU_NLIMB;
+  for (int i = 0; i < me->nlimb; i++) {
+    if (me->a[i] > h) h = me->a[i];
+    l += me->l1[i] / me->nlimb;
   }
   return h > 0.1 * l ? h : 0.25 * l;
 }
@@ -423,12 +427,13 @@ static int cmp_double(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
-/* Per frame: row, t, q, R (9 NBODY), p (3 NBODY); the U-joint centres and
+/* Per frame: row, t, q, R (9 nbody), p (3 nbody); the U-joint centres and
  * forces when the run has them. */
 static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
 {
   int ct = prru_table_column(t, "t"), cq[3] = {prru_table_column(t, "q1"), prru_table_column(t, "q2"),
                                                 prru_table_column(t, "q3")};
+  const int nbody = prru_cli_model()->mech->nbody, nlimb = prru_cli_model()->mech->nlimb;
   prru_cli_out_printf(o, "\"frames\":{\"row\":[");
   for (long k = 0; k < f->n; k++) prru_cli_out_printf(o, "%s%ld", k ? "," : "", f->row[k]);
   prru_cli_out_printf(o, "],\"t\":[");
@@ -445,13 +450,13 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
   prru_cli_out_printf(o, "],\n\"R\":[");
   for (long k = 0; k < f->n; k++) {
     if (k) prru_cli_out_write(o, ",\n", 2);
-    out_array(o, f->R + (size_t)k * 9 * PRRU_NBODY, 9 * PRRU_NBODY);
+    out_array(o, f->R + (size_t)k * 9 * (size_t)nbody, 9 * nbody);
     prru_cli_out_line(o);
   }
   prru_cli_out_printf(o, "],\n\"p\":[");
   for (long k = 0; k < f->n; k++) {
     if (k) prru_cli_out_write(o, ",\n", 2);
-    out_array(o, f->p + (size_t)k * 3 * PRRU_NBODY, 3 * PRRU_NBODY);
+    out_array(o, f->p + (size_t)k * 3 * (size_t)nbody, 3 * nbody);
     prru_cli_out_line(o);
   }
   prru_cli_out_printf(o, "]},\n\"reactions\":");
@@ -462,44 +467,44 @@ static void out_frames(prru_cli_out *o, const prru_table *t, const frames *f)
   /* A force at the 90th percentile of the run's as long as the mean upper
    * link (the largest, at a jerk of the start, would make most arrows
    * invisible). */
-  double *mag = malloc((size_t)f->n * PRRU_NLIMB * sizeof *mag), fref = 0.0;
+  double *mag = malloc((size_t)f->n * (size_t)nlimb * sizeof *mag), fref = 0.0;
   if (mag) {
     for (long k = 0; k < f->n; k++)
-      for (int i = 0; i < PRRU_NLIMB; i++) {
+      for (int i = 0; i < nlimb; i++) {
         const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
         double fx = r[f->react_col[i][0]], fy = r[f->react_col[i][1]], fz = r[f->react_col[i][2]];
-        mag[k * PRRU_NLIMB + i] = sqrt(fx * fx + fy * fy + fz * fz);
+        mag[k * nlimb + i] = sqrt(fx * fx + fy * fy + fz * fz);
       }
-    qsort(mag, (size_t)f->n * PRRU_NLIMB, sizeof *mag, cmp_double);
-    fref = mag[(size_t)(0.9 * (double)(f->n * PRRU_NLIMB - 1))];
+    qsort(mag, (size_t)f->n * (size_t)nlimb, sizeof *mag, cmp_double);
+    fref = mag[(size_t)(0.9 * (double)(f->n * nlimb - 1))];
     free(mag);
   } else {
     o->err = ENOMEM;
   }
   prru_cli_out_printf(o, "{\"scale\":%.17g,\"labels\":[", fref > 0 ? prru_length_scale(prru_cli_model()->mech) / fref : 0.0);
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < nlimb; i++) {
     if (i) prru_cli_out_write(o, ",", 1);
     prru_cli_out_json_string(o, prru_cli_model()->mech->joint[u_joint(i)].name);
   }
   prru_cli_out_printf(o, "],\"at\":[");
   for (long k = 0; k < f->n; k++) {
-    double at[3 * PRRU_NLIMB];
-    const double *R = f->R + (size_t)k * 9 * PRRU_NBODY, *p = f->p + (size_t)k * 3 * PRRU_NBODY;
-    for (int i = 0; i < PRRU_NLIMB; i++) {
+    double at[3 * PRRU_MAX_LIMB];
+    const double *R = f->R + (size_t)k * 9 * (size_t)nbody, *p = f->p + (size_t)k * 3 * (size_t)nbody;
+    for (int i = 0; i < nlimb; i++) {
       double A[3], B[3];
       prru_limb_joints(prru_cli_model(), R, p, i, A, B, at + 3 * i);
     }
     if (k) prru_cli_out_write(o, ",", 1);
-    out_array(o, at, 3 * PRRU_NLIMB);
+    out_array(o, at, 3 * nlimb);
   }
   prru_cli_out_printf(o, "],\n\"f\":[");
   for (long k = 0; k < f->n; k++) {
     const double *r = t->data + (size_t)f->row[k] * (size_t)t->ncols;
-    double fv[3 * PRRU_NLIMB];
-    for (int i = 0; i < PRRU_NLIMB; i++)
+    double fv[3 * PRRU_MAX_LIMB];
+    for (int i = 0; i < nlimb; i++)
       for (int c = 0; c < 3; c++) fv[3 * i + c] = r[f->react_col[i][c]];
     if (k) prru_cli_out_write(o, ",", 1);
-    out_array(o, fv, 3 * PRRU_NLIMB);
+    out_array(o, fv, 3 * nlimb);
   }
   prru_cli_out_printf(o, "]}");
 }
@@ -554,7 +559,7 @@ static void out_data(prru_cli_out *o, const prru_table *t, const frames *f, cons
   prru_cli_out_printf(o, ",\"hi\":");
   out_array(o, hi, 3);
   prru_cli_out_printf(o, "},\"rails\":[");
-  for (int i = 0; i < PRRU_NLIMB; i++) {
+  for (int i = 0; i < prru_cli_model()->mech->nlimb; i++) {
     double A[3], B[3], C[3];
     prru_limb_joints(prru_cli_model(), f->R, f->p, i, A, B, C);
     const double r[4] = {A[0], A[1], lo[2], hi[2]};

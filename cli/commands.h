@@ -9,13 +9,6 @@
 #include <stdio.h>
 
 #include "prru.h"
-/* The build's model: the sizes (PRRU_NACT, ...) the CLI's arrays and
- * output columns still have, its descriptor and regressor names. The
- * library's public headers carry none of them (one ABI for every model);
- * the CLI is built with the library, for the same model. */
-#include "prru_kernels.h"
-#include "prru_mechanism.h"
-#include "prru_regressor.h"
 
 /* The program's version, the CMake project version (cli/CMakeLists.txt). */
 #ifndef PRRU_VERSION
@@ -23,10 +16,10 @@
 #endif
 
 /* The CLI writes q as q1,q2,q3 (names, help texts): the 3-PRRU's three
- * coordinates. Everything else sized by the mechanism uses the PRRU_N*
- * macros (the build's topology) and the current model's descriptor
- * (prru_cli_model()->mech: names and numbers). */
-typedef char prru_cli_nq_is_3[PRRU_NQ == 3 ? 1 : -1];
+ * coordinates. Everything else sized by the mechanism comes from the
+ * model a command computes with (prru_cli_model()->mech: its counts,
+ * names and numbers), so that one build serves every model the library
+ * loads; fixed arrays have the public maxima of prru_sizes.h. */
 
 int prru_cmd_eval(int argc, char **argv);
 int prru_cmd_gen(int argc, char **argv);
@@ -69,6 +62,12 @@ void prru_cli_print_version(FILE *f);
 /* 1 when the kernels were generated from the paper's model file
  * (models/3prru_paper.json, by its SHA-256), 0 otherwise. */
 int prru_cli_is_paper_model(void);
+/* The dimensions of null(J_d^T), actuator forces that move nothing (an
+ * internal preload), and of null(Q), reaction coordinates no motion or
+ * load determines, for the model m: 0 and 0 with three limbs, 1 and 1
+ * with four (docs/model.md section 13). */
+int prru_cli_npreload(const prru_model *m);
+int prru_cli_nreaction_null(const prru_model *m);
 /* The paper's section 4.3 scenario as the CLI runs it (`prru paper`,
  * `prru simulate --scenario paper`): prru_scenario_paper, and on a model
  * with redundant actuators every actuator beyond the third gets the third's
@@ -212,7 +211,7 @@ typedef struct {
  * and the values for rail forces fd (prru_model_motor_units); nothing
  * when !motor. */
 void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current);
-void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current);
+void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[], int motor, int current);
 /* Opens (checks that it can be written: the directory exists and takes a
  * new file); 0, or 1 after a message with the reason. */
 int prru_cli_out_open(prru_cli_out *o, const char *cmd, const char *path);
@@ -238,10 +237,11 @@ int prru_cli_out_line(prru_cli_out *o);
  * last flush. 0 or -1 after a write error. */
 int prru_cli_out_row(prru_cli_out *o);
 /* A data row of a motion CSV (cli/util.c): t, q, qd, qdd (3 numbers
- * each), d and v (PRRU_NACT each: the actuators' positions and a quantity
- * per actuator, their forces or rates); prru_cli_out_row's result. */
+ * each), d and v (nact each, of the current model: the actuators'
+ * positions and a quantity per actuator, their forces or rates);
+ * prru_cli_out_row's result. */
 int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const double qd[3],
-                            const double qdd[3], const double d[PRRU_NACT], const double v[PRRU_NACT]);
+                            const double qdd[3], const double d[], const double v[]);
 int prru_cli_out_flush(prru_cli_out *o);
 /* The model comment line, as prru_cli_csv_comment. */
 void prru_cli_out_comment(prru_cli_out *o);
@@ -265,9 +265,9 @@ int prru_cli_out_close(prru_cli_out *o, int keep);
 int prru_cli_out_finish(prru_cli_out *o, int st, const char *why);
 
 /* CSV of simulation samples: the model comment line, then the header
- * t,q1..3,qd1..3,d1..dNACT, the PRRU_NLAMBDA reactions (named by
- * the model's lambda_labels, when computed), qdd1..3, fd1..fdNACT, fp1..3,
- * mp1..3, T, V. */
+ * t,q1..3,qd1..3,d1..dN, the model's nlambda reactions (named by its
+ * lambda_labels, when computed), qdd1..3, fd1..fdN, fp1..3, mp1..3, T, V
+ * (N = nact, of the current model). */
 typedef struct {
   prru_cli_out *out;
   const prru_load_schedule *loads;

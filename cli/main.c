@@ -36,6 +36,13 @@ static const struct {
 
 static void usage(FILE *f)
 {
+  /* The robot described is the model a command would compute with (main
+   * loads --model or PRRU_MODEL before this runs); "built in" and the
+   * limbs a model file must have are the built-in model's, since
+   * prru_model_load accepts only the build's number of limbs. */
+  const prru_mechanism *me = prru_cli_model()->mech;
+  prru_model built;
+  prru_model_default(&built);
   fprintf(f, "usage: prru [--model FILE] COMMAND [OPTIONS]\n"
              "       prru --help | --version\n"
              "(prru COMMAND --help for the command's options)\n\n"
@@ -50,8 +57,8 @@ static void usage(FILE *f)
              "when it was built: the fastest) or parameter (any other numbers, read\n"
              "from FILE).\n\n"
              "commands:\n",
-          PRRU_NLIMB, PRRU_NACT > 3 ? " (redundantly actuated)" : "", PRRU_NACT, prru_mech.name,
-          prru_mech.model_file, PRRU_NLIMB);
+          me->nlimb, me->nact > 3 ? " (redundantly actuated)" : "", me->nact, built.mech->name,
+          built.mech->model_file, built.mech->nlimb);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
   fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");
@@ -73,7 +80,7 @@ static void usage(FILE *f)
              "environment:\n"
              "  PRRU_MODEL     the model file when no --model is given (empty: the\n"
              "                 built-in model)\n",
-          PRRU_NLIMB);
+          built.mech->nlimb);
 }
 
 /* Every command's stdout (JSON, summaries, help) is checked once flushed

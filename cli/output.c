@@ -112,19 +112,21 @@ void prru_cli_out_write(prru_cli_out *o, const void *data, size_t n)
 
 void prru_cli_out_motor_names(prru_cli_out *o, int motor, int current)
 {
+  const int nact = prru_cli_model()->mech->nact;
   char names[256];
-  if (motor) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "tau", PRRU_NACT, ","));
-  if (motor && current) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "i", PRRU_NACT, ","));
+  if (motor) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "tau", nact, ","));
+  if (motor && current) prru_cli_out_printf(o, ",%s", prru_cli_names(names, sizeof names, "i", nact, ","));
 }
 
-void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[PRRU_NACT], int motor, int current)
+void prru_cli_out_motor(prru_cli_out *o, const prru_model *m, const double fd[], int motor, int current)
 {
-  double tau[PRRU_NACT], cur[PRRU_NACT];
+  const int nact = m->mech->nact;
+  double tau[PRRU_MAX_ACT], cur[PRRU_MAX_ACT];
   if (!motor) return;
   if (prru_model_motor_units(m, fd, tau, cur) != PRRU_OK) /* checked by prru_cli_units */
-    for (int i = 0; i < PRRU_NACT; i++) tau[i] = cur[i] = NAN;
-  prru_cli_out_numbers(o, tau, PRRU_NACT);
-  if (current) prru_cli_out_numbers(o, cur, PRRU_NACT);
+    for (int i = 0; i < nact; i++) tau[i] = cur[i] = NAN;
+  prru_cli_out_numbers(o, tau, nact);
+  if (current) prru_cli_out_numbers(o, cur, nact);
 }
 
 void prru_cli_out_numbers(prru_cli_out *o, const double *v, int n)

@@ -74,7 +74,7 @@ static int write_fig7a(const fig7_dirs *dirs, const prru_model *m, prru_data *d)
   prru_cli_csv_comment(fs);
   fputs("# pose index, half-length (m/s^2 per N), label\n", fs);
   for (int k = 0; k < FIG7A_NPOSE; k++) {
-    double q[PRRU_NQ] = {fig7a_poses[k][0], fig7a_poses[k][1], 0.0};
+    double q[3] = {fig7a_poses[k][0], fig7a_poses[k][1], 0.0};
     prru_dme r;
     int st = prru_dme_eval(m, d, q, &r);
     char label[96];

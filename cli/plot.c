@@ -467,14 +467,15 @@ static void plot_components(FILE *g, int j, char kind)
 static void joint_figure(FILE *g, char type, char kind, const char *png, const char *title,
                          const char *unit)
 {
+  const int njoint = prru_cli_model()->mech->njoint;
   int n = 0;
-  for (int j = 0; j < PRRU_NJOINT; j++) n += prru_cli_model()->mech->joint[j].type == type;
+  for (int j = 0; j < njoint; j++) n += prru_cli_model()->mech->joint[j].type == type;
   const int px = 130 + 210 * (n ? n : 1);
   fprintf(g, "set output '%s'\nset terminal pngcairo size 1000,%d enhanced font 'Sans,11'\n", png, px);
   fputs(footer_label, g);
   fputs("unset xlabel\n", g);
   put_layout(g, n ? n : 1, px, title);
-  for (int j = 0, p = 0; j < PRRU_NJOINT; j++) {
+  for (int j = 0, p = 0; j < njoint; j++) {
     if (prru_cli_model()->mech->joint[j].type != type) continue;
     if (++p == n) fputs("set xlabel 'time t (s)'\n", g);
     fputs("set ylabel '", g);
@@ -528,7 +529,7 @@ char *prru_plot_paper_sim_script(const char *csv)
   fputs(footer_label, g);
   put_layout(g, 1, 700, "\"Slider heights in the paper's study (section 4.3; not one of its figures), model \".model");
   fputs("set xlabel 'time t (s)'\nset ylabel 'slider height d_i (m)'\nplot ", g);
-  for (int i = 1; i <= PRRU_NACT; i++)
+  for (int i = 1; i <= prru_cli_model()->mech->nact; i++)
     fprintf(g, "%s't':'d%d' with lines lt %d title 'd_%d'", i == 1 ? "f using " : ", '' using ", i, i, i);
   fputs("\nunset multiplot\n", g);
   joint_figure(g, 'U', 'f', "fig4_u_joint_forces.png",

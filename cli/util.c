@@ -157,7 +157,7 @@ int prru_cli_units(const char *cmd, const char *units, int *motor, int *current)
   }
   *motor = 1;
   *current = 1;
-  for (int i = 0; i < PRRU_NACT; i++) *current &= m->mech->torque_constant[i] > 0;
+  for (int i = 0; i < m->mech->nact; i++) *current &= m->mech->torque_constant[i] > 0;
   return 0;
 }
 
@@ -318,13 +318,18 @@ const char *prru_cli_model_id(void)
   return id;
 }
 
+int prru_cli_npreload(const prru_model *m) { return m->mech->nact - 3; }
+
+int prru_cli_nreaction_null(const prru_model *m) { return m->mech->nlambda - (6 * m->mech->nbody - 3); }
+
 const char *prru_cli_paper_fd_text(void)
 {
-  static char text[32 * PRRU_NACT];
+  static char text[32 * PRRU_MAX_ACT];
   prru_scenario s;
+  /* No model argument: fd beyond the third is filled up to the build's actuator count. */
   prru_scenario_paper(&s);
   size_t used = 0;
-  for (int i = 0; i < PRRU_NACT && used < sizeof text; i++)
+  for (int i = 0; i < prru_cli_model()->mech->nact && used < sizeof text; i++)
     used += (size_t)snprintf(text + used, sizeof text - used, "%s%g", i ? ", " : "", s.loads.base.fd[i]);
   prru_scenario_free(&s);
   return text;
@@ -342,7 +347,7 @@ void prru_cli_print_version(FILE *f)
   fprintf(f, "model: %s\n", m->mech->name);
   fprintf(f, "model file: %s\n", plain);
   fprintf(f, "model format: %d\n", m->mech->format);
-  fprintf(f, "model actuators: %d\n", PRRU_NACT);
+  fprintf(f, "model actuators: %d\n", m->mech->nact);
   fprintf(f, "model sha256: %s\n", m->mech->sha256);
   fprintf(f, "model kernels: %s\n", m->kernels->path);
 }
@@ -377,14 +382,15 @@ void prru_cli_json_matrix(FILE *f, const double *v, int rows, int cols)
 }
 
 int prru_cli_out_motion_row(prru_cli_out *o, double t, const double q[3], const double qd[3],
-                            const double qdd[3], const double d[PRRU_NACT], const double v[PRRU_NACT])
+                            const double qdd[3], const double d[], const double v[])
 {
+  const int nact = prru_cli_model()->mech->nact;
   prru_cli_out_printf(o, "%.17g", t);
   prru_cli_out_numbers(o, q, 3);
   prru_cli_out_numbers(o, qd, 3);
   prru_cli_out_numbers(o, qdd, 3);
-  prru_cli_out_numbers(o, d, PRRU_NACT);
-  prru_cli_out_numbers(o, v, PRRU_NACT);
+  prru_cli_out_numbers(o, d, nact);
+  prru_cli_out_numbers(o, v, nact);
   prru_cli_out_printf(o, "\n");
   return prru_cli_out_row(o);
 }
