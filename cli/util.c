@@ -326,7 +326,7 @@ const char *prru_cli_paper_fd_text(void)
 {
   static char text[32 * PRRU_MAX_ACT];
   prru_scenario s;
-  /* No model argument: fd beyond the third is filled up to the build's actuator count. */
+  /* The paper's forces for every actuator a model may have (a fourth gets limb 3's). */
   prru_scenario_paper(&s);
   size_t used = 0;
   for (int i = 0; i < prru_cli_model()->mech->nact && used < sizeof text; i++)
