@@ -936,7 +936,7 @@ static int track_options_checked(const prru_track_options *o)
       {"q0_offset", "--q0-offset"}, {"abs_tol", "--atol"}, {"rel_tol", "--rtol"},
       {"lqr_q", "--lqr-q"}, {"lqr_r", "--lqr-r"}};
   char msg[600], text[800];
-  if (prru_track_options_check(o, msg, sizeof msg) == PRRU_OK) return 0;
+  if (prru_track_options_check(prru_cli_model(), o, msg, sizeof msg) == PRRU_OK) return 0;
   const int nflag = (int)(sizeof flag / sizeof flag[0]);
   size_t n = 0;
   for (const char *p = msg; *p && n + 1 < sizeof text;) {
@@ -1059,7 +1059,7 @@ int prru_cmd_track(int argc, char **argv)
       prru_cli_refuse_same_file("track", "ref", refs, "plot", plot))
     return 2;
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(prru_cli_model(), &o);
   if (plant_params(plants, &o.plant)) return 2;
   /* The drives' limits: the model file's unless overridden (spec 13). The
    * forces are clipped to force_max, the stroke ends the run like an end

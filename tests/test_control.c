@@ -45,7 +45,7 @@ static void plant_is_model(prru_data *d)
 {
   double worst = 0, worst_ct = 0;
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   for (int k = 0; k < 200; k++) {
     double q[3] = {tu_uniform(-0.15, 0.15), tu_uniform(-0.12, 0.12), tu_uniform(-0.03, 0.03)};
     double qd[3] = {tu_uniform(-1, 1), tu_uniform(-1, 1), tu_uniform(-0.2, 0.2)};
@@ -54,7 +54,7 @@ static void plant_is_model(prru_data *d)
     for (int i = 0; i < PRRU_NACT; i++) l.fd[i] = tu_uniform(-80, 80);
     double a[3], b[3];
     if (prru_forward_dynamics(&model, d, q, qd, &l, a) != PRRU_OK) continue;
-    TU_TRUE(prru_plant_accel(&prru_params_model, q, qd, l.fd, b) == PRRU_OK, "plant accel");
+    TU_TRUE(prru_plant_accel(&model, &prru_params_model, q, qd, l.fd, b) == PRRU_OK, "plant accel");
     worst = fmax(worst, tu_relerr(b, a, 3, 1.0));
     /* The controller's forces, unclipped, give the plant the commanded
      * acceleration qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q). */
@@ -63,7 +63,7 @@ static void plant_is_model(prru_data *d)
     int sat[PRRU_NACT];
     TU_TRUE(prru_computed_torque(&model, d, &o, qr, qdr, qddr, q, qd, fc, f, sat) == PRRU_OK,
             "computed torque");
-    prru_plant_accel(&prru_params_model, q, qd, f, acc);
+    prru_plant_accel(&model, &prru_params_model, q, qd, f, acc);
     for (int i = 0; i < 3; i++)
       want[i] = qddr[i] + o.kd[i] * (qdr[i] - qd[i]) + o.kp[i] * (qr[i] - q[i]);
     worst_ct = fmax(worst_ct, tu_relerr(acc, want, 3, 1.0));
@@ -75,7 +75,7 @@ static void plant_is_model(prru_data *d)
 static void exact_tracking(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   prru_track_summary s;
   char msg[512];
   int st = prru_track(&model, &ref, &o, &s, msg, sizeof msg);
@@ -102,7 +102,7 @@ static int decay_check(const prru_track_sample *s, void *p)
 static void error_dynamics(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   decay_ctx c = {{0.01, -0.008, 0.002}, 20.0, 0.0};
   memcpy(o.q0_offset, c.e0, sizeof c.e0);
   o.on_sample = decay_check;
@@ -122,7 +122,7 @@ static void error_dynamics(void)
 static double mismatch_max_error(double w, double period)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   for (int i = 0; i < 3; i++) {
     o.kp[i] = w * w;
     o.kd[i] = 2 * w;
@@ -150,7 +150,7 @@ static void mismatch(void)
    * reduced) and for evaluating delta on the reference. Falls as 1/w^2
    * (a factor 4 per doubling; at least 3). */
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   prru_params plant = prru_params_model;
   prru_params_scale(&plant, "mass", 1.1);
   prru_data *d = malloc(sizeof *d);
@@ -160,7 +160,7 @@ static void mismatch(void)
     int sat[PRRU_NACT];
     prru_quintic_eval(&ref, k * 1e-3, qr, qdr, qddr);
     prru_computed_torque(&model, d, &o, qr, qdr, qddr, qr, qdr, fc, f, sat);
-    prru_plant_accel(&plant, qr, qdr, f, a);
+    prru_plant_accel(&model, &plant, qr, qdr, f, a);
     for (int i = 0; i < 3; i++) sup = fmax(sup, fabs(qddr[i] - a[i]));
   }
   free(d);
@@ -178,7 +178,7 @@ static void mismatch(void)
 static void noise_deterministic(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.control_period = 1e-3;
   o.noise_q = 1e-5;
   o.noise_qd = 1e-3;
@@ -216,7 +216,7 @@ static int sat_check(const prru_track_sample *s, void *p)
 static void saturation(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   prru_track_summary s;
   char msg[512];
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_OK, msg);
@@ -241,7 +241,7 @@ static void saturation(void)
 static void stroke(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   /* Slider 1's extreme height on the reference away from its start (the
    * start is home, where it may already be at one extreme), moved 1 mm
    * inwards. */
@@ -275,7 +275,7 @@ static void stroke(void)
 static void stroke_between_samples(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.control_period = 0.0;
   const double dt = 0.3;
   o.dt_out = dt;
@@ -320,22 +320,22 @@ static void refusals(void)
   prru_track_options o;
   prru_track_summary s;
   char msg[512];
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.kp[1] = -1;
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "kp"),
           "negative kp refused");
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.f_max[0] = 0;
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "force limit of actuator 1"),
           "zero force limit refused");
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.d_min[2] = 0.1;
   o.d_max[2] = 0.1;
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "stroke of slider 3"),
           "empty stroke refused");
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.noise_q = 1e-6;
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "control period"),
@@ -385,7 +385,7 @@ static int speed_check(const prru_track_sample *s, void *p)
 static void slider_speeds(void)
 {
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   /* Off the reference and a heavier plant: the speeds are the plant's
    * state's, not the reference's. */
   prru_params_scale(&o.plant, "mass", 1.2);
@@ -421,7 +421,8 @@ static void slider_speeds(void)
   TU_TRUE(memcmp(s2.max_dd, s.max_dd, PRRU_NACT * sizeof(double)) == 0 && memcmp(s2.max_e, s.max_e, sizeof s.max_e) == 0,
           "a speed limit changes nothing in the run");
   o.speed_max[1] = 0;
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "speed limit of actuator 2"),
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_EINPUT &&
+              strstr(msg, "speed limit of actuator 2"),
           "zero speed limit refused");
 }
 
@@ -429,12 +430,21 @@ static void option_checks(void)
 {
   prru_track_options o, d;
   char msg[512] = "stale";
-  prru_track_options_default(&o);
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0', "defaults pass");
+  prru_track_options_default(&model, &o);
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0', "defaults pass");
   /* The bandwidth rule: the defaults are w = 20; bad w leaves o alone. */
-  prru_track_options_default(&d);
+  prru_track_options_default(&model, &d);
   TU_TRUE(prru_track_gains_bandwidth(20.0, &o) == PRRU_OK && memcmp(&o, &d, sizeof o) == 0,
           "default gains = bandwidth 20 rad/s");
+  TU_TRUE(memcmp(&d.plant, &prru_params_model, sizeof d.plant) == 0,
+          "the default plant is the model's numbers");
+  /* Only the model's actuators' entries are checked: one past them may
+   * hold anything. */
+  if (model.mech->nact < PRRU_MAX_ACT) {
+    d.f_max[PRRU_MAX_ACT - 1] = 0;
+    d.d_min[PRRU_MAX_ACT - 1] = d.d_max[PRRU_MAX_ACT - 1] = NAN;
+    TU_TRUE(prru_track_options_check(&model, &d, msg, sizeof msg) == PRRU_OK, "entries past nact not read");
+  }
   TU_TRUE(prru_track_gains_bandwidth(7.0, &o) == PRRU_OK && o.kp[0] == 49.0 && o.kp[2] == 49.0 &&
               o.kd[0] == 14.0 && o.kd[1] == 14.0,
           "bandwidth 7: kp = 49, kd = 14");
@@ -443,29 +453,32 @@ static void option_checks(void)
   for (int k = 0; k < 5; k++) refused &= prru_track_gains_bandwidth(bad[k], &o) == PRRU_EINPUT && o.kp[1] == 49.0;
   TU_TRUE(refused, "bandwidth not > 0 or with infinite gains refused, gains kept");
   /* The names a front end replaces (prru_control.h). */
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.noise_qd = 1e-3;
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT &&
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "sensor noise needs control period > 0"),
           "noise needs a control period");
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.controller = PRRU_TRACK_LQR;
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT &&
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "controller PRRU_TRACK_LQR needs control period > 0"),
           "LQR needs a control period");
   o.control_period = 1e-2;
   o.rel_tol = 1e-15;
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_EINPUT && strncmp(msg, "rel_tol: ", 9) == 0,
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_EINPUT &&
+              strncmp(msg, "rel_tol: ", 9) == 0,
           "tolerance below PRRU_TOL_MIN refused");
   /* One rule for all-zero weights: the defaults, Q and R alike. */
   o.rel_tol = 1e-12;
-  TU_TRUE(prru_track_options_check(&o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0', "LQR weights all 0 accepted");
+  TU_TRUE(prru_track_options_check(&model, &o, msg, sizeof msg) == PRRU_OK && msg[0] == '\0',
+          "LQR weights all 0 accepted");
   prru_lqr_schedule sch;
   double q[6], r[PRRU_NACT];
   TU_TRUE(prru_lqr_default_weights(&model, &ref, o.control_period, q, r, msg, sizeof msg) == PRRU_OK, msg);
   TU_TRUE(prru_lqr_schedule_build(&model, &ref, &o, &sch, msg, sizeof msg) == PRRU_OK, msg);
   TU_TRUE(memcmp(sch.q, q, sizeof q) == 0 && memcmp(sch.r, r, sizeof r) == 0,
           "all-zero weights are prru_lqr_default_weights'");
+  TU_TRUE(sch.nact == model.mech->nact, "the schedule records the model's actuators");
   prru_lqr_schedule_free(&sch);
 }
 
@@ -577,7 +590,7 @@ static void lqr_stationary(void)
   prru_quintic hold;
   hold_reference(&hold, q, 2.0);
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.controller = PRRU_TRACK_LQR;
   o.control_period = period;
   prru_lqr_schedule s;
@@ -683,7 +696,7 @@ static void lqr_tracking(void)
 {
   const double period = 1e-3, w = 20;
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.control_period = period;
   prru_track_summary ct, lqr;
   char msg[512];
@@ -757,7 +770,7 @@ static void lqr_wrong_gain(void)
   prru_quintic hold;
   hold_reference(&hold, q, 1.0);
   prru_track_options o;
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.controller = PRRU_TRACK_LQR;
   o.control_period = 1e-3;
   prru_lqr_schedule s;
@@ -784,7 +797,7 @@ static void lqr_refusals(void)
   prru_track_options o;
   prru_track_summary s;
   char msg[512];
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.controller = PRRU_TRACK_LQR;
   TU_TRUE(prru_track(&model, &ref, &o, &s, msg, sizeof msg) == PRRU_EINPUT && strstr(msg, "control period"),
           "LQR without a control period refused");
@@ -808,7 +821,7 @@ static void lqr_refusals(void)
           "unknown controller refused");
   /* A reference that leaves the workspace: the schedule fails at the
    * first tick whose pose has no dynamics, naming its time. */
-  prru_track_options_default(&o);
+  prru_track_options_default(&model, &o);
   o.controller = PRRU_TRACK_LQR;
   o.control_period = 1e-2;
   const double wp[6] = {0, 0, 0, 1.5, 0, 0};

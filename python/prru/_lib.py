@@ -443,8 +443,8 @@ class Library:
         self.topp_free = _declare(dll, "prru_topp_free", None, tpp)
         self.topp_row = _declare(dll, "prru_topp_row", i, mp, dp, lmp, tpp, d, vp, vp, vp, vp, vp, cp, i)
         top, pp = ctypes.POINTER(t.TrackOptions), ctypes.POINTER(t.Params)
-        self.track_options_default = _declare(dll, "prru_track_options_default", None, top)
-        self.track_options_check = _declare(dll, "prru_track_options_check", i, top, cp, i)
+        self.track_options_default = _declare(dll, "prru_track_options_default", None, mp, top)
+        self.track_options_check = _declare(dll, "prru_track_options_check", i, mp, top, cp, i)
         self.track_gains_bandwidth = _declare(dll, "prru_track_gains_bandwidth", i, d, top)
         self.track_check_reference = _declare(dll, "prru_track_check_reference", i, mp, qp, top, d,
                                               vp, cp, i)
@@ -643,7 +643,7 @@ class Library:
         t, m = self.types, self.new_model()
         g = t.GuardedTrackOptions()
         fill_guard(g)
-        self.track_options_default(ctypes.byref(g.s))
+        self.track_options_default(ctypes.byref(m), ctypes.byref(g.s))
         o, p = g.s, t.Params()
         self.model_params(ctypes.byref(m), ctypes.byref(p))
         if (list(o.kp) != [400.0] * 3 or list(o.kd) != [40.0] * 3 or o.control_period != 0

@@ -323,7 +323,7 @@ def track(self, reference, *, bandwidth=None, kp=None, kd=None, period=0.0, dt=1
     lim, c = _c_limits(self, limits)
     g = t.GuardedTrackOptions()
     _lib.fill_guard(g)
-    lib.track_options_default(ctypes.byref(g.s))
+    lib.track_options_default(ctypes.byref(self._m), ctypes.byref(g.s))
     o = g.s
     if bandwidth is not None:
         w = _convert.scalar("bandwidth", bandwidth, positive=True, allow_zero=False)
@@ -353,7 +353,7 @@ def track(self, reference, *, bandwidth=None, kp=None, kd=None, period=0.0, dt=1
     if plant_model.lib is not self.lib:
         raise ValueError("plant must use this model's library (%s)" % self.lib.path)
     _track_controller(self, o, controller, lqr_q, lqr_r)
-    _track_options_check(lib, o)
+    _track_options_check(self, o)
     lib.model_params(ctypes.byref(plant_model._m), ctypes.byref(o.plant))
     for key, f in (mismatch or {}).items():
         f = _convert.scalar("mismatch[%r]" % key, f, positive=True, allow_zero=False)
@@ -390,10 +390,10 @@ _TRACK_OPTION_NAMES = {"controller PRRU_TRACK_LQR": "controller 'lqr'", "control
 _TRACK_OPTION_RE = re.compile(r"(?<![\w-])(%s)(?!\w)" % "|".join(map(re.escape, _TRACK_OPTION_NAMES)))
 
 
-def _track_options_check(lib, o):
+def _track_options_check(model, o):
     """prru_track_options_check: InputError in track's words."""
     msg = ctypes.create_string_buffer(600)
-    st = lib.track_options_check(ctypes.byref(o), msg, len(msg))
+    st = model.lib.track_options_check(ctypes.byref(model._m), ctypes.byref(o), msg, len(msg))
     if st != errors.OK:
         text = _TRACK_OPTION_RE.sub(lambda m: _TRACK_OPTION_NAMES[m.group(1)],
                                     msg.value.decode("utf-8", "replace"))

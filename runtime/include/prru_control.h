@@ -12,9 +12,10 @@
  * starts on the reference stays on it.
  *
  * Plant: the same equations of motion with its own parameters, evaluated
- * by the runtime-parameter kernels (prru_param_kernels.h): a plant with
- * heavier links, other drive friction, ... than the controller's model
- * (model mismatch). prru_params_model is the exact plant.
+ * by the parameter kernels of the tracked model's topology (a robot of
+ * its limbs): a plant with heavier links, other drive friction, ... than
+ * the controller's model (model mismatch). The model's own numbers
+ * (prru_model_params) are the exact plant.
  *
  * Timing: control_period = 0 evaluates the controller inside every
  * right-hand-side evaluation of the integrator (continuous control, the
@@ -121,9 +122,11 @@ typedef struct {
 enum { PRRU_TRACK_CT = 0, PRRU_TRACK_LQR = 1 };
 
 /* Gains kp = w^2, kd = 2 w with w = 20 rad/s, continuous, dt_out 1 ms, no
- * limits, no noise, seed 1, the exact plant (prru_params_model), rk8pd at
- * 1e-12; computed torque, the LQR weights 0 (prru_lqr_default_weights). */
-PRRU_API void prru_track_options_default(prru_track_options *o);
+ * limits (every entry, for any number of actuators), no noise, seed 1,
+ * the exact plant of m (prru_model_params: m's numbers, the plant a robot
+ * of m's limbs), rk8pd at 1e-12; computed torque, the LQR weights 0
+ * (prru_lqr_default_weights). m: the model to be tracked. */
+PRRU_API void prru_track_options_default(const prru_model *m, prru_track_options *o);
 
 /* Critically damped computed-torque gains of bandwidth w (rad/s): kp_i =
  * w^2, kd_i = 2 w for every coordinate (e'' + kd e' + kp e = 0 has the
@@ -132,7 +135,9 @@ PRRU_API void prru_track_options_default(prru_track_options *o);
 PRRU_API int prru_track_gains_bandwidth(double w, prru_track_options *o);
 
 /* The checks prru_track makes of o before it runs (prru_lqr_schedule_build
- * makes the LQR's part): gains finite and >= 0; control_period finite and
+ * makes the LQR's part), for tracking m (the per-actuator entries of its
+ * m->mech->nact actuators are checked; those past them are not read):
+ * gains finite and >= 0; control_period finite and
  * >= 0, dt_out finite and > 0 when continuous; force and speed limits > 0
  * (INFINITY allowed), strokes d_min < d_max; sensor noise finite, >= 0
  * and only with control_period > 0; q0_offset finite; tolerances finite
@@ -143,7 +148,8 @@ PRRU_API int prru_track_gains_bandwidth(double w, prru_track_options *o);
  * name (kp, kd, dt_out, q0_offset, abs_tol, rel_tol, lqr_q, lqr_r), or
  * as "control period", "sensor noise", "controller PRRU_TRACK_LQR", so
  * that a front end can put its own option names in their place. */
-PRRU_API int prru_track_options_check(const prru_track_options *o, char *msg, int msglen);
+PRRU_API int prru_track_options_check(const prru_model *m, const prru_track_options *o, char *msg,
+                                      int msglen);
 
 typedef struct {
   long samples;
@@ -207,8 +213,9 @@ PRRU_API int prru_computed_torque(const prru_model *m, prru_data *d, const prru_
  *     fd = u_ff,k - K_k (x_measured - x_ref,k), then clipped to f_max. */
 typedef struct {
   long n;              /* ticks */
+  int nact;            /* the model's actuators: the rows of K_k and u_ff,k */
   double period;       /* s */
-  double q[6], r[PRRU_MAX_ACT]; /* the weights used */
+  double q[6], r[PRRU_MAX_ACT]; /* the weights used (r: nact of them) */
   double *K;           /* n x nact x 6: K_k at K + 6 nact k, row-major */
   double *u_ff;        /* n x nact: u_ff,k at u_ff + nact k */
   double *x_ref;       /* n x 6 */
@@ -251,22 +258,27 @@ PRRU_API void prru_lqr_schedule_free(prru_lqr_schedule *s);
 
 /* The LQR law at tick k (0 <= k < s->n) on the measured state x (q then
  * qd): fd_cmd = u_ff,k - K_k (x - x_ref,k), fd clipped to o->f_max, sat[i]
- * set where clipped. PRRU_EINPUT where fd_cmd is not finite (k out of
- * range, x not finite or overflowing). */
+ * set where clipped, for the s->nact actuators of the model s was built
+ * for. PRRU_EINPUT where fd_cmd is not finite (k out of range, x not
+ * finite or overflowing). */
 PRRU_API int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_options *o,
                               const double x[6], double fd_cmd[], double fd[],
                               int sat[]);
 
 /* The plant's accelerations under fd (no platform loads): M qdd = b from
- * prru_param_eom with o->plant, solved by Cholesky. PRRU_EUNREACHABLE
- * where the plant's q is unreachable (NaN), PRRU_ESINGULAR when M is not
- * positive definite. Derives p (prru_param_derive) at every call, about
- * as long as the solve: prru_track derives its plant once per run. */
-PRRU_API int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
+ * the equations of motion of m's topology with the numbers p (a plant of
+ * m's limbs: o->plant), solved by Cholesky. m: the model whose topology
+ * (m->mech->nlimb) p is read in; its own numbers are not used.
+ * PRRU_EUNREACHABLE where the plant's q is unreachable (NaN),
+ * PRRU_ESINGULAR when M is not positive definite, PRRU_EINPUT for a
+ * model of neither topology. Derives p at every call, about as long as
+ * the solve: prru_track derives its plant once per run. */
+PRRU_API int prru_plant_accel(const prru_model *m, const prru_params *p, const double q[3], const double qd[3],
                               const double fd[], double qdd[3]);
 
 /* Model mismatch: multiplies one group of *p's parameters by factor
- * (finite, > 0): "mass" every body's mass and inertia tensor (the same
+ * (finite, > 0), every entry of the group (whatever the model's sizes):
+ * "mass" every body's mass and inertia tensor (the same
  * shapes made of a denser material: centres of mass unchanged), "inertia"
  * the inertia tensors alone, "armature", "damping", "coulomb" the drives'
  * numbers, "gravity" the gravity vector. PRRU_EINPUT for another key or

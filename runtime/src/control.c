@@ -27,19 +27,20 @@ int prru_track_gains_bandwidth(double w, prru_track_options *o)
   return PRRU_OK;
 }
 
-void prru_track_options_default(prru_track_options *o)
+void prru_track_options_default(const prru_model *m, prru_track_options *o)
 {
   memset(o, 0, sizeof *o);
   prru_track_gains_bandwidth(TRACK_BANDWIDTH, o);
   o->dt_out = 1e-3;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  /* Every entry: unlimited whatever the number of actuators. */
+  for (int i = 0; i < PRRU_MAX_ACT; i++) {
     o->f_max[i] = INFINITY;
     o->speed_max[i] = INFINITY;
     o->d_min[i] = -INFINITY;
     o->d_max[i] = INFINITY;
   }
   o->seed = 1;
-  o->plant = prru_params_model;
+  prru_model_params(m, &o->plant);
   o->abs_tol = 1e-12;
   o->rel_tol = 1e-12;
 }
@@ -66,32 +67,35 @@ static int spd3_solve(const double M[9], const double b[3], double x[3])
   return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) ? 0 : -1;
 }
 
-/* prru_plant_accel with the plant's numbers derived (prru_param_derive). */
-static int plant_accel(const prru_param_derived *p, const double q[3], const double qd[3],
-                       const double fd[PRRU_NACT], double qdd[3])
+/* prru_plant_accel with the plant's numbers derived for its topology t
+ * (t->derive). */
+static int plant_accel(const prru_topology *t, const prru_topo_derived *p, const double q[3],
+                       const double qd[3], const double fd[], double qdd[3])
 {
   static const double zero[3] = {0.0, 0.0, 0.0};
   double M[9], b[3];
-  prru_param_eom(p, q, qd, fd, zero, zero, M, b);
+  t->general->eom(p, q, qd, fd, zero, zero, M, b);
   for (int i = 0; i < 9; i++)
     if (!isfinite(M[i])) return PRRU_EUNREACHABLE;
   if (!prru_finite_n(b, 3)) {
     /* M finite: q is reachable. b at rest without forces finite: the
      * velocities or forces overflow b (PRRU_EINPUT); else q lies on the
      * workspace boundary, where the velocity mapping divides by zero. */
-    static const double zero_fd[PRRU_NACT] = {0};
-    prru_param_eom(p, q, zero, zero_fd, zero, zero, M, b);
+    static const double zero_fd[PRRU_MAX_ACT] = {0};
+    t->general->eom(p, q, zero, zero_fd, zero, zero, M, b);
     return prru_finite_n(b, 3) ? PRRU_EINPUT : PRRU_ESINGULAR;
   }
   return spd3_solve(M, b, qdd) == 0 ? PRRU_OK : PRRU_ESINGULAR;
 }
 
-int prru_plant_accel(const prru_params *p, const double q[3], const double qd[3],
+int prru_plant_accel(const prru_model *m, const prru_params *p, const double q[3], const double qd[3],
                      const double fd[], double qdd[3])
 {
-  prru_param_derived dp;
-  prru_params_derive(p, &dp);
-  return plant_accel(&dp, q, qd, fd, qdd);
+  const prru_topology *t = prru_topology_of(m->mech->nlimb);
+  if (!t) return PRRU_EINPUT;
+  prru_topo_derived dp;
+  t->derive(p, &dp);
+  return plant_accel(t, &dp, q, qd, fd, qdd);
 }
 
 int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_options *o,
@@ -107,8 +111,9 @@ int prru_computed_torque(const prru_model *m, prru_data *d, const prru_track_opt
   if (!prru_finite_n(qdd_c, 3)) return PRRU_EINPUT; /* the gains times the errors overflow */
   int st = prru_inverse_dynamics(m, d, q, qd, qdd_c, &l, fd_cmd);
   if (st != PRRU_OK) return st;
-  if (!prru_finite_n(fd_cmd, PRRU_NACT)) return PRRU_EINPUT;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  const int na = m->mech->nact;
+  if (!prru_finite_n(fd_cmd, na)) return PRRU_EINPUT;
+  for (int i = 0; i < na; i++) {
     double lim = o->f_max[i];
     sat[i] = fabs(fd_cmd[i]) > lim;
     fd[i] = sat[i] ? copysign(lim, fd_cmd[i]) : fd_cmd[i];
@@ -152,13 +157,13 @@ static int all_zero(const double *v, int n)
 /* The reference at tick k of a run with period step: x = (q, qd), the
  * feed-forward u (inverse dynamics without loads). */
 static int lqr_reference_tick(const prru_model *m, prru_data *d, const prru_quintic *ref, double step,
-                              long k, long last, double x[6], double u[PRRU_NACT], char *msg, int msglen)
+                              long k, long last, double x[6], double u[], char *msg, int msglen)
 {
   static const prru_loads none;
   double t = tick_time(ref, step, k, last), qdd[3];
   prru_quintic_eval(ref, clamp_time(ref, t), x, x + 3, qdd);
   int st = prru_inverse_dynamics(m, d, x, x + 3, qdd, &none, u);
-  if (st == PRRU_OK && !prru_finite_n(u, PRRU_NACT)) st = PRRU_EINPUT;
+  if (st == PRRU_OK && !prru_finite_n(u, m->mech->nact)) st = PRRU_EINPUT;
   if (st != PRRU_OK)
     return prru_fail(msg, msglen, st, "LQR schedule: tick %ld (t = %.9g s): the reference's inverse "
                      "dynamics at q = (%.9g, %.9g, %.9g) failed: %s", k, t, x[0], x[1], x[2],
@@ -168,12 +173,12 @@ static int lqr_reference_tick(const prru_model *m, prru_data *d, const prru_quin
 
 /* The zero-order-hold linearisation at tick k's reference (x, u). */
 static int lqr_linearize_tick(const prru_model *m, prru_data *d, const double x[6],
-                              const double u[PRRU_NACT], double step, double t, long k,
+                              const double u[], double step, double t, long k,
                               prru_linearization *lin, char *msg, int msglen)
 {
   prru_loads l;
   memset(&l, 0, sizeof l);
-  memcpy(l.fd, u, PRRU_NACT * sizeof(double));
+  memcpy(l.fd, u, (size_t)m->mech->nact * sizeof(double));
   char why[300];
   int st = prru_linearize_why(m, d, x, x + 3, &l, step, lin, why, sizeof why);
   if (st != PRRU_OK)
@@ -184,26 +189,26 @@ static int lqr_linearize_tick(const prru_model *m, prru_data *d, const double x[
 }
 
 /* a_j: the acceleration coordinate j alone gets from forces of size F,
- * F / |G^+ e_j| with G = dqdd/dfd (3 x PRRU_NACT) and G^+ = G^T (G
+ * F / |G^+ e_j| with G = dqdd/dfd (3 x na) and G^+ = G^T (G
  * G^T)^-1 (the least-norm forces for an acceleration): the scale of a
  * decoupled double integrator, where the largest acceleration of j
  * (F |row j of G|) would count the other coordinates' motion too. 0, or
  * -1 when G G^T is singular. */
-static int decoupled_accel(const double G[3 * PRRU_NACT], double F, double a[3])
+static int decoupled_accel(const double G[], int na, double F, double a[3])
 {
   double H[9], Hi[9];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       double h = 0.0;
-      for (int k = 0; k < PRRU_NACT; k++) h += G[i * PRRU_NACT + k] * G[j * PRRU_NACT + k];
+      for (int k = 0; k < na; k++) h += G[i * na + k] * G[j * na + k];
       H[3 * i + j] = h;
     }
   if (!(prru_rcond3(H, Hi) > 1e-14)) return -1;
   for (int j = 0; j < 3; j++) {
     double n = 0.0;
-    for (int k = 0; k < PRRU_NACT; k++) {
+    for (int k = 0; k < na; k++) {
       double c = 0.0; /* (G^T H^-1)_kj */
-      for (int i = 0; i < 3; i++) c += G[i * PRRU_NACT + k] * Hi[3 * i + j];
+      for (int i = 0; i < 3; i++) c += G[i * na + k] * Hi[3 * i + j];
       n = hypot(n, c);
     }
     a[j] = F / n;
@@ -224,17 +229,18 @@ int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, doubl
   prru_linearization *lin = malloc(sizeof *lin);
   int st = d && lin ? PRRU_OK : prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
   const long last = last_tick(ref, period);
-  double x[6], u[PRRU_NACT], x0[6], u0[PRRU_NACT], F = 0.0;
+  const int na = m->mech->nact;
+  double x[6], u[PRRU_MAX_ACT], x0[6], u0[PRRU_MAX_ACT], F = 0.0;
   for (long k = 0; k <= last && st == PRRU_OK; k++) {
     st = lqr_reference_tick(m, d, ref, period, k, last, x, u, msg, msglen);
-    for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++) F = fmax(F, fabs(u[i]));
-    if (k == 0) memcpy(x0, x, sizeof x0), memcpy(u0, u, sizeof u0);
+    for (int i = 0; i < na && st == PRRU_OK; i++) F = fmax(F, fabs(u[i]));
+    if (k == 0) memcpy(x0, x, sizeof x0), memcpy(u0, u, (size_t)na * sizeof *u0);
   }
   if (F == 0.0) F = 1.0;
   if (st == PRRU_OK)
     st = lqr_linearize_tick(m, d, x0, u0, 0.0, prru_quintic_t_begin(ref), 0, lin, msg, msglen);
   double a[3];
-  if (st == PRRU_OK && decoupled_accel(lin->dqdd_dfd, F, a) != 0)
+  if (st == PRRU_OK && decoupled_accel(lin->dqdd_dfd, na, F, a) != 0)
     st = prru_fail(msg, msglen, PRRU_ESINGULAR, "LQR default weights: the actuators do not move "
                    "every coordinate at the reference's start (dqdd/dfd rank-deficient)");
   for (int j = 0; j < 3 && st == PRRU_OK && q; j++) {
@@ -242,7 +248,7 @@ int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, doubl
     q[j] = (w * w / a[j]) * (w * w / a[j]);
     q[3 + j] = 2.0 * (w / a[j]) * (w / a[j]);
   }
-  for (int i = 0; i < PRRU_NACT && r && st == PRRU_OK; i++) r[i] = 1.0 / (F * F);
+  for (int i = 0; i < na && r && st == PRRU_OK; i++) r[i] = 1.0 / (F * F);
   free(d);
   free(lin);
   if (st == PRRU_OK && msg && msglen > 0) msg[0] = '\0';
@@ -250,8 +256,9 @@ int prru_lqr_default_weights(const prru_model *m, const prru_quintic *ref, doubl
 }
 
 /* The option names as prru_track_options_check promises them: front ends
- * replace them by their own. */
-static int lqr_weights_check(const prru_track_options *o, char *msg, int msglen)
+ * replace them by their own. na: the model's actuators (lqr_r's entries
+ * past them are not read). */
+static int lqr_weights_check(const prru_track_options *o, int na, char *msg, int msglen)
 {
   if (!(o->control_period > 0.0))
     return prru_fail(msg, msglen, PRRU_EINPUT, "controller PRRU_TRACK_LQR needs control period > 0: "
@@ -260,26 +267,28 @@ static int lqr_weights_check(const prru_track_options *o, char *msg, int msglen)
     if (!(o->lqr_q[i] >= 0.0 && isfinite(o->lqr_q[i])))
       return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_q: weight %d is %g, not >= 0 and finite", i + 1,
                        o->lqr_q[i]);
-  if (all_zero(o->lqr_r, PRRU_NACT)) return PRRU_OK;
-  for (int i = 0; i < PRRU_NACT; i++)
+  if (all_zero(o->lqr_r, na)) return PRRU_OK;
+  for (int i = 0; i < na; i++)
     if (!(o->lqr_r[i] > 0.0 && isfinite(o->lqr_r[i])))
       return prru_fail(msg, msglen, PRRU_EINPUT, "lqr_r: weight %d is %g, not > 0 and finite", i + 1,
                        o->lqr_r[i]);
   return PRRU_OK;
 }
 
-/* One backward Riccati step: K = (R + B^T P B)^-1 B^T P A (Cholesky),
- * P <- Q + A^T P (A - B K), symmetrised. Works on the caller's arrays: no
- * allocation. GSL_EDOM where R + B^T P B is not positive definite. */
-static int riccati_step(const double A[36], const double B[6 * PRRU_NACT], const double Q[6],
-                        const double R[PRRU_NACT], double P[36], double K[PRRU_NACT * 6])
+/* One backward Riccati step with N inputs: K = (R + B^T P B)^-1 B^T P A
+ * (Cholesky), P <- Q + A^T P (A - B K), symmetrised. Works on the
+ * caller's arrays: no allocation. GSL_EDOM where R + B^T P B is not
+ * positive definite. */
+static int riccati_step(const double A[36], const double B[], const double Q[6], const double R[], int N,
+                        double P[36], double K[])
 {
-  enum { N = PRRU_NACT };
-  double PA[36], PB[6 * N], S[N * N], BtPA[N * 6], AmBK[36], PAmBK[36];
-  gsl_matrix_const_view a = gsl_matrix_const_view_array(A, 6, 6), b = gsl_matrix_const_view_array(B, 6, N);
+  enum { NMAX = PRRU_MAX_ACT };
+  double PA[36], PB[6 * NMAX], S[NMAX * NMAX], BtPA[NMAX * 6], AmBK[36], PAmBK[36];
+  const size_t n = (size_t)N;
+  gsl_matrix_const_view a = gsl_matrix_const_view_array(A, 6, 6), b = gsl_matrix_const_view_array(B, 6, n);
   gsl_matrix_view p = gsl_matrix_view_array(P, 6, 6), pa = gsl_matrix_view_array(PA, 6, 6),
-                  pb = gsl_matrix_view_array(PB, 6, N), s = gsl_matrix_view_array(S, N, N),
-                  btpa = gsl_matrix_view_array(BtPA, N, 6), k = gsl_matrix_view_array(K, N, 6),
+                  pb = gsl_matrix_view_array(PB, 6, n), s = gsl_matrix_view_array(S, n, n),
+                  btpa = gsl_matrix_view_array(BtPA, n, 6), k = gsl_matrix_view_array(K, n, 6),
                   ambk = gsl_matrix_view_array(AmBK, 6, 6), pambk = gsl_matrix_view_array(PAmBK, 6, 6);
   gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &p.matrix, &a.matrix, 0.0, &pa.matrix);
   gsl_blas_dgemm(CblasNoTrans, CblasNoTrans, 1.0, &p.matrix, &b.matrix, 0.0, &pb.matrix);
@@ -305,7 +314,7 @@ static int lqr_weights(const prru_model *m, const prru_quintic *ref, const prru_
 {
   memcpy(s->q, o->lqr_q, sizeof s->q);
   memcpy(s->r, o->lqr_r, sizeof s->r);
-  int dq = all_zero(o->lqr_q, 6), dr = all_zero(o->lqr_r, PRRU_NACT);
+  int dq = all_zero(o->lqr_q, 6), dr = all_zero(o->lqr_r, s->nact);
   if (!dq && !dr) return PRRU_OK;
   return prru_lqr_default_weights(m, ref, o->control_period, dq ? s->q : NULL, dr ? s->r : NULL, msg,
                                   msglen);
@@ -318,22 +327,23 @@ static int lqr_schedule_fill(const prru_model *m, const prru_quintic *ref, prru_
                              double *AB, prru_data *d, prru_linearization *lin, char *msg, int msglen)
 {
   const long last = s->n - 1;
-  enum { NAB = 36 + 6 * PRRU_NACT };
+  const int na = s->nact;
+  const long NAB = 36 + 6 * na;
   for (long k = 0; k < s->n; k++) {
-    double *x = s->x_ref + 6 * k, *u = s->u_ff + PRRU_NACT * k;
+    double *x = s->x_ref + 6 * k, *u = s->u_ff + na * k;
     int st = lqr_reference_tick(m, d, ref, s->period, k, last, x, u, msg, msglen);
     if (st == PRRU_OK)
       st = lqr_linearize_tick(m, d, x, u, s->period, tick_time(ref, s->period, k, last), k, lin, msg,
                               msglen);
     if (st != PRRU_OK) return st;
     memcpy(AB + NAB * k, lin->Ad, sizeof lin->Ad);
-    memcpy(AB + NAB * k + 36, lin->Bd, 6 * PRRU_NACT * sizeof(double));
+    memcpy(AB + NAB * k + 36, lin->Bd, 6 * (size_t)na * sizeof(double));
   }
   double P[36];
   memset(P, 0, sizeof P);
   for (int i = 0; i < 6; i++) P[i * 6 + i] = s->q[i];
   for (long k = last; k >= 0; k--) {
-    if (riccati_step(AB + NAB * k, AB + NAB * k + 36, s->q, s->r, P, s->K + 6 * PRRU_NACT * k) != GSL_SUCCESS)
+    if (riccati_step(AB + NAB * k, AB + NAB * k + 36, s->q, s->r, na, P, s->K + 6 * na * k) != GSL_SUCCESS)
       return prru_fail(msg, msglen, PRRU_ENOCONV, "LQR schedule: tick %ld (t = %.9g s): R + B^T P B is "
                        "not positive definite (weights or dynamics out of scale)", k,
                        tick_time(ref, s->period, k, last));
@@ -347,18 +357,20 @@ int prru_lqr_schedule_build(const prru_model *m, const prru_quintic *ref, const 
 {
   memset(s, 0, sizeof *s);
   if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
-  int st = lqr_weights_check(o, msg, msglen);
+  const int na = m->mech->nact;
+  int st = lqr_weights_check(o, na, msg, msglen);
   if (st != PRRU_OK) return st;
   prru_gsl_init();
+  s->nact = na;
   s->period = o->control_period;
   s->n = last_tick(ref, s->period) + 1;
   if (!((double)s->n <= 1e8))
     return prru_fail(msg, msglen, PRRU_EINPUT, "control period: more than 1e8 ticks");
   size_t n = (size_t)s->n;
-  s->K = malloc(n * 6 * PRRU_NACT * sizeof *s->K);
-  s->u_ff = malloc(n * PRRU_NACT * sizeof *s->u_ff);
+  s->K = malloc(n * 6 * (size_t)na * sizeof *s->K);
+  s->u_ff = malloc(n * (size_t)na * sizeof *s->u_ff);
   s->x_ref = malloc(n * 6 * sizeof *s->x_ref);
-  double *AB = malloc(n * (36 + 6 * PRRU_NACT) * sizeof *AB);
+  double *AB = malloc(n * (36 + 6 * (size_t)na) * sizeof *AB);
   prru_data *d = malloc(sizeof *d);
   prru_linearization *lin = malloc(sizeof *lin);
   if (!s->K || !s->u_ff || !s->x_ref || !AB || !d || !lin)
@@ -386,16 +398,17 @@ int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_option
                      double fd_cmd[], double fd[], int sat[])
 {
   if (!(k >= 0 && k < s->n)) return PRRU_EINPUT;
-  const double *K = s->K + 6 * PRRU_NACT * k, *xr = s->x_ref + 6 * k, *u = s->u_ff + PRRU_NACT * k;
+  const int na = s->nact;
+  const double *K = s->K + 6 * na * k, *xr = s->x_ref + 6 * k, *u = s->u_ff + na * k;
   double dx[6];
   for (int j = 0; j < 6; j++) dx[j] = x[j] - xr[j];
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     double f = u[i];
     for (int j = 0; j < 6; j++) f -= K[6 * i + j] * dx[j];
     fd_cmd[i] = f;
   }
-  if (!prru_finite_n(fd_cmd, PRRU_NACT)) return PRRU_EINPUT;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  if (!prru_finite_n(fd_cmd, na)) return PRRU_EINPUT;
+  for (int i = 0; i < na; i++) {
     double lim = o->f_max[i];
     sat[i] = fabs(fd_cmd[i]) > lim;
     fd[i] = sat[i] ? copysign(lim, fd_cmd[i]) : fd_cmd[i];
@@ -403,8 +416,9 @@ int prru_lqr_control(const prru_lqr_schedule *s, long k, const prru_track_option
   return PRRU_OK;
 }
 
-int prru_track_options_check(const prru_track_options *o, char *msg, int msglen)
+int prru_track_options_check(const prru_model *m, const prru_track_options *o, char *msg, int msglen)
 {
+  const int na = m->mech->nact;
   for (int i = 0; i < 3; i++) {
     if (!(o->kp[i] >= 0.0 && isfinite(o->kp[i])))
       return prru_fail(msg, msglen, PRRU_EINPUT, "kp: gain %d is %g, not >= 0 and finite", i + 1, o->kp[i]);
@@ -416,7 +430,7 @@ int prru_track_options_check(const prru_track_options *o, char *msg, int msglen)
                      o->control_period);
   if (o->control_period == 0.0 && !(o->dt_out > 0.0 && isfinite(o->dt_out)))
     return prru_fail(msg, msglen, PRRU_EINPUT, "dt_out: %g s is not > 0 and finite", o->dt_out);
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     if (!(o->f_max[i] > 0.0))
       return prru_fail(msg, msglen, PRRU_EINPUT,
                        "force limit of actuator %d must be > 0 (or infinite), got %g", i + 1,
@@ -449,7 +463,7 @@ int prru_track_options_check(const prru_track_options *o, char *msg, int msglen)
     return prru_fail(msg, msglen, PRRU_EINPUT, "controller: %d is neither PRRU_TRACK_CT nor "
                      "PRRU_TRACK_LQR", o->controller);
   if (o->controller == PRRU_TRACK_LQR) {
-    int st = lqr_weights_check(o, msg, msglen);
+    int st = lqr_weights_check(o, na, msg, msglen);
     if (st != PRRU_OK) return st;
   }
   if (msg && msglen > 0) msg[0] = '\0';
@@ -462,9 +476,12 @@ typedef struct {
   const prru_track_options *o;
   prru_data *d;
   const prru_lqr_schedule *lqr; /* the LQR's gains, NULL for computed torque */
-  const prru_param_derived *plant; /* o->plant derived, once per run */
+  /* o->plant derived for the topology of m (the plant is a robot of m's
+   * limbs), once per run. */
+  const prru_topology *topo;
+  const prru_topo_derived *plant;
   int continuous;
-  double fd_hold[PRRU_NACT];
+  double fd_hold[PRRU_MAX_ACT];
   int status; /* why the right-hand side last failed */
   /* Where it failed: an integrator's trial state (abandoned, so y no
    * longer holds it) at time t, in the controller or in the plant, and
@@ -481,8 +498,8 @@ static int track_rhs(double t, const double y[], double f[], void *p)
     c->status = PRRU_EINTERRUPTED;
     return GSL_EBADFUNC;
   }
-  double fd[PRRU_NACT], fd_cmd[PRRU_NACT];
-  int sat[PRRU_NACT], st = PRRU_OK;
+  double fd[PRRU_MAX_ACT], fd_cmd[PRRU_MAX_ACT];
+  int sat[PRRU_MAX_ACT], st = PRRU_OK;
   if (c->continuous) {
     double qr[3], qdr[3], qddr[3];
     prru_quintic_eval(c->ref, clamp_time(c->ref, t), qr, qdr, qddr);
@@ -492,8 +509,8 @@ static int track_rhs(double t, const double y[], double f[], void *p)
   }
   c->in_plant = st == PRRU_OK;
   if (st == PRRU_OK && c->continuous)
-    for (int i = 0; i < PRRU_NACT; i++) c->fd_step_peak = fmax(c->fd_step_peak, fabs(fd_cmd[i]));
-  if (st == PRRU_OK) st = plant_accel(c->plant, y, y + 3, fd, f + 3);
+    for (int i = 0; i < c->m->mech->nact; i++) c->fd_step_peak = fmax(c->fd_step_peak, fabs(fd_cmd[i]));
+  if (st == PRRU_OK) st = plant_accel(c->topo, c->plant, y, y + 3, fd, f + 3);
   if (st != PRRU_OK) {
     c->status = st;
     c->fail_t = t;
@@ -576,24 +593,25 @@ static int track_tick(track_ctx *c, gsl_rng *rng, long k, double t, const double
     if (st != PRRU_OK) return tick_failure(c, st, t, y, meas, rng != NULL, msg, msglen);
   }
   memcpy(c->fd_hold, s->fd, sizeof c->fd_hold);
-  st = plant_accel(c->plant, y, y + 3, s->fd, s->qdd);
+  st = plant_accel(c->topo, c->plant, y, y + 3, s->fd, s->qdd);
   if (st != PRRU_OK)
     return prru_fail(msg, msglen, st, "stopped at t = %.9g s: %s at q = (%.9g, %.9g, %.9g) (the plant's "
                      "equations of motion)", t, prru_strerror(st), y[0], y[1], y[2]);
-  prru_param_ik(c->plant, y, s->d);
-  if (!prru_finite_n(s->d, PRRU_NACT))
+  c->topo->general->ik(c->plant, y, s->d);
+  if (!prru_finite_n(s->d, c->m->mech->nact))
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                      "stopped at t = %.9g s: the plant left the workspace: %s at q = (%.9g, "
                      "%.9g, %.9g)", t, prru_strerror(PRRU_EUNREACHABLE), y[0], y[1], y[2]);
   /* The controller's model's kernels, which prru track and the binding
    * used before this moved here: the plant's parameter kernels agree with
    * them only to rounding, and the reported speeds stay to the bit. */
-  double ddb[PRRU_NACT];
+  double ddb[PRRU_MAX_ACT];
   prru_model_actuator_rates(c->m, s->q, s->qd, s->dd, ddb);
   return PRRU_OK;
 }
 
-static void summary_add(prru_track_summary *sum, const prru_track_sample *s, const prru_track_options *o)
+static void summary_add(prru_track_summary *sum, const prru_track_sample *s, const prru_track_options *o,
+                        int na)
 {
   sum->samples++;
   sum->t_end = s->t;
@@ -602,7 +620,7 @@ static void summary_add(prru_track_summary *sum, const prru_track_sample *s, con
     sum->rms_e[i] += s->e[i] * s->e[i]; /* a sum of squares until the end */
     sum->max_e[i] = fmax(sum->max_e[i], fabs(s->e[i]));
   }
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     sum->max_fd[i] = fmax(sum->max_fd[i], fabs(s->fd[i]));
     sum->saturated[i] += s->saturated[i];
     any |= s->saturated[i];
@@ -619,10 +637,10 @@ static void summary_finish(prru_track_summary *sum)
     sum->rms_e[i] = sum->samples > 0 ? sqrt(sum->rms_e[i] / (double)sum->samples) : 0.0;
 }
 
-/* The first slider outside its stroke, or -1. */
-static int stroke_violation(const prru_track_options *o, const double d[PRRU_NACT])
+/* The first of the na sliders outside its stroke, or -1. */
+static int stroke_violation(const prru_track_options *o, const double d[], int na)
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (d[i] < o->d_min[i] || d[i] > o->d_max[i]) return i;
   return -1;
 }
@@ -645,9 +663,9 @@ static int track_advance(gsl_odeiv2_driver *drv, const track_ctx *c, double *t,
     if (fabs(drv->h) < drv->hmin) return GSL_ENOPROG;
     drv->n++;
     if (*t >= t1) break; /* the tick itself: track_run checks its sample */
-    double d[PRRU_NACT];
-    prru_param_ik(c->plant, y, d); /* the plant's sliders, as at the ticks */
-    if ((*bad = stroke_violation(c->o, d)) >= 0) return GSL_EDOM;
+    double d[PRRU_MAX_ACT];
+    c->topo->general->ik(c->plant, y, d); /* the plant's sliders, as at the ticks */
+    if ((*bad = stroke_violation(c->o, d, c->m->mech->nact)) >= 0) return GSL_EDOM;
   }
   return GSL_SUCCESS;
 }
@@ -662,7 +680,7 @@ static int trial_failure(const track_ctx *c, int st, double t, char *msg, int ms
   const prru_track_options *o = c->o;
   const double *y = c->fail_y;
   double peak = c->fd_step_peak;
-  for (int i = 0; i < PRRU_NACT && !c->continuous; i++) peak = fmax(peak, fabs(c->fd_hold[i]));
+  for (int i = 0; i < c->m->mech->nact && !c->continuous; i++) peak = fmax(peak, fabs(c->fd_hold[i]));
   const char *where = c->in_plant ? "the plant's equations of motion" : "the controller's inverse dynamics";
   char what[200];
   if (st == PRRU_EINPUT)
@@ -693,8 +711,8 @@ static int track_step(gsl_odeiv2_driver *drv, track_ctx *c, double *t, double tk
   int bad = -1, gs = track_advance(drv, c, t, tk, y, &bad);
   if (gs == GSL_SUCCESS) return PRRU_OK;
   if (gs == GSL_EDOM && bad >= 0) {
-    double d[PRRU_NACT];
-    prru_param_ik(c->plant, y, d);
+    double d[PRRU_MAX_ACT];
+    c->topo->general->ik(c->plant, y, d);
     return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                      "stopped at t = %.9g s (between samples): slider %d at d = %.9g m "
                      "left its stroke [%g, %g]", *t, bad + 1, d[bad], c->o->d_min[bad],
@@ -729,12 +747,12 @@ static int track_run(track_ctx *c, gsl_odeiv2_driver *drv, gsl_rng *rng, prru_tr
     }
     int st = track_tick(c, rng, k, tk, y, s, msg, msglen);
     if (st != PRRU_OK) return st;
-    int bad = stroke_violation(o, s->d);
+    int bad = stroke_violation(o, s->d, c->m->mech->nact);
     if (bad >= 0)
       return prru_fail(msg, msglen, PRRU_EUNREACHABLE,
                        "stopped at t = %.9g s: slider %d at d = %.9g m left its stroke [%g, %g]",
                        tk, bad + 1, s->d[bad], o->d_min[bad], o->d_max[bad]);
-    summary_add(sum, s, o);
+    summary_add(sum, s, o, c->m->mech->nact);
     if (o->on_sample && o->on_sample(s, o->ctx) != 0)
       return prru_fail(msg, msglen, PRRU_EINTERRUPTED,
                        "stopped at t = %.9g s by the sample consumer", tk);
@@ -749,8 +767,12 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
 {
   memset(sum, 0, sizeof *sum);
   if (!ref || ref->n < 2) return prru_fail(msg, msglen, PRRU_EINPUT, "no reference trajectory");
-  int st = prru_track_options_check(o, msg, msglen);
+  int st = prru_track_options_check(m, o, msg, msglen);
   if (st != PRRU_OK) return st;
+  const prru_topology *topo = prru_topology_of(m->mech->nlimb);
+  if (!topo)
+    return prru_fail(msg, msglen, PRRU_EINPUT, "the model has %d limbs: no plant of that topology",
+                     m->mech->nlimb);
   prru_gsl_init();
   track_ctx c;
   memset(&c, 0, sizeof c);
@@ -758,8 +780,9 @@ int prru_track(const prru_model *m, const prru_quintic *ref, const prru_track_op
   c.ref = ref;
   c.o = o;
   c.d = malloc(sizeof(prru_data));
-  prru_param_derived *plant = malloc(sizeof *plant);
-  if (plant) prru_params_derive(&o->plant, plant);
+  prru_topo_derived *plant = malloc(sizeof *plant);
+  if (plant) topo->derive(&o->plant, plant);
+  c.topo = topo;
   c.plant = plant;
   c.continuous = o->control_period == 0.0;
   prru_lqr_schedule lqr;
@@ -820,12 +843,13 @@ int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, con
   prru_data *d = malloc(sizeof *d);
   if (!d) return prru_fail(msg, msglen, PRRU_ENOMEM, "out of memory");
   const long n = (long)fmax(1.0, ceil(span / step - 1e-9));
+  const int na = m->mech->nact;
   int st = PRRU_OK, crossed;
   prru_path_side side;
   prru_path_side_init(&side);
   static const prru_loads none;
   for (long k = 0; k <= n && st == PRRU_OK; k++) {
-    double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_NACT], rcond;
+    double t = k == n ? t1 : t0 + (double)k * step, q[3], qd[3], qdd[3], fd[PRRU_MAX_ACT], rcond;
     prru_quintic_eval(ref, t, q, qd, qdd);
     int ps = prru_path_sample(&side, m, d, q, &rcond, &crossed);
     if (crossed) {
@@ -839,13 +863,13 @@ int prru_track_check_reference(const prru_model *m, const prru_quintic *ref, con
                      "%.9g) is %s", k + 1, t, q[0], q[1], q[2], pose_problem(ps));
       break;
     }
-    for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++)
+    for (int i = 0; i < na && st == PRRU_OK; i++)
       if (d->d[i] < o->d_min[i] || d->d[i] > o->d_max[i])
         st = prru_fail(msg, msglen, PRRU_EINPUT, "reference at sample %ld (t = %.9g s): slider %d at d = "
                        "%.9g m is outside its stroke [%g, %g]", k + 1, t, i + 1, d->d[i], o->d_min[i],
                        o->d_max[i]);
     if (st == PRRU_OK && prru_inverse_dynamics(m, d, q, qd, qdd, &none, fd) == PRRU_OK)
-      for (int i = 0; i < PRRU_NACT; i++) *ff_peak = fmax(*ff_peak, fabs(fd[i]));
+      for (int i = 0; i < na; i++) *ff_peak = fmax(*ff_peak, fabs(fd[i]));
   }
   free(d);
   return st;
@@ -856,20 +880,22 @@ static void scale_n(double *v, int n, double f)
   for (int i = 0; i < n; i++) v[i] *= f;
 }
 
+/* Every entry, also those past a model's sizes (which no kernel reads): a
+ * model's own are scaled alike for either topology, and p needs no model. */
 int prru_params_scale(prru_params *p, const char *key, double factor)
 {
   if (!key || !(factor > 0.0) || !isfinite(factor)) return PRRU_EINPUT;
   if (strcmp(key, "mass") == 0) {
-    scale_n(p->mass, PRRU_NBODY, factor);
-    scale_n(&p->inertia[0][0], PRRU_NBODY * 6, factor);
+    scale_n(p->mass, PRRU_MAX_BODY, factor);
+    scale_n(&p->inertia[0][0], PRRU_MAX_BODY * 6, factor);
   } else if (strcmp(key, "inertia") == 0) {
-    scale_n(&p->inertia[0][0], PRRU_NBODY * 6, factor);
+    scale_n(&p->inertia[0][0], PRRU_MAX_BODY * 6, factor);
   } else if (strcmp(key, "armature") == 0) {
-    scale_n(p->armature, PRRU_NACT, factor);
+    scale_n(p->armature, PRRU_MAX_ACT, factor);
   } else if (strcmp(key, "damping") == 0) {
-    scale_n(p->damping, PRRU_NACT, factor);
+    scale_n(p->damping, PRRU_MAX_ACT, factor);
   } else if (strcmp(key, "coulomb") == 0) {
-    scale_n(p->coulomb, PRRU_NACT, factor);
+    scale_n(p->coulomb, PRRU_MAX_ACT, factor);
   } else if (strcmp(key, "gravity") == 0) {
     scale_n(p->gravity, 3, factor);
   } else {

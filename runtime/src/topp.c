@@ -17,7 +17,7 @@
 #define ROW_TOL 1e-9
 /* Rows of one interval's programme: force limits at both ends (2 sides),
  * speed at both ends, x >= 0 at both ends, the target set (2), the box (3). */
-#define MAX_ROWS (4 * PRRU_NACT + 9)
+#define MAX_ROWS (4 * PRRU_MAX_ACT + 9)
 /* Points of an interval checked with the exact inverse dynamics. */
 #define CHECK_POINTS 8
 /* "Active": within this share of a limit. */
@@ -26,11 +26,11 @@
 /* What the programmes need at one grid point. f = a u + b x + c + h(x)
  * per actuator; h (damping and friction) enters as hc + hs x. */
 typedef struct {
-  double a[PRRU_NACT], b[PRRU_NACT], c[PRRU_NACT];
-  double w[PRRU_NACT];                   /* dd_i / ds */
-  double hs[PRRU_NACT], hc[PRRU_NACT];   /* h as hc + hs x */
-  double mu_hi[PRRU_NACT], mu_lo[PRRU_NACT]; /* tightenings (N) */
-  double rho[PRRU_NACT];                 /* speed tightening factor on x */
+  double a[PRRU_MAX_ACT], b[PRRU_MAX_ACT], c[PRRU_MAX_ACT];
+  double w[PRRU_MAX_ACT];                      /* dd_i / ds */
+  double hs[PRRU_MAX_ACT], hc[PRRU_MAX_ACT];   /* h as hc + hs x */
+  double mu_hi[PRRU_MAX_ACT], mu_lo[PRRU_MAX_ACT]; /* tightenings (N) */
+  double rho[PRRU_MAX_ACT];                    /* speed tightening factor on x */
 } topp_point;
 
 typedef struct {
@@ -39,6 +39,7 @@ typedef struct {
 
 typedef struct {
   const prru_model *m;
+  int na; /* m's actuators */
   prru_data *d;
   const prru_limits *lim;
   int N, seg;
@@ -62,7 +63,7 @@ static void path_pose(const topp_ctx *c, double s, double q[3])
   for (int k = 0; k < 3; k++) q[k] = c->qa[k] + s * c->dq[k];
 }
 
-static int id(const topp_ctx *c, const double q[3], double v, double acc, double f[PRRU_NACT])
+static int id(const topp_ctx *c, const double q[3], double v, double acc, double f[])
 {
   double qd[3], qdd[3];
   for (int k = 0; k < 3; k++) qd[k] = c->dq[k] * v, qdd[k] = c->dq[k] * acc;
@@ -74,21 +75,22 @@ int prru_limits_ratio(const prru_model *m, prru_data *d, const prru_limits *lim,
                       double fd[], double dd[], double *ratio, int *which,
                       int *kind)
 {
-  double f[PRRU_NACT], v[PRRU_NACT];
+  const int na = m->mech->nact;
+  double f[PRRU_MAX_ACT], v[PRRU_MAX_ACT];
   int st = prru_inverse_dynamics(m, d, q, qd, qdd, &NO_LOADS, f);
   if (st != PRRU_OK) return st;
   /* prru_inverse_dynamics leaves J_d in d->Jd: dd = J_d qd. */
   double r = 0;
   int wi = 0, wk = 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     v[i] = 0;
     for (int k = 0; k < 3; k++) v[i] += d->Jd[3 * i + k] * qd[k];
     double rf = fabs(f[i]) / lim->force_max[i], rv = fabs(v[i]) / lim->speed_max[i];
     if (rf > r) r = rf, wi = i, wk = 0;
     if (rv > r) r = rv, wi = i, wk = 1;
   }
-  if (fd) memcpy(fd, f, sizeof f);
-  if (dd) memcpy(dd, v, sizeof v);
+  if (fd) memcpy(fd, f, (size_t)na * sizeof *f);
+  if (dd) memcpy(dd, v, (size_t)na * sizeof *v);
   if (ratio) *ratio = r;
   if (which) *which = wi;
   if (kind) *kind = wk;
@@ -107,7 +109,7 @@ static int where(const topp_ctx *c, int j, char *buf, size_t len)
  * terms a, b, c, w. */
 static int point_terms(topp_ctx *c, int j)
 {
-  double q[3], rc, f0[PRRU_NACT], f1[PRRU_NACT], f2[PRRU_NACT];
+  double q[3], rc, f0[PRRU_MAX_ACT], f1[PRRU_MAX_ACT], f2[PRRU_MAX_ACT];
   char at[160];
   topp_point *p = &c->p[j];
   path_pose(c, (double)j / c->N, q);
@@ -119,11 +121,11 @@ static int point_terms(topp_ctx *c, int j)
                      st == PRRU_EUNREACHABLE ? "outside the workspace"
                      : st == PRRU_ESINGULAR  ? "at a singularity (J_d singular)"
                                              : prru_strerror(st));
-  if (prru_path_side_crossed(&c->side, c->d->Jd, c->m->mech->nact))
+  if (prru_path_side_crossed(&c->side, c->d->Jd, c->na))
     return prru_fail(c->msg, c->msglen, PRRU_EINPUT,
                      "%s: the path crosses a singularity before q = (%.9g, %.9g, %.9g) (det J_d "
                      "changes sign)", at, q[0], q[1], q[2]);
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     if (!(c->d->d[i] >= c->lim->d_min[i] && c->d->d[i] <= c->lim->d_max[i]))
       return prru_fail(c->msg, c->msglen, PRRU_EINPUT,
                        "%s: slider %d at d = %.9g m is outside its stroke [%g, %g] m", at, i + 1,
@@ -137,9 +139,9 @@ static int point_terms(topp_ctx *c, int j)
   if ((st = id(c, q, 0, 0, f0)) != PRRU_OK || (st = id(c, q, 0, 1, f1)) != PRRU_OK ||
       (st = id(c, q, 1, 0, f2)) != PRRU_OK)
     goto refused;
-  for (int i = 0; i < PRRU_NACT; i++) p->c[i] = f0[i], p->a[i] = f1[i] - f0[i], p->b[i] = f2[i];
+  for (int i = 0; i < c->na; i++) p->c[i] = f0[i], p->a[i] = f1[i] - f0[i], p->b[i] = f2[i];
   if ((st = id(c, q, -1, 0, f2)) != PRRU_OK) goto refused;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     p->b[i] = 0.5 * (p->b[i] + f2[i]) - p->c[i];
     p->hs[i] = p->hc[i] = p->mu_hi[i] = p->mu_lo[i] = 0;
     p->rho[i] = 1;
@@ -152,15 +154,15 @@ refused:
 
 /* The drives' term h (the odd part of inverse dynamics in s') at grid
  * point j and s'^2 = x. */
-static int drive_term(topp_ctx *c, int j, double x, double h[PRRU_NACT])
+static int drive_term(topp_ctx *c, int j, double x, double h[])
 {
-  double q[3], fp[PRRU_NACT], fm[PRRU_NACT];
+  double q[3], fp[PRRU_MAX_ACT], fm[PRRU_MAX_ACT];
   const double v = sqrt(x);
   path_pose(c, (double)j / c->N, q);
   int st = id(c, q, v, 0, fp);
   if (st == PRRU_OK) st = id(c, q, -v, 0, fm);
   if (st != PRRU_OK) return st;
-  for (int i = 0; i < PRRU_NACT; i++) h[i] = 0.5 * (fp[i] - fm[i]);
+  for (int i = 0; i < c->na; i++) h[i] = 0.5 * (fp[i] - fm[i]);
   return PRRU_OK;
 }
 
@@ -169,10 +171,10 @@ static int drive_term(topp_ctx *c, int j, double x, double h[PRRU_NACT])
  * stricter than the drives near rest. */
 static int drive_secant(topp_ctx *c, int j, double x0)
 {
-  double h0[PRRU_NACT];
+  double h0[PRRU_MAX_ACT];
   int st = drive_term(c, j, x0, h0);
   if (st != PRRU_OK) return st;
-  for (int i = 0; i < PRRU_NACT; i++) c->p[j].hs[i] = h0[i] / x0, c->p[j].hc[i] = 0;
+  for (int i = 0; i < c->na; i++) c->p[j].hs[i] = h0[i] / x0, c->p[j].hc[i] = 0;
   return PRRU_OK;
 }
 
@@ -185,13 +187,13 @@ static int drive_secant(topp_ctx *c, int j, double x0)
  * (1e-8 of h'' x0^2) only slows the iteration down. */
 static int drive_tangent(topp_ctx *c, int j, double x0)
 {
-  double h0[PRRU_NACT], hp[PRRU_NACT], hm[PRRU_NACT];
+  double h0[PRRU_MAX_ACT], hp[PRRU_MAX_ACT], hm[PRRU_MAX_ACT];
   const double dx = 1e-4 * x0;
   int st = drive_term(c, j, x0, h0);
   if (st == PRRU_OK) st = drive_term(c, j, x0 + dx, hp);
   if (st == PRRU_OK) st = drive_term(c, j, x0 - dx, hm);
   if (st != PRRU_OK) return st;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     c->p[j].hs[i] = (hp[i] - hm[i]) / (2 * dx);
     c->p[j].hc[i] = h0[i] - c->p[j].hs[i] * x0;
   }
@@ -202,7 +204,7 @@ static int drive_tangent(topp_ctx *c, int j, double x0)
 static double speed_bound(const topp_ctx *c, int j)
 {
   double xs = INFINITY;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     double w = fabs(c->p[j].w[i]), v = c->lim->speed_max[i];
     if (w > 0 && isfinite(v)) xs = fmin(xs, c->p[j].rho[i] * (v / w) * (v / w));
   }
@@ -214,7 +216,7 @@ static double speed_bound(const topp_ctx *c, int j)
 static int force_rows(const topp_ctx *c, const topp_point *p, double two_delta, lp_row *r)
 {
   int n = 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     const double F = c->lim->force_max[i];
     if (!isfinite(F)) continue;
     const double B = p->b[i] + p->hs[i], A = p->a[i] + two_delta * B;
@@ -277,7 +279,7 @@ static void static_load(const topp_ctx *c, int j, char *buf, size_t len)
 {
   int wi = 0;
   double r = -1;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     double ri = fabs(c->p[j].c[i]) / c->lim->force_max[i];
     if (ri > r) r = ri, wi = i;
   }
@@ -363,7 +365,7 @@ static int forward(topp_ctx *c)
 }
 
 /* The interval's state at fraction sg of interval j (x linear in s). */
-static int state_at(topp_ctx *c, int j, double sg, double f[PRRU_NACT], double v[PRRU_NACT])
+static int state_at(topp_ctx *c, int j, double sg, double f[], double v[])
 {
   const double s = (j + sg) / c->N, x = c->x[j] + sg * (c->x[j + 1] - c->x[j]);
   double q[3], qd[3], qdd[3];
@@ -398,13 +400,13 @@ static double coulomb_arg(const topp_ctx *c, int j, int i, double sg)
  * crosses +-2^k coulomb_velocity, k = -4..4, so that the ramp is
  * resolved too. */
 #define RAMP_POINTS 9
-#define MAX_SAMPLES (CHECK_POINTS + 1 + 2 * RAMP_POINTS * PRRU_NACT)
+#define MAX_SAMPLES (CHECK_POINTS + 1 + 2 * RAMP_POINTS * PRRU_MAX_ACT)
 static int sample_points(const topp_ctx *c, int j, double *sg)
 {
   int n = 0;
   for (int k = 0; k <= CHECK_POINTS; k++) sg[n++] = (double)k / CHECK_POINTS;
   if (!(c->m->mech->coulomb_velocity > 0)) return n;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < c->na; i++) {
     if (c->m->mech->coulomb[i] == 0) continue;
     const double z0 = coulomb_arg(c, j, i, 0), z1 = coulomb_arg(c, j, i, 1);
     for (int k = 0; k < 2 * RAMP_POINTS; k++) {
@@ -436,7 +438,7 @@ static int sample_points(const topp_ctx *c, int j, double *sg)
 static int refine_force(topp_ctx *c, int j, int i, double lo, double hi, double *sg, double *f)
 {
   const double g = 0.5 * (sqrt(5.0) - 1);
-  double fa[PRRU_NACT], fb[PRRU_NACT], v[PRRU_NACT];
+  double fa[PRRU_MAX_ACT], fb[PRRU_MAX_ACT], v[PRRU_MAX_ACT];
   double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
   int st = state_at(c, j, a, fa, v);
   if (st == PRRU_OK) st = state_at(c, j, b, fb, v);
@@ -474,14 +476,14 @@ static int check(topp_ctx *c, double *excess, int *active)
   *excess = 0;
   *active = 0;
   for (int j = 0; j < c->N; j++) {
-    double sg[MAX_SAMPLES], fbig[PRRU_NACT] = {0}, vbig[PRRU_NACT] = {0};
-    int best[PRRU_NACT] = {0}, act = 0;
+    double sg[MAX_SAMPLES], fbig[PRRU_MAX_ACT] = {0}, vbig[PRRU_MAX_ACT] = {0};
+    int best[PRRU_MAX_ACT] = {0}, act = 0;
     const int n = sample_points(c, j, sg);
     for (int k = 0; k < n; k++) {
-      double f[PRRU_NACT], v[PRRU_NACT];
+      double f[PRRU_MAX_ACT], v[PRRU_MAX_ACT];
       int st = state_at(c, j, sg[k], f, v);
       if (st != PRRU_OK) return st;
-      for (int i = 0; i < PRRU_NACT; i++) {
+      for (int i = 0; i < c->na; i++) {
         if (fabs(f[i]) > fabs(fbig[i])) fbig[i] = f[i], best[i] = k;
         vbig[i] = fmax(vbig[i], fabs(v[i]));
         if ((sg[k] == 0 || sg[k] == 1) &&
@@ -490,7 +492,7 @@ static int check(topp_ctx *c, double *excess, int *active)
           act = 1;
       }
     }
-    for (int i = 0; i < PRRU_NACT; i++) {
+    for (int i = 0; i < c->na; i++) {
       const double F = c->lim->force_max[i], V = c->lim->speed_max[i];
       if (fabs(fbig[i]) >= (1 - ACTIVE_TOL) * F) {
         const int k = best[i];
@@ -588,7 +590,7 @@ static int solve_segment(topp_ctx *c, int *iterations, int *active)
 
 static int has_drives(const prru_model *m)
 {
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < m->mech->nact; i++)
     if (m->mech->damping[i] != 0 || m->mech->coulomb[i] != 0) return 1;
   return 0;
 }
@@ -601,7 +603,7 @@ static int topp_check_args(const prru_model *m, int n, const double *q, const pr
   if (grid != 0 && (grid < 2 || grid > 100000))
     return prru_fail(msg, msglen, PRRU_EINPUT, "grid: %d intervals per segment, need 2 to 100000", grid);
   int forces = 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < m->mech->nact; i++) {
     if (!(lim->force_max[i] > 0) || !(lim->speed_max[i] > 0) || isnan(lim->d_min[i]) ||
         isnan(lim->d_max[i]) || !(lim->d_min[i] < lim->d_max[i]))
       return prru_fail(msg, msglen, PRRU_EINPUT, "limits of actuator %d: force_max and speed_max "
@@ -657,8 +659,8 @@ int prru_topp_solve(prru_topp *tp, const prru_model *m, int n, const double *q,
   if (st != PRRU_OK) return st;
   const int N = grid ? grid : PRRU_TOPP_GRID_DEFAULT;
   const size_t np = (size_t)(n - 1) * (size_t)(N + 1);
-  topp_ctx c = {m, NULL, lim, N, 0, {0}, has_drives(m), 0, 0.05, NULL, NULL, {0}, NULL, NULL, NULL,
-                NULL, NULL, NULL, msg, msglen};
+  topp_ctx c = {m, m->mech->nact, NULL, lim, N, 0, {0}, has_drives(m), 0, 0.05, NULL, NULL, {0}, NULL, NULL,
+                NULL, NULL, NULL, NULL, msg, msglen};
   c.d = malloc(sizeof *c.d);
   c.p = malloc((size_t)(N + 1) * sizeof *c.p);
   c.lo = malloc(3 * (size_t)(N + 1) * sizeof *c.lo);
@@ -753,7 +755,7 @@ int prru_topp_row(const prru_model *m, prru_data *d, const prru_limits *lim, con
   if (r > 1 + PRRU_TOPP_ROW_TOL)
     return prru_fail(msg, msglen, PRRU_ENOCONV, "t = %.9g s: the %s of actuator %d exceeds its limit by %.3g of "
                      "it; the profile cannot be trusted", t, kind ? "slider speed" : "force", which + 1, r - 1);
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < m->mech->nact; i++)
     if (!(d->d[i] >= lim->d_min[i] && d->d[i] <= lim->d_max[i]))
       return prru_fail(msg, msglen, PRRU_ENOCONV, "t = %.9g s: slider %d at d = %.9g m is outside its stroke "
                        "between two grid points", t, i + 1, d->d[i]);
