@@ -1003,6 +1003,13 @@ static int plant_params(const char *plant, prru_params *p)
     prru_cli_error("track", "--plant: %s", msg);
     return 2;
   }
+  /* The plant's numbers are read in the controller's topology. */
+  if (pm.mech->nlimb != prru_cli_model()->mech->nlimb) {
+    prru_cli_error("track", "--plant: %s: a model with %d limbs; the controller's model %s has %d", plant,
+                   pm.mech->nlimb, prru_cli_model()->mech->name, prru_cli_model()->mech->nlimb);
+    prru_model_free(&pm);
+    return 2;
+  }
   prru_model_params(&pm, p);
   prru_model_free(&pm);
   return 0;

@@ -352,6 +352,9 @@ def track(self, reference, *, bandwidth=None, kp=None, kd=None, period=0.0, dt=1
         plant_model = type(self)(self.lib, model=plant)
     if plant_model.lib is not self.lib:
         raise ValueError("plant must use this model's library (%s)" % self.lib.path)
+    if plant_model.nlimb != self.nlimb:
+        raise ValueError("plant: a model with %d limbs; this model has %d (the plant's numbers "
+                         "are read in the controller's topology)" % (plant_model.nlimb, self.nlimb))
     _track_controller(self, o, controller, lqr_q, lqr_r)
     _track_options_check(self, o)
     lib.model_params(ctypes.byref(plant_model._m), ctypes.byref(o.plant))
