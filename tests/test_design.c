@@ -13,10 +13,11 @@
 #include "testbuild.h"
 #include "prru_design.h"
 #include "testutil.h"
+#include "topology.h" /* the other topology's layout (runtime/src) */
 
 #define PI 3.14159265358979323846
 
-/* The build's model: the topology of the designs here. */
+/* The build's model: the topology of the designs here but other_topology's. */
 static prru_model model;
 
 /* Fig. 7's rectangle: every model's generic tests use it; points that a
@@ -496,6 +497,56 @@ static void tiny_steps(void)
   prru_design_data_free(&dd);
 }
 
+/* Names and counts are the designed model's topology's, not the build's:
+ * a model with the other topology's layout (prru_topology_layout, as a
+ * model of it loaded at run time has) gets its own limbs, bodies and
+ * actuators. */
+static void other_topology(void)
+{
+  const int n = PRRU_NLIMB == 3 ? 4 : 3, nbody = 1 + 3 * n;
+  static prru_mechanism me; /* about 4 kB */
+  me = prru_mech;
+  prru_topology_layout(prru_topology_of(n), &me);
+  prru_model other = model;
+  other.mech = &me;
+  TU_TRUE(prru_design_param_count(&other) == 3 * n + 2 + 10 * nbody + n,
+          "other topology: its parameter count");
+  int ok = 1;
+  for (int k = 0; k < prru_design_param_count(&other); k++) {
+    prru_design_var v, w;
+    if (prru_design_param(&other, k, &v) != PRRU_OK ||
+        prru_design_var_parse(&other, v.name, &w, NULL, 0) != PRRU_OK || w.n != 1 ||
+        w.offset[0] != v.offset[0])
+      ok = 0;
+  }
+  TU_TRUE(ok, "other topology: every canonical parameter name parses to itself");
+  static const struct {
+    const char *name;
+    int n;
+  } tied[] = {{"b", 0}, {"l1", 0}, {"m_U", 0}, {"com_S_z", 0}, {"armature", 0}, {"a", 2}, {"b12", 2}};
+  for (size_t i = 0; i < sizeof tied / sizeof tied[0]; i++) {
+    prru_design_var v;
+    char what[64];
+    const int want = tied[i].n ? tied[i].n : n;
+    snprintf(what, sizeof what, "other topology: %s ties %d", tied[i].name, want);
+    TU_TRUE(prru_design_var_parse(&other, tied[i].name, &v, NULL, 0) == PRRU_OK && v.n == want, what);
+  }
+  /* The first upper link follows the lower links of every limb. */
+  prru_design_var u;
+  prru_design_var_parse(&other, "m_U1", &u, NULL, 0);
+  TU_TRUE(u.n == 1 && u.offset[0] == offsetof(prru_params, mass) + (size_t)(1 + n) * sizeof(double),
+          "other topology: U1 is body 1 + nlimb");
+  prru_design_var v4;
+  TU_TRUE((prru_design_var_parse(&other, "b4", &v4, NULL, 0) == PRRU_OK) == (n == 4) &&
+              (prru_design_var_parse(&other, "armature_4", &v4, NULL, 0) == PRRU_OK) == (n == 4) &&
+              (prru_design_var_parse(&other, "m_S4", &v4, NULL, 0) == PRRU_OK) == (n == 4),
+          "other topology: a fourth limb exactly when it has one");
+  prru_params p = prru_params_model;
+  double s = 0;
+  for (int i = 0; i < n; i++) s += p.l1[i] = 0.1 + 0.01 * i;
+  TU_TRUE(prru_design_length_scale(&other, &p) == s / n, "other topology: the mean of its upper links");
+}
+
 int main(void)
 {
   prru_model_default(&model);
@@ -509,5 +560,6 @@ int main(void)
   optimizer();
   tied_bounds();
   tiny_steps();
+  other_topology();
   return tu_finish("test_design");
 }
