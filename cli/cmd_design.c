@@ -70,7 +70,7 @@ static int parse_set(const char *cmd, const char *text, prru_params *p)
       return 2;
     }
     *eq = '\0';
-    if (prru_design_var_parse(item, &v, msg, sizeof msg) != PRRU_OK) {
+    if (prru_design_var_parse(prru_cli_model(), item, &v, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error(cmd, "--set: %s", msg);
       return 2;
     }
@@ -103,7 +103,7 @@ static int parse_problem(const char *cmd, problem_text *t, prru_design_problem *
     prru_cli_error(cmd, "--q1/--q2: %d x %d points is more than the limit of 1e7", g.n1, g.n2);
     return 2;
   }
-  prru_design_problem_default(pr, &g);
+  prru_design_problem_default(prru_cli_model(), pr, &g);
   if (t->rcond) {
     if (prru_cli_number(cmd, "rcond-min", t->rcond, &pr->rcond_min)) return 2;
     if (!(pr->rcond_min > 0 && pr->rcond_min < 1)) {
@@ -120,7 +120,7 @@ static int parse_problem(const char *cmd, problem_text *t, prru_design_problem *
   prru_model_params(prru_cli_model(), start); /* the current (--model's) numbers */
   if (t->set && parse_set(cmd, t->set, start)) return 2;
   char msg[512];
-  if (prru_design_check(start, msg, sizeof msg) != PRRU_OK) {
+  if (prru_design_check(prru_cli_model(), start, msg, sizeof msg) != PRRU_OK) {
     prru_cli_error(cmd, "the start design is not a buildable robot: %s", msg);
     return 2;
   }
@@ -295,12 +295,13 @@ typedef struct {
 
 static int parse_params(const char *cmd, const char *text, param_list *pl)
 {
-  int cap = prru_design_param_count() + 64;
+  int cap = prru_design_param_count(prru_cli_model()) + 64;
   pl->vars = calloc((size_t)cap, sizeof *pl->vars);
   pl->nparam = 0;
   if (!pl->vars) return 1;
   if (!text) {
-    for (int k = 0; k < prru_design_param_count(); k++) prru_design_param(k, &pl->vars[pl->nparam++]);
+    for (int k = 0; k < prru_design_param_count(prru_cli_model()); k++)
+      prru_design_param(prru_cli_model(), k, &pl->vars[pl->nparam++]);
     return 0;
   }
   char *buf = strdup(text);
@@ -311,7 +312,8 @@ static int parse_params(const char *cmd, const char *text, param_list *pl)
     if (pl->nparam >= cap) {
       prru_cli_error(cmd, "--params: more than %d parameters", cap);
       rc = 2;
-    } else if (prru_design_var_parse(it, &pl->vars[pl->nparam], msg, sizeof msg) != PRRU_OK) {
+    } else if (prru_design_var_parse(prru_cli_model(), it, &pl->vars[pl->nparam], msg, sizeof msg) !=
+               PRRU_OK) {
       prru_cli_error(cmd, "--params: %s", msg);
       rc = 2;
     } else {
@@ -382,7 +384,7 @@ int prru_cmd_sensitivity(int argc, char **argv)
   int rc = parse_params(cmd, params, &pl);
   for (int i = 0; i < pl.nparam && !rc; i++) {
     char msg[512];
-    if (prru_design_step_check(&p, &pl.vars[i], h, msg, sizeof msg) != PRRU_OK) {
+    if (prru_design_step_check(pr.model, &p, &pl.vars[i], h, msg, sizeof msg) != PRRU_OK) {
       prru_cli_error(cmd, "--step '%s': %s", steps, msg);
       rc = 2;
     }
@@ -809,7 +811,7 @@ static int parse_vars(const char *cmd, const char *text, double pct, const prru_
     if (*n >= PRRU_DESIGN_MAX_VARS) {
       prru_cli_error(cmd, "--vars: more than %d variables", PRRU_DESIGN_MAX_VARS);
       rc = 2;
-    } else if (prru_design_var_parse(it, &vars[*n], msg, sizeof msg) != PRRU_OK) {
+    } else if (prru_design_var_parse(prru_cli_model(), it, &vars[*n], msg, sizeof msg) != PRRU_OK) {
       prru_cli_error(cmd, "--vars: %s", msg);
       rc = 2;
     } else if (eq) {
@@ -818,7 +820,7 @@ static int parse_vars(const char *cmd, const char *text, double pct, const prru_
       rc = parse_pair(cmd, opt, eq + 1, &vars[*n].lo, &vars[*n].hi);
       (*n)++;
     } else {
-      prru_design_var_bounds(p, &vars[(*n)++], pct); /* every tied limb within pct % */
+      prru_design_var_bounds(prru_cli_model(), p, &vars[(*n)++], pct); /* every tied limb within pct % */
     }
   }
   free(buf);

@@ -13,8 +13,12 @@
 #include "testbuild.h"
 #include "prru_design.h"
 #include "testutil.h"
+#include "topology.h" /* the other topology's layout (runtime/src) */
 
 #define PI 3.14159265358979323846
+
+/* The build's model: the topology of the designs here but other_topology's. */
+static prru_model model;
 
 /* Fig. 7's rectangle: every model's generic tests use it; points that a
  * model cannot reach are counted as such by both paths. */
@@ -37,7 +41,7 @@ static int det_sign_at(double q1, double q2, double q3)
 static void objective_equals_map(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &fig7);
+  prru_design_problem_default(&model, &pr, &fig7);
   prru_design_data dd;
   TU_TRUE(prru_design_data_alloc(&dd, &fig7) == PRRU_OK, "alloc");
   prru_design_eval ev;
@@ -103,7 +107,7 @@ static void objective_equals_map(void)
 static void threads_same_bits(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &fig7);
+  prru_design_problem_default(&model, &pr, &fig7);
   pr.stroke = 1;
   pr.stroke_lo = 0.1;
   pr.stroke_hi = 0.3;
@@ -138,7 +142,7 @@ static void float_evaluation(void)
 {
   const prru_map_grid g = {-1.55, 1.55, -1.55, 1.55, 0.0, 47, 53}; /* as test_map_batch's: every status */
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &g);
+  prru_design_problem_default(&model, &pr, &g);
   prru_design_data a, b;
   prru_design_data_alloc(&a, &g);
   prru_design_data_alloc(&b, &g);
@@ -167,7 +171,7 @@ static void float_evaluation(void)
               ea.stroke_violation == eb.stroke_violation && ea.feasible == eb.feasible,
           "float evaluation: the violations are double's, bit for bit");
   TU_TRUE(w_ok, "float evaluation: w_R within 64 FLT_EPSILON w_R / rcond of double's");
-  const double L = prru_design_length_scale(&prru_params_model);
+  const double L = prru_design_length_scale(&model, &prru_params_model);
   TU_TRUE(fabs(eb.d_min - ea.d_min) <= 256 * FLT_EPSILON * (fabs(ea.d_min) + 4 * L) &&
               fabs(eb.d_max - ea.d_max) <= 256 * FLT_EPSILON * (fabs(ea.d_max) + 4 * L),
           "float evaluation: the slider range within float's error");
@@ -178,7 +182,7 @@ static void float_evaluation(void)
 static void stroke_limits(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_data dd;
   prru_design_data_alloc(&dd, &home);
   prru_design_eval ev;
@@ -200,14 +204,14 @@ static void stroke_limits(void)
 static void sensitivity_two_steps(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_data dd;
   prru_design_data_alloc(&dd, &home);
   const char *names[] = {"b_1", "b3", "l1", "l2_2", "a", "m_P", "I_P_xx", "I_U_zz", "com_P_x",
                          "I_P_xy", "m_S", "armature"};
   for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
     prru_design_var v;
-    TU_TRUE(prru_design_var_parse(names[i], &v, NULL, 0) == PRRU_OK, names[i]);
+    TU_TRUE(prru_design_var_parse(&model, names[i], &v, NULL, 0) == PRRU_OK, names[i]);
     prru_design_sens s1, s2;
     int r1 = prru_design_sensitivity(&pr, &prru_params_model, &v, 1e-3, &dd, &s1);
     int r2 = prru_design_sensitivity(&pr, &prru_params_model, &v, 5e-4, &dd, &s2);
@@ -232,16 +236,16 @@ static void sensitivity_two_steps(void)
     prru_design_var vm, va, vc, vi;
     snprintf(nm, sizeof nm, "m_S%d", i + 1);
     snprintf(na, sizeof na, "armature_%d", i + 1);
-    prru_design_var_parse(nm, &vm, NULL, 0);
-    prru_design_var_parse(na, &va, NULL, 0);
+    prru_design_var_parse(&model, nm, &vm, NULL, 0);
+    prru_design_var_parse(&model, na, &va, NULL, 0);
     snprintf(nm, sizeof nm, "com_S%d_y", i + 1);
-    prru_design_var_parse(nm, &vc, NULL, 0);
+    prru_design_var_parse(&model, nm, &vc, NULL, 0);
     snprintf(nm, sizeof nm, "I_S%d_zz", i + 1);
-    prru_design_var_parse(nm, &vi, NULL, 0);
+    prru_design_var_parse(&model, nm, &vi, NULL, 0);
     prru_design_sens sm, sa, sc, si;
     prru_design_sensitivity(&pr, &prru_params_model, &vm, 1e-3, &dd, &sm);
     /* the same step h for both */
-    double ascale = prru_design_scale(&prru_params_model, &va);
+    double ascale = prru_design_scale(&model, &prru_params_model, &va);
     prru_design_sensitivity(&pr, &prru_params_model, &va, 1e-3 * sm.scale / ascale, &dd, &sa);
     snprintf(what, sizeof what, "d/d m_S%d = d/d armature_%d", i + 1, i + 1);
     TU_CLOSE(&sa.derivative, &sm.derivative, 1, 1e-6, what);
@@ -254,12 +258,12 @@ static void sensitivity_two_steps(void)
   }
   /* Every single parameter is reachable by name and perturbs the
    * objective only through itself. */
-  int np = prru_design_param_count(), ok = 1;
+  int np = prru_design_param_count(&model), ok = 1;
   TU_TRUE(np == 3 * PRRU_NLIMB + 2 + 10 * PRRU_NBODY + PRRU_NACT, "parameter count");
   for (int k = 0; k < np; k++) {
     prru_design_var v, w;
-    prru_design_param(k, &v);
-    if (prru_design_var_parse(v.name, &w, NULL, 0) != PRRU_OK || w.n != 1 ||
+    prru_design_param(&model, k, &v);
+    if (prru_design_var_parse(&model, v.name, &w, NULL, 0) != PRRU_OK || w.n != 1 ||
         w.offset[0] != v.offset[0])
       ok = 0;
   }
@@ -280,7 +284,7 @@ static void variables(void)
     prru_design_var v;
     char what[64];
     snprintf(what, sizeof what, "variable %s ties %d", good[i].name, good[i].n);
-    TU_TRUE(prru_design_var_parse(good[i].name, &v, NULL, 0) == PRRU_OK && v.n == good[i].n, what);
+    TU_TRUE(prru_design_var_parse(&model, good[i].name, &v, NULL, 0) == PRRU_OK && v.n == good[i].n, what);
   }
   const char *bad[] = {"", "b0", "b_", "b11", "l1_9", "l13", "a3", "foo", "I_P_xw", "m_Q", "com_P",
                        "m_", "armature_0", "l1_12345", "gravity", "damping"};
@@ -288,7 +292,7 @@ static void variables(void)
     prru_design_var v;
     char msg[512] = "", what[64];
     snprintf(what, sizeof what, "'%s' refused with its name in the message", bad[i]);
-    TU_TRUE(prru_design_var_parse(bad[i], &v, msg, sizeof msg) == PRRU_EINPUT &&
+    TU_TRUE(prru_design_var_parse(&model, bad[i], &v, msg, sizeof msg) == PRRU_EINPUT &&
                 strstr(msg, bad[i]) && strstr(msg, "not a design parameter"),
             what);
   }
@@ -296,7 +300,7 @@ static void variables(void)
   prru_params p = prru_params_model;
   p.l1[1] += 0.01;
   prru_design_var v;
-  prru_design_var_parse("l1", &v, NULL, 0);
+  prru_design_var_parse(&model, "l1", &v, NULL, 0);
   prru_design_set(&p, &p, &v, p.l1[0] + 0.002);
   TU_TRUE(p.l1[0] == prru_params_model.l1[0] + 0.002 &&
               fabs(p.l1[1] - (prru_params_model.l1[1] + 0.012)) < 1e-15,
@@ -311,7 +315,7 @@ static void variables(void)
 static void check_refuses(const prru_params *p, const char *needle, const char *what)
 {
   char msg[512] = "";
-  int st = prru_design_check(p, msg, sizeof msg);
+  int st = prru_design_check(&model, p, msg, sizeof msg);
   if (!TU_TRUE(st == PRRU_EINPUT && strstr(msg, needle), what))
     fprintf(stderr, "  message: %s\n", msg);
 }
@@ -319,7 +323,7 @@ static void check_refuses(const prru_params *p, const char *needle, const char *
 static void validity(void)
 {
   char msg[512] = "";
-  TU_TRUE(prru_design_check(&prru_params_model, msg, sizeof msg) == PRRU_OK, "the model is valid");
+  TU_TRUE(prru_design_check(&model, &prru_params_model, msg, sizeof msg) == PRRU_OK, "the model is valid");
   prru_params p = prru_params_model;
   p.l1[0] = -0.1;
   check_refuses(&p, "limb 1", "negative l1");
@@ -346,7 +350,7 @@ static void validity(void)
   check_refuses(&p, "l1_1", "NaN");
   /* An invalid design gets the invalid merit, not an evaluation. */
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_data dd;
   prru_design_data_alloc(&dd, &home);
   prru_design_eval ev;
@@ -360,10 +364,10 @@ static void validity(void)
 static void optimizer(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_var vars[2];
-  prru_design_var_parse("b", &vars[0], NULL, 0);
-  prru_design_var_parse("l2", &vars[1], NULL, 0);
+  prru_design_var_parse(&model, "b", &vars[0], NULL, 0);
+  prru_design_var_parse(&model, "l2", &vars[1], NULL, 0);
   for (int i = 0; i < 2; i++) {
     double x = prru_design_get(&prru_params_model, &vars[i]);
     vars[i].lo = 0.95 * x;
@@ -430,13 +434,13 @@ static void tied_bounds(void)
   prru_params p = prru_params_model;
   p.l2[PRRU_NLIMB - 1] *= 0.9;
   prru_design_var v;
-  prru_design_var_parse("l2", &v, NULL, 0);
-  TU_TRUE(prru_design_var_bounds(&p, &v, pct) == PRRU_OK && v.lo < p.l2[0] && p.l2[0] < v.hi,
+  prru_design_var_parse(&model, "l2", &v, NULL, 0);
+  TU_TRUE(prru_design_var_bounds(&model, &p, &v, pct) == PRRU_OK && v.lo < p.l2[0] && p.l2[0] < v.hi,
           "bounds of a tied variable around its value");
-  TU_TRUE(prru_design_var_bounds(&p, &v, 0) == PRRU_EINPUT && prru_design_var_bounds(&p, &v, 100) ==
-                                                                   PRRU_EINPUT,
+  TU_TRUE(prru_design_var_bounds(&model, &p, &v, 0) == PRRU_EINPUT &&
+              prru_design_var_bounds(&model, &p, &v, 100) == PRRU_EINPUT,
           "a percentage outside (0, 100) refused");
-  prru_design_var_bounds(&p, &v, pct);
+  prru_design_var_bounds(&model, &p, &v, pct);
   double worst = 0;
   for (int e = 0; e < 2; e++) {
     prru_params q = p;
@@ -447,7 +451,7 @@ static void tied_bounds(void)
   TU_TRUE(worst <= 1 + eps / (pct / 100) && worst >= 1 - eps / (pct / 100),
           "every limb within its own 5 %, the shortest on its edge");
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_options o;
   prru_design_options_default(&o);
   o.max_iter = 40;
@@ -466,33 +470,86 @@ static void tied_bounds(void)
 static void tiny_steps(void)
 {
   prru_design_problem pr;
-  prru_design_problem_default(&pr, &home);
+  prru_design_problem_default(&model, &pr, &home);
   prru_design_data dd;
   TU_TRUE(prru_design_data_alloc(&dd, &home) == PRRU_OK, "alloc");
   prru_design_var b, arm;
-  prru_design_var_parse("b_1", &b, NULL, 0);
-  prru_design_var_parse("armature_1", &arm, NULL, 0);
+  prru_design_var_parse(&model, "b_1", &b, NULL, 0);
+  prru_design_var_parse(&model, "armature_1", &arm, NULL, 0);
   prru_design_sens s;
   char msg[512] = "";
   TU_TRUE(prru_design_sensitivity(&pr, &prru_params_model, &b, 1e-300, &dd, &s) == PRRU_EINPUT,
           "sensitivity with the step 1e-300 refused");
-  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 1e-300, msg, sizeof msg) == PRRU_EINPUT &&
+  TU_TRUE(prru_design_step_check(&model, &prru_params_model, &b, 1e-300, msg, sizeof msg) == PRRU_EINPUT &&
               strstr(msg, "b_1") && strstr(msg, "lost to rounding"),
           "the message names the parameter and the reason");
   /* b_1 is its own scale: the smallest relative step is 100 DBL_EPSILON. */
-  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 0.99 * 100 * DBL_EPSILON, NULL, 0) == PRRU_EINPUT &&
-              prru_design_step_check(&prru_params_model, &b, 1.01 * 100 * DBL_EPSILON, NULL, 0) == PRRU_OK,
+  TU_TRUE(prru_design_step_check(&model, &prru_params_model, &b, 0.99 * 100 * DBL_EPSILON, NULL, 0) ==
+                  PRRU_EINPUT &&
+              prru_design_step_check(&model, &prru_params_model, &b, 1.01 * 100 * DBL_EPSILON, NULL, 0) ==
+                  PRRU_OK,
           "the limit is 100 DBL_EPSILON of the value");
-  TU_TRUE(prru_design_step_check(&prru_params_model, &arm, 1e-300, NULL, 0) == PRRU_EINPUT,
+  TU_TRUE(prru_design_step_check(&model, &prru_params_model, &arm, 1e-300, NULL, 0) == PRRU_EINPUT,
           "a parameter at 0: the step is measured against its scale");
-  TU_TRUE(prru_design_step_check(&prru_params_model, &b, 1e-4, NULL, 0) == PRRU_OK &&
-              prru_design_step_check(&prru_params_model, &b, 0.5, NULL, 0) == PRRU_EINPUT,
+  TU_TRUE(prru_design_step_check(&model, &prru_params_model, &b, 1e-4, NULL, 0) == PRRU_OK &&
+              prru_design_step_check(&model, &prru_params_model, &b, 0.5, NULL, 0) == PRRU_EINPUT,
           "the default step passes, 0.5 does not");
   prru_design_data_free(&dd);
 }
 
+/* Names and counts are the designed model's topology's, not the build's:
+ * a model with the other topology's layout (prru_topology_layout, as a
+ * model of it loaded at run time has) gets its own limbs, bodies and
+ * actuators. */
+static void other_topology(void)
+{
+  const int n = PRRU_NLIMB == 3 ? 4 : 3, nbody = 1 + 3 * n;
+  static prru_mechanism me; /* about 4 kB */
+  me = prru_mech;
+  prru_topology_layout(prru_topology_of(n), &me);
+  prru_model other = model;
+  other.mech = &me;
+  TU_TRUE(prru_design_param_count(&other) == 3 * n + 2 + 10 * nbody + n,
+          "other topology: its parameter count");
+  int ok = 1;
+  for (int k = 0; k < prru_design_param_count(&other); k++) {
+    prru_design_var v, w;
+    if (prru_design_param(&other, k, &v) != PRRU_OK ||
+        prru_design_var_parse(&other, v.name, &w, NULL, 0) != PRRU_OK || w.n != 1 ||
+        w.offset[0] != v.offset[0])
+      ok = 0;
+  }
+  TU_TRUE(ok, "other topology: every canonical parameter name parses to itself");
+  static const struct {
+    const char *name;
+    int n;
+  } tied[] = {{"b", 0}, {"l1", 0}, {"m_U", 0}, {"com_S_z", 0}, {"armature", 0}, {"a", 2}, {"b12", 2}};
+  for (size_t i = 0; i < sizeof tied / sizeof tied[0]; i++) {
+    prru_design_var v;
+    char what[64];
+    const int want = tied[i].n ? tied[i].n : n;
+    snprintf(what, sizeof what, "other topology: %s ties %d", tied[i].name, want);
+    TU_TRUE(prru_design_var_parse(&other, tied[i].name, &v, NULL, 0) == PRRU_OK && v.n == want, what);
+  }
+  /* The first upper link follows the lower links of every limb. */
+  prru_design_var u;
+  prru_design_var_parse(&other, "m_U1", &u, NULL, 0);
+  TU_TRUE(u.n == 1 && u.offset[0] == offsetof(prru_params, mass) + (size_t)(1 + n) * sizeof(double),
+          "other topology: U1 is body 1 + nlimb");
+  prru_design_var v4;
+  TU_TRUE((prru_design_var_parse(&other, "b4", &v4, NULL, 0) == PRRU_OK) == (n == 4) &&
+              (prru_design_var_parse(&other, "armature_4", &v4, NULL, 0) == PRRU_OK) == (n == 4) &&
+              (prru_design_var_parse(&other, "m_S4", &v4, NULL, 0) == PRRU_OK) == (n == 4),
+          "other topology: a fourth limb exactly when it has one");
+  prru_params p = prru_params_model;
+  double s = 0;
+  for (int i = 0; i < n; i++) s += p.l1[i] = 0.1 + 0.01 * i;
+  TU_TRUE(prru_design_length_scale(&other, &p) == s / n, "other topology: the mean of its upper links");
+}
+
 int main(void)
 {
+  prru_model_default(&model);
   objective_equals_map();
   threads_same_bits();
   float_evaluation();
@@ -503,5 +560,6 @@ int main(void)
   optimizer();
   tied_bounds();
   tiny_steps();
+  other_topology();
   return tu_finish("test_design");
 }

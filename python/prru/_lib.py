@@ -135,7 +135,9 @@ DESIGN_MAX_VARS = 64
 
 
 class _DesignProblem(ctypes.Structure):
-    _fields_ = [("grid", _MapGrid), ("rcond_min", ctypes.c_double), ("objective", ctypes.c_int),
+    """prru_design_problem: the model designed (a prru_model pointer, set
+    by prru_design_problem_default), the grid and the constraints."""
+    _fields_ = [("model", ctypes.c_void_p), ("grid", _MapGrid), ("rcond_min", ctypes.c_double), ("objective", ctypes.c_int),
                 ("stroke", ctypes.c_int), ("stroke_lo", ctypes.c_double), ("stroke_hi", ctypes.c_double),
                 ("penalty_weight", ctypes.c_double)]
 
@@ -485,15 +487,15 @@ class Library:
         self.regressor_names = (ctypes.c_char_p * t.nreg).in_dll(dll, "prru_regressor_names")
         # Design optimisation.
         dpp, dvp = ctypes.POINTER(_DesignProblem), ctypes.POINTER(t.DesignVar)
-        self.design_problem_default = _declare(dll, "prru_design_problem_default", None, dpp,
+        self.design_problem_default = _declare(dll, "prru_design_problem_default", None, mp, dpp,
                                                ctypes.POINTER(_MapGrid))
         self.design_problem_check = _declare(dll, "prru_design_problem_check", i, dpp, cp, i)
         self.design_problem_stroke = _declare(dll, "prru_design_problem_stroke", i, dpp, lmp, cp, i)
         self.objective_parse = _declare(dll, "prru_objective_parse", i, cp, c_int_p)
-        self.design_var_parse = _declare(dll, "prru_design_var_parse", i, cp, dvp, cp, i)
-        self.design_var_bounds = _declare(dll, "prru_design_var_bounds", i, pp, dvp, d)
+        self.design_var_parse = _declare(dll, "prru_design_var_parse", i, mp, cp, dvp, cp, i)
+        self.design_var_bounds = _declare(dll, "prru_design_var_bounds", i, mp, pp, dvp, d)
         self.design_get = _declare(dll, "prru_design_get", d, pp, dvp)
-        self.design_check = _declare(dll, "prru_design_check", i, pp, cp, i)
+        self.design_check = _declare(dll, "prru_design_check", i, mp, pp, cp, i)
         self.design_options_default = _declare(dll, "prru_design_options_default", None,
                                                ctypes.POINTER(t.DesignOptions))
         self.design_optimize = _declare(dll, "prru_design_optimize", i, dpp, pp, dvp, i,

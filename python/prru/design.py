@@ -65,7 +65,7 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
     grid.q2_lo, grid.q2_hi, grid.n2 = _range("q2", q2)
     grid.q3 = _convert.scalar("q3", q3)
     pr, msg = _lib._DesignProblem(), ctypes.create_string_buffer(600)
-    lib.design_problem_default(ctypes.byref(pr), ctypes.byref(grid))
+    lib.design_problem_default(ctypes.byref(self._m), ctypes.byref(pr), ctypes.byref(grid))
     if rcond_min is not None:
         pr.rcond_min = _convert.scalar("rcond_min", rcond_min, positive=True, allow_zero=False)
     if penalty is not None:
@@ -84,7 +84,7 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
         raise ValueError("range must be a percentage in (0, 100), got %r" % range)
     start = T.Params()
     lib.model_params(ctypes.byref(self._m), ctypes.byref(start))
-    if lib.design_check(ctypes.byref(start), msg, len(msg)) != errors.OK:
+    if lib.design_check(ctypes.byref(self._m), ctypes.byref(start), msg, len(msg)) != errors.OK:
         raise errors.make_error(errors.EINPUT, "optimize: the start design is not a buildable robot: "
                                 + msg.value.decode())
     items = _convert.ordered("vars", vars, "a sequence of variable names or (name, lo, hi)")
@@ -99,10 +99,11 @@ def optimize(self, vars, *, q1, q2, q3=0.0, range=20.0, objective="mean", rcond_
                 raise ValueError("vars[%d] must be a name or (name, lo, hi), got %r" % (k, item))
             bounds = (_convert.scalar("vars[%d] lo" % k, item[1]), _convert.scalar("vars[%d] hi" % k, item[2]))
             item = item[0]
-        if lib.design_var_parse(item.encode(), ctypes.byref(cv[k]), msg, len(msg)) != errors.OK:
+        if lib.design_var_parse(ctypes.byref(self._m), item.encode(), ctypes.byref(cv[k]), msg,
+                                len(msg)) != errors.OK:
             raise ValueError("vars[%d]: %s" % (k, msg.value.decode()))
         if bounds is None:
-            lib.design_var_bounds(ctypes.byref(start), ctypes.byref(cv[k]), pct)
+            lib.design_var_bounds(ctypes.byref(self._m), ctypes.byref(start), ctypes.byref(cv[k]), pct)
         else:
             cv[k].lo, cv[k].hi = bounds
         x = lib.design_get(ctypes.byref(start), ctypes.byref(cv[k]))

@@ -3,17 +3,22 @@
  * toward the plane w_R = 1 over the workspace) and the sensitivity of the
  * global index to every parameter.
  *
- * A design is a prru_params (prru_param_kernels.h): every number of the
- * model, which the runtime-parameter kernels take at run time, so that a
- * candidate costs no code generation. A design is judged exactly as a
- * model's map is by `prru map`: w_R by prru_dme_from, regularity by
- * prru_jd_regular (with the design's own length scale, the mean upper
- * link), a regular pose whose det J_d has the other sign than at home
- * (0, 0, q3) counted as singular (the other assembly mode, cut off from
- * home by the singular locus; three actuators only), the global index by
- * prru_map_summarize; a design evaluated here and the same design written
- * as a model file, regenerated and mapped by `prru map` give the same
- * index (to the kernels' 1e-13 agreement).
+ * A design is a prru_params (prru_descriptor.h): every number of a model,
+ * which the parameter kernels of the model's topology take at run time, so
+ * that a candidate costs no code generation. Designs have the topology of
+ * the model designed (three or four limbs: its limbs, bodies and
+ * actuators, so its parameter names and their count): the problem holds
+ * that model (prru_design_problem.model), and a function that needs the
+ * topology without a problem takes it first (m). Only m's topology is
+ * read, never its numbers: a design is the prru_params given. A design is
+ * judged exactly as a model's map is by `prru map`: w_R by prru_dme_from,
+ * regularity by prru_jd_regular (with the design's own length scale, the
+ * mean upper link), a regular pose whose det J_d has the other sign than
+ * at home (0, 0, q3) counted as singular (the other assembly mode, cut off
+ * from home by the singular locus; three actuators only), the global index
+ * by prru_map_summarize; a design evaluated here and the same design
+ * written as a model file, regenerated and mapped by `prru map` give the
+ * same index (to the kernels' 1e-13 agreement).
  *
  * Parameter names (one number each):
  *   b_i, l1_i, l2_i        rail offset, upper link, lower link of limb i (m)
@@ -62,14 +67,17 @@ typedef struct {
   double lo, hi;                       /* bounds of the value (the first parameter's) */
 } prru_design_var;
 
-/* Parses a parameter or variable name (grammar above) into v (bounds not
- * set): PRRU_OK, or PRRU_EINPUT with msg saying why. */
-PRRU_API int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen);
-/* The number of single parameters, and the k-th (0-based, order of the
- * list above: geometry by limb, then every body's m, com, I, then the
- * armatures) as a one-parameter variable named canonically ("b_1"). */
-PRRU_API int prru_design_param_count(void);
-PRRU_API int prru_design_param(int k, prru_design_var *v);
+/* Parses a parameter or variable name (grammar above) of m's topology
+ * (its limbs, bodies and actuators) into v (bounds not set): PRRU_OK, or
+ * PRRU_EINPUT with msg saying why. */
+PRRU_API int prru_design_var_parse(const prru_model *m, const char *name, prru_design_var *v, char *msg,
+                                   int msglen);
+/* The number of single parameters of m's topology, and the k-th
+ * (0-based, order of the list above: geometry by limb, then every body's
+ * m, com, I, then the armatures) as a one-parameter variable named
+ * canonically ("b_1"). */
+PRRU_API int prru_design_param_count(const prru_model *m);
+PRRU_API int prru_design_param(const prru_model *m, int k, prru_design_var *v);
 /* The variable's value in p (its first parameter's). */
 PRRU_API double prru_design_get(const prru_params *p, const prru_design_var *v);
 /* Sets the variable to x: every tied parameter moves by x minus the
@@ -79,29 +87,34 @@ PRRU_API void prru_design_set(prru_params *p, const prru_params *base, const prr
  * and b2 both 0.3): a start design stated outright (prru optimize
  * --set), where prru_design_set keeps the tied parameters' differences. */
 PRRU_API void prru_design_assign(prru_params *p, const prru_design_var *v, double x);
-/* A natural scale of the variable at p, for difference steps and scaled
- * sensitivities: |value|, or where the value may be 0, the body's mean
- * principal moment (products of inertia), the design's length scale
- * (centres of mass), the mean slider mass (armature). */
-PRRU_API double prru_design_scale(const prru_params *p, const prru_design_var *v);
+/* A natural scale of the variable at p (a design of m's topology), for
+ * difference steps and scaled sensitivities: |value|, or where the value
+ * may be 0, the body's mean principal moment (products of inertia), the
+ * design's length scale (centres of mass), the mean slider mass
+ * (armature). */
+PRRU_API double prru_design_scale(const prru_model *m, const prru_params *p, const prru_design_var *v);
 
 /* Bounds of v: -+ pct % (0 < pct < 100) of the value of every parameter v
  * ties (of its prru_design_scale where it is 0). Tied parameters move by
  * one shift (prru_design_set), so the bounds of the value are the
  * intersection of every parameter's: no tied parameter leaves its own
  * -+ pct %, whatever the limbs' values. PRRU_OK, or PRRU_EINPUT (pct). */
-PRRU_API int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct);
+PRRU_API int prru_design_var_bounds(const prru_model *m, const prru_params *p, prru_design_var *v,
+                                    double pct);
 
-/* The design's length scale: the mean upper link (prru_length_scale). */
-PRRU_API double prru_design_length_scale(const prru_params *p);
+/* The length scale of p, a design of m's topology: the mean upper link
+ * (prru_length_scale). */
+PRRU_API double prru_design_length_scale(const prru_model *m, const prru_params *p);
 
-/* Is p a buildable robot, by the rules a model file must follow: lengths
- * and masses positive, armature not negative, every number 0 or of
- * magnitude in [1e-9, 1e6], inertia tensors positive definite with
- * principal moments obeying the triangle inequality, and every limb
- * assembled at q = 0 (horizontal gap |b - a - l2| shorter than l1).
- * PRRU_OK, or PRRU_EINPUT with msg naming the parameter and the rule. */
-PRRU_API int prru_design_check(const prru_params *p, char *msg, int msglen);
+/* Is p a buildable robot of m's topology, by the rules a model file must
+ * follow: lengths and masses positive, armature not negative, every
+ * number 0 or of magnitude in [1e-9, 1e6], inertia tensors positive
+ * definite with principal moments obeying the triangle inequality, and
+ * every limb assembled at q = 0 (horizontal gap |b - a - l2| shorter
+ * than l1).
+ * PRRU_OK, or PRRU_EINPUT with msg naming the parameter and the rule (or
+ * saying that m, NULL or of no topology, has no design). */
+PRRU_API int prru_design_check(const prru_model *m, const prru_params *p, char *msg, int msglen);
 
 typedef enum {
   PRRU_OBJ_MEAN = 0, /* global index: mean of w_R - 1 over the regular grid points */
@@ -115,6 +128,10 @@ PRRU_API const char *prru_objective_name(prru_objective o);
 
 /* The optimisation problem: where and how a design is judged. */
 typedef struct {
+  /* The model designed: its topology is the designs' (prru_params of its
+   * limbs, bodies and actuators, evaluated with its topology's parameter
+   * kernels); it must outlive the problem. */
+  const prru_model *model;
   prru_map_grid grid;     /* the workspace rectangle (prru_map_check) */
   double rcond_min;       /* J_d regular where rcond >= this, in (0, 1) */
   prru_objective objective;
@@ -126,15 +143,17 @@ typedef struct {
   double penalty_weight;
 } prru_design_problem;
 
-/* Fig. 7-like defaults for a grid: rcond_min 4e-3 (cond_1 <= 250), mean,
- * no stroke limits, weight 1000. */
-PRRU_API void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g);
-/* PRRU_OK, or PRRU_EINPUT with msg (grid, rcond_min, stroke, weight). */
+/* Fig. 7-like defaults for designs of m on a grid: rcond_min 4e-3
+ * (cond_1 <= 250), mean, no stroke limits, weight 1000. */
+PRRU_API void prru_design_problem_default(const prru_model *m, prru_design_problem *pr,
+                                          const prru_map_grid *g);
+/* PRRU_OK, or PRRU_EINPUT with msg (model, grid, rcond_min, stroke,
+ * weight). */
 PRRU_API int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen);
 /* A run's strokes (prru_limits_for_run) as the problem's: one interval
- * for every slider, the intersection of theirs (none when no slider has
- * one). PRRU_OK, or PRRU_EINPUT with msg when they have no common
- * interval (pr untouched). */
+ * for every slider of its model (pr->model set), the intersection of
+ * theirs (none when no slider has one). PRRU_OK, or PRRU_EINPUT with msg
+ * when they have no common interval (pr untouched). */
 PRRU_API int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen);
 
 /* The status of a regular grid point in the other assembly mode: the
@@ -152,7 +171,7 @@ typedef struct {
   unsigned char *status; /* n, a prru_status per point or PRRU_DESIGN_OTHER_MODE */
   struct prru_design_row *rows; /* per grid row sums (private) */
   int precision; /* PRRU_PRECISION_DOUBLE (default) or _FLOAT: w_R and the sliders' range in
-                    float (prru_param_f_batch_dme_terms), the statuses double's as in the maps
+                    float (the topology's f_batch_dme_terms), the statuses double's as in the maps
                     (prru_dme.h), rcond double's wherever it is penalised */
 } prru_design_data;
 
@@ -243,12 +262,13 @@ typedef struct {
   int set_changed;
 } prru_design_sens;
 
-/* Is rel_step a usable relative step for v at p: in (0, 0.5), and the
+/* Is rel_step a usable relative step for v at p (a design of m's
+ * topology): in (0, 0.5), and the
  * step h = rel_step * scale not lost to rounding (value +- h, for every
  * tied parameter, must differ by 2 h to within 1 %). PRRU_OK, or
  * PRRU_EINPUT with msg giving the smallest step that is. */
-PRRU_API int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
-                                    int msglen);
+PRRU_API int prru_design_step_check(const prru_model *m, const prru_params *p, const prru_design_var *v,
+                                    double rel_step, char *msg, int msglen);
 /* Central difference of the objective with respect to v at p (why not
  * closed-form derivatives: docs/studies.md; truncation O(h^2), 1.5e-4 of
  * the largest sensitivity at rel_step 1e-4 on fig. 7's rectangle). Perturbed

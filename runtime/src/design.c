@@ -1,6 +1,7 @@
 /* Design variables, validity, the global-index objective over a grid with
- * the runtime-parameter kernels, Nelder-Mead optimisation and finite
- * difference sensitivity; definitions in prru_design.h. */
+ * the parameter kernels of the designed model's topology (topology.h),
+ * Nelder-Mead optimisation and finite difference sensitivity; definitions
+ * in prru_design.h. */
 #define _POSIX_C_SOURCE 200809L
 #include <float.h>
 #include <math.h>
@@ -14,6 +15,7 @@
 
 #include "internal.h"
 #include "prru_design.h"
+#include "topology.h"
 
 /* ---- Names ---- */
 
@@ -32,28 +34,26 @@ static double get(const prru_params *p, size_t off)
   return *(const double *)(const void *)((const char *)p + off);
 }
 
-static int body_index(const char *s, size_t len)
+static int body_index(const prru_mechanism *me, const char *s, size_t len)
 {
-  for (int b = 0; b < PRRU_NBODY; b++)
-    if (strlen(prru_mech.body_names[b]) == len && strncmp(prru_mech.body_names[b], s, len) == 0)
-      return b;
+  for (int b = 0; b < me->nbody; b++)
+    if (strlen(me->body_names[b]) == len && strncmp(me->body_names[b], s, len) == 0) return b;
   return -1;
 }
 
 /* Bodies named by s[0..len): a body, or the kind L, U, S of every limb. */
-static int bodies_of(const char *s, size_t len, int bodies[PRRU_NBODY])
+static int bodies_of(const prru_mechanism *me, const char *s, size_t len, int bodies[PRRU_MAX_BODY])
 {
-  int b = body_index(s, len);
+  int b = body_index(me, s, len);
   if (b >= 0) {
     bodies[0] = b;
     return 1;
   }
   if (len != 1) return 0;
-  const int *kind = s[0] == 'L' ? prru_mech.lower : s[0] == 'U' ? prru_mech.upper
-                                : s[0] == 'S' ? prru_mech.slider : NULL;
+  const int *kind = s[0] == 'L' ? me->lower : s[0] == 'U' ? me->upper : s[0] == 'S' ? me->slider : NULL;
   if (!kind) return 0;
-  for (int i = 0; i < PRRU_NLIMB; i++) bodies[i] = kind[i];
-  return PRRU_NLIMB;
+  for (int i = 0; i < me->nlimb; i++) bodies[i] = kind[i];
+  return me->nlimb;
 }
 
 static void add(prru_design_var *v, size_t off)
@@ -62,21 +62,21 @@ static void add(prru_design_var *v, size_t off)
 }
 
 /* Limbs from a digit string ("12"): each once, within 1..nmax. */
-static int limbs_of(const char *digits, int nmax, int limbs[PRRU_NLIMB])
+static int limbs_of(const char *digits, int nmax, int limbs[PRRU_MAX_LIMB])
 {
   int n = 0, seen[10] = {0};
   if (!*digits) return 0;
   for (const char *c = digits; *c; c++) {
     if (*c < '1' || *c > '9') return 0;
     int l = *c - '0';
-    if (l > nmax || seen[l] || n >= PRRU_NLIMB) return 0;
+    if (l > nmax || seen[l] || n >= PRRU_MAX_LIMB) return 0;
     seen[l] = 1;
     limbs[n++] = l - 1;
   }
   return n;
 }
 
-static int parse_geometry(const char *name, prru_design_var *v)
+static int parse_geometry(const prru_mechanism *me, const char *name, prru_design_var *v)
 {
   static const struct {
     const char *base;
@@ -87,7 +87,7 @@ static int parse_geometry(const char *name, prru_design_var *v)
     size_t bl = strlen(geo[g].base);
     if (strncmp(name, geo[g].base, bl) != 0) continue;
     const char *rest = name + bl;
-    int nmax = geo[g].off == OFF(a) ? 2 : PRRU_NLIMB, limbs[PRRU_NLIMB], n;
+    int nmax = geo[g].off == OFF(a) ? 2 : me->nlimb, limbs[PRRU_MAX_LIMB], n;
     if (!*rest) {
       n = nmax;
       for (int i = 0; i < n; i++) limbs[i] = i;
@@ -105,11 +105,11 @@ static int parse_geometry(const char *name, prru_design_var *v)
   return 0;
 }
 
-static int parse_inertial(const char *name, prru_design_var *v)
+static int parse_inertial(const prru_mechanism *me, const char *name, prru_design_var *v)
 {
-  int bodies[PRRU_NBODY], nb;
+  int bodies[PRRU_MAX_BODY], nb;
   if (strncmp(name, "m_", 2) == 0) {
-    nb = bodies_of(name + 2, strlen(name + 2), bodies);
+    nb = bodies_of(me, name + 2, strlen(name + 2), bodies);
     for (int i = 0; i < nb; i++) add(v, OFF(mass) + (size_t)bodies[i] * sizeof(double));
     return nb > 0;
   }
@@ -117,7 +117,7 @@ static int parse_inertial(const char *name, prru_design_var *v)
   if (!is_com && !is_i) return 0;
   const char *s = name + (is_com ? 4 : 2), *us = strrchr(s, '_');
   if (!us) return 0;
-  nb = bodies_of(s, (size_t)(us - s), bodies);
+  nb = bodies_of(me, s, (size_t)(us - s), bodies);
   int comp = -1;
   for (int c = 0; c < (is_com ? 3 : 6); c++)
     if (strcmp(us + 1, is_com ? axis_names[c] : inertia_names[c]) == 0) comp = c;
@@ -128,25 +128,27 @@ static int parse_inertial(const char *name, prru_design_var *v)
   return 1;
 }
 
-static int parse_armature(const char *name, prru_design_var *v)
+static int parse_armature(const prru_mechanism *me, const char *name, prru_design_var *v)
 {
   if (strcmp(name, "armature") == 0) {
-    for (int i = 0; i < PRRU_NACT; i++) add(v, OFF(armature) + (size_t)i * sizeof(double));
+    for (int i = 0; i < me->nact; i++) add(v, OFF(armature) + (size_t)i * sizeof(double));
     return 1;
   }
   if (strncmp(name, "armature_", 9) != 0) return 0;
-  int acts[PRRU_NLIMB], n = limbs_of(name + 9, PRRU_NACT, acts);
+  int acts[PRRU_MAX_LIMB], n = limbs_of(name + 9, me->nact, acts);
   for (int i = 0; i < n; i++) add(v, OFF(armature) + (size_t)acts[i] * sizeof(double));
   return n > 0;
 }
 
-int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int msglen)
+int prru_design_var_parse(const prru_model *m, const char *name, prru_design_var *v, char *msg, int msglen)
 {
   memset(v, 0, sizeof *v);
   if (strlen(name) >= sizeof v->name)
     return prru_fail(msg, msglen, PRRU_EINPUT, "'%.30s...': not a design parameter (too long)", name);
   snprintf(v->name, sizeof v->name, "%s", name);
-  if (parse_geometry(name, v) || parse_inertial(name, v) || parse_armature(name, v)) return PRRU_OK;
+  const prru_mechanism *me = m->mech;
+  if (parse_geometry(me, name, v) || parse_inertial(me, name, v) || parse_armature(me, name, v))
+    return PRRU_OK;
   return prru_fail(msg, msglen, PRRU_EINPUT,
                    "'%s': not a design parameter (b, l1, l2, a with limb digits such as b12, "
                    "l1_2; m_B, com_B_x, I_B_xy with B a body (P L1 U1 S1 ...) or L, U, S; "
@@ -154,32 +156,40 @@ int prru_design_var_parse(const char *name, prru_design_var *v, char *msg, int m
                    name);
 }
 
-/* Single parameters in order: geometry by limb, then every body's mass,
- * com, inertia, then the armatures. */
-#define NGEO (3 * PRRU_NLIMB + 2)
+/* Single parameters in order: geometry by limb (b, l1, l2 of every limb,
+ * then a_1, a_2), then every body's mass, com, inertia, then the
+ * armatures. */
 #define NPERBODY 10
 
-int prru_design_param_count(void)
+static int ngeo(const prru_mechanism *me)
 {
-  return NGEO + NPERBODY * PRRU_NBODY + PRRU_NACT;
+  return 3 * me->nlimb + 2;
 }
 
-int prru_design_param(int k, prru_design_var *v)
+int prru_design_param_count(const prru_model *m)
 {
+  const prru_mechanism *me = m->mech;
+  return ngeo(me) + NPERBODY * me->nbody + me->nact;
+}
+
+int prru_design_param(const prru_model *m, int k, prru_design_var *v)
+{
+  const prru_mechanism *me = m->mech;
+  const int n = me->nlimb;
   memset(v, 0, sizeof *v);
-  if (k < 0 || k >= prru_design_param_count()) return PRRU_EINPUT;
-  if (k < NGEO) {
+  if (k < 0 || k >= prru_design_param_count(m)) return PRRU_EINPUT;
+  if (k < ngeo(me)) {
     static const char *const base[3] = {"b", "l1", "l2"};
     static const size_t off[3] = {OFF(b), OFF(l1), OFF(l2)};
-    int g = k < 3 * PRRU_NLIMB ? k / PRRU_NLIMB : -1, i = g >= 0 ? k % PRRU_NLIMB : k - 3 * PRRU_NLIMB;
+    int g = k < 3 * n ? k / n : -1, i = g >= 0 ? k % n : k - 3 * n;
     snprintf(v->name, sizeof v->name, "%s_%d", g >= 0 ? base[g] : "a", i + 1);
     add(v, (g >= 0 ? off[g] : OFF(a)) + (size_t)i * sizeof(double));
     return PRRU_OK;
   }
-  k -= NGEO;
-  if (k < NPERBODY * PRRU_NBODY) {
+  k -= ngeo(me);
+  if (k < NPERBODY * me->nbody) {
     int b = k / NPERBODY, c = k % NPERBODY;
-    const char *bn = prru_mech.body_names[b];
+    const char *bn = me->body_names[b];
     if (c == 0) {
       snprintf(v->name, sizeof v->name, "m_%s", bn);
       add(v, OFF(mass) + (size_t)b * sizeof(double));
@@ -192,7 +202,7 @@ int prru_design_param(int k, prru_design_var *v)
     }
     return PRRU_OK;
   }
-  k -= NPERBODY * PRRU_NBODY;
+  k -= NPERBODY * me->nbody;
   snprintf(v->name, sizeof v->name, "armature_%d", k + 1);
   add(v, OFF(armature) + (size_t)k * sizeof(double));
   return PRRU_OK;
@@ -216,20 +226,21 @@ void prru_design_assign(prru_params *p, const prru_design_var *v, double x)
   for (int i = 0; i < v->n; i++) *at(p, v->offset[i]) = x;
 }
 
-double prru_design_length_scale(const prru_params *p)
+double prru_design_length_scale(const prru_model *m, const prru_params *p)
 {
   /* The same sum as prru_length_scale, so that a design and its
    * regenerated model use the same bits. */
+  const int n = m->mech->nlimb;
   double s = 0;
-  for (int i = 0; i < PRRU_NLIMB; i++) s += p->l1[i];
-  return s / PRRU_NLIMB;
+  for (int i = 0; i < n; i++) s += p->l1[i];
+  return s / n;
 }
 
-double prru_design_scale(const prru_params *p, const prru_design_var *v)
+double prru_design_scale(const prru_model *m, const prru_params *p, const prru_design_var *v)
 {
   size_t off = v->offset[0];
   double x = fabs(get(p, off));
-  if (off >= OFF(com) && off < OFF(com) + sizeof p->com) return prru_design_length_scale(p);
+  if (off >= OFF(com) && off < OFF(com) + sizeof p->com) return prru_design_length_scale(m, p);
   if (off >= OFF(inertia) && off < OFF(inertia) + sizeof p->inertia) {
     size_t e = (off - OFF(inertia)) / sizeof(double);
     if (e % 6 < 3) return x;
@@ -237,9 +248,10 @@ double prru_design_scale(const prru_params *p, const prru_design_var *v)
     return (fabs(t[0]) + fabs(t[1]) + fabs(t[2])) / 3.0;
   }
   if (off >= OFF(armature) && off < OFF(armature) + sizeof p->armature && !(x > 0)) {
+    const prru_mechanism *me = m->mech;
     double s = 0;
-    for (int i = 0; i < PRRU_NLIMB; i++) s += p->mass[prru_mech.slider[i]];
-    return s / PRRU_NLIMB;
+    for (int i = 0; i < me->nlimb; i++) s += p->mass[me->slider[i]];
+    return s / me->nlimb;
   }
   return x;
 }
@@ -253,16 +265,16 @@ static prru_design_var member(const prru_design_var *v, int k)
   return m;
 }
 
-int prru_design_var_bounds(const prru_params *p, prru_design_var *v, double pct)
+int prru_design_var_bounds(const prru_model *m, const prru_params *p, prru_design_var *v, double pct)
 {
   if (!(pct > 0 && pct < 100)) return PRRU_EINPUT;
   /* Every parameter's bounds are symmetric, x_k -+ pct % r_k: the shifts
    * all of them allow are -+ pct % of the smallest r_k. */
   double r = INFINITY;
   for (int k = 0; k < v->n; k++) {
-    prru_design_var m = member(v, k);
-    double x = fabs(prru_design_get(p, &m));
-    r = fmin(r, x > 0 ? x : prru_design_scale(p, &m));
+    prru_design_var one = member(v, k);
+    double x = fabs(prru_design_get(p, &one));
+    r = fmin(r, x > 0 ? x : prru_design_scale(m, p, &one));
   }
   double x0 = prru_design_get(p, v);
   v->lo = x0 - pct / 100 * r;
@@ -307,11 +319,11 @@ static int inertia_ok(const double e[6], const char *body, char *msg, int msglen
   return PRRU_OK;
 }
 
-static int numbers_ok(const prru_params *p, char *msg, int msglen)
+static int numbers_ok(const prru_model *m, const prru_params *p, char *msg, int msglen)
 {
-  for (int k = 0; k < prru_design_param_count(); k++) {
+  for (int k = 0; k < prru_design_param_count(m); k++) {
     prru_design_var v;
-    prru_design_param(k, &v);
+    prru_design_param(m, k, &v);
     double x = prru_design_get(p, &v);
     if (!in_file_range(x))
       return prru_fail(msg, msglen, PRRU_EINPUT, "%s = %.17g: not 0 and not of magnitude in [1e-9, 1e6]",
@@ -337,17 +349,22 @@ static int limb_ok(const prru_params *p, int i, char *msg, int msglen)
   return PRRU_OK;
 }
 
-int prru_design_check(const prru_params *p, char *msg, int msglen)
+int prru_design_check(const prru_model *m, const prru_params *p, char *msg, int msglen)
 {
-  int st = numbers_ok(p, msg, msglen);
-  for (int i = 0; i < PRRU_NLIMB && st == PRRU_OK; i++) st = limb_ok(p, i, msg, msglen);
-  for (int b = 0; b < PRRU_NBODY && st == PRRU_OK; b++) {
+  /* A design is evaluated with its model's topology's kernels: without
+   * them there is nothing to judge it by (a problem never defaulted). */
+  if (!m || !prru_topology_of(m->mech->nlimb))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "no model of 3 or 4 limbs to design");
+  const prru_mechanism *me = m->mech;
+  int st = numbers_ok(m, p, msg, msglen);
+  for (int i = 0; i < me->nlimb && st == PRRU_OK; i++) st = limb_ok(p, i, msg, msglen);
+  for (int b = 0; b < me->nbody && st == PRRU_OK; b++) {
     if (!(p->mass[b] > 0))
-      return prru_fail(msg, msglen, PRRU_EINPUT, "m_%s = %g: must be positive",
-                       prru_mech.body_names[b], p->mass[b]);
-    st = inertia_ok(p->inertia[b], prru_mech.body_names[b], msg, msglen);
+      return prru_fail(msg, msglen, PRRU_EINPUT, "m_%s = %g: must be positive", me->body_names[b],
+                       p->mass[b]);
+    st = inertia_ok(p->inertia[b], me->body_names[b], msg, msglen);
   }
-  for (int i = 0; i < PRRU_NACT && st == PRRU_OK; i++)
+  for (int i = 0; i < me->nact && st == PRRU_OK; i++)
     if (!(p->armature[i] >= 0))
       return prru_fail(msg, msglen, PRRU_EINPUT, "armature_%d = %g: must not be negative", i + 1,
                        p->armature[i]);
@@ -371,8 +388,9 @@ const char *prru_objective_name(prru_objective o)
   return o == PRRU_OBJ_MAX ? "max" : o == PRRU_OBJ_LOG ? "log" : "mean";
 }
 
-void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g)
+void prru_design_problem_default(const prru_model *m, prru_design_problem *pr, const prru_map_grid *g)
 {
+  pr->model = m;
   pr->grid = *g;
   pr->rcond_min = 4e-3;
   pr->objective = PRRU_OBJ_MEAN;
@@ -384,7 +402,8 @@ void prru_design_problem_default(prru_design_problem *pr, const prru_map_grid *g
 int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, char *msg, int msglen)
 {
   double lo = -INFINITY, hi = INFINITY;
-  for (int i = 0; i < PRRU_NACT; i++) lo = fmax(lo, l->d_min[i]), hi = fmin(hi, l->d_max[i]);
+  for (int i = 0; i < pr->model->mech->nact; i++)
+    lo = fmax(lo, l->d_min[i]), hi = fmin(hi, l->d_max[i]);
   if (isinf(lo) && isinf(hi)) return PRRU_OK;
   if (!(lo < hi))
     return prru_fail(msg, msglen, PRRU_EINPUT, "the sliders' strokes have no common interval ([%g, %g]): the "
@@ -396,6 +415,9 @@ int prru_design_problem_stroke(prru_design_problem *pr, const prru_limits *l, ch
 
 int prru_design_problem_check(const prru_design_problem *pr, char *msg, int msglen)
 {
+  if (!pr->model || !prru_topology_of(pr->model->mech->nlimb))
+    return prru_fail(msg, msglen, PRRU_EINPUT, "the problem has no model of 3 or 4 limbs "
+                                               "(prru_design_problem_default sets it)");
   if (prru_map_check(&pr->grid) != PRRU_OK)
     return prru_fail(msg, msglen, PRRU_EINPUT, "the grid is not valid (finite ranges lo < hi, "
                                                "at least 2 points per axis)");
@@ -443,34 +465,34 @@ void prru_design_data_free(prru_design_data *dd)
   dd->n = 0;
 }
 
-/* Distance of the sliders outside [lo, hi], summed. */
-static double stroke_excess(const prru_design_problem *pr, const double d[PRRU_NACT])
+/* Distance of the nact sliders outside [lo, hi], summed. */
+static double stroke_excess(const prru_design_problem *pr, const double d[], int nact)
 {
   double e = 0;
-  for (int i = 0; i < PRRU_NACT; i++) e += fmax(0.0, pr->stroke_lo - d[i]) + fmax(0.0, d[i] - pr->stroke_hi);
+  for (int i = 0; i < nact; i++) e += fmax(0.0, pr->stroke_lo - d[i]) + fmax(0.0, d[i] - pr->stroke_hi);
   return e;
 }
 
 /* The assembly mode of the design at home, (0, 0, q3), as
  * prru_map_home_mode tells the model's (0: no point is in "the other"
  * mode). */
-static int home_mode(const prru_param_derived *p, double q3)
+static int home_mode(const prru_topology *t, const prru_topo_derived *p, double q3)
 {
   const double q[3] = {0.0, 0.0, q3};
-  double d[PRRU_NACT], Jd[PRRU_NACT * 3];
-  prru_param_ik_jd(p, q, d, Jd);
-  return prru_assembly_mode(d, Jd, PRRU_NACT);
+  double d[PRRU_MAX_ACT], Jd[PRRU_MAX_ACT * 3];
+  t->general->ik_jd(p, q, d, Jd);
+  return prru_assembly_mode(d, Jd, t->nact);
 }
 
 /* The design's kernels at a block of grid points, from the batched
- * dme_terms (bit for bit prru_param_ik_jd, _mass, _platform_jacobian):
+ * dme_terms (bit for bit its topology's ik_jd, mass, platform_jacobian):
  * rows of GRID_BLOCK, point c's entry i at [i * n + c]; then w_R, the
  * status, rcond and the mode of every point from prru_dme_batch (bit for
  * bit prru_jd_regular, prru_mode_status and prru_dme_from). */
 #define GRID_BLOCK 64
 typedef struct {
   int n;
-  double q[3 * GRID_BLOCK], d[PRRU_NACT * GRID_BLOCK], Jd[3 * PRRU_NACT * GRID_BLOCK],
+  double q[3 * GRID_BLOCK], d[PRRU_MAX_ACT * GRID_BLOCK], Jd[3 * PRRU_MAX_ACT * GRID_BLOCK],
       M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK], rc[GRID_BLOCK];
   unsigned char st[GRID_BLOCK], other[GRID_BLOCK];
   prru_dme_batch_ws ws;
@@ -479,7 +501,7 @@ typedef struct {
 /* The float evaluation of a block (prru_design_data.precision): its
  * kernels' inputs and outputs, and the points redone in double. */
 typedef struct {
-  float q[3 * GRID_BLOCK], d[PRRU_NACT * GRID_BLOCK], Jd[3 * PRRU_NACT * GRID_BLOCK],
+  float q[3 * GRID_BLOCK], d[PRRU_MAX_ACT * GRID_BLOCK], Jd[3 * PRRU_MAX_ACT * GRID_BLOCK],
       M[9 * GRID_BLOCK], JP[18 * GRID_BLOCK];
   unsigned char sure[GRID_BLOCK];
   int redo[GRID_BLOCK];
@@ -494,10 +516,10 @@ typedef struct {
  * (256 FLT_EPSILON (|d| + 4 L), as the map's stroke test). Its d, w_R then
  * enter in float; every other point is redone in double, rcond with it. */
 static int float_point_clear(const prru_design_problem *pr, const grid_block_f *f, int n, int c,
-                             double L)
+                             double L, int nact)
 {
   if (!f->sure[c]) return 0;
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < nact; i++) {
     const double di = f->d[(long)i * n + c], e = 256.0 * FLT_EPSILON * (fabs(di) + 4.0 * L);
     if (pr->stroke && !(di - e >= pr->stroke_lo && di + e <= pr->stroke_hi)) return 0;
   }
@@ -507,35 +529,36 @@ static int float_point_clear(const prru_design_problem *pr, const grid_block_f *
 /* b (q filled, n points) in float: w_R into w, and b's d, rc, st, other
  * as the double path gives them (d of the points taken in float: float's
  * converted; rc: rcond_min there, whose violation is 0 as the true rcond's). */
-static void grid_block_float(const prru_design_problem *pr, const prru_param_derived *p, double L, int home,
-                             grid_block *b, grid_block_f *f, double *w)
+static void grid_block_float(const prru_design_problem *pr, const prru_topology *t,
+                             const prru_topo_derived *p, double L, int home, grid_block *b,
+                             grid_block_f *f, double *w)
 {
-  const int n = b->n;
+  const int n = b->n, nact = t->nact;
   for (int i = 0; i < 3 * n; i++) f->q[i] = (float)b->q[i];
-  prru_param_f_batch_dme_terms(p, n, f->q, f->d, f->Jd, f->M, f->JP);
-  prru_dme_batch_f(PRRU_NACT, n, f->d, f->Jd, f->M, f->JP, L, pr->rcond_min, home, &f->ws, w, b->st, f->sure);
+  t->f_batch_dme_terms(p, n, f->q, f->d, f->Jd, f->M, f->JP);
+  prru_dme_batch_f(nact, n, f->d, f->Jd, f->M, f->JP, L, pr->rcond_min, home, &f->ws, w, b->st, f->sure);
   int nx = 0;
   for (int c = 0; c < n; c++) {
-    for (int i = 0; i < PRRU_NACT; i++) b->d[(long)i * n + c] = f->d[(long)i * n + c];
+    for (int i = 0; i < nact; i++) b->d[(long)i * n + c] = f->d[(long)i * n + c];
     b->rc[c] = pr->rcond_min;
     b->other[c] = 0;
-    if (!float_point_clear(pr, f, n, c, L)) f->redo[nx++] = c;
+    if (!float_point_clear(pr, f, n, c, L, nact)) f->redo[nx++] = c;
   }
   if (nx == 0) return;
   grid_block *x = &f->x;
   x->n = nx;
   for (int r = 0; r < 3; r++)
-    for (int t = 0; t < nx; t++) x->q[(long)r * nx + t] = b->q[(long)r * n + f->redo[t]];
+    for (int k = 0; k < nx; k++) x->q[(long)r * nx + k] = b->q[(long)r * n + f->redo[k]];
   double wx[GRID_BLOCK];
-  prru_param_batch_dme_terms(p, nx, x->q, x->d, x->Jd, x->M, x->JP);
-  prru_dme_batch(PRRU_NACT, nx, x->d, x->Jd, x->M, x->JP, L, pr->rcond_min, home, &x->ws, wx, x->st, x->rc, x->other);
-  for (int t = 0; t < nx; t++) {
-    const int c = f->redo[t];
-    w[c] = wx[t];
-    b->st[c] = x->st[t];
-    b->rc[c] = x->rc[t];
-    b->other[c] = x->other[t];
-    for (int i = 0; i < PRRU_NACT; i++) b->d[(long)i * n + c] = x->d[(long)i * nx + t];
+  t->general->batch_dme_terms(p, nx, x->q, x->d, x->Jd, x->M, x->JP);
+  prru_dme_batch(nact, nx, x->d, x->Jd, x->M, x->JP, L, pr->rcond_min, home, &x->ws, wx, x->st, x->rc, x->other);
+  for (int k = 0; k < nx; k++) {
+    const int c = f->redo[k];
+    w[c] = wx[k];
+    b->st[c] = x->st[k];
+    b->rc[c] = x->rc[k];
+    b->other[c] = x->other[k];
+    for (int i = 0; i < nact; i++) b->d[(long)i * n + c] = x->d[(long)i * nx + k];
   }
 }
 
@@ -563,7 +586,8 @@ static double point_violation(const prru_design_problem *pr, const grid_block *b
  * point's regularity differs from the status dd holds from before. */
 typedef struct {
   const prru_design_problem *pr;
-  const prru_param_derived *p;
+  const prru_topology *t; /* the problem's model's: the design's kernels and sizes */
+  const prru_topo_derived *p;
   prru_design_data *dd;
   double L;
   int home, compare, next_row;
@@ -575,6 +599,7 @@ static void grid_row(grid_job *j, int i)
   const prru_design_problem *pr = j->pr;
   const prru_map_grid *g = &pr->grid;
   struct prru_design_row *r = &j->dd->rows[i];
+  const int nact = j->t->nact;
   const double q1 = prru_map_axis(g->q1_lo, g->q1_hi, g->n1, i);
   grid_block b PRRU_ALIGN64; /* about 40 KB of this thread's stack: no allocation */
   /* float: about 70 KB more, allocated (without it, double: slower, the
@@ -596,10 +621,10 @@ static void grid_row(grid_job *j, int i)
     }
     const long k0 = (long)i * g->n2 + c0;
     if (f) {
-      grid_block_float(pr, j->p, j->L, j->home, &b, f, &j->dd->w_R[k0]);
+      grid_block_float(pr, j->t, j->p, j->L, j->home, &b, f, &j->dd->w_R[k0]);
     } else {
-      prru_param_batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
-      prru_dme_batch(PRRU_NACT, b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
+      j->t->general->batch_dme_terms(j->p, b.n, b.q, b.d, b.Jd, b.M, b.JP);
+      prru_dme_batch(nact, b.n, b.d, b.Jd, b.M, b.JP, j->L, pr->rcond_min, j->home, &b.ws,
                      &j->dd->w_R[k0], b.st, b.rc, b.other);
     }
     for (int c = 0; c < b.n; c++) {
@@ -610,13 +635,13 @@ static void grid_row(grid_job *j, int i)
       r->viol += point_violation(pr, &b, c);
       if (st == PRRU_EUNREACHABLE) continue;
       r->nreach++;
-      double d[PRRU_NACT];
-      for (int a = 0; a < PRRU_NACT; a++) {
+      double d[PRRU_MAX_ACT];
+      for (int a = 0; a < nact; a++) {
         d[a] = b.d[a * b.n + c];
         r->dmin = fmin(r->dmin, d[a]);
         r->dmax = fmax(r->dmax, d[a]);
       }
-      if (pr->stroke) r->stroke += stroke_excess(pr, d) / j->L;
+      if (pr->stroke) r->stroke += stroke_excess(pr, d, nact) / j->L;
     }
   }
   free(f);
@@ -639,21 +664,23 @@ static void *grid_worker(void *arg)
 static void grid_eval(const prru_design_problem *pr, const prru_params *p, prru_design_data *dd,
                       int compare)
 {
-  /* The design's numbers as the kernels read them: derived once here. */
-  prru_param_derived dp;
-  prru_params_derive(p, &dp);
-  grid_job j = {pr, &dp, dd, prru_design_length_scale(p), home_mode(&dp, pr->grid.q3), compare, 0,
-                PTHREAD_MUTEX_INITIALIZER};
+  /* The design's numbers as its topology's kernels read them: derived
+   * once here, on this thread's stack (an evaluation allocates nothing). */
+  const prru_topology *t = prru_topology_of(pr->model->mech->nlimb);
+  prru_topo_derived dp;
+  t->derive(p, &dp);
+  grid_job j = {pr, t, &dp, dd, prru_design_length_scale(pr->model, p), home_mode(t, &dp, pr->grid.q3),
+                compare, 0, PTHREAD_MUTEX_INITIALIZER};
   enum { MAX_THREADS = 64 };
   pthread_t tid[MAX_THREADS];
   int nt = dd->nthreads < 1 ? 1 : dd->nthreads > MAX_THREADS ? MAX_THREADS : dd->nthreads, started = 0;
   if (nt > pr->grid.n1) nt = pr->grid.n1;
-  for (int t = 1; t < nt; t++) {
+  for (int i = 1; i < nt; i++) {
     if (pthread_create(&tid[started], NULL, grid_worker, &j) != 0) break;
     started++;
   }
   grid_worker(&j);
-  for (int t = 0; t < started; t++) pthread_join(tid[t], NULL);
+  for (int i = 0; i < started; i++) pthread_join(tid[i], NULL);
   pthread_mutex_destroy(&j.lock);
 }
 
@@ -673,7 +700,7 @@ int prru_design_evaluate(const prru_design_problem *pr, const prru_params *p,
   memset(ev, 0, sizeof *ev);
   ev->objective = ev->d_min = ev->d_max = NAN;
   ev->merit = INVALID_MERIT;
-  if (prru_design_check(p, NULL, 0) != PRRU_OK) return PRRU_EINPUT;
+  if (prru_design_check(pr->model, p, NULL, 0) != PRRU_OK) return PRRU_EINPUT;
   ev->valid = 1;
   const prru_map_grid *g = &pr->grid;
   grid_eval(pr, p, dd, 0);
@@ -900,15 +927,15 @@ static double objective_unchecked(const prru_design_problem *pr, const prru_para
  * every derivative exactly 0. */
 #define STEP_ROUNDING 100.0
 
-int prru_design_step_check(const prru_params *p, const prru_design_var *v, double rel_step, char *msg,
-                           int msglen)
+int prru_design_step_check(const prru_model *m, const prru_params *p, const prru_design_var *v,
+                           double rel_step, char *msg, int msglen)
 {
   if (!(rel_step > 0 && rel_step < 0.5))
     return prru_fail(msg, msglen, PRRU_EINPUT, "step %.17g: must be in (0, 0.5)", rel_step);
-  double scale = prru_design_scale(p, v), big = scale;
+  double scale = prru_design_scale(m, p, v), big = scale;
   for (int k = 0; k < v->n; k++) {
-    prru_design_var m = member(v, k);
-    big = fmax(big, fabs(prru_design_get(p, &m)));
+    prru_design_var one = member(v, k);
+    big = fmax(big, fabs(prru_design_get(p, &one)));
   }
   double h_min = STEP_ROUNDING * DBL_EPSILON * big;
   if (!(rel_step * scale >= h_min))
@@ -924,10 +951,12 @@ int prru_design_sensitivity(const prru_design_problem *pr, const prru_params *p,
                             prru_design_sens *s)
 {
   memset(s, 0, sizeof *s);
-  if (prru_design_check(p, NULL, 0) != PRRU_OK || prru_design_step_check(p, v, rel_step, NULL, 0) != PRRU_OK)
+  const prru_model *m = pr->model;
+  if (prru_design_check(m, p, NULL, 0) != PRRU_OK ||
+      prru_design_step_check(m, p, v, rel_step, NULL, 0) != PRRU_OK)
     return PRRU_EINPUT;
   s->value = prru_design_get(p, v);
-  s->scale = prru_design_scale(p, v);
+  s->scale = prru_design_scale(m, p, v);
   s->step = rel_step * s->scale;
   /* Without the validity check: the difference may reach past a
    * parameter's limit (an armature of 0). */
