@@ -266,7 +266,7 @@ static int has_drives(void)
 /* ---- the parameters are the descriptor's ---- */
 static void test_params(void)
 {
-  int same = 1;
+  int same = P.nlimb == prru_mech.nlimb;
   for (int i = 0; i < 3; i++) same &= P.g[i] == prru_mech.gravity[i];
   for (int b = 0; b < NB; b++) {
     same &= P.mass[b] == prru_mech.mass[b];
