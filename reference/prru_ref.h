@@ -12,18 +12,19 @@
  *
  * The topology is the parameters' own (p->nlimb), not the build's: one
  * build evaluates a model of either. Its counts are nact = nlimb,
- * nbody = 1 + 3 nlimb and nlambda = 19 nlimb, and every output holds
- * exactly that many entries, compact: a caller's arrays sized for its
- * model (or for the PRRU_MAX_* of prru_sizes.h) fit.
+ * nbody = 1 + 3 nlimb and nlambda = 19 nlimb; the outputs have exactly
+ * those lengths and are compact (J_d's row stride is 3, Q's nlambda), so
+ * a caller's arrays sized for its model, or for the PRRU_MAX_* of
+ * prru_sizes.h, fit.
  *
  * All arrays are row-major, body order P L1 L2 L3 U1 U2 U3 S1 S2 S3 (three
  * limbs) or P L1..L4 U1..U4 S1..S4 (four limbs, spec section 12).
  * Functions return GSL_SUCCESS, GSL_EDOM when q is unreachable (an acos
  * argument outside [-1, 1]) or not finite, GSL_ESING when a matrix that must
  * be inverted is singular; on failure every output element is NaN. An
- * nlimb other than 3 or 4 is GSL_EINVAL with the arrays left untouched
- * (their length is unknown). Below NACT, NBODY and NLAMBDA name the
- * parameters' counts. */
+ * nlimb other than 3 or 4 is GSL_EINVAL: the outputs whose length depends
+ * on the counts are then left untouched (that length is unknown), the
+ * others NaN. Below NACT, NBODY and NLAMBDA name the parameters' counts. */
 #ifndef PRRU_REF_H
 #define PRRU_REF_H
 
