@@ -14,7 +14,7 @@
 typedef struct {
   prru_ref_params p;
   prru_ref_ws *w;
-  double fd[PRRU_NACT];
+  double fd[PRRU_MAX_ACT];
 } refsim_ctx;
 
 void bench_refsim_initial(double q0[3], double qd0[3])
@@ -46,7 +46,7 @@ int bench_refsim_paper(const bench_refsim_options *o, double y[6], unsigned long
 {
   refsim_ctx c;
   prru_ref_params_default(&c.p);
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < c.p.nlimb; i++) /* one actuator per limb */
     c.fd[i] = paper_fd[i < 3 ? i : 2]; /* as prru_schedule_paper */
   c.w = prru_ref_alloc();
   if (!c.w) {

@@ -25,9 +25,42 @@
 
 #include "ref_internal.h"
 
-#define NB REF_NB
-#define NW REF_NW
-#define NL REF_NL
+/* The workspace's model-sized matrices and vectors as views of their
+ * storage at the counts n (see ref_priv.store). */
+static gsl_matrix *view_matrix(ref_matrix *m, int n1, int n2)
+{
+  m->cur = gsl_matrix_view_array(m->max->data, n1, n2);
+  return &m->cur.matrix;
+}
+
+static gsl_vector *view_vector(ref_vector *v, int n)
+{
+  v->cur = gsl_vector_view_array(v->max->data, n);
+  return &v->cur.vector;
+}
+
+static void size_workspace(prru_ref_ws *w, const ref_size *n)
+{
+  ref_priv *s = w->priv;
+  w->H = view_matrix(&s->store.H, n->nw, 3);
+  w->Phi = view_matrix(&s->store.Phi, n->nw, n->nw);
+  w->K = view_vector(&s->store.K, n->nw);
+  w->dm = view_vector(&s->store.dm, n->nw);
+  w->PhiH = view_matrix(&s->store.PhiH, n->nw, 3);
+  w->Q = view_matrix(&s->store.Q, n->nw, n->nl);
+  w->Jd = view_matrix(&s->store.Jd, n->na, 3);
+  s->L = view_matrix(&s->store.L, n->nw, n->nw);
+  s->Y = view_matrix(&s->store.Y, n->nw, n->nl);
+  s->A = view_matrix(&s->store.A, n->nl, n->nl);
+  s->V = view_matrix(&s->store.V, n->nl, n->nl);
+  s->S = view_vector(&s->store.S, n->nl);
+  s->svw = view_vector(&s->store.svw, n->nl);
+  s->rW = view_vector(&s->store.rW, n->nw);
+  s->rL = view_vector(&s->store.rL, n->nl);
+  s->Fbar = view_vector(&s->store.Fbar, n->nw);
+  s->Fg = view_vector(&s->store.Fg, n->nw);
+  s->jdk = view_matrix(&s->store.jdk, n->na, 3);
+}
 
 prru_ref_ws *prru_ref_alloc(void)
 {
@@ -35,38 +68,43 @@ prru_ref_ws *prru_ref_alloc(void)
   ref_priv *s = calloc(1, sizeof *s);
   if (!w || !s) { free(w); free(s); return NULL; }
   w->priv = s;
-  w->H = gsl_matrix_calloc(NW, 3);
-  w->Phi = gsl_matrix_calloc(NW, NW);
-  w->K = gsl_vector_calloc(NW);
-  w->dm = gsl_vector_calloc(NW);
-  w->PhiH = gsl_matrix_calloc(NW, 3);
+  /* Storage for the largest model: every model's views fit in it. */
+  const ref_size n = ref_size_of_nlimb(PRRU_MAX_LIMB);
+  s->store.H.max = gsl_matrix_calloc(n.nw, 3);
+  s->store.Phi.max = gsl_matrix_calloc(n.nw, n.nw);
+  s->store.K.max = gsl_vector_calloc(n.nw);
+  s->store.dm.max = gsl_vector_calloc(n.nw);
+  s->store.PhiH.max = gsl_matrix_calloc(n.nw, 3);
   w->M = gsl_matrix_calloc(3, 3);
-  w->Q = gsl_matrix_calloc(NW, NL);
-  w->Jd = gsl_matrix_calloc(REF_NA, 3);
-  s->L = gsl_matrix_calloc(NW, NW);
-  s->Y = gsl_matrix_calloc(NW, NL);
-  s->A = gsl_matrix_calloc(NL, NL);
-  s->V = gsl_matrix_calloc(NL, NL);
-  s->S = gsl_vector_calloc(NL);
-  s->svw = gsl_vector_calloc(NL);
-  s->rW = gsl_vector_calloc(NW);
-  s->rL = gsl_vector_calloc(NL);
-  s->Fbar = gsl_vector_calloc(NW);
-  s->Fg = gsl_vector_calloc(NW);
+  s->store.Q.max = gsl_matrix_calloc(n.nw, n.nl);
+  s->store.Jd.max = gsl_matrix_calloc(n.na, 3);
+  s->store.L.max = gsl_matrix_calloc(n.nw, n.nw);
+  s->store.Y.max = gsl_matrix_calloc(n.nw, n.nl);
+  s->store.A.max = gsl_matrix_calloc(n.nl, n.nl);
+  s->store.V.max = gsl_matrix_calloc(n.nl, n.nl);
+  s->store.S.max = gsl_vector_calloc(n.nl);
+  s->store.svw.max = gsl_vector_calloc(n.nl);
+  s->store.rW.max = gsl_vector_calloc(n.nw);
+  s->store.rL.max = gsl_vector_calloc(n.nl);
+  s->store.Fbar.max = gsl_vector_calloc(n.nw);
+  s->store.Fg.max = gsl_vector_calloc(n.nw);
   s->m3a = gsl_matrix_calloc(3, 3);
   s->m3b = gsl_matrix_calloc(3, 3);
   s->m3c = gsl_matrix_calloc(3, 3);
-  s->jdk = gsl_matrix_calloc(REF_NA, 3);
+  s->store.jdk.max = gsl_matrix_calloc(n.na, 3);
   s->v3a = gsl_vector_calloc(3);
   s->v3b = gsl_vector_calloc(3);
   s->v3c = gsl_vector_calloc(3);
   s->perm3 = gsl_permutation_calloc(3);
-  if (!w->H || !w->Phi || !w->K || !w->dm || !w->PhiH || !w->M || !w->Q || !w->Jd || !s->L ||
-      !s->Y || !s->A || !s->V || !s->S || !s->svw || !s->rW || !s->rL || !s->Fbar || !s->Fg || !s->m3a ||
-      !s->m3b || !s->m3c || !s->jdk || !s->v3a || !s->v3b || !s->v3c || !s->perm3) {
+  if (!s->store.H.max || !s->store.Phi.max || !s->store.K.max || !s->store.dm.max ||
+      !s->store.PhiH.max || !w->M || !s->store.Q.max || !s->store.Jd.max || !s->store.L.max ||
+      !s->store.Y.max || !s->store.A.max || !s->store.V.max || !s->store.S.max || !s->store.svw.max ||
+      !s->store.rW.max || !s->store.rL.max || !s->store.Fbar.max || !s->store.Fg.max || !s->m3a ||
+      !s->m3b || !s->m3c || !s->store.jdk.max || !s->v3a || !s->v3b || !s->v3c || !s->perm3) {
     prru_ref_free(w);
     return NULL;
   }
+  size_workspace(w, &n);
   return w;
 }
 
@@ -74,30 +112,31 @@ void prru_ref_free(prru_ref_ws *w)
 {
   if (!w) return;
   ref_priv *s = w->priv;
-  /* gsl_*_free accept NULL, so a partly failed allocation frees cleanly. */
-  gsl_matrix_free(w->H);
-  gsl_matrix_free(w->Phi);
-  gsl_vector_free(w->K);
-  gsl_vector_free(w->dm);
-  gsl_matrix_free(w->PhiH);
+  /* gsl_*_free accept NULL, so a partly failed allocation frees cleanly;
+   * the model-sized members are views of s->store. */
   gsl_matrix_free(w->M);
-  gsl_matrix_free(w->Q);
-  gsl_matrix_free(w->Jd);
   if (s) {
-    gsl_matrix_free(s->L);
-    gsl_matrix_free(s->Y);
-    gsl_matrix_free(s->A);
-    gsl_matrix_free(s->V);
-    gsl_vector_free(s->S);
-    gsl_vector_free(s->svw);
-    gsl_vector_free(s->rW);
-    gsl_vector_free(s->rL);
-    gsl_vector_free(s->Fbar);
-    gsl_vector_free(s->Fg);
+    gsl_matrix_free(s->store.H.max);
+    gsl_matrix_free(s->store.Phi.max);
+    gsl_vector_free(s->store.K.max);
+    gsl_vector_free(s->store.dm.max);
+    gsl_matrix_free(s->store.PhiH.max);
+    gsl_matrix_free(s->store.Q.max);
+    gsl_matrix_free(s->store.Jd.max);
+    gsl_matrix_free(s->store.L.max);
+    gsl_matrix_free(s->store.Y.max);
+    gsl_matrix_free(s->store.A.max);
+    gsl_matrix_free(s->store.V.max);
+    gsl_vector_free(s->store.S.max);
+    gsl_vector_free(s->store.svw.max);
+    gsl_vector_free(s->store.rW.max);
+    gsl_vector_free(s->store.rL.max);
+    gsl_vector_free(s->store.Fbar.max);
+    gsl_vector_free(s->store.Fg.max);
     gsl_matrix_free(s->m3a);
     gsl_matrix_free(s->m3b);
     gsl_matrix_free(s->m3c);
-    gsl_matrix_free(s->jdk);
+    gsl_matrix_free(s->store.jdk.max);
     gsl_vector_free(s->v3a);
     gsl_vector_free(s->v3b);
     gsl_vector_free(s->v3c);
@@ -145,15 +184,17 @@ int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], co
   ref_kin *k = &s->kin;
   int st = ref_kinematics(p, q, qd, k);
   if (st) return st;
+  const int nb = k->n.nb;
+  size_workspace(w, &k->n);
   gsl_matrix_set_zero(w->Phi);
   gsl_vector_set_zero(s->Fg);
   gsl_vector_set_zero(w->K);
-  for (int b = 0; b < NB; b++) {
+  for (int b = 0; b < nb; b++) {
     const double *R = k->R[b], *Ib = p->inertia[b];
     for (int i = 0; i < 3; i++) {
       for (int j = 0; j < 3; j++) {
         gsl_matrix_set(w->H, 3 * b + i, j, k->JR[b][3 * i + j]);
-        gsl_matrix_set(w->H, 3 * NB + 3 * b + i, j, k->JT[b][3 * i + j]);
+        gsl_matrix_set(w->H, 3 * nb + 3 * b + i, j, k->JT[b][3 * i + j]);
         /* I_b = R I R^T: the body-axes tensor about the centre seen in
          * {S} (the angular momentum R I R^T omega = R (I (R^T omega))). */
         double Iij = 0;
@@ -161,16 +202,16 @@ int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], co
           for (int m = 0; m < 3; m++) Iij += R[3 * i + l] * Ib[3 * l + m] * R[3 * j + m];
         gsl_matrix_set(w->Phi, 3 * b + i, 3 * b + j, Iij);
       }
-      gsl_matrix_set(w->Phi, 3 * NB + 3 * b + i, 3 * NB + 3 * b + i, p->mass[b]);
+      gsl_matrix_set(w->Phi, 3 * nb + 3 * b + i, 3 * nb + 3 * b + i, p->mass[b]);
       gsl_vector_set(w->dm, 3 * b + i, qd ? k->delta[b][i] : 0.0);
-      gsl_vector_set(w->dm, 3 * NB + 3 * b + i, qd ? k->mu[b][i] : 0.0);
+      gsl_vector_set(w->dm, 3 * nb + 3 * b + i, qd ? k->mu[b][i] : 0.0);
       /* Gravity: the force m_b g at the centre of mass, no moment about it. */
-      gsl_vector_set(s->Fg, 3 * NB + 3 * b + i, p->mass[b] * p->g[i]);
+      gsl_vector_set(s->Fg, 3 * nb + 3 * b + i, p->mass[b] * p->g[i]);
     }
   }
   if (qd) {
     /* K: I delta + omega x (I omega) (paper eq. 28, errata), m mu. */
-    for (int b = 0; b < NB; b++) {
+    for (int b = 0; b < nb; b++) {
       double Id[3] = {0, 0, 0}, Iw[3] = {0, 0, 0};
       const double *om = k->omega[b];
       for (int i = 0; i < 3; i++)
@@ -183,11 +224,11 @@ int ref_assemble(const prru_ref_params *p, prru_ref_ws *w, const double q[3], co
                         om[0] * Iw[1] - om[1] * Iw[0]};
       for (int i = 0; i < 3; i++) {
         gsl_vector_set(w->K, 3 * b + i, Id[i] + gyro[i]);
-        gsl_vector_set(w->K, 3 * NB + 3 * b + i, p->mass[b] * k->mu[b][i]);
+        gsl_vector_set(w->K, 3 * nb + 3 * b + i, p->mass[b] * k->mu[b][i]);
       }
     }
   }
-  for (int i = 0; i < REF_NA; i++)
+  for (int i = 0; i < k->n.na; i++)
     for (int j = 0; j < 3; j++) gsl_matrix_set(w->Jd, i, j, k->Jd[3 * i + j]);
   return GSL_SUCCESS;
 }
@@ -199,7 +240,7 @@ void ref_mass_matrix(const prru_ref_params *p, prru_ref_ws *w)
   gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, w->H, w->PhiH, 0.0, w->M);
   /* + J_d^T diag(k) J_d (the armature, see the top of this file). */
   gsl_matrix_memcpy(s->jdk, w->Jd);
-  for (int i = 0; i < REF_NA; i++) {
+  for (int i = 0; i < s->kin.n.na; i++) {
     gsl_vector_view row = gsl_matrix_row(s->jdk, i);
     gsl_vector_scale(&row.vector, p->armature[i]);
   }
@@ -210,9 +251,10 @@ void ref_mass_matrix(const prru_ref_params *p, prru_ref_ws *w)
 static void bias_vector(const prru_ref_params *p, prru_ref_ws *w, gsl_vector *h)
 {
   ref_priv *s = w->priv;
-  double fa[REF_NA];
-  for (int i = 0; i < REF_NA; i++) fa[i] = p->armature[i] * s->kin.ddb[i];
-  gsl_vector_view Fa = gsl_vector_view_array(fa, REF_NA);
+  const int na = s->kin.n.na;
+  double fa[PRRU_MAX_ACT];
+  for (int i = 0; i < na; i++) fa[i] = p->armature[i] * s->kin.ddb[i];
+  gsl_vector_view Fa = gsl_vector_view_array(fa, na);
   gsl_blas_dgemv(CblasTrans, 1.0, w->H, w->K, 0.0, h);
   gsl_blas_dgemv(CblasTrans, 1.0, w->Jd, &Fa.vector, 1.0, h);
 }
@@ -220,9 +262,9 @@ static void bias_vector(const prru_ref_params *p, prru_ref_ws *w, gsl_vector *h)
 /* phi_i = -c_i dd_i - f_i tanh(dd_i / v_s), the force drive i puts on its
  * slider besides fd_i and the armature's inertia (v_s is only defined,
  * and only read, where f_i != 0). */
-void ref_drive_friction(const prru_ref_params *p, const ref_kin *k, double phi[REF_NA])
+void ref_drive_friction(const prru_ref_params *p, const ref_kin *k, double phi[PRRU_MAX_ACT])
 {
-  for (int i = 0; i < REF_NA; i++) {
+  for (int i = 0; i < k->n.na; i++) {
     phi[i] = -p->damping[i] * k->dd[i];
     if (p->coulomb[i] != 0.0) phi[i] -= p->coulomb[i] * tanh(k->dd[i] / p->coulomb_velocity);
   }
@@ -232,9 +274,9 @@ void ref_drive_friction(const prru_ref_params *p, const ref_kin *k, double phi[R
 static void passive_vector(const prru_ref_params *p, prru_ref_ws *w, gsl_vector *Qp)
 {
   ref_priv *s = w->priv;
-  double phi[REF_NA];
+  double phi[PRRU_MAX_ACT];
   ref_drive_friction(p, &s->kin, phi);
-  gsl_vector_view Phi = gsl_vector_view_array(phi, REF_NA);
+  gsl_vector_view Phi = gsl_vector_view_array(phi, s->kin.n.na);
   gsl_blas_dgemv(CblasTrans, 1.0, w->Jd, &Phi.vector, 0.0, Qp);
 }
 
@@ -255,26 +297,24 @@ static void copy_vector(const gsl_vector *v, double *out)
   for (size_t i = 0; i < v->size; i++) out[i] = gsl_vector_get(v, i);
 }
 
-int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                       double H[6 * PRRU_NBODY * PRRU_NQ])
+int prru_ref_jacobians(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double H[])
 {
   int st = ref_assemble(p, w, q, NULL);
-  if (st) { fill_nan(H, NW * 3); return st; }
+  if (st) { fill_nan(H, ref_size_of(p).nw * 3); return st; }
   copy_matrix(w->H, H);
   return GSL_SUCCESS;
 }
 
-int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                        const double qd[PRRU_NQ], double dm[6 * PRRU_NBODY])
+int prru_ref_bias_terms(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                        const double qd[3], double dm[])
 {
   int st = ref_assemble(p, w, q, qd);
-  if (st) { fill_nan(dm, NW); return st; }
+  if (st) { fill_nan(dm, ref_size_of(p).nw); return st; }
   copy_vector(w->dm, dm);
   return GSL_SUCCESS;
 }
 
-int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                  double M[PRRU_NQ * PRRU_NQ])
+int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double M[9])
 {
   int st = ref_assemble(p, w, q, NULL);
   if (st) { fill_nan(M, 9); return st; }
@@ -283,8 +323,8 @@ int prru_ref_mass(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_
   return GSL_SUCCESS;
 }
 
-int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                  const double qd[PRRU_NQ], double h[PRRU_NQ])
+int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                  const double qd[3], double h[3])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
@@ -295,8 +335,7 @@ int prru_ref_bias(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_
 }
 
 /* G = sum_b J_T,b^T (m_b g) = H^T Fg with Fg the stacked gravity wrenches. */
-int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                     double G[PRRU_NQ])
+int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double G[3])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, NULL);
@@ -306,9 +345,8 @@ int prru_ref_gravity(const prru_ref_params *p, prru_ref_ws *w, const double q[PR
   return GSL_SUCCESS;
 }
 
-int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                      const double qd[PRRU_NQ], double M[PRRU_NQ * PRRU_NQ], double h[PRRU_NQ],
-                      double G[PRRU_NQ])
+int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                      const double qd[3], double M[9], double h[3], double G[3])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
@@ -325,15 +363,15 @@ int prru_ref_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[P
 /* Body by body, from the velocities, not from M: the tests compare the two.
  * The armature's share is k_i dd_i^2 / 2; V is the work against the
  * constant field g: -sum_b m_b g . p_b. */
-int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                    const double qd[PRRU_NQ], double E[2])
+int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                    const double qd[3], double E[2])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
   if (st) { fill_nan(E, 2); return st; }
   const ref_kin *k = &s->kin;
   double T = 0, V = 0;
-  for (int b = 0; b < NB; b++) {
+  for (int b = 0; b < k->n.nb; b++) {
     for (int i = 0; i < 3; i++) {
       T += 0.5 * p->mass[b] * k->v[b][i] * k->v[b][i];
       for (int j = 0; j < 3; j++)
@@ -341,14 +379,14 @@ int prru_ref_energy(const prru_ref_params *p, prru_ref_ws *w, const double q[PRR
       V -= p->mass[b] * p->g[i] * k->p[b][i];
     }
   }
-  for (int i = 0; i < REF_NA; i++) T += 0.5 * p->armature[i] * k->dd[i] * k->dd[i];
+  for (int i = 0; i < k->n.na; i++) T += 0.5 * p->armature[i] * k->dd[i] * k->dd[i];
   E[0] = T;
   E[1] = V;
   return GSL_SUCCESS;
 }
 
-int prru_ref_passive(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                     const double qd[PRRU_NQ], double Qp[PRRU_NQ])
+int prru_ref_passive(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                     const double qd[3], double Qp[3])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
@@ -375,7 +413,7 @@ static void generalized_load(prru_ref_ws *w, const double *fd, const double fp[3
       t += JTO[3 * i + j] * fp[i];
       t += gsl_matrix_get(w->H, 3 * REF_P + i, j) * mp[i];
     }
-    for (int i = 3; i < REF_NA; i++)
+    for (int i = 3; i < s->kin.n.na; i++)
       if (fd) t += gsl_matrix_get(w->Jd, i, j) * fd[i]; /* limb 4 */
     gsl_vector_set(tau, j, gsl_vector_get(tau, j) + t);
   }
@@ -396,9 +434,9 @@ int ref_solve_qdd(const prru_ref_params *p, prru_ref_ws *w, const double *fd, co
   return GSL_SUCCESS;
 }
 
-int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                              const double qd[PRRU_NQ], const double fd[PRRU_NACT],
-                              const double fp[3], const double mp[3], double qdd[PRRU_NQ])
+int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                              const double qd[3], const double fd[], const double fp[3],
+                              const double mp[3], double qdd[3])
 {
   ref_priv *s = w->priv;
   int st = ref_assemble(p, w, q, qd);
@@ -414,7 +452,7 @@ int prru_ref_forward_dynamics(const prru_ref_params *p, prru_ref_ws *w, const do
 int ref_jd_pinv(prru_ref_ws *w, gsl_matrix *Jp)
 {
   ref_priv *s = w->priv;
-  if (REF_NA == 3) {
+  if (s->kin.n.na == 3) {
     gsl_matrix_memcpy(s->m3a, w->Jd);
     return ref_lu3(s->m3a, s->perm3, Jp);
   }
@@ -433,13 +471,14 @@ int ref_jd_pinv(prru_ref_ws *w, gsl_matrix *Jp)
  * preload the platform does not feel) and the minimum-norm solution is the
  * one in the range of J_d, fd = J_d x with J_d^T J_d x = tau, i.e.
  * fd = J_d (J_d^T J_d)^-1 tau = J_d^+T tau (spec section 12). */
-int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                              const double qd[PRRU_NQ], const double qdd[PRRU_NQ],
-                              const double fp[3], const double mp[3], double fd[PRRU_NACT])
+int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                              const double qd[3], const double qdd[3], const double fp[3],
+                              const double mp[3], double fd[])
 {
   ref_priv *s = w->priv;
+  const int na = ref_size_of(p).na;
   int st = ref_assemble(p, w, q, qd);
-  if (st) { fill_nan(fd, REF_NA); return st; }
+  if (st) { fill_nan(fd, na); return st; }
   ref_mass_matrix(p, w);
   gsl_vector_const_view a = gsl_vector_const_view_array(qdd, 3);
   generalized_load(w, NULL, fp, mp, s->v3b);
@@ -448,18 +487,18 @@ int prru_ref_inverse_dynamics(const prru_ref_params *p, prru_ref_ws *w, const do
   bias_vector(p, w, s->v3c);
   gsl_vector_sub(s->v3c, s->v3b);                                  /* h - (G + ... + Qp) */
   gsl_blas_dgemv(CblasNoTrans, 1.0, w->M, &a.vector, 1.0, s->v3c); /* + M qdd */
-  if (REF_NA == 3) {
+  if (na == 3) {
     /* As J_d^-T tau, but by LU solve of J_d^T rather than the inverse. */
     gsl_matrix_transpose_memcpy(s->m3a, w->Jd);
-    if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, REF_NA); return GSL_ESING; }
+    if (ref_lu3(s->m3a, s->perm3, s->m3b)) { fill_nan(fd, na); return GSL_ESING; }
     gsl_linalg_LU_solve(s->m3a, s->perm3, s->v3c, s->v3a);
     copy_vector(s->v3a, fd);
     return GSL_SUCCESS;
   }
-  double jp[3 * REF_NA];
-  gsl_matrix_view Jp = gsl_matrix_view_array(jp, 3, REF_NA);
-  gsl_vector_view Fd = gsl_vector_view_array(fd, REF_NA);
-  if (ref_jd_pinv(w, &Jp.matrix)) { fill_nan(fd, REF_NA); return GSL_ESING; }
+  double jp[3 * PRRU_MAX_ACT];
+  gsl_matrix_view Jp = gsl_matrix_view_array(jp, 3, na);
+  gsl_vector_view Fd = gsl_vector_view_array(fd, na);
+  if (ref_jd_pinv(w, &Jp.matrix)) { fill_nan(fd, na); return GSL_ESING; }
   gsl_blas_dgemv(CblasTrans, 1.0, &Jp.matrix, s->v3c, 0.0, &Fd.vector);
   return GSL_SUCCESS;
 }

@@ -23,32 +23,7 @@
 
 #include <gsl/gsl_errno.h>
 
-#include "prru_mechanism.h"
 #include "ref_internal.h"
-
-void prru_ref_params_default(prru_ref_params *p)
-{
-  const prru_mechanism *me = &prru_mech;
-  memset(p, 0, sizeof *p);
-  for (int i = 0; i < 3; i++) p->g[i] = me->gravity[i];
-  for (int l = 0; l < PRRU_NLIMB; l++) {
-    p->b[l] = me->b[l];
-    p->l1[l] = me->l1[l];
-    p->l2[l] = me->l2[l];
-    p->a[l] = me->a[l];
-  }
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    p->mass[b] = me->mass[b];
-    for (int i = 0; i < 3; i++) p->com[b][i] = me->com[b][i];
-    for (int i = 0; i < 9; i++) p->inertia[b][i] = me->inertia[b][i];
-  }
-  for (int i = 0; i < PRRU_NACT; i++) {
-    p->armature[i] = me->armature[i];
-    p->damping[i] = me->damping[i];
-    p->coulomb[i] = me->coulomb[i];
-  }
-  p->coulomb_velocity = me->coulomb_velocity;
-}
 
 /* A scalar of the limb and its first two derivatives in xi. */
 typedef struct { double v, x, xx; } scal;
@@ -193,7 +168,7 @@ static int limb12(const prru_ref_params *p, const double q[3], int limb, const c
   const double b = p->b[limb], l1 = p->l1[limb], l2 = p->l2[limb], a = p->a[limb];
   const double c1 = cos(q[0]), s1 = sin(q[0]), q3 = q[2];
   const double e = a + l2, kl = a + 0.5 * l2;
-  const int L = REF_L(limb), U = REF_U(limb), S = REF_S(limb);
+  const int n = k->n.nlimb, L = REF_L(n, limb), U = REF_U(n, limb), S = REF_S(n, limb);
 
   double C[3] = {0, s * a * c1, q3 + s * a * s1};
   double B[3] = {0, s * e * c1, q3 + s * e * s1};
@@ -267,7 +242,7 @@ static int limb3(const prru_ref_params *p, const double q[3], int limb, double s
 {
   const double gam = k->gamma, cg = cos(gam), sg = sin(gam), q3 = q[2];
   const double b = p->b[limb], l1 = p->l1[limb], l2 = p->l2[limb], kl = 0.5 * l2;
-  const int L = REF_L(limb), U = REF_U(limb), S = REF_S(limb);
+  const int n = k->n.nlimb, L = REF_L(n, limb), U = REF_U(n, limb), S = REF_S(n, limb);
 
   double C[3] = {0, 0, q3}, B[3] = {s * l2 * cg, 0, q3 - s * l2 * sg};
   memcpy(k->C[limb], C, sizeof C);
@@ -301,22 +276,24 @@ static int limb3(const prru_ref_params *p, const double q[3], int limb, double s
 int ref_kinematics(const prru_ref_params *p, const double q[3], const double *qd, ref_kin *k)
 {
   memset(k, 0, sizeof *k);
+  k->n = ref_size_of(p);
+  if (!k->n.nlimb) return GSL_EINVAL;
   if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]))) return GSL_EDOM;
   chain c12 = {{1.0, 0.0, 0.0}, qd ? qd[0] : 0.0, 0.0}, c34; /* xi = q1 exactly; xi = gamma */
   k->gamma = gamma_chain(q, qd, &c34);
   platform(p, q, qd, k);
   if (limb12(p, q, 0, &c12, k) || limb12(p, q, 1, &c12, k) || limb3(p, q, 2, +1.0, &c34, k))
     return GSL_EDOM;
-  for (int l = 3; l < REF_NLIMB; l++)
+  for (int l = 3; l < k->n.nlimb; l++)
     if (limb3(p, q, l, -1.0, &c34, k)) return GSL_EDOM;
   if (qd) {
-    for (int b = 0; b < REF_NB; b++)
+    for (int b = 0; b < k->n.nb; b++)
       for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
           k->omega[b][i] += k->JR[b][3 * i + j] * qd[j];
           k->v[b][i] += k->JT[b][3 * i + j] * qd[j];
         }
-    for (int i = 0; i < REF_NA; i++)
+    for (int i = 0; i < k->n.na; i++)
       for (int j = 0; j < 3; j++) k->dd[i] += k->Jd[3 * i + j] * qd[j];
   }
   return GSL_SUCCESS;
@@ -327,44 +304,43 @@ static void fill_nan(double *x, int n)
   for (int i = 0; i < n; i++) x[i] = NAN;
 }
 
-int prru_ref_ik(const prru_ref_params *p, const double q[PRRU_NQ], double d[PRRU_NACT])
+int prru_ref_ik(const prru_ref_params *p, const double q[3], double d[])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(d, REF_NA); return st; }
-  memcpy(d, k.d, sizeof k.d);
+  if (st) { fill_nan(d, k.n.na); return st; }
+  memcpy(d, k.d, k.n.na * sizeof *d);
   return GSL_SUCCESS;
 }
 
-int prru_ref_jd(const prru_ref_params *p, const double q[PRRU_NQ], double Jd[PRRU_NACT * PRRU_NQ])
+int prru_ref_jd(const prru_ref_params *p, const double q[3], double Jd[])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(Jd, 3 * REF_NA); return st; }
-  memcpy(Jd, k.Jd, sizeof k.Jd);
+  if (st) { fill_nan(Jd, 3 * k.n.na); return st; }
+  memcpy(Jd, k.Jd, 3 * k.n.na * sizeof *Jd);
   return GSL_SUCCESS;
 }
 
-int prru_ref_poses(const prru_ref_params *p, const double q[PRRU_NQ], double R[9 * PRRU_NBODY],
-                   double pos[3 * PRRU_NBODY])
+int prru_ref_poses(const prru_ref_params *p, const double q[3], double R[], double pos[])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, NULL, &k);
-  if (st) { fill_nan(R, 9 * REF_NB); fill_nan(pos, 3 * REF_NB); return st; }
-  memcpy(R, k.R, sizeof k.R);
-  memcpy(pos, k.p, sizeof k.p);
+  if (st) { fill_nan(R, 9 * k.n.nb); fill_nan(pos, 3 * k.n.nb); return st; }
+  memcpy(R, k.R, k.n.nb * sizeof k.R[0]);
+  memcpy(pos, k.p, k.n.nb * sizeof k.p[0]);
   return GSL_SUCCESS;
 }
 
 /* d' = J_d qd, and d'' = J_d qdd + Jd' qd from the chain rule on d_i(xi)
  * (set_actuator): d_i'' = d_xx xi'^2 + d_x xi'' with xi'' = g.qdd + quad. */
-int prru_ref_actuator_rates(const prru_ref_params *p, const double q[PRRU_NQ],
-                            const double qd[PRRU_NQ], double dd[PRRU_NACT], double ddb[PRRU_NACT])
+int prru_ref_actuator_rates(const prru_ref_params *p, const double q[3], const double qd[3],
+                            double dd[], double ddb[])
 {
   ref_kin k;
   int st = ref_kinematics(p, q, qd, &k);
-  if (st) { fill_nan(dd, REF_NA); fill_nan(ddb, REF_NA); return st; }
-  memcpy(dd, k.dd, sizeof k.dd);
-  memcpy(ddb, k.ddb, sizeof k.ddb);
+  if (st) { fill_nan(dd, k.n.na); fill_nan(ddb, k.n.na); return st; }
+  memcpy(dd, k.dd, k.n.na * sizeof *dd);
+  memcpy(ddb, k.ddb, k.n.na * sizeof *ddb);
   return GSL_SUCCESS;
 }

@@ -14,9 +14,6 @@
 
 #include "ref_internal.h"
 
-#define NB REF_NB
-#define NW REF_NW
-#define NL REF_NL
 #define GROUND (-1)
 
 /* A unit force f through the joint centre c: on body b (centre p_b) it is
@@ -25,11 +22,12 @@ static void add_force(gsl_matrix *Q, int col, const ref_kin *k, int b, const dou
                       const double f[3], double sign)
 {
   if (b == GROUND) return;
+  const int nb = k->n.nb;
   const double r[3] = {c[0] - k->p[b][0], c[1] - k->p[b][1], c[2] - k->p[b][2]};
   const double m[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
   for (int i = 0; i < 3; i++) {
     gsl_matrix_set(Q, 3 * b + i, col, gsl_matrix_get(Q, 3 * b + i, col) + sign * m[i]);
-    gsl_matrix_set(Q, 3 * NB + 3 * b + i, col, gsl_matrix_get(Q, 3 * NB + 3 * b + i, col) + sign * f[i]);
+    gsl_matrix_set(Q, 3 * nb + 3 * b + i, col, gsl_matrix_get(Q, 3 * nb + 3 * b + i, col) + sign * f[i]);
   }
 }
 
@@ -60,6 +58,7 @@ static void build_Q(const ref_kin *k, gsl_matrix *Q)
 {
   static const double E[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   const double *RP = k->R[REF_P];
+  const int nlimb = k->n.nlimb;
   int col = 0;
   gsl_matrix_set_zero(Q);
 
@@ -70,10 +69,10 @@ static void build_Q(const ref_kin *k, gsl_matrix *Q)
    * section 12) n4 = w x x4 / |w x x4| with x4 = -R_L4 e1 (its lower link
    * points along local -x). */
   const double u[3] = {RP[0], RP[3], RP[6]}, wv[3] = {RP[2], RP[5], RP[8]};
-  for (int l = 0; l < REF_NLIMB; l++) {
+  for (int l = 0; l < nlimb; l++) {
     double n[3] = {u[0], u[1], u[2]};
     if (l >= 2) {
-      const double *Rl = k->R[REF_L(l)], s = l == 2 ? 1.0 : -1.0;
+      const double *Rl = k->R[REF_L(nlimb, l)], s = l == 2 ? 1.0 : -1.0;
       const double x[3] = {s * Rl[0], s * Rl[3], s * Rl[6]};
       n[0] = wv[1] * x[2] - wv[2] * x[1];
       n[1] = wv[2] * x[0] - wv[0] * x[2];
@@ -82,33 +81,33 @@ static void build_Q(const ref_kin *k, gsl_matrix *Q)
       for (int i = 0; i < 3; i++) n[i] /= nn;
     }
     const double mn[1][3] = {{n[0], n[1], n[2]}};
-    joint(Q, &col, k, REF_L(l), REF_P, k->C[l], E, 3, mn, 1);
+    joint(Q, &col, k, REF_L(nlimb, l), REF_P, k->C[l], E, 3, mn, 1);
   }
 
   /* R joints B_i, A_i: moments along the two coordinate axes normal to the
    * hinge axis (e1 in limbs 1, 2, e2 in limbs 3, 4). */
   const double m12[2][3] = {{0, 1, 0}, {0, 0, 1}}, m34[2][3] = {{1, 0, 0}, {0, 0, 1}};
-  for (int l = 0; l < REF_NLIMB; l++)
-    joint(Q, &col, k, REF_U(l), REF_L(l), k->B[l], E, 3, l < 2 ? m12 : m34, 2);
-  for (int l = 0; l < REF_NLIMB; l++)
-    joint(Q, &col, k, REF_S(l), REF_U(l), k->A[l], E, 3, l < 2 ? m12 : m34, 2);
+  for (int l = 0; l < nlimb; l++)
+    joint(Q, &col, k, REF_U(nlimb, l), REF_L(nlimb, l), k->B[l], E, 3, l < 2 ? m12 : m34, 2);
+  for (int l = 0; l < nlimb; l++)
+    joint(Q, &col, k, REF_S(nlimb, l), REF_U(nlimb, l), k->A[l], E, 3, l < 2 ? m12 : m34, 2);
 
   /* P joints: rail (ground) to slider, free along e3; the joint centre is
    * A_i, the slider's frame origin (its centre of mass lies com off it). */
-  for (int l = 0; l < REF_NLIMB; l++) joint(Q, &col, k, GROUND, REF_S(l), k->A[l], E, 2, E, 3);
+  for (int l = 0; l < nlimb; l++) joint(Q, &col, k, GROUND, REF_S(nlimb, l), k->A[l], E, 2, E, 3);
 }
 
-int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                            double Q[6 * PRRU_NBODY * PRRU_NLAMBDA])
+int prru_ref_reaction_basis(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double Q[])
 {
+  const ref_size n = ref_size_of(p);
   int st = ref_assemble(p, w, q, NULL);
   if (st) {
-    for (int i = 0; i < NW * NL; i++) Q[i] = NAN;
+    for (int i = 0; i < n.nw * n.nl; i++) Q[i] = NAN;
     return st;
   }
   build_Q(&((ref_priv *)w->priv)->kin, w->Q);
-  for (int i = 0; i < NW; i++)
-    for (int j = 0; j < NL; j++) Q[i * NL + j] = gsl_matrix_get(w->Q, i, j);
+  for (int i = 0; i < n.nw; i++)
+    for (int j = 0; j < n.nl; j++) Q[i * n.nl + j] = gsl_matrix_get(w->Q, i, j);
   return GSL_SUCCESS;
 }
 
@@ -130,48 +129,51 @@ static int reaction_factor(prru_ref_ws *w)
  * reaction_factor (GSL's Golub-Reinsch SVD, U overwriting s->Y, V in s->V,
  * S descending in s->S), so Q^T Phi^-1 Q = V S^2 V^T, and Q's null space is
  * spanned by the columns of V whose singular values are cut. The cut-off
- * is relative: sigma_i <= max(NW, NL) DBL_EPSILON sigma_1 counts as zero
- * (the usual numerical-rank rule: the rounding error of Y and of its SVD is
- * about that size; measured over the reachable workspace, the redundant
- * direction of four limbs has sigma / sigma_1 ~ 1e-17 and the smallest kept
- * one ~ 1e-4). *rank counts the singular values kept; GSL_ESING unless that
- * is the rank REF_RANK = 6 NBODY - 3 of the mechanism's Q: fewer is a
- * constraint singularity, more would leave the redundant direction
- * unresolved (H^T Q = 0 rules it out in exact arithmetic). */
+ * is relative: sigma_i <= max(6 NBODY, NLAMBDA) DBL_EPSILON sigma_1 counts
+ * as zero (the usual numerical-rank rule: the rounding error of Y and of
+ * its SVD is about that size; measured over the reachable workspace, the
+ * redundant direction of four limbs has sigma / sigma_1 ~ 1e-17 and the
+ * smallest kept one ~ 1e-4). *rank counts the singular values kept;
+ * GSL_ESING unless that is the rank 6 NBODY - 3 of the mechanism's Q
+ * (ref_size.rank): fewer is a constraint singularity, more would leave the
+ * redundant direction unresolved (H^T Q = 0 rules it out in exact
+ * arithmetic). */
 static int reaction_svd(prru_ref_ws *w, int *rank)
 {
   ref_priv *s = w->priv;
+  const ref_size n = s->kin.n;
   *rank = 0;
   gsl_error_handler_t *old = gsl_set_error_handler_off();
   int st = gsl_linalg_SV_decomp(s->Y, s->V, s->S, s->svw);
   gsl_set_error_handler(old);
   if (st) return GSL_ESING;
-  const double tol = (NW > NL ? NW : NL) * DBL_EPSILON * gsl_vector_get(s->S, 0);
-  for (int i = 0; i < NL; i++) *rank += gsl_vector_get(s->S, i) > tol;
-  return *rank == REF_RANK ? GSL_SUCCESS : GSL_ESING;
+  const double tol = (n.nw > n.nl ? n.nw : n.nl) * DBL_EPSILON * gsl_vector_get(s->S, 0);
+  for (int i = 0; i < n.nl; i++) *rank += gsl_vector_get(s->S, i) > tol;
+  return *rank == n.rank ? GSL_SUCCESS : GSL_ESING;
 }
 
-int prru_ref_reaction_null(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                           double z[PRRU_NLAMBDA], int *nullity)
+int prru_ref_reaction_null(const prru_ref_params *p, prru_ref_ws *w, const double q[3], double z[],
+                           int *nullity)
 {
   ref_priv *s = w->priv;
+  const int nl = ref_size_of(p).nl;
   int rank = 0, st = ref_assemble(p, w, q, NULL);
   if (!st) st = reaction_factor(w);
   if (st) {
-    for (int i = 0; i < NL; i++) z[i] = NAN;
+    for (int i = 0; i < nl; i++) z[i] = NAN;
     *nullity = -1;
     return st;
   }
   st = reaction_svd(w, &rank);
-  *nullity = NL - rank;
+  *nullity = nl - rank;
   /* The last column of V: the smallest singular value's right vector. */
   int imax = 0;
-  for (int i = 0; i < NL; i++) {
-    z[i] = gsl_matrix_get(s->V, i, NL - 1);
+  for (int i = 0; i < nl; i++) {
+    z[i] = gsl_matrix_get(s->V, i, nl - 1);
     if (fabs(z[i]) > fabs(z[imax])) imax = i;
   }
   if (z[imax] < 0)
-    for (int i = 0; i < NL; i++) z[i] = -z[i];
+    for (int i = 0; i < nl; i++) z[i] = -z[i];
   return st;
 }
 
@@ -201,12 +203,13 @@ int prru_ref_reaction_null(const prru_ref_params *p, prru_ref_ws *w, const doubl
  * Q lambda are consistent (their H^T projection is the EOM with the
  * armature moved to the right-hand side), and qdd itself drops out of
  * lambda through H^T Q = 0. */
-int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[PRRU_NQ],
-                       const double qd[PRRU_NQ], const double fd[PRRU_NACT], const double fp[3],
-                       const double mp[3], double lambda[PRRU_NLAMBDA])
+int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[3],
+                       const double qd[3], const double fd[], const double fp[3],
+                       const double mp[3], double lambda[])
 {
   ref_priv *s = w->priv;
-  int rank = NL;
+  const ref_size n = ref_size_of(p);
+  int rank = n.nl;
   int st = ref_assemble(p, w, q, qd);
   if (!st) {
     ref_mass_matrix(p, w);
@@ -214,7 +217,7 @@ int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[
   }
   if (!st) st = reaction_factor(w);
   if (!st) {
-    if (REF_RANK == NL) {
+    if (n.rank == n.nl) {
       gsl_blas_dgemm(CblasTrans, CblasNoTrans, 1.0, s->Y, s->Y, 0.0, s->A);
       st = ref_cholesky(s->A);
     } else {
@@ -222,11 +225,11 @@ int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[
     }
   }
   if (st) {
-    for (int i = 0; i < NL; i++) lambda[i] = NAN;
+    for (int i = 0; i < n.nl; i++) lambda[i] = NAN;
     return st;
   }
   const ref_kin *k = &s->kin;
-  double phi[REF_NA];
+  double phi[PRRU_MAX_ACT];
   ref_drive_friction(p, k, phi);
   gsl_vector_memcpy(s->Fbar, s->Fg);
   /* fp at O' = (0, 0, q3) is fp at the platform's centre p_P plus the
@@ -237,25 +240,25 @@ int prru_ref_reactions(const prru_ref_params *p, prru_ref_ws *w, const double q[
                          r[0] * fp[1] - r[1] * fp[0]};
   for (int i = 0; i < 3; i++) {
     *gsl_vector_ptr(s->Fbar, 3 * REF_P + i) += mp[i] + rxf[i];
-    *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_P + i) += fp[i];
+    *gsl_vector_ptr(s->Fbar, 3 * n.nb + 3 * REF_P + i) += fp[i];
   }
-  for (int i = 0; i < REF_NA; i++) {
+  for (int i = 0; i < n.na; i++) {
     double dd2 = k->ddb[i];
     for (int j = 0; j < 3; j++) dd2 += k->Jd[3 * i + j] * gsl_vector_get(s->v3a, j);
-    *gsl_vector_ptr(s->Fbar, 3 * NB + 3 * REF_S(i) + 2) += fd[i] - p->armature[i] * dd2 + phi[i];
+    *gsl_vector_ptr(s->Fbar, 3 * n.nb + 3 * REF_S(n.nlimb, i) + 2) += fd[i] - p->armature[i] * dd2 + phi[i];
   }
   /* rW = L^-1 (K - Fbar), rL = Y^T rW (three limbs) or U^T rW (four). */
   gsl_vector_memcpy(s->rW, w->K);
   gsl_vector_sub(s->rW, s->Fbar);
   gsl_blas_dtrsv(CblasLower, CblasNoTrans, CblasNonUnit, s->L, s->rW);
   gsl_blas_dgemv(CblasTrans, 1.0, s->Y, s->rW, 0.0, s->rL);
-  gsl_vector_view lam = gsl_vector_view_array(lambda, NL);
-  if (REF_RANK == NL) {
+  gsl_vector_view lam = gsl_vector_view_array(lambda, n.nl);
+  if (n.rank == n.nl) {
     gsl_linalg_cholesky_solve(s->A, s->rL, &lam.vector);
     return GSL_SUCCESS;
   }
   /* lambda = V S^+ (U^T rW). */
-  for (int i = 0; i < NL; i++)
+  for (int i = 0; i < n.nl; i++)
     gsl_vector_set(s->rL, i, i < rank ? gsl_vector_get(s->rL, i) / gsl_vector_get(s->S, i) : 0.0);
   gsl_blas_dgemv(CblasNoTrans, 1.0, s->V, s->rL, 0.0, &lam.vector);
   return GSL_SUCCESS;

@@ -357,9 +357,12 @@ static void random_design(prru_params *p)
   p->coulomb_velocity = tu_uniform(0.002, 0.02);
 }
 
-/* The same design as the reference's parameters. */
+/* The same design as the reference's parameters (the param kernels are
+ * the build's topology). */
 static void to_ref(const prru_params *p, prru_ref_params *r)
 {
+  memset(r, 0, sizeof *r);
+  r->nlimb = PRRU_NLIMB;
   for (int k = 0; k < 3; k++) r->g[k] = p->gravity[k];
   for (int i = 0; i < PRRU_NLIMB; i++) {
     r->b[i] = p->b[i];

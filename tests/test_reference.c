@@ -9,8 +9,10 @@
  * dynamics. With four limbs (spec section 12) also the mirror symmetry of
  * limbs 3 and 4, the minimum-norm inverse dynamics, the redundant reaction
  * direction z (Q z = 0) and lambda . z = 0; w_R against section 8 (three
- * limbs) and section 12 (J_d^+) written out here. The paper's numbers are
- * in paper_reference.c. */
+ * limbs) and section 12 (J_d^+) written out here. And the committed model
+ * of the other topology, evaluated by this build's reference (its
+ * topology is its parameters'). The paper's numbers are in
+ * paper_reference.c. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -18,6 +20,7 @@
 #include <gsl/gsl_errno.h>
 
 #include "prru_mechanism.h"
+#include "prru_model_file.h"
 #include "prru_ref.h"
 #include "testref.h"
 #include "testutil.h"
@@ -266,7 +269,7 @@ static int has_drives(void)
 /* ---- the parameters are the descriptor's ---- */
 static void test_params(void)
 {
-  int same = 1;
+  int same = P.nlimb == prru_mech.nlimb;
   for (int i = 0; i < 3; i++) same &= P.g[i] == prru_mech.gravity[i];
   for (int b = 0; b < NB; b++) {
     same &= P.mass[b] == prru_mech.mass[b];
@@ -1016,6 +1019,307 @@ static void test_unreachable(void)
   }
 }
 
+/* ---- the other topology: the reference computes with its parameters'
+ * nlimb, not the build's, so a three-limb build's evaluates a four-limb
+ * model and a four-limb build's a three-limb one. The committed model of
+ * the other topology (models/4prru.json, models/3prru_paper.json), read
+ * with the runtime's model-file reader, against properties that hold for
+ * any model, with tolerances from the unit roundoff u = DBL_EPSILON / 2
+ * and gamma(n) = n u / (1 - n u), the bound on the relative error of n
+ * successive roundings (Higham, Accuracy and Stability, section 3.1). ---- */
+
+#define U_ROUND (DBL_EPSILON / 2)
+#define SENTINEL 12345.0
+
+static double gamma_n(int n) { return n * U_ROUND / (1 - n * U_ROUND); }
+
+/* A model file's numbers as the reference's parameters: Ixx Iyy Izz Ixy
+ * Ixz Iyz as the symmetric tensor, as the runtime fills a descriptor. */
+static void ref_params_of_spec(const prru_model_spec *s, prru_ref_params *p)
+{
+  memset(p, 0, sizeof *p);
+  p->nlimb = s->nlimb;
+  for (int i = 0; i < 3; i++) p->g[i] = s->gravity[i];
+  for (int l = 0; l < s->nlimb; l++) {
+    p->b[l] = s->limb[l].b;
+    p->l1[l] = s->limb[l].l1;
+    p->l2[l] = s->limb[l].l2;
+    p->a[l] = s->limb[l].a;
+    p->armature[l] = s->armature[l];
+    p->damping[l] = s->damping[l];
+    p->coulomb[l] = s->coulomb[l];
+  }
+  for (int b = 0; b < s->nbody; b++) {
+    const double *I = s->inertia[b];
+    const double T[9] = {I[0], I[3], I[4], I[3], I[1], I[5], I[4], I[5], I[2]};
+    p->mass[b] = s->mass[b];
+    memcpy(p->com[b], s->com[b], sizeof p->com[b]);
+    memcpy(p->inertia[b], T, sizeof T);
+  }
+  p->coulomb_velocity = s->coulomb_velocity;
+}
+
+static int read_model(const char *path, prru_ref_params *p)
+{
+  static prru_model_spec spec;
+  char msg[512];
+  if (prru_model_file_read(path, &spec, msg, sizeof msg) != PRRU_OK) {
+    printf("%s\n", msg);
+    return 0;
+  }
+  ref_params_of_spec(&spec, p);
+  return 1;
+}
+
+/* Every number, the unused entries included (both sides zero them). */
+static int same_params(const prru_ref_params *a, const prru_ref_params *b)
+{
+  int same = a->nlimb == b->nlimb && a->coulomb_velocity == b->coulomb_velocity;
+  for (int i = 0; i < 3; i++) same &= a->g[i] == b->g[i];
+  for (int l = 0; l < PRRU_MAX_LIMB; l++)
+    same &= a->b[l] == b->b[l] && a->l1[l] == b->l1[l] && a->l2[l] == b->l2[l] && a->a[l] == b->a[l];
+  for (int i = 0; i < PRRU_MAX_ACT; i++)
+    same &= a->armature[i] == b->armature[i] && a->damping[i] == b->damping[i] &&
+            a->coulomb[i] == b->coulomb[i];
+  for (int k = 0; k < PRRU_MAX_BODY; k++) {
+    same &= a->mass[k] == b->mass[k];
+    for (int i = 0; i < 3; i++) same &= a->com[k][i] == b->com[k][i];
+    for (int i = 0; i < 9; i++) same &= a->inertia[k][i] == b->inertia[k][i];
+  }
+  return same;
+}
+
+/* J^T J of p's nact x 3 J_d. */
+static void gram_of(const prru_ref_params *p, const double *J, double N[9])
+{
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      N[3 * i + j] = 0;
+      for (int l = 0; l < p->nlimb; l++) N[3 * i + j] += J[3 * l + i] * J[3 * l + j];
+    }
+}
+
+/* A reachable q of p at least MARGIN from the singular boundaries with
+ * cond(J_d) <= COND_JD (measured as cond_jd does), and a qd. */
+static void other_state(const prru_ref_params *p, double q[3], double qd[3])
+{
+  double L = 0, J[3 * PRRU_MAX_ACT], N[9];
+  for (int l = 0; l < p->nlimb; l++) L = fmax(L, p->l1[l] + p->l2[l]);
+  for (;;) {
+    q[0] = tu_uniform(-PI / 2, PI / 2);
+    q[1] = tu_uniform(-PI / 2, PI / 2);
+    q[2] = tu_uniform(-2 * L, 2 * L);
+    if (ref_margin(p, q) < MARGIN || prru_ref_jd(p, q, J) != GSL_SUCCESS) continue;
+    gram_of(p, J, N);
+    if ((p->nlimb == 3 ? cond3(J) : sqrt(cond3(N))) <= COND_JD) break;
+  }
+  for (int i = 0; i < 3; i++) qd[i] = tu_uniform(-1, 1);
+}
+
+/* A = |H|^T |Phi| |H| + |J_d|^T K |J_d| after a call that left p's H in
+ * W, with Phi's rotational blocks bounded by |R_b| |I_b| |R_b|^T: every
+ * product of M's with its magnitude, the scale of any rounding in M. */
+static void mass_scale(const prru_ref_params *p, const double *R, const double *Jd, double A[9])
+{
+  const int nb = 1 + 3 * p->nlimb;
+  memset(A, 0, 9 * sizeof *A);
+  for (int b = 0; b < nb; b++) {
+    const double *Rb = R + 9 * b, *Ib = p->inertia[b];
+    double Ia[9];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        Ia[3 * i + j] = 0;
+        for (int l = 0; l < 3; l++)
+          for (int m = 0; m < 3; m++)
+            Ia[3 * i + j] += fabs(Rb[3 * i + l]) * fabs(Ib[3 * l + m]) * fabs(Rb[3 * j + m]);
+      }
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++) {
+          const double JTri = fabs(gsl_matrix_get(W->H, 3 * nb + 3 * b + r, i));
+          A[3 * i + j] += p->mass[b] * JTri * fabs(gsl_matrix_get(W->H, 3 * nb + 3 * b + r, j));
+          for (int c = 0; c < 3; c++)
+            A[3 * i + j] += fabs(gsl_matrix_get(W->H, 3 * b + r, i)) * Ia[3 * r + c] *
+                            fabs(gsl_matrix_get(W->H, 3 * b + c, j));
+        }
+  }
+  for (int l = 0; l < p->nlimb; l++)
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) A[3 * i + j] += p->armature[l] * fabs(Jd[3 * l + i] * Jd[3 * l + j]);
+}
+
+/* The inverse of the forward dynamics, compared as generalized forces:
+ * J_d^T fd1 = J_d^T fd (fd1 = fd for three limbs; for four fd1 is the
+ * minimum-norm force with the same J_d^T fd). The forward dynamics solves
+ * M qdd = b by Cholesky (backward error gamma(10) |R^T| |R| <= 3 gamma(10)
+ * ||M|| for a 3x3); the inverse rebuilds tau = M qdd + h - G - ... from
+ * the same G, h, Qp, M (bit for bit the same in both calls: their own
+ * rounding cancels), so tau - b is the rounding of a few sums of the
+ * terms S = |G| + |h| + |Qp| + |J_d|^T |fd| + |fp_3| e3 + |J_R,P|^T |mp| +
+ * |M| |qdd| (componentwise). Then it solves J_d^T fd1 = tau: for three
+ * limbs by LU with partial pivoting (backward error gamma(9) |L| |U|,
+ * |L| |U| <= 12 |J_d^T| in norm for a 3x3 with growth <= 4), for four
+ * through the inverse of J_d^T J_d, whose error is kappa = cond_1(J_d^T
+ * J_d) times larger. Every constant (gamma(n) / u for the sums' n <= 30,
+ * 3 gamma(10) / u, 12 gamma(9) / u = 108) is at most 128:
+ *   |J_d^T (fd1 - fd)| <= 128 u (||S|| + ||M|| ||qdd|| + kappa || |J_d|^T |fd1| ||).
+ * Returns the error over that bound, -1 where a call fails. */
+static double id_fd_ratio(const prru_ref_params *p, const double q[3], const double qd[3], const double *fd,
+                          const double fp[3], const double mp[3])
+{
+  const int na = p->nlimb;
+  double qdd[3], fd1[PRRU_MAX_ACT], Jd[3 * PRRU_MAX_ACT], M[9], h[3], G[3], Qp[3], N[9];
+  if (prru_ref_forward_dynamics(p, W, q, qd, fd, fp, mp, qdd) != GSL_SUCCESS ||
+      prru_ref_inverse_dynamics(p, W, q, qd, qdd, fp, mp, fd1) != GSL_SUCCESS ||
+      prru_ref_passive(p, W, q, qd, Qp) != GSL_SUCCESS || prru_ref_jd(p, q, Jd) != GSL_SUCCESS ||
+      prru_ref_dynamics(p, W, q, qd, M, h, G) != GSL_SUCCESS)
+    return -1;
+  double kappa = 1, S = 0, Mn = 0, qn = 0, Jf = 0, err = 0;
+  if (na == 4) {
+    gram_of(p, Jd, N);
+    kappa = cond3(N);
+  }
+  for (int j = 0; j < 3; j++) {
+    double s = fabs(G[j]) + fabs(h[j]) + fabs(Qp[j]) + (j == 2 ? fabs(fp[2]) : 0);
+    double jf = 0, t1 = 0, t0 = 0, mrow = 0;
+    for (int i = 0; i < na; i++) {
+      s += fabs(Jd[3 * i + j] * fd[i]);
+      jf += fabs(Jd[3 * i + j] * fd1[i]);
+      t1 += Jd[3 * i + j] * fd1[i];
+      t0 += Jd[3 * i + j] * fd[i];
+    }
+    for (int i = 0; i < 3; i++) { /* J_R,P: the first rows of p's H, in W */
+      s += fabs(gsl_matrix_get(W->H, i, j) * mp[i]) + fabs(M[3 * j + i] * qdd[i]);
+      mrow += fabs(M[3 * j + i]);
+    }
+    S = fmax(S, s);
+    Jf = fmax(Jf, jf);
+    Mn = fmax(Mn, mrow);
+    qn = fmax(qn, fabs(qdd[j]));
+    err = fmax(err, fabs(t1 - t0));
+  }
+  return err / (128 * U_ROUND * (S + Mn * qn + kappa * Jf));
+}
+
+static void test_other_topology(void)
+{
+  const char *src = getenv("PRRU_SOURCE_DIR"), *own = getenv("PRRU_MODEL");
+  if (!TU_TRUE(src && own, "PRRU_SOURCE_DIR and PRRU_MODEL set (ctest sets them)")) return;
+  static prru_ref_params Pf, Po;
+  /* The reader and the conversion on the build's own file first. */
+  TU_TRUE(read_model(own, &Pf) && same_params(&Pf, &P),
+          "the build's model file, read and converted, is prru_ref_params_default");
+  char path[1024], what[1200];
+  snprintf(path, sizeof path, "%s/models/%s", src, PRRU_NLIMB == 3 ? "4prru.json" : "3prru_paper.json");
+  snprintf(what, sizeof what, "%s reads: %d limbs", path, 7 - PRRU_NLIMB);
+  if (!TU_TRUE(read_model(path, &Po) && Po.nlimb == 7 - PRRU_NLIMB, what)) return;
+  const int na = Po.nlimb, nb = 1 + 3 * na, nw = 6 * nb, nl = 19 * na;
+
+  /* The build's model before and after the other one in the same
+   * workspace: bit for bit the same (the workspace follows each model). */
+  double q0[3], qd0[3], fd0[NA], fp0[3], mp0[3], M0a[9], M0b[9], lam0a[NL], lam0b[NL];
+  random_state(q0, qd0, 0);
+  random_loads(fd0, fp0, mp0);
+  prru_ref_mass(&P, W, q0, M0a);
+  prru_ref_reactions(&P, W, q0, qd0, fd0, fp0, mp0, lam0a);
+
+  static double Q[6 * PRRU_MAX_BODY * PRRU_MAX_LAMBDA + 1];
+  double e_len = 0, w_sym = 0, w_T = 0, w_id = 0;
+  int fails = 0, nullity_ok = 1, not_pd = 0, sized = 1;
+  for (int n = 0; n < 200; n++) {
+    double q[3], qd[3], d[PRRU_MAX_ACT + 1], lam[PRRU_MAX_LAMBDA + 1], z[PRRU_MAX_LAMBDA];
+    double R[9 * PRRU_MAX_BODY], pos[3 * PRRU_MAX_BODY], Jd[3 * PRRU_MAX_ACT], M[9], E[2], A[9];
+    double fd[PRRU_MAX_ACT], fp[3], mp[3];
+    int nullity;
+    other_state(&Po, q, qd);
+    for (int i = 0; i < 3; i++) {
+      fp[i] = tu_uniform(-30, 30);
+      mp[i] = tu_uniform(-3, 3);
+    }
+    for (int i = 0; i < na; i++) fd[i] = tu_uniform(-60, 60);
+
+    /* The outputs are the model's length: the entry after them is not
+     * written. Q's null space: one redundant reaction direction with four
+     * limbs, none with three. */
+    for (int i = 0; i <= PRRU_MAX_ACT; i++) d[i] = SENTINEL;
+    for (int i = 0; i <= PRRU_MAX_LAMBDA; i++) lam[i] = SENTINEL;
+    Q[nw * nl] = SENTINEL;
+    int st = prru_ref_ik(&Po, q, d) | prru_ref_reaction_basis(&Po, W, q, Q) |
+             prru_ref_reactions(&Po, W, q, qd, fd, fp, mp, lam);
+    e_len = fmax(e_len, fabs(d[na] - SENTINEL) + fabs(lam[nl] - SENTINEL) + fabs(Q[nw * nl] - SENTINEL));
+    nullity_ok &= prru_ref_reaction_null(&Po, W, q, z, &nullity) == GSL_SUCCESS && nullity == (na == 4);
+
+    st |= prru_ref_poses(&Po, q, R, pos) | prru_ref_jd(&Po, q, Jd) | prru_ref_energy(&Po, W, q, qd, E) |
+          prru_ref_mass(&Po, W, q, M);
+    if (st != GSL_SUCCESS) {
+      fails++;
+      continue;
+    }
+    sized &= W->H->size1 == (size_t)nw && W->Q->size2 == (size_t)nl && W->Jd->size1 == (size_t)na;
+    mass_scale(&Po, R, Jd, A);
+
+    /* M symmetric: M_ij and M_ji are the same exact sum, each rounded along
+     * R I R^T (9 products of 3), Phi H and H^T (Phi H) (6 nbody terms
+     * each), then + J_d^T (K J_d) (nact terms, 2 more roundings): within
+     * gamma(2 nw + nact + 13) A_ij of it, so of each other within twice
+     * that. Positive definite: its leading minors (Sylvester). */
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        const double bound = 2 * gamma_n(2 * nw + na + 13) * A[3 * i + j];
+        w_sym = fmax(w_sym, fabs(M[3 * i + j] - M[3 * j + i]) / bound);
+      }
+    const double m2 = M[0] * M[4] - M[1] * M[3];
+    const double m3 = M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
+                      M[2] * (M[3] * M[7] - M[4] * M[6]);
+    not_pd += !(M[0] > 0 && m2 > 0 && m3 > 0);
+
+    /* T body by body = qd^T M qd / 2: two evaluations of the same quadratic
+     * form in the same computed H, Phi, J_d. prru_ref_energy rounds the
+     * velocities (3 terms) and sums 12 nbody + nact products of at most 4
+     * factors; the form in M rounds M (above) and its own 9 products of 3:
+     * each within gamma(12 nbody + nact + 16) Tabs, Tabs = |qd|^T A |qd| / 2. */
+    double Tm = 0, Tabs = 0;
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        Tm += 0.5 * qd[i] * M[3 * i + j] * qd[j];
+        Tabs += 0.5 * fabs(qd[i]) * A[3 * i + j] * fabs(qd[j]);
+      }
+    w_T = fmax(w_T, fabs(E[0] - Tm) / (2 * gamma_n(12 * nb + na + 16) * Tabs));
+
+    const double r = id_fd_ratio(&Po, q, qd, fd, fp, mp);
+    if (r < 0) fails++;
+    else w_id = fmax(w_id, r);
+  }
+  prru_ref_mass(&P, W, q0, M0b);
+  prru_ref_reactions(&P, W, q0, qd0, fd0, fp0, mp0, lam0b);
+
+  snprintf(what, sizeof what, "the %d-limb model evaluates at every drawn state", na);
+  tu_check(fails == 0, what, fails, 0);
+  tu_check(e_len == 0, "outputs of the other model's lengths (the entry after them untouched)", e_len, 0);
+  TU_TRUE(sized, "the workspace's H, Q, J_d are the other model's size");
+  snprintf(what, sizeof what, "Q's null space: %d redundant reaction direction(s) for %d limbs", na == 4, na);
+  TU_TRUE(nullity_ok, what);
+  tu_check(w_sym <= 1, "other topology: M symmetric (asymmetry / bound)", w_sym, 1);
+  tu_check(not_pd == 0, "other topology: M positive definite", not_pd, 0);
+  tu_check(w_T <= 1, "other topology: T body by body = qd^T M qd / 2 (error / bound)", w_T, 1);
+  tu_check(w_id <= 1, "other topology: J_d^T ID(FD(fd)) = J_d^T fd (error / bound)", w_id, 1);
+  TU_TRUE(memcmp(M0a, M0b, sizeof M0a) == 0 && memcmp(lam0a, lam0b, sizeof lam0a) == 0,
+          "the build's model after the other in the same workspace: M and lambda bit for bit the same");
+
+  /* An nlimb the reference does not know (a zeroed struct's 0, or 5). */
+  for (int bad = 0; bad <= 5; bad += 5) {
+    prru_ref_params Pb = Po;
+    Pb.nlimb = bad;
+    double d[PRRU_MAX_ACT] = {SENTINEL, SENTINEL, SENTINEL, SENTINEL}, M[9];
+    const double q[3] = {0, 0, 0};
+    const int ik = prru_ref_ik(&Pb, q, d), mass = prru_ref_mass(&Pb, W, q, M);
+    snprintf(what, sizeof what, "nlimb = %d: GSL_EINVAL, d untouched, M NaN", bad);
+    TU_TRUE(ik == GSL_EINVAL && d[0] == SENTINEL && mass == GSL_EINVAL && all_nan(M, 9), what);
+  }
+  printf("other topology (%d limbs, %s; 200 states): error / bound: M asymmetry %.1e, T %.1e,"
+         " ID(FD) %.1e\n", na, path, w_sym, w_T, w_id);
+}
+
 int main(void)
 {
   prru_ref_params_default(&P);
@@ -1030,6 +1334,7 @@ int main(void)
   test_w_r();
   test_mirror();
   test_unreachable();
+  test_other_topology();
   prru_ref_free(W);
   return tu_finish("test_reference");
 }
