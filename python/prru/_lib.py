@@ -278,7 +278,7 @@ class Types:
         nreg = MAX_REG
         i = ctypes.c_int
         self.Base = type("prru_base", (ctypes.Structure,), {"_fields_": [
-            ("nbase", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
+            ("nbase", i), ("nreg", i), ("nbody", i), ("nact", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
             ("vs", d), ("last_kept", d), ("first_dropped", d), ("nstates", i), ("seed", ctypes.c_ulong)]})
         self.IdentResult = type("prru_ident_result", (ctypes.Structure,), {"_fields_": [
             ("nsamples", i), ("nrows", i), ("dof", i), ("beta", _arr(d, nreg)), ("se", _arr(d, nreg)),
