@@ -179,6 +179,12 @@ static void check_base(prru_base *b)
   TU_TRUE(b2->nbase == b->nbase, "the number of base parameters does not change with more states");
   TU_TRUE(b->nreg == PRRU_NREG && b->nbody == PRRU_NBODY && b->nact == PRRU_NACT,
           "the base holds the model's counts");
+  int names_same = prru_base_param_name(b, -1) == NULL && prru_base_param_name(b, PRRU_NREG) == NULL;
+  for (int j = 0; j < PRRU_NREG; j++) {
+    const char *nm = prru_base_param_name(b, j);
+    names_same &= nm && strcmp(nm, prru_regressor_names[j]) == 0;
+  }
+  TU_TRUE(names_same, "prru_base_param_name: the generated regressor's column names");
   tu_check(b->first_dropped < 1e-12 && b->last_kept > 1e-6, "a clear gap at the rank cut",
            b->first_dropped, 1e-12);
   free(b2);

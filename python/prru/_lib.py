@@ -461,6 +461,7 @@ class Library:
         self.ident_default_vs = _declare(dll, "prru_ident_default_vs", d, mp)
         self.base_compute = _declare(dll, "prru_base_compute", i, mp, d, i, ctypes.c_ulong, bp)
         self.base_params = _declare(dll, "prru_base_params", None, bp, vp, vp)
+        self.base_param_name = _declare(dll, "prru_base_param_name", ctypes.c_char_p, bp, i)
         self.ident_standard = _declare(dll, "prru_ident_standard", None, ctypes.c_void_p, vp)
         self.identify = _declare(dll, "prru_identify", i, mp, bp, i, vp, vp, vp, vp, irp, c_int_p)
         self.consistent_options_default = _declare(dll, "prru_consistent_options_default", None,

@@ -105,6 +105,11 @@ PRRU_API void prru_base_regressor(const prru_base *b, const double *Y, int rows,
  * that the combination equals beta (the others keep pi0's values). */
 PRRU_API void prru_base_to_standard(const prru_base *b, const double beta[],
                                     const double pi0[], double pi[]);
+/* The name of standard parameter j (0 <= j < b->nreg) of the model b was
+ * computed for, as prru_regressor.h names the columns: "P.m", "P.mcx",
+ * ..., "S3.Iyz", "armature1", ..., "coulomb3" for three limbs (bodies P,
+ * L1.., U1.., S1..); NULL for another j. */
+PRRU_API const char *prru_base_param_name(const prru_base *b, int j);
 
 /* Observation rows of one sample: A (nact x nbase) = J_d^+T Y_base
  * and y (nact) = J_d^+T J_d^T fd. The status of prru_check_regular
@@ -289,7 +294,7 @@ PRRU_API int prru_identify_model(const prru_model *m, const prru_base *b, int n,
 
 /* The k base parameters whose consistent value is furthest from the
  * estimate, in standard errors: "#3 P.m at 4.1 se, ..." (1-based index,
- * its regressor column's name). */
+ * its regressor column's name, prru_base_param_name). */
 PRRU_API void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len);
 
 /* ---- Periodic excitation ----

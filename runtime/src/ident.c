@@ -247,6 +247,36 @@ void prru_base_to_standard(const prru_base *b, const double beta[],
   }
 }
 
+/* The regressor's column names of each topology, in prru_topology_layout's
+ * body order (P, the lower links, the upper links, the sliders): the
+ * generated prru_regressor_names names the build's model's only, and a
+ * base of either topology is named in any build (test_ident compares the
+ * two). */
+#define BODY_PARAMS(b) b ".m", b ".mcx", b ".mcy", b ".mcz", b ".Ixx", b ".Iyy", b ".Izz", b ".Ixy", b ".Ixz", b ".Iyz"
+static const char *const names3[] = {
+    BODY_PARAMS("P"),  BODY_PARAMS("L1"), BODY_PARAMS("L2"), BODY_PARAMS("L3"), BODY_PARAMS("U1"),
+    BODY_PARAMS("U2"), BODY_PARAMS("U3"), BODY_PARAMS("S1"), BODY_PARAMS("S2"), BODY_PARAMS("S3"),
+    "armature1", "armature2", "armature3", "damping1", "damping2", "damping3", "coulomb1", "coulomb2", "coulomb3"};
+static const char *const names4[] = {
+    BODY_PARAMS("P"),  BODY_PARAMS("L1"), BODY_PARAMS("L2"), BODY_PARAMS("L3"), BODY_PARAMS("L4"),
+    BODY_PARAMS("U1"), BODY_PARAMS("U2"), BODY_PARAMS("U3"), BODY_PARAMS("U4"), BODY_PARAMS("S1"),
+    BODY_PARAMS("S2"), BODY_PARAMS("S3"), BODY_PARAMS("S4"),
+    "armature1", "armature2", "armature3", "armature4", "damping1", "damping2", "damping3", "damping4",
+    "coulomb1", "coulomb2", "coulomb3", "coulomb4"};
+#undef BODY_PARAMS
+typedef char names_cover_both_topologies[sizeof names3 / sizeof *names3 == (1 + 3 * 3) * PRRU_NBODYPAR + 3 * 3 &&
+                                                 sizeof names4 / sizeof *names4 == PRRU_MAX_REG
+                                             ? 1
+                                             : -1];
+
+const char *prru_base_param_name(const prru_base *b, int j)
+{
+  if (j < 0 || j >= b->nreg) return NULL;
+  if (b->nbody == 10 && b->nact == 3) return names3[j];
+  if (b->nbody == 13 && b->nact == 4) return names4[j];
+  return NULL;
+}
+
 int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
                     const double qd[3], const double qdd[3], const double fd[],
                     double *A, double y[])

@@ -23,7 +23,7 @@ void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, 
       if (!used[i] && (w < 0 || fabs(c->t[i]) > fabs(c->t[w]))) w = i;
     used[w] = 1;
     at += (size_t)snprintf(buf + at, (size_t)len - at, "%s#%d %s at %.3g se", n ? ", " : "", w + 1,
-                           prru_regressor_names[b->col[w]], c->t[w]);
+                           prru_base_param_name(b, b->col[w]), c->t[w]);
   }
 }
 
