@@ -140,18 +140,16 @@ typedef struct {
   double inflation;
   int hac_lags;
   /* X = Q R (R: nbase x nbase upper triangular, row stride the base's
-   * nreg), so
-   * that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2: the
-   * covariance of beta^ is s^2 (R^T R)^-1. */
+   * nreg), so that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2:
+   * the covariance of beta^ is s^2 (R^T R)^-1. */
   double R[PRRU_MAX_REG * PRRU_MAX_REG];
 } prru_ident_result;
 
 /* Least squares of the base parameters from n samples (q, qd, qdd, fd:
  * row-major n x 3 and n x nact). PRRU_EINPUT when n is too small
  * (3 n <= nbase) or b is of another topology than m's, or with *bad the
- * 0-based sample and its status
- * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, PRRU_EINPUT for non-finite values)
- * when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
+ * 0-based sample and its status (PRRU_EUNREACHABLE, PRRU_ESINGULAR,
+ * PRRU_EINPUT for non-finite values) when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
  * is rank deficient (the motion does not excite every base parameter);
  * PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
@@ -229,8 +227,8 @@ typedef struct {
  * filled; PRRU_ESINGULAR (pi and c filled: the consistent set nearest the
  * estimate) when d^2 > d2_max, the data contradicting physics; PRRU_EINPUT
  * for bad options, b of another topology than m's or a prior with a mass
- * <= 0, a non-finite value or a negative drive coefficient; PRRU_ENOCONV when the Newton budget runs
- * out; PRRU_ENOMEM. Allocates. */
+ * <= 0, a non-finite value or a negative drive coefficient; PRRU_ENOCONV
+ * when the Newton budget runs out; PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
                                    const double pi0[], const prru_consistent_options *o,
                                    double pi[], prru_consistent_result *c);
@@ -283,11 +281,11 @@ typedef struct {
  * rules). PRRU_OK with stage PRRU_IDENTIFY_DONE and out->text; otherwise
  * the first failing step's status with out->stage and out->msg:
  * PRRU_EINPUT for b of another topology than m's, prru_identify's (with
- * out->bad for a sample that gives no rows),
- * prru_ident_consistent's PRRU_EINPUT or PRRU_ENOCONV, PRRU_ESINGULAR when
- * the data contradict physics (the consistent result is filled: a report
- * can show it), PRRU_EINPUT when the parameters make no model file (never
- * for a consistent result), PRRU_ENOMEM. Allocates. */
+ * out->bad for a sample that gives no rows), prru_ident_consistent's
+ * PRRU_EINPUT or PRRU_ENOCONV, PRRU_ESINGULAR when the data contradict
+ * physics (the consistent result is filled: a report can show it),
+ * PRRU_EINPUT when the parameters make no model file (never for a
+ * consistent result), PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_identify_model(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
                                  const double *qdd, const double *fd, const char *name, const char *description,
                                  prru_identification *out);
@@ -332,14 +330,13 @@ typedef struct {
 
 /* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, check samples 0 (20 times samples, whatever samples becomes), 3000 evaluations,
- * seed 1; rows every 0.01 s over 1 period. Every one of the PRRU_MAX_ACT entries: the
- * options suit a model of any number of actuators. */
+ * seed 1; rows every 0.01 s over 1 period. All PRRU_MAX_ACT entries, so that the options suit a
+ * model of either number of actuators. */
 PRRU_API void prru_excite_options_default(prru_excite_options *o);
 /* A run's limits (prru_limits_for_run) into o: the force bounds where
  * finite (an excitation needs one: o's, 500 N by default, where the run
- * has none), the speed limits and the strokes; every one of the
- * PRRU_MAX_ACT entries, as lim holds them (no actuator's past the
- * model's). */
+ * has none), the speed limits and the strokes; all PRRU_MAX_ACT
+ * entries, as lim holds them. */
 PRRU_API void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
 /* The rows t_i = i o->dt, i = 0..n-1, of a run of o->periods periods of
  * f: n = floor(periods period / dt (1 + 1e-12)) + 1, the last row at the
@@ -364,8 +361,9 @@ typedef struct {
  * checked point being reachable, regular (rcond >= rcond_min), in the
  * assembly mode of the centre and within the force and stroke limits. Deterministic
  * (seeded start, GSL nmsimplex2). PRRU_EINPUT for bad options or centre
- * or b of another topology than m's (msg says which), PRRU_ENOCONV when no feasible trajectory was found,
- * PRRU_EINTERRUPTED when *stop became non-zero. Allocates. */
+ * or b of another topology than m's (msg says which), PRRU_ENOCONV when
+ * no feasible trajectory was found, PRRU_EINTERRUPTED when *stop became
+ * non-zero. Allocates. */
 PRRU_API int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_options *o,
                          volatile sig_atomic_t *stop, prru_fourier *f, prru_excite_result *r, char *msg,
                          int msglen);

@@ -18,7 +18,7 @@
 void prru_excite_options_default(prru_excite_options *o)
 {
   memset(o, 0, sizeof *o);
-  /* Every actuator's entry, whatever the model o will be used with. */
+  /* Every entry: o does not know the model it will be used with. */
   for (int i = 0; i < PRRU_MAX_ACT; i++)
     o->fd_max[i] = 500.0, o->d_min[i] = -HUGE_VAL, o->d_max[i] = HUGE_VAL, o->speed_max[i] = HUGE_VAL;
   o->rcond_min = 1e-2;
@@ -59,8 +59,8 @@ long prru_excite_rows(const prru_fourier *f, const prru_excite_options *o)
 
 void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim)
 {
-  /* Every entry: lim holds the model's actuators and no limit past them
-   * (prru_limits), which o then holds for no actuator. */
+  /* Every entry, as for the defaults: those past the model's actuators
+   * are read by no one. */
   for (int i = 0; i < PRRU_MAX_ACT; i++) {
     if (isfinite(lim->force_max[i])) o->fd_max[i] = lim->force_max[i];
     o->speed_max[i] = lim->speed_max[i];
