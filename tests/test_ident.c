@@ -177,6 +177,14 @@ static void check_base(prru_base *b)
   printf("base parameters: %d of %d (pivot gap %.1e kept / %.1e dropped); %d with %d states, seed 7\n",
          b->nbase, PRRU_NREG, b->last_kept, b->first_dropped, b2->nbase, b2->nstates);
   TU_TRUE(b2->nbase == b->nbase, "the number of base parameters does not change with more states");
+  TU_TRUE(b->nreg == PRRU_NREG && b->nbody == PRRU_NBODY && b->nact == PRRU_NACT,
+          "the base holds the model's counts");
+  int names_same = prru_base_param_name(b, -1) == NULL && prru_base_param_name(b, PRRU_NREG) == NULL;
+  for (int j = 0; j < PRRU_NREG; j++) {
+    const char *nm = prru_base_param_name(b, j);
+    names_same &= nm && strcmp(nm, prru_regressor_names[j]) == 0;
+  }
+  TU_TRUE(names_same, "prru_base_param_name: the generated regressor's column names");
   tu_check(b->first_dropped < 1e-12 && b->last_kept > 1e-6, "a clear gap at the rank cut",
            b->first_dropped, 1e-12);
   free(b2);
@@ -834,6 +842,19 @@ static void check_identify_model(const prru_base *b)
   st = prru_identify_model(&model, b, 3, q, qd, qdd, fd, "x", "", r);
   TU_TRUE(st == PRRU_EINPUT && r->stage == PRRU_IDENTIFY_FIT && strstr(r->msg, "fewer than"),
           "identify_model: too few samples");
+  prru_base *other = malloc(sizeof *other);
+  if (other) { /* a base of the other topology's counts */
+    *other = *b;
+    other->nact = NA == 3 ? 4 : 3, other->nbody = NB == 10 ? 13 : 10;
+    other->nreg = PRRU_NBODYPAR * other->nbody + 3 * other->nact;
+    st = prru_identify_model(&model, other, N, q, qd, qdd, fd, "x", "", r);
+    TU_TRUE(st == PRRU_EINPUT && r->stage == PRRU_IDENTIFY_FIT && strstr(r->msg, "computed for a model of"),
+            "identify_model: a base of another topology is refused");
+    prru_ident_result *fit = malloc(sizeof *fit);
+    TU_TRUE(fit && prru_identify(&model, other, N, q, qd, qdd, fd, fit, NULL) == PRRU_EINPUT,
+            "identify: a base of another topology is refused");
+    free(fit), free(other);
+  }
   make_data(N, 0, q, qd, qdd, fd);
   for (int i = 0; i < NA * N; i++) fd[i] = -fd[i]; /* a sign convention flipped */
   st = prru_identify_model(&model, b, N, q, qd, qdd, fd, "x", "", r);

@@ -280,7 +280,7 @@ class Types:
         nreg = MAX_REG
         i = ctypes.c_int
         self.Base = type("prru_base", (ctypes.Structure,), {"_fields_": [
-            ("nbase", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
+            ("nbase", i), ("nreg", i), ("nbody", i), ("nact", i), ("col", _arr(i, nreg)), ("role", _arr(i, nreg)), ("B", _arr(d, nreg * nreg)),
             ("vs", d), ("last_kept", d), ("first_dropped", d), ("nstates", i), ("seed", ctypes.c_ulong)]})
         self.IdentResult = type("prru_ident_result", (ctypes.Structure,), {"_fields_": [
             ("nsamples", i), ("nrows", i), ("dof", i), ("beta", _arr(d, nreg)), ("se", _arr(d, nreg)),
@@ -463,6 +463,7 @@ class Library:
         self.ident_default_vs = _declare(dll, "prru_ident_default_vs", d, mp)
         self.base_compute = _declare(dll, "prru_base_compute", i, mp, d, i, ctypes.c_ulong, bp)
         self.base_params = _declare(dll, "prru_base_params", None, bp, vp, vp)
+        self.base_param_name = _declare(dll, "prru_base_param_name", ctypes.c_char_p, bp, i)
         self.ident_standard = _declare(dll, "prru_ident_standard", None, ctypes.c_void_p, vp)
         self.identify = _declare(dll, "prru_identify", i, mp, bp, i, vp, vp, vp, vp, irp, c_int_p)
         self.consistent_options_default = _declare(dll, "prru_consistent_options_default", None,

@@ -241,9 +241,8 @@ def identify(self, t, q, qd, qdd, fd, *, name=None, coulomb_velocity=None):
         if st != errors.OK and out.stage == _lib.IDENTIFY_CONSISTENT:
             raise errors.make_error(st, msg)
         r, c = out.fit, out.consistent
-        names = lib.regressor_names
-        params = [Parameter(names[b.col[i]].decode(), r.beta[i], r.se[i], out.prior[i], c.beta[i], c.t[i])
-                  for i in range(b.nbase)]
+        params = [Parameter(lib.base_param_name(ctypes.byref(b), b.col[i]).decode(), r.beta[i], r.se[i],
+                            out.prior[i], c.beta[i], c.t[i]) for i in range(b.nbase)]
         result = Identification(text=None, name=name, nsamples=r.nsamples, nbase=b.nbase, sigma=r.sigma,
                                 cond=r.cond, inflation=r.inflation,
                                 consistent="exact" if c.how == _lib.CONSISTENT_EXACT else "covariance",

@@ -41,8 +41,9 @@ extern "C" {
 #define PRRU_BASE_RTOL 1e-9     /* relative pivot size of a base column */
 #define PRRU_BASE_STATES 200    /* random states of prru_base_compute */
 
-/* The standard parameters of a mechanism descriptor: pi from its mass,
- * com, inertia (about the centre) and drives. */
+/* The standard parameters of a mechanism descriptor: pi (10 me->nbody +
+ * 3 me->nact values) from its mass, com, inertia (about the centre) and
+ * drives. */
 PRRU_API void prru_ident_standard(const prru_mechanism *me, double pi[]);
 /* One body's mass, centre of mass and inertia about the centre (Ixx Iyy
  * Izz Ixy Ixz Iyz, as in model files) from its 10 standard parameters:
@@ -55,9 +56,14 @@ enum { PRRU_PAR_BASE = 0, PRRU_PAR_COMBINED = 1, PRRU_PAR_NONE = 2 };
 
 typedef struct {
   int nbase;                      /* number of base parameters */
+  /* The counts of the model it was computed for (prru_base_compute):
+   * nreg = 10 nbody + 3 nact standard parameters, the length of pi and
+   * the row stride of B. The functions taking a model and a base refuse
+   * a base of another topology (PRRU_EINPUT). */
+  int nreg, nbody, nact;
   int col[PRRU_MAX_REG];             /* col[i], i < nbase: base parameter i's own standard one */
   int role[PRRU_MAX_REG];            /* per standard parameter */
-  double B[PRRU_MAX_REG * PRRU_MAX_REG];/* rows i < nbase: beta_i = sum_j B[i][j] pi_j */
+  double B[PRRU_MAX_REG * PRRU_MAX_REG];/* rows i < nbase: beta_i = sum_j B[i][j] pi_j (row stride nreg) */
   double vs;                      /* Coulomb smoothing velocity Y was evaluated with (m/s) */
   double last_kept, first_dropped;/* |R_ii| / |R_00| on either side of the cut */
   int nstates;
@@ -84,24 +90,31 @@ PRRU_API void prru_model_regressor(const prru_model *m, const double q[3], const
  * with unless told otherwise: the model's, else 1 mm/s (m/s). */
 PRRU_API double prru_ident_default_vs(const prru_model *m);
 
-/* Base parameters from nstates random states (PRRU_BASE_STATES when <= 0)
- * drawn with seed; vs > 0 the Coulomb smoothing velocity. Allocates (a
- * set-up call). PRRU_EINPUT for vs <= 0, PRRU_ENOMEM, PRRU_ENOCONV. */
+/* Base parameters of m from nstates random states (PRRU_BASE_STATES when
+ * <= 0, at least nreg / 3) drawn with seed; vs > 0 the Coulomb smoothing
+ * velocity. Allocates (a set-up call). PRRU_EINPUT for vs <= 0,
+ * PRRU_ENOMEM, PRRU_ENOCONV. */
 PRRU_API int prru_base_compute(const prru_model *m, double vs, int nstates, unsigned long seed,
                                prru_base *b);
-/* beta = B pi (nbase values). */
+/* beta = B pi (nbase values; pi b->nreg values). */
 PRRU_API void prru_base_params(const prru_base *b, const double pi[], double beta[]);
-/* The base columns of rows x nreg Y: Yb (rows x nbase). */
+/* The base columns of rows x nreg Y (nreg b's): Yb (rows x nbase). */
 PRRU_API void prru_base_regressor(const prru_base *b, const double *Y, int rows, double *Yb);
 /* A standard parameter vector with B pi = beta: pi0 (a prior, e.g. the
  * model's) with each base parameter's own standard parameter replaced so
  * that the combination equals beta (the others keep pi0's values). */
 PRRU_API void prru_base_to_standard(const prru_base *b, const double beta[],
                                     const double pi0[], double pi[]);
+/* The name of standard parameter j (0 <= j < b->nreg) of the model b was
+ * computed for, as prru_regressor.h names the columns: "P.m", "P.mcx",
+ * ..., "S3.Iyz", "armature1", ..., "coulomb3" for three limbs (bodies P,
+ * L1.., U1.., S1..); NULL for another j. */
+PRRU_API const char *prru_base_param_name(const prru_base *b, int j);
 
 /* Observation rows of one sample: A (nact x nbase) = J_d^+T Y_base
  * and y (nact) = J_d^+T J_d^T fd. The status of prru_check_regular
- * (unreachable or singular poses give no rows). */
+ * (unreachable or singular poses give no rows); PRRU_EINPUT for a
+ * non-finite qd, qdd or fd, or b of another topology than m's. */
 PRRU_API int prru_ident_rows(const prru_model *m, prru_data *d, const prru_base *b, const double q[3],
                              const double qd[3], const double qdd[3], const double fd[],
                              double *A, double y[]);
@@ -126,17 +139,17 @@ typedef struct {
    * anticorrelated. prru_ident_consistent judges with it. */
   double inflation;
   int hac_lags;
-  /* X = Q R (R: nbase x nbase upper triangular, row stride nreg), so
-   * that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2: the
-   * covariance of beta^ is s^2 (R^T R)^-1. */
+  /* X = Q R (R: nbase x nbase upper triangular, row stride the base's
+   * nreg), so that |X beta - y|^2 = |X beta^ - y|^2 + |R (beta - beta^)|^2:
+   * the covariance of beta^ is s^2 (R^T R)^-1. */
   double R[PRRU_MAX_REG * PRRU_MAX_REG];
 } prru_ident_result;
 
 /* Least squares of the base parameters from n samples (q, qd, qdd, fd:
  * row-major n x 3 and n x nact). PRRU_EINPUT when n is too small
- * (3 n <= nbase), or with *bad the 0-based sample and its status
- * (PRRU_EUNREACHABLE, PRRU_ESINGULAR, PRRU_EINPUT for non-finite values)
- * when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
+ * (3 n <= nbase) or b is of another topology than m's, or with *bad the
+ * 0-based sample and its status (PRRU_EUNREACHABLE, PRRU_ESINGULAR,
+ * PRRU_EINPUT for non-finite values) when a sample gives no rows; PRRU_ESINGULAR when the stacked regressor
  * is rank deficient (the motion does not excite every base parameter);
  * PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_identify(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
@@ -213,9 +226,9 @@ typedef struct {
  * the prior pi0 (the model's, prru_ident_standard). PRRU_OK with pi and c
  * filled; PRRU_ESINGULAR (pi and c filled: the consistent set nearest the
  * estimate) when d^2 > d2_max, the data contradicting physics; PRRU_EINPUT
- * for bad options or a prior with a mass <= 0, a non-finite value or a
- * negative drive coefficient; PRRU_ENOCONV when the Newton budget runs
- * out; PRRU_ENOMEM. Allocates. */
+ * for bad options, b of another topology than m's or a prior with a mass
+ * <= 0, a non-finite value or a negative drive coefficient; PRRU_ENOCONV
+ * when the Newton budget runs out; PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_ident_result *r,
                                    const double pi0[], const prru_consistent_options *o,
                                    double pi[], prru_consistent_result *c);
@@ -228,7 +241,8 @@ PRRU_API int prru_ident_consistent(const prru_model *m, const prru_base *b, cons
  * model file can hold and which keeps the body consistent. PRRU_EINPUT
  * with why naming the body or drive that is not physical (a mass <= 0,
  * an inertia not positive definite, a negative drive coefficient; never
- * for prru_ident_consistent's output). prru_model_file_text writes p. */
+ * for prru_ident_consistent's output), or b of another topology than m's.
+ * prru_model_file_text writes p. */
 PRRU_API int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[], prru_params *p,
                                      char *why, int len);
 
@@ -266,18 +280,19 @@ typedef struct {
  * the model named name, described by description (prru_model_file_text's
  * rules). PRRU_OK with stage PRRU_IDENTIFY_DONE and out->text; otherwise
  * the first failing step's status with out->stage and out->msg:
- * prru_identify's (with out->bad for a sample that gives no rows),
- * prru_ident_consistent's PRRU_EINPUT or PRRU_ENOCONV, PRRU_ESINGULAR when
- * the data contradict physics (the consistent result is filled: a report
- * can show it), PRRU_EINPUT when the parameters make no model file (never
- * for a consistent result), PRRU_ENOMEM. Allocates. */
+ * PRRU_EINPUT for b of another topology than m's, prru_identify's (with
+ * out->bad for a sample that gives no rows), prru_ident_consistent's
+ * PRRU_EINPUT or PRRU_ENOCONV, PRRU_ESINGULAR when the data contradict
+ * physics (the consistent result is filled: a report can show it),
+ * PRRU_EINPUT when the parameters make no model file (never for a
+ * consistent result), PRRU_ENOMEM. Allocates. */
 PRRU_API int prru_identify_model(const prru_model *m, const prru_base *b, int n, const double *q, const double *qd,
                                  const double *qdd, const double *fd, const char *name, const char *description,
                                  prru_identification *out);
 
 /* The k base parameters whose consistent value is furthest from the
- * estimate, in standard errors: "#3 m_P at 4.1 se, ..." (1-based index,
- * its regressor column's name). */
+ * estimate, in standard errors: "#3 P.m at 4.1 se, ..." (1-based index,
+ * its regressor column's name, prru_base_param_name). */
 PRRU_API void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len);
 
 /* ---- Periodic excitation ----
@@ -315,11 +330,13 @@ typedef struct {
 
 /* fd_max 500 N each, no stroke or speed limits, rcond_min 1e-2, amplitude 0.25 rad, 0.25 rad, 0.1 L,
  * 100 samples, check samples 0 (20 times samples, whatever samples becomes), 3000 evaluations,
- * seed 1; rows every 0.01 s over 1 period. */
+ * seed 1; rows every 0.01 s over 1 period. All PRRU_MAX_ACT entries, so that the options suit a
+ * model of either number of actuators. */
 PRRU_API void prru_excite_options_default(prru_excite_options *o);
 /* A run's limits (prru_limits_for_run) into o: the force bounds where
  * finite (an excitation needs one: o's, 500 N by default, where the run
- * has none), the speed limits and the strokes. */
+ * has none), the speed limits and the strokes; all PRRU_MAX_ACT
+ * entries, as lim holds them. */
 PRRU_API void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim);
 /* The rows t_i = i o->dt, i = 0..n-1, of a run of o->periods periods of
  * f: n = floor(periods period / dt (1 + 1e-12)) + 1, the last row at the
@@ -344,8 +361,9 @@ typedef struct {
  * checked point being reachable, regular (rcond >= rcond_min), in the
  * assembly mode of the centre and within the force and stroke limits. Deterministic
  * (seeded start, GSL nmsimplex2). PRRU_EINPUT for bad options or centre
- * (msg says which), PRRU_ENOCONV when no feasible trajectory was found,
- * PRRU_EINTERRUPTED when *stop became non-zero. Allocates. */
+ * or b of another topology than m's (msg says which), PRRU_ENOCONV when
+ * no feasible trajectory was found, PRRU_EINTERRUPTED when *stop became
+ * non-zero. Allocates. */
 PRRU_API int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_options *o,
                          volatile sig_atomic_t *stop, prru_fourier *f, prru_excite_result *r, char *msg,
                          int msglen);

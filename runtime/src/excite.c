@@ -11,13 +11,15 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_multimin.h>
 
+#include "ident_internal.h"
 #include "internal.h"
 #include "prru_ident.h"
 
 void prru_excite_options_default(prru_excite_options *o)
 {
   memset(o, 0, sizeof *o);
-  for (int i = 0; i < PRRU_NACT; i++)
+  /* Every entry: o does not know the model it will be used with. */
+  for (int i = 0; i < PRRU_MAX_ACT; i++)
     o->fd_max[i] = 500.0, o->d_min[i] = -HUGE_VAL, o->d_max[i] = HUGE_VAL, o->speed_max[i] = HUGE_VAL;
   o->rcond_min = 1e-2;
   o->amplitude_max[0] = o->amplitude_max[1] = 0.25;
@@ -57,7 +59,9 @@ long prru_excite_rows(const prru_fourier *f, const prru_excite_options *o)
 
 void prru_excite_options_limits(prru_excite_options *o, const prru_limits *lim)
 {
-  for (int i = 0; i < PRRU_NACT; i++) {
+  /* Every entry, as for the defaults: those past the model's actuators
+   * are read by no one. */
+  for (int i = 0; i < PRRU_MAX_ACT; i++) {
     if (isfinite(lim->force_max[i])) o->fd_max[i] = lim->force_max[i];
     o->speed_max[i] = lim->speed_max[i];
     o->d_min[i] = lim->d_min[i], o->d_max[i] = lim->d_max[i];
@@ -90,26 +94,23 @@ static double amplitude_bound(const prru_model *m, const prru_excite_options *o,
 
 /* The assembly mode: det J_d's sign (three actuators; four have no second
  * mode in reach). d holds J_d of the pose. */
-static int pose_mode(const prru_data *d)
+static int pose_mode(const prru_model *m, const prru_data *d)
 {
-#if PRRU_NACT == 3
+  if (m->mech->nact != 3) return 1;
   const double *a = d->Jd;
   const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
                      a[2] * (a[3] * a[7] - a[4] * a[6]);
   return det > 0 ? 1 : -1;
-#else
-  (void)d;
-  return 1;
-#endif
 }
 
 /* One point: 0 when usable (reachable, regular, in mode, within the
  * limits), with fd and rcond; else the status and *excess, a continuous
  * measure of how far the point is outside (for the penalty). */
 static int point(const prru_model *m, prru_data *d, const prru_excite_options *o, int mode,
-                 const double q[3], const double qd[3], const double qdd[3], double fd[PRRU_NACT],
+                 const double q[3], const double qd[3], const double qdd[3], double fd[],
                  double *rcond, double *excess)
 {
+  const int na = m->mech->nact;
   prru_loads l;
   memset(&l, 0, sizeof l);
   *excess = 0;
@@ -117,7 +118,7 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
   if (st == PRRU_ESTROKE) {
     /* Beyond the model's own stroke: measured like the options' stroke
      * below (check_regular left d), so the penalty stays continuous. */
-    for (int i = 0; i < PRRU_NACT; i++) {
+    for (int i = 0; i < na; i++) {
       const double range = m->mech->d_max[i] - m->mech->d_min[i];
       if (d->d[i] < m->mech->d_min[i]) *excess += (m->mech->d_min[i] - d->d[i]) / range;
       if (d->d[i] > m->mech->d_max[i]) *excess += (d->d[i] - m->mech->d_max[i]) / range;
@@ -125,10 +126,10 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
     if (!(*excess > 0)) *excess = 10; /* an infinite end: no distance to measure */
     return st;
   }
-  if (st == PRRU_ESINGULAR || (st == PRRU_OK && (*rcond < o->rcond_min || pose_mode(d) != mode))) {
+  if (st == PRRU_ESINGULAR || (st == PRRU_OK && (*rcond < o->rcond_min || pose_mode(m, d) != mode))) {
     /* Continuous through the mode change: the other mode counts as
      * negative rcond. */
-    const double s = st == PRRU_OK && pose_mode(d) != mode ? -*rcond : st == PRRU_OK ? *rcond : 0;
+    const double s = st == PRRU_OK && pose_mode(m, d) != mode ? -*rcond : st == PRRU_OK ? *rcond : 0;
     *excess = 1 + (o->rcond_min - s) / o->rcond_min;
     return PRRU_ESINGULAR;
   }
@@ -138,7 +139,7 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
   }
   /* Stroke violations relative to the stroke (d holds the sliders), and
    * slider speeds d' = J_d qd beyond speed_max (J_d from check_regular). */
-  for (int i = 0; i < PRRU_NACT; i++) {
+  for (int i = 0; i < na; i++) {
     const double range = o->d_max[i] - o->d_min[i];
     if (d->d[i] < o->d_min[i]) *excess += (o->d_min[i] - d->d[i]) / range;
     if (d->d[i] > o->d_max[i]) *excess += (d->d[i] - o->d_max[i]) / range;
@@ -150,7 +151,7 @@ static int point(const prru_model *m, prru_data *d, const prru_excite_options *o
     *excess = 10;
     return st;
   }
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (fabs(fd[i]) > o->fd_max[i]) *excess += fabs(fd[i]) / o->fd_max[i] - 1;
   return *excess > 0 ? PRRU_EINPUT : PRRU_OK;
 }
@@ -160,12 +161,13 @@ int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_exc
 {
   prru_data *d = malloc(sizeof *d);
   if (!d) return PRRU_ENOMEM;
+  const int na = m->mech->nact;
   int st = prru_check_regular(m, d, f->centre, NULL);
-  const int mode = st == PRRU_OK ? pose_mode(d) : 1;
-  for (int i = 0; i < PRRU_NACT; i++) fd_peak[i] = 0;
+  const int mode = st == PRRU_OK ? pose_mode(m, d) : 1;
+  for (int i = 0; i < na; i++) fd_peak[i] = 0;
   *rcond_worst = INFINITY;
   for (int s = 0; s < n && st == PRRU_OK; s++) {
-    double t = f->period * s / n, q[3], qd[3], qdd[3], fd[PRRU_NACT], rc, ex;
+    double t = f->period * s / n, q[3], qd[3], qdd[3], fd[PRRU_MAX_ACT], rc, ex;
     prru_fourier_eval(f, t, q, qd, qdd);
     st = point(m, d, o, mode, q, qd, qdd, fd, &rc, &ex);
     if (st != PRRU_OK) {
@@ -173,7 +175,7 @@ int prru_excite_check(const prru_model *m, const prru_fourier *f, const prru_exc
       break;
     }
     if (rc < *rcond_worst) *rcond_worst = rc;
-    for (int i = 0; i < PRRU_NACT; i++)
+    for (int i = 0; i < na; i++)
       if (fabs(fd[i]) > fd_peak[i]) fd_peak[i] = fabs(fd[i]);
   }
   free(d);
@@ -238,7 +240,7 @@ static double merit(const gsl_vector *x, void *ctx)
   const int n = c->o->samples, p = c->b->nbase;
   double excess = 0;
   for (int s = 0; s < n; s++) {
-    double q[3], qd[3], qdd[3], fd[PRRU_NACT], rc, ex, Y[3 * PRRU_NREG], Yb[3 * PRRU_NREG];
+    double q[3], qd[3], qdd[3], fd[PRRU_MAX_ACT], rc, ex, Y[3 * PRRU_MAX_REG], Yb[3 * PRRU_MAX_REG];
     prru_fourier_eval(&c->f, c->f.period * s / n, q, qd, qdd);
     if (point(c->m, c->d, c->o, c->mode, q, qd, qdd, fd, &rc, &ex) != PRRU_OK) {
       excess += ex;
@@ -272,17 +274,23 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
     snprintf(msg, (size_t)msglen, "harmonics must be 1..%d", PRRU_EXCITE_MAX_HARMONICS);
     return PRRU_EINPUT;
   }
-  for (int i = 0; i < PRRU_NACT; i++)
+  const int na = m->mech->nact;
+  if (!prru_base_fits(m, b)) {
+    snprintf(msg, (size_t)msglen, "the base parameters were computed for a model of %d bodies and %d actuators, "
+             "not this one's %d and %d", b->nbody, b->nact, m->mech->nbody, na);
+    return PRRU_EINPUT;
+  }
+  for (int i = 0; i < na; i++)
     if (!(o->fd_max[i] > 0) || !isfinite(o->fd_max[i])) {
       snprintf(msg, (size_t)msglen, "force limit of actuator %d must be positive", i + 1);
       return PRRU_EINPUT;
     }
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (!(o->speed_max[i] > 0)) {
       snprintf(msg, (size_t)msglen, "speed limit of actuator %d must be positive", i + 1);
       return PRRU_EINPUT;
     }
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (!(o->d_min[i] < o->d_max[i])) {
       snprintf(msg, (size_t)msglen, "stroke of slider %d is empty", i + 1);
       return PRRU_EINPUT;
@@ -315,7 +323,7 @@ static int check_options(const prru_model *m, const prru_base *b, const prru_exc
              st == PRRU_OK ? "too close to a singularity (rcond below the limit)" : prru_strerror(st));
     return PRRU_EINPUT;
   }
-  for (int i = 0; i < PRRU_NACT; i++)
+  for (int i = 0; i < na; i++)
     if (d.d[i] < o->d_min[i] || d.d[i] > o->d_max[i]) {
       snprintf(msg, (size_t)msglen, "centre (%g, %g, %g) puts slider %d at %g m, outside its stroke", f->centre[0],
                f->centre[1], f->centre[2], i + 1, d.d[i]);
@@ -386,7 +394,7 @@ int prru_excite(const prru_model *m, const prru_base *b, const prru_excite_optio
   st = c.d && c.W && c.V && c.sv && c.work && x ? PRRU_OK : PRRU_ENOMEM;
   if (st == PRRU_OK) {
     prru_check_regular(m, c.d, f->centre, NULL);
-    c.mode = pose_mode(c.d);
+    c.mode = pose_mode(m, c.d);
     start_point(&c, x, o->seed);
     const double m0 = merit(x, &c);
     r->cond_start = m0 < MERIT_RANK ? pow(10, m0) : INFINITY;

@@ -14,12 +14,10 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_matrix.h>
 
+#include "ident_internal.h"
 #include "internal.h"
 #include "prru_control.h"
 #include "prru_ident.h"
-
-#define NP PRRU_NREG
-#define NDRV (NP - PRRU_NBODYPAR * PRRU_NBODY)
 /* The bounded set the barrier needs: T_b^-1 J T_b^-T <= UPPER I (a body up
  * to 1e4 times its prior's mass and second moments) and x_k <= UPPER w_k. */
 #define UPPER 1e4
@@ -334,9 +332,12 @@ static void pseudo_inertia(const double *pb, double *J)
 }
 
 typedef struct {
-  double G[PRRU_NBODY][PRRU_NBODYPAR][16]; /* T_b^-1 J(e_k) T_b^-T */
-  double W[NP * NP];                       /* the prior norm: |dpi|_W^2 = dpi^T W dpi */
-  double w[NP];                            /* drive weights (0 elsewhere) */
+  /* The model's counts: np = nbody bodies' parameters and ndrv drive
+   * coefficients. */
+  int nbody, np, ndrv;
+  double G[PRRU_MAX_BODY][PRRU_NBODYPAR][16]; /* T_b^-1 J(e_k) T_b^-T */
+  double W[PRRU_MAX_REG * PRRU_MAX_REG];      /* the prior norm: |dpi|_W^2 = dpi^T W dpi (row stride np) */
+  double w[PRRU_MAX_REG];                     /* drive weights (0 elsewhere) */
 } geometry;
 
 /* T_b from the prior body, G and W; PRRU_EINPUT for a prior body that is
@@ -344,7 +345,9 @@ typedef struct {
 static int prior_geometry(const prru_model *m, const double *pi0, geometry *G)
 {
   memset(G, 0, sizeof *G);
-  for (int b = 0; b < PRRU_NBODY; b++) {
+  const int nb = m->mech->nbody, na = m->mech->nact, np = PRRU_NBODYPAR * nb + 3 * na;
+  G->nbody = nb, G->np = np, G->ndrv = 3 * na;
+  for (int b = 0; b < nb; b++) {
     const double *pb = pi0 + PRRU_NBODYPAR * b;
     double J[16], L[16], Li[16];
     if (!(pb[0] > 0)) return PRRU_EINPUT;
@@ -375,7 +378,7 @@ static int prior_geometry(const prru_model *m, const double *pi0, geometry *G)
       for (int l = 0; l < PRRU_NBODYPAR; l++) {
         double s = 0;
         for (int q = 0; q < 16; q++) s += G->G[b][k][q] * G->G[b][l][q];
-        G->W[(size_t)(PRRU_NBODYPAR * b + k) * NP + PRRU_NBODYPAR * b + l] = s;
+        G->W[(size_t)(PRRU_NBODYPAR * b + k) * np + PRRU_NBODYPAR * b + l] = s;
       }
   }
   const double L = prru_length_scale(m->mech);
@@ -383,21 +386,22 @@ static int prior_geometry(const prru_model *m, const double *pi0, geometry *G)
   double g = sqrt(gv[0] * gv[0] + gv[1] * gv[1] + gv[2] * gv[2]);
   if (!(g > 0)) g = 9.81;
   const double tau = sqrt(L / g);
-  for (int k = 0; k < NDRV; k++) {
-    const int j = PRRU_NBODYPAR * PRRU_NBODY + k, limb = k % PRRU_NACT, kind = k / PRRU_NACT;
+  for (int k = 0; k < G->ndrv; k++) {
+    const int j = PRRU_NBODYPAR * nb + k, limb = k % na, kind = k / na;
     const double ms = pi0[PRRU_NBODYPAR * m->mech->slider[limb]];
     const double unit = kind == 0 ? ms : kind == 1 ? ms / tau : ms * g;
     if (!(pi0[j] >= 0) || !isfinite(pi0[j])) return PRRU_EINPUT;
     G->w[j] = fmax(pi0[j], unit);
-    G->W[(size_t)j * NP + j] = 1 / (G->w[j] * G->w[j]);
+    G->W[(size_t)j * np + j] = 1 / (G->w[j] * G->w[j]);
   }
   return PRRU_OK;
 }
 
-/* The affine map of the variables to pi: pi = p0 + P x (P: NP x n). */
+/* The affine map of the variables to pi: pi = p0 + P x (P: np x n, np
+ * the model's standard parameters). */
 typedef struct {
   int n;
-  double p0[NP];
+  double p0[PRRU_MAX_REG];
   double *P;
 } affine;
 
@@ -405,8 +409,8 @@ typedef struct {
  * x_k / w_k - dmargin >= s of the map a (with s = x[a->n] when phase1). */
 static void constraints(const geometry *G, const affine *a, double eps, double dmargin, int phase1, barrier *p)
 {
-  const int n = p->n;
-  for (int b = 0; b < PRRU_NBODY; b++) {
+  const int n = p->n, nb = G->nbody, ndrv = G->ndrv;
+  for (int b = 0; b < nb; b++) {
     double *F0 = p->F0 + 16 * b;
     for (int k = 0; k < PRRU_NBODYPAR; k++) {
       const int j = PRRU_NBODYPAR * b + k;
@@ -423,16 +427,16 @@ static void constraints(const geometry *G, const affine *a, double eps, double d
       if (phase1) p->F[((size_t)b * n + a->n) * 16 + 5 * r] = -1;
     }
   }
-  for (int k = 0; k < NDRV; k++) {
-    const int j = PRRU_NBODYPAR * PRRU_NBODY + k;
+  for (int k = 0; k < ndrv; k++) {
+    const int j = PRRU_NBODYPAR * nb + k;
     p->a0[k] = a->p0[j] / G->w[j] - dmargin;
     for (int i = 0; i < a->n; i++) p->a[(size_t)k * n + i] = a->P[(size_t)j * a->n + i] / G->w[j];
     if (phase1) p->a[(size_t)k * n + a->n] = -1;
   }
   /* The upper bounds: a log barrier needs a bounded set (a body no motion
    * reveals could otherwise grow without bound while the barrier falls). */
-  for (int b = 0; b < PRRU_NBODY; b++) {
-    const int u = PRRU_NBODY + b;
+  for (int b = 0; b < nb; b++) {
+    const int u = nb + b;
     for (int q = 0; q < 16; q++) p->F0[16 * u + q] = -p->F0[16 * b + q];
     for (int r = 0; r < 4; r++) p->F0[16 * u + 5 * r] += UPPER - eps;
     for (int i = 0; i < a->n; i++)
@@ -440,8 +444,8 @@ static void constraints(const geometry *G, const affine *a, double eps, double d
     if (phase1)
       for (int r = 0; r < 4; r++) p->F[((size_t)u * n + a->n) * 16 + 5 * r] = -1;
   }
-  for (int k = 0; k < NDRV; k++) {
-    const int u = NDRV + k;
+  for (int k = 0; k < ndrv; k++) {
+    const int u = ndrv + k;
     p->a0[u] = UPPER - dmargin - p->a0[k];
     for (int i = 0; i < a->n; i++) p->a[(size_t)u * n + i] = -p->a[(size_t)k * n + i];
     if (phase1) p->a[(size_t)u * n + a->n] = -1;
@@ -452,33 +456,33 @@ static void constraints(const geometry *G, const affine *a, double eps, double d
 /* mu |pi(x) - pi0|_W^2 added to p's objective; PRRU_ENOMEM. */
 static int add_prior(const geometry *G, const affine *a, const double *pi0, double mu, barrier *p)
 {
-  const int n = a->n;
-  double r0[NP], Wr[NP];
-  for (int j = 0; j < NP; j++) r0[j] = a->p0[j] - pi0[j];
-  for (int j = 0; j < NP; j++) {
+  const int n = a->n, np = G->np;
+  double r0[PRRU_MAX_REG], Wr[PRRU_MAX_REG];
+  for (int j = 0; j < np; j++) r0[j] = a->p0[j] - pi0[j];
+  for (int j = 0; j < np; j++) {
     double s = 0;
-    for (int k = 0; k < NP; k++) s += G->W[(size_t)j * NP + k] * r0[k];
+    for (int k = 0; k < np; k++) s += G->W[(size_t)j * np + k] * r0[k];
     Wr[j] = s;
   }
   double f0 = 0;
-  for (int j = 0; j < NP; j++) f0 += r0[j] * Wr[j];
+  for (int j = 0; j < np; j++) f0 += r0[j] * Wr[j];
   p->f0 += mu * f0;
   /* Q += 2 mu P^T W P, c += 2 mu P^T W r0. */
-  double *WP = malloc(sizeof(double) * NP * (size_t)n);
+  double *WP = malloc(sizeof(double) * (size_t)np * (size_t)n);
   if (!WP) return PRRU_ENOMEM;
-  for (int j = 0; j < NP; j++)
+  for (int j = 0; j < np; j++)
     for (int i = 0; i < n; i++) {
       double s = 0;
-      for (int k = 0; k < NP; k++) s += G->W[(size_t)j * NP + k] * a->P[(size_t)k * n + i];
+      for (int k = 0; k < np; k++) s += G->W[(size_t)j * np + k] * a->P[(size_t)k * n + i];
       WP[(size_t)j * n + i] = s;
     }
   for (int i = 0; i < n; i++) {
     double s = 0;
-    for (int j = 0; j < NP; j++) s += a->P[(size_t)j * n + i] * Wr[j];
+    for (int j = 0; j < np; j++) s += a->P[(size_t)j * n + i] * Wr[j];
     p->c[i] += 2 * mu * s;
     for (int l = 0; l < n; l++) {
       double q = 0;
-      for (int j = 0; j < NP; j++) q += a->P[(size_t)j * n + i] * WP[(size_t)j * n + l];
+      for (int j = 0; j < np; j++) q += a->P[(size_t)j * n + i] * WP[(size_t)j * n + l];
       p->Q[(size_t)i * p->n + l] += 2 * mu * q;
     }
   }
@@ -486,9 +490,9 @@ static int add_prior(const geometry *G, const affine *a, const double *pi0, doub
   return PRRU_OK;
 }
 
-static void apply(const affine *a, const double *x, double *pi)
+static void apply(const geometry *G, const affine *a, const double *x, double *pi)
 {
-  for (int j = 0; j < NP; j++) {
+  for (int j = 0; j < G->np; j++) {
     double s = a->p0[j];
     for (int i = 0; i < a->n; i++) s += a->P[(size_t)j * a->n + i] * x[i];
     pi[j] = s;
@@ -497,9 +501,10 @@ static void apply(const affine *a, const double *x, double *pi)
 
 static double prior_norm2(const geometry *G, const double *pi, const double *pi0)
 {
+  const int np = G->np;
   double s = 0;
-  for (int j = 0; j < NP; j++)
-    for (int k = 0; k < NP; k++) s += (pi[j] - pi0[j]) * G->W[(size_t)j * NP + k] * (pi[k] - pi0[k]);
+  for (int j = 0; j < np; j++)
+    for (int k = 0; k < np; k++) s += (pi[j] - pi0[j]) * G->W[(size_t)j * np + k] * (pi[k] - pi0[k]);
   return s;
 }
 
@@ -511,7 +516,7 @@ static double smallest_margin(const geometry *G, const double *pi)
   gsl_vector *ev = gsl_vector_alloc(4);
   gsl_eigen_symm_workspace *w = gsl_eigen_symm_alloc(4);
   if (!F || !ev || !w) lo = NAN;
-  for (int b = 0; b < PRRU_NBODY && F && ev && w; b++) {
+  for (int b = 0; b < G->nbody && F && ev && w; b++) {
     for (int q = 0; q < 16; q++) {
       double s = 0;
       for (int k = 0; k < PRRU_NBODYPAR; k++) s += pi[PRRU_NBODYPAR * b + k] * G->G[b][k][q];
@@ -532,13 +537,13 @@ static double smallest_margin(const geometry *G, const double *pi)
 static void null_map(const prru_base *b, const geometry *G, const double *beta, const double *pi0, affine *a)
 {
   prru_base_to_standard(b, beta, pi0, a->p0);
-  const int n = a->n;
-  memset(a->P, 0, sizeof(double) * NP * (size_t)n);
+  const int n = a->n, np = b->nreg;
+  memset(a->P, 0, sizeof(double) * (size_t)np * (size_t)n);
   for (int i = 0; i < n; i++) {
     const int j = b->col[b->nbase + i];
-    const double u = 1 / sqrt(G->W[(size_t)j * NP + j]);
+    const double u = 1 / sqrt(G->W[(size_t)j * np + j]);
     a->P[(size_t)j * n + i] = u;
-    for (int r = 0; r < b->nbase; r++) a->P[(size_t)b->col[r] * n + i] -= u * b->B[r * NP + j];
+    for (int r = 0; r < b->nbase; r++) a->P[(size_t)b->col[r] * n + i] -= u * b->B[r * np + j];
   }
 }
 
@@ -548,19 +553,19 @@ static void null_map(const prru_base *b, const geometry *G, const double *beta, 
  * regular. */
 static int inverse_R(const prru_base *b, const prru_ident_result *r, double sigma_w, double **Rinv, double *v)
 {
-  const int p = b->nbase;
+  const int p = b->nbase, np = b->nreg;
   double *Ri = calloc((size_t)p * p, sizeof(double));
   if (!Ri) return PRRU_ENOMEM;
   int st = PRRU_OK;
   for (int j = p - 1; j >= 0 && st == PRRU_OK; j--) {
-    const double rjj = r->R[j * NP + j];
+    const double rjj = r->R[j * np + j];
     if (!(rjj != 0) || !isfinite(rjj)) st = PRRU_ESINGULAR;
     else {
       Ri[j * p + j] = 1 / rjj;
       for (int i = j - 1; i >= 0; i--) {
         double s = 0;
-        for (int k = i + 1; k <= j; k++) s += r->R[i * NP + k] * Ri[k * p + j];
-        Ri[i * p + j] = -s / r->R[i * NP + i];
+        for (int k = i + 1; k <= j; k++) s += r->R[i * np + k] * Ri[k * p + j];
+        Ri[i * p + j] = -s / r->R[i * np + i];
       }
     }
   }
@@ -580,7 +585,7 @@ static double mahalanobis2(const prru_base *b, const prru_ident_result *r, doubl
   double d2 = 0;
   for (int i = 0; i < b->nbase; i++) {
     double s = 0;
-    for (int j = i; j < b->nbase; j++) s += r->R[i * NP + j] * (beta[j] - r->beta[j]);
+    for (int j = i; j < b->nbase; j++) s += r->R[i * b->nreg + j] * (beta[j] - r->beta[j]);
     d2 += (s / sigma_w) * (s / sigma_w);
   }
   return d2;
@@ -592,7 +597,7 @@ static int exact_feasible(const geometry *G, const affine *a, double eps, double
 {
   barrier p;
   const int n = a->n + 1;
-  int st = barrier_alloc(&p, n, 2 * PRRU_NBODY, 2 * NDRV);
+  int st = barrier_alloc(&p, n, 2 * G->nbody, 2 * G->ndrv);
   if (st != PRRU_OK) return st;
   p.phase1 = 1;
   p.s_goal = 1e-3;
@@ -619,7 +624,7 @@ static int exact_feasible(const geometry *G, const affine *a, double eps, double
 static int nearest_prior(const geometry *G, const affine *a, const double *pi0, double eps, double *x, int *steps)
 {
   barrier p;
-  int st = barrier_alloc(&p, a->n, 2 * PRRU_NBODY, 2 * NDRV);
+  int st = barrier_alloc(&p, a->n, 2 * G->nbody, 2 * G->ndrv);
   if (st != PRRU_OK) return st;
   constraints(G, a, eps, DRIVE_MARGIN, 0, &p);
   st = add_prior(G, a, pi0, 1, &p);
@@ -637,17 +642,17 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
                             const double *pi0, const double *Rinv, double sigma_w, const prru_consistent_options *o,
                             double *pi, int *steps)
 {
-  const int nb = b->nbase, nz = a0->n, n = nz + nb;
-  affine a = {n, {0}, calloc(NP * (size_t)n, sizeof(double))};
+  const int nb = b->nbase, nz = a0->n, n = nz + nb, np = G->np;
+  affine a = {n, {0}, calloc((size_t)np * (size_t)n, sizeof(double))};
   double *x = calloc((size_t)n, sizeof(double));
   barrier p;
-  int st = a.P && x ? barrier_alloc(&p, n, 2 * PRRU_NBODY, 2 * NDRV) : PRRU_ENOMEM;
+  int st = a.P && x ? barrier_alloc(&p, n, 2 * G->nbody, 2 * G->ndrv) : PRRU_ENOMEM;
   if (st != PRRU_OK) {
     free(a.P), free(x);
     return st;
   }
-  memcpy(a.p0, a0->p0, sizeof a.p0);
-  for (int j = 0; j < NP; j++)
+  memcpy(a.p0, a0->p0, sizeof(double) * (size_t)np);
+  for (int j = 0; j < np; j++)
     for (int i = 0; i < nz; i++) a.P[(size_t)j * n + i] = a0->P[(size_t)j * nz + i];
   for (int i = 0; i < nb; i++)
     for (int k = i; k < nb; k++) a.P[(size_t)b->col[i] * n + nz + k] = sigma_w * Rinv[i * nb + k];
@@ -658,16 +663,16 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
   for (int i = 0; i < nb; i++) p.Q[(size_t)(nz + i) * n + nz + i] += 2;
   /* Start at the prior with each drive coefficient at least 1e-3 of its
    * weight (strictly inside); pi -> (x, y) inverts the map. */
-  double ps[NP], beta[NP];
-  memcpy(ps, pi0, sizeof ps);
-  for (int k = 0; k < NDRV; k++) {
-    const int j = PRRU_NBODYPAR * PRRU_NBODY + k;
+  double ps[PRRU_MAX_REG], beta[PRRU_MAX_REG];
+  memcpy(ps, pi0, sizeof(double) * (size_t)np);
+  for (int k = 0; k < G->ndrv; k++) {
+    const int j = PRRU_NBODYPAR * G->nbody + k;
     ps[j] = fmax(ps[j], 1e-3 * G->w[j]);
   }
   prru_base_params(b, ps, beta);
   for (int i = 0; i < nb; i++) {
     double s = 0;
-    for (int k = i; k < nb; k++) s += r->R[i * NP + k] * (beta[k] - r->beta[k]);
+    for (int k = i; k < nb; k++) s += r->R[i * np + k] * (beta[k] - r->beta[k]);
     x[nz + i] = s / sigma_w;
   }
   for (int i = 0; i < nz; i++) {
@@ -675,7 +680,7 @@ static int nearest_estimate(const prru_base *b, const prru_ident_result *r, cons
     x[i] = (ps[j] - a.p0[j]) / a0->P[(size_t)j * nz + i];
   }
   if (st == PRRU_OK) st = barrier_solve(&p, x, 1e-10, steps);
-  apply(&a, x, pi);
+  apply(G, &a, x, pi);
   barrier_free(&p);
   free(a.P), free(x);
   return st;
@@ -687,16 +692,18 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
 {
   memset(c, 0, sizeof *c);
   if (!(o->mu > 0) || !isfinite(o->mu) || !(o->alpha > 0 && o->alpha < 1) || !(o->sigma_floor >= 0) ||
-      !isfinite(o->sigma_floor) || !(o->eps >= 0 && o->eps <= 1e-3) || o->max_newton <= 0 || b->nbase <= 0)
+      !isfinite(o->sigma_floor) || !(o->eps >= 0 && o->eps <= 1e-3) || o->max_newton <= 0 || b->nbase <= 0 ||
+      !prru_base_fits(m, b))
     return PRRU_EINPUT;
-  for (int j = 0; j < NP; j++)
+  const int np = b->nreg;
+  for (int j = 0; j < np; j++)
     if (!isfinite(pi0[j])) return PRRU_EINPUT;
   prru_gsl_init();
   geometry *G = malloc(sizeof *G);
-  const int nz = NP - b->nbase;
-  affine a = {nz, {0}, calloc(NP * (size_t)(nz > 0 ? nz : 1), sizeof(double))};
+  const int nz = np - b->nbase;
+  affine a = {nz, {0}, calloc((size_t)np * (size_t)(nz > 0 ? nz : 1), sizeof(double))};
   double *x = calloc((size_t)nz + 1, sizeof(double));
-  double v[NP], *Rinv = NULL;
+  double v[PRRU_MAX_REG], *Rinv = NULL;
   int st = G && a.P && x ? PRRU_OK : PRRU_ENOMEM;
   if (st == PRRU_OK) st = prior_geometry(m, pi0, G);
   c->sigma_w = fmax(r->sigma * sqrt(r->inflation > 1 ? r->inflation : 1), o->sigma_floor * r->yrms);
@@ -710,14 +717,14 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
   if (st == PRRU_OK && feasible) {
     c->how = PRRU_CONSISTENT_EXACT;
     st = nearest_prior(G, &a, pi0, o->eps, x, &steps);
-    apply(&a, x, pi);
+    apply(G, &a, x, pi);
   } else if (st == PRRU_OK) {
     c->how = PRRU_CONSISTENT_COVARIANCE;
     st = nearest_estimate(b, r, G, &a, pi0, Rinv, c->sigma_w, o, pi, &steps);
     /* Then the prior alone decides the directions no motion reveals, at
      * those base parameters: in the problem above its weight mu makes
      * them converge only to sqrt(gap / mu). pi is strictly feasible. */
-    double beta[NP];
+    double beta[PRRU_MAX_REG];
     if (st == PRRU_OK) prru_base_params(b, pi, beta);
     if (st == PRRU_OK && mahalanobis2(b, r, c->sigma_w, beta) <= gsl_cdf_chisq_Qinv(o->alpha, b->nbase)) {
       /* A start from phase I: pi's own coordinates in this map can round
@@ -725,7 +732,7 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
       null_map(b, G, beta, pi0, &a);
       int sf = exact_feasible(G, &a, o->eps, x, &steps, &feasible);
       /* A refinement: where it fails (the Newton budget), pi stands. */
-      if (sf == PRRU_OK && feasible && nearest_prior(G, &a, pi0, o->eps, x, &steps) == PRRU_OK) apply(&a, x, pi);
+      if (sf == PRRU_OK && feasible && nearest_prior(G, &a, pi0, o->eps, x, &steps) == PRRU_OK) apply(G, &a, x, pi);
       steps = steps < 0 ? 0 : steps;
     }
   }
@@ -734,7 +741,7 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
     c->d2 = mahalanobis2(b, r, c->sigma_w, c->beta);
     c->d2_max = gsl_cdf_chisq_Qinv(o->alpha, b->nbase);
     for (int i = 0; i < b->nbase; i++) c->t[i] = (c->beta[i] - r->beta[i]) / v[i];
-    memcpy(c->w, G->w, sizeof G->w);
+    memcpy(c->w, G->w, sizeof(double) * (size_t)np);
     c->prior_dist = sqrt(prior_norm2(G, pi, pi0));
     c->margin = smallest_margin(G, pi);
     c->newton = o->max_newton - steps;
@@ -751,9 +758,13 @@ int prru_ident_consistent(const prru_model *m, const prru_base *b, const prru_id
 int prru_ident_model_params(const prru_model *m, const prru_base *b, const double pi[], prru_params *p,
                             char *why, int len)
 {
+  const int nb = m->mech->nbody, na = m->mech->nact;
+  if (!prru_base_fits(m, b))
+    return prru_fail(why, len, PRRU_EINPUT, "the base parameters were computed for a model of %d bodies and %d "
+                     "actuators, not this one's %d and %d", b->nbody, b->nact, nb, na);
   /* Geometry and gravity: the model's (the regressor's, which identification needs). */
   prru_model_params(m, p);
-  for (int k = 0; k < PRRU_NBODY; k++) {
+  for (int k = 0; k < nb; k++) {
     double mass, c[3], I[6];
     if (prru_ident_body(pi + PRRU_NBODYPAR * k, &mass, c, I) != PRRU_OK)
       return prru_fail(why, len, PRRU_EINPUT, "body %s: mass %.6g kg is not positive", m->mech->body_names[k],
@@ -780,8 +791,8 @@ int prru_ident_model_params(const prru_model *m, const prru_base *b, const doubl
   double *dr[3] = {p->armature, p->damping, p->coulomb};
   static const char *const dn[3] = {"armature", "damping", "coulomb"};
   for (int g = 0; g < 3; g++)
-    for (int i = 0; i < PRRU_NACT; i++) {
-      const double v = pi[PRRU_NBODYPAR * PRRU_NBODY + g * PRRU_NACT + i];
+    for (int i = 0; i < na; i++) {
+      const double v = pi[PRRU_NBODYPAR * nb + g * na + i];
       if (!(v >= 0)) return prru_fail(why, len, PRRU_EINPUT, "%s%d = %.6g is negative", dn[g], i + 1, v);
       dr[g][i] = v;
     }

@@ -6,13 +6,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ident_internal.h"
 #include "internal.h"
 #include "prru_control.h"
 #include "prru_ident.h"
 
 void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, int k, char *buf, int len)
 {
-  int used[PRRU_NREG] = {0};
+  int used[PRRU_MAX_REG] = {0};
   size_t at = 0;
   if (len <= 0) return;
   buf[0] = 0;
@@ -22,7 +23,7 @@ void prru_consistent_worst(const prru_base *b, const prru_consistent_result *c, 
       if (!used[i] && (w < 0 || fabs(c->t[i]) > fabs(c->t[w]))) w = i;
     used[w] = 1;
     at += (size_t)snprintf(buf + at, (size_t)len - at, "%s#%d %s at %.3g se", n ? ", " : "", w + 1,
-                           prru_regressor_names[b->col[w]], c->t[w]);
+                           prru_base_param_name(b, b->col[w]), c->t[w]);
   }
 }
 
@@ -71,6 +72,10 @@ int prru_identify_model(const prru_model *m, const prru_base *b, int n, const do
   out->bad = -1;
   out->text = NULL;
   out->msg[0] = 0;
+  if (!prru_base_fits(m, b))
+    return prru_fail(out->msg, (int)sizeof out->msg, PRRU_EINPUT, "the base parameters were computed for a model "
+                     "of %d bodies and %d actuators, not this one's %d and %d", b->nbody, b->nact, m->mech->nbody,
+                     m->mech->nact);
   int st = prru_identify(m, b, n, q, qd, qdd, fd, &out->fit, &out->bad);
   if (st != PRRU_OK) return fit_failed(b, n, st, out);
   out->stage = PRRU_IDENTIFY_CONSISTENT;

@@ -120,7 +120,7 @@ int prru_measure_poses(const prru_model *m, int n, const double *d, double dres,
   if (n > 0) prru_fk_default_seed(m, d, seed);
   int st = PRRU_OK;
   for (int i = 0; i < n && st == PRRU_OK; i++) {
-    const double *act = d + (size_t)PRRU_NACT * i;
+    const double *act = d + (size_t)m->mech->nact * i;
     double res = NAN;
     st = prru_forward_kinematics_lsq(m, ws, act, seed, q + 3 * i, &res);
     if (st != PRRU_OK) {
