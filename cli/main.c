@@ -37,9 +37,8 @@ static const struct {
 static void usage(FILE *f)
 {
   /* The robot described is the model a command would compute with (main
-   * loads --model or PRRU_MODEL before this runs); "built in" and the
-   * limbs a model file must have are the built-in model's, since
-   * prru_model_load accepts only the build's number of limbs. */
+   * loads --model or PRRU_MODEL before this runs); "built in" is the
+   * build's own model. */
   const prru_mechanism *me = prru_cli_model()->mech;
   prru_model built;
   prru_model_default(&built);
@@ -49,7 +48,7 @@ static void usage(FILE *f)
              "Dynamics of the %d-PRRU 1T2R parallel manipulator%s:\n"
              "q = (q1, q2) rad rotations of the platform about x then y', q3 its height\n"
              "(m); d the %d slider heights (m).\n"
-             "Model: %s (%s), built in, or a %d-limb model file given by\n"
+             "Model: %s (%s), built in, or any model file (3 or 4 limbs) given by\n"
              "--model FILE (see prru --version). Every JSON output names it in\n"
              "\"model\", every CSV in its first line:\n"
              "  # prru VERSION model NAME (FILE, sha256 HASH, KERNELS kernels)\n"
@@ -58,7 +57,7 @@ static void usage(FILE *f)
              "from FILE).\n\n"
              "commands:\n",
           me->nlimb, me->nact > 3 ? " (redundantly actuated)" : "", me->nact, built.mech->name,
-          built.mech->model_file, built.mech->nlimb);
+          built.mech->model_file);
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
     fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].help);
   fprintf(f, "  %-9s %s\n", "version", "version and model: name, file, format, actuators, SHA-256");

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Random valid models loaded at run time, no rebuild: PRRU_RANDOM_LOADED
-# (default 20) seeded models of the build's number of limbs
+# (default 20) seeded models of the build's number of limbs, and half as
+# many of the other
 # (tests/random_model.py, seeds PRRU_RANDOM_LOADED_BASE, default 2000, on)
 # each pass test_model_load's checks on the parameter kernels: forward and
 # inverse dynamics and the reactions against the GSL reference built from
@@ -46,6 +47,34 @@ else
       "$check $keep/$(basename "$f")" >&2
   done
   bad "test_model_load on random models (seeds above; FAILED lines name the files)"
+fi
+
+# The other topology on this build (no rebuild): half as many random
+# models of the other number of limbs through test_model_load's checks
+# (the reference evaluates either topology). test_derivs, above, still
+# sizes its checks by the build's model.
+other=$((7 - limbs))
+ofiles=()
+for ((k = 0; k < (n + 1) / 2; k++)); do
+  seed=$((base + 1000 + k))
+  f="$tmp/rand_other_$seed.json"
+  python3 "$PRRU_SOURCE_DIR/tests/random_model.py" --seed "$seed" --limbs "$other" --out "$f" >/dev/null ||
+    bad "random_model.py --seed $seed --limbs $other"
+  ofiles+=("$f")
+done
+echo "random models of the other topology: ${#ofiles[@]} of $other limbs, seeds $((base + 1000))..$((base + 999 + ${#ofiles[@]}))"
+"$check" "${ofiles[@]}" >"$tmp/out_other" 2>&1
+st=$?
+cat "$tmp/out_other"
+if [ $st = 0 ]; then
+  ok
+else
+  mkdir -p "$keep"
+  for f in $(sed -n 's/^FAILED: //p' "$tmp/out_other"); do
+    cp "$f" "$keep/" && echo "kept $keep/$(basename "$f"); reproduce:" \
+      "$check $keep/$(basename "$f")" >&2
+  done
+  bad "test_model_load on random models of the other topology (seeds above; FAILED lines name the files)"
 fi
 
 # The closed-form derivatives (prru_linearize, the topology kernels) on

@@ -56,8 +56,8 @@ class Model:
     tree's build/runtime/ and the system's library path (load_library).
     model: a model file (format 1 or 2) read at run time by the library
     (prru_model_load), with the same validation and messages as the
-    generator; a first argument ending in ".json" is taken as model. It
-    must have the library's number of limbs. The kernels: "specialised"
+    generator; a first argument ending in ".json" is taken as model, of
+    3 or 4 limbs whatever the library's own. The kernels: "specialised"
     (the library's constant-folded ones) when its numbers are the
     library's model's, else "parameter" (the attribute kernels says
     which). None: the library's own model.

@@ -263,11 +263,46 @@ class TestModelFile(unittest.TestCase):
         with self.assertRaises(prru.ParseError) as e:
             prru.Model(model=self.write("negative.json", spec), lib=MODEL.lib)
         self.assertIn("mass", str(e.exception))
+
+    def test_other_topology(self):
+        """Any model file loads, whatever the library's build: the other
+        topology's committed model, on its parameter kernels, sized by its
+        own counts. ID(FD(fd)) gives back the generalised forces J_d^T fd
+        (exactly fd with three actuators, its minimum-norm part with four)
+        within K = 256 times the rounding bound of the two solves:
+        |M|_1 bfd (FD's error in qdd, bfd = u (kappa_1(M) |qdd| +
+        |M^-1|_1 S), mapped by M) plus u (|M|_1 |qdd| + S) (ID's own),
+        S = |h| + |G| + |passive| + max_j sum_i |J_d,ij fd_i|."""
         other = os.path.join(SOURCE_DIR, "models",
                              "3prru_paper.json" if MODEL.nlimb == 4 else "4prru.json")
-        with self.assertRaises(prru.InputError) as e:
-            prru.Model(model=other, lib=MODEL.lib)
-        self.assertIn("limbs", str(e.exception))
+        m = prru.Model(model=other, lib=MODEL.lib)
+        self.assertEqual((m.nlimb, m.nact), (7 - MODEL.nlimb, 7 - MODEL.nlimb))
+        self.assertEqual(m.kernels, "parameter")
+        q, qd = (0.05, -0.08, -0.36), (0.2, -0.1, 0.05)
+        fd = [30.0 + 5 * i for i in range(m.nact)]
+        d, Jd = m.ik(q)
+        self.assertEqual(len(d), m.nact)
+        qdd = list(m.forward_dynamics(q, qd, fd))
+        back = list(m.inverse_dynamics(q, qd, qdd))
+        self.assertEqual(len(back), m.nact)
+        M, h, G = m.dynamics(q, qd)
+        M = [list(r) for r in M]
+        Jd = [list(r) for r in Jd]
+        u, n1 = 2.0 ** -53, lambda a: max(sum(abs(a[i][j]) for i in range(3)) for j in range(3))
+        c = [[M[(i + 1) % 3][(j + 1) % 3] * M[(i + 2) % 3][(j + 2) % 3]
+              - M[(i + 1) % 3][(j + 2) % 3] * M[(i + 2) % 3][(j + 1) % 3] for i in range(3)]
+             for j in range(3)]
+        det = sum(M[0][j] * c[j][0] for j in range(3))
+        Minv = [[c[i][j] / det for j in range(3)] for i in range(3)]
+        S = (max(map(abs, h)) + max(map(abs, G)) + max(map(abs, m.passive(q, qd)))
+             + max(sum(abs(Jd[i][j] * fd[i]) for i in range(m.nact)) for j in range(3)))
+        nq = max(map(abs, qdd))
+        bfd = u * (n1(M) * n1(Minv) * nq + n1(Minv) * S)
+        bound = 256 * (n1(M) * bfd + u * (n1(M) * nq + S))
+        for j in range(3):
+            a = sum(Jd[i][j] * fd[i] for i in range(m.nact))
+            b = sum(Jd[i][j] * back[i] for i in range(m.nact))
+            self.assertLessEqual(abs(a - b), bound, (j, a, b, bound))
 
 
 class TestExamples(unittest.TestCase):

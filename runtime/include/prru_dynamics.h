@@ -191,10 +191,9 @@ PRRU_API void prru_model_default(prru_model *m);
  * default settings. Its kernels: the specialised set when every number
  * equals the build's model's (names and descriptions aside: the same
  * robot, so a whitespace or comment edit keeps the fast path), else the
- * parameter set of the build's topology. PRRU_OK; PRRU_EIO or PRRU_EPARSE
- * with msg "path: key: reason"; PRRU_EINPUT with msg when the file has
- * another number of limbs than this build's model (the runtime computes
- * with its build's number of limbs); PRRU_ENOMEM. m is untouched on
+ * parameter set of the file's topology (3 or 4 limbs: every build has
+ * both, whatever its own model). PRRU_OK; PRRU_EIO or PRRU_EPARSE with
+ * msg "path: key: reason"; PRRU_ENOMEM. m is untouched on
  * failure: nothing is computed with a partly loaded model. Allocates: prru_model_free (m must
  * not hold a loaded model already: free it first). */
 PRRU_API int prru_model_load(prru_model *m, const char *path, char *msg, int msglen);

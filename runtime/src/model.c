@@ -340,11 +340,10 @@ int prru_model_load(prru_model *m, const char *path, char *msg, int msglen)
   }
   strcpy(p, path);
   int st = prru_model_file_read(path, s, msg, msglen);
-  if (st == PRRU_OK && s->nlimb != PRRU_NLIMB) {
-    snprintf(msg, (size_t)msglen,
-             "%s: a model with %d limbs; this build evaluates %d-limb models (its runtime computes with "
-             "its model's number of limbs): use a build of a %d-limb model (make build MODEL=%s)",
-             path, s->nlimb, PRRU_NLIMB, s->nlimb, path);
+  /* Every topology a valid file can have is in every build (the reader
+   * accepts 3 or 4 limbs): the test guards the two against drifting. */
+  if (st == PRRU_OK && !prru_topology_of(s->nlimb)) {
+    snprintf(msg, (size_t)msglen, "%s: a model with %d limbs: this library evaluates 3 or 4", path, s->nlimb);
     st = PRRU_EINPUT;
   }
   if (st != PRRU_OK) {
