@@ -71,11 +71,10 @@ demo: build
 	$(MAKE) --no-print-directory compare-designs
 
 # The paper's future work: three limbs (the paper's model) vs four
-# (models/4prru.json), each in its own build directory.
+# (models/4prru.json), both on one build (--model).
 compare-designs: deps-demo
 	$(MAKE) --no-print-directory build MODEL=$(PAPER_MODEL) BUILD=build
-	$(MAKE) --no-print-directory build MODEL=models/4prru.json BUILD=build-4prru
-	studies/compare_designs.sh build build-4prru $(RESULTS)/compare
+	studies/compare_designs.sh build $(RESULTS)/compare
 
 # The paper's purpose for w_R: optimise its b12, b3, l1, l2, a (+-20 %) over
 # fig. 7's rectangle (also with the paper's slider travel, and with limb 3's

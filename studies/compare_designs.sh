@@ -3,10 +3,12 @@
 # limb 3 so that q2 is driven by two limbs, bring the rotational dynamic
 # manipulability index w_R closer to 1?
 #
-# usage: studies/compare_designs.sh BUILD3 BUILD4 OUTDIR [--clip W]
-#   BUILD3, BUILD4: build directories of the 3-limb and the 4-limb model
-#   (`make compare-designs` makes both: build/ and build-4prru/).
-# Both prru binaries map w_R over the paper's fig. 7 rectangle (q1 in
+# usage: studies/compare_designs.sh BUILD OUTDIR [--clip W]
+#   BUILD: a build directory (any model: `make compare-designs` uses
+#   build/); its prru evaluates both model files, models/3prru_paper.json
+#   and models/4prru.json, with --model (the parameter kernels of each
+#   file's topology, or the specialised ones for the build's own).
+# Both models map w_R over the paper's fig. 7 rectangle (q1 in
 # [-pi/6, pi/6], q2 in [-pi/4, pi/6], q3 = 0, 201 x 201) with the same
 # practical singularity tolerance, and report w_R at q = 0. A grid point
 # counts as regular only when J_d is regular there and the pose is in the
@@ -18,19 +20,21 @@
 # default at the 99th percentile of both maps' w_R, as prru's own maps) and
 # summary.txt.
 set -euo pipefail
-usage() { echo "usage: $0 BUILD3 BUILD4 OUTDIR [--clip W]" >&2; exit 2; }
-[ $# -eq 3 ] || [ $# -eq 5 ] || usage
-b3=$1 b4=$2 out=$3 clip=
-if [ $# -eq 5 ]; then
-  [ "$4" = --clip ] || usage
-  clip=$5
+usage() { echo "usage: $0 BUILD OUTDIR [--clip W]" >&2; exit 2; }
+[ $# -eq 2 ] || [ $# -eq 4 ] || usage
+b=$1 out=$2 clip=
+if [ $# -eq 4 ]; then
+  [ "$3" = --clip ] || usage
+  clip=$4
   python3 -c "import math, sys; v = float(sys.argv[1]); sys.exit(not (math.isfinite(v) and v > 1))" "$clip" 2>/dev/null ||
     { echo "$0: --clip '$clip': must be a number above 1" >&2; exit 2; }
 fi
-for b in "$b3" "$b4"; do
-  [ -x "$b/cli/prru" ] || { echo "$0: $b/cli/prru: not built" >&2; exit 2; }
-done
+[ -x "$b/cli/prru" ] || { echo "$0: $b/cli/prru: not built" >&2; exit 2; }
 mkdir -p "$out"
+# From the source tree, so that outputs name the model files as
+# models/NAME.json, wherever it is checked out.
+b=$(cd "$b" && pwd) out=$(cd "$out" && pwd)
+cd "$(dirname "$0")/.."
 PI=3.141592653589793
 Q1="-$(python3 -c "print(repr($PI/6))"):$(python3 -c "print(repr($PI/6))"):201"
 Q2="-$(python3 -c "print(repr($PI/4))"):$(python3 -c "print(repr($PI/6))"):201"
@@ -38,10 +42,10 @@ RCOND=4e-3 # cond_1 > 250 of J_d with rotations in units of the upper link, as f
 
 field() { grep "^$2:" "$1" | awk '{print $2}'; }
 for n in 3 4; do
-  b=$b3; [ $n = 4 ] && b=$b4
-  "$b/cli/prru" map --q1 "$Q1" --q2 "$Q2" --q3 0 --rcond-min "$RCOND" \
+  model=models/3prru_paper.json; [ $n = 4 ] && model=models/4prru.json
+  "$b/cli/prru" --model "$model" map --q1 "$Q1" --q2 "$Q2" --q3 0 --rcond-min "$RCOND" \
     --out "$out/${n}prru_map.csv" >"$out/${n}prru_summary.txt"
-  "$b/cli/prru" dme --q 0,0,0 >"$out/${n}prru_dme0.json"
+  "$b/cli/prru" --model "$model" dme --q 0,0,0 >"$out/${n}prru_dme0.json"
 done
 w0() { python3 -c "import json,sys; print('%.6f' % json.load(open(sys.argv[1]))['w_R'])" "$1"; }
 w3=$(w0 "$out/3prru_dme0.json") w4=$(w0 "$out/4prru_dme0.json")

@@ -74,7 +74,7 @@ PRRU_API size_t prru_struct_size(const char *name);
 /* The code a model evaluates with. MuJoCo's Model holds its numbers; a
  * prru_model also chooses its kernels: the specialised set, constant-folded
  * from the build's model file (prru_kernels.h), or the parameter set of
- * the build's topology (prru_p3_kernels.h or prru_p4_kernels.h), which
+ * the model's topology (prru_p3_kernels.h or prru_p4_kernels.h), which
  * reads the numbers of a model file loaded at run time (prru_model_load).
  * Each entry has the arguments and outputs of the prru_kernels.h kernel of
  * its name after p, the table's parameters (kernel_params of the model;
