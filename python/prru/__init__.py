@@ -42,7 +42,7 @@ from .motion import Limits, Motion, TimeOptimal, TrackRun
 from .identification import Excitation, Identification, Parameter, write_model_text
 from .design import Design
 
-__version__ = "0.5.0"
+__version__ = "0.6.0"
 
 __all__ = ["Model", "Scenario", "Trajectory", "Sample", "Dme", "Joint", "Linearization", "MapResult",
            "Measurement", "Limits", "Motion", "TimeOptimal", "TrackRun", "Excitation", "Identification", "Parameter",
