@@ -150,6 +150,23 @@ model_edit "$PRRU_MODEL" "$tmp/neg.json" "d['bodies']['$first_body']['mass'] = -
 refused "prru: $tmp/neg.json: bodies.$first_body.mass: must be positive" --model "$tmp/neg.json"
 if [ "$nact" = 3 ]; then other="$PRRU_SOURCE_DIR/models/4prru.json" other_limbs=4
 else other="$PRRU_SOURCE_DIR/models/3prru_paper.json" other_limbs=3; fi
+# identifies_itself MODEL TAG WHAT: excite then identify on MODEL without
+# a build of its own (the topology's regressor reads geometry and gravity
+# at run time): its own exact forces give back its base parameters, to
+# 1e-8 of each one's resolution (the report's column; the issue's bound
+# for exact data).
+identifies_itself() {
+  local m=$1 t=$2 what=$3
+  "$PRRU" --model "$m" excite --evals 40 --period 4 --out "$tmp/${t}ex.csv" 2>"$tmp/err" &&
+    "$PRRU" --model "$m" identify --data "$tmp/${t}ex.csv" --out "$tmp/${t}id.json" \
+      --report "$tmp/${t}rep.csv" 2>"$tmp/err" && ok || bad "excite and identify $what: $(cat "$tmp/err")"
+  python3 - "$tmp/${t}rep.csv" <<'PY' && ok || bad "identify $what: base parameters"
+import csv, sys
+rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
+worst = max(abs(float(r['estimate']) - float(r['prior'])) / float(r['resolution']) for r in rows)
+assert rows and worst <= 1e-8, worst
+PY
+}
 # The other topology on this build, no rebuild: eval sizes its outputs by
 # the file's actuators on the parameter kernels (--model and PRRU_MODEL
 # alike), and excite then identify give back its own base parameters from
@@ -164,36 +181,16 @@ assert a == b, "--model and PRRU_MODEL differ"
 assert a["model"]["kernels"] == "parameter", a["model"]
 assert len(a["d"]) == n and len(a["Jd"]) == n and len(a["fd"]) == n and len(a["lambda"]) == 19 * n
 PY
-"$PRRU" --model "$other" excite --evals 40 --period 4 --out "$tmp/oex.csv" 2>"$tmp/err" &&
-  "$PRRU" --model "$other" identify --data "$tmp/oex.csv" --out "$tmp/oid.json" --report "$tmp/orep.csv" \
-    2>"$tmp/err" && ok || bad "excite and identify on the other topology: $(cat "$tmp/err")"
-python3 - "$tmp/orep.csv" <<'PY' && ok || bad "identify on the other topology: base parameters"
-import csv, sys
-rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
-worst = max(abs(float(r['estimate']) - float(r['prior'])) / float(r['resolution']) for r in rows)
-assert rows and worst <= 1e-8, worst
-PY
+identifies_itself "$other" o "on the other topology"
 expect 2 "prru: --model needs a model file" -- eval --q "$q" --model
 expect 2 "prru: --model needs a model file" -- --model= eval --q "$q"
 expect 2 "prru: --model given twice" -- --model "$F" eval --q "$q" --model "$F"
-# identify and excite on a model of another geometry, without a build of
-# its own (the topology's regressor reads geometry and gravity at run
-# time): its own exact forces give back its base parameters, to 1e-8 of
-# each one's resolution (the report's column; issue bound for exact data).
+# identify and excite on a model of another geometry (identifies_itself).
 model_edit "$PRRU_MODEL" "$tmp/geo.json" "
 g = d['geometry']
 g['l1'] = [g['l1'][0] * 1.01] + g['l1'][1:] if isinstance(g['l1'], list) else g['l1'] * 1.01"
 "$PRRU" --model "$tmp/geo.json" eval --q "$q" >/dev/null 2>&1 && ok || bad "eval with another geometry"
-"$PRRU" --model "$tmp/geo.json" excite --evals 40 --period 4 --out "$tmp/gex.csv" 2>"$tmp/err" && ok \
-  || bad "excite with another geometry: $(cat "$tmp/err")"
-"$PRRU" --model "$tmp/geo.json" identify --data "$tmp/gex.csv" --out "$tmp/gid.json" --report "$tmp/grep.csv" \
-  2>"$tmp/err" && ok || bad "identify with another geometry: $(cat "$tmp/err")"
-python3 - "$tmp/grep.csv" <<'PY' && ok || bad "identify with another geometry: base parameters (above)"
-import csv, sys
-rows = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#')))
-worst = max(abs(float(r['estimate']) - float(r['prior'])) / float(r['resolution']) for r in rows)
-assert rows and worst <= 1e-8, worst
-PY
+identifies_itself "$tmp/geo.json" g "with another geometry"
 # A heavier body keeps the geometry: identification works from it.
 "$PRRU" --model "$F" excite --evals 20 --period 4 --out "$tmp/hex.csv" 2>/dev/null && ok \
   || bad "excite with the build's geometry and another mass refused"

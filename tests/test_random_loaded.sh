@@ -26,56 +26,52 @@ print(model.parse(open(sys.argv[2]).read(), sys.argv[2]).nlimb)
 PY
 ) || { bad "the build's model $PRRU_MODEL does not parse"; finish test_random_loaded; }
 
-files=()
-for ((k = 0; k < n; k++)); do
-  seed=$((base + k))
-  f="$tmp/rand_$seed.json"
-  python3 "$PRRU_SOURCE_DIR/tests/random_model.py" --seed "$seed" --limbs "$limbs" --out "$f" >/dev/null ||
-    bad "random_model.py --seed $seed --limbs $limbs"
-  files+=("$f")
-done
-echo "random models: $n of $limbs limbs, seeds $base..$((base + n - 1))"
-"$check" "${files[@]}" >"$tmp/out" 2>&1
-st=$?
-cat "$tmp/out"
-if [ $st = 0 ]; then
-  ok
-else
-  mkdir -p "$keep"
-  for f in $(sed -n 's/^FAILED: //p' "$tmp/out"); do
-    cp "$f" "$keep/" && echo "kept $keep/$(basename "$f"); reproduce:" \
-      "$check $keep/$(basename "$f")" >&2
+# random_models COUNT BASE LIMBS: COUNT random models of LIMBS limbs from
+# seed BASE on, their paths into the array models.
+random_models() {
+  models=()
+  local k seed f
+  for ((k = 0; k < $1; k++)); do
+    seed=$(($2 + k))
+    f="$tmp/rand_${3}_$seed.json"
+    python3 "$PRRU_SOURCE_DIR/tests/random_model.py" --seed "$seed" --limbs "$3" --out "$f" >/dev/null ||
+      bad "random_model.py --seed $seed --limbs $3"
+    models+=("$f")
   done
-  bad "test_model_load on random models (seeds above; FAILED lines name the files)"
-fi
+  echo "random models: $1 of $3 limbs, seeds $2..$(($2 + $1 - 1))"
+}
+
+# check_models OUT WHAT FILE...: test_model_load on the files (output in
+# $tmp/OUT); a failing file is kept in $keep with the command that
+# reproduces it.
+check_models() {
+  local out=$tmp/$1 what=$2
+  shift 2
+  "$check" "$@" >"$out" 2>&1
+  local st=$?
+  cat "$out"
+  if [ $st = 0 ]; then
+    ok
+  else
+    mkdir -p "$keep"
+    for f in $(sed -n 's/^FAILED: //p' "$out"); do
+      cp "$f" "$keep/" && echo "kept $keep/$(basename "$f"); reproduce:" \
+        "$check $keep/$(basename "$f")" >&2
+    done
+    bad "test_model_load on $what (seeds above; FAILED lines name the files)"
+  fi
+}
+
+random_models "$n" "$base" "$limbs"
+files=("${models[@]}")
+check_models out "random models" "${files[@]}"
 
 # The other topology on this build (no rebuild): half as many random
 # models of the other number of limbs through test_model_load's checks
-# (the reference evaluates either topology). test_derivs, above, still
-# sizes its checks by the build's model.
-other=$((7 - limbs))
-ofiles=()
-for ((k = 0; k < (n + 1) / 2; k++)); do
-  seed=$((base + 1000 + k))
-  f="$tmp/rand_other_$seed.json"
-  python3 "$PRRU_SOURCE_DIR/tests/random_model.py" --seed "$seed" --limbs "$other" --out "$f" >/dev/null ||
-    bad "random_model.py --seed $seed --limbs $other"
-  ofiles+=("$f")
-done
-echo "random models of the other topology: ${#ofiles[@]} of $other limbs, seeds $((base + 1000))..$((base + 999 + ${#ofiles[@]}))"
-"$check" "${ofiles[@]}" >"$tmp/out_other" 2>&1
-st=$?
-cat "$tmp/out_other"
-if [ $st = 0 ]; then
-  ok
-else
-  mkdir -p "$keep"
-  for f in $(sed -n 's/^FAILED: //p' "$tmp/out_other"); do
-    cp "$f" "$keep/" && echo "kept $keep/$(basename "$f"); reproduce:" \
-      "$check $keep/$(basename "$f")" >&2
-  done
-  bad "test_model_load on random models of the other topology (seeds above; FAILED lines name the files)"
-fi
+# (the reference evaluates either topology). test_derivs, below, sizes its
+# checks by the build's model.
+random_models $(((n + 1) / 2)) $((base + 1000)) $((7 - limbs))
+check_models out_other "random models of the other topology" "${models[@]}"
 
 # The closed-form derivatives (prru_linearize, the topology kernels) on
 # the same models against the reference's Richardson differences.

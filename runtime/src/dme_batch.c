@@ -17,8 +17,9 @@
  * small loops over matrix entries are unrolled inside the loop over
  * poses.
  *
- * The stages are written once over the type (dme_batch_stages.h) and
- * instantiated in double (prru_dme_batch, as above) and float
+ * The stages are written once over the type and the number of actuators
+ * (dme_batch_stages.h) and instantiated for three and four actuators
+ * (dme_batch_types.inc), each in double (prru_dme_batch, as above) and float
  * (prru_dme_batch_f, the maps' --precision float: not bit for bit, it
  * says which statuses it is sure of). */
 #include <float.h>
@@ -40,55 +41,13 @@
 /* One instance per number of actuators N and type: the loops over
  * matrix entries keep constant bounds, unrolled inside the loops over
  * poses. */
+#define STAGE_NAME_(name, type, n) name##_##type##n
+#define STAGE_NAME(name, type, n) STAGE_NAME_(name, type, n)
 #define N 3
-#define REAL double
-#define WS prru_dme_batch_ws
-#define STAGE(name) name##_d3
-#define SQRT sqrt
-#define FABS fabs
-#define REAL_MAX DBL_MAX
-#include "dme_batch_stages.h"
-#undef REAL
-#undef WS
-#undef STAGE
-#undef SQRT
-#undef FABS
-#undef REAL_MAX
-#define REAL float
-#define WS prru_dme_batch_wsf
-#define STAGE(name) name##_f3
-#define SQRT sqrtf
-#define FABS fabsf
-#define REAL_MAX FLT_MAX
-#include "dme_batch_stages.h"
-#undef REAL
-#undef WS
-#undef STAGE
-#undef SQRT
-#undef FABS
-#undef REAL_MAX
+#include "dme_batch_types.inc"
 #undef N
 #define N 4
-#define REAL double
-#define WS prru_dme_batch_ws
-#define STAGE(name) name##_d4
-#define SQRT sqrt
-#define FABS fabs
-#define REAL_MAX DBL_MAX
-#include "dme_batch_stages.h"
-#undef REAL
-#undef WS
-#undef STAGE
-#undef SQRT
-#undef FABS
-#undef REAL_MAX
-#define REAL float
-#define WS prru_dme_batch_wsf
-#define STAGE(name) name##_f4
-#define SQRT sqrtf
-#define FABS fabsf
-#define REAL_MAX FLT_MAX
-#include "dme_batch_stages.h"
+#include "dme_batch_types.inc"
 #undef N
 
 PRRU_BATCH_TARGETS
