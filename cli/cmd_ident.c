@@ -26,32 +26,6 @@ static int coulomb_velocity(const char *cmd, const char *text, double *vs)
   return 0;
 }
 
-/* The standard parameters (regressor columns) of the current model:
- * PRRU_NBODYPAR per body, then per actuator its armature, damping and
- * Coulomb force (prru_ident.h). */
-static int nreg(void)
-{
-  const prru_mechanism *me = prru_cli_model()->mech;
-  return PRRU_NBODYPAR * me->nbody + 3 * me->nact;
-}
-
-/* Column j's name, as the generator writes prru_regressor_names: "P.m",
- * "P.mcx", ..., "S3.Iyz" body by body, then "armature1".., "damping1"..,
- * "coulomb1".. per actuator. Into buf (len bytes); returns buf. */
-static const char *reg_name(int j, char *buf, size_t len)
-{
-  static const char *const body_par[PRRU_NBODYPAR] = {"m", "mcx", "mcy", "mcz", "Ixx",
-                                                      "Iyy", "Izz", "Ixy", "Ixz", "Iyz"};
-  static const char *const drive_par[3] = {"armature", "damping", "coulomb"};
-  const prru_mechanism *me = prru_cli_model()->mech;
-  const int nb = PRRU_NBODYPAR * me->nbody;
-  if (j < nb)
-    snprintf(buf, len, "%s.%s", me->body_names[j / PRRU_NBODYPAR], body_par[j % PRRU_NBODYPAR]);
-  else
-    snprintf(buf, len, "%s%d", drive_par[(j - nb) / me->nact], (j - nb) % me->nact + 1);
-  return buf;
-}
-
 static int base_or_fail(const char *cmd, const prru_model *m, double vs, prru_base **b)
 {
   *b = malloc(sizeof **b);
@@ -507,13 +481,12 @@ static int read_data(const char *path, const prru_diff_options *dopt, double dre
 /* "U1.Ixx + 0.25 L1.m - ...": base parameter i as a combination. */
 static void combination(const prru_base *b, int i, char *buf, size_t len)
 {
-  const int n = nreg();
-  char name[64];
-  size_t k = (size_t)snprintf(buf, len, "%s", reg_name(b->col[i], name, sizeof name));
+  const int n = b->nreg;
+  size_t k = (size_t)snprintf(buf, len, "%s", prru_base_param_name(b, b->col[i]));
   for (int j = 0; j < n && k < len; j++) {
     const double c = b->B[i * n + j];
     if (j == b->col[i] || fabs(c) < 1e-12) continue;
-    k += (size_t)snprintf(buf + k, len - k, " %c %.10g %s", c < 0 ? '-' : '+', fabs(c), reg_name(j, name, sizeof name));
+    k += (size_t)snprintf(buf + k, len - k, " %c %.10g %s", c < 0 ? '-' : '+', fabs(c), prru_base_param_name(b, j));
   }
 }
 
@@ -522,8 +495,7 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
                          const prru_consistent_options *co, const prru_consistent_result *c, const double *pi0,
                          const double *pi)
 {
-  const int n = nreg();
-  char name[64];
+  const int n = b->nreg;
   prru_cli_out_comment(o);
   prru_cli_out_printf(o, "# identify: %d samples, %d rows, %d base parameters of %d, %d degrees of freedom; "
                       "residual sigma %.6g N; condition number %.6g; Coulomb smoothing velocity %.6g m/s\n",
@@ -534,10 +506,10 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   prru_cli_out_printf(o, "\n# no effect on any actuator force (set by the prior):");
   prru_cli_out_line(o);
   for (int j = 0; j < n; j++)
-    if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", reg_name(j, name, sizeof name));
+    if (b->role[j] == PRRU_PAR_NONE) prru_cli_out_printf(o, " %s", prru_base_param_name(b, j));
   prru_cli_out_printf(o, "\n# only in combinations (split by the prior):");
   for (int j = 0; j < n; j++)
-    if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", reg_name(j, name, sizeof name));
+    if (b->role[j] == PRRU_PAR_COMBINED) prru_cli_out_printf(o, " %s", prru_base_param_name(b, j));
   prru_cli_out_printf(o, "\n# physically consistent model (docs/control.md): %s; Mahalanobis distance^2 of its "
                       "base parameters to the estimate %.4g, chi^2 quantile (%d dof, 1 - %g) %.4g, sigma_w %.4g N "
                       "= max(sigma sqrt(inflation), %g rms(y)); distance to the prior %.4g (pseudo-inertia norm); smallest "
@@ -562,10 +534,10 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
     const double ref = c->w[j] > 0 ? fmax(fabs(pi0[j]), c->w[j]) : fabs(pi0[j]);
     if (fabs(pi[j] - pi0[j]) <= 1e-9 * ref) continue;
     if (ref > 0)
-      prru_cli_out_printf(o, "\n#   %s %.4g (prior %.4g, %+.3g %%)", reg_name(j, name, sizeof name), pi[j], pi0[j],
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior %.4g, %+.3g %%)", prru_base_param_name(b, j), pi[j], pi0[j],
                           100 * (pi[j] - pi0[j]) / ref);
     else
-      prru_cli_out_printf(o, "\n#   %s %.4g (prior 0)", reg_name(j, name, sizeof name), pi[j]);
+      prru_cli_out_printf(o, "\n#   %s %.4g (prior 0)", prru_base_param_name(b, j), pi[j]);
     moved++;
   }
   if (!moved) prru_cli_out_printf(o, " none");
@@ -574,7 +546,7 @@ static void write_report(prru_cli_out *o, const prru_base *b, const prru_ident_r
   for (int i = 0; i < b->nbase; i++) {
     char comb[4096];
     combination(b, i, comb, sizeof comb);
-    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%s\n", i + 1, reg_name(b->col[i], name, sizeof name),
+    prru_cli_out_printf(o, "%d,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.6g,%s\n", i + 1, prru_base_param_name(b, b->col[i]),
                         r->beta[i], r->se[i], prior[i], r->scale[i], c->beta[i], c->t[i], comb);
     prru_cli_out_row(o);
   }
